@@ -1,0 +1,1 @@
+"""studio.capture (see docs/interfaces.md)."""

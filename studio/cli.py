@@ -1,0 +1,68 @@
+"""The ``studio`` command.
+
+Each verb lives in its own module under :mod:`studio.commands` (``serve``, ``record``, ``reproduce``,
+...). A verb module defines ``NAME``, ``HELP``, ``add_arguments(parser)`` and ``run(args) -> int``;
+this file only collects them, so adding a verb never touches another's code. With no verb,
+``studio`` runs ``serve``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import pkgutil
+import sys
+from collections.abc import Sequence
+from types import ModuleType
+
+from . import __version__, commands
+from ._errors import StudioError
+
+DEFAULT_VERB = "serve"
+
+
+def _verb_modules() -> dict[str, ModuleType]:
+    modules: dict[str, ModuleType] = {}
+    for info in sorted(pkgutil.iter_modules(commands.__path__), key=lambda m: m.name):
+        if info.name.startswith("_"):
+            continue
+        module = importlib.import_module(f"{commands.__name__}.{info.name}")
+        modules[module.NAME] = module
+    return modules
+
+
+def build_parser() -> tuple[argparse.ArgumentParser, dict[str, ModuleType]]:
+    """The argument parser with one sub-parser per verb."""
+    parser = argparse.ArgumentParser(
+        prog="studio",
+        description="Teach Studio: teach a robot arm by showing it a motion. "
+        f"With no verb, runs `studio {DEFAULT_VERB}`.",
+    )
+    parser.add_argument("--version", action="version", version=f"teach-studio {__version__}")
+    sub = parser.add_subparsers(dest="verb", metavar="VERB")
+    modules = _verb_modules()
+    for name, module in modules.items():
+        verb_parser = sub.add_parser(name, help=module.HELP, description=module.HELP)
+        module.add_arguments(verb_parser)
+    return parser, modules
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of the ``studio`` console script."""
+    argv = list(sys.argv[1:] if argv is None else argv)
+    parser, modules = build_parser()
+    if not argv or (argv[0].startswith("-") and argv[0] not in ("-h", "--help", "--version")):
+        argv = [DEFAULT_VERB, *argv]
+    args = parser.parse_args(argv)
+    try:
+        return int(modules[args.verb].run(args) or 0)
+    except StudioError as err:
+        print(f"studio {args.verb}: {err}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print(f"studio {args.verb}: interrupted.", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

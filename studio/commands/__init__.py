@@ -1,0 +1,1 @@
+"""One module per ``studio`` verb; see :mod:`studio.cli` for the contract a verb module meets."""

@@ -1,0 +1,1 @@
+"""studio.kinematics (see docs/interfaces.md)."""

@@ -1,0 +1,1 @@
+"""studio.learning (see docs/interfaces.md)."""

@@ -1,0 +1,1 @@
+"""studio.web (see docs/interfaces.md)."""
