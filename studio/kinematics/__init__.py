@@ -1,1 +1,3 @@
 """studio.kinematics (see docs/interfaces.md)."""
+
+from ._errors import KinematicsError as KinematicsError
