@@ -14,7 +14,7 @@ cheap to call per frame but is not thread-safe: give each thread its own instanc
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Literal
 
@@ -91,7 +91,8 @@ class IKConfig:
     """Defaults of the damped-least-squares IK, documented once.
 
     Attributes:
-        max_iterations: iterations per attempt (one warm-started attempt, then the restarts).
+        max_iterations: iterations per attempt (the warm-started one, then one per closed-form
+            seed).
         tolerance: success when the error norm falls below this (m for position-only; the
             norm of [position error in m, rotation error in rad] for a full pose).
         damping: DLS damping lambda; keeps steps bounded near singularities (q5 = 0 is one).
@@ -100,8 +101,6 @@ class IKConfig:
         stall_steps: give up an attempt when the error has not dropped by ``stall_ratio``
             over this many iterations (stuck on a limit or a local minimum).
         stall_ratio: the relative improvement that counts as progress.
-        restarts: extra attempts from other seeds when the warm-started one fails.
-        seed: seed of the generator drawing the random restart seeds (repeatable results).
     """
 
     max_iterations: int = 100
@@ -110,8 +109,6 @@ class IKConfig:
     max_step: float = 0.5
     stall_steps: int = 10
     stall_ratio: float = 1e-3
-    restarts: int = 6
-    seed: int = 0
 
 
 @dataclass(frozen=True)
@@ -342,6 +339,96 @@ def _as_pose(value: object, what: str, check_rotation: bool) -> np.ndarray:
     return pose
 
 
+def _wrap_into_limits(
+    q: np.ndarray, q_ref: np.ndarray, lower: np.ndarray, upper: np.ndarray
+) -> np.ndarray | None:
+    """``q`` with each angle moved by whole turns into its limits, nearest ``q_ref``; None if
+    some angle fits no turn (joints 4 and 6 span more than one turn, so several may fit)."""
+    turns = np.arange(-2, 3) * (2 * math.pi)
+    out = np.empty_like(q)
+    for j in range(q.shape[0]):
+        options = q[j] + turns
+        options = options[(options >= lower[j]) & (options <= upper[j])]
+        if options.size == 0:
+            return None
+        out[j] = options[np.argmin(np.abs(options - q_ref[j]))]
+    return out
+
+
+def closed_form_solutions(
+    dh: Sequence[DHRow],
+    p: np.ndarray,
+    R: np.ndarray | None,
+    q_ref: np.ndarray,
+    lower: np.ndarray,
+    upper: np.ndarray,
+) -> list[np.ndarray]:
+    """The Puma's closed-form IK solutions within the limits, nearest ``q_ref`` first.
+
+    Valid for Puma-shaped DH tables (a1 = d2 = 0, alpha = (pi/2, 0, -pi/2, pi/2, -pi/2, 0),
+    d5 = d6 = a4..a6 = 0: a spherical wrist whose centre is the tool). Up to eight branches:
+    shoulder left/right, elbow up/down, wrist flip. The wrist centre fixes q1..q3; with
+    ``R is None`` (position only) the wrist angles are kept from ``q_ref``.
+
+    Args:
+        dh: the DH table.
+        p: tool position in the base frame.
+        R: tool rotation in the base frame, or None for position only.
+        q_ref: the angles to stay near (rad, shape (6,)).
+        lower, upper: joint limits (rad).
+
+    Returns:
+        The solutions (possibly none), each of shape (6,).
+    """
+    d1, a2, d3, a3, d4 = dh[0].d, dh[1].a, dh[2].d, dh[2].a, dh[3].d
+    px, py, pz = (float(v) for v in p)
+    radial = math.hypot(px, py)
+    if radial < abs(d3):
+        return []  # inside the cylinder the shoulder offset d3 sweeps: unreachable
+    phi = math.atan2(py, px)
+    lean = math.asin(d3 / radial)
+    forearm = math.hypot(a3, d4)
+    beta = math.atan2(d4, a3)
+    Y = pz - d1
+    solutions: list[np.ndarray] = []
+    for q1 in (phi + lean, phi + math.pi - lean):
+        X = px * math.cos(q1) + py * math.sin(q1)
+        cos_elbow = (X * X + Y * Y - a2 * a2 - forearm * forearm) / (2 * a2 * forearm)
+        if abs(cos_elbow) > 1.0 + 1e-12:
+            continue
+        elbow = math.acos(max(-1.0, min(1.0, cos_elbow)))
+        for u in (elbow, -elbow):
+            q3 = u - beta
+            q2 = math.atan2(Y, X) - math.atan2(forearm * math.sin(u), a2 + forearm * math.cos(u))
+            if R is None:
+                wrists = [q_ref[3:6]]
+            else:
+                R03 = np.eye(3)
+                for row, angle in zip(dh[:3], (q1, q2, q3), strict=True):
+                    R03 = R03 @ pin.utils.rotate("z", angle) @ pin.utils.rotate("x", row.alpha)
+                M = R03.T @ R
+                s5 = math.hypot(M[0, 2], M[1, 2])
+                if s5 < 1e-9:  # wrist singular: only q4 + q6 matters; keep q4 from q_ref
+                    if M[2, 2] < 0:
+                        continue  # q5 = pi is beyond joint 5's limits
+                    q4 = float(q_ref[3])
+                    wrists = [np.array([q4, 0.0, math.atan2(M[1, 0], M[0, 0]) - q4])]
+                else:
+                    q4 = math.atan2(-M[1, 2], -M[0, 2])
+                    q5 = math.atan2(s5, M[2, 2])
+                    q6 = math.atan2(-M[2, 1], M[2, 0])
+                    wrists = [
+                        np.array([q4, q5, q6]),
+                        np.array([q4 + math.pi, -q5, q6 + math.pi]),
+                    ]
+            for wrist in wrists:
+                q = _wrap_into_limits(np.concatenate(([q1, q2, q3], wrist)), q_ref, lower, upper)
+                if q is not None:
+                    solutions.append(q)
+    solutions.sort(key=lambda q: float(np.linalg.norm(q - q_ref)))
+    return solutions
+
+
 class Puma560:
     """The Puma560 arm (Corke's standard DH model) with FK, Jacobian and DLS IK.
 
@@ -473,9 +560,11 @@ class Puma560:
 
         Each iteration takes the DLS step ``dq = J^T (J J^T + lambda^2 I)^-1 e`` and projects
         the result onto the joint limits, so every returned ``q`` is within them. The first
-        attempt starts from ``q0`` (warm start, e.g. the previous frame's solution); if it
-        fails, a few other seeds are tried (``IKConfig.restarts``). Failure is reported
-        (``success=False`` and a message), with ``q`` the closest configuration found.
+        attempt starts from ``q0`` (warm start, e.g. the previous frame's solution). If it
+        fails (a joint limit or a local minimum in the way), the Puma's closed-form solutions
+        that lie within the limits seed further attempts, nearest to ``q0`` first, so a
+        reachable target is always found. Failure is reported (``success=False`` and a
+        message), with ``q`` the closest configuration found.
 
         Args:
             oMdes: desired tool pose in the base frame (4x4 or ``pin.SE3``); with
@@ -526,7 +615,9 @@ class Puma560:
             )
 
         best_q, best_err, total = start, math.inf, 0
-        for seed in self._seeds(start):
+        candidates: list[np.ndarray] | None = None
+        seed: np.ndarray | None = start
+        while seed is not None:
             q, err, used = self._solve(
                 seed, target_p, target_R, position_only, iterations_per_attempt, tol
             )
@@ -541,6 +632,16 @@ class Puma560:
                     iterations=total,
                     message=f"converged to {err:.1e} in {total} iterations.",
                 )
+            if candidates is None:
+                candidates = closed_form_solutions(
+                    self.dh,
+                    target_p,
+                    None if position_only else target_R,
+                    start,
+                    self.lower,
+                    self.upper,
+                )
+            seed = candidates.pop(0) if candidates else None
         unit = "m" if position_only else "(m, rad norm)"
         return IKResult(
             q=best_q,
@@ -561,16 +662,6 @@ class Puma560:
             self.lower,
             self.upper,
         )
-
-    def _seeds(self, start: np.ndarray) -> Iterator[np.ndarray]:
-        """The warm start, then the named poses within limits, then seeded random poses."""
-        yield start
-        if self.ik.restarts <= 0:
-            return
-        named = [self._default_seed(), np.clip(PUMA_QR, self.lower, self.upper)]
-        rng = np.random.default_rng(self.ik.seed)
-        for k in range(self.ik.restarts):
-            yield named[k] if k < len(named) else rng.uniform(self.lower, self.upper)
 
     def _solve(
         self,
