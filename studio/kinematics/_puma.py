@@ -311,6 +311,14 @@ def _as_vector(value: object, size: int, what: str) -> np.ndarray:
     return array
 
 
+_LAST_ROW = np.array([0.0, 0.0, 0.0, 1.0])
+_EYE3 = np.eye(3)
+#: How far from (0, 0, 0, 1) a pose's last row and from orthonormal its rotation may be (float
+#: noise of poses composed in single or double precision), before the pose counts as malformed.
+_POSE_ATOL = 1e-9
+_ROTATION_ATOL = 1e-6
+
+
 def _as_pose(value: object, what: str, check_rotation: bool) -> np.ndarray:
     """``value`` (4x4 array or ``pin.SE3``) as a finite homogeneous pose, or a KinematicsError."""
     if isinstance(value, pin.SE3):
@@ -325,13 +333,13 @@ def _as_pose(value: object, what: str, check_rotation: bool) -> np.ndarray:
         raise KinematicsError(f"{what} must be a 4x4 homogeneous pose, got shape {pose.shape}.")
     if not np.isfinite(pose).all():
         raise KinematicsError(f"{what} contains NaN or infinite values; pass a finite pose.")
-    if not np.allclose(pose[3], (0.0, 0.0, 0.0, 1.0)):
+    if np.abs(pose[3] - _LAST_ROW).max() > _POSE_ATOL:
         raise KinematicsError(f"{what} must end with the row (0, 0, 0, 1), got {pose[3]}.")
     if check_rotation:
-        rotation = pose[:3, :3]
-        if not (
-            np.allclose(rotation.T @ rotation, np.eye(3), atol=1e-6) and np.linalg.det(rotation) > 0
-        ):
+        r = pose[:3, :3]
+        (a, b, c), (d, e, f), (g, h, i) = r.tolist()
+        det = a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g)
+        if np.abs(r.T @ r - _EYE3).max() > _ROTATION_ATOL or det < 0:
             raise KinematicsError(
                 f"{what} has a rotation block that is not a proper rotation matrix; "
                 "orthonormalise it (or pass position_only=True)."
@@ -463,6 +471,8 @@ class Puma560:
         # jointMframe: DH frame i in Pinocchio joint i's frame (identity for the base).
         self._jointMdh = [pin.SE3.Identity()] + [row.fixed() for row in self.dh]
         self._jointMtool = self.model.frames[self._tool].placement
+        self._damping3 = np.eye(3) * self.ik.damping**2
+        self._damping6 = np.eye(6) * self.ik.damping**2
         self._visuals = _build_visuals(self.dh, self.style)
         self._visual_joints = np.array([v.joint for v in self._visuals])
         self._visual_offsets = np.stack([v.offset for v in self._visuals])
@@ -674,9 +684,7 @@ class Puma560:
     ) -> tuple[np.ndarray, float, int]:
         """One projected-DLS attempt from ``q``: (final q, final error norm, iterations)."""
         cfg = self.ik
-        lam2 = cfg.damping**2
-        rows = 3 if position_only else 6
-        eye = np.eye(rows) * lam2
+        damping = self._damping3 if position_only else self._damping6
         q = q.copy()
         last_progress_err, last_progress_it = math.inf, 0
         err_norm = math.inf
@@ -690,14 +698,14 @@ class Puma560:
                 e = np.concatenate(
                     (target_p - oMtool.translation, pin.log3(target_R @ oMtool.rotation.T))
                 )
-            err_norm = float(np.linalg.norm(e))
+            err_norm = math.sqrt(float(e @ e))
             if err_norm <= tol or it == max_iterations:
                 return q, err_norm, it
             if err_norm < last_progress_err * (1.0 - cfg.stall_ratio):
                 last_progress_err, last_progress_it = err_norm, it
             elif it - last_progress_it >= cfg.stall_steps:
                 return q, err_norm, it
-            dq = J.T @ np.linalg.solve(J @ J.T + eye, e)
+            dq = J.T @ np.linalg.solve(J @ J.T + damping, e)
             biggest = float(np.abs(dq).max())
             if biggest > cfg.max_step:
                 dq *= cfg.max_step / biggest
