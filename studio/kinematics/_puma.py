@@ -445,10 +445,14 @@ class Puma560:
         style: sizes and colours of :meth:`visuals`.
 
     Attributes:
-        model: the immutable Pinocchio model (joints ``joint1`` ... ``joint6``, frame ``tool``).
+        model: the immutable Pinocchio model: joints ``joint1`` ... ``joint6``, operational
+            frames ``dh1`` ... ``dh6`` (the DH frames) and ``tool``.
+        data: Pinocchio scratch space (one per instance, hence not thread-safe).
+        dh: the DH table (``DH_TABLE``).
         nq: number of joints (6).
         lower, upper: joint limits (rad, shape (6,), read-only).
         qz, qr, qn, qs: Corke's named poses (see ``PUMA_QZ`` etc.).
+        reach: largest distance from the shoulder (joint 2's axis on joint 1's) to the tool (m).
     """
 
     nq = 6
@@ -479,7 +483,6 @@ class Puma560:
         self._shoulder = np.array([0.0, 0.0, self.dh[0].d])
         forearm = math.hypot(self.dh[2].a, self.dh[3].d)
         self.reach = math.hypot(self.dh[1].a + forearm, self.dh[2].d)
-        """Largest distance from the shoulder (joint 2 on joint 1's axis) to the tool (m)."""
 
     def _build_model(self) -> pin.Model:
         model = pin.Model()
@@ -488,7 +491,7 @@ class Puma560:
         for i, row in enumerate(self.dh, start=1):
             parent = model.addJoint(parent, pin.JointModelRZ(), placement, f"joint{i}")
             model.addJointFrame(parent)
-            model.addFrame(pin.Frame(f"link{i}", parent, row.fixed(), pin.FrameType.OP_FRAME))
+            model.addFrame(pin.Frame(f"dh{i}", parent, row.fixed(), pin.FrameType.OP_FRAME))
             placement = row.fixed()
         model.addFrame(pin.Frame("tool", parent, self.dh[-1].fixed(), pin.FrameType.OP_FRAME))
         model.lowerPositionLimit = np.array([row.lower for row in self.dh])
