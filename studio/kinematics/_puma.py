@@ -347,20 +347,27 @@ def _as_pose(value: object, what: str, check_rotation: bool) -> np.ndarray:
     return pose
 
 
+_TURNS = tuple(k * 2 * math.pi for k in (0, -1, 1, -2, 2))
+
+
 def _wrap_into_limits(
-    q: np.ndarray, q_ref: np.ndarray, lower: np.ndarray, upper: np.ndarray
-) -> np.ndarray | None:
+    q: Sequence[float], q_ref: Sequence[float], lower: Sequence[float], upper: Sequence[float]
+) -> list[float] | None:
     """``q`` with each angle moved by whole turns into its limits, nearest ``q_ref``; None if
     some angle fits no turn (joints 4 and 6 span more than one turn, so several may fit)."""
-    turns = np.arange(-2, 3) * (2 * math.pi)
-    out = np.empty_like(q)
-    for j in range(q.shape[0]):
-        options = q[j] + turns
-        options = options[(options >= lower[j]) & (options <= upper[j])]
-        if options.size == 0:
+    out = []
+    for angle, ref, low, high in zip(q, q_ref, lower, upper, strict=True):
+        options = [angle + turn for turn in _TURNS if low <= angle + turn <= high]
+        if not options:
             return None
-        out[j] = options[np.argmin(np.abs(options - q_ref[j]))]
+        out.append(min(options, key=lambda v, ref=ref: abs(v - ref)))
     return out
+
+
+def _rz_rx(theta: float, alpha: float) -> np.ndarray:
+    """The rotation ``Rz(theta) Rx(alpha)`` of one DH row."""
+    ct, st, ca, sa = math.cos(theta), math.sin(theta), math.cos(alpha), math.sin(alpha)
+    return np.array([[ct, -st * ca, st * sa], [st, ct * ca, -ct * sa], [0.0, sa, ca]])
 
 
 def closed_form_solutions(
@@ -390,6 +397,7 @@ def closed_form_solutions(
     """
     d1, a2, d3, a3, d4 = dh[0].d, dh[1].a, dh[2].d, dh[2].a, dh[3].d
     px, py, pz = (float(v) for v in p)
+    ref, low, high = q_ref.tolist(), lower.tolist(), upper.tolist()
     radial = math.hypot(px, py)
     if radial < abs(d3):
         return []  # inside the cylinder the shoulder offset d3 sweeps: unreachable
@@ -398,7 +406,7 @@ def closed_form_solutions(
     forearm = math.hypot(a3, d4)
     beta = math.atan2(d4, a3)
     Y = pz - d1
-    solutions: list[np.ndarray] = []
+    solutions: list[list[float]] = []
     for q1 in (phi + lean, phi + math.pi - lean):
         X = px * math.cos(q1) + py * math.sin(q1)
         cos_elbow = (X * X + Y * Y - a2 * a2 - forearm * forearm) / (2 * a2 * forearm)
@@ -409,32 +417,26 @@ def closed_form_solutions(
             q3 = u - beta
             q2 = math.atan2(Y, X) - math.atan2(forearm * math.sin(u), a2 + forearm * math.cos(u))
             if R is None:
-                wrists = [q_ref[3:6]]
+                wrists = [ref[3:6]]
             else:
-                R03 = np.eye(3)
-                for row, angle in zip(dh[:3], (q1, q2, q3), strict=True):
-                    R03 = R03 @ pin.utils.rotate("z", angle) @ pin.utils.rotate("x", row.alpha)
-                M = R03.T @ R
-                s5 = math.hypot(M[0, 2], M[1, 2])
+                R03 = _rz_rx(q1, dh[0].alpha) @ _rz_rx(q2, dh[1].alpha) @ _rz_rx(q3, dh[2].alpha)
+                (m00, _, m02), (m10, _, m12), (m20, m21, m22) = (R03.T @ R).tolist()
+                s5 = math.hypot(m02, m12)
                 if s5 < 1e-9:  # wrist singular: only q4 + q6 matters; keep q4 from q_ref
-                    if M[2, 2] < 0:
+                    if m22 < 0:
                         continue  # q5 = pi is beyond joint 5's limits
-                    q4 = float(q_ref[3])
-                    wrists = [np.array([q4, 0.0, math.atan2(M[1, 0], M[0, 0]) - q4])]
+                    wrists = [[ref[3], 0.0, math.atan2(m10, m00) - ref[3]]]
                 else:
-                    q4 = math.atan2(-M[1, 2], -M[0, 2])
-                    q5 = math.atan2(s5, M[2, 2])
-                    q6 = math.atan2(-M[2, 1], M[2, 0])
-                    wrists = [
-                        np.array([q4, q5, q6]),
-                        np.array([q4 + math.pi, -q5, q6 + math.pi]),
-                    ]
+                    q4 = math.atan2(-m12, -m02)
+                    q5 = math.atan2(s5, m22)
+                    q6 = math.atan2(-m21, m20)
+                    wrists = [[q4, q5, q6], [q4 + math.pi, -q5, q6 + math.pi]]
             for wrist in wrists:
-                q = _wrap_into_limits(np.concatenate(([q1, q2, q3], wrist)), q_ref, lower, upper)
+                q = _wrap_into_limits([q1, q2, q3, *wrist], ref, low, high)
                 if q is not None:
                     solutions.append(q)
-    solutions.sort(key=lambda q: float(np.linalg.norm(q - q_ref)))
-    return solutions
+    solutions.sort(key=lambda q: sum((a - b) ** 2 for a, b in zip(q, ref, strict=True)))
+    return [np.array(q) for q in solutions]
 
 
 class Puma560:
@@ -574,16 +576,16 @@ class Puma560:
         Each iteration takes the DLS step ``dq = J^T (J J^T + lambda^2 I)^-1 e`` and projects
         the result onto the joint limits, so every returned ``q`` is within them. The first
         attempt starts from ``q0`` (warm start, e.g. the previous frame's solution). If it
-        fails (a joint limit or a local minimum in the way), the Puma's closed-form solutions
-        that lie within the limits seed further attempts, nearest to ``q0`` first, so a
-        reachable target is always found. Failure is reported (``success=False`` and a
+        fails (a joint limit or a local minimum in the way), or when there is no ``q0``, the
+        Puma's closed-form solutions that lie within the limits seed the attempts, nearest to
+        ``q0`` first, so a reachable target is always found. Failure is reported (``success=False`` and a
         message), with ``q`` the closest configuration found.
 
         Args:
             oMdes: desired tool pose in the base frame (4x4 or ``pin.SE3``); with
                 ``position_only`` a 3-vector position is accepted too.
-            q0: starting angles (rad, shape (6,)); clipped to the limits. Default: ``qz``
-                moved off the wrist singularity.
+            q0: starting angles (rad, shape (6,)); clipped to the limits. Default: none; the
+                solution nearest ``qn`` (with joint 3 folded into its limits) is returned.
             position_only: match the tool position only and leave its orientation free.
             max_iterations: iterations per attempt (default ``IKConfig.max_iterations``).
             tolerance: success threshold on the error norm (default ``IKConfig.tolerance``).
@@ -630,6 +632,9 @@ class Puma560:
         best_q, best_err, total = start, math.inf, 0
         candidates: list[np.ndarray] | None = None
         seed: np.ndarray | None = start
+        if q0 is None:  # nothing to stay near: start from the closed form's nearest solution
+            candidates = self._closed_form(target_p, target_R, position_only, start)
+            seed = candidates.pop(0) if candidates else start
         while seed is not None:
             q, err, used = self._solve(
                 seed, target_p, target_R, position_only, iterations_per_attempt, tol
@@ -646,14 +651,7 @@ class Puma560:
                     message=f"converged to {err:.1e} in {total} iterations.",
                 )
             if candidates is None:
-                candidates = closed_form_solutions(
-                    self.dh,
-                    target_p,
-                    None if position_only else target_R,
-                    start,
-                    self.lower,
-                    self.upper,
-                )
+                candidates = self._closed_form(target_p, target_R, position_only, start)
             seed = candidates.pop(0) if candidates else None
         unit = "m" if position_only else "(m, rad norm)"
         return IKResult(
@@ -666,6 +664,13 @@ class Puma560:
                 f"found is {best_err:.3g} {unit} away; move the target"
                 + ("." if position_only else " or use position_only=True.")
             ),
+        )
+
+    def _closed_form(
+        self, p: np.ndarray, R: np.ndarray, position_only: bool, q_ref: np.ndarray
+    ) -> list[np.ndarray]:
+        return closed_form_solutions(
+            self.dh, p, None if position_only else R, q_ref, self.lower, self.upper
         )
 
     def _default_seed(self) -> np.ndarray:
@@ -687,20 +692,20 @@ class Puma560:
     ) -> tuple[np.ndarray, float, int]:
         """One projected-DLS attempt from ``q``: (final q, final error norm, iterations)."""
         cfg = self.ik
+        model, data, tool = self.model, self.data, self._tool
         damping = self._damping3 if position_only else self._damping6
+        lower, upper = self.lower, self.upper
+        rows = 3 if position_only else 6
+        e = np.empty(rows)
         q = q.copy()
         last_progress_err, last_progress_it = math.inf, 0
         err_norm = math.inf
         for it in range(max_iterations + 1):
-            J = self._jacobian(q)
-            oMtool = self.data.oMf[self._tool]
-            if position_only:
-                e = target_p - oMtool.translation
-                J = J[:3]
-            else:
-                e = np.concatenate(
-                    (target_p - oMtool.translation, pin.log3(target_R @ oMtool.rotation.T))
-                )
+            pin.forwardKinematics(model, data, q)
+            oMtool = pin.updateFramePlacement(model, data, tool)
+            e[:3] = target_p - oMtool.translation
+            if not position_only:
+                e[3:] = pin.log3(target_R @ oMtool.rotation.T)
             err_norm = math.sqrt(float(e @ e))
             if err_norm <= tol or it == max_iterations:
                 return q, err_norm, it
@@ -708,11 +713,15 @@ class Puma560:
                 last_progress_err, last_progress_it = err_norm, it
             elif it - last_progress_it >= cfg.stall_steps:
                 return q, err_norm, it
+            pin.computeJointJacobians(model, data, q)
+            J = pin.getFrameJacobian(model, data, tool, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
+            if position_only:
+                J = J[:3]
             dq = J.T @ np.linalg.solve(J @ J.T + damping, e)
-            biggest = float(np.abs(dq).max())
+            biggest = max(float(dq.max()), -float(dq.min()))
             if biggest > cfg.max_step:
                 dq *= cfg.max_step / biggest
-            np.clip(q + dq, self.lower, self.upper, out=q)
+            q = np.minimum(np.maximum(q + dq, lower), upper)
         return q, err_norm, max_iterations
 
     # ------------------------------------------------------------------------------- visuals
