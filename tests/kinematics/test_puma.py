@@ -227,6 +227,17 @@ def test_pose_that_needs_a_joint_beyond_its_limit_reports_failure() -> None:
     assert ROBOT.inverse(ROBOT.forward(beyond), position_only=True).success
 
 
+def test_qn_pose_is_reached_on_a_branch_within_the_limits() -> None:
+    # Corke's qn has q3 = pi, beyond joint 3's 135 deg limit; its pose is reachable elbow-up.
+    assert PUMA_QN[2] > ROBOT.upper[2]
+    oMdes = ROBOT.forward(PUMA_QN)
+    for q0 in (None, PUMA_QN):
+        result = ROBOT.inverse(oMdes, q0=q0)
+        assert result.success, result.message
+        assert_within_limits(result.q)
+        np.testing.assert_allclose(ROBOT.forward(result.q), oMdes, atol=1e-5)
+
+
 def test_ik_result_is_frozen() -> None:
     result = ROBOT.inverse(ROBOT.forward(PUMA_QR))
     assert isinstance(result, IKResult)
