@@ -82,8 +82,8 @@ PUMA_QN = np.array([0.0, math.pi / 4, math.pi, 0.0, math.pi / 4, 0.0])
 #: The arm stretched out along x.
 PUMA_QS = np.array([0.0, 0.0, -math.pi / 2, 0.0, 0.0, 0.0])
 
-for _pose in (PUMA_QZ, PUMA_QR, PUMA_QN, PUMA_QS):
-    _pose.setflags(write=False)
+for _named in (PUMA_QZ, PUMA_QR, PUMA_QN, PUMA_QS):
+    _named.setflags(write=False)
 
 
 @dataclass(frozen=True)
