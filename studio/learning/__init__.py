@@ -1,1 +1,34 @@
-"""studio.learning (see docs/interfaces.md)."""
+"""Learning engine: tabular MDPs, Dyna-Q with four planners, the arm grid task, policy files.
+
+The public names (see ``docs/interfaces.md`` and this package's ``README.md``)::
+
+    from studio.learning import ArmGrid, DynaQConfig, run_experiments
+
+    grid = ArmGrid()  # the paper's 3 joints x 11 bins, 27 actions
+    result = run_experiments(grid.mdp(), DynaQConfig(planning="full"), experiments=20, episodes=100, seed=0)
+    result.mean_steps()  # the learning curve
+"""
+
+from __future__ import annotations
+
+from ._arm import MAX_TABLE_ENTRIES as MAX_TABLE_ENTRIES
+from ._arm import ArmGrid as ArmGrid
+from ._config import MAX_EPISODE_RUNS as MAX_EPISODE_RUNS
+from ._config import MAX_EPISODES as MAX_EPISODES
+from ._config import MAX_EXPERIMENTS as MAX_EXPERIMENTS
+from ._config import PLANNERS as PLANNERS
+from ._config import DynaQConfig as DynaQConfig
+from ._config import check_budget as check_budget
+from ._dynaq import ExperimentResult as ExperimentResult
+from ._dynaq import LiveProgress as LiveProgress
+from ._dynaq import run_experiments as run_experiments
+from ._errors import ConfigError as ConfigError
+from ._errors import LearningError as LearningError
+from ._errors import PolicyFileError as PolicyFileError
+from ._mdp import TabularMDP as TabularMDP
+from ._policy import PolicyFile as PolicyFile
+from ._policy import greedy_path as greedy_path
+from ._policy import load_policy as load_policy
+from ._policy import rollout as rollout
+from ._policy import save_policy as save_policy
+from ._policy import save_trajectory_csv as save_trajectory_csv

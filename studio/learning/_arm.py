@@ -1,0 +1,262 @@
+"""The paper's arm task: joints 1..J of a Puma560 on a grid of joint-angle bins.
+
+Each joint's range ``[low_deg, high_deg]`` is cut into ``bins`` equal bins; a state is one bin per
+joint, and an action moves every joint by -1, 0 or +1 bin at once (3**J actions). A move that would
+leave the range leaves that joint where it is. Reaching the goal pays +100 and ends the episode,
+every other transition pays -1. Episodes start uniformly from every state but the goal. With the
+defaults (3 joints, 11 bins over [-180, 180] degrees) this is the paper's 1331-state, 27-action
+task.
+
+Numbering: states and actions are mixed-radix numbers with joint 1 as the most significant digit
+(``numpy.ravel_multi_index`` order). Action digit ``d`` moves its joint by ``d - 1`` bins, so action
+``(3**J - 1) // 2`` (all digits 1) stays put.
+
+Default goal: the paper shows its goal only as a picture (Fig. 7), so we pick the bins nearest to
+joint angles (0, 45, -90) degrees for joints 1-3 (an arm reaching forward and down, inside the
+Puma560's limits) and 0 degrees for joints 4-6. With 11 bins that is bins (5, 6, 2).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+
+from ._errors import LearningError
+from ._mdp import TabularMDP
+
+MAX_JOINTS = 6
+"""The Puma560 has six joints."""
+MAX_TABLE_ENTRIES = 20_000_000
+"""Largest states x actions table a grid may have: one Q table is then 160 MB and one experiment's
+working memory (Q, model, visit list) about 700 MB. Six joints fit with up to 5 bins each."""
+GOAL_REWARD = 100.0
+"""Reward for the step that reaches the goal (paper)."""
+STEP_REWARD = -1.0
+"""Reward for every other step (paper)."""
+DEFAULT_GOAL_DEG = (0.0, 45.0, -90.0, 0.0, 0.0, 0.0)
+"""Joint angles whose nearest bins are the default goal (see the module docstring)."""
+
+
+@dataclass(frozen=True)
+class ArmGrid:
+    """A grid of joint-angle bins over the first ``joints`` joints of the arm.
+
+    Args:
+        joints: how many joints, from joint 1, the grid covers (1 to 6; the paper used 3).
+        bins: bins per joint (the paper used 11).
+        low_deg: lower end of every joint's range, degrees.
+        high_deg: upper end of every joint's range, degrees.
+        goal: the goal's bin per joint; default: the bins nearest :data:`DEFAULT_GOAL_DEG`.
+
+    Raises:
+        LearningError: for a bad value, or a grid whose table would not fit in memory.
+    """
+
+    joints: int = 3
+    bins: int = 11
+    low_deg: float = -180.0
+    high_deg: float = 180.0
+    goal: tuple[int, ...] | None = None
+
+    def __post_init__(self) -> None:
+        for name in ("joints", "bins"):
+            value = getattr(self, name)
+            if not isinstance(value, int | np.integer) or isinstance(value, bool):
+                raise LearningError(f"{name} is {value!r}; give a whole number.")
+        if not 1 <= self.joints <= MAX_JOINTS:
+            raise LearningError(
+                f"joints is {self.joints}; give 1 to {MAX_JOINTS} (the arm has six joints)."
+            )
+        if self.bins < 2:
+            raise LearningError(f"bins is {self.bins}; give at least 2 bins per joint.")
+        for name in ("low_deg", "high_deg"):
+            value = getattr(self, name)
+            if not isinstance(value, int | float | np.floating) or not np.isfinite(value):
+                raise LearningError(f"{name} is {value!r}; give a finite angle in degrees.")
+        if not self.low_deg < self.high_deg:
+            raise LearningError(
+                f"The joint range [{self.low_deg}, {self.high_deg}] degrees is empty; give low_deg below high_deg."
+            )
+        entries = self.bins**self.joints * 3**self.joints
+        if entries > MAX_TABLE_ENTRIES:
+            raise LearningError(
+                f"A grid of {self.joints} joints x {self.bins} bins has {self.bins**self.joints:,} states x {3**self.joints} actions = {entries:,} table entries, over the limit of {MAX_TABLE_ENTRIES:,}; use fewer bins or joints."
+            )
+        object.__setattr__(self, "joints", int(self.joints))
+        object.__setattr__(self, "bins", int(self.bins))
+        object.__setattr__(self, "low_deg", float(self.low_deg))
+        object.__setattr__(self, "high_deg", float(self.high_deg))
+        if self.goal is None:
+            goal = self.bins_of_angles(np.radians(DEFAULT_GOAL_DEG[: self.joints]))
+        else:
+            goal = np.asarray(self.goal)
+            if goal.shape != (self.joints,) or not np.issubdtype(goal.dtype, np.integer):
+                raise LearningError(
+                    f"goal is {self.goal!r}; give {self.joints} bin indices, one per joint."
+                )
+            if goal.min() < 0 or goal.max() >= self.bins:
+                raise LearningError(
+                    f"goal {self.goal!r} has a bin outside [0, {self.bins - 1}]; give bins in range."
+                )
+        object.__setattr__(self, "goal", tuple(int(b) for b in goal))
+
+    # ------------------------------------------------------------------ sizes and numbering
+
+    @property
+    def n_states(self) -> int:
+        """bins ** joints."""
+        return self.bins**self.joints
+
+    @property
+    def n_actions(self) -> int:
+        """3 ** joints: every joint moves -1, 0 or +1 bin."""
+        return 3**self.joints
+
+    @property
+    def goal_state(self) -> int:
+        """The goal's state number."""
+        return self.state_of(self.goal)
+
+    @property
+    def stay_action(self) -> int:
+        """The action that moves no joint."""
+        return (self.n_actions - 1) // 2
+
+    @property
+    def bin_width(self) -> float:
+        """Width of one bin, radians."""
+        return float(np.radians(self.high_deg - self.low_deg) / self.bins)
+
+    def to_dict(self) -> dict:
+        """The grid spec as JSON-ready values (the inverse of ``ArmGrid(**spec)``)."""
+        return {
+            "joints": self.joints,
+            "bins": self.bins,
+            "low_deg": self.low_deg,
+            "high_deg": self.high_deg,
+            "goal": list(self.goal),
+        }
+
+    def state_of(self, bins: Sequence[int] | np.ndarray) -> int:
+        """State number of one bin per joint."""
+        b = np.asarray(bins)
+        if b.shape != (self.joints,) or not np.issubdtype(b.dtype, np.integer):
+            raise LearningError(f"bins is {bins!r}; give {self.joints} bin indices, one per joint.")
+        if b.min() < 0 or b.max() >= self.bins:
+            raise LearningError(
+                f"bins {bins!r} has a bin outside [0, {self.bins - 1}]; give bins in range."
+            )
+        return int(np.ravel_multi_index(tuple(b), (self.bins,) * self.joints))
+
+    def bins_of(self, state: int) -> tuple[int, ...]:
+        """Bin per joint of a state number."""
+        self._check_state(state)
+        return tuple(int(b) for b in np.unravel_index(int(state), (self.bins,) * self.joints))
+
+    def angles_of(self, state: int) -> np.ndarray:
+        """Joint angles of the state's bin centres, radians ``(joints,)``."""
+        return self._centres(np.asarray(self.bins_of(state)))
+
+    def bins_of_angles(self, q_rad: Sequence[float] | np.ndarray) -> np.ndarray:
+        """Nearest bin per joint for joint angles in radians (angles outside the range clip)."""
+        q = np.asarray(q_rad, dtype=np.float64)
+        if q.shape[-1:] != (self.joints,):
+            raise LearningError(
+                f"The joint angles have shape {q.shape}; give {self.joints} angles (radians) per row."
+            )
+        if not np.all(np.isfinite(q)):
+            raise LearningError(
+                "The joint angles hold NaN or infinite values; give finite angles in radians."
+            )
+        low = np.radians(self.low_deg)
+        b = np.floor((q - low) / self.bin_width).astype(np.int64)
+        return np.clip(b, 0, self.bins - 1)
+
+    def state_of_angles(self, q_rad: Sequence[float] | np.ndarray) -> int:
+        """State whose bins are nearest to the joint angles (radians, ``(joints,)``)."""
+        return self.state_of(self.bins_of_angles(q_rad))
+
+    def _centres(self, bins: np.ndarray) -> np.ndarray:
+        return np.radians(self.low_deg) + (bins + 0.5) * self.bin_width
+
+    def _check_state(self, state: int) -> None:
+        if (
+            not isinstance(state, int | np.integer)
+            or isinstance(state, bool)
+            or not 0 <= state < self.n_states
+        ):
+            raise LearningError(
+                f"state is {state!r}; give a state number from 0 to {self.n_states - 1}."
+            )
+
+    def action_deltas(self) -> np.ndarray:
+        """int ``(n_actions, joints)``: the bin change of every joint under every action."""
+        digits = np.array(np.unravel_index(np.arange(self.n_actions), (3,) * self.joints)).T
+        return digits.astype(np.int64) - 1
+
+    # ------------------------------------------------------------------ the task
+
+    def mdp(self) -> TabularMDP:
+        """The grid as a :class:`TabularMDP` (the paper's rewards; starts anywhere but the goal).
+
+        Built once per grid and shared: a :class:`TabularMDP` is read-only.
+        """
+        return self._table
+
+    @cached_property
+    def _table(self) -> TabularMDP:
+        shape = (self.bins,) * self.joints
+        state_bins = np.array(np.unravel_index(np.arange(self.n_states), shape)).T  # (S, J)
+        moved = state_bins[:, None, :] + self.action_deltas()[None, :, :]  # (S, A, J)
+        inside = (moved >= 0) & (moved < self.bins)
+        moved = np.where(inside, moved, state_bins[:, None, :])
+        next_state = np.ravel_multi_index(tuple(np.moveaxis(moved, -1, 0)), shape)
+        goal = self.goal_state
+        reward = np.where(next_state == goal, GOAL_REWARD, STEP_REWARD)
+        terminal = np.zeros(self.n_states, np.bool_)
+        terminal[goal] = True
+        starts = np.flatnonzero(~terminal)
+        return TabularMDP(next_state, reward, terminal, starts)
+
+    def shortest_steps(self, state: int) -> int:
+        """Fewest actions from ``state`` to the goal: the largest bin distance over the joints."""
+        return int(np.max(np.abs(np.asarray(self.bins_of(state)) - np.asarray(self.goal))))
+
+    def mean_shortest_steps(self) -> float:
+        """Mean of :meth:`shortest_steps` over the start states: the best possible curve level."""
+        shape = (self.bins,) * self.joints
+        state_bins = np.array(np.unravel_index(np.arange(self.n_states), shape)).T
+        dist = np.max(np.abs(state_bins - np.asarray(self.goal)), axis=1)
+        return float(dist[dist > 0].mean()) if np.any(dist > 0) else 0.0
+
+    def path_from_joints(self, q_path_rad: np.ndarray | Sequence[Sequence[float]]) -> list[int]:
+        """A valid grid path (consecutive states one action apart) following a joint trajectory.
+
+        Each row is mapped to its nearest bins, repeats are dropped (pauses), and jumps of more
+        than one bin are filled in by moving every lagging joint one bin per step toward the next
+        sample at the same time (a diagonal, then straight, walk).
+
+        Args:
+            q_path_rad: joint angles in radians, ``(N, joints)``; wider rows (for example the
+                Puma560's six joints) use their first ``joints`` columns.
+
+        Returns:
+            State numbers, the first nearest to the first sample, the last to the last.
+        """
+        q = np.asarray(q_path_rad, dtype=np.float64)
+        if q.ndim != 2 or q.shape[0] < 1 or q.shape[1] < self.joints:
+            raise LearningError(
+                f"The joint path has shape {q.shape}; give an (N, {self.joints}) or wider array of angles in radians with N >= 1."
+            )
+        bins = self.bins_of_angles(q[:, : self.joints])
+        path = [bins[0]]
+        for target in bins[1:]:
+            current = path[-1]
+            while np.any(current != target):
+                current = current + np.sign(target - current)
+                path.append(current)
+        shape = (self.bins,) * self.joints
+        return [int(s) for s in np.ravel_multi_index(tuple(np.array(path).T), shape)]
