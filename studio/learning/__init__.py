@@ -22,6 +22,7 @@ from ._config import check_budget as check_budget
 from ._dynaq import ExperimentResult as ExperimentResult
 from ._dynaq import LiveProgress as LiveProgress
 from ._dynaq import run_experiments as run_experiments
+from ._dynaq import warm_up as warm_up
 from ._errors import ConfigError as ConfigError
 from ._errors import LearningError as LearningError
 from ._errors import PolicyFileError as PolicyFileError
@@ -32,3 +33,6 @@ from ._policy import load_policy as load_policy
 from ._policy import rollout as rollout
 from ._policy import save_policy as save_policy
 from ._policy import save_trajectory_csv as save_trajectory_csv
+from ._reproduce import ReproduceResult as ReproduceResult
+from ._reproduce import generate_demonstrations as generate_demonstrations
+from ._reproduce import reproduce as reproduce
