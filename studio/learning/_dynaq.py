@@ -21,8 +21,11 @@ Planners (``DynaQConfig.planning``):
 - ``prioritized``: prioritized sweeping (Sutton & Barto, section 8.4). Every Q update, real or
   planned, queues the predecessors of the updated state whose own update would change Q by more than
   ``priority_threshold``; after each real step up to ``planning_steps`` queued pairs are updated,
-  highest priority first. Unlike the book's box, the real step's update is applied directly (as in
-  Dyna-Q) rather than queued, so prioritized with 0 planning steps is exactly Q-learning.
+  highest priority first. Two departures from the book's box: the real step's update is applied
+  directly (as in Dyna-Q) rather than queued, so prioritized with 0 planning steps is exactly
+  Q-learning; and since with alpha < 1 an update removes only part of a pair's error, the pair is
+  queued again with what remains (the book's box assumes the error is gone, which with the paper's
+  alpha = 0.1 leaves values far from converged).
 
 The model is deterministic, as the MDP is: ``Model(s, a)`` stores the observed next state and reward.
 """
@@ -178,6 +181,15 @@ def _heap_pop(heap_idx, heap_pri, pos, size):
 
 
 @njit(nogil=True, cache=True)
+def _queue_pair(q, v, idx, s_next, r, gamma, threshold, heap_idx, heap_pri, pos, size):
+    """Queue (s, a) (flat index ``idx``) with its remaining error if it exceeds the threshold."""
+    priority = abs(r + gamma * v[s_next] - q[idx])
+    if priority > threshold:
+        size = _heap_push(heap_idx, heap_pri, pos, size, idx, priority)
+    return size
+
+
+@njit(nogil=True, cache=True)
 def _queue_predecessors(
     q, v, s, gamma, threshold, pred_head, pred_link, model_next, model_reward,
     heap_idx, heap_pri, pos, size,
@@ -292,6 +304,9 @@ def _run_experiment(
             updates += 1
             # plan
             if prioritized:
+                heap_size = _queue_pair(
+                    qf, v, idx, s_next, r, gamma, threshold, heap_idx, heap_pri, pos, heap_size
+                )
                 heap_size = _queue_predecessors(
                     qf, v, s, gamma, threshold, pred_head, pred_link, model_next, model_reward,
                     heap_idx, heap_pri, pos, heap_size,
@@ -303,6 +318,10 @@ def _run_experiment(
                     ps = p // n_actions
                     _q_update(qf, v, p, ps, model_next[p], model_reward[p], alpha, gamma, n_actions)
                     updates += 1
+                    heap_size = _queue_pair(
+                        qf, v, p, model_next[p], model_reward[p], gamma, threshold,
+                        heap_idx, heap_pri, pos, heap_size,
+                    )  # fmt: skip
                     heap_size = _queue_predecessors(
                         qf, v, ps, gamma, threshold, pred_head, pred_link, model_next,
                         model_reward, heap_idx, heap_pri, pos, heap_size,

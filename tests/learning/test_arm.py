@@ -1,0 +1,103 @@
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from studio.learning import MAX_TABLE_ENTRIES, ArmGrid, LearningError
+
+grids = st.builds(
+    ArmGrid,
+    joints=st.integers(1, 4),
+    bins=st.integers(2, 7),
+    low_deg=st.sampled_from([-180.0, -90.0, 0.0]),
+    high_deg=st.sampled_from([120.0, 180.0]),
+)
+
+
+def test_paper_grid() -> None:
+    grid = ArmGrid()
+    mdp = grid.mdp()
+    assert (grid.n_states, grid.n_actions) == (1331, 27)
+    assert grid.goal == (5, 6, 2)
+    assert mdp.terminal.sum() == 1 and mdp.terminal[grid.goal_state]
+    assert grid.goal_state not in mdp.start_states and mdp.start_states.size == 1330
+    into_goal = mdp.next_state == grid.goal_state
+    np.testing.assert_array_equal(mdp.reward[into_goal], 100.0)
+    np.testing.assert_array_equal(mdp.reward[~into_goal], -1.0)
+    # out-of-range moves leave that joint in place: from the corner (0, 0, 0) the all -1 action stays
+    corner = grid.state_of((0, 0, 0))
+    assert mdp.next_state[corner, 0] == corner
+    assert grid.bins_of(int(mdp.next_state[corner, 26])) == (1, 1, 1)
+    assert mdp.next_state[corner, grid.stay_action] == corner
+    np.testing.assert_allclose(
+        np.degrees(grid.angles_of(grid.goal_state)), [0, 360 / 11, -360 / 11 * 3]
+    )
+
+
+@settings(max_examples=40, deadline=None)
+@given(grid=grids, data=st.data())
+def test_state_bins_angles_round_trip(grid: ArmGrid, data: st.DataObject) -> None:
+    state = data.draw(st.integers(0, grid.n_states - 1))
+    bins = grid.bins_of(state)
+    assert grid.state_of(bins) == state
+    assert grid.state_of_angles(grid.angles_of(state)) == state
+    # anywhere inside a bin maps to that bin
+    offset = data.draw(st.floats(-0.49, 0.49)) * grid.bin_width
+    assert grid.state_of_angles(grid.angles_of(state) + offset) == state
+
+
+@settings(max_examples=40, deadline=None)
+@given(grid=grids, data=st.data())
+def test_path_from_joints_is_a_valid_grid_path(grid: ArmGrid, data: st.DataObject) -> None:
+    low, high = np.radians(grid.low_deg) - 0.3, np.radians(grid.high_deg) + 0.3
+    n = data.draw(st.integers(1, 8))
+    q = np.array(
+        data.draw(
+            st.lists(
+                st.lists(st.floats(low, high), min_size=grid.joints, max_size=grid.joints),
+                min_size=n,
+                max_size=n,
+            )
+        )
+    )
+    path = grid.path_from_joints(q)
+    mdp = grid.mdp()
+    assert path[0] == grid.state_of_angles(q[0]) and path[-1] == grid.state_of_angles(q[-1])
+    for s, s_next in zip(path[:-1], path[1:], strict=True):
+        assert s != s_next  # pauses removed
+        assert mdp.action_between(s, s_next) >= 0  # one action apart
+    samples = {grid.state_of_angles(row) for row in q}
+    assert samples <= set(path)  # every sample's bin is visited
+
+
+def test_path_from_joints_uses_the_first_columns_of_a_robot_path() -> None:
+    grid = ArmGrid()
+    q_robot = np.zeros((3, 6))
+    q_robot[:, 3:] = 2.0  # wrist joints are ignored by a 3-joint grid
+    q_robot[2, 0] = np.radians(100)
+    path = grid.path_from_joints(q_robot)
+    assert [grid.bins_of(s) for s in path] == [(5, 5, 5), (6, 5, 5), (7, 5, 5), (8, 5, 5)]
+    with pytest.raises(LearningError, match="joint path has shape"):
+        grid.path_from_joints(np.zeros((3, 2)))
+    with pytest.raises(LearningError, match="NaN"):
+        grid.path_from_joints(np.full((2, 3), np.nan))
+
+
+def test_six_joints_where_memory_allows_and_a_clear_refusal_beyond() -> None:
+    assert ArmGrid(joints=6, bins=4).n_actions == 729
+    with pytest.raises(LearningError, match=f"over the limit of {MAX_TABLE_ENTRIES:,}"):
+        ArmGrid(joints=6, bins=11)
+    with pytest.raises(LearningError, match="joints is 7"):
+        ArmGrid(joints=7)
+    with pytest.raises(LearningError, match="goal"):
+        ArmGrid(goal=(11, 0, 0))
+    with pytest.raises(LearningError, match="empty"):
+        ArmGrid(low_deg=10, high_deg=-10)
+
+
+def test_shortest_steps_is_the_chebyshev_distance() -> None:
+    grid = ArmGrid(joints=2, bins=5, goal=(1, 3))
+    assert grid.shortest_steps(grid.state_of((4, 0))) == 3
+    assert grid.shortest_steps(grid.goal_state) == 0
