@@ -233,9 +233,9 @@ def _run_experiment(
     v = np.zeros(n_states, np.float64)  # max_a Q(s, a), kept exact by _q_update
     seen = np.zeros(n_pairs, np.bool_)
     # the model, twice: by flat (s, a) index (prioritized sweeping's predecessor lists), and in
-    # order of first visit as rows (idx, s, s') plus reward, so a uniform draw reads one row
-    visited = np.empty((n_pairs, 3), np.int64)
-    visited_reward = np.empty(n_pairs, np.float64)
+    # order of first visit as rows (idx, s, s', r), stored as float64 (exact for indices below
+    # 2**53) so that one 32-byte row, one cache line, holds everything a uniform draw needs
+    visited = np.empty((n_pairs, 4), np.float64)
     n_visited = 0
     model_next = np.empty(n_pairs, np.int64)
     model_reward = np.empty(n_pairs, np.float64)
@@ -292,7 +292,7 @@ def _run_experiment(
                 visited[n_visited, 0] = idx
                 visited[n_visited, 1] = s
                 visited[n_visited, 2] = s_next
-                visited_reward[n_visited] = r
+                visited[n_visited, 3] = r
                 n_visited += 1
                 model_next[idx] = s_next
                 model_reward[idx] = r
@@ -331,8 +331,8 @@ def _run_experiment(
                     rng += _GOLDEN
                     k = _below(_mix(rng), n_visited)
                     _q_update(
-                        qf, v, visited[k, 0], visited[k, 1], visited[k, 2], visited_reward[k],
-                        alpha, gamma, n_actions,
+                        qf, v, np.int64(visited[k, 0]), np.int64(visited[k, 1]),
+                        np.int64(visited[k, 2]), visited[k, 3], alpha, gamma, n_actions,
                     )  # fmt: skip
                 updates += n_plan
             s = s_next
