@@ -164,7 +164,7 @@ def bench_startup() -> None:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument(
-        "--reference-sample", type=int, default=2, help="reference experiments per configuration"
+        "--reference-sample", type=int, default=5, help="reference experiments per configuration"
     )
     parser.add_argument(
         "--full-reference", action="store_true", help=f"run the reference on all {EXPERIMENTS}"

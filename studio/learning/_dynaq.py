@@ -85,47 +85,59 @@ def _unit(z: np.uint64) -> float:
 
 
 @njit(nogil=True, cache=True)
-def _q_update(q, v, idx, s, s_next, r, alpha, gamma, n_actions):
+def _q_update(q, v, n_max, idx, s, s_next, r, alpha, gamma, n_actions):
     """Eq. 1 on Q(s, a) (flat index ``idx``), keeping ``v[s] = max_a Q(s, a)`` exact.
 
     ``v`` caches each state's greedy value so the target costs one lookup instead of a scan of
-    the next state's row; the row of ``s`` is rescanned only when its maximum entry went down.
-    Terminal states are never acted from, so their row and value stay 0 (nothing follows them).
+    the next state's row, and ``n_max[s]`` counts the entries of row ``s`` equal to it, so the row
+    is rescanned only when its last maximal entry went down. Terminal states are never acted
+    from, so their row and value stay 0 (nothing follows them).
     """
     old = q[idx]
     new = old + alpha * (r + gamma * v[s_next] - old)
     q[idx] = new
-    if new >= v[s]:
+    best = v[s]
+    if new > best:
         v[s] = new
-    elif old == v[s]:
-        row = s * n_actions
-        best = q[row]
-        for b in range(row + 1, row + n_actions):
-            if q[b] > best:
-                best = q[b]
-        v[s] = best
+        n_max[s] = 1
+    elif new == best:
+        if old != best:
+            n_max[s] += 1
+    elif old == best:
+        n_max[s] -= 1
+        if n_max[s] == 0:
+            row = s * n_actions
+            best = q[row]
+            count = 1
+            for b in range(row + 1, row + n_actions):
+                if q[b] > best:
+                    best = q[b]
+                    count = 1
+                elif q[b] == best:
+                    count += 1
+            v[s] = best
+            n_max[s] = count
 
 
 @njit(nogil=True, cache=True)
-def _greedy_with_ties(q, s, n_actions, ties, rng):
-    """argmax_a Q(s, a) with ties broken uniformly at random; returns (action, rng)."""
+def _greedy_with_ties(q, v, n_max, s, n_actions, rng):
+    """argmax_a Q(s, a) with ties broken uniformly at random; returns (action, rng).
+
+    The cached maximum ``v[s]`` and its count ``n_max[s]`` say how many actions tie, so one draw
+    picks the k-th of them and a scan for equality finds it.
+    """
+    k = 0
+    if n_max[s] > 1:
+        rng += _GOLDEN
+        k = _below(_mix(rng), n_max[s])
+    best = v[s]
     row = s * n_actions
-    best = q[row]
-    ties[0] = 0
-    n_ties = 1
-    for b in range(1, n_actions):
-        v = q[row + b]
-        if v > best:
-            best = v
-            ties[0] = b
-            n_ties = 1
-        elif v == best:
-            ties[n_ties] = b
-            n_ties += 1
-    if n_ties == 1:
-        return ties[0], rng
-    rng += _GOLDEN
-    return ties[_below(_mix(rng), n_ties)], rng
+    for b in range(n_actions):
+        if q[row + b] == best:
+            if k == 0:
+                return b, rng
+            k -= 1
+    return -1, rng  # unreachable while v and n_max are exact
 
 
 @njit(nogil=True, cache=True)
@@ -231,6 +243,7 @@ def _run_experiment(
     qf = q.reshape(n_pairs)
 
     v = np.zeros(n_states, np.float64)  # max_a Q(s, a), kept exact by _q_update
+    n_max = np.full(n_states, n_actions, np.int64)  # entries of each row equal to v
     seen = np.zeros(n_pairs, np.bool_)
     # the model, twice: by flat (s, a) index (prioritized sweeping's predecessor lists), and in
     # order of first visit as rows (idx, s, s', r), stored as float64 (exact for indices below
@@ -239,7 +252,6 @@ def _run_experiment(
     n_visited = 0
     model_next = np.empty(n_pairs, np.int64)
     model_reward = np.empty(n_pairs, np.float64)
-    ties = np.empty(n_actions, np.int64)
     prioritized = planner == _PRIORITIZED
     queue_len = n_pairs if prioritized else 0
     pred_head = np.full(n_states if prioritized else 0, -1, np.int64)
@@ -282,7 +294,7 @@ def _run_experiment(
                     rng += _GOLDEN
                     a = _below(_mix(rng), n_actions)
                 else:
-                    a, rng = _greedy_with_ties(qf, s, n_actions, ties, rng)
+                    a, rng = _greedy_with_ties(qf, v, n_max, s, n_actions, rng)
             idx = s * n_actions + a
             s_next = nxt[idx]
             r = rew[idx]
@@ -300,7 +312,7 @@ def _run_experiment(
                     pred_link[idx] = pred_head[s_next]
                     pred_head[s_next] = idx
             # learn: Eq. 1
-            _q_update(qf, v, idx, s, s_next, r, alpha, gamma, n_actions)
+            _q_update(qf, v, n_max, idx, s, s_next, r, alpha, gamma, n_actions)
             updates += 1
             # plan
             if prioritized:
@@ -316,7 +328,9 @@ def _run_experiment(
                         break
                     p, heap_size = _heap_pop(heap_idx, heap_pri, pos, heap_size)
                     ps = p // n_actions
-                    _q_update(qf, v, p, ps, model_next[p], model_reward[p], alpha, gamma, n_actions)
+                    _q_update(
+                        qf, v, n_max, p, ps, model_next[p], model_reward[p], alpha, gamma, n_actions
+                    )
                     updates += 1
                     heap_size = _queue_pair(
                         qf, v, p, model_next[p], model_reward[p], gamma, threshold,
@@ -331,7 +345,7 @@ def _run_experiment(
                     rng += _GOLDEN
                     k = _below(_mix(rng), n_visited)
                     _q_update(
-                        qf, v, np.int64(visited[k, 0]), np.int64(visited[k, 1]),
+                        qf, v, n_max, np.int64(visited[k, 0]), np.int64(visited[k, 1]),
                         np.int64(visited[k, 2]), visited[k, 3], alpha, gamma, n_actions,
                     )  # fmt: skip
                 updates += n_plan

@@ -227,3 +227,66 @@ def test_mdp_validation() -> None:
         TabularMDP(np.array([[0]]), np.zeros((2, 1)), np.array([False]), np.array([0]))
     with pytest.raises(LearningError, match="start_states is empty"):
         TabularMDP(np.array([[0]]), np.zeros((1, 1)), np.array([False]), np.array([], int))
+
+
+_MASK = (1 << 64) - 1
+
+
+def _python_dyna_q(mdp, config, episodes, seed, demos):
+    """The kernel's algorithm in plain Python, drawing the same random numbers in the same order."""
+    from studio.learning._dynaq import experiment_seed
+
+    state = int(experiment_seed(seed, 0))
+
+    def draw() -> int:
+        nonlocal state
+        state = (state + 0x9E3779B97F4A7C15) & _MASK
+        z = state
+        z = ((z ^ (z >> 30)) * 0xBF58476D1CE4E5B9) & _MASK
+        z = ((z ^ (z >> 27)) * 0x94D049BB133111EB) & _MASK
+        return z ^ (z >> 31)
+
+    def below(n: int) -> int:
+        return ((draw() >> 32) * n) >> 32
+
+    n_states, n_actions = mdp.next_state.shape
+    q = [[0.0] * n_actions for _ in range(n_states)]
+    visited: list[tuple[int, int]] = []
+    for episode in range(episodes):
+        n = {"zero": 0, "full": config.planning_steps}.get(
+            config.planning, max(config.planning_steps - episode, 0)
+        )
+        demo = demos[episode] if episode < len(demos) else None
+        s = demo[0] if demo else int(mdp.start_states[below(mdp.start_states.size)])
+        steps = 0
+        while not mdp.terminal[s] and steps < config.max_steps_per_episode:
+            if demo:
+                a = mdp.action_between(s, demo[steps + 1])
+            elif (draw() >> 11) * 2.0**-53 < config.epsilon:
+                a = below(n_actions)
+            else:
+                ties = [b for b in range(n_actions) if q[s][b] == max(q[s])]
+                a = ties[below(len(ties))] if len(ties) > 1 else ties[0]
+            s2, r = int(mdp.next_state[s, a]), float(mdp.reward[s, a])
+            if (s, a) not in visited:
+                visited.append((s, a))
+            q[s][a] = q[s][a] + config.alpha * (r + config.gamma * max(q[s2]) - q[s][a])
+            for _ in range(n):
+                ps, pa = visited[below(len(visited))]
+                ps2, pr = int(mdp.next_state[ps, pa]), float(mdp.reward[ps, pa])
+                q[ps][pa] = q[ps][pa] + config.alpha * (pr + config.gamma * max(q[ps2]) - q[ps][pa])
+            s = s2
+            steps += 1
+    return np.array(q)
+
+
+@pytest.mark.parametrize("planning", ["zero", "full", "soft"])
+def test_kernel_matches_a_plain_python_transcription_bit_for_bit(planning: str) -> None:
+    # checks the kernel's cached maxima, tie counts and random draws against the obvious code
+    grid = ArmGrid(joints=2, bins=5)
+    mdp = grid.mdp()
+    demos = generate_demonstrations(grid, 2, np.random.default_rng(1))
+    config = DynaQConfig(planning=planning, planning_steps=6, epsilon=0.2)
+    result = run_experiments(mdp, config, 1, 12, seed=7, demonstrations=demos)
+    expected = _python_dyna_q(mdp, config, 12, 7, demos)
+    assert result.q[0].tobytes() == expected.tobytes()
