@@ -375,13 +375,18 @@ def judge_claims(results: dict[str, ExperimentResult], grid: ArmGrid, demos: int
             + ", ".join(f"{p} {ratios[p]:.1f}x (paper {paper[p]:.1f}x)" for p in ratios)
             + "; Q updates full/zero: "
             + ", ".join(f"{p} {upd[p]:.1f}x" for p in upd)
-            + ". Counted as reproduced for a CPU ratio between 25x and 100x; our zero-planning time is "
-            "dominated by the action choice and per-step work that Matlab's planning loop dwarfed.",
+            + ". Counted as reproduced for a CPU ratio between 25x and 100x. The work itself (Q updates) "
+            f"grows only {min(upd.values()):.0f}-{max(upd.values()):.0f}x, so the paper's 50x reflects Matlab's costly planning loop; in our kernel "
+            "a planning update costs a fraction of a real step (action choice, model bookkeeping).",
             all(25 <= r <= 100 for r in ratios.values()),
         )
     )
     soft = {
         prefix: cpu[f"{prefix}-SPL"] / max(cpu[f"{prefix}-FPL"], 1e-12) for prefix in ("SV", "US")
+    }
+    soft_updates = {
+        prefix: updates[f"{prefix}-SPL"] / max(updates[f"{prefix}-FPL"], 1)
+        for prefix in ("SV", "US")
     }
     paper_soft = {
         prefix: PAPER_MATLAB_SECONDS[f"{prefix}-SPL"] / PAPER_MATLAB_SECONDS[f"{prefix}-FPL"]
@@ -392,7 +397,10 @@ def judge_claims(results: dict[str, ExperimentResult], grid: ArmGrid, demos: int
             "Soft planning costs about a third to half of full planning.",
             "CPU soft/full: "
             + ", ".join(f"{p} {soft[p]:.2f} (paper {paper_soft[p]:.2f})" for p in soft)
-            + ". Counted as reproduced for a ratio between 0.2 and 0.7.",
+            + "; Q updates soft/full: "
+            + ", ".join(f"{p} {soft_updates[p]:.2f}" for p in soft_updates)
+            + ". Counted as reproduced for a CPU ratio between 0.2 and 0.7; most planning happens "
+            "in the long early episodes, where soft still plans almost as much as full.",
             all(0.2 <= r <= 0.7 for r in soft.values()),
         )
     )
