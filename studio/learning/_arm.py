@@ -29,9 +29,10 @@ from ._mdp import TabularMDP
 
 MAX_JOINTS = 6
 """The Puma560 has six joints."""
-MAX_TABLE_ENTRIES = 20_000_000
-"""Largest states x actions table a grid may have: one Q table is then 160 MB and one experiment's
-working memory (Q, model, visit list) about 700 MB. Six joints fit with up to 5 bins each."""
+MAX_TABLE_ENTRIES = 12_000_000
+"""Largest states x actions table a grid may have: one Q table is then 96 MB, the task's tables
+200 MB, and each running experiment's working memory (Q, visit list, model; prioritized sweeping's
+queue) 0.6 to 1 GB. Six joints fit with up to 5 bins each (11.4 million entries)."""
 GOAL_REWARD = 100.0
 """Reward for the step that reaches the goal (paper)."""
 STEP_REWARD = -1.0
@@ -209,11 +210,13 @@ class ArmGrid:
     @cached_property
     def _table(self) -> TabularMDP:
         shape = (self.bins,) * self.joints
-        state_bins = np.array(np.unravel_index(np.arange(self.n_states), shape)).T  # (S, J)
-        moved = state_bins[:, None, :] + self.action_deltas()[None, :, :]  # (S, A, J)
-        inside = (moved >= 0) & (moved < self.bins)
-        moved = np.where(inside, moved, state_bins[:, None, :])
-        next_state = np.ravel_multi_index(tuple(np.moveaxis(moved, -1, 0)), shape)
+        state_bins = np.unravel_index(np.arange(self.n_states), shape)  # J arrays (S,)
+        deltas = self.action_deltas()  # (A, J)
+        next_state = np.zeros((self.n_states, self.n_actions), np.int64)
+        for j in range(self.joints):  # one joint at a time keeps the peak memory at a few (S, A)
+            moved = state_bins[j][:, None] + deltas[None, :, j]
+            moved = np.where((moved >= 0) & (moved < self.bins), moved, state_bins[j][:, None])
+            next_state += moved * self.bins ** (self.joints - 1 - j)
         goal = self.goal_state
         reward = np.where(next_state == goal, GOAL_REWARD, STEP_REWARD)
         terminal = np.zeros(self.n_states, np.bool_)

@@ -245,15 +245,14 @@ def _run_experiment(
     v = np.zeros(n_states, np.float64)  # max_a Q(s, a), kept exact by _q_update
     n_max = np.full(n_states, n_actions, np.int64)  # entries of each row equal to v
     seen = np.zeros(n_pairs, np.bool_)
-    # the model, twice: by flat (s, a) index (prioritized sweeping's predecessor lists), and in
-    # order of first visit as rows (idx, s, s', r), stored as float64 (exact for indices below
-    # 2**53) so that one 32-byte row, one cache line, holds everything a uniform draw needs
+    # the model in order of first visit as rows (idx, s, s', r), stored as float64 (exact for
+    # indices below 2**53) so that one 32-byte row, one cache line, holds all a uniform draw needs
     visited = np.empty((n_pairs, 4), np.float64)
     n_visited = 0
-    model_next = np.empty(n_pairs, np.int64)
-    model_reward = np.empty(n_pairs, np.float64)
     prioritized = planner == _PRIORITIZED
     queue_len = n_pairs if prioritized else 0
+    model_next = np.empty(queue_len, np.int64)  # the model by flat (s, a), for the sweeps
+    model_reward = np.empty(queue_len, np.float64)
     pred_head = np.full(n_states if prioritized else 0, -1, np.int64)
     pred_link = np.full(queue_len, -1, np.int64)
     heap_idx = np.empty(queue_len, np.int64)
@@ -306,9 +305,9 @@ def _run_experiment(
                 visited[n_visited, 2] = s_next
                 visited[n_visited, 3] = r
                 n_visited += 1
-                model_next[idx] = s_next
-                model_reward[idx] = r
                 if prioritized:
+                    model_next[idx] = s_next
+                    model_reward[idx] = r
                     pred_link[idx] = pred_head[s_next]
                     pred_head[s_next] = idx
             # learn: Eq. 1
