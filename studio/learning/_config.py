@@ -15,6 +15,8 @@ import math
 from dataclasses import asdict, dataclass, fields
 from typing import Any
 
+import numpy as np
+
 from ._errors import ConfigError, LearningError
 
 PLANNERS = ("zero", "full", "soft", "prioritized")
@@ -63,7 +65,11 @@ class DynaQConfig:
     def __post_init__(self) -> None:
         problems = _problems(self)
         if problems:
-            raise ConfigError(problems)
+            raise ConfigError([text for _, text in problems], [name for name, _ in problems])
+        for f in fields(self):  # plain Python numbers, so the settings serialise to JSON as is
+            value = getattr(self, f.name)
+            if isinstance(value, np.integer | np.floating):
+                object.__setattr__(self, f.name, value.item())
 
     def to_dict(self) -> dict[str, Any]:
         """The settings as a JSON-ready dict (the inverse of :meth:`from_dict`)."""
@@ -91,38 +97,48 @@ class DynaQConfig:
 
 
 def _is_number(value: object) -> bool:
-    return isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value)
+    return (
+        isinstance(value, int | float | np.integer | np.floating)
+        and not isinstance(value, bool)
+        and math.isfinite(value)
+    )
 
 
 def _is_int(value: object) -> bool:
-    return isinstance(value, int) and not isinstance(value, bool)
+    return isinstance(value, int | np.integer) and not isinstance(value, bool)
 
 
-def _problems(config: DynaQConfig) -> list[str]:
-    """One sentence per bad field of ``config``."""
-    problems: list[str] = []
+def _problems(config: DynaQConfig) -> list[tuple[str, str]]:
+    """``(field, sentence)`` per bad field of ``config``."""
+    problems: list[tuple[str, str]] = []
 
     def number(name: str, low: float, high: float, low_open: bool = False) -> None:
         value = getattr(config, name)
         lo = "(" if low_open else "["
         if not _is_number(value) or value < low or value > high or (low_open and value <= low):
-            problems.append(f"{name} is {value!r}; give a number in {lo}{low}, {high}].")
+            problems.append((name, f"{name} is {value!r}; give a number in {lo}{low}, {high}]."))
 
     def integer(name: str, low: int, high: int) -> None:
         value = getattr(config, name)
         if not _is_int(value) or value < low or value > high:
-            problems.append(f"{name} is {value!r}; give a whole number from {low} to {high:,}.")
+            problems.append(
+                (name, f"{name} is {value!r}; give a whole number from {low} to {high:,}.")
+            )
 
     number("alpha", 0.0, 1.0, low_open=True)
     number("gamma", 0.0, 1.0)
     number("epsilon", 0.0, 1.0)
     if config.planning not in PLANNERS:
-        problems.append(f"planning is {config.planning!r}; give one of {', '.join(PLANNERS)}.")
+        problems.append(
+            ("planning", f"planning is {config.planning!r}; give one of {', '.join(PLANNERS)}.")
+        )
     integer("planning_steps", 0, MAX_PLANNING_STEPS)
     integer("max_steps_per_episode", 1, MAX_STEPS_PER_EPISODE)
     value = config.priority_threshold
     if not _is_number(value) or value < 0:
-        problems.append(f"priority_threshold is {value!r}; give a finite number >= 0.")
+        problems.append(
+            ("priority_threshold", f"priority_threshold is {value!r}; give a finite number >= 0.")
+        )
     return problems
 
 
@@ -140,29 +156,29 @@ def check_budget(
     Raises:
         ConfigError: one sentence per problem, naming the value and the allowed range.
     """
-    problems: list[str] = []
-    if not _is_int(experiments) or not 1 <= experiments <= MAX_EXPERIMENTS:
-        problems.append(
-            f"experiments is {experiments!r}; give a whole number from 1 to {MAX_EXPERIMENTS:,}."
-        )
-    if not _is_int(episodes) or not 1 <= episodes <= MAX_EPISODES:
-        problems.append(
-            f"episodes is {episodes!r}; give a whole number from 1 to {MAX_EPISODES:,}."
-        )
+    problems: list[tuple[str, str]] = []
+    for name, value, high in (
+        ("experiments", experiments, MAX_EXPERIMENTS),
+        ("episodes", episodes, MAX_EPISODES),
+    ):
+        if not _is_int(value) or not 1 <= value <= high:
+            problems.append((name, f"{name} is {value!r}; give a whole number from 1 to {high:,}."))
     if problems:
-        raise ConfigError(problems)
-    assert isinstance(experiments, int) and isinstance(episodes, int)
+        raise ConfigError([text for _, text in problems], [name for name, _ in problems])
+    experiments, episodes = int(experiments), int(episodes)  # type: ignore[call-overload]
     if experiments * episodes > MAX_EPISODE_RUNS:
         raise ConfigError(
             [
                 f"experiments x episodes is {experiments * episodes:,}; keep it at most {MAX_EPISODE_RUNS:,} by running fewer experiments or episodes."
-            ]
+            ],
+            ["episodes"],
         )
     if experiments * n_states * n_actions > MAX_Q_ENTRIES:
         raise ConfigError(
             [
                 f"{experiments} experiments of a {n_states:,} x {n_actions} table need {experiments * n_states * n_actions * 8 / 1e9:.1f} GB of Q tables; run at most {max(1, MAX_Q_ENTRIES // (n_states * n_actions))} experiments or a smaller grid."
-            ]
+            ],
+            ["experiments"],
         )
 
 

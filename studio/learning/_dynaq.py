@@ -4,8 +4,8 @@ Reads top to bottom like the paper's algorithm box:
 
 1. a tiny deterministic random number generator (splitmix64) so every experiment is reproducible
    bit for bit, whichever thread runs it;
-2. small pure step functions: the greedy value of a state, the epsilon-greedy choice (ties broken
-   at random), the Q-learning update of Eq. 1, a max-heap for prioritized sweeping;
+2. small pure step functions: the Q-learning update of Eq. 1 (keeping each state's greedy value
+   cached), the greedy choice with ties broken at random, a max-heap for prioritized sweeping;
 3. :func:`_run_experiment`, one experiment of ``episodes`` episodes: act, learn, update the model,
    plan; it writes each episode's step count as soon as the episode ends (live curves) and stops
    at an episode boundary when asked;

@@ -18,12 +18,20 @@ class ConfigError(LearningError):
 
     Attributes:
         problems: one sentence per bad field, each naming the field, its value and the allowed
-            range; ``str(err)`` joins them, so a form can also show them field by field.
+            range; ``str(err)`` joins them.
+        by_field: the same sentences keyed by field name, so a form can show each next to its
+            field (a problem that concerns no single field is keyed ``""``).
     """
 
-    def __init__(self, problems: list[str]) -> None:
+    def __init__(self, problems: list[str], fields: list[str] | None = None) -> None:
         super().__init__(" ".join(problems))
         self.problems = list(problems)
+        names = fields if fields is not None else [""] * len(problems)
+        self.by_field: dict[str, str] = {}
+        for name, problem in zip(names, problems, strict=True):
+            self.by_field[name] = (
+                f"{self.by_field[name]} {problem}" if name in self.by_field else problem
+            )
 
 
 class PolicyFileError(LearningError):

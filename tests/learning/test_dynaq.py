@@ -290,3 +290,14 @@ def test_kernel_matches_a_plain_python_transcription_bit_for_bit(planning: str) 
     result = run_experiments(mdp, config, 1, 12, seed=7, demonstrations=demos)
     expected = _python_dyna_q(mdp, config, 12, 7, demos)
     assert result.q[0].tobytes() == expected.tobytes()
+
+
+def test_config_errors_are_keyed_by_field_and_numpy_numbers_are_accepted() -> None:
+    with pytest.raises(ConfigError) as err:
+        DynaQConfig(alpha=2.0, planning="x")
+    assert set(err.value.by_field) == {"alpha", "planning"}
+    with pytest.raises(ConfigError) as err:
+        check_budget(0, 1_000_000_000)
+    assert set(err.value.by_field) == {"experiments", "episodes"}
+    config = DynaQConfig(planning_steps=np.int64(5), alpha=np.float64(0.5))
+    assert type(config.planning_steps) is int and type(config.alpha) is float  # JSON-ready
