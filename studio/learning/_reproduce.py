@@ -30,7 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from ._arm import ArmGrid
-from ._config import DynaQConfig
+from ._config import DynaQConfig, check_budget
 from ._dynaq import ExperimentResult, LiveProgress, run_experiments, warm_up
 from ._errors import LearningError
 
@@ -485,6 +485,8 @@ def reproduce(
     Returns:
         The results, the claims judged and the paths written.
     """
+    grid = ArmGrid()
+    check_budget(experiments, episodes, grid.n_states, grid.n_actions)
     out = Path(out_dir)
     try:
         out.mkdir(parents=True, exist_ok=True)
