@@ -494,7 +494,6 @@ def reproduce(
         raise LearningError(
             f"Cannot create the output directory {out} ({err.strerror}); choose another --out."
         ) from None
-    grid = ArmGrid()
     mdp = grid.mdp()
     demos = generate_demonstrations(grid, DEMONSTRATIONS, np.random.default_rng([seed, 1]))
     n_demos = min(DEMONSTRATIONS, episodes)
