@@ -38,7 +38,7 @@ def test_reproduce_tiny_budget(tmp_path, capsys) -> None:
     assert float(timing["US-FPL"]["paper_matlab_seconds"]) == PAPER_MATLAB_SECONDS["US-FPL"]
     assert int(timing["US-FPL"]["updates"]) > int(timing["US-ZPL"]["updates"])
     report = (out / "REPORT.md").read_text()
-    assert "thousands of steps" in report and "| 7 |" in report
+    assert "thousands of steps" in report and "| 7 |" in report and "| US-PSW |" in report
     printed = capsys.readouterr().out
     assert "paper Matlab" in printed and "1435.4" in printed
 
