@@ -8,7 +8,8 @@ outputs in ``out_dir``:
 - ``fig5.png``/``.svg``: steps per episode, supervised left, unsupervised right (paper Fig. 5);
 - ``fig8.png``/``.svg``: supervised against unsupervised (paper Fig. 8);
 - ``timing.csv``: CPU seconds per configuration beside the paper's Matlab seconds (paper Fig. 9);
-- ``REPORT.md``: each claim of the paper, our numbers, and whether they reproduce it.
+- ``REPORT.md``: each claim of the paper, our numbers, and whether they reproduce it; then, beyond
+  the paper, prioritized sweeping against full planning (``EXTENSIONS``, unsupervised).
 
 The supervised agents replay ``DEMONSTRATIONS`` generated paths (the paper, too, used generated
 trajectories rather than tape recordings): from a uniformly random start, every joint steps one bin
