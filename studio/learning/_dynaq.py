@@ -587,6 +587,10 @@ def run_experiments(
         raise LearningError(
             f"live follows a run of shape {getattr(getattr(live, 'steps', None), 'shape', None)}; create LiveProgress({experiments}, {episodes}) for this run."
         )
+    if live.completed:
+        raise LearningError(
+            "live already holds a finished run; create a new LiveProgress for each run."
+        )
     demo_actions, demo_offsets, demo_starts = demonstration_actions(mdp, demonstrations or [])
 
     q = np.zeros((experiments, mdp.n_states, mdp.n_actions), np.float64)

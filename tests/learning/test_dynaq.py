@@ -157,6 +157,8 @@ def test_live_progress_is_filled_and_stop_is_obeyed() -> None:
     result = run_experiments(mdp, DynaQConfig(), 2, 5, 0, live=live)
     np.testing.assert_array_equal(live.steps, result.steps)
     assert live.completed == 10 and not result.stopped
+    with pytest.raises(LearningError, match="new LiveProgress"):
+        run_experiments(mdp, DynaQConfig(), 2, 5, 0, live=live)
 
     live = LiveProgress(2, 5)
     live.stop()
