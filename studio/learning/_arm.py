@@ -235,7 +235,9 @@ class ArmGrid:
         dist = np.max(np.abs(state_bins - np.asarray(self.goal)), axis=1)
         return float(dist[dist > 0].mean()) if np.any(dist > 0) else 0.0
 
-    def path_from_joints(self, q_path_rad: np.ndarray | Sequence[Sequence[float]]) -> list[int]:
+    def path_from_joints(
+        self, q_path_rad: np.ndarray | Sequence[Sequence[float]], *, stop_at_goal: bool = False
+    ) -> list[int]:
         """A valid grid path (consecutive states one action apart) following a joint trajectory.
 
         Each row is mapped to its nearest bins, repeats are dropped (pauses), and jumps of more
@@ -245,9 +247,13 @@ class ArmGrid:
         Args:
             q_path_rad: joint angles in radians, ``(N, joints)``; wider rows (for example the
                 Puma560's six joints) use their first ``joints`` columns.
+            stop_at_goal: end the path at its first visit to the goal, as an episode would; a
+                human motion often wobbles in and out of the goal bin before it settles, and a
+                demonstration must not go on past the goal.
 
         Returns:
-            State numbers, the first nearest to the first sample, the last to the last.
+            State numbers, the first nearest to the first sample, the last to the last (or the
+            goal, with ``stop_at_goal`` when the path reaches it).
         """
         q = np.asarray(q_path_rad, dtype=np.float64)
         if q.ndim != 2 or q.shape[0] < 1 or q.shape[1] < self.joints:
@@ -262,4 +268,7 @@ class ArmGrid:
                 current = current + np.sign(target - current)
                 path.append(current)
         shape = (self.bins,) * self.joints
-        return [int(s) for s in np.ravel_multi_index(tuple(np.array(path).T), shape)]
+        states = [int(s) for s in np.ravel_multi_index(tuple(np.array(path).T), shape)]
+        if stop_at_goal and self.goal_state in states:
+            states = states[: states.index(self.goal_state) + 1]
+        return states

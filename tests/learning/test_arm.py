@@ -79,6 +79,11 @@ def test_path_from_joints_uses_the_first_columns_of_a_robot_path() -> None:
     q_robot[2, 0] = np.radians(100)
     path = grid.path_from_joints(q_robot)
     assert [grid.bins_of(s) for s in path] == [(5, 5, 5), (6, 5, 5), (7, 5, 5), (8, 5, 5)]
+    # a motion that wobbles through the goal bin and back ends at its first arrival when asked
+    grid = ArmGrid(goal=(7, 5, 5))
+    assert grid.path_from_joints(q_robot)[-1] == grid.state_of((8, 5, 5))
+    assert grid.path_from_joints(q_robot, stop_at_goal=True)[-1] == grid.goal_state
+    assert len(grid.path_from_joints(q_robot, stop_at_goal=True)) == 3
     with pytest.raises(LearningError, match="joint path has shape"):
         grid.path_from_joints(np.zeros((3, 2)))
     with pytest.raises(LearningError, match="NaN"):
