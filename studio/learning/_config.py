@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from ._errors import ConfigError, LearningError
+from ._errors import ConfigError
 
 PLANNERS = ("zero", "full", "soft", "prioritized")
 """Planning modes: none, n uniform updates per real step, n falling by one per episode, and
@@ -50,6 +50,7 @@ class DynaQConfig:
             first episode (``"soft"``, falling by one per episode to 0); ignored for ``"zero"``.
         max_steps_per_episode: an episode that has not reached a terminal state after this many
             real steps is cut off (the paper had no cap; this one is far above its 2500 steps).
+            Replayed demonstrations always run to their end.
         priority_threshold: prioritized sweeping queues a (state, action) only when its update
             would change Q by more than this (Sutton & Barto's theta).
     """
@@ -180,6 +181,3 @@ def check_budget(
             ],
             ["experiments"],
         )
-
-
-__all__ = ["DynaQConfig", "LearningError", "PLANNERS", "check_budget"]
