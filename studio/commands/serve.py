@@ -1,17 +1,69 @@
-"""``studio serve``: start the studio (the default verb)."""
+"""``studio serve``: start the studio in the browser (the default verb)."""
 
 from __future__ import annotations
 
 import argparse
+import sys
+from pathlib import Path
+
+from studio._errors import StudioError
 
 NAME = "serve"
 HELP = "Start the studio in the browser (the default verb)."
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--data-dir", default=".", help="where recordings, runs and policies live")
+    parser.add_argument(
+        "--data-dir", type=Path, default=Path("."), help="where recordings, runs and policies live"
+    )
+    parser.add_argument("--host", default="127.0.0.1", help="address to bind (default: loopback)")
+    parser.add_argument("--port", type=int, default=8000, help="port of the page and API")
+    parser.add_argument("--viser-port", type=int, default=8080, help="port of the 3D scene")
+    parser.add_argument(
+        "--source",
+        default="simulator",
+        help="live source at start: simulator (default) or the name/path of a recording",
+    )
+    parser.add_argument(
+        "--allow-host",
+        action="append",
+        default=[],
+        metavar="NAME",
+        help="also accept this Host name (when serving beyond loopback); repeatable",
+    )
+    parser.add_argument("--no-browser", action="store_true", help="do not open a browser")
 
 
 def run(args: argparse.Namespace) -> int:
-    print("Teach Studio: the web page is not built yet. Available verbs: studio --help")
+    from studio.web import Settings, serve
+    from studio.web._settings import is_loopback
+
+    source = args.source
+    data_dir: Path = args.data_dir
+    if source != "simulator" and not Path(source).is_file():
+        by_name = data_dir / "recordings" / f"{source}.tape.csv"
+        if not by_name.is_file():
+            raise StudioError(
+                f"--source {source} is neither 'simulator', a recording file nor a recording in {by_name.parent}; check the name."
+            )
+    if not is_loopback(args.host):
+        print(
+            f"studio serve: WARNING: binding {args.host} makes the studio (and its files) reachable "
+            "from other machines; there is no login. Use only on a trusted network.",
+            file=sys.stderr,
+        )
+    allowed = list(args.allow_host)
+    if not is_loopback(args.host):
+        import socket
+
+        allowed += [socket.gethostname(), socket.getfqdn()]
+    settings = Settings(
+        data_dir=data_dir,
+        host=args.host,
+        port=args.port,
+        viser_port=args.viser_port,
+        source=source,
+        allowed_hosts=tuple(allowed),
+    )
+    serve(settings, open_browser=not args.no_browser)
     return 0

@@ -1,1 +1,12 @@
-"""studio.web (see docs/interfaces.md)."""
+"""The studio in the browser: the FastAPI app, its settings, and the server that runs both.
+
+``studio serve`` (the default verb) runs :func:`serve`; tests and scripts build the app with
+:func:`create_app` and a :class:`Settings`. The HTTP contract with the page is ``docs/api.md``.
+"""
+
+from __future__ import annotations
+
+from ._app import create_app as create_app
+from ._serve import serve as serve
+from ._settings import Settings as Settings
+from ._settings import get_settings as get_settings

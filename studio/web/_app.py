@@ -1,0 +1,171 @@
+"""The FastAPI app: the API routers, the page, plotly served locally, and the host guard.
+
+:func:`create_app` builds the app for given :class:`Settings`; the studio state (stores, live
+pipeline, run queue) is created when the app starts and closed when it stops, so tests get a
+fresh studio per ``with TestClient(create_app(settings))`` block.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import AsyncIterator
+from contextlib import asynccontextmanager
+from pathlib import Path
+from typing import Any
+
+from fastapi import FastAPI, Request
+from fastapi.exceptions import RequestValidationError
+from fastapi.responses import FileResponse, JSONResponse
+from fastapi.staticfiles import StaticFiles
+from starlette.middleware.trustedhost import TrustedHostMiddleware
+from starlette.types import ASGIApp, Receive, Scope, Send
+
+from .. import __version__
+from .._errors import StudioError
+from ._errors import NotFoundError, WebError
+from ._settings import Settings, get_settings
+from ._state import Studio
+from .routers import (
+    capture,
+    config,
+    demonstrations,
+    events,
+    policies,
+    recordings,
+    runs,
+    sources,
+    watch,
+)
+
+log = logging.getLogger(__name__)
+
+STATIC_DIR = Path(__file__).parent / "static"
+MULTIPART_OVERHEAD_BYTES = 64 * 1024
+"""Room for the multipart framing around an upload at the size limit."""
+
+
+def plotly_js_path() -> Path:
+    """``plotly.min.js`` as shipped inside the installed ``plotly`` Python package."""
+    import plotly
+
+    return Path(plotly.__file__).parent / "package_data" / "plotly.min.js"
+
+
+def create_app(settings: Settings | None = None, scene: Any = None) -> FastAPI:
+    """The studio's web app.
+
+    Args:
+        settings: data directory, ports, limits (default: ``Settings()``).
+        scene: the :class:`~studio.web._scene.StudioScene` the studio drives, or None.
+    """
+    settings = settings if settings is not None else get_settings()
+
+    @asynccontextmanager
+    async def lifespan(app: FastAPI) -> AsyncIterator[None]:
+        studio = Studio(settings, scene)
+        app.state.studio = studio
+        studio.start()
+        try:
+            yield
+        finally:
+            studio.close()
+
+    app = FastAPI(
+        title="Teach Studio",
+        version=__version__,
+        description="Teach a robot arm by showing it a motion: capture, demonstrations, "
+        "Dyna-Q training with live curves, policies. The contract is docs/api.md.",
+        lifespan=lifespan,
+    )
+    app.dependency_overrides[get_settings] = lambda: settings
+    app.add_middleware(UploadLimitMiddleware, limit=settings.upload_limit_bytes)
+    app.add_middleware(TrustedHostMiddleware, allowed_hosts=settings.trusted_hosts())
+
+    @app.exception_handler(StudioError)
+    async def studio_error(request: Request, err: StudioError) -> JSONResponse:
+        status = err.status_code if isinstance(err, WebError) else 422
+        return JSONResponse({"detail": str(err)}, status_code=status)
+
+    @app.exception_handler(RequestValidationError)
+    async def validation_error(request: Request, err: RequestValidationError) -> JSONResponse:
+        return JSONResponse({"detail": validation_sentence(err.errors())}, status_code=422)
+
+    for module in (
+        config,
+        sources,
+        capture,
+        recordings,
+        demonstrations,
+        runs,
+        policies,
+        watch,
+        events,
+    ):
+        app.include_router(module.router)
+
+    @app.get("/", include_in_schema=False)
+    def index() -> FileResponse:
+        page = STATIC_DIR / "index.html"
+        if not page.is_file():
+            raise NotFoundError(
+                f"The page is missing from {STATIC_DIR}; reinstall Teach Studio (the API still works at /docs)."
+            )
+        return FileResponse(page, headers={"Cache-Control": "no-cache"})
+
+    @app.get("/vendor/plotly.min.js", include_in_schema=False)
+    def plotly_js() -> FileResponse:
+        return FileResponse(plotly_js_path(), media_type="text/javascript")
+
+    app.mount("/static", StaticFiles(directory=STATIC_DIR, check_dir=False), name="static")
+    return app
+
+
+def validation_sentence(errors: list[dict[str, Any]]) -> str:
+    """One sentence for FastAPI's validation errors, naming the first bad field and the fix."""
+    if not errors:
+        return "The request is malformed; check its fields and try again."
+    first = errors[0]
+    loc = [str(p) for p in first.get("loc", ()) if p not in ("body", "query", "path")]
+    field = ".".join(loc) or "the request body"
+    message = str(first.get("msg", "is invalid")).rstrip(".")
+    given = first.get("input")
+    kind = first.get("type", "")
+    if kind == "missing":
+        return f"{field} is missing; add it to the request."
+    if kind == "extra_forbidden":
+        return f"{field} is not a known field; remove it or check its spelling."
+    if kind in ("json_invalid", "model_attributes_type", "dict_type"):
+        return f"The request body is not a JSON object ({message}); send a JSON object."
+    shown = repr(given) if given is not None and len(repr(given)) <= 60 else "the value given"
+    return f"{field} is {shown}: {message[0].lower()}{message[1:]}; fix {field} and try again."
+
+
+class UploadLimitMiddleware:
+    """Refuse request bodies announced larger than the upload limit before reading them (413).
+
+    The upload routes also count the bytes they receive, which covers bodies sent without a
+    ``Content-Length``.
+    """
+
+    def __init__(self, app: ASGIApp, limit: int) -> None:
+        self.app = app
+        self.limit = limit
+
+    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
+        if scope["type"] == "http":
+            for key, value in scope.get("headers", ()):
+                if key == b"content-length":
+                    try:
+                        size = int(value)
+                    except ValueError:
+                        size = 0
+                    if size > self.limit + MULTIPART_OVERHEAD_BYTES:
+                        response = JSONResponse(
+                            {
+                                "detail": f"The upload is {size / 1e6:.1f} MB, over the limit of {self.limit / 1e6:.0f} MB; upload a smaller file or start the studio with a larger limit."
+                            },
+                            status_code=413,
+                        )
+                        await response(scope, receive, send)
+                        return
+        await self.app(scope, receive, send)

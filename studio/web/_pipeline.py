@@ -1,0 +1,347 @@
+"""The live pipeline: frames from the current source through the kinematics into the scene.
+
+One thread reads the current :class:`studio.capture.FrameSource`; every raw frame goes to the
+capture writer (when recording), and frames are turned into poses with
+``reconstruct -> ArmFitter.fit -> Retargeter.robot_from_human`` (warm-started frame to frame).
+The newest pose goes to the scene with ``update_live`` (latest wins, never blocks). When the
+kinematics fall behind the stream, only the newest frames of a batch are fitted: the recording
+still gets every frame, the scene the newest pose.
+
+Switching sources stops the old one before the new one starts. A source that fails (a dropped
+bridge connection, an unplugged serial device) shows its error in :meth:`Pipeline.status` and the
+studio keeps running.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .._errors import StudioError
+from ._errors import ConflictError
+
+log = logging.getLogger(__name__)
+
+READ_TIMEOUT_S = 0.05
+"""How long one read waits for frames, so the thread notices a stop or a source switch quickly."""
+MAX_FITS_PER_BATCH = 4
+"""At most this many frames of one batch are fitted (the newest); the rest only get recorded."""
+IDLE_SLEEP_S = 0.05
+"""Sleep between polls when there is no source or it failed."""
+ROBOT_JOINTS = 6
+
+
+class Pipeline:
+    """The live source, its kinematics, the capture writer, and live demonstration marking.
+
+    Args:
+        scene: the :class:`studio.web._scene.StudioScene` to feed, or None (headless, tests).
+    """
+
+    def __init__(self, scene: Any = None) -> None:
+        self.scene = scene
+        self._lock = threading.RLock()
+        self._source: Any = None
+        self._kind: str | None = None
+        self._recording: str | None = None
+        self._start_error: str | None = None
+        self._mode = "joint"
+        self._mirror = True
+        self._kin: dict[str, Any] | None = None  # config, fitter, retargeter for the source
+        self._q_human: np.ndarray | None = None
+        self._q_robot = np.zeros(ROBOT_JOINTS)
+        self._residual: float | None = None
+        self._last_t: float | None = None
+        self._writer: Any = None
+        self._capture_name: str | None = None
+        self._capture_path: Path | None = None
+        self._capture_frames = 0
+        self._capture_t0: float | None = None
+        self._capture_last_t: float | None = None
+        self._kin_error: str | None = None
+        self._stop = threading.Event()
+        self._thread: threading.Thread | None = None
+
+    # ------------------------------------------------------------------ lifecycle
+
+    def start(self) -> None:
+        """Start the pipeline thread."""
+        if self._thread is None:
+            self._stop.clear()
+            self._thread = threading.Thread(target=self._loop, name="studio-pipeline", daemon=True)
+            self._thread.start()
+
+    def close(self) -> None:
+        """Stop the capture (closing its file cleanly), the source and the thread."""
+        self._stop.set()
+        if self._thread is not None:
+            self._thread.join(timeout=5.0)
+            self._thread = None
+        with self._lock:
+            if self._writer is not None:
+                self._close_writer()
+            self._stop_source()
+
+    # ------------------------------------------------------------------ source
+
+    def set_source(self, source: Any, kind: str, recording: str | None = None) -> None:
+        """Switch to ``source`` (already constructed, not started); stops the old one first.
+
+        Raises:
+            ConflictError: a capture is running (stop it before switching).
+        """
+        with self._lock:
+            if self._writer is not None:
+                raise ConflictError(
+                    "A recording is being captured from the current source; stop the recording before switching the source."
+                )
+            self._stop_source()
+            self._kind, self._recording, self._source = kind, recording, source
+            self._start_error = None
+            self._kin = None
+            self._kin_error = None
+            self._residual = None
+            if source is None:
+                return
+            try:
+                source.start()
+            except StudioError as err:
+                self._start_error = str(err)
+            except OSError as err:
+                self._start_error = f"The {kind} source could not start ({err.strerror or err}); check the device or port and try again."
+
+    def clear_source(self) -> None:
+        """Stop the source and run without one."""
+        self.set_source(None, None)  # type: ignore[arg-type]
+
+    def _stop_source(self) -> None:
+        source = self._source
+        self._source = None
+        if source is not None:
+            try:
+                source.stop()
+            except Exception:  # a failing device must not keep the studio from switching
+                log.exception("stopping the %s source failed", self._kind)
+
+    @property
+    def source(self) -> Any:
+        """The current source object (None without one)."""
+        return self._source
+
+    @property
+    def kind(self) -> str | None:
+        """The current source kind."""
+        return self._kind
+
+    @property
+    def recording(self) -> str | None:
+        """Name of the recording being played back, if the source is a recording."""
+        return self._recording
+
+    def set_retarget(self, mode: str, mirror: bool | None) -> None:
+        """Switch the human-to-robot mapping (applies from the next frame)."""
+        with self._lock:
+            self._mode = mode
+            if mirror is not None and mirror != self._mirror:
+                self._mirror = mirror
+                self._kin = None  # a new retargeter with the new mirroring
+            elif self._kin is not None:
+                self._kin["retargeter"].mode = mode
+
+    def status(self) -> dict[str, Any]:
+        """The ``SourcePublic`` fields (without playback, which the state adds)."""
+        with self._lock:
+            source = self._source
+            st = None
+            if source is not None:
+                try:
+                    st = source.status()
+                except Exception as err:  # a broken status call is itself a source error
+                    self._start_error = f"The source stopped answering ({type(err).__name__}); switch the source again."
+            error = self._start_error or (st.error if st is not None else None) or self._kin_error
+            return {
+                "kind": self._kind,
+                "running": bool(st.running) if st is not None else False,
+                "rate_hz": float(st.rate_hz) if st is not None else 0.0,
+                "frames": int(st.frames) if st is not None else 0,
+                "dropped": int(st.dropped) if st is not None else 0,
+                "error": error,
+                "recording": self._recording,
+                "retarget": {"mode": self._mode, "mirror": self._mirror},
+                "fit_residual_mm": None if self._residual is None else self._residual * 1000.0,
+                "q_robot": [float(x) for x in self._q_robot],
+                "recording_active": self._writer is not None,
+            }
+
+    def q_robot(self) -> np.ndarray:
+        """The newest retargeted robot pose (rad)."""
+        with self._lock:
+            return self._q_robot.copy()
+
+    def last_time(self) -> float | None:
+        """Time stamp of the newest frame."""
+        return self._last_t
+
+    # ------------------------------------------------------------------ capture
+
+    def start_capture(self, writer: Any, name: str, path: Path) -> None:
+        """Send every raw frame to ``writer`` from now on.
+
+        Raises:
+            ConflictError: a capture is already running, or there is no running source.
+        """
+        with self._lock:
+            if self._writer is not None:
+                writer.close()
+                raise ConflictError(
+                    f"Recording {self._capture_name!r} is already running; stop it before starting another."
+                )
+            self._writer, self._capture_name, self._capture_path = writer, name, path
+            self._capture_frames = 0
+            self._capture_t0 = None
+            self._capture_last_t = None
+
+    def stop_capture(self) -> tuple[str, Path]:
+        """Close the capture file cleanly; returns its name and path.
+
+        Raises:
+            ConflictError: no capture is running.
+        """
+        with self._lock:
+            if self._writer is None:
+                raise ConflictError("No recording is running; press Record to start one.")
+            name, path = self._capture_name, self._capture_path
+            self._close_writer()
+        assert name is not None and path is not None
+        return name, path
+
+    def flush_capture(self) -> None:
+        """Write the capture's buffered frames to disk now (for cutting a demonstration)."""
+        with self._lock:
+            if self._writer is not None and hasattr(self._writer, "flush"):
+                self._writer.flush()
+
+    def _close_writer(self) -> None:
+        try:
+            self._writer.close()
+        except Exception:  # the file's flushed frames are still there, marked recovered
+            log.exception("closing the capture %s failed", self._capture_name)
+        self._writer = None
+        self._capture_name = None
+
+    def capture_status(self) -> dict[str, Any]:
+        """The ``CapturePublic`` fields."""
+        with self._lock:
+            active = self._writer is not None
+            seconds = 0.0
+            if active and self._capture_t0 is not None and self._capture_last_t is not None:
+                seconds = self._capture_last_t - self._capture_t0
+            return {
+                "active": active,
+                "name": self._capture_name,
+                "seconds": round(float(seconds), 3),
+                "frames": self._capture_frames if active else 0,
+            }
+
+    def capture_time(self) -> float | None:
+        """Seconds since the capture started (in the recording's own time), or None."""
+        with self._lock:
+            if self._writer is None:
+                return None
+            if self._capture_t0 is None or self._capture_last_t is None:
+                return 0.0
+            return self._capture_last_t - self._capture_t0
+
+    @property
+    def capture_name(self) -> str | None:
+        """Name of the recording being captured, if any."""
+        return self._capture_name
+
+    # ------------------------------------------------------------------ the thread
+
+    def _loop(self) -> None:
+        while not self._stop.is_set():
+            source = self._source
+            if source is None or self._start_error is not None:
+                time.sleep(IDLE_SLEEP_S)
+                continue
+            try:
+                frames = source.read(timeout=READ_TIMEOUT_S)
+            except StudioError as err:
+                with self._lock:
+                    if source is self._source:
+                        self._start_error = str(err)
+                continue
+            except Exception as err:  # a source bug must not kill the studio
+                log.exception("reading the %s source failed", self._kind)
+                with self._lock:
+                    if source is self._source:
+                        self._start_error = f"The {self._kind} source failed ({type(err).__name__}: {err}); switch the source again."
+                continue
+            if not frames:
+                continue
+            self._record(frames)
+            self._fit(source, frames[-MAX_FITS_PER_BATCH:])
+
+    def _record(self, frames: list[Any]) -> None:
+        with self._lock:
+            writer = self._writer
+            if writer is None:
+                return
+            try:
+                for frame in frames:
+                    writer.write(frame)
+            except Exception as err:
+                log.exception("writing the capture failed")
+                self._kin_error = f"Writing the recording failed ({err}); it was stopped, its frames so far are kept."
+                self._close_writer()
+                return
+            if self._capture_t0 is None:
+                self._capture_t0 = float(frames[0].t)
+            self._capture_last_t = float(frames[-1].t)
+            self._capture_frames += len(frames)
+
+    def _kinematics(self, source: Any) -> dict[str, Any]:
+        from studio.kinematics import ArmFitter, HumanArm, Retargeter
+
+        kin = self._kin
+        if kin is None:
+            config = source.config
+            arm = HumanArm()
+            kin = {
+                "config": config,
+                "fitter": ArmFitter(arm, config),
+                "retargeter": Retargeter(mode=self._mode, mirror=self._mirror),
+            }
+            self._kin = kin
+        return kin
+
+    def _fit(self, source: Any, frames: list[Any]) -> None:
+        from studio.kinematics import reconstruct
+
+        try:
+            kin = self._kinematics(source)
+            for frame in frames:
+                shape = reconstruct(frame.bend, frame.twist, kin["config"])
+                fit = kin["fitter"].fit(shape)
+                q_robot = kin["retargeter"].robot_from_human(fit.q_human)
+                with self._lock:
+                    self._q_human = np.asarray(fit.q_human, dtype=float)
+                    self._q_robot = np.asarray(q_robot, dtype=float)
+                    self._residual = float(fit.residual)
+                    self._last_t = float(frame.t)
+                    self._kin_error = None
+            if self.scene is not None:
+                self.scene.update_live(self._q_human, self._q_robot, shape.positions)
+        except StudioError as err:
+            with self._lock:
+                self._kin_error = str(err)
+        except Exception as err:  # e.g. NaN frames from a device: shown, not fatal
+            log.exception("the kinematics failed on a frame")
+            with self._lock:
+                self._kin_error = f"The arm fit failed on a frame ({type(err).__name__}: {err})."

@@ -1,0 +1,282 @@
+"""Request and response bodies of the API (see ``docs/api.md``).
+
+Families follow FastAPI's convention: ``XCreate`` / ``XUpdate`` are what a client sends,
+``XPublic`` is what the API returns. Field types are checked here; the domain rules (budget
+limits, reachable goals, demonstration paths) are checked by the learning and capture packages,
+whose one-sentence messages the API passes on as 422.
+"""
+
+from __future__ import annotations
+
+from typing import Literal
+
+from pydantic import BaseModel, ConfigDict, Field
+
+PlanningName = Literal["zero", "full", "soft", "prioritized"]
+RunStatus = Literal["queued", "running", "done", "stopped", "failed"]
+SourceKind = Literal["simulator", "recording", "network", "serial"]
+
+DEFAULT_GOAL_DEG = (0.0, 45.0, -90.0)
+"""The learning package's default goal for joints 1-3 (an arm reaching forward and down)."""
+
+
+class _Body(BaseModel):
+    """Request bodies refuse unknown fields, so a typo is an error and not silently ignored."""
+
+    model_config = ConfigDict(extra="forbid")
+
+
+# ----------------------------------------------------------------------------- config
+
+
+class ConfigPublic(BaseModel):
+    """What the page needs to know at start."""
+
+    viser_url: str
+    version: str
+    upload_limit_bytes: int
+    data_dir: str
+
+
+# ----------------------------------------------------------------------------- source
+
+
+class PlaybackPublic(BaseModel):
+    """Playback state of a recording source."""
+
+    playing: bool
+    speed: float
+    t: float
+    duration: float
+    loop: bool
+
+
+class RetargetPublic(BaseModel):
+    """How the human arm is mapped onto the robot."""
+
+    mode: Literal["joint", "cartesian"]
+    mirror: bool
+
+
+class SourcePublic(BaseModel):
+    """The live source and pipeline as the page shows them."""
+
+    kind: SourceKind | None
+    running: bool
+    rate_hz: float
+    frames: int
+    dropped: int
+    error: str | None
+    recording: str | None
+    playback: PlaybackPublic | None
+    retarget: RetargetPublic
+    fit_residual_mm: float | None
+    q_robot: list[float]
+    recording_active: bool
+
+
+class SourceUpdate(_Body):
+    """Switch the live source."""
+
+    kind: SourceKind
+    recording: str | None = None
+    port: int | None = Field(None, ge=1, le=65535)
+    device: str | None = None
+    speed: float | None = Field(None, gt=0, le=100)
+    loop: bool | None = None
+    seed: int | None = Field(None, ge=0)
+
+
+class PlaybackAction(_Body):
+    """Control a recording source."""
+
+    action: Literal["play", "pause", "seek"]
+    t: float | None = Field(None, ge=0)
+    speed: float | None = Field(None, gt=0, le=100)
+
+
+class RetargetUpdate(_Body):
+    """Change the human-to-robot mapping."""
+
+    mode: Literal["joint", "cartesian"]
+    mirror: bool | None = None
+
+
+# ----------------------------------------------------------------------------- capture
+
+
+class CaptureStart(_Body):
+    """Start recording every raw frame of the live source."""
+
+    name: str | None = None
+    operator: str | None = Field(None, max_length=200)
+    notes: str | None = Field(None, max_length=10_000)
+
+
+class CapturePublic(BaseModel):
+    """The capture in progress, if any."""
+
+    active: bool
+    name: str | None
+    seconds: float
+    frames: int
+
+
+class RecordingPublic(BaseModel):
+    """A recording file in the list."""
+
+    name: str
+    frames: int
+    duration: float
+    rate_hz: float | None
+    created: str
+    operator: str
+    notes: str
+    source: str
+    recovered: bool
+    size_bytes: int
+    sample: bool
+    error: str | None = None
+
+
+class RecordingUpdate(_Body):
+    """Rename or annotate a recording."""
+
+    name: str | None = None
+    notes: str | None = Field(None, max_length=10_000)
+    operator: str | None = Field(None, max_length=200)
+
+
+# ----------------------------------------------------------------------------- demonstrations
+
+
+class DemonstrationCreate(_Body):
+    """Cut a demonstration out of a recording."""
+
+    recording: str
+    t0: float = Field(ge=0)
+    t1: float = Field(ge=0)
+    goal_from_end: bool = False
+    name: str | None = None
+
+
+class DemonstrationMark(_Body):
+    """Mark the start or the end of a demonstration in the live stream."""
+
+    action: Literal["start", "stop"]
+    name: str | None = None
+    goal_from_end: bool = False
+
+
+class DemonstrationPublic(BaseModel):
+    """A demonstration in the list."""
+
+    name: str
+    recording: str
+    t0: float
+    t1: float
+    steps: int
+    goal: list[float]
+    reaches_goal: bool
+    created: str
+
+
+class DemonstrationDetail(DemonstrationPublic):
+    """A demonstration with its robot path (radians, one row per sample)."""
+
+    times: list[float]
+    q_robot: list[list[float]]
+    grid_path: list[int]
+
+
+class MarkPublic(BaseModel):
+    """The state of live demonstration marking."""
+
+    marking: bool
+    t0: float | None
+    demonstration: DemonstrationPublic | None = None
+
+
+# ----------------------------------------------------------------------------- runs
+
+
+class RunCreate(_Body):
+    """A training run (defaults are the paper's)."""
+
+    name: str | None = None
+    planning: PlanningName = "full"
+    planning_steps: int = 100
+    epsilon: float = 0.1
+    alpha: float = 0.1
+    gamma: float = 0.95
+    episodes: int = 100
+    experiments: int = 20
+    bins: int = 11
+    goal_deg: list[float] = Field(default_factory=lambda: list(DEFAULT_GOAL_DEG))
+    demonstrations: list[str] = Field(default_factory=list)
+    seed: int = 0
+
+
+class RunPublic(BaseModel):
+    """A training run and how far it got."""
+
+    id: str
+    name: str
+    status: RunStatus
+    config: RunCreate
+    created: str
+    started: str | None
+    finished: str | None
+    episodes_done: int
+    episodes_total: int
+    cpu_seconds: float
+    error: str | None
+    has_policy: bool
+
+
+class CurvePublic(BaseModel):
+    """Steps per episode over the experiments that finished each episode."""
+
+    episodes: list[int]
+    mean: list[float]
+    std: list[float]
+    min: list[float]
+    max: list[float]
+    count: list[int]
+
+
+# ----------------------------------------------------------------------------- policies, watch
+
+
+class PolicyPublic(BaseModel):
+    """A policy that can be watched or downloaded."""
+
+    name: str
+    source: Literal["upload", "run"]
+    run: str | None
+    planning: str
+    grid: dict
+    goal_deg: list[float]
+    episodes: int
+    experiments: int
+    created: str
+    notes: str
+    size_bytes: int
+
+
+class WatchCreate(_Body):
+    """Play a policy on the robot in the scene."""
+
+    run: str | None = None
+    policy: str | None = None
+    start: Literal["random", "current"] = "random"
+    seed: int | None = Field(None, ge=0)
+
+
+class WatchPublic(BaseModel):
+    """The greedy rollout being played."""
+
+    states: list[int]
+    times: list[float]
+    q_robot: list[list[float]]
+    reached_goal: bool

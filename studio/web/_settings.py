@@ -1,0 +1,101 @@
+"""The studio server's settings: one pydantic object, served to the routes through a dependency.
+
+`studio serve` builds a :class:`Settings` from its flags and hands it to
+:func:`studio.web.create_app`; tests build one with a temporary ``data_dir`` and
+``allowed_hosts=["testserver"]`` (the host name FastAPI's ``TestClient`` sends).
+"""
+
+from __future__ import annotations
+
+import ipaddress
+from pathlib import Path
+
+from pydantic import BaseModel, ConfigDict, Field
+
+DEFAULT_UPLOAD_LIMIT_BYTES = 50 * 1024 * 1024
+"""Largest accepted upload (recordings, policies): 50 MB, about 40 minutes of 110 Hz tape frames."""
+
+LOOPBACK_NAMES = ("127.0.0.1", "localhost", "::1", "[::1]")
+"""Host names that always reach this machine only."""
+
+
+class Settings(BaseModel):
+    """Where the studio keeps its data and where it listens.
+
+    Attributes:
+        data_dir: holds ``recordings/`` (recordings and ``*.demo.json``), ``runs/`` and
+            ``policies/``; the current directory by default.
+        host: address both servers bind to; loopback unless the user opens it up.
+        port: HTTP port of the page and the API.
+        viser_port: port of the viser 3D scene server.
+        upload_limit_bytes: uploads larger than this are refused with 413.
+        source: the live source at start: ``"simulator"``, the name of a recording in
+            ``recordings/``, or ``None`` for no live source (tests, headless use).
+        allowed_hosts: extra ``Host`` header names accepted besides the loopback names and
+            ``host`` (the DNS-rebinding guard refuses every other name).
+        viser_url: the scene URL the page embeds; default ``http://<host>:<viser_port>``.
+        run_workers: threads one training run uses (``None``: one per CPU core).
+    """
+
+    model_config = ConfigDict(frozen=True)
+
+    data_dir: Path = Path(".")
+    host: str = "127.0.0.1"
+    port: int = Field(8000, ge=1, le=65535)
+    viser_port: int = Field(8080, ge=1, le=65535)
+    upload_limit_bytes: int = Field(DEFAULT_UPLOAD_LIMIT_BYTES, ge=1)
+    source: str | None = "simulator"
+    allowed_hosts: tuple[str, ...] = ()
+    viser_url: str | None = None
+    run_workers: int | None = Field(None, ge=1)
+
+    @property
+    def recordings_dir(self) -> Path:
+        """Recordings (``*.tape.csv``) and demonstrations (``*.demo.json``)."""
+        return self.data_dir / "recordings"
+
+    @property
+    def runs_dir(self) -> Path:
+        """One folder per training run."""
+        return self.data_dir / "runs"
+
+    @property
+    def policies_dir(self) -> Path:
+        """Uploaded policy files."""
+        return self.data_dir / "policies"
+
+    @property
+    def is_loopback(self) -> bool:
+        """Whether ``host`` only accepts connections from this machine."""
+        return is_loopback(self.host)
+
+    def trusted_hosts(self) -> list[str]:
+        """Host header names the API answers (everything else gets 400)."""
+        names = [*LOOPBACK_NAMES, *self.allowed_hosts]
+        if self.host not in ("0.0.0.0", "::", ""):
+            names.append(self.host)
+        return list(dict.fromkeys(names))
+
+    def scene_url(self) -> str:
+        """The URL of the viser scene as the page should load it."""
+        if self.viser_url:
+            return self.viser_url
+        host = "127.0.0.1" if self.host in ("0.0.0.0", "::", "") else self.host
+        if ":" in host and not host.startswith("["):
+            host = f"[{host}]"
+        return f"http://{host}:{self.viser_port}"
+
+
+def is_loopback(host: str) -> bool:
+    """Whether ``host`` (an address or ``localhost``) is reachable from this machine only."""
+    if host == "localhost":
+        return True
+    try:
+        return ipaddress.ip_address(host.strip("[]")).is_loopback
+    except ValueError:
+        return False
+
+
+def get_settings() -> Settings:
+    """The settings of the running app; :func:`studio.web.create_app` overrides this dependency."""
+    return Settings()

@@ -1,0 +1,356 @@
+"""The studio's state: the stores, the live pipeline, the run queue, the scene and the last rollout.
+
+One :class:`Studio` per app, built when the app starts and closed when it stops. Routes reach it
+through the ``StudioDep`` dependency. List changes bump a version per list; the SSE stream
+compares versions, so a slow or vanished client never holds anything up.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+from datetime import UTC, datetime
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .._errors import StudioError
+from ._errors import ConflictError, InvalidError, NotFoundError
+from ._pipeline import Pipeline
+from ._runs import RunQueue
+from ._settings import Settings
+from ._store import (
+    DEMONSTRATION_SUFFIX,
+    RECORDING_SUFFIX,
+    DemonstrationStore,
+    PolicyStore,
+    RecordingStore,
+    check_name,
+)
+
+log = logging.getLogger(__name__)
+
+LIST_NAMES = ("recordings", "demonstrations", "runs", "policies")
+
+
+class ListChanges:
+    """A version number per list (recordings, demonstrations, runs, policies)."""
+
+    def __init__(self) -> None:
+        self._lock = threading.Lock()
+        self._versions = dict.fromkeys(LIST_NAMES, 0)
+
+    def bump(self, name: str) -> None:
+        """Record that list ``name`` changed."""
+        with self._lock:
+            self._versions[name] += 1
+
+    def versions(self) -> dict[str, int]:
+        """The current versions."""
+        with self._lock:
+            return dict(self._versions)
+
+
+class Studio:
+    """Everything the API acts on.
+
+    Args:
+        settings: data directory, ports, limits.
+        scene: the viser scene to drive, or None (tests, headless).
+    """
+
+    def __init__(self, settings: Settings, scene: Any = None) -> None:
+        self.settings = settings
+        for folder in (settings.recordings_dir, settings.runs_dir, settings.policies_dir):
+            folder.mkdir(parents=True, exist_ok=True)
+        self.changes = ListChanges()
+        self.recordings = RecordingStore(settings.recordings_dir)
+        self.policies = PolicyStore(settings.policies_dir)
+        self.demonstrations = DemonstrationStore(settings.recordings_dir)
+        self.runs = RunQueue(settings.runs_dir, self.changes.bump, settings.run_workers)
+        self.scene = scene
+        self.pipeline = Pipeline(scene)
+        self.watch_lock = threading.Lock()
+        self.watching: str | None = None  # "policy:<name>" or "run:<id>" being played
+        self.last_rollout: tuple[np.ndarray, np.ndarray] | None = None
+        self.mark_t0: float | None = None  # live demonstration start, recording time (s)
+
+    def start(self) -> None:
+        """Start the run worker and the pipeline (with the configured source, if any)."""
+        self.runs.start()
+        self.pipeline.start()
+        if self.settings.source is not None:
+            try:
+                self.start_source(self.settings.source)
+            except StudioError as err:
+                log.warning("could not start the source %s: %s", self.settings.source, err)
+
+    def close(self) -> None:
+        """Stop training (keeping partial curves), close a capture cleanly, stop the source."""
+        self.runs.close()
+        self.pipeline.close()
+
+    # ------------------------------------------------------------------ source
+
+    def start_source(self, source: str) -> None:
+        """Start ``"simulator"``, a recording by name, or a recording file by path."""
+        if source == "simulator":
+            self.set_source(kind="simulator")
+            return
+        path = Path(source)
+        if path.is_file() and path.resolve().parent != self.settings.recordings_dir.resolve():
+            from studio.capture import PlaybackSource
+
+            name = path.name.removesuffix(RECORDING_SUFFIX)
+            self.pipeline.set_source(PlaybackSource(path, loop=True), "recording", name)
+            return
+        name = path.name.removesuffix(RECORDING_SUFFIX) if path.is_file() else source
+        self.set_source(kind="recording", recording=name, loop=True)
+
+    def set_source(
+        self,
+        kind: str,
+        recording: str | None = None,
+        port: int | None = None,
+        device: str | None = None,
+        speed: float | None = None,
+        loop: bool | None = None,
+        seed: int | None = None,
+    ) -> None:
+        """Build a source of ``kind`` and make it the live one."""
+        from studio.capture import NetworkSource, PlaybackSource, SerialSource, SimulatorSource
+
+        if kind == "simulator":
+            source = SimulatorSource(seed=seed if seed is not None else 0)
+            self.pipeline.set_source(source, kind)
+        elif kind == "recording":
+            if recording is None:
+                raise InvalidError(
+                    "recording is missing; give the name of a recording to play back."
+                )
+            path = self.recordings.path(recording)
+            source = PlaybackSource(
+                path, speed=speed if speed is not None else 1.0, loop=bool(loop)
+            )
+            self.pipeline.set_source(source, kind, recording)
+        elif kind == "network":
+            source = NetworkSource(port=port) if port is not None else NetworkSource()
+            self.pipeline.set_source(source, kind)
+        elif kind == "serial":
+            if not device:
+                raise InvalidError(
+                    "device is missing; give the serial device of the tape, for example /dev/ttyUSB0."
+                )
+            source = SerialSource(device)
+            self.pipeline.set_source(source, kind)
+        else:  # the schema allows only the kinds above
+            raise InvalidError(f"kind is {kind!r}; give simulator, recording, network or serial.")
+
+    def source_public(self) -> dict[str, Any]:
+        """``SourcePublic``: the pipeline status plus the playback state."""
+        status = self.pipeline.status()
+        status["playback"] = None
+        source = self.pipeline.source
+        if self.pipeline.kind == "recording" and source is not None:
+            status["playback"] = _playback_state(source)
+        return status
+
+    def playback(self, action: str, t: float | None, speed: float | None) -> None:
+        """Play, pause or seek the recording source.
+
+        Raises:
+            ConflictError: the live source is not a recording.
+        """
+        source = self.pipeline.source
+        if self.pipeline.kind != "recording" or source is None:
+            raise ConflictError(
+                "The live source is not a recording; switch the source to a recording first."
+            )
+        if speed is not None:
+            source.speed = speed
+        if action == "play":
+            source.play()
+        elif action == "pause":
+            source.pause()
+        elif action == "seek":
+            if t is None:
+                raise InvalidError("t is missing; give the time to seek to, in seconds.")
+            source.seek(t)
+
+    # ------------------------------------------------------------------ capture
+
+    def start_capture(self, name: str | None, operator: str | None, notes: str | None) -> str:
+        """Start recording every raw frame of the live source into a new file.
+
+        Raises:
+            ConflictError: a capture is already running, or there is no running source.
+        """
+        from studio.capture import RecordingWriter
+
+        if self.pipeline.capture_name is not None:
+            raise ConflictError(
+                f"Recording {self.pipeline.capture_name!r} is already running; stop it before starting another."
+            )
+        source = self.pipeline.source
+        if source is None:
+            raise ConflictError("There is no live source to record; choose a source first.")
+        base = name or f"capture-{datetime.now(UTC):%Y%m%d-%H%M%S}"
+        if name is not None:
+            check_name(name, "recording name")
+            if self.recordings.exists(name):
+                raise ConflictError(
+                    f"A recording named {name!r} already exists; choose another name."
+                )
+        final = self.recordings.new_name(base)
+        path = self.settings.recordings_dir / f"{final}{RECORDING_SUFFIX}"
+        writer = RecordingWriter(
+            path,
+            source.config,
+            operator=operator or "",
+            notes=notes or "",
+            source=self.pipeline.kind or "",
+        )
+        self.pipeline.start_capture(writer, final, path)
+        self.mark_t0 = None
+        self.changes.bump("recordings")
+        return final
+
+    def stop_capture(self) -> str:
+        """Close the capture cleanly; returns the new recording's name."""
+        name, _ = self.pipeline.stop_capture()
+        self.mark_t0 = None
+        self.changes.bump("recordings")
+        return name
+
+    # ------------------------------------------------------------------ demonstrations
+
+    def demonstration_path(self, name: str) -> np.ndarray:
+        """The Puma560 joint path ``(N, 6)`` (rad) of a demonstration, for training runs."""
+        return np.asarray(self.demonstrations.load(name).q_robot, dtype=np.float64)
+
+    def cut_demonstration(
+        self,
+        recording: str,
+        t0: float,
+        t1: float,
+        goal_from_end: bool = False,
+        name: str | None = None,
+    ) -> str:
+        """Cut ``[t0, t1]`` (s) of a recording into a saved demonstration; returns its name.
+
+        Raises:
+            InvalidError: the segment is refused (the capture package's reason) or the name is bad.
+        """
+        from studio.capture import extract_demonstration, read_recording, save_demonstration
+
+        if t1 <= t0:
+            raise InvalidError(
+                f"The segment ends at {t1:g} s, not after its start at {t0:g} s; give t1 > t0."
+            )
+        if name is not None:
+            check_name(name, "demonstration name")
+            if self.demonstrations.exists(name):
+                raise ConflictError(
+                    f"A demonstration named {name!r} already exists; choose another name."
+                )
+        path = self.recordings.path(recording)
+        demo = extract_demonstration(read_recording(path), t0, t1, goal_from_end=goal_from_end)
+        final = name or self.demonstrations.new_name(
+            f"{recording}-{t0:.1f}-{t1:.1f}".replace(".", "_")
+        )
+        save_demonstration(demo, self.settings.recordings_dir / f"{final}{DEMONSTRATION_SUFFIX}")
+        self.changes.bump("demonstrations")
+        if self.scene is not None:
+            self.scene.show_path(f"demo-{final}", np.asarray(demo.q_robot))
+        return final
+
+    def mark_start(self) -> float:
+        """Mark the start of a live demonstration (needs a running capture)."""
+        t = self.pipeline.capture_time()
+        if t is None:
+            raise ConflictError(
+                "Marking a demonstration needs a running recording; press Record first."
+            )
+        self.mark_t0 = t
+        return t
+
+    def mark_stop(self, goal_from_end: bool, name: str | None) -> str:
+        """Cut the marked segment out of the recording being captured."""
+        t1 = self.pipeline.capture_time()
+        recording = self.pipeline.capture_name
+        if t1 is None or recording is None:
+            raise ConflictError(
+                "Marking a demonstration needs a running recording; press Record first."
+            )
+        if self.mark_t0 is None:
+            raise ConflictError("No demonstration start is marked; mark the start first.")
+        t0, self.mark_t0 = self.mark_t0, None
+        self.pipeline.flush_capture()
+        return self.cut_demonstration(recording, t0, t1, goal_from_end, name)
+
+    def preview_demonstration(self, name: str) -> None:
+        """Draw a demonstration's path and play it on the robot."""
+        demo = self.demonstrations.load(name)
+        if self.scene is not None:
+            q = np.asarray(demo.q_robot, dtype=float)
+            self.scene.show_path(f"demo-{name}", q)
+            self.scene.play_trajectory(np.asarray(demo.times, dtype=float), q)
+
+    # ------------------------------------------------------------------ in-use checks
+
+    def recording_in_use(self, name: str) -> str | None:
+        """Why recording ``name`` cannot be deleted or renamed now, or None."""
+        if self.pipeline.kind == "recording" and self.pipeline.recording == name:
+            return f"Recording {name!r} is the live source; switch the source to another one first."
+        if self.pipeline.capture_name == name:
+            return f"Recording {name!r} is being captured; stop the recording first."
+        return None
+
+    def policy_in_use(self, key: str) -> bool:
+        """Whether the scene is playing this policy (``policy:<name>`` or ``run:<id>``)."""
+        return (
+            self.watching == key
+            and self.scene is not None
+            and bool(getattr(self.scene, "playing", False))
+        )
+
+    def policy_names(self) -> set[str]:
+        """Names taken by uploaded policies and runs (a policy upload must not shadow them)."""
+        return set(self.policies.names()) | {run.id for run in self.runs.list()}
+
+    def load_policy(self, run: str | None, policy: str | None) -> tuple[Any, str]:
+        """Load the policy of a run or an uploaded policy; returns it and its key."""
+        from studio.learning import load_policy
+
+        if (run is None) == (policy is None):
+            raise InvalidError("Give either run or policy (exactly one) to choose what to watch.")
+        if run is not None:
+            r = self.runs.get(run)
+            if not r.has_policy:
+                raise ConflictError(
+                    f"Run {run} has no policy yet; wait until it has finished episodes, then try again."
+                )
+            return load_policy(r.policy_path), f"run:{run}"
+        assert policy is not None
+        if not self.policies.exists(policy):
+            try:
+                r = self.runs.get(policy)
+            except (NotFoundError, InvalidError):
+                r = None
+            if r is not None and r.has_policy:
+                return load_policy(r.policy_path), f"run:{policy}"
+        return self.policies.load(policy), f"policy:{policy}"
+
+
+def _playback_state(source: Any) -> dict[str, Any] | None:
+    try:
+        return {
+            "playing": bool(source.playing),
+            "speed": float(source.speed),
+            "t": float(source.position),
+            "duration": float(source.duration),
+            "loop": bool(source.loop),
+        }
+    except AttributeError:
+        return None

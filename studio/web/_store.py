@@ -1,0 +1,486 @@
+"""The on-disk stores under the data directory: names, uploads, recordings and policies.
+
+Everything a user makes lives in plain files so it survives a restart and can be used without the
+studio: ``recordings/*.tape.csv`` (and a ``*.meta.json`` sidecar holding the operator and notes
+edited in the page; the recording itself is never rewritten), ``recordings/*.demo.json``,
+``policies/*.policy.npz``. Training runs have their own store in :mod:`studio.web._runs`.
+
+Names are plain file stems (letters, digits, ``-``, ``_``, ``.``; no separators, no ``..``), so a
+name from a request can never point outside its folder. New files never replace old ones: an
+upload or a new capture whose name is taken gets ``-2``, ``-3``, ... appended.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import threading
+import uuid
+from collections.abc import Callable
+from datetime import UTC, datetime
+from pathlib import Path
+from typing import Any, TypeVar
+
+from fastapi import UploadFile
+
+from .._errors import StudioError
+from ._errors import ConflictError, InvalidError, NotFoundError, TooLargeError
+
+NAME_PATTERN = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.-]{0,99}$")
+"""A valid name: 1-100 characters, letters, digits, ``-``, ``_``, ``.``, not starting with ``.``."""
+RECORDING_SUFFIX = ".tape.csv"
+DEMONSTRATION_SUFFIX = ".demo.json"
+POLICY_SUFFIX = ".policy.npz"
+META_SUFFIX = ".meta.json"
+SAMPLE_PREFIX = "sample-"
+"""Recordings shipped with the repository start with this prefix."""
+UPLOAD_CHUNK_BYTES = 1024 * 1024
+
+T = TypeVar("T")
+
+
+def check_name(name: str, what: str = "name") -> str:
+    """Return ``name`` if it is a plain file stem, else raise a 422 naming the rule."""
+    if not isinstance(name, str) or ".." in name or "/" in name or "\\" in name:
+        raise InvalidError(
+            f"The {what} {name!r} contains a path separator or '..'; use only letters, digits, '-', '_' and '.'."
+        )
+    if not NAME_PATTERN.match(name):
+        raise InvalidError(
+            f"The {what} {name!r} is not allowed; use 1 to 100 letters, digits, '-', '_' or '.', not starting with '.'."
+        )
+    return name
+
+
+def clean_upload_name(filename: str | None, suffix: str, fallback: str) -> str:
+    """The store name for an uploaded file: its stem with odd characters replaced by ``-``.
+
+    A file name holding a path separator or ``..`` is refused (422): browsers send bare names,
+    so such a name is a crafted request.
+    """
+    filename = filename or ""
+    if "/" in filename or "\\" in filename or ".." in filename:
+        raise InvalidError(
+            f"The file name {filename!r} contains a path separator or '..'; upload a file with a plain name."
+        )
+    stem = filename[: -len(suffix)] if filename.endswith(suffix) else Path(filename).stem
+    for extra in (".tape", ".policy", ".demo"):
+        stem = stem.removesuffix(extra)
+    stem = re.sub(r"[^A-Za-z0-9_.-]+", "-", stem).strip("-.")[:80]
+    return stem or fallback
+
+
+def unique_name(base: str, taken: Callable[[str], bool]) -> str:
+    """``base``, or ``base-2``, ``base-3``, ... : the first that is not ``taken``."""
+    if not taken(base):
+        return base
+    k = 2
+    while taken(f"{base}-{k}"):
+        k += 1
+    return f"{base}-{k}"
+
+
+def atomic_write_text(path: Path, text: str) -> None:
+    """Write a small file so that readers see either the old or the new content, never half."""
+    tmp = path.with_name(f".{path.name}.{uuid.uuid4().hex[:8]}.tmp")
+    tmp.write_text(text)
+    os.replace(tmp, path)
+
+
+def now_iso() -> str:
+    """The current UTC time, ISO 8601 to the second."""
+    return datetime.now(UTC).isoformat(timespec="seconds")
+
+
+async def receive_upload(upload: UploadFile, folder: Path, limit: int) -> Path:
+    """Stream an upload into a hidden temporary file in ``folder``, refusing more than ``limit`` bytes.
+
+    Returns:
+        The temporary file; the caller validates it and moves it to its final name (or deletes it).
+
+    Raises:
+        TooLargeError: the upload is over ``limit`` (nothing is kept).
+    """
+    folder.mkdir(parents=True, exist_ok=True)
+    tmp = folder / f".upload-{uuid.uuid4().hex}.tmp"
+    size = 0
+    try:
+        with tmp.open("wb") as out:
+            while chunk := await upload.read(UPLOAD_CHUNK_BYTES):
+                size += len(chunk)
+                if size > limit:
+                    raise TooLargeError(
+                        f"The upload is larger than the limit of {limit / 1e6:.0f} MB; upload a smaller file or start the studio with a larger limit."
+                    )
+                out.write(chunk)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
+    if size == 0:
+        tmp.unlink(missing_ok=True)
+        raise InvalidError("The uploaded file is empty; choose a non-empty file.")
+    return tmp
+
+
+class _FileCache:
+    """Parsed file summaries, re-read only when a file's size or modification time changes."""
+
+    def __init__(self) -> None:
+        self._lock = threading.Lock()
+        self._entries: dict[Path, tuple[tuple[int, int], Any]] = {}
+
+    def get(self, path: Path, load: Callable[[Path], T]) -> T:
+        stat = path.stat()
+        key = (stat.st_mtime_ns, stat.st_size)
+        with self._lock:
+            hit = self._entries.get(path)
+        if hit is not None and hit[0] == key:
+            return hit[1]
+        value = load(path)
+        with self._lock:
+            self._entries[path] = (key, value)
+        return value
+
+
+class RecordingStore:
+    """Recordings ``<data_dir>/recordings/<name>.tape.csv`` with their editable operator and notes."""
+
+    def __init__(self, folder: Path) -> None:
+        self.folder = folder
+        self._cache = _FileCache()
+
+    def path(self, name: str) -> Path:
+        """The file of recording ``name`` (404 if it does not exist)."""
+        path = self.folder / f"{check_name(name, 'recording name')}{RECORDING_SUFFIX}"
+        if not path.is_file():
+            raise NotFoundError(
+                f"There is no recording named {name!r}; pick one from the recordings list."
+            )
+        return path
+
+    def exists(self, name: str) -> bool:
+        """Whether a recording of that name exists."""
+        return (self.folder / f"{name}{RECORDING_SUFFIX}").exists()
+
+    def names(self) -> list[str]:
+        """Every recording's name, samples first, then alphabetical."""
+        if not self.folder.is_dir():
+            return []
+        names = [
+            p.name[: -len(RECORDING_SUFFIX)]
+            for p in self.folder.glob(f"*{RECORDING_SUFFIX}")
+            if NAME_PATTERN.match(p.name[: -len(RECORDING_SUFFIX)])
+        ]
+        return sorted(names, key=lambda n: (not n.startswith(SAMPLE_PREFIX), n))
+
+    def read(self, name: str) -> Any:
+        """The recording as :func:`studio.capture.read_recording` returns it."""
+        from studio.capture import read_recording
+
+        return read_recording(self.path(name))
+
+    def info(self, name: str) -> dict[str, Any]:
+        """The ``RecordingPublic`` fields of one recording."""
+        path = self.path(name)
+        summary = self._cache.get(path, _recording_summary)
+        meta = self._meta(name)
+        return {
+            "name": name,
+            **summary,
+            "operator": meta.get("operator", summary["operator"]),
+            "notes": meta.get("notes", summary["notes"]),
+            "size_bytes": path.stat().st_size,
+            "sample": name.startswith(SAMPLE_PREFIX),
+        }
+
+    def list(self) -> list[dict[str, Any]]:
+        """Every readable recording's summary (an unreadable file is listed with its error)."""
+        out = []
+        for name in self.names():
+            try:
+                out.append(self.info(name))
+            except StudioError as err:
+                path = self.folder / f"{name}{RECORDING_SUFFIX}"
+                out.append(_broken_recording(name, path, str(err)))
+        return out
+
+    def _meta_path(self, name: str) -> Path:
+        return self.folder / f"{name}{META_SUFFIX}"
+
+    def _meta(self, name: str) -> dict[str, Any]:
+        try:
+            data = json.loads(self._meta_path(name).read_text())
+        except (OSError, ValueError):
+            return {}
+        return data if isinstance(data, dict) else {}
+
+    def update(
+        self,
+        name: str,
+        new_name: str | None = None,
+        notes: str | None = None,
+        operator: str | None = None,
+    ) -> str:
+        """Rename and/or annotate a recording; returns its (new) name.
+
+        The recording file is renamed, never rewritten; the operator and notes go to its sidecar.
+        """
+        path = self.path(name)
+        meta = self._meta(name)
+        if notes is not None:
+            meta["notes"] = notes
+        if operator is not None:
+            meta["operator"] = operator
+        if notes is not None or operator is not None:
+            atomic_write_text(self._meta_path(name), json.dumps(meta, indent=1))
+        if new_name is not None and new_name != name:
+            check_name(new_name, "new recording name")
+            if self.exists(new_name):
+                raise ConflictError(
+                    f"A recording named {new_name!r} already exists; choose another name."
+                )
+            os.rename(path, self.folder / f"{new_name}{RECORDING_SUFFIX}")
+            if self._meta_path(name).exists():
+                os.rename(self._meta_path(name), self._meta_path(new_name))
+            return new_name
+        return name
+
+    def delete(self, name: str) -> None:
+        """Delete a recording and its sidecar."""
+        self.path(name).unlink()
+        self._meta_path(name).unlink(missing_ok=True)
+
+    def adopt(self, tmp: Path, filename: str | None) -> str:
+        """Validate an uploaded temporary file as a recording and give it a free name.
+
+        Raises:
+            InvalidError: the file is not a readable recording (the temporary file is removed).
+        """
+        from studio.capture import read_recording
+
+        try:
+            read_recording(tmp)
+        except StudioError as err:
+            tmp.unlink(missing_ok=True)
+            raise InvalidError(
+                f"{filename or 'The upload'} is not a Teach Studio recording ({err})"
+            ) from None
+        except Exception as err:  # a file the reader did not anticipate: still the user's file
+            tmp.unlink(missing_ok=True)
+            raise InvalidError(
+                f"{filename or 'The upload'} is not a readable Teach Studio recording ({type(err).__name__}); upload a .tape.csv file."
+            ) from None
+        base = clean_upload_name(filename, RECORDING_SUFFIX, "upload")
+        name = unique_name(base, self.exists)
+        os.replace(tmp, self.folder / f"{name}{RECORDING_SUFFIX}")
+        return name
+
+    def new_name(self, base: str) -> str:
+        """A free recording name starting with ``base``."""
+        return unique_name(check_name(base, "recording name"), self.exists)
+
+
+def _recording_summary(path: Path) -> dict[str, Any]:
+    from studio.capture import read_recording
+
+    rec = read_recording(path)
+    meta = dict(rec.meta or {})
+    frames = len(rec.t)
+    duration = float(rec.duration)
+    rate = meta.get("rate_hz")
+    if rate is None and duration > 0:
+        rate = (frames - 1) / duration
+    return {
+        "frames": frames,
+        "duration": duration,
+        "rate_hz": float(rate) if rate is not None else None,
+        "created": str(meta.get("created", "")),
+        "operator": str(meta.get("operator", "") or ""),
+        "notes": str(meta.get("notes", "") or ""),
+        "source": str(meta.get("source", "") or ""),
+        "recovered": bool(rec.recovered),
+        "error": None,
+    }
+
+
+def _broken_recording(name: str, path: Path, error: str) -> dict[str, Any]:
+    return {
+        "name": name,
+        "frames": 0,
+        "duration": 0.0,
+        "rate_hz": None,
+        "created": "",
+        "operator": "",
+        "notes": "",
+        "source": "",
+        "recovered": False,
+        "error": error,
+        "size_bytes": path.stat().st_size if path.exists() else 0,
+        "sample": name.startswith(SAMPLE_PREFIX),
+    }
+
+
+class PolicyStore:
+    """Uploaded policy files ``<data_dir>/policies/<name>.policy.npz``."""
+
+    def __init__(self, folder: Path) -> None:
+        self.folder = folder
+        self._cache = _FileCache()
+
+    def path(self, name: str) -> Path:
+        """The file of uploaded policy ``name`` (404 if it does not exist)."""
+        path = self.folder / f"{check_name(name, 'policy name')}{POLICY_SUFFIX}"
+        if not path.is_file():
+            raise NotFoundError(f"There is no policy named {name!r}; pick one from the list.")
+        return path
+
+    def exists(self, name: str) -> bool:
+        """Whether an uploaded policy of that name exists."""
+        return (self.folder / f"{name}{POLICY_SUFFIX}").exists()
+
+    def names(self) -> list[str]:
+        """Every uploaded policy's name, alphabetical."""
+        if not self.folder.is_dir():
+            return []
+        return sorted(
+            p.name[: -len(POLICY_SUFFIX)]
+            for p in self.folder.glob(f"*{POLICY_SUFFIX}")
+            if NAME_PATTERN.match(p.name[: -len(POLICY_SUFFIX)])
+        )
+
+    def load(self, name: str) -> Any:
+        """The policy as :func:`studio.learning.load_policy` returns it (cached)."""
+        from studio.learning import load_policy
+
+        return self._cache.get(self.path(name), load_policy)
+
+    def delete(self, name: str) -> None:
+        """Delete an uploaded policy."""
+        self.path(name).unlink()
+
+    def adopt(self, tmp: Path, filename: str | None, taken: Callable[[str], bool]) -> str:
+        """Validate an uploaded temporary file as a policy and give it a free name.
+
+        Args:
+            tmp: the received file.
+            filename: the name the browser sent.
+            taken: whether a name is used (by an uploaded policy or a run).
+
+        Raises:
+            InvalidError: the file is not a readable policy (the temporary file is removed).
+        """
+        from studio.learning import load_policy
+
+        try:
+            load_policy(tmp)
+        except StudioError as err:
+            tmp.unlink(missing_ok=True)
+            message = str(err).replace(tmp.name, filename or "The upload")
+            raise InvalidError(message) from None
+        base = clean_upload_name(filename, POLICY_SUFFIX, "policy")
+        name = unique_name(base, taken)
+        os.replace(tmp, self.folder / f"{name}{POLICY_SUFFIX}")
+        return name
+
+
+def policy_summary(policy: Any) -> dict[str, Any]:
+    """The learning-side fields of ``PolicyPublic`` from a loaded policy file."""
+    grid = policy.grid
+    goal_deg = [float(x) for x in _degrees(grid.angles_of(grid.goal_state))]
+    return {
+        "grid": grid.to_dict(),
+        "goal_deg": goal_deg,
+        "planning": policy.config.planning,
+        "episodes": int(len(policy.mean_steps)),
+        "experiments": int(policy.experiments),
+        "created": policy.created,
+        "notes": policy.notes,
+    }
+
+
+def _degrees(rad: Any) -> list[float]:
+    import numpy as np
+
+    return [round(float(x), 6) for x in np.degrees(rad)]
+
+
+class DemonstrationStore:
+    """Demonstrations ``<data_dir>/recordings/<name>.demo.json`` (next to their recordings)."""
+
+    def __init__(self, folder: Path) -> None:
+        self.folder = folder
+        self._cache = _FileCache()
+
+    def path(self, name: str) -> Path:
+        """The file of demonstration ``name`` (404 if it does not exist)."""
+        path = self.folder / f"{check_name(name, 'demonstration name')}{DEMONSTRATION_SUFFIX}"
+        if not path.is_file():
+            raise NotFoundError(
+                f"There is no demonstration named {name!r}; pick one from the demonstrations list."
+            )
+        return path
+
+    def exists(self, name: str) -> bool:
+        """Whether a demonstration of that name exists."""
+        return (self.folder / f"{name}{DEMONSTRATION_SUFFIX}").exists()
+
+    def names(self) -> list[str]:
+        """Every demonstration's name, alphabetical."""
+        if not self.folder.is_dir():
+            return []
+        return sorted(
+            p.name[: -len(DEMONSTRATION_SUFFIX)]
+            for p in self.folder.glob(f"*{DEMONSTRATION_SUFFIX}")
+            if NAME_PATTERN.match(p.name[: -len(DEMONSTRATION_SUFFIX)])
+        )
+
+    def load(self, name: str) -> Any:
+        """The demonstration as :mod:`studio.capture` reads it (cached)."""
+        from studio.capture import load_demonstration
+
+        return self._cache.get(self.path(name), load_demonstration)
+
+    def info(self, name: str) -> dict[str, Any]:
+        """The ``DemonstrationPublic`` fields."""
+        import numpy as np
+
+        demo = self.load(name)
+        return {
+            "name": name,
+            "recording": str(demo.recording),
+            "t0": float(demo.t0),
+            "t1": float(demo.t1),
+            "steps": max(0, len(demo.grid_path) - 1),
+            "goal": [float(x) for x in np.degrees(np.asarray(demo.goal_q, dtype=float))],
+            "reaches_goal": bool(demo.reaches_goal),
+            "created": str(getattr(demo, "created", "") or ""),
+        }
+
+    def detail(self, name: str) -> dict[str, Any]:
+        """``DemonstrationDetail``: the summary plus the robot and grid paths."""
+        demo = self.load(name)
+        return {
+            **self.info(name),
+            "times": [round(float(t), 6) for t in demo.times],
+            "q_robot": [[round(float(x), 6) for x in row] for row in demo.q_robot],
+            "grid_path": [int(s) for s in demo.grid_path],
+        }
+
+    def list(self) -> list[dict[str, Any]]:
+        """Every readable demonstration's summary, newest first."""
+        out = []
+        for name in self.names():
+            try:
+                out.append(self.info(name))
+            except StudioError:
+                continue
+        return sorted(out, key=lambda d: (d["created"], d["name"]), reverse=True)
+
+    def delete(self, name: str) -> None:
+        """Delete a demonstration file."""
+        self.path(name).unlink()
+
+    def new_name(self, base: str) -> str:
+        """A free demonstration name starting with ``base``."""
+        return unique_name(check_name(base, "demonstration name"), self.exists)

@@ -1,0 +1,125 @@
+"""``/api/events``: the live stream (Server-Sent Events) of source status, captures, run curves
+and list changes.
+
+Each client gets its own generator that polls the studio state; nothing is queued per client, so
+a slow or vanished client never holds up the pipeline or training, and a client that disconnects
+just ends its generator.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import json
+import time
+from collections.abc import AsyncIterator
+
+from fastapi import APIRouter, Request
+from fastapi.responses import StreamingResponse
+
+from .._deps import StudioDep
+from .._state import Studio
+
+router = APIRouter(prefix="/api/events", tags=["events"])
+
+TICK_S = 0.1
+"""The stream wakes up this often."""
+SOURCE_EVERY_S = 0.25
+"""Source status: about 4 per second."""
+RUN_EVERY_S = 0.1
+"""Run progress while training: up to 10 per second (at least 5 when the curve moves slowly)."""
+KEEPALIVE_EVERY_S = 15.0
+"""A comment line this often keeps proxies from closing an idle stream."""
+
+
+def sse(event: str, data: object) -> str:
+    """One Server-Sent Event."""
+    return f"event: {event}\ndata: {json.dumps(data, separators=(',', ':'))}\n\n"
+
+
+async def stream_events(
+    studio: Studio, request: Request | None = None, max_seconds: float | None = None
+) -> AsyncIterator[str]:
+    """The event stream of one client (see ``docs/api.md``).
+
+    Args:
+        studio: the studio state to watch.
+        request: the client's request, to notice a disconnect.
+        max_seconds: end the stream after this long (None: until the client leaves).
+    """
+    start = time.monotonic()
+    versions = studio.changes.versions()
+    run_counts: dict[str, list[int]] = {}
+    last = {"source": -1e9, "run": -1e9, "keepalive": start, "capture": -1e9}
+    capture_was_active = False
+    yield "retry: 2000\n\n"
+    while True:
+        now = time.monotonic()
+        if max_seconds is not None and now - start > max_seconds:
+            return
+        if request is not None and await request.is_disconnected():
+            return
+        if now - last["source"] >= SOURCE_EVERY_S:
+            last["source"] = now
+            yield sse("source", studio.source_public())
+            capture = studio.pipeline.capture_status()
+            if capture["active"] or capture_was_active:
+                yield sse("capture", capture)
+            capture_was_active = capture["active"]
+        if now - last["run"] >= RUN_EVERY_S:
+            last["run"] = now
+            for run in studio.runs.running():
+                yield sse("run", run_event(run, run_counts))
+        current = studio.changes.versions()
+        for name, version in current.items():
+            if version != versions.get(name):
+                if name == "runs":
+                    for run_id in list(run_counts):
+                        final = _final_run(studio, run_id, run_counts)
+                        if final is not None:
+                            yield sse("run", final)
+                yield sse("lists", {"changed": name})
+        versions = current
+        if now - last["keepalive"] >= KEEPALIVE_EVERY_S:
+            last["keepalive"] = now
+            yield ": keep-alive\n\n"
+        await asyncio.sleep(TICK_S)
+
+
+def run_event(run, counts: dict[str, list[int]]) -> dict:  # noqa: ANN001 - a _runs.Run
+    """A ``run`` event: the run and its curve from the first episode that changed for this client."""
+    curve = run.curve()
+    previous = counts.get(run.id, [])
+    now = curve["count"]
+    start = 0
+    while start < len(previous) and start < len(now) and previous[start] == now[start]:
+        start += 1
+    counts[run.id] = now
+    part = {key: values[start:] for key, values in curve.items()}
+    return {"run": run.public(), "curve": part, "from": start}
+
+
+def _final_run(studio: Studio, run_id: str, counts: dict[str, list[int]]) -> dict | None:
+    """The last event of a run that stopped training since the previous tick."""
+    try:
+        run = studio.runs.get(run_id)
+    except Exception:
+        counts.pop(run_id, None)
+        return None
+    if run.status == "running":
+        return None
+    event = run_event(run, counts)
+    counts.pop(run_id, None)
+    return event
+
+
+@router.get("")
+async def events(request: Request, studio: StudioDep, max_seconds: float | None = None):
+    """Server-Sent Events: ``source`` (~4/s), ``capture``, ``run`` (>= 5/s while training), ``lists``.
+
+    ``max_seconds`` ends the stream after that long (scripts, tests); browsers leave it out.
+    """
+    return StreamingResponse(
+        stream_events(studio, request, max_seconds),
+        media_type="text/event-stream",
+        headers={"Cache-Control": "no-cache", "X-Accel-Buffering": "no"},
+    )

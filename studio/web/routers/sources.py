@@ -1,0 +1,42 @@
+"""``/api/source``: the live source (simulator, recording, network bridge, serial), playback and
+the human-to-robot mapping."""
+
+from __future__ import annotations
+
+from fastapi import APIRouter
+
+from .._deps import StudioDep
+from .._schemas import PlaybackAction, RetargetUpdate, SourcePublic, SourceUpdate
+
+router = APIRouter(prefix="/api/source", tags=["source"])
+
+
+@router.get("", response_model=SourcePublic)
+def read_source(studio: StudioDep) -> dict:
+    """The live source: kind, rate, frames, dropped frames, error, fit residual, robot pose."""
+    return studio.source_public()
+
+
+@router.put("", response_model=SourcePublic)
+def set_source(body: SourceUpdate, studio: StudioDep) -> dict:
+    """Switch the live source; the old one is stopped first (409 while recording).
+
+    A source that cannot start (no such serial device, port in use) is still selected and shows
+    its error in ``error``, so the page can show it next to the source.
+    """
+    studio.set_source(**body.model_dump())
+    return studio.source_public()
+
+
+@router.post("/playback", response_model=SourcePublic)
+def control_playback(body: PlaybackAction, studio: StudioDep) -> dict:
+    """Play, pause or seek the recording source (409 if the source is not a recording)."""
+    studio.playback(body.action, body.t, body.speed)
+    return studio.source_public()
+
+
+@router.put("/retarget", response_model=SourcePublic)
+def set_retarget(body: RetargetUpdate, studio: StudioDep) -> dict:
+    """Map the arm onto the robot joint by joint or by hand position, mirrored or not."""
+    studio.pipeline.set_retarget(body.mode, body.mirror)
+    return studio.source_public()

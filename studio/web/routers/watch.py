@@ -1,0 +1,86 @@
+"""``/api/watch``: the robot in the scene performs a learned policy, step by step."""
+
+from __future__ import annotations
+
+import io
+
+import numpy as np
+from fastapi import APIRouter, Response
+
+from .._deps import StudioDep
+from .._errors import ConflictError
+from .._schemas import WatchCreate, WatchPublic
+
+router = APIRouter(prefix="/api/watch", tags=["watch"])
+
+ROLLOUT_RATE_HZ = 50.0
+"""Samples per second of a watched rollout (the scene interpolates between them)."""
+
+
+@router.post("", response_model=WatchPublic)
+def watch(body: WatchCreate, studio: StudioDep) -> dict:
+    """Roll the greedy policy out from a random or the current pose and play it in the scene."""
+    from studio.learning import greedy_path, rollout
+
+    policy, key = studio.load_policy(body.run, body.policy)
+    grid = policy.grid
+    if body.start == "current":
+        q_now = (
+            studio.scene.current_q_robot()
+            if studio.scene is not None
+            else studio.pipeline.q_robot()
+        )
+        start = grid.state_of_angles(np.asarray(q_now)[: grid.joints])
+    else:
+        rng = np.random.default_rng(body.seed)
+        starts = grid.mdp().start_states
+        start = int(starts[rng.integers(len(starts))])
+    hold = np.zeros(6)
+    if body.start == "current":
+        hold[grid.joints :] = np.asarray(q_now)[grid.joints : 6]
+    times, q = rollout(policy, start, ROLLOUT_RATE_HZ, hold=hold)
+    states = greedy_path(policy, start)
+    with studio.watch_lock:
+        studio.last_rollout = (times, q)
+        studio.watching = key
+    if studio.scene is not None:
+        goal = np.zeros(6)
+        goal[: grid.joints] = grid.angles_of(grid.goal_state)
+        studio.scene.set_goal(goal)
+        studio.scene.play_trajectory(times, q, states)
+    return {
+        "states": states,
+        "times": [round(float(t), 6) for t in times],
+        "q_robot": [[round(float(x), 6) for x in row] for row in q],
+        "reached_goal": states[-1] == grid.goal_state,
+    }
+
+
+@router.post("/stop", status_code=204)
+def stop_watch(studio: StudioDep) -> Response:
+    """Stop the playback; the robot follows the live source again."""
+    with studio.watch_lock:
+        studio.watching = None
+    if studio.scene is not None:
+        studio.scene.stop_playback()
+    return Response(status_code=204)
+
+
+@router.get("/trajectory.csv")
+def download_trajectory(studio: StudioDep) -> Response:
+    """The last rollout as CSV: ``time,q1..q6`` (seconds, radians); 409 before any watch."""
+    with studio.watch_lock:
+        last = studio.last_rollout
+    if last is None:
+        raise ConflictError("Nothing has been watched yet; watch a policy first, then download.")
+    times, q = last
+    buffer = io.StringIO()
+    header = ",".join(["time", *(f"q{j + 1}" for j in range(q.shape[1]))])
+    np.savetxt(
+        buffer, np.column_stack([times, q]), delimiter=",", header=header, comments="", fmt="%.6f"
+    )
+    return Response(
+        buffer.getvalue(),
+        media_type="text/csv",
+        headers={"Content-Disposition": 'attachment; filename="rollout.csv"'},
+    )
