@@ -1,0 +1,195 @@
+"""Edit recordings without ever rewriting one in place.
+
+Every edit writes a complete new file next to the old one, fsyncs it, and swaps it in with
+``os.replace`` (atomic on POSIX), so a crash mid-edit leaves either the old or the new file, never
+a half-written one. A file under a running capture (its writer holds an ``flock``) is refused.
+"""
+
+from __future__ import annotations
+
+import fcntl
+import json
+import os
+import tempfile
+from datetime import UTC, datetime
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ._errors import RecordingError
+from ._recording_format import (
+    RECORDING_SUFFIX,
+    columns,
+    end_line,
+    format_row,
+    header_line,
+)
+from ._recording_reader import Recording, _parse_header
+
+EDITABLE_KEYS = ("name", "operator", "notes")
+"""Header keys :func:`update_recording_meta` may change (the rest describe the data)."""
+DEMO_SUFFIX = ".demo.json"
+"""File name ending of demonstrations (they reference their recording by file name)."""
+
+
+def atomic_write_text(path: str | os.PathLike[str], text: str) -> Path:
+    """Write ``text`` to ``path`` through a fsynced temporary file and ``os.replace``."""
+    path = Path(path)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as f:
+            f.write(text)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    return path
+
+
+def _check_not_recording(path: Path) -> None:
+    try:
+        with open(path, "rb") as f:
+            try:
+                fcntl.flock(f.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except BlockingIOError:
+                raise RecordingError(
+                    f"{path} is being recorded right now; stop the capture before editing it."
+                ) from None
+            fcntl.flock(f.fileno(), fcntl.LOCK_UN)
+    except FileNotFoundError:
+        raise RecordingError(f"{path} does not exist; check the path.") from None
+
+
+def update_recording_meta(path: str | os.PathLike[str], **changes: Any) -> dict[str, Any]:
+    """Change a recording's ``name``, ``operator`` or ``notes`` (atomic replace, data untouched).
+
+    Only line 1 changes; every other byte (frames, the ``# end`` line, or its absence in a
+    recovered file) is copied as is.
+
+    Args:
+        path: the recording.
+        changes: new values for keys in :data:`EDITABLE_KEYS`.
+
+    Returns:
+        The new header.
+
+    Raises:
+        RecordingError: an unknown key, a non-string value, a bad file, or a capture in progress.
+    """
+    path = Path(path)
+    for key, value in changes.items():
+        if key not in EDITABLE_KEYS:
+            raise RecordingError(
+                f"'{key}' cannot be edited; edit one of {', '.join(EDITABLE_KEYS)}."
+            )
+        if not isinstance(value, str):
+            raise RecordingError(f"{key} must be text, got {type(value).__name__}; give a string.")
+    _check_not_recording(path)
+    raw = path.read_bytes()
+    first, sep, rest = raw.partition(b"\n")
+    meta = _parse_header(path, first.decode("utf-8", errors="replace"))
+    meta.update(changes)
+    meta["edited"] = datetime.now(UTC).isoformat(timespec="seconds")
+    text = header_line(meta) + rest.decode("utf-8")
+    atomic_write_text(path, text)
+    return meta
+
+
+def rename_recording(path: str | os.PathLike[str], new_name: str) -> Path:
+    """Rename a recording's file to ``<new_name>.tape.csv`` and its display name to ``new_name``.
+
+    The header is rewritten (atomic replace) and the file moved without overwriting anything;
+    demonstrations in the same folder that reference the old file are updated to the new one.
+
+    Returns:
+        The new path.
+
+    Raises:
+        RecordingError: a name with a path separator, an existing target, or a capture in progress.
+    """
+    path = Path(path)
+    new_name = new_name.removesuffix(RECORDING_SUFFIX).strip()
+    if not new_name or "/" in new_name or "\\" in new_name or new_name.startswith("."):
+        raise RecordingError(
+            f"'{new_name}' is not a usable file name; give a plain name without '/'."
+        )
+    target = path.with_name(new_name + RECORDING_SUFFIX)
+    if target == path:
+        update_recording_meta(path, name=new_name)
+        return path
+    if target.exists():
+        raise RecordingError(f"{target} already exists; choose another name.")
+    update_recording_meta(path, name=new_name)
+    try:
+        os.link(path, target)  # fails if the target appeared meanwhile: never overwrite
+    except FileExistsError:
+        raise RecordingError(f"{target} already exists; choose another name.") from None
+    path.unlink()
+    for demo in path.parent.glob("*" + DEMO_SUFFIX):
+        try:
+            data = json.loads(demo.read_text(encoding="utf-8"))
+        except (OSError, ValueError):
+            continue
+        if isinstance(data, dict) and data.get("recording") == path.name:
+            data["recording"] = target.name
+            atomic_write_text(demo, json.dumps(data, indent=1) + "\n")
+    return target
+
+
+def write_recording(
+    path: str | os.PathLike[str],
+    meta: dict[str, Any],
+    t: np.ndarray,
+    frame: np.ndarray,
+    status: np.ndarray,
+    bend: np.ndarray,
+    twist: np.ndarray,
+    *,
+    overwrite: bool = False,
+) -> Path:
+    """Write a whole recording at once (imports, cuts), atomically, with its ``# end`` line.
+
+    Raises:
+        RecordingError: the target exists and ``overwrite`` is false, or the arrays disagree.
+    """
+    path = Path(path)
+    n = len(t)
+    regions = int(meta["regions"])
+    if (
+        bend.shape != (n, regions)
+        or twist.shape != (n, regions)
+        or len(frame) != n
+        or len(status) != n
+    ):
+        raise RecordingError(
+            f"{path}: the frame arrays do not agree on {n} frames of {regions} regions."
+        )
+    if path.exists() and not overwrite:
+        raise RecordingError(f"{path} already exists; choose another file name.")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    parts = [header_line(meta), ",".join(columns(regions)) + "\n"]
+    parts.extend(format_row(t[i], frame[i], status[i], bend[i], twist[i]) for i in range(n))
+    duration = float(t[-1] - t[0]) if n >= 2 else 0.0
+    parts.append(end_line(n, duration, datetime.now(UTC).isoformat(timespec="seconds")))
+    return atomic_write_text(path, "".join(parts))
+
+
+def copy_recording(
+    recording: Recording, path: str | os.PathLike[str], rows: slice | None = None
+) -> Path:
+    """Write (a slice of) a recording to a new file, e.g. to repair a recovered one or cut a segment."""
+    rows = rows or slice(None)
+    meta = dict(recording.meta)
+    meta["derived_from"] = recording.path.name
+    return write_recording(
+        path,
+        meta,
+        recording.t[rows],
+        recording.frame[rows],
+        recording.status[rows],
+        recording.bend[rows],
+        recording.twist[rows],
+    )

@@ -1,0 +1,225 @@
+"""What every frame source shares: a lifecycle, a producer thread, a bounded queue, a status.
+
+A source runs its producer in its own daemon thread and pushes frames into a bounded queue; the
+consumer drains it with :meth:`ThreadedSource.read`. A full queue drops the frame and counts it,
+so a stalled consumer never blocks the device. A producer error (a lost connection, a closed
+port) ends the thread and is reported in :meth:`ThreadedSource.status`, never raised in it.
+"""
+
+from __future__ import annotations
+
+import collections
+import queue
+import threading
+import time
+from dataclasses import dataclass
+from typing import Any, Protocol, runtime_checkable
+
+from ._errors import CaptureError
+from ._frames import TapeFrame
+
+DEFAULT_QUEUE_FRAMES = 4096
+"""Frames a source buffers before it drops (37 s at 110 Hz: a consumer may stall that long)."""
+RATE_WINDOW_FRAMES = 110
+"""Frames over which the measured rate is averaged (one second at 110 Hz)."""
+STOP_JOIN_SECONDS = 2.0
+"""How long :meth:`ThreadedSource.stop` waits for the producer thread to end."""
+
+
+@dataclass(frozen=True)
+class SourceStatus:
+    """A snapshot of a source's health.
+
+    Args:
+        kind: ``"simulator"``, ``"playback"``, ``"network"`` or ``"serial"``.
+        running: whether the producer thread is running.
+        rate_hz: measured frame rate over the last second of frames (0 before two frames).
+        frames: frames produced so far.
+        dropped: frames lost (queue full, checksum errors, gaps in the device's counter).
+        error: why the source stopped (one sentence with the fix), or ``None``.
+        rejected: malformed input ignored (network datagrams that failed to decode).
+        warning: the last non-fatal problem (for example why a datagram was rejected), or ``None``.
+    """
+
+    kind: str
+    running: bool
+    rate_hz: float
+    frames: int
+    dropped: int
+    error: str | None = None
+    rejected: int = 0
+    warning: str | None = None
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready fields."""
+        return {
+            "kind": self.kind,
+            "running": self.running,
+            "rate_hz": self.rate_hz,
+            "frames": self.frames,
+            "dropped": self.dropped,
+            "error": self.error,
+            "rejected": self.rejected,
+            "warning": self.warning,
+        }
+
+
+@runtime_checkable
+class FrameSource(Protocol):
+    """The lifecycle every source follows."""
+
+    def start(self) -> None:
+        """Start producing frames in the source's own thread."""
+
+    def stop(self) -> None:
+        """Stop producing and release the device."""
+
+    def read(self, timeout: float | None = 0.0) -> list[TapeFrame]:
+        """All frames since the last call, waiting up to ``timeout`` s for the first one."""
+
+    def status(self) -> SourceStatus:
+        """The source's health."""
+
+
+class ThreadedSource:
+    """Base of the sources: subclasses implement :meth:`_produce` (the loop) and ``kind``.
+
+    Args:
+        queue_frames: capacity of the frame queue; frames beyond it are dropped and counted.
+    """
+
+    kind = "source"
+
+    def __init__(self, queue_frames: int = DEFAULT_QUEUE_FRAMES) -> None:
+        if queue_frames < 1:
+            raise CaptureError(f"queue_frames is {queue_frames}; give at least 1.")
+        self._queue: queue.Queue[TapeFrame] = queue.Queue(maxsize=queue_frames)
+        self._stop_event = threading.Event()
+        self._thread: threading.Thread | None = None
+        self._lock = threading.Lock()
+        self._frames = 0
+        self._dropped = 0
+        self._rejected = 0
+        self._error: str | None = None
+        self._warning: str | None = None
+        self._arrivals: collections.deque[float] = collections.deque(maxlen=RATE_WINDOW_FRAMES)
+
+    # lifecycle -------------------------------------------------------------------------------
+    def start(self) -> None:
+        """Start the producer thread (a no-op if it is running)."""
+        if self._thread is not None and self._thread.is_alive():
+            return
+        self._stop_event.clear()
+        self._error = None
+        self._open()
+        self._thread = threading.Thread(target=self._run, name=f"studio-{self.kind}", daemon=True)
+        self._thread.start()
+
+    def stop(self) -> None:
+        """Ask the producer to stop, wait for it, and release resources."""
+        self._stop_event.set()
+        thread = self._thread
+        if thread is not None and thread is not threading.current_thread():
+            thread.join(STOP_JOIN_SECONDS)
+        self._close()
+
+    def __enter__(self) -> ThreadedSource:
+        self.start()
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.stop()
+
+    @property
+    def running(self) -> bool:
+        """Whether the producer thread is alive."""
+        return self._thread is not None and self._thread.is_alive()
+
+    def read(self, timeout: float | None = 0.0) -> list[TapeFrame]:
+        """All frames since the last call.
+
+        Args:
+            timeout: seconds to wait for the first frame (0: don't wait; ``None``: wait until a
+                frame arrives or the source stops).
+
+        Returns:
+            The frames in order, possibly none.
+        """
+        out: list[TapeFrame] = []
+        if timeout is None:
+            while not out:
+                try:
+                    out.append(self._queue.get(timeout=0.1))
+                except queue.Empty:
+                    if not self.running:
+                        break
+        elif timeout > 0:
+            try:
+                out.append(self._queue.get(timeout=timeout))
+            except queue.Empty:
+                return out
+        while True:
+            try:
+                out.append(self._queue.get_nowait())
+            except queue.Empty:
+                return out
+
+    def status(self) -> SourceStatus:
+        """A snapshot of the source's health."""
+        with self._lock:
+            arrivals = list(self._arrivals)
+            frames, dropped, rejected = self._frames, self._dropped, self._rejected
+            error, warning = self._error, self._warning
+        rate = 0.0
+        if len(arrivals) >= 2 and arrivals[-1] > arrivals[0]:
+            rate = (len(arrivals) - 1) / (arrivals[-1] - arrivals[0])
+        return SourceStatus(
+            self.kind, self.running, rate, frames, dropped, error, rejected, warning
+        )
+
+    # for subclasses --------------------------------------------------------------------------
+    def _open(self) -> None:
+        """Acquire the device before the thread starts (raise :class:`CaptureError` if you can't)."""
+
+    def _close(self) -> None:
+        """Release the device after the thread ended."""
+
+    def _produce(self) -> None:
+        """The producer loop: call :meth:`_push` per frame until :attr:`_stop_event` is set."""
+        raise NotImplementedError
+
+    def _run(self) -> None:
+        try:
+            self._produce()
+        except Exception as err:  # a producer must never crash silently: report it in status
+            message = str(err) if isinstance(err, CaptureError) else f"{type(err).__name__}: {err}"
+            self._fail(message)
+
+    def _record_arrival(self) -> None:
+        now = time.monotonic()
+        with self._lock:
+            self._frames += 1
+            self._arrivals.append(now)
+
+    def _push(self, frame: TapeFrame) -> None:
+        """Queue one frame (or count it dropped when the queue is full)."""
+        self._record_arrival()
+        try:
+            self._queue.put_nowait(frame)
+        except queue.Full:
+            with self._lock:
+                self._dropped += 1
+
+    def _count_dropped(self, n: int = 1) -> None:
+        with self._lock:
+            self._dropped += n
+
+    def _reject(self, why: str) -> None:
+        with self._lock:
+            self._rejected += 1
+            self._warning = why
+
+    def _fail(self, message: str) -> None:
+        with self._lock:
+            self._error = message
+        self._stop_event.set()
