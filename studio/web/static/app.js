@@ -1,0 +1,990 @@
+/* Teach Studio page: talks to the API in docs/api.md, renders lists, live status and curves.
+ *
+ * Plain JS, no build step. Live data arrives over one EventSource('/api/events'); the curve chart
+ * is redrawn with Plotly.react at most CURVE_FPS times a second, whatever the event rate.
+ */
+"use strict";
+
+const CURVE_FPS = 10;
+const PALETTE = ["#2a62b8", "#d9822b", "#23874b", "#b83280", "#6b4fbb", "#0f8b8d", "#a0522d", "#7a7a7a"];
+const $ = (id) => document.getElementById(id);
+
+/* ------------------------------------------------------------------ state */
+const S = {
+  config: null,
+  source: null,
+  capture: null,
+  recordings: [],
+  demos: [],
+  runs: [],
+  policies: [],
+  curves: new Map(), // run id -> {episodes, mean, std, min, max}
+  shown: new Set(), // run ids plotted
+  shownTouched: false, // the user changed which runs are plotted
+  marking: false,
+  watchedRun: null,
+  curveDirty: true,
+};
+window.studio = S; // for the browser tests and for poking around in the console
+
+/* ------------------------------------------------------------------ API helpers */
+class ApiError extends Error {}
+
+async function api(method, path, body) {
+  const opts = { method, headers: {} };
+  if (body instanceof FormData) {
+    opts.body = body;
+  } else if (body !== undefined) {
+    opts.headers["Content-Type"] = "application/json";
+    opts.body = JSON.stringify(body);
+  }
+  let resp;
+  try {
+    resp = await fetch(path, opts);
+  } catch (e) {
+    throw new ApiError("The studio server is not reachable; check that `studio serve` is still running.");
+  }
+  if (resp.status === 204) return null;
+  const text = await resp.text();
+  let data = null;
+  try { data = text ? JSON.parse(text) : null; } catch (e) { data = null; }
+  if (!resp.ok) {
+    throw new ApiError(detailOf(data, resp, text));
+  }
+  return data;
+}
+
+function detailOf(data, resp, text) {
+  if (data && data.detail !== undefined) {
+    const d = data.detail;
+    if (typeof d === "string") return d;
+    if (Array.isArray(d)) return d.map((x) => (x && x.msg) || JSON.stringify(x)).join("; ");
+    return JSON.stringify(d);
+  }
+  if (resp.status === 413) return "The file is larger than the upload limit.";
+  if (resp.status === 404) return `Not found (${resp.url.replace(location.origin, "")}): this server does not offer that yet.`;
+  return `The server answered ${resp.status} ${resp.statusText}${text ? ": " + text.slice(0, 200) : ""}.`;
+}
+
+function showError(id, err) {
+  const el = $(id);
+  if (!el) return;
+  if (!err) { el.hidden = true; el.textContent = ""; return; }
+  el.textContent = err instanceof Error ? err.message : String(err);
+  el.hidden = false;
+}
+
+/** Run an action, showing its error (or clearing the old one) next to the control. */
+async function guarded(errId, fn, button) {
+  showError(errId, null);
+  if (button) button.disabled = true;
+  try {
+    return await fn();
+  } catch (e) {
+    showError(errId, e);
+    if (!(e instanceof ApiError)) console.error(e);
+    return undefined;
+  } finally {
+    if (button) button.disabled = false;
+  }
+}
+
+/** Fetch a file and save it, so that a refusal (409, 404) shows up as a message, not a page. */
+async function download(url, fallbackName, errId) {
+  showError(errId, null);
+  let resp;
+  try {
+    resp = await fetch(url);
+  } catch (e) {
+    showError(errId, "The studio server is not reachable.");
+    return;
+  }
+  if (!resp.ok) {
+    const text = await resp.text();
+    let data = null;
+    try { data = JSON.parse(text); } catch (e) { data = null; }
+    showError(errId, detailOf(data, resp, text));
+    return;
+  }
+  const blob = await resp.blob();
+  const cd = resp.headers.get("Content-Disposition") || "";
+  const m = /filename\*?=(?:UTF-8'')?"?([^";]+)"?/i.exec(cd);
+  const name = m ? decodeURIComponent(m[1]) : fallbackName;
+  const a = document.createElement("a");
+  a.href = URL.createObjectURL(blob);
+  a.download = name;
+  document.body.appendChild(a);
+  a.click();
+  setTimeout(() => { URL.revokeObjectURL(a.href); a.remove(); }, 1000);
+}
+
+function confirmDialog(text, okLabel = "Delete") {
+  const dlg = $("confirm-dialog");
+  $("confirm-text").textContent = text;
+  dlg.querySelector('[data-testid="confirm-ok"]').textContent = okLabel;
+  dlg.returnValue = "";
+  dlg.showModal();
+  return new Promise((resolve) => {
+    dlg.addEventListener("close", () => resolve(dlg.returnValue === "ok"), { once: true });
+  });
+}
+
+const enc = encodeURIComponent;
+const fmt = (x, d = 1) => (x === null || x === undefined || Number.isNaN(x) ? "–" : Number(x).toFixed(d));
+function fmtDuration(s) {
+  if (s === null || s === undefined) return "–";
+  if (s < 60) return `${s.toFixed(1)} s`;
+  const m = Math.floor(s / 60);
+  return `${m}:${String(Math.floor(s - 60 * m)).padStart(2, "0")}`;
+}
+function fmtCpu(s) {
+  if (!s) return "0 s";
+  return s < 100 ? `${s.toFixed(1)} s` : `${(s / 60).toFixed(1)} min`;
+}
+function el(tag, attrs = {}, ...children) {
+  const e = document.createElement(tag);
+  for (const [k, v] of Object.entries(attrs)) {
+    if (v === undefined || v === null || v === false) continue;
+    if (k === "class") e.className = v;
+    else if (k === "text") e.textContent = v;
+    else if (k.startsWith("on")) e.addEventListener(k.slice(2), v);
+    else if (k === "testid") e.dataset.testid = v;
+    else e.setAttribute(k, v === true ? "" : v);
+  }
+  for (const c of children) if (c !== null && c !== undefined) e.append(c);
+  return e;
+}
+function emptyRow(cols, text) {
+  return el("tr", { class: "empty" }, el("td", { colspan: cols, text }));
+}
+function fillSelect(sel, items, keep = true) {
+  const old = sel.value;
+  sel.replaceChildren(...items.map(([value, label]) => el("option", { value, text: label })));
+  if (keep && items.some(([v]) => v === old)) sel.value = old;
+}
+
+/* ------------------------------------------------------------------ source */
+function renderSource() {
+  const s = S.source;
+  if (!s) return;
+  $("top-source-kind").textContent = s.kind ? (s.kind === "recording" ? `recording ${s.recording || ""}` : s.kind) : "none";
+  $("top-rate").textContent = fmt(s.rate_hz, 0);
+  $("top-dropped").textContent = s.dropped ?? "–";
+  $("src-running").textContent = s.running ? "yes" : "no";
+  $("src-rate").textContent = fmt(s.rate_hz, 1);
+  $("src-frames").textContent = s.frames ?? "–";
+  $("src-dropped").textContent = s.dropped ?? "–";
+  $("src-residual").textContent = fmt(s.fit_residual_mm, 1);
+  $("src-q").textContent = (s.q_robot || []).map((v) => ((v * 180) / Math.PI).toFixed(0).padStart(4)).join(" ") + " °";
+  if (s.error) showError("source-error", s.error);
+  else if ($("source-error").dataset.fromStatus === "1") showError("source-error", null);
+  $("source-error").dataset.fromStatus = s.error ? "1" : "";
+  if (document.activeElement !== $("retarget-mode") && s.retarget) $("retarget-mode").value = s.retarget.mode;
+  if (s.retarget) $("retarget-mirror").checked = !!s.retarget.mirror;
+  const pb = s.playback;
+  $("playback").hidden = !(s.kind === "recording" && pb);
+  if (pb) {
+    $("playback-toggle").textContent = pb.playing ? "❚❚" : "▶";
+    $("playback-toggle").dataset.playing = pb.playing ? "1" : "0";
+    const seek = $("playback-seek");
+    seek.max = String(Math.max(pb.duration, 0.01));
+    if (!seek.dataset.dragging) seek.value = String(pb.t);
+    $("playback-time").textContent = `${pb.t.toFixed(1)} / ${pb.duration.toFixed(1)} s`;
+    if (document.activeElement !== $("playback-speed")) {
+      const sp = String(pb.speed);
+      if ([...$("playback-speed").options].some((o) => o.value === sp)) $("playback-speed").value = sp;
+    }
+    $("playback-loop").checked = !!pb.loop;
+  }
+  renderCaptureButton();
+  updateMarkButton();
+}
+
+function syncKindOptions() {
+  const kind = $("source-kind").value;
+  for (const e of document.querySelectorAll(".kind-opt")) e.hidden = e.dataset.kind !== kind;
+}
+
+async function applySource() {
+  const kind = $("source-kind").value;
+  const body = { kind };
+  if (kind === "recording") {
+    body.recording = $("source-recording").value;
+    if (!body.recording) { showError("source-error", "Choose a recording first (or upload one under Record)."); return; }
+    body.speed = Number($("playback-speed").value);
+    body.loop = $("playback-loop").checked;
+  } else if (kind === "network") {
+    body.port = Number($("source-port").value);
+  } else if (kind === "serial") {
+    body.device = $("source-device").value.trim();
+  } else if ($("source-seed").value !== "") {
+    body.seed = Number($("source-seed").value);
+  }
+  await guarded("source-error", async () => {
+    S.source = await api("PUT", "/api/source", body);
+    renderSource();
+  }, $("source-apply"));
+}
+
+async function playback(action, extra = {}) {
+  await guarded("source-error", async () => {
+    S.source = await api("POST", "/api/source/playback", { action, ...extra });
+    renderSource();
+  });
+}
+
+async function setRetarget() {
+  await guarded("source-error", async () => {
+    S.source = await api("PUT", "/api/source/retarget", {
+      mode: $("retarget-mode").value,
+      mirror: $("retarget-mirror").checked,
+    });
+    renderSource();
+  });
+}
+
+/* ------------------------------------------------------------------ capture & recordings */
+function renderCaptureButton() {
+  const active = !!(S.capture && S.capture.active) || !!(S.source && S.source.recording_active);
+  const b = $("capture-toggle");
+  b.classList.toggle("active", active);
+  b.textContent = active ? "■ Stop" : "● Record";
+  b.dataset.active = active ? "1" : "0";
+  const secs = S.capture && S.capture.active ? S.capture.seconds : 0;
+  $("capture-elapsed").textContent = `${fmt(secs, 1)} s`;
+  $("top-rec").hidden = !active;
+  $("top-rec-time").textContent = fmt(secs, 1);
+}
+
+async function toggleCapture() {
+  const b = $("capture-toggle");
+  if (b.dataset.active === "1") {
+    await guarded("capture-error", async () => {
+      const rec = await api("POST", "/api/capture/stop");
+      S.capture = { active: false, name: null, seconds: 0, frames: 0 };
+      renderCaptureButton();
+      await loadRecordings();
+      flashRow("recordings-body", rec && rec.name);
+    }, b);
+  } else {
+    const body = {};
+    if ($("capture-name").value.trim()) body.name = $("capture-name").value.trim();
+    if ($("capture-operator").value.trim()) body.operator = $("capture-operator").value.trim();
+    await guarded("capture-error", async () => {
+      S.capture = await api("POST", "/api/capture/start", body);
+      renderCaptureButton();
+    }, b);
+  }
+}
+
+function flashRow(bodyId, name) {
+  if (!name) return;
+  const row = $(bodyId).querySelector(`tr[data-name="${CSS.escape(name)}"]`);
+  if (row) { row.classList.add("selected"); setTimeout(() => row.classList.remove("selected"), 2500); }
+}
+
+async function loadRecordings() {
+  await guarded("recordings-error", async () => {
+    S.recordings = await api("GET", "/api/recordings");
+    renderRecordings();
+  });
+}
+
+function renderRecordings() {
+  const body = $("recordings-body");
+  $("rec-count").textContent = S.recordings.length ? `(${S.recordings.length})` : "";
+  if (!S.recordings.length) {
+    body.replaceChildren(emptyRow(4, "No recordings yet: press Record, or upload a .tape.csv."));
+  } else {
+    body.replaceChildren(...S.recordings.map((r) => {
+      const flags = [];
+      if (r.sample) flags.push(el("span", { class: "badge", text: "sample", title: "shipped with the studio" }));
+      if (r.recovered) flags.push(el("span", { class: "badge warn", text: "recovered", title: "the capture did not close cleanly; every frame written is kept" }));
+      if (r.error) flags.push(el("span", { class: "badge failed", text: "unreadable", title: r.error }));
+      const title = [r.notes, r.operator && `operator: ${r.operator}`, r.created].filter(Boolean).join("\n");
+      return el("tr", { "data-name": r.name, testid: "recording-row", title },
+        el("td", { class: "name" }, el("span", { text: r.name, testid: "recording-name" }), " ", ...flags),
+        el("td", { class: "num", testid: "recording-duration", text: fmtDuration(r.duration) }),
+        el("td", { class: "num", text: String(r.frames) }),
+        el("td", { class: "actions" },
+          el("button", { class: "icon", title: "play as the live source", testid: "recording-play", onclick: () => useRecording(r.name) }, "▶"),
+          el("button", { class: "icon", title: "rename / notes", testid: "recording-edit", onclick: () => editRecording(r) }, "✎"),
+          el("button", { class: "icon", title: "download", testid: "recording-download", onclick: () => download(`/api/recordings/${enc(r.name)}/file`, `${r.name}.tape.csv`, "recordings-error") }, "⤓"),
+          el("button", { class: "icon", title: "delete", testid: "recording-delete", onclick: () => deleteRecording(r.name) }, "✕"),
+        ),
+      );
+    }));
+  }
+  const items = S.recordings.filter((r) => !r.error).map((r) => [r.name, `${r.name} (${fmtDuration(r.duration)})`]);
+  fillSelect($("source-recording"), items);
+  fillSelect($("demo-recording"), items);
+  syncDemoRange();
+}
+
+async function useRecording(name) {
+  $("source-kind").value = "recording";
+  syncKindOptions();
+  $("source-recording").value = name;
+  $("sec-source").open = true;
+  await applySource();
+}
+
+function editRecording(r) {
+  const dlg = $("edit-dialog");
+  $("edit-title").textContent = r.name;
+  $("edit-name").value = r.name;
+  $("edit-operator").value = r.operator || "";
+  $("edit-notes").value = r.notes || "";
+  showError("edit-error", null);
+  dlg.dataset.name = r.name;
+  dlg.showModal();
+}
+
+async function saveRecordingEdit(ev) {
+  const dlg = $("edit-dialog");
+  if (ev.submitter && ev.submitter.value !== "save") return;
+  ev.preventDefault();
+  const old = dlg.dataset.name;
+  const patch = {};
+  const name = $("edit-name").value.trim();
+  if (name && name !== old) patch.name = name;
+  patch.notes = $("edit-notes").value;
+  patch.operator = $("edit-operator").value;
+  const ok = await guarded("edit-error", async () => {
+    await api("PATCH", `/api/recordings/${enc(old)}`, patch);
+    return true;
+  }, $("edit-save"));
+  if (ok) {
+    dlg.close("save");
+    await loadRecordings();
+  }
+}
+
+async function deleteRecording(name) {
+  if (!(await confirmDialog(`Delete the recording ${name}? Its file is removed from the data directory.`))) return;
+  await guarded("recordings-error", async () => {
+    await api("DELETE", `/api/recordings/${enc(name)}`);
+    await loadRecordings();
+  });
+}
+
+async function uploadRecording(input) {
+  const f = input.files[0];
+  if (!f) return;
+  await guarded("recordings-error", async () => {
+    checkUploadSize(f);
+    const fd = new FormData();
+    fd.append("file", f, f.name);
+    const rec = await api("POST", "/api/recordings", fd);
+    await loadRecordings();
+    flashRow("recordings-body", rec && rec.name);
+  });
+  input.value = "";
+}
+
+function checkUploadSize(f) {
+  const limit = S.config && S.config.upload_limit_bytes;
+  if (limit && f.size > limit) {
+    throw new ApiError(`${f.name} is ${(f.size / 1e6).toFixed(1)} MB, over the ${(limit / 1e6).toFixed(0)} MB upload limit.`);
+  }
+}
+
+/* ------------------------------------------------------------------ demonstrations */
+function currentDemoRecording() {
+  return S.recordings.find((r) => r.name === $("demo-recording").value);
+}
+
+function syncDemoRange() {
+  const r = currentDemoRecording();
+  const dur = r ? r.duration : 1;
+  for (const id of ["demo-t0-range", "demo-t1-range"]) $(id).max = String(dur);
+  for (const id of ["demo-t0", "demo-t1"]) $(id).max = String(dur);
+  const t0 = Math.min(Number($("demo-t0").value) || 0, dur);
+  let t1 = Number($("demo-t1").value) || 0;
+  if (t1 <= 0 || t1 > dur) t1 = dur;
+  setDemoRange(t0, t1);
+}
+
+function setDemoRange(t0, t1) {
+  $("demo-t0").value = t0.toFixed(2);
+  $("demo-t1").value = t1.toFixed(2);
+  $("demo-t0-range").value = String(t0);
+  $("demo-t1-range").value = String(t1);
+}
+
+async function cutDemo() {
+  const body = {
+    recording: $("demo-recording").value,
+    t0: Number($("demo-t0").value),
+    t1: Number($("demo-t1").value),
+    goal_from_end: $("demo-goal-from-end").checked,
+  };
+  if ($("demo-name").value.trim()) body.name = $("demo-name").value.trim();
+  $("demo-ok").hidden = true;
+  if (!body.recording) { showError("demo-error", "Choose a recording to cut from (record or upload one first)."); return; }
+  await guarded("demo-error", async () => {
+    const d = await api("POST", "/api/demonstrations", body);
+    demoAccepted(d);
+  }, $("demo-cut"));
+}
+
+function demoAccepted(d) {
+  if (!d) return;
+  const el2 = $("demo-ok");
+  el2.textContent = `Kept ${d.name}: ${d.steps} grid steps${d.reaches_goal ? ", reaches the goal" : ""}; its robot path is drawn in the scene.`;
+  el2.hidden = false;
+  loadDemos().then(() => flashRow("demos-body", d.name));
+}
+
+async function toggleMark() {
+  const action = S.marking ? "stop" : "start";
+  $("demo-ok").hidden = true;
+  await guarded("demo-error", async () => {
+    const body = { action };
+    if (action === "stop") {
+      if ($("demo-name").value.trim()) body.name = $("demo-name").value.trim();
+      body.goal_from_end = $("demo-goal-from-end").checked;
+    }
+    let res;
+    try {
+      res = await api("POST", "/api/demonstrations/mark", body);
+    } finally {
+      if (action === "stop") S.marking = false;
+    }
+    if (action === "start") {
+      S.marking = true;
+      S.markT0 = res && res.t0;
+    } else {
+      const d = res && res.demonstration ? res.demonstration : res;
+      if (d && d.name) demoAccepted(d);
+    }
+  }, $("demo-mark"));
+  updateMarkButton();
+}
+
+function updateMarkButton() {
+  const b = $("demo-mark");
+  const capturing = !!(S.capture && S.capture.active) || !!(S.source && S.source.recording_active);
+  b.textContent = S.marking ? "Mark stop" : "Mark start";
+  b.classList.toggle("active", S.marking);
+  b.disabled = !capturing && !S.marking;
+  b.title = capturing ? "mark a demonstration in the recording being captured" : "start a recording first (Record)";
+  $("demo-mark-state").textContent = S.marking ? `marking from ${fmt(S.markT0, 1)} s` : "";
+}
+
+async function loadDemos() {
+  await guarded("demo-error", async () => {
+    S.demos = await api("GET", "/api/demonstrations");
+    renderDemos();
+  });
+}
+
+function renderDemos() {
+  const body = $("demos-body");
+  if (!S.demos.length) {
+    body.replaceChildren(emptyRow(5, "No demonstrations: mark one while recording, or cut one from a recording."));
+  } else {
+    body.replaceChildren(...S.demos.map((d) => el("tr", { "data-name": d.name, testid: "demo-row" },
+      el("td", { class: "name", title: d.name, text: d.name }),
+      el("td", { class: "mono small", title: `from ${d.recording}`, text: `${fmt(d.t0, 1)}–${fmt(d.t1, 1)} s` }),
+      el("td", { class: "num", text: String(d.steps) }),
+      el("td", {}, el("span", { class: d.reaches_goal ? "badge done" : "badge warn", text: d.reaches_goal ? "reached" : "not reached", title: `goal ${(d.goal || []).map((g) => fmt(g, 0)).join(", ")}°` })),
+      el("td", { class: "actions" },
+        el("button", { class: "icon", title: "preview on the robot", testid: "demo-preview", onclick: () => previewDemo(d.name) }, "▶"),
+        el("button", { class: "icon", title: "delete", testid: "demo-delete", onclick: () => deleteDemo(d.name) }, "✕"),
+      ),
+    )));
+  }
+  // The training form's demonstration checkboxes keep their ticks across refreshes.
+  const box = $("train-demos");
+  const ticked = new Set([...box.querySelectorAll("input:checked")].map((i) => i.value));
+  if (!S.demos.length) {
+    box.replaceChildren(el("span", { class: "muted", text: "none yet" }));
+  } else {
+    box.replaceChildren(...S.demos.map((d) => el("label", { title: `${d.steps} steps from ${d.recording}` },
+      el("input", { type: "checkbox", value: d.name, testid: "train-demo", checked: ticked.has(d.name) }), d.name)));
+  }
+}
+
+async function previewDemo(name) {
+  await guarded("demo-error", () => api("POST", `/api/demonstrations/${enc(name)}/preview`));
+}
+
+async function deleteDemo(name) {
+  if (!(await confirmDialog(`Delete the demonstration ${name}? The recording it came from is kept.`))) return;
+  await guarded("demo-error", async () => {
+    await api("DELETE", `/api/demonstrations/${enc(name)}`);
+    await loadDemos();
+  });
+}
+
+/* ------------------------------------------------------------------ training */
+const TRAIN_DEFAULTS = {
+  planning: "full", planning_steps: 100, epsilon: 0.1, alpha: 0.1, gamma: 0.95,
+  episodes: 100, experiments: 20, bins: 11, seed: 0, goal0: 0, goal1: 45, goal2: -90,
+};
+
+function resetTrainForm() {
+  const f = $("train-form");
+  for (const [k, v] of Object.entries(TRAIN_DEFAULTS)) f.elements[k].value = String(v);
+  f.elements.name.value = "";
+}
+
+function readTrainForm() {
+  const f = $("train-form").elements;
+  const num = (k) => {
+    const raw = f[k].value.trim();
+    if (raw === "") throw new ApiError(`${k.replace("_", " ")} is empty; enter a number.`);
+    return Number(raw);
+  };
+  const body = {
+    planning: f.planning.value,
+    planning_steps: num("planning_steps"),
+    epsilon: num("epsilon"),
+    alpha: num("alpha"),
+    gamma: num("gamma"),
+    episodes: num("episodes"),
+    experiments: num("experiments"),
+    bins: num("bins"),
+    seed: num("seed"),
+    goal_deg: [num("goal0"), num("goal1"), num("goal2")],
+    demonstrations: [...$("train-demos").querySelectorAll("input:checked")].map((i) => i.value),
+  };
+  if (f.name.value.trim()) body.name = f.name.value.trim();
+  return body;
+}
+
+async function startRun(ev) {
+  ev.preventDefault();
+  await guarded("train-error", async () => {
+    const body = readTrainForm();
+    const run = await api("POST", "/api/runs", body);
+    upsertRun(run);
+    if (!S.shown.has(run.id)) S.shown.add(run.id);
+    S.curves.set(run.id, emptyCurve());
+    renderRuns();
+    markCurvesDirty();
+  }, $("train-start"));
+}
+
+function emptyCurve() {
+  return { episodes: [], mean: [], std: [], min: [], max: [] };
+}
+
+function upsertRun(run) {
+  const i = S.runs.findIndex((r) => r.id === run.id);
+  if (i >= 0) S.runs[i] = run;
+  else S.runs.unshift(run);
+}
+
+async function loadRuns() {
+  await guarded("runs-error", async () => {
+    S.runs = await api("GET", "/api/runs");
+    if (!S.shownTouched) {
+      // By default plot the newest few runs, so a fresh page shows the latest comparison.
+      S.shown = new Set(S.runs.slice(0, 4).map((r) => r.id));
+    }
+    renderRuns();
+    await Promise.all([...S.shown].filter((id) => !S.curves.has(id)).map(loadCurve));
+    renderWatchChoices();
+  });
+}
+
+async function loadCurve(id) {
+  try {
+    const c = await api("GET", `/api/runs/${enc(id)}/curve`);
+    S.curves.set(id, { episodes: c.episodes, mean: c.mean, std: c.std, min: c.min, max: c.max });
+    markCurvesDirty();
+  } catch (e) {
+    showError("runs-error", e);
+  }
+}
+
+function runColor(id) {
+  const i = S.runs.length - 1 - S.runs.findIndex((r) => r.id === id);
+  return PALETTE[((i % PALETTE.length) + PALETTE.length) % PALETTE.length];
+}
+
+function runLabel(r) {
+  const c = r.config || {};
+  const demos = (c.demonstrations || []).length;
+  return `${r.name || r.id} · ${c.planning}${demos ? ` +${demos} demo` : ""}`;
+}
+
+function renderRuns() {
+  const body = $("runs-body");
+  if (!S.runs.length) {
+    body.replaceChildren(emptyRow(6, "No runs yet: fill in the form and press Start."));
+    return;
+  }
+  body.replaceChildren(...S.runs.map((r) => {
+    const total = r.episodes_total || (r.config && r.config.episodes) || 1;
+    const pct = Math.min(100, (100 * (r.episodes_done || 0)) / total);
+    const live = r.status === "running" || r.status === "queued";
+    const c = r.config || {};
+    const title = `planning ${c.planning} n=${c.planning_steps} ε=${c.epsilon} α=${c.alpha} γ=${c.gamma}\n` +
+      `${c.episodes} episodes × ${c.experiments} experiments, ${c.bins} bins, goal ${(c.goal_deg || []).join(", ")}°, seed ${c.seed}` +
+      `${(c.demonstrations || []).length ? `\ndemonstrations: ${c.demonstrations.join(", ")}` : ""}` +
+      `${r.error ? `\n${r.error}` : ""}`;
+    return el("tr", { "data-id": r.id, testid: "run-row", "data-status": r.status, title },
+      el("td", {}, el("input", {
+        type: "checkbox", testid: "run-show", checked: S.shown.has(r.id),
+        onchange: (e) => toggleShown(r.id, e.target.checked),
+      })),
+      el("td", { class: "name" }, el("span", { class: "swatch", style: `background:${runColor(r.id)}` }), runLabel(r)),
+      el("td", {}, el("span", { class: `badge ${r.status}`, testid: "run-status", text: r.status })),
+      el("td", { title: `${r.episodes_done} / ${total} episodes` },
+        el("span", { class: "progress", testid: "run-progress", "data-done": r.episodes_done },
+          el("span", { style: `width:${pct.toFixed(1)}%` }))),
+      el("td", { class: "num", testid: "run-cpu", text: fmtCpu(r.cpu_seconds) }),
+      el("td", { class: "actions" },
+        live ? el("button", { class: "icon", title: "stop", testid: "run-stop", onclick: () => stopRun(r.id) }, "■") : null,
+        !live ? el("button", { class: "icon", title: "delete", testid: "run-delete", onclick: () => deleteRun(r.id) }, "✕") : null,
+      ),
+    );
+  }));
+  const failed = S.runs.find((r) => r.status === "failed" && r.error && !r._errorShown);
+  if (failed) { failed._errorShown = true; showError("runs-error", `${failed.name || failed.id}: ${failed.error}`); }
+}
+
+function toggleShown(id, on) {
+  S.shownTouched = true;
+  if (on) {
+    S.shown.add(id);
+    if (!S.curves.has(id)) loadCurve(id);
+  } else {
+    S.shown.delete(id);
+  }
+  markCurvesDirty();
+}
+
+async function stopRun(id) {
+  await guarded("runs-error", async () => {
+    upsertRun(await api("POST", `/api/runs/${enc(id)}/stop`));
+    renderRuns();
+  });
+}
+
+async function deleteRun(id) {
+  const r = S.runs.find((x) => x.id === id);
+  if (!(await confirmDialog(`Delete the run ${(r && r.name) || id} with its curves and policy?`))) return;
+  await guarded("runs-error", async () => {
+    await api("DELETE", `/api/runs/${enc(id)}`);
+    S.shown.delete(id);
+    S.curves.delete(id);
+    await loadRuns();
+    markCurvesDirty();
+  });
+}
+
+/** Merge an SSE curve piece (episodes from `from`, or the whole curve) into the run's curve. */
+function mergeCurve(id, piece) {
+  if (!piece || !piece.episodes) return;
+  let c = S.curves.get(id);
+  if (!c) { c = emptyCurve(); S.curves.set(id, c); }
+  const first = piece.from !== undefined ? piece.from : piece.episodes[0];
+  // Episodes are numbered; drop what we already hold from `first` on, then append.
+  let cut = c.episodes.length;
+  if (first !== undefined) {
+    cut = c.episodes.findIndex((e) => e >= first);
+    if (cut < 0) cut = c.episodes.length;
+  }
+  for (const k of ["episodes", "mean", "std", "min", "max"]) {
+    c[k] = c[k].slice(0, cut).concat(piece[k] || []);
+  }
+  markCurvesDirty();
+}
+
+/* ------------------------------------------------------------------ the chart */
+function markCurvesDirty() { S.curveDirty = true; }
+
+function curveTraces() {
+  const band = $("curve-band").value;
+  const log = $("curve-log").checked;
+  const traces = [];
+  for (const r of [...S.runs].reverse()) {
+    if (!S.shown.has(r.id)) continue;
+    const c = S.curves.get(r.id);
+    if (!c || !c.episodes.length) continue;
+    const color = runColor(r.id);
+    if (band !== "none") {
+      let lo; let hi;
+      if (band === "minmax") { lo = c.min; hi = c.max; } else {
+        lo = c.mean.map((m, i) => Math.max(m - (c.std[i] || 0), log ? Math.max(c.min[i] || 1, 1) : 0));
+        hi = c.mean.map((m, i) => m + (c.std[i] || 0));
+      }
+      traces.push({
+        x: c.episodes.concat([...c.episodes].reverse()),
+        y: hi.concat([...lo].reverse()),
+        fill: "toself", fillcolor: hexAlpha(color, 0.16), line: { width: 0 },
+        hoverinfo: "skip", showlegend: false, type: "scatter", mode: "lines", name: `${r.id} band`,
+        meta: { run: r.id, kind: "band" },
+      });
+    }
+    traces.push({
+      x: c.episodes, y: c.mean, type: "scatter", mode: c.episodes.length < 40 ? "lines+markers" : "lines",
+      line: { color, width: 1.8 }, marker: { size: 4 }, name: runLabel(r),
+      hovertemplate: "episode %{x}<br>%{y:.1f} steps<extra>" + (r.name || r.id) + "</extra>",
+      meta: { run: r.id, kind: "mean" },
+    });
+  }
+  return traces;
+}
+
+function hexAlpha(hex, a) {
+  const n = parseInt(hex.slice(1), 16);
+  return `rgba(${(n >> 16) & 255},${(n >> 8) & 255},${n & 255},${a})`;
+}
+
+function renderCurves() {
+  if (!S.curveDirty || typeof Plotly === "undefined") return;
+  S.curveDirty = false;
+  const traces = curveTraces();
+  $("curve-empty").hidden = traces.length > 0;
+  const layout = {
+    margin: { l: 52, r: 10, t: 6, b: 32 },
+    xaxis: { title: { text: "episode", standoff: 4 }, zeroline: false },
+    yaxis: { title: { text: "steps", standoff: 4 }, type: $("curve-log").checked ? "log" : "linear", zeroline: false },
+    legend: { orientation: "h", x: 1, xanchor: "right", y: 1, font: { size: 10 }, bgcolor: "rgba(255,255,255,0.7)" },
+    font: { size: 11, family: "system-ui, sans-serif" },
+    paper_bgcolor: "#fff", plot_bgcolor: "#fff",
+    uirevision: "keep",
+  };
+  Plotly.react("curve-plot", traces, layout, { displaylogo: false, responsive: true, modeBarButtonsToRemove: ["lasso2d", "select2d"] });
+}
+
+/** Number of plotted mean-curve points of a run (used by the browser tests). */
+S.curvePoints = (id) => {
+  const div = $("curve-plot");
+  const data = (div && div.data) || [];
+  return data.filter((t) => t.meta && t.meta.kind === "mean" && (id === undefined || t.meta.run === id))
+    .reduce((n, t) => n + t.x.length, 0);
+};
+
+/* ------------------------------------------------------------------ policies, watch, export */
+async function loadPolicies() {
+  await guarded("policies-error", async () => {
+    S.policies = await api("GET", "/api/policies");
+    renderPolicies();
+    renderWatchChoices();
+  });
+}
+
+function renderPolicies() {
+  const body = $("policies-body");
+  if (!S.policies.length) {
+    body.replaceChildren(emptyRow(4, "No policies: finish a run, or upload a .policy.npz."));
+    return;
+  }
+  body.replaceChildren(...S.policies.map((p) => el("tr", { "data-name": p.name, testid: "policy-row" },
+    el("td", { class: "name", title: p.notes || p.name, text: p.name }),
+    el("td", { text: p.planning }),
+    el("td", { class: "muted", text: p.source === "run" ? `run ${p.run}` : "upload" }),
+    el("td", { class: "actions" },
+      el("button", { class: "icon", title: "watch", testid: "policy-watch", onclick: () => { selectWatch(p); watch(); } }, "▶"),
+      p.source === "upload" ? el("button", { class: "icon", title: "delete", testid: "policy-delete", onclick: () => deletePolicy(p.name) }, "✕") : null,
+    ),
+  )));
+}
+
+function selectWatch(p) {
+  $("watch-policy").value = p.source === "run" && p.run ? `run:${p.run}` : `policy:${p.name}`;
+}
+
+function renderWatchChoices() {
+  const items = [];
+  const seenRuns = new Set();
+  for (const r of S.runs) {
+    if (r.has_policy) { items.push([`run:${r.id}`, `run ${runLabel(r)}`]); seenRuns.add(r.id); }
+  }
+  for (const p of S.policies) {
+    if (p.source === "run" && p.run && seenRuns.has(p.run)) continue;
+    items.push([p.source === "run" && p.run ? `run:${p.run}` : `policy:${p.name}`, `${p.source === "upload" ? "file" : "run"} ${p.name}`]);
+  }
+  if (!items.length) items.push(["", "(no policy yet)"]);
+  fillSelect($("watch-policy"), items);
+}
+
+function watchTarget() {
+  const v = $("watch-policy").value;
+  if (!v) return null;
+  const i = v.indexOf(":");
+  return { type: v.slice(0, i), id: v.slice(i + 1) };
+}
+
+async function watch() {
+  const t = watchTarget();
+  if (!t) { showError("watch-error", "There is no policy to watch yet: train a run to the end, or upload a policy file."); return; }
+  const body = { start: $("watch-start").value };
+  if (t.type === "run") body.run = t.id; else body.policy = t.id;
+  if ($("watch-seed").value !== "") body.seed = Number($("watch-seed").value);
+  $("watch-result").textContent = "";
+  await guarded("watch-error", async () => {
+    const w = await api("POST", "/api/watch", body);
+    const steps = Math.max(0, (w.states || []).length - 1);
+    const secs = w.times && w.times.length ? w.times[w.times.length - 1] : 0;
+    $("watch-result").textContent = `${steps} steps, ${secs.toFixed(1)} s — ${w.reached_goal ? "reaches the goal" : "does not reach the goal"}`;
+    S.watchedRun = t;
+  }, $("watch-go"));
+}
+
+async function deletePolicy(name) {
+  if (!(await confirmDialog(`Delete the uploaded policy ${name}?`))) return;
+  await guarded("policies-error", async () => {
+    await api("DELETE", `/api/policies/${enc(name)}`);
+    await loadPolicies();
+  });
+}
+
+async function uploadPolicy(input) {
+  const f = input.files[0];
+  if (!f) return;
+  await guarded("policies-error", async () => {
+    checkUploadSize(f);
+    const fd = new FormData();
+    fd.append("file", f, f.name);
+    const p = await api("POST", "/api/policies", fd);
+    await loadPolicies();
+    if (p) { selectWatch(p); flashRow("policies-body", p.name); }
+  });
+  input.value = "";
+}
+
+function exportFile(kind) {
+  const t = watchTarget();
+  if (kind === "rollout") return download("/api/watch/trajectory.csv", "rollout.csv", "export-error");
+  if (!t) { showError("export-error", "Choose a run or a policy first."); return; }
+  if (kind === "policy") {
+    if (t.type === "run") return download(`/api/runs/${enc(t.id)}/policy`, `${t.id}.policy.npz`, "export-error");
+    return download(`/api/policies/${enc(t.id)}/file`, `${t.id}.policy.npz`, "export-error");
+  }
+  if (t.type !== "run") { showError("export-error", "Curves and plots belong to a training run; choose a run, not an uploaded file."); return; }
+  const path = { curve: "curve.csv", png: "plot.png", svg: "plot.svg" }[kind];
+  return download(`/api/runs/${enc(t.id)}/${path}`, `${t.id}-${path}`, "export-error");
+}
+
+/* ------------------------------------------------------------------ live events */
+let events = null;
+function connectEvents() {
+  if (events) events.close();
+  events = new EventSource("/api/events");
+  const conn = $("conn");
+  events.onopen = () => { conn.textContent = "live"; conn.className = "chip ok"; };
+  events.onerror = () => {
+    conn.textContent = "reconnecting…"; conn.className = "chip bad";
+  };
+  events.addEventListener("source", (e) => { S.source = JSON.parse(e.data); renderSource(); });
+  events.addEventListener("capture", (e) => { S.capture = JSON.parse(e.data); renderCaptureButton(); updateMarkButton(); });
+  events.addEventListener("run", (e) => {
+    const d = JSON.parse(e.data);
+    if (!d.run) return;
+    const before = S.runs.find((r) => r.id === d.run.id);
+    upsertRun(d.run);
+    if (!before && !S.shownTouched) S.shown.add(d.run.id);
+    if (d.curve) mergeCurve(d.run.id, d.curve);
+    scheduleRunsRender();
+    if (before && before.status !== d.run.status && !["running", "queued"].includes(d.run.status)) {
+      loadCurve(d.run.id);
+      renderWatchChoices();
+      loadPolicies();
+    }
+  });
+  events.addEventListener("lists", (e) => {
+    const d = JSON.parse(e.data);
+    ({ recordings: loadRecordings, demonstrations: loadDemos, runs: loadRuns, policies: loadPolicies }[d.changed] || (() => {}))();
+  });
+}
+
+let runsRenderPending = false;
+function scheduleRunsRender() {
+  if (runsRenderPending) return;
+  runsRenderPending = true;
+  setTimeout(() => { runsRenderPending = false; renderRuns(); }, 1000 / CURVE_FPS);
+}
+
+/* ------------------------------------------------------------------ start-up */
+async function loadConfig() {
+  try {
+    S.config = await api("GET", "/api/config");
+  } catch (e) {
+    $("scene-msg").textContent = `The 3D scene is unavailable: ${e.message}`;
+    $("scene-msg").hidden = false;
+    return;
+  }
+  $("version").textContent = `v${S.config.version}`;
+  const url = S.config.viser_url;
+  if (!url) {
+    $("scene-msg").textContent = "This studio runs without a 3D scene (no viser URL configured).";
+    $("scene-msg").hidden = false;
+    return;
+  }
+  $("scene").src = url;
+}
+
+function wire() {
+  $("source-kind").addEventListener("change", syncKindOptions);
+  $("source-apply").addEventListener("click", applySource);
+  $("playback-toggle").addEventListener("click", () => playback($("playback-toggle").dataset.playing === "1" ? "pause" : "play"));
+  const seek = $("playback-seek");
+  seek.addEventListener("input", () => { seek.dataset.dragging = "1"; });
+  seek.addEventListener("change", () => { delete seek.dataset.dragging; playback("seek", { t: Number(seek.value) }); });
+  $("playback-speed").addEventListener("change", () => {
+    if (S.source && S.source.kind === "recording") playback(S.source.playback && S.source.playback.playing ? "play" : "pause", { speed: Number($("playback-speed").value) });
+  });
+  $("playback-loop").addEventListener("change", () => {
+    if (S.source && S.source.kind === "recording") applySource();
+  });
+  $("retarget-mode").addEventListener("change", setRetarget);
+  $("retarget-mirror").addEventListener("change", setRetarget);
+
+  $("capture-toggle").addEventListener("click", toggleCapture);
+  $("recording-upload").addEventListener("change", (e) => uploadRecording(e.target));
+  $("edit-form").addEventListener("submit", saveRecordingEdit);
+
+  $("demo-recording").addEventListener("change", () => { setDemoRange(0, 0); syncDemoRange(); });
+  $("demo-t0-range").addEventListener("input", () => {
+    const t0 = Math.min(Number($("demo-t0-range").value), Number($("demo-t1-range").value));
+    setDemoRange(t0, Number($("demo-t1-range").value));
+  });
+  $("demo-t1-range").addEventListener("input", () => {
+    const t1 = Math.max(Number($("demo-t1-range").value), Number($("demo-t0-range").value));
+    setDemoRange(Number($("demo-t0-range").value), t1);
+  });
+  for (const id of ["demo-t0", "demo-t1"]) {
+    $(id).addEventListener("change", () => setDemoRange(Number($("demo-t0").value) || 0, Number($("demo-t1").value) || 0));
+  }
+  $("demo-cut").addEventListener("click", cutDemo);
+  $("demo-mark").addEventListener("click", toggleMark);
+
+  $("train-form").addEventListener("submit", startRun);
+  $("train-defaults").addEventListener("click", resetTrainForm);
+  $("curve-log").addEventListener("change", markCurvesDirty);
+  $("curve-band").addEventListener("change", markCurvesDirty);
+
+  $("watch-go").addEventListener("click", watch);
+  $("watch-stop").addEventListener("click", () => guarded("watch-error", () => api("POST", "/api/watch/stop")));
+  $("policy-upload").addEventListener("change", (e) => uploadPolicy(e.target));
+  for (const b of document.querySelectorAll("[data-dl]")) b.addEventListener("click", () => exportFile(b.dataset.dl));
+}
+
+async function main() {
+  wire();
+  syncKindOptions();
+  updateMarkButton();
+  renderCaptureButton();
+  setInterval(renderCurves, 1000 / CURVE_FPS);
+  connectEvents();
+  await loadConfig();
+  const initial = api("GET", "/api/source").then((s) => {
+    S.source = s;
+    if (s.kind) $("source-kind").value = s.kind;
+    syncKindOptions();
+    renderSource();
+  }).catch((e) => showError("source-error", e));
+  const cap = api("GET", "/api/capture").then((c) => { S.capture = c; renderCaptureButton(); updateMarkButton(); }).catch(() => {});
+  await Promise.all([initial, cap, loadRecordings(), loadDemos(), loadRuns(), loadPolicies()]);
+  if (S.source && S.source.recording) $("source-recording").value = S.source.recording;
+  document.body.dataset.ready = "1";
+}
+
+main();
