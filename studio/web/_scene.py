@@ -54,13 +54,13 @@ class SceneLayout:
         camera_look_at: initial camera target (m).
     """
 
-    human_origin: tuple[float, float, float] = (0.05, 1.05, 1.38)
+    human_origin: tuple[float, float, float] = (0.0, -0.95, 1.38)
     mirror_axis: int | None = 1
     torso_size: tuple[float, float, float] = (0.22, 0.36, 0.55)
     rate_hz: float = 40.0
     playback_hold_s: float = 2.0
-    camera_position: tuple[float, float, float] = (2.1, -1.0, 1.55)
-    camera_look_at: tuple[float, float, float] = (0.15, 0.45, 0.8)
+    camera_position: tuple[float, float, float] = (2.4, -0.7, 1.75)
+    camera_look_at: tuple[float, float, float] = (0.1, -0.45, 0.9)
     colors: dict[str, tuple[int, int, int]] = field(
         default_factory=lambda: {
             "skin": (226, 182, 150),
@@ -224,15 +224,15 @@ class StudioScene:
             height=6.0,
             cell_size=0.25,
             section_size=1.0,
-            position=(0.0, 0.5, 0.0),
+            position=(0.0, -0.5, 0.0),
             plane_color=(238, 240, 243),
             plane_opacity=1.0,
         )
-        s.add_label("/labels/robot", "Puma560", position=(0.0, -0.45, 0.05))
+        s.add_label("/labels/robot", "Puma560", position=(0.0, 0.3, 0.05))
         s.add_label(
             "/labels/human",
             "operator (mirrored)",
-            position=(lay.human_origin[0], lay.human_origin[1] + 0.15, 0.05),
+            position=(lay.human_origin[0], lay.human_origin[1] - 0.2, 0.05),
         )
 
         self._robot_handles = self._add_robot("/robot", opacity=None)
@@ -321,15 +321,10 @@ class StudioScene:
         s = self.server.scene
         c = self.layout.colors
         depth, width, height = self.layout.torso_size
-        # The body's midline lies on the side of the shoulder away from the arm's hanging hand
-        # along the lateral axis; the mirrored arm hangs on the robot's side of the torso.
-        pose = self.arm.forward(np.asarray(self.arm.neutral, dtype=float))
-        lateral = self._arm_points(pose)[3] - shoulder
-        lateral[2] = 0.0
-        axis = np.zeros(3)
-        axis[1] = 1.0 if lateral[1] < 0 else -1.0
-        if abs(lateral[1]) < 1e-3:  # hand straight below: put the body away from the robot
-            axis[1] = 1.0
+        # In the arm base frame (x forward, y left, z up) the body's midline lies on +y of a
+        # right shoulder and on -y of a left one; the drawing mirrors it with the arm.
+        side = getattr(self.arm, "side", self._side)
+        axis = self._human_R @ np.array([0.0, 1.0 if side == "right" else -1.0, 0.0])
         centre = shoulder + axis * (width / 2 + 0.03) + np.array([0.0, 0.0, -height / 2 + 0.04])
         s.add_box(
             "/human/torso", color=c["shirt"], dimensions=(depth, width, height), position=centre
