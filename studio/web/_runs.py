@@ -151,8 +151,9 @@ class Run:
         """The learning curve (see :func:`curve_of`)."""
         return curve_of(self.steps(), start)
 
-    def public(self) -> dict[str, Any]:
-        """The ``RunPublic`` fields."""
+    def public(self, steps: np.ndarray | None = None) -> dict[str, Any]:
+        """The ``RunPublic`` fields (``episodes_done`` from ``steps`` when given)."""
+        steps = self.steps() if steps is None else steps
         cpu = self.cpu_seconds
         if self.status == "running":
             cpu = time.process_time() - self._cpu_start
@@ -164,7 +165,7 @@ class Run:
             "created": self.created,
             "started": self.started,
             "finished": self.finished,
-            "episodes_done": self.episodes_done(),
+            "episodes_done": int(np.count_nonzero(steps >= 0)),
             "episodes_total": self.create.experiments * self.create.episodes,
             "cpu_seconds": round(float(cpu), 3),
             "error": self.error,

@@ -255,26 +255,30 @@ class RecordingStore:
         """Validate an uploaded temporary file as a recording and give it a free name.
 
         Raises:
-            InvalidError: the file is not a readable recording (the temporary file is removed).
+            InvalidError: a bad file name, or the file is not a readable recording (the
+                temporary file is removed either way).
         """
         from studio.capture import read_recording
 
         try:
-            read_recording(tmp)
-        except StudioError as err:
+            base = clean_upload_name(filename, RECORDING_SUFFIX, "upload")
+            try:
+                read_recording(tmp)
+            except StudioError as err:
+                message = str(err).replace(str(tmp), filename or "the upload")
+                message = message.replace(tmp.name, filename or "the upload")
+                raise InvalidError(
+                    f"{filename or 'The upload'} is not a valid Teach Studio recording: {message}"
+                ) from None
+            except Exception as err:  # a file the reader did not anticipate
+                raise InvalidError(
+                    f"{filename or 'The upload'} is not a readable Teach Studio recording ({type(err).__name__}); upload a .tape.csv file."
+                ) from None
+            name = unique_name(base, self.exists)
+            os.replace(tmp, self.folder / f"{name}{RECORDING_SUFFIX}")
+            return name
+        finally:
             tmp.unlink(missing_ok=True)
-            raise InvalidError(
-                f"{filename or 'The upload'} is not a Teach Studio recording ({err})"
-            ) from None
-        except Exception as err:  # a file the reader did not anticipate: still the user's file
-            tmp.unlink(missing_ok=True)
-            raise InvalidError(
-                f"{filename or 'The upload'} is not a readable Teach Studio recording ({type(err).__name__}); upload a .tape.csv file."
-            ) from None
-        base = clean_upload_name(filename, RECORDING_SUFFIX, "upload")
-        name = unique_name(base, self.exists)
-        os.replace(tmp, self.folder / f"{name}{RECORDING_SUFFIX}")
-        return name
 
     def new_name(self, base: str) -> str:
         """A free recording name starting with ``base``."""
@@ -373,15 +377,16 @@ class PolicyStore:
         from studio.learning import load_policy
 
         try:
-            load_policy(tmp)
-        except StudioError as err:
+            base = clean_upload_name(filename, POLICY_SUFFIX, "policy")
+            try:
+                load_policy(tmp)
+            except StudioError as err:
+                raise InvalidError(str(err).replace(tmp.name, filename or "The upload")) from None
+            name = unique_name(base, taken)
+            os.replace(tmp, self.folder / f"{name}{POLICY_SUFFIX}")
+            return name
+        finally:
             tmp.unlink(missing_ok=True)
-            message = str(err).replace(tmp.name, filename or "The upload")
-            raise InvalidError(message) from None
-        base = clean_upload_name(filename, POLICY_SUFFIX, "policy")
-        name = unique_name(base, taken)
-        os.replace(tmp, self.folder / f"{name}{POLICY_SUFFIX}")
-        return name
 
 
 def policy_summary(policy: Any) -> dict[str, Any]:
@@ -437,9 +442,10 @@ class DemonstrationStore:
 
     def load(self, name: str) -> Any:
         """The demonstration as :mod:`studio.capture` reads it (cached)."""
+        path = self.path(name)
         from studio.capture import load_demonstration
 
-        return self._cache.get(self.path(name), load_demonstration)
+        return self._cache.get(path, load_demonstration)
 
     def info(self, name: str) -> dict[str, Any]:
         """The ``DemonstrationPublic`` fields."""

@@ -17,6 +17,7 @@ from fastapi import APIRouter, Request
 from fastapi.responses import StreamingResponse
 
 from .._deps import StudioDep
+from .._runs import curve_of
 from .._state import Studio
 
 router = APIRouter(prefix="/api/events", tags=["events"])
@@ -87,7 +88,8 @@ async def stream_events(
 
 def run_event(run, counts: dict[str, list[int]]) -> dict:  # noqa: ANN001 - a _runs.Run
     """A ``run`` event: the run and its curve from the first episode that changed for this client."""
-    curve = run.curve()
+    steps = run.steps()
+    curve = curve_of(steps)
     previous = counts.get(run.id, [])
     now = curve["count"]
     start = 0
@@ -95,7 +97,7 @@ def run_event(run, counts: dict[str, list[int]]) -> dict:  # noqa: ANN001 - a _r
         start += 1
     counts[run.id] = now
     part = {key: values[start:] for key, values in curve.items()}
-    return {"run": run.public(), "curve": part, "from": start}
+    return {"run": run.public(steps), "curve": part, "from": start}
 
 
 def _final_run(studio: Studio, run_id: str, counts: dict[str, list[int]]) -> dict | None:

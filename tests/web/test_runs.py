@@ -1,0 +1,259 @@
+"""Training runs through the API: validation, the queue, stop, downloads, persistence."""
+
+from __future__ import annotations
+
+import io
+import json
+
+import numpy as np
+import pytest
+
+from studio.learning import load_policy
+from tests.web.conftest import TINY_RUN, wait_run
+
+BAD_RUNS = [
+    ({"bins": 0}, "bins"),
+    ({"bins": 1}, "bins"),
+    ({"episodes": -5}, "episodes"),
+    ({"episodes": 0}, "episodes"),
+    ({"episodes": 1_000_000_000}, "episodes"),
+    ({"experiments": 0}, "experiments"),
+    ({"experiments": 1000, "episodes": 100_000}, "experiments x episodes"),
+    ({"epsilon": 2}, "epsilon"),
+    ({"epsilon": -0.1}, "epsilon"),
+    ({"alpha": 0}, "alpha"),
+    ({"gamma": 1.5}, "gamma"),
+    ({"planning_steps": -1}, "planning_steps"),
+    ({"planning": "psychic"}, "planning"),
+    ({"goal_deg": [170, 0, 0]}, "goal_deg joint 1"),
+    ({"goal_deg": [0, 0, -150]}, "goal_deg joint 3"),
+    ({"goal_deg": [150, 0, 0]}, "bin centred at 163.6"),  # inside the limit, its bin is not
+    ({"goal_deg": [0, 0]}, "goal_deg"),
+    ({"goal_deg": [0, "up", 0]}, "goal_deg"),
+    ({"seed": -1}, "seed"),
+    ({"episodes": "many"}, "episodes"),
+    ({"demonstrations": ["no-such-demo"]}, "no-such-demo"),
+    ({"demonstrations": ["../etc"]}, "separator"),
+    ({"turbo": True}, "turbo"),
+]
+
+
+@pytest.mark.parametrize(("body", "names"), BAD_RUNS)
+def test_bad_run_settings_get_one_sentence(client, body, names):
+    r = client.post("/api/runs", json={**TINY_RUN, **body})
+    assert r.status_code in (404, 422), r.text
+    detail = r.json()["detail"]
+    assert isinstance(detail, str) and names in detail
+    assert detail.rstrip().endswith(".") and "\n" not in detail
+    assert client.get("/api/runs").json() == []  # nothing was queued
+
+
+def test_a_tiny_run_trains_and_yields_a_loadable_policy(client, tmp_path):
+    r = client.post("/api/runs", json={**TINY_RUN, "name": "my first run"})
+    assert r.status_code == 201
+    run = r.json()
+    assert run["status"] in ("queued", "running") and run["name"] == "my first run"
+    done = wait_run(client, run["id"])
+    assert done["status"] == "done", done
+    assert done["episodes_done"] == done["episodes_total"] == 8
+    assert done["has_policy"] and done["cpu_seconds"] > 0
+
+    curve = client.get(f"/api/runs/{run['id']}/curve").json()
+    assert curve["episodes"] == [1, 2, 3, 4]
+    assert curve["count"] == [2, 2, 2, 2]
+    for k in range(4):
+        assert curve["min"][k] <= curve["mean"][k] <= curve["max"][k]
+        assert curve["std"][k] >= 0
+
+    r = client.get(f"/api/runs/{run['id']}/policy")
+    assert r.status_code == 200
+    path = tmp_path / "download.policy.npz"
+    path.write_bytes(r.content)
+    policy = load_policy(path)
+    assert policy.config.planning == "zero"
+    assert policy.grid.bins == 11 and policy.experiments == 2
+    assert np.allclose(policy.mean_steps, curve["mean"])
+
+    csv = client.get(f"/api/runs/{run['id']}/curve.csv")
+    assert csv.headers["content-type"].startswith("text/csv")
+    rows = csv.text.strip().splitlines()
+    assert rows[0] == "episode,mean,std,min,max,experiments" and len(rows) == 5
+    assert float(rows[1].split(",")[1]) == pytest.approx(curve["mean"][0])
+
+    png = client.get(f"/api/runs/{run['id']}/plot.png?log=true")
+    assert png.status_code == 200 and png.content[:8] == b"\x89PNG\r\n\x1a\n"
+    svg = client.get(f"/api/runs/{run['id']}/plot.svg")
+    assert svg.status_code == 200 and b"<svg" in svg.content[:1000]
+    assert client.get(f"/api/runs/{run['id']}/plot.gif").status_code == 404
+
+    on_disk = tmp_path / "runs" / run["id"]
+    assert {"config.json", "status.json", "steps.csv", "curves.csv", "policy.policy.npz"} <= {
+        p.name for p in on_disk.iterdir()
+    }
+    assert json.loads((on_disk / "config.json").read_text())["request"]["name"] == "my first run"
+
+
+def test_the_goal_is_the_bin_containing_goal_deg(client, tmp_path):
+    run = client.post("/api/runs", json={**TINY_RUN, "bins": 5, "goal_deg": [10, -20, 30]}).json()
+    wait_run(client, run["id"])
+    policy = load_policy(tmp_path / "runs" / run["id"] / "policy.policy.npz")
+    assert policy.grid.bins == 5
+    assert policy.grid.goal == tuple(policy.grid.bins_of_angles(np.radians([10, -20, 30])))
+
+
+def test_runs_queue_and_stop_queued_and_running(client):
+    long = {"planning": "full", "experiments": 1, "episodes": 100_000, "seed": 0}
+    first = client.post("/api/runs", json=long).json()
+    second = client.post("/api/runs", json={**TINY_RUN}).json()
+    assert client.get(f"/api/runs/{second['id']}").json()["status"] == "queued"
+    assert client.delete(f"/api/runs/{first['id']}").status_code in (204, 409)
+
+    stopped = client.post(f"/api/runs/{second['id']}/stop").json()
+    assert stopped["status"] == "stopped" and stopped["episodes_done"] == 0
+
+    for _ in range(200):  # wait until the first run has finished an episode
+        if client.get(f"/api/runs/{first['id']}").json()["episodes_done"] > 0:
+            break
+        client.app.state.studio.runs.wait_idle(0.05)
+    running = client.get(f"/api/runs/{first['id']}").json()
+    assert running["status"] == "running"
+    r = client.delete(f"/api/runs/{first['id']}")
+    assert r.status_code == 409 and "stop it first" in r.json()["detail"]
+
+    client.post(f"/api/runs/{first['id']}/stop")
+    done = wait_run(client, first["id"])
+    assert done["status"] == "stopped"
+    assert 0 < done["episodes_done"] < 100_000
+    assert done["has_policy"]
+    curve = client.get(f"/api/runs/{first['id']}/curve").json()
+    assert len(curve["episodes"]) == done["episodes_done"]
+    # the queued run stopped before it started never trained
+    assert client.get(f"/api/runs/{second['id']}").json()["episodes_done"] == 0
+
+
+def test_delete_run_removes_it_and_its_policy(client, tmp_path):
+    run = client.post("/api/runs", json=TINY_RUN).json()
+    wait_run(client, run["id"])
+    assert any(p["run"] == run["id"] for p in client.get("/api/policies").json())
+    assert client.delete(f"/api/runs/{run['id']}").status_code == 204
+    assert not (tmp_path / "runs" / run["id"]).exists()
+    assert client.get(f"/api/runs/{run['id']}").status_code == 404
+    assert client.get(f"/api/runs/{run['id']}/policy").status_code == 404
+    assert all(p["run"] != run["id"] for p in client.get("/api/policies").json())
+
+
+@pytest.mark.parametrize("path", ["", "/curve", "/curve.csv", "/plot.png", "/policy"])
+def test_unknown_runs_are_404_and_bad_ids_422(client, path):
+    r = client.get(f"/api/runs/20990101-000000-zero-abcd{path}")
+    assert r.status_code == 404 and "no run" in r.json()["detail"]
+    r = client.get(f"/api/runs/a..b{path}")
+    assert r.status_code == 422 and "not valid" in r.json()["detail"]
+    assert client.post("/api/runs/nope/stop").status_code == 404
+    assert client.delete("/api/runs/nope").status_code == 404
+
+
+def test_policy_download_before_there_is_one_is_409(client):
+    long = {"planning": "full", "experiments": 1, "episodes": 100_000}
+    run = client.post("/api/runs", json=long).json()
+    queued = client.post("/api/runs", json=TINY_RUN).json()
+    r = client.get(f"/api/runs/{queued['id']}/policy")
+    assert r.status_code == 409 and "no policy yet" in r.json()["detail"]
+    client.post(f"/api/runs/{run['id']}/stop")
+    client.post(f"/api/runs/{queued['id']}/stop")
+    wait_run(client, run["id"])
+
+
+def test_runs_survive_a_restart_and_interrupted_runs_show_stopped(open_client, tmp_path):
+    first = open_client()
+    done = first.post("/api/runs", json=TINY_RUN).json()
+    wait_run(first, done["id"])
+    curve = first.get(f"/api/runs/{done['id']}/curve").json()
+    first.__exit__(None, None, None)
+
+    # fake a crash during a second run: its folder says running, with a partial curve
+    runs = tmp_path / "runs"
+    crashed = runs / "20200101-000000-full-dead"
+    crashed.mkdir()
+    record = json.loads((runs / done["id"] / "config.json").read_text())
+    record["id"] = crashed.name
+    (crashed / "config.json").write_text(json.dumps(record))
+    status = json.loads((runs / done["id"] / "status.json").read_text())
+    (crashed / "status.json").write_text(json.dumps({**status, "status": "running"}))
+    (crashed / "steps.csv").write_text("# partial\n7,5,-1,-1\n9,-1,-1,-1\n")
+
+    second = open_client()
+    listed = {r["id"]: r for r in second.get("/api/runs").json()}
+    assert listed[done["id"]]["status"] == "done"
+    assert second.get(f"/api/runs/{done['id']}/curve").json() == curve
+    assert second.get(f"/api/runs/{done['id']}/policy").status_code == 200
+    interrupted = listed[crashed.name]
+    assert interrupted["status"] == "stopped"
+    assert "stopped while this run was training" in interrupted["error"]
+    partial = second.get(f"/api/runs/{crashed.name}/curve").json()
+    assert partial["episodes"] == [1, 2] and partial["count"] == [2, 1]
+    assert partial["mean"] == [8.0, 5.0]
+    assert json.loads((crashed / "status.json").read_text())["status"] == "stopped"
+
+
+def test_a_shutdown_mid_run_keeps_the_partial_curve(open_client):
+    first = open_client()
+    run = first.post(
+        "/api/runs", json={"planning": "full", "experiments": 1, "episodes": 100_000}
+    ).json()
+    for _ in range(400):
+        if first.get(f"/api/runs/{run['id']}").json()["episodes_done"] > 0:
+            break
+        first.app.state.studio.runs.wait_idle(0.05)
+    first.__exit__(None, None, None)
+    second = open_client()
+    after = second.get(f"/api/runs/{run['id']}").json()
+    assert after["status"] == "stopped" and after["episodes_done"] > 0
+    assert "shut down" in after["error"]
+    assert after["has_policy"]
+
+
+def test_run_events_stream_the_curve_while_training(client):
+    run = client.post(
+        "/api/runs", json={"planning": "full", "experiments": 1, "episodes": 100_000}
+    ).json()
+    events = []
+    with client.stream("GET", "/api/events?max_seconds=1.5") as r:
+        assert r.headers["content-type"].startswith("text/event-stream")
+        event = None
+        for line in r.iter_lines():
+            if line.startswith("event: "):
+                event = line[7:]
+            elif line.startswith("data: ") and event == "run":
+                events.append(json.loads(line[6:]))
+    client.post(f"/api/runs/{run['id']}/stop")
+    wait_run(client, run["id"])
+    assert len(events) >= 5
+    assert all(e["run"]["id"] == run["id"] for e in events)
+    assert events[0]["from"] == 0
+    # replaying the partial updates rebuilds the curve the API serves at that moment
+    counts: list[int] = []
+    for e in events:
+        counts = counts[: e["from"]] + e["curve"]["count"]
+        assert e["curve"]["episodes"][:1] in ([], [e["from"] + 1])
+        assert sum(counts) == e["run"]["episodes_done"]
+    assert events[-1]["run"]["episodes_done"] > events[0]["run"]["episodes_done"]
+
+
+def test_a_client_that_disconnects_mid_run_changes_nothing(client):
+    run = client.post("/api/runs", json={**TINY_RUN, "episodes": 200}).json()
+    with client.stream("GET", "/api/events") as r:
+        for line in r.iter_lines():
+            if line.startswith("event: "):
+                break  # leave after the first event
+    done = wait_run(client, run["id"])
+    assert done["status"] == "done" and done["episodes_done"] == 400
+    assert client.get("/api/source").status_code == 200
+
+
+def test_csv_of_curve_is_parseable(client):
+    run = client.post("/api/runs", json=TINY_RUN).json()
+    wait_run(client, run["id"])
+    data = np.loadtxt(
+        io.StringIO(client.get(f"/api/runs/{run['id']}/curve.csv").text), delimiter=",", skiprows=1
+    )
+    assert data.shape == (4, 6) and list(data[:, 0]) == [1, 2, 3, 4]
