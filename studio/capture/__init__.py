@@ -12,6 +12,10 @@ See ``docs/interfaces.md`` for the contract and :mod:`._recording_format` for th
 
 from __future__ import annotations
 
+from ._calibration import Calibration as Calibration
+from ._calibration import load_calibration as load_calibration
+from ._capture_loop import capture as capture
+from ._emulator import ShapeTapeEmulator as ShapeTapeEmulator
 from ._errors import CaptureError as CaptureError
 from ._errors import DemonstrationError as DemonstrationError
 from ._errors import RecordingError as RecordingError
@@ -20,7 +24,12 @@ from ._frames import SWITCH1_BIT as SWITCH1_BIT
 from ._frames import TRIGGER_BIT as TRIGGER_BIT
 from ._frames import TapeFrame as TapeFrame
 from ._frames import frames_to_arrays as frames_to_arrays
+from ._network import FrameSender as FrameSender
+from ._network import NetworkSource as NetworkSource
+from ._network import stream_source as stream_source
 from ._playback import PlaybackSource as PlaybackSource
+from ._raw_import import import_raw as import_raw
+from ._raw_import import read_raw_text as read_raw_text
 from ._recording_edit import copy_recording as copy_recording
 from ._recording_edit import rename_recording as rename_recording
 from ._recording_edit import update_recording_meta as update_recording_meta
@@ -32,6 +41,13 @@ from ._recording_reader import read_header as read_header
 from ._recording_reader import read_recording as read_recording
 from ._recording_writer import RecordingWriter as RecordingWriter
 from ._recording_writer import recording_meta as recording_meta
+from ._serial import SerialSource as SerialSource
 from ._source import FrameSource as FrameSource
 from ._source import SourceStatus as SourceStatus
 from ._source import ThreadedSource as ThreadedSource
+from ._source_spec import SOURCE_SPECS as SOURCE_SPECS
+from ._source_spec import parse_host_port as parse_host_port
+from ._source_spec import source_from_spec as source_from_spec
+from ._wire import DEFAULT_PORT as DEFAULT_PORT
+from ._wire import decode_frame as decode_frame
+from ._wire import encode_frame as encode_frame

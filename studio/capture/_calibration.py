@@ -1,0 +1,174 @@
+"""ShapeTape calibration: raw channel counts to bend/twist radians.
+
+The tape reports two channels per region; channel ``2 i`` carries region ``i``'s bend and channel
+``2 i + 1`` its twist. A calibration subtracts the flat-pose reading and applies a linear gain per
+channel: ``angle[c] = gains[c] * (raw[c] - offsets[c])``.
+
+File (``*.calibration.json``)::
+
+    {"format": "teach-studio-calibration", "version": 1, "regions": 16,
+     "offsets": [32 raw counts], "gains": [32 radians per count], "serial": 5001, "notes": "..."}
+
+How to make one: lay the tape flat and straight on a table, record a few seconds of raw frames
+(``Measurand``'s raw text, or a :class:`SerialSource` with :meth:`Calibration.identity`), and
+average each channel: that is ``offsets`` (:meth:`Calibration.from_flat` does it). ``gains``
+come from the maker's sheet, or from bending the tape round a cylinder of known radius (bend =
+region length / radius) and dividing by the change in counts.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ._errors import CaptureError
+
+CALIBRATION_FORMAT = "teach-studio-calibration"
+"""The ``format`` value of calibration files."""
+CALIBRATION_VERSION = 1
+"""The version this code writes and the newest it reads."""
+RAW_CENTRE = 32768
+"""A uint16 channel's mid-scale count: the flat reading of an uncalibrated channel."""
+DEFAULT_GAIN = 1.0e-4
+"""Radians per count when no gain is known (the full uint16 range spans about +-3.3 rad)."""
+
+
+@dataclass(frozen=True, eq=False)
+class Calibration:
+    """Flat-pose offsets and per-channel gains of one tape.
+
+    Args:
+        offsets: raw counts of the flat tape, ``(2 * regions,)``.
+        gains: radians per count, ``(2 * regions,)``.
+        serial: the tape's serial number, if known.
+        notes: free text.
+    """
+
+    offsets: np.ndarray
+    gains: np.ndarray
+    serial: int | None = None
+    notes: str = ""
+
+    def __post_init__(self) -> None:
+        offsets = np.asarray(self.offsets, dtype=np.float64)
+        gains = np.asarray(self.gains, dtype=np.float64)
+        if offsets.ndim != 1 or offsets.shape != gains.shape or offsets.size % 2:
+            raise CaptureError(
+                f"calibration offsets {offsets.shape} and gains {gains.shape} must be two equal even-length lists (two channels per region)."
+            )
+        if not (np.isfinite(offsets).all() and np.isfinite(gains).all()):
+            raise CaptureError(
+                "the calibration holds a NaN or infinite value; remake it from a flat recording."
+            )
+        object.__setattr__(self, "offsets", offsets)
+        object.__setattr__(self, "gains", gains)
+
+    @property
+    def channels(self) -> int:
+        """Raw channels (two per region)."""
+        return int(self.offsets.shape[0])
+
+    @property
+    def regions(self) -> int:
+        """Bend/twist regions."""
+        return self.channels // 2
+
+    @classmethod
+    def identity(cls, regions: int = 16, gain: float = DEFAULT_GAIN) -> Calibration:
+        """Mid-scale offsets and one gain for every channel (before a real calibration exists)."""
+        return cls(np.full(2 * regions, float(RAW_CENTRE)), np.full(2 * regions, float(gain)))
+
+    @classmethod
+    def from_flat(
+        cls, raw: np.ndarray, gains: np.ndarray | float = DEFAULT_GAIN, **kw: Any
+    ) -> Calibration:
+        """Offsets from raw frames of the flat tape (their per-channel mean), with given gains.
+
+        Args:
+            raw: ``(frames, channels)`` raw counts recorded with the tape held flat.
+            gains: radians per count, one per channel or one for all.
+        """
+        raw = np.asarray(raw, dtype=np.float64)
+        if raw.ndim != 2 or raw.shape[0] < 1:
+            raise CaptureError(
+                f"flat raw frames have shape {raw.shape}; give (frames, channels) with frames >= 1."
+            )
+        offsets = raw.mean(axis=0)
+        return cls(
+            offsets,
+            np.broadcast_to(np.asarray(gains, dtype=np.float64), offsets.shape).copy(),
+            **kw,
+        )
+
+    def angles(self, raw: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``(bend, twist)`` in radians from raw counts ``(..., channels)``."""
+        raw = np.asarray(raw, dtype=np.float64)
+        angle = (raw - self.offsets) * self.gains
+        return angle[..., 0::2], angle[..., 1::2]
+
+    def raw(self, bend: np.ndarray, twist: np.ndarray) -> np.ndarray:
+        """The raw counts (uint16, rounded and clipped) a device would report for these angles."""
+        bend, twist = np.asarray(bend, dtype=np.float64), np.asarray(twist, dtype=np.float64)
+        angle = np.empty(bend.shape[:-1] + (self.channels,))
+        angle[..., 0::2], angle[..., 1::2] = bend, twist
+        return np.clip(np.rint(angle / self.gains + self.offsets), 0, 0xFFFF).astype(np.uint16)
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready file contents."""
+        return {
+            "format": CALIBRATION_FORMAT,
+            "version": CALIBRATION_VERSION,
+            "regions": self.regions,
+            "offsets": self.offsets.tolist(),
+            "gains": self.gains.tolist(),
+            "serial": self.serial,
+            "notes": self.notes,
+        }
+
+    def save(self, path: str | os.PathLike[str]) -> Path:
+        """Write the calibration as JSON."""
+        path = Path(path)
+        path.write_text(json.dumps(self.to_dict(), indent=1) + "\n", encoding="utf-8")
+        return path
+
+
+def load_calibration(path: str | os.PathLike[str] | Calibration) -> Calibration:
+    """Read a calibration JSON file (a :class:`Calibration` passes through).
+
+    Raises:
+        CaptureError: the file is missing or not a calibration (the message says which).
+    """
+    if isinstance(path, Calibration):
+        return path
+    path = Path(path)
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except OSError as err:
+        raise CaptureError(
+            f"cannot open calibration {path} ({err.strerror}); check the path."
+        ) from None
+    except ValueError:
+        raise CaptureError(
+            f"{path} is not valid JSON; give a calibration file (see the capture docs)."
+        ) from None
+    if not isinstance(data, dict) or data.get("format") != CALIBRATION_FORMAT:
+        raise CaptureError(
+            f"{path} is not a calibration (no format '{CALIBRATION_FORMAT}'); give a calibration file."
+        )
+    if data.get("version") != CALIBRATION_VERSION:
+        raise CaptureError(
+            f"{path} has calibration version {data.get('version')!r}; this studio reads version {CALIBRATION_VERSION}."
+        )
+    try:
+        return Calibration(
+            data["offsets"], data["gains"], data.get("serial"), str(data.get("notes", ""))
+        )
+    except KeyError as err:
+        raise CaptureError(
+            f"{path} has no {err.args[0]!r} list; give offsets and gains per channel."
+        ) from None

@@ -1,0 +1,110 @@
+"""Record a source into a file: the loop behind ``studio record`` (and any scripted capture)."""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+from ._errors import CaptureError
+from ._recording_format import DEFAULT_RATE_HZ
+from ._recording_writer import RecordingWriter
+from ._source import SourceStatus, ThreadedSource
+
+READ_TIMEOUT_SECONDS = 0.1
+"""How long one read waits for frames (bounds how late a stop request is seen)."""
+
+
+def capture(
+    source: ThreadedSource,
+    out: str | os.PathLike[str],
+    seconds: float | None = None,
+    *,
+    operator: str = "",
+    notes: str = "",
+    source_name: str | None = None,
+    on_progress: Callable[[int, SourceStatus], None] | None = None,
+    stop: Callable[[], bool] | None = None,
+) -> Path:
+    """Record ``source`` into a new recording until ``seconds`` of frames, its end, or ``stop()``.
+
+    The file is closed (``# end`` line) whatever ends the capture, including Ctrl-C
+    (``KeyboardInterrupt`` is re-raised after the file is safe), so nothing captured is lost.
+
+    Args:
+        source: an unstarted source (started and stopped here).
+        out: the new ``*.tape.csv`` file.
+        seconds: frames' duration to record (``None``: until the source ends or ``stop()``).
+        operator: who wore the tape.
+        notes: free text.
+        source_name: stored in the header (default: the source's kind).
+        on_progress: called with ``(frames written, source status)`` after each batch.
+        stop: polled after each batch; true ends the capture.
+
+    Returns:
+        The recording's path.
+
+    Raises:
+        CaptureError: the source failed (the frames up to then are kept in the file).
+    """
+    config = getattr(source, "config", None)
+    regions = int(getattr(config, "regions", 16)) if config is not None else 16
+    rate = float(getattr(source, "rate_hz", DEFAULT_RATE_HZ) or DEFAULT_RATE_HZ)
+    writer = RecordingWriter(
+        out,
+        regions,
+        config=config,
+        operator=operator,
+        notes=notes,
+        rate_hz=rate,
+        source=source_name or source.kind,
+    )
+    first_t: float | None = None
+    try:
+        source.start()
+        while True:
+            frames = source.read(timeout=READ_TIMEOUT_SECONDS)
+            if frames:
+                if first_t is None:
+                    first_t = frames[0].t
+                if seconds is not None:
+                    frames = [f for f in frames if f.t - first_t < seconds - 0.5 / rate]
+                writer.write_many(frames)
+            status = source.status()
+            if on_progress is not None:
+                on_progress(writer.frames, status)
+            if status.error:
+                raise CaptureError(f"{status.error} ({writer.frames} frames kept in {writer.path})")
+            if (
+                seconds is not None
+                and first_t is not None
+                and writer.frames >= round(seconds * rate)
+            ):
+                break
+            if not frames and not status.running:
+                break
+            if stop is not None and stop():
+                break
+    finally:
+        source.stop()
+        writer.close()
+    return writer.path
+
+
+def describe(summary: dict[str, Any]) -> str:
+    """A few human lines about a recording summary (for ``studio info``)."""
+    lines = [
+        f"{summary['path']}",
+        f"  name      {summary['name']}",
+        f"  frames    {summary['frames']} ({summary['duration']:.2f} s at {summary['rate_hz']:g} Hz, {summary['regions']} regions)",
+        f"  source    {summary['source']}",
+        f"  operator  {summary['operator'] or '-'}",
+        f"  created   {summary['created']}",
+        f"  recovered {'yes (the capture was interrupted; every flushed frame is here)' if summary['recovered'] else 'no'}",
+    ]
+    if summary["notes"]:
+        lines.append(f"  notes     {summary['notes']}")
+    for problem in summary["problems"]:
+        lines.append(f"  problem   {problem}")
+    return "\n".join(lines)

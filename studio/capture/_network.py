@@ -1,0 +1,187 @@
+"""The network bridge: receive tape frames over UDP (:class:`NetworkSource`) and send them.
+
+A small device-side program (or ``studio bridge``) sends one datagram per frame in the format of
+:mod:`._wire`. UDP suits a 110 Hz stream on a LAN: no head-of-line blocking, and a lost frame is
+better late than never. Lost frames show up as gaps in the frame counter and are counted as
+dropped; malformed datagrams are counted as rejected, with the reason in ``status().warning``.
+"""
+
+from __future__ import annotations
+
+import socket
+import time
+
+from ._errors import CaptureError
+from ._frames import TapeFrame
+from ._source import DEFAULT_QUEUE_FRAMES, ThreadedSource
+from ._wire import DEFAULT_PORT, WireError, decode_frame, encode_frame
+
+RECEIVE_POLL_SECONDS = 0.1
+"""Socket timeout: how quickly the receiver notices a stop request."""
+SILENCE_SECONDS = 2.0
+"""After this long without a datagram, the status reports that the sender went quiet."""
+MAX_DATAGRAM_BYTES = 65535
+"""Largest UDP payload."""
+MAX_COUNTER_GAP = 10_000
+"""A larger jump in the frame counter is a restarted sender, not lost frames."""
+
+
+class NetworkSource(ThreadedSource):
+    """Tape frames from UDP datagrams (wire format in :mod:`studio.capture._wire`).
+
+    Args:
+        host: address to listen on (loopback by default; ``"0.0.0.0"`` for a device on the LAN).
+        port: UDP port (0 picks a free one; see :attr:`address`).
+        config: the tape config the frames belong to (informational).
+        queue_frames: frames buffered before dropping.
+
+    Raises:
+        CaptureError: from :meth:`start` when the port cannot be bound.
+    """
+
+    kind = "network"
+
+    def __init__(
+        self,
+        host: str = "127.0.0.1",
+        port: int = DEFAULT_PORT,
+        config: object = None,
+        queue_frames: int = DEFAULT_QUEUE_FRAMES,
+    ) -> None:
+        super().__init__(queue_frames)
+        self.host, self.port = host, int(port)
+        self.config = config
+        self._sock: socket.socket | None = None
+        self._last_counter: int | None = None
+
+    @property
+    def address(self) -> tuple[str, int]:
+        """The bound ``(host, port)`` (after :meth:`start`), else the requested one."""
+        if self._sock is not None:
+            return self._sock.getsockname()[:2]
+        return self.host, self.port
+
+    def _open(self) -> None:
+        if self._sock is not None:
+            return
+        sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 1 << 20)
+        try:
+            sock.bind((self.host, self.port))
+        except OSError as err:
+            sock.close()
+            raise CaptureError(
+                f"cannot listen on UDP {self.host}:{self.port} ({err.strerror}); choose another port."
+            ) from None
+        sock.settimeout(RECEIVE_POLL_SECONDS)
+        self._sock = sock
+
+    def _close(self) -> None:
+        if self._sock is not None:
+            self._sock.close()
+            self._sock = None
+
+    def _produce(self) -> None:
+        sock = self._sock
+        assert sock is not None
+        last_datagram = time.monotonic()
+        while not self._stop_event.is_set():
+            try:
+                data, sender = sock.recvfrom(MAX_DATAGRAM_BYTES)
+            except TimeoutError:
+                quiet = time.monotonic() - last_datagram
+                if quiet > SILENCE_SECONDS and self._frames:
+                    with self._lock:
+                        self._warning = (
+                            f"no frames for {quiet:.0f} s; check that the sender is running."
+                        )
+                continue
+            except OSError as err:
+                if self._stop_event.is_set():
+                    return
+                raise CaptureError(
+                    f"the UDP socket failed ({err.strerror}); restart the network source."
+                ) from None
+            last_datagram = time.monotonic()
+            try:
+                frame = decode_frame(data)
+            except WireError as err:
+                self._reject(f"rejected a datagram from {sender[0]}:{sender[1]}: {err}.")
+                continue
+            if self._last_counter is not None:
+                gap = (frame.frame - self._last_counter - 1) & 0xFFFFFFFF
+                if 0 < gap < MAX_COUNTER_GAP:
+                    self._count_dropped(gap)
+            self._last_counter = frame.frame
+            self._push(frame)
+
+
+class FrameSender:
+    """Send frames to a :class:`NetworkSource` (what a device-side program does).
+
+    Args:
+        host: the receiver's address.
+        port: the receiver's UDP port.
+    """
+
+    def __init__(self, host: str = "127.0.0.1", port: int = DEFAULT_PORT) -> None:
+        self.target = (host, int(port))
+        self._sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        self.sent = 0
+
+    def send(self, frame: TapeFrame) -> None:
+        """Send one frame as one datagram."""
+        self._sock.sendto(encode_frame(frame), self.target)
+        self.sent += 1
+
+    def close(self) -> None:
+        """Release the socket."""
+        self._sock.close()
+
+    def __enter__(self) -> FrameSender:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+def stream_source(
+    source: ThreadedSource,
+    host: str,
+    port: int,
+    seconds: float | None = None,
+    on_frames: object = None,
+) -> int:
+    """Forward every frame of ``source`` to ``host:port`` until it ends or ``seconds`` pass.
+
+    Args:
+        source: a started or unstarted source (it is started and stopped here).
+        host: the receiver's address.
+        port: the receiver's UDP port.
+        seconds: how long to stream (``None``: until the source ends).
+        on_frames: optional callable given each batch of frames sent (for progress).
+
+    Returns:
+        Frames sent.
+
+    Raises:
+        CaptureError: the source reported an error.
+    """
+    deadline = None if seconds is None else time.monotonic() + seconds
+    with FrameSender(host, port) as sender:
+        source.start()
+        try:
+            while deadline is None or time.monotonic() < deadline:
+                frames = source.read(timeout=0.1)
+                for frame in frames:
+                    sender.send(frame)
+                if frames and callable(on_frames):
+                    on_frames(frames)
+                status = source.status()
+                if status.error:
+                    raise CaptureError(status.error)
+                if not frames and not status.running:
+                    break
+        finally:
+            source.stop()
+        return sender.sent

@@ -1,0 +1,92 @@
+"""Build a source from a short text spec, as the CLI and the web page name them.
+
+Specs: ``simulator`` (or ``simulator:SEED``), a recording path (``*.tape.csv``, played back),
+``udp`` / ``udp:PORT`` / ``udp:HOST:PORT`` (a :class:`NetworkSource`), ``serial:PORT`` (a
+:class:`SerialSource`, with ``calibration``).
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from typing import Any
+
+from ._errors import CaptureError
+from ._source import ThreadedSource
+from ._wire import DEFAULT_PORT
+
+SOURCE_SPECS = "simulator[:SEED] | FILE.tape.csv | udp[:[HOST:]PORT] | serial:PORT"
+"""What :func:`source_from_spec` accepts (for help texts)."""
+
+
+def source_from_spec(
+    spec: str,
+    *,
+    seed: int = 0,
+    speed: float | None = 1.0,
+    loop: bool = False,
+    calibration: str | os.PathLike[str] | None = None,
+    **kwargs: Any,
+) -> ThreadedSource:
+    """The source a spec names (not started).
+
+    Args:
+        spec: see the module docstring.
+        seed: simulator seed (when the spec gives none).
+        speed: playback speed (``None``: as fast as possible).
+        loop: playback loops.
+        calibration: serial calibration file.
+        kwargs: passed to the source's constructor.
+
+    Raises:
+        CaptureError: an unknown spec (the message lists the valid ones).
+    """
+    kind, _, rest = spec.partition(":")
+    if kind == "simulator":
+        from ._simulator import SimulatorSource
+
+        return SimulatorSource(seed=int(rest) if rest else seed, **kwargs)
+    if kind == "udp":
+        host, port = "127.0.0.1", DEFAULT_PORT
+        if rest:
+            host_part, _, port_part = rest.rpartition(":")
+            host = host_part or host
+            try:
+                port = int(port_part)
+            except ValueError:
+                raise CaptureError(
+                    f"'{spec}' has no valid port; write udp:PORT or udp:HOST:PORT."
+                ) from None
+        from ._network import NetworkSource
+
+        return NetworkSource(host, port, **kwargs)
+    if kind == "serial":
+        if not rest:
+            raise CaptureError("'serial' needs a port; write serial:/dev/ttyUSB0.")
+        from ._serial import SerialSource
+
+        return SerialSource(rest, calibration=calibration, **kwargs)
+    if Path(spec).is_file():
+        from ._playback import PlaybackSource
+
+        return PlaybackSource(spec, speed=speed, loop=loop, **kwargs)
+    raise CaptureError(
+        f"'{spec}' is neither a source nor an existing recording; give one of {SOURCE_SPECS}."
+    )
+
+
+def parse_host_port(text: str, default_port: int = DEFAULT_PORT) -> tuple[str, int]:
+    """``HOST:PORT`` (or ``HOST``, or ``:PORT``) as a tuple.
+
+    Raises:
+        CaptureError: the port is not a number.
+    """
+    host, sep, port = text.rpartition(":")
+    if not sep:
+        return text or "127.0.0.1", default_port
+    try:
+        return host or "127.0.0.1", int(port)
+    except ValueError:
+        raise CaptureError(
+            f"'{text}' has no valid port; write HOST:PORT, e.g. 127.0.0.1:{default_port}."
+        ) from None

@@ -1,0 +1,54 @@
+"""``studio bridge``: stream the simulator or a recording over UDP in the network wire format.
+
+It plays the part of a device-side program, so the network path can be exercised end to end:
+run ``studio bridge --source simulator --to 127.0.0.1:47110`` and pick the ``udp`` source.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from studio.capture import DEFAULT_PORT, parse_host_port, source_from_spec, stream_source
+
+NAME = "bridge"
+HELP = "Stream the simulator or a recording to a Teach Studio network source over UDP."
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--source",
+        default="simulator",
+        help="simulator[:SEED] or FILE.tape.csv (default: simulator)",
+    )
+    parser.add_argument(
+        "--to",
+        default=f"127.0.0.1:{DEFAULT_PORT}",
+        help=f"receiver HOST:PORT (default: 127.0.0.1:{DEFAULT_PORT})",
+    )
+    parser.add_argument(
+        "--seconds",
+        type=float,
+        default=None,
+        help="stop after this long (default: until the source ends or Ctrl-C)",
+    )
+    parser.add_argument("--seed", type=int, default=0, help="simulator seed (default: 0)")
+    parser.add_argument("--speed", type=float, default=1.0, help="playback speed for a recording")
+    parser.add_argument("--loop", action="store_true", help="loop a recording")
+
+
+def run(args: argparse.Namespace) -> int:
+    host, port = parse_host_port(args.to)
+    source = source_from_spec(args.source, seed=args.seed, speed=args.speed, loop=args.loop)
+    sent = [0]
+
+    def progress(frames: list) -> None:
+        sent[0] += len(frames)
+        print(f"\rsent {sent[0]} frames to {host}:{port}", end="", file=sys.stderr, flush=True)
+
+    try:
+        total = stream_source(source, host, port, args.seconds, on_frames=progress)
+    except KeyboardInterrupt:
+        total = sent[0]
+    print(f"\nsent {total} frames to {host}:{port}.", file=sys.stderr)
+    return 0

@@ -1,0 +1,41 @@
+"""``studio info``: what a recording (``*.tape.csv``) or demonstration (``*.demo.json``) holds."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+from studio.capture import read_recording
+from studio.capture._capture_loop import describe
+
+NAME = "info"
+HELP = "Show a recording's or demonstration's metadata, length and any problems."
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "files", type=Path, nargs="+", metavar="FILE", help="*.tape.csv or *.demo.json files"
+    )
+    parser.add_argument("--json", action="store_true", help="print JSON instead of text")
+    parser.add_argument(
+        "--lenient",
+        action="store_true",
+        help="list a damaged recording's problems instead of stopping at the first",
+    )
+
+
+def run(args: argparse.Namespace) -> int:
+    for path in args.files:
+        if path.name.endswith(".demo.json"):
+            from studio.capture import load_demonstration
+
+            summary = load_demonstration(path).summary()
+            text = "\n".join(
+                [str(path), *(f"  {k:<10}{v}" for k, v in summary.items() if k != "path")]
+            )
+        else:
+            summary = read_recording(path, strict=not args.lenient).summary()
+            text = describe(summary)
+        print(json.dumps(summary) if args.json else text)
+    return 0
