@@ -59,8 +59,8 @@ class SceneLayout:
     torso_size: tuple[float, float, float] = (0.22, 0.36, 0.55)
     rate_hz: float = 40.0
     playback_hold_s: float = 2.0
-    camera_position: tuple[float, float, float] = (2.4, -0.7, 1.75)
-    camera_look_at: tuple[float, float, float] = (0.1, -0.45, 0.9)
+    camera_position: tuple[float, float, float] = (1.95, -0.6, 1.6)
+    camera_look_at: tuple[float, float, float] = (0.1, -0.42, 0.9)
     colors: dict[str, tuple[int, int, int]] = field(
         default_factory=lambda: {
             "skin": (226, 182, 150),

@@ -607,8 +607,10 @@ function runColor(id) {
 
 function runLabel(r) {
   const c = r.config || {};
+  const name = r.name || r.id;
   const demos = (c.demonstrations || []).length;
-  return `${r.name || r.id} · ${c.planning}${demos ? ` +${demos} demo` : ""}`;
+  const planning = c.planning && !name.includes(c.planning) ? ` · ${c.planning}` : "";
+  return `${name}${planning}${demos && !/demo/.test(name) ? ` +${demos} demo` : ""}`;
 }
 
 function renderRuns() {
@@ -744,7 +746,9 @@ function renderCurves() {
   const layout = {
     margin: { l: 52, r: 10, t: 6, b: 32 },
     xaxis: { title: { text: "episode", standoff: 4 }, zeroline: false },
-    yaxis: { title: { text: "steps", standoff: 4 }, type: $("curve-log").checked ? "log" : "linear", zeroline: false },
+    yaxis: $("curve-log").checked
+      ? { title: { text: "steps", standoff: 4 }, type: "log", dtick: 1, zeroline: false }
+      : { title: { text: "steps", standoff: 4 }, type: "linear", rangemode: "tozero", zeroline: false },
     legend: { orientation: "h", x: 1, xanchor: "right", y: 1, font: { size: 10 }, bgcolor: "rgba(255,255,255,0.7)" },
     font: { size: 11, family: "system-ui, sans-serif" },
     paper_bgcolor: "#fff", plot_bgcolor: "#fff",
