@@ -178,6 +178,27 @@ class Pipeline:
                 "recording_active": self._writer is not None,
             }
 
+    def tape_config(self) -> Any:
+        """The tape config of the current source (the default tape when the source has none)."""
+        config = getattr(self._source, "config", None)
+        if config is None:
+            from studio.kinematics import TapeConfig
+
+            config = TapeConfig()
+        return config
+
+    def source_label(self) -> str:
+        """Where frames come from, for a recording's header (``serial:/dev/ttyUSB0``, ...)."""
+        source = self._source
+        if self._kind == "serial":
+            return f"serial:{getattr(source, 'port', '')}"
+        if self._kind == "network":
+            host, port = getattr(source, "address", ("", 0))
+            return f"network:{host}:{port}"
+        if self._kind == "recording":
+            return f"recording:{self._recording}"
+        return self._kind or ""
+
     def q_robot(self) -> np.ndarray:
         """The newest retargeted robot pose (rad)."""
         with self._lock:
@@ -286,7 +307,8 @@ class Pipeline:
             if not frames:
                 continue
             self._record(frames)
-            self._fit(source, frames[-MAX_FITS_PER_BATCH:])
+            if source is self._source:
+                self._fit(source, frames[-MAX_FITS_PER_BATCH:])
 
     def _record(self, frames: list[Any]) -> None:
         with self._lock:
@@ -294,8 +316,7 @@ class Pipeline:
             if writer is None:
                 return
             try:
-                for frame in frames:
-                    writer.write(frame)
+                writer.write_many(frames)
             except Exception as err:
                 log.exception("writing the capture failed")
                 self._kin_error = f"Writing the recording failed ({err}); it was stopped, its frames so far are kept."
@@ -311,7 +332,7 @@ class Pipeline:
 
         kin = self._kin
         if kin is None:
-            config = source.config
+            config = self.tape_config()
             arm = HumanArm()
             kin = {
                 "config": config,
@@ -322,9 +343,9 @@ class Pipeline:
         return kin
 
     def _fit(self, source: Any, frames: list[Any]) -> None:
-        from studio.kinematics import reconstruct
-
         try:
+            from studio.kinematics import reconstruct
+
             kin = self._kinematics(source)
             for frame in frames:
                 shape = reconstruct(frame.bend, frame.twist, kin["config"])
@@ -342,6 +363,8 @@ class Pipeline:
             with self._lock:
                 self._kin_error = str(err)
         except Exception as err:  # e.g. NaN frames from a device: shown, not fatal
-            log.exception("the kinematics failed on a frame")
+            message = f"The arm fit failed on a frame ({type(err).__name__}: {err})."
+            if message != self._kin_error:  # log each new problem once, not 110 times a second
+                log.exception("the kinematics failed on a frame")
             with self._lock:
-                self._kin_error = f"The arm fit failed on a frame ({type(err).__name__}: {err})."
+                self._kin_error = message

@@ -45,7 +45,7 @@ class PlaybackPublic(BaseModel):
     """Playback state of a recording source."""
 
     playing: bool
-    speed: float
+    speed: float | None
     t: float
     duration: float
     loop: bool

@@ -119,9 +119,9 @@ class Studio:
         seed: int | None = None,
     ) -> None:
         """Build a source of ``kind`` and make it the live one."""
-        from studio.capture import NetworkSource, PlaybackSource, SerialSource, SimulatorSource
-
         if kind == "simulator":
+            from studio.capture import SimulatorSource
+
             source = SimulatorSource(seed=seed if seed is not None else 0)
             self.pipeline.set_source(source, kind)
         elif kind == "recording":
@@ -129,19 +129,28 @@ class Studio:
                 raise InvalidError(
                     "recording is missing; give the name of a recording to play back."
                 )
+            from studio.capture import PlaybackSource
+
             path = self.recordings.path(recording)
             source = PlaybackSource(
-                path, speed=speed if speed is not None else 1.0, loop=bool(loop)
+                path, speed=speed if speed is not None else 1.0, loop=True if loop is None else loop
             )
             self.pipeline.set_source(source, kind, recording)
         elif kind == "network":
+            from studio.capture import NetworkSource
+
             source = NetworkSource(port=port) if port is not None else NetworkSource()
+            # the bridge listens on loopback unless the studio itself is opened up
+            if not self.settings.is_loopback:
+                source.host = "0.0.0.0"
             self.pipeline.set_source(source, kind)
         elif kind == "serial":
             if not device:
                 raise InvalidError(
                     "device is missing; give the serial device of the tape, for example /dev/ttyUSB0."
                 )
+            from studio.capture import SerialSource
+
             source = SerialSource(device)
             self.pipeline.set_source(source, kind)
         else:  # the schema allows only the kinds above
@@ -170,7 +179,7 @@ class Studio:
         if speed is not None:
             source.speed = speed
         if action == "play":
-            source.play()
+            source.resume()
         elif action == "pause":
             source.pause()
         elif action == "seek":
@@ -206,10 +215,10 @@ class Studio:
         path = self.settings.recordings_dir / f"{final}{RECORDING_SUFFIX}"
         writer = RecordingWriter(
             path,
-            source.config,
+            config=self.pipeline.tape_config(),
             operator=operator or "",
             notes=notes or "",
-            source=self.pipeline.kind or "",
+            source=self.pipeline.source_label(),
         )
         self.pipeline.start_capture(writer, final, path)
         self.mark_t0 = None
@@ -344,13 +353,10 @@ class Studio:
 
 
 def _playback_state(source: Any) -> dict[str, Any] | None:
-    try:
-        return {
-            "playing": bool(source.playing),
-            "speed": float(source.speed),
-            "t": float(source.position),
-            "duration": float(source.duration),
-            "loop": bool(source.loop),
-        }
-    except AttributeError:
-        return None
+    return {
+        "playing": bool(source.running and not source.paused),
+        "speed": None if source.speed is None else float(source.speed),
+        "t": float(source.position),
+        "duration": float(source.duration),
+        "loop": bool(source.loop),
+    }

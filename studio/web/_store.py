@@ -1,8 +1,8 @@
 """The on-disk stores under the data directory: names, uploads, recordings and policies.
 
 Everything a user makes lives in plain files so it survives a restart and can be used without the
-studio: ``recordings/*.tape.csv`` (and a ``*.meta.json`` sidecar holding the operator and notes
-edited in the page; the recording itself is never rewritten), ``recordings/*.demo.json``,
+studio: ``recordings/*.tape.csv`` (edits of the operator and notes replace the header line
+atomically, the frames are never rewritten), ``recordings/*.demo.json``,
 ``policies/*.policy.npz``. Training runs have their own store in :mod:`studio.web._runs`.
 
 Names are plain file stems (letters, digits, ``-``, ``_``, ``.``; no separators, no ``..``), so a
@@ -12,7 +12,6 @@ upload or a new capture whose name is taken gets ``-2``, ``-3``, ... appended.
 
 from __future__ import annotations
 
-import json
 import os
 import re
 import threading
@@ -32,7 +31,6 @@ NAME_PATTERN = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.-]{0,99}$")
 RECORDING_SUFFIX = ".tape.csv"
 DEMONSTRATION_SUFFIX = ".demo.json"
 POLICY_SUFFIX = ".policy.npz"
-META_SUFFIX = ".meta.json"
 SAMPLE_PREFIX = "sample-"
 """Recordings shipped with the repository start with this prefix."""
 UPLOAD_CHUNK_BYTES = 1024 * 1024
@@ -183,19 +181,15 @@ class RecordingStore:
     def info(self, name: str) -> dict[str, Any]:
         """The ``RecordingPublic`` fields of one recording."""
         path = self.path(name)
-        summary = self._cache.get(path, _recording_summary)
-        meta = self._meta(name)
         return {
             "name": name,
-            **summary,
-            "operator": meta.get("operator", summary["operator"]),
-            "notes": meta.get("notes", summary["notes"]),
+            **self._cache.get(path, _recording_summary),
             "size_bytes": path.stat().st_size,
             "sample": name.startswith(SAMPLE_PREFIX),
         }
 
     def list(self) -> list[dict[str, Any]]:
-        """Every readable recording's summary (an unreadable file is listed with its error)."""
+        """Every recording's summary (an unreadable file is listed with its error)."""
         out = []
         for name in self.names():
             try:
@@ -203,17 +197,9 @@ class RecordingStore:
             except StudioError as err:
                 path = self.folder / f"{name}{RECORDING_SUFFIX}"
                 out.append(_broken_recording(name, path, str(err)))
+            except FileNotFoundError:  # deleted meanwhile
+                continue
         return out
-
-    def _meta_path(self, name: str) -> Path:
-        return self.folder / f"{name}{META_SUFFIX}"
-
-    def _meta(self, name: str) -> dict[str, Any]:
-        try:
-            data = json.loads(self._meta_path(name).read_text())
-        except (OSError, ValueError):
-            return {}
-        return data if isinstance(data, dict) else {}
 
     def update(
         self,
@@ -224,32 +210,30 @@ class RecordingStore:
     ) -> str:
         """Rename and/or annotate a recording; returns its (new) name.
 
-        The recording file is renamed, never rewritten; the operator and notes go to its sidecar.
+        The header is changed by an atomic replace, the frames are never touched
+        (:func:`studio.capture.update_recording_meta`); a rename also updates the demonstrations
+        that reference the file (:func:`studio.capture.rename_recording`).
         """
+        from studio.capture import rename_recording, update_recording_meta
+
         path = self.path(name)
-        meta = self._meta(name)
-        if notes is not None:
-            meta["notes"] = notes
-        if operator is not None:
-            meta["operator"] = operator
-        if notes is not None or operator is not None:
-            atomic_write_text(self._meta_path(name), json.dumps(meta, indent=1))
         if new_name is not None and new_name != name:
             check_name(new_name, "new recording name")
             if self.exists(new_name):
                 raise ConflictError(
                     f"A recording named {new_name!r} already exists; choose another name."
                 )
-            os.rename(path, self.folder / f"{new_name}{RECORDING_SUFFIX}")
-            if self._meta_path(name).exists():
-                os.rename(self._meta_path(name), self._meta_path(new_name))
+        changes = {k: v for k, v in (("notes", notes), ("operator", operator)) if v is not None}
+        if changes:
+            update_recording_meta(path, **changes)
+        if new_name is not None and new_name != name:
+            rename_recording(path, new_name)
             return new_name
         return name
 
     def delete(self, name: str) -> None:
-        """Delete a recording and its sidecar."""
+        """Delete a recording."""
         self.path(name).unlink()
-        self._meta_path(name).unlink(missing_ok=True)
 
     def adopt(self, tmp: Path, filename: str | None) -> str:
         """Validate an uploaded temporary file as a recording and give it a free name.
@@ -288,22 +272,16 @@ class RecordingStore:
 def _recording_summary(path: Path) -> dict[str, Any]:
     from studio.capture import read_recording
 
-    rec = read_recording(path)
-    meta = dict(rec.meta or {})
-    frames = len(rec.t)
-    duration = float(rec.duration)
-    rate = meta.get("rate_hz")
-    if rate is None and duration > 0:
-        rate = (frames - 1) / duration
+    summary = read_recording(path).summary()
     return {
-        "frames": frames,
-        "duration": duration,
-        "rate_hz": float(rate) if rate is not None else None,
-        "created": str(meta.get("created", "")),
-        "operator": str(meta.get("operator", "") or ""),
-        "notes": str(meta.get("notes", "") or ""),
-        "source": str(meta.get("source", "") or ""),
-        "recovered": bool(rec.recovered),
+        "frames": int(summary["frames"]),
+        "duration": float(summary["duration"]),
+        "rate_hz": float(summary["rate_hz"]) if summary.get("rate_hz") else None,
+        "created": str(summary.get("created") or ""),
+        "operator": str(summary.get("operator") or ""),
+        "notes": str(summary.get("notes") or ""),
+        "source": str(summary.get("source") or ""),
+        "recovered": bool(summary["recovered"]),
         "error": None,
     }
 

