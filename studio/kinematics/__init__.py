@@ -1,6 +1,9 @@
 """studio.kinematics (see docs/interfaces.md)."""
 
 from ._errors import KinematicsError as KinematicsError
+from ._human import ArmPose as ArmPose
+from ._human import HumanArm as HumanArm
+from ._human import mirror_human_q as mirror_human_q
 from ._puma import PUMA_QN as PUMA_QN
 from ._puma import PUMA_QR as PUMA_QR
 from ._puma import PUMA_QS as PUMA_QS
@@ -9,3 +12,8 @@ from ._puma import IKConfig as IKConfig
 from ._puma import IKResult as IKResult
 from ._puma import LinkVisual as LinkVisual
 from ._puma import Puma560 as Puma560
+from ._tape import TapeConfig as TapeConfig
+from ._tape import TapeShape as TapeShape
+from ._tape import reconstruct as reconstruct
+from ._tape import tape_angles as tape_angles
+from ._tape import tape_from_arm as tape_from_arm

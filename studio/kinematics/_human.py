@@ -1,0 +1,250 @@
+"""The 7-DOF human arm from example-robot-data's ``human.urdf``, reduced with Pinocchio.
+
+Gepetto's human model is Y-up with the arms hanging along -Y. We lock every joint except one
+arm's seven (shoulder Z/X/Y, elbow Z/Y, wrist Z/X; the paper's arm) and express all poses in the
+*arm base frame*: origin at the shoulder, x forward, y to the operator's left, z up.
+
+Joint conventions (from the URDF, anatomical, identical for both sides):
+
+- ``shoulder_Z``: flexion (+ raises the arm forward), ``shoulder_X``: abduction (+ raises it
+  sideways, away from the body), ``shoulder_Y``: humeral rotation,
+- ``elbow_Z``: flexion (0 is a straight arm), ``elbow_Y``: forearm rotation,
+- ``wrist_Z``: wrist flexion, ``wrist_X``: wrist deviation.
+
+The left chain of ``human.urdf`` uses mirrored joint axes, so the same ``q_human`` puts the left
+arm in the mirror image (through the sagittal plane, y -> -y) of the right arm's pose; see
+:func:`mirror_human_q`.
+"""
+
+from __future__ import annotations
+
+import importlib.metadata
+import sysconfig
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Literal
+
+import numpy as np
+import pinocchio as pin
+
+from ._errors import KinematicsError
+
+URDF_RELATIVE = Path(
+    "cmeel.prefix/share/example-robot-data/robots/human_description/robots/human.urdf"
+)
+"""Where the ``example-robot-data`` wheel installs ``human.urdf``, relative to site-packages."""
+
+ARM_JOINTS = ("shoulder_Z", "shoulder_X", "shoulder_Y", "elbow_Z", "elbow_Y", "wrist_Z", "wrist_X")
+"""The seven arm joints kept from ``human.urdf`` (prefixed ``right_`` or ``left_``)."""
+
+YUP_TO_ZUP = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])
+"""Rotation taking ``human.urdf`` vectors (x forward, y up, z right) to the arm base frame."""
+
+SAGITTAL_MIRROR = np.diag([1.0, -1.0, 1.0])
+"""Reflection through the sagittal plane in the arm base frame (y -> -y)."""
+
+
+def find_human_urdf() -> Path:
+    """Locate ``human.urdf`` from the installed ``example-robot-data`` distribution.
+
+    Returns:
+        The path of ``human.urdf``.
+
+    Raises:
+        KinematicsError: the package is not installed.
+    """
+    candidates: list[Path] = []
+    try:
+        dist = importlib.metadata.distribution("example-robot-data")
+        candidates.append(Path(str(dist.locate_file(URDF_RELATIVE))))
+    except importlib.metadata.PackageNotFoundError:
+        pass
+    for key in ("purelib", "platlib"):
+        candidates.append(Path(sysconfig.get_paths()[key]) / URDF_RELATIVE)
+    for path in candidates:
+        if path.is_file():
+            return path
+    raise KinematicsError(
+        "The human arm model human.urdf was not found; install it with "
+        "`pip install example-robot-data`."
+    )
+
+
+def _as_q(value: object, size: int, what: str) -> np.ndarray:
+    try:
+        q = np.asarray(value, dtype=float)
+    except (TypeError, ValueError) as err:
+        raise KinematicsError(f"{what} must be an array of {size} numbers; got {value!r}.") from err
+    if q.shape[-1:] != (size,):
+        raise KinematicsError(f"{what} must have shape (..., {size}); got shape {q.shape}.")
+    if not np.all(np.isfinite(q)):
+        raise KinematicsError(f"{what} contains NaN or infinite angles; pass finite radians.")
+    return q
+
+
+def mirror_human_q(q_human: object) -> np.ndarray:
+    """The joint angles of the opposite arm that give the mirror-image pose.
+
+    ``human.urdf`` defines the left arm's joint axes as the mirror images of the right arm's
+    (anatomical convention: flexion, abduction and rotation are positive the same way on both
+    sides), so mirroring a pose from one arm to the other keeps the angles: this returns a copy.
+    It exists so that callers say what they mean, and its law (the left arm's pose at
+    ``mirror_human_q(q)`` is the right arm's pose at ``q`` mirrored through the sagittal plane;
+    twice is the identity) is tested.
+
+    Args:
+        q_human: joint angles (rad), shape ``(..., 7)``.
+
+    Returns:
+        The mirrored joint angles, shape ``(..., 7)``.
+
+    Raises:
+        KinematicsError: wrong shape or non-finite angles.
+    """
+    return _as_q(q_human, len(ARM_JOINTS), "q_human").copy()
+
+
+@dataclass(frozen=True)
+class ArmPose:
+    """Poses of the arm's landmarks in the arm base frame (4x4 each).
+
+    Orientations are the ``human.urdf`` joint frames turned into the Z-up base frame: in each,
+    the limb points along local -y (towards the hand).
+
+    Attributes:
+        shoulder: the shoulder joint frame after all three shoulder rotations (upper-arm frame).
+        elbow: the elbow frame after both elbow rotations (forearm frame).
+        wrist: the wrist frame after both wrist rotations (hand frame at the wrist).
+        hand: the hand frame moved along the hand to its centre (``HumanArm.hand_length``).
+    """
+
+    shoulder: np.ndarray
+    elbow: np.ndarray
+    wrist: np.ndarray
+    hand: np.ndarray
+
+
+class HumanArm:
+    """One human arm (7 DOF) with forward kinematics in a Z-up, shoulder-centred frame.
+
+    Args:
+        side: ``"right"`` or ``"left"``.
+        upper_arm: shoulder-to-elbow length in metres (default: the URDF's 0.276 m).
+        forearm: elbow-to-wrist length in metres (default: the URDF's 0.287 m).
+        hand: wrist-to-hand-centre length in metres (default: the URDF hand's centre of mass
+            depth, 0.153 m).
+
+    Attributes:
+        model: the reduced Pinocchio model (immutable after construction); its root placement
+            already maps into the arm base frame, so ``data.oMi`` are arm-base poses.
+        data: scratch space for :meth:`forward` (not thread-safe).
+        side, nq (7), joint_names, lower, upper, neutral (zeros: arm hanging),
+        upper_arm_length, forearm_length, hand_length.
+    """
+
+    nq = len(ARM_JOINTS)
+
+    def __init__(
+        self,
+        side: Literal["right", "left"] = "right",
+        upper_arm: float | None = None,
+        forearm: float | None = None,
+        hand: float | None = None,
+    ) -> None:
+        if side not in ("right", "left"):
+            raise KinematicsError(f'side must be "right" or "left"; got {side!r}.')
+        self.side = side
+        self.joint_names = tuple(f"{side}_{name}" for name in ARM_JOINTS)
+        full = pin.buildModelFromUrdf(str(find_human_urdf()))
+        keep = {full.getJointId(name) for name in self.joint_names}
+        lock = [j for j in range(1, full.njoints) if j not in keep]
+        model = pin.buildReducedModel(full, lock, pin.neutral(full))
+        if model.nq != self.nq:  # pragma: no cover - guards a changed URDF
+            raise KinematicsError("human.urdf no longer has the expected arm joints; reinstall it.")
+        ids = [model.getJointId(name) for name in self.joint_names]
+        if ids != list(range(1, self.nq + 1)):  # pragma: no cover
+            raise KinematicsError("human.urdf's arm joints are not one chain; reinstall it.")
+
+        # Move the root into the arm base frame: Z-up, shoulder at the origin.
+        oMshoulder = model.jointPlacements[1]
+        baseMurdf = pin.SE3(YUP_TO_ZUP, -YUP_TO_ZUP @ oMshoulder.translation)
+        model.jointPlacements[1] = baseMurdf * oMshoulder
+
+        hand_body = full.inertias[full.getJointId(f"{side}_wrist_X")]
+        defaults = {
+            "upper_arm": -model.jointPlacements[4].translation[1],
+            "forearm": -model.jointPlacements[6].translation[1],
+            "hand": -hand_body.lever[1],
+        }
+        lengths = {"upper_arm": upper_arm, "forearm": forearm, "hand": hand}
+        for key, value in lengths.items():
+            if value is None:
+                lengths[key] = float(defaults[key])
+            elif not (np.isfinite(value) and value > 0):
+                raise KinematicsError(f"{key} must be a positive length in metres; got {value!r}.")
+        self.upper_arm_length = float(lengths["upper_arm"])
+        self.forearm_length = float(lengths["forearm"])
+        self.hand_length = float(lengths["hand"])
+        for joint, length in ((4, self.upper_arm_length), (6, self.forearm_length)):
+            placement = model.jointPlacements[joint]
+            model.jointPlacements[joint] = pin.SE3(
+                placement.rotation, np.array([0.0, -length, 0.0])
+            )
+        self.hand_frame = model.addFrame(
+            pin.Frame(
+                "hand",
+                self.nq,
+                pin.SE3(np.eye(3), np.array([0.0, -self.hand_length, 0.0])),
+                pin.FrameType.OP_FRAME,
+            )
+        )
+        self.model = model
+        self.data = model.createData()
+        self.lower = model.lowerPositionLimit.copy()
+        self.upper = model.upperPositionLimit.copy()
+        self.neutral = np.zeros(self.nq)
+        for arr in (self.lower, self.upper, self.neutral):
+            arr.setflags(write=False)
+
+    def forward(self, q_human: object) -> ArmPose:
+        """Landmark poses of the arm at ``q_human``.
+
+        Args:
+            q_human: joint angles (rad), shape (7,). Angles beyond the limits are accepted.
+
+        Returns:
+            An :class:`ArmPose` (new arrays).
+
+        Raises:
+            KinematicsError: wrong shape or non-finite angles.
+        """
+        q = _as_q(q_human, self.nq, "q_human")
+        if q.shape != (self.nq,):
+            raise KinematicsError(f"q_human must have shape (7,); got shape {q.shape}.")
+        pin.forwardKinematics(self.model, self.data, q)
+        oMi = self.data.oMi
+        hand = oMi[self.nq] * self.model.frames[self.hand_frame].placement
+        return ArmPose(
+            shoulder=oMi[3].homogeneous,
+            elbow=oMi[5].homogeneous,
+            wrist=oMi[7].homogeneous,
+            hand=hand.homogeneous,
+        )
+
+    def points(self, q_human: object) -> np.ndarray:
+        """Shoulder, elbow, wrist and hand positions, shape ``(..., 4, 3)``, vectorised over q.
+
+        Args:
+            q_human: joint angles (rad), shape ``(..., 7)``.
+
+        Returns:
+            Landmark positions in the arm base frame.
+        """
+        q = _as_q(q_human, self.nq, "q_human")
+        flat = q.reshape(-1, self.nq)
+        out = np.empty((flat.shape[0], 4, 3))
+        for k, qk in enumerate(flat):
+            pose = self.forward(qk)
+            for j, m in enumerate((pose.shoulder, pose.elbow, pose.wrist, pose.hand)):
+                out[k, j] = m[:3, 3]
+        return out.reshape(*q.shape[:-1], 4, 3)
