@@ -422,16 +422,14 @@ class StudioScene:
                 live_robot = self._live[1]
         q_robot: np.ndarray | None = None
         marks_upto = -1
+        finished = False
         if playback is not None:
             t = now - playback.started
             times = playback.times
             if t >= times[-1]:
                 q_robot = playback.q[-1]
                 k = len(times) - 1
-                with self._lock:
-                    if self._playback is playback:
-                        self._playback = None
-                        self._hold_until = now + self.layout.playback_hold_s
+                finished = True
             else:
                 k = int(np.searchsorted(times, t, side="right")) - 1
                 k = min(max(k, 0), len(times) - 2)
@@ -452,9 +450,13 @@ class StudioScene:
                 self._push_robot(self._robot_handles, q_robot)
             if playback is not None and marks_upto > playback.shown_until:
                 self._push_trace(playback, marks_upto)
-        if q_robot is not None:
-            with self._lock:
+        with self._lock:
+            if q_robot is not None:
                 self._q_robot_shown = np.array(q_robot, dtype=float)
+            if finished and self._playback is playback:
+                # Cleared only after the last pose is shown, so `playing` false means "at the end".
+                self._playback = None
+                self._hold_until = now + self.layout.playback_hold_s
         if live is not None:
             with self._lock:
                 self._q_human_shown = np.array(live[0], dtype=float)
