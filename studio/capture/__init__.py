@@ -15,6 +15,11 @@ from __future__ import annotations
 from ._calibration import Calibration as Calibration
 from ._calibration import load_calibration as load_calibration
 from ._capture_loop import capture as capture
+from ._demonstration import MAX_FIT_RESIDUAL_M as MAX_FIT_RESIDUAL_M
+from ._demonstration import Demonstration as Demonstration
+from ._demonstration import demonstrations_for as demonstrations_for
+from ._demonstration import extract_demonstration as extract_demonstration
+from ._demonstration import load_demonstration as load_demonstration
 from ._emulator import ShapeTapeEmulator as ShapeTapeEmulator
 from ._errors import CaptureError as CaptureError
 from ._errors import DemonstrationError as DemonstrationError
@@ -42,6 +47,11 @@ from ._recording_reader import read_recording as read_recording
 from ._recording_writer import RecordingWriter as RecordingWriter
 from ._recording_writer import recording_meta as recording_meta
 from ._serial import SerialSource as SerialSource
+from ._simulator import OperatorConfig as OperatorConfig
+from ._simulator import OperatorMotion as OperatorMotion
+from ._simulator import Simulated as Simulated
+from ._simulator import SimulatorSource as SimulatorSource
+from ._simulator import simulate as simulate
 from ._source import FrameSource as FrameSource
 from ._source import SourceStatus as SourceStatus
 from ._source import ThreadedSource as ThreadedSource

@@ -1,0 +1,327 @@
+"""Demonstrations: a recording segment turned into a Puma560 trajectory and a grid path to the goal.
+
+A segment ``[t0, t1]`` of a recording runs through the kinematics (reconstruct + fit the human
+arm, retarget onto the Puma560), then onto the learning task's :class:`ArmGrid` as a path of
+valid consecutive actions, with pauses removed, ending at the goal. A segment that never reaches
+the goal, drives the robot into a joint limit, or fits the arm badly is refused with the reason;
+with ``goal_from_end=True`` the goal becomes wherever the segment ends.
+
+File (``*.demo.json``, next to its recording)::
+
+    {"format": "teach-studio-demonstration", "version": 1,
+     "recording": "reach.tape.csv", "segment": [t0, t1], "mode": "joint", "mirror": true,
+     "grid": {"joints": 3, "bins": 11, "low_deg": -180, "high_deg": 180, "goal": [5, 6, 2]},
+     "goal": [5, 6, 2], "grid_path": [state, ...], "reached_at": t,
+     "fit": {"residual_max": m, "residual_mean": m, "max_allowed": m},
+     "trajectory": {"t": [...], "q_robot": [[6 angles], ...]}, "name": "...", "created": "..."}
+
+``grid_path`` is what ``studio train --demos`` and the learning engine replay.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import os
+from dataclasses import dataclass, field
+from datetime import UTC, datetime
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ._errors import DemonstrationError
+from ._recording_edit import DEMO_SUFFIX, atomic_write_text
+from ._recording_format import RECORDING_SUFFIX
+from ._recording_reader import Recording, read_recording
+
+DEMO_FORMAT = "teach-studio-demonstration"
+"""The ``format`` value of demonstration files."""
+DEMO_VERSION = 1
+"""The version this code writes and the newest it reads."""
+MAX_FIT_RESIDUAL_M = 0.03
+"""Largest RMS landmark residual (m) of any frame's arm fit before a segment counts as a bad fit:
+3 cm is well above the fit of a well-placed tape with sensor noise, and well below a misplaced
+tape or a tape that is not on an arm."""
+LIMIT_TOLERANCE_RAD = 1e-6
+"""A retargeted joint this close to a Puma560 limit was clamped: the segment left the range."""
+MIN_SEGMENT_FRAMES = 2
+"""Fewest frames a segment needs."""
+TRAJECTORY_DECIMALS = 6
+"""Radians and seconds are stored to a micro-unit: small files, far below the grid's resolution."""
+
+
+@dataclass(eq=False)
+class Demonstration:
+    """One demonstration.
+
+    Attributes:
+        recording: the recording's path.
+        t0: segment start (s, recording time).
+        t1: segment end (s).
+        times: times of the trajectory samples ``(N,)``.
+        q_robot: the Puma560 joint trajectory ``(N, 6)`` (rad).
+        grid_path: states of the grid, one action apart, ending at the goal.
+        grid: the grid spec (``ArmGrid.to_dict()``), with the goal used.
+        goal: the goal's bins.
+        mode: retargeting mode (``"joint"`` or ``"cartesian"``).
+        reached_at: time the path first reached the goal.
+        residual_max: worst fit residual (m).
+        residual_mean: mean fit residual (m).
+        name: display name.
+        created: ISO time of extraction.
+    """
+
+    recording: Path
+    t0: float
+    t1: float
+    times: np.ndarray
+    q_robot: np.ndarray
+    grid_path: list[int]
+    grid: dict[str, Any]
+    goal: tuple[int, ...]
+    mode: str = "joint"
+    reached_at: float | None = None
+    residual_max: float = 0.0
+    residual_mean: float = 0.0
+    name: str = ""
+    created: str = field(default_factory=lambda: datetime.now(UTC).isoformat(timespec="seconds"))
+
+    def arm_grid(self) -> Any:
+        """The :class:`studio.learning.ArmGrid` this demonstration's path lives on."""
+        from studio.learning import ArmGrid
+
+        return ArmGrid(**{**self.grid, "goal": tuple(self.grid["goal"])})
+
+    def default_path(self) -> Path:
+        """Where :meth:`save` writes by default: ``<recording stem>.<t0>-<t1>.demo.json``."""
+        stem = self.recording.name.removesuffix(RECORDING_SUFFIX)
+        return self.recording.with_name(f"{stem}.{self.t0:.2f}-{self.t1:.2f}{DEMO_SUFFIX}")
+
+    def to_dict(self) -> dict[str, Any]:
+        """The JSON file's contents."""
+        return {
+            "format": DEMO_FORMAT,
+            "version": DEMO_VERSION,
+            "name": self.name,
+            "created": self.created,
+            "recording": self.recording.name,
+            "segment": [self.t0, self.t1],
+            "mode": self.mode,
+            "mirror": True,
+            "grid": self.grid,
+            "goal": list(self.goal),
+            "grid_path": list(self.grid_path),
+            "reached_at": self.reached_at,
+            "fit": {
+                "residual_max": self.residual_max,
+                "residual_mean": self.residual_mean,
+                "max_allowed": MAX_FIT_RESIDUAL_M,
+            },
+            "trajectory": {
+                "t": np.round(self.times, TRAJECTORY_DECIMALS).tolist(),
+                "q_robot": np.round(self.q_robot, TRAJECTORY_DECIMALS).tolist(),
+            },
+        }
+
+    def summary(self) -> dict[str, Any]:
+        """JSON-ready facts for listings (no trajectory)."""
+        return {
+            "name": self.name,
+            "recording": self.recording.name,
+            "segment": [self.t0, self.t1],
+            "mode": self.mode,
+            "goal": list(self.goal),
+            "steps": max(0, len(self.grid_path) - 1),
+            "grid_path": list(self.grid_path),
+            "reached_at": self.reached_at,
+            "residual_max": self.residual_max,
+            "created": self.created,
+        }
+
+    def save(self, path: str | os.PathLike[str] | None = None) -> Path:
+        """Write the ``*.demo.json`` file (atomic replace); default :meth:`default_path`."""
+        path = Path(path) if path is not None else self.default_path()
+        return atomic_write_text(path, json.dumps(self.to_dict(), separators=(",", ":")) + "\n")
+
+
+def load_demonstration(path: str | os.PathLike[str]) -> Demonstration:
+    """Read a ``*.demo.json`` file.
+
+    Raises:
+        DemonstrationError: the file is missing, not a demonstration, or of an unknown version.
+    """
+    path = Path(path)
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except OSError as err:
+        raise DemonstrationError(
+            f"cannot open {path} ({err.strerror}); check the path.", "bad_file"
+        ) from None
+    except ValueError:
+        raise DemonstrationError(
+            f"{path} is not valid JSON; give a *.demo.json file.", "bad_file"
+        ) from None
+    if not isinstance(data, dict) or data.get("format") != DEMO_FORMAT:
+        raise DemonstrationError(
+            f"{path} is not a demonstration (no format '{DEMO_FORMAT}'); give a *.demo.json file.",
+            "bad_file",
+        )
+    if not isinstance(data.get("version"), int) or not 1 <= data["version"] <= DEMO_VERSION:
+        raise DemonstrationError(
+            f"{path} has demonstration version {data.get('version')!r}; this studio reads 1 to {DEMO_VERSION}, update Teach Studio.",
+            "bad_file",
+        )
+    try:
+        trajectory = data["trajectory"]
+        return Demonstration(
+            recording=path.with_name(data["recording"]),
+            t0=float(data["segment"][0]),
+            t1=float(data["segment"][1]),
+            times=np.asarray(trajectory["t"], dtype=np.float64),
+            q_robot=np.asarray(trajectory["q_robot"], dtype=np.float64).reshape(-1, 6),
+            grid_path=[int(s) for s in data["grid_path"]],
+            grid=dict(data["grid"]),
+            goal=tuple(int(b) for b in data["goal"]),
+            mode=str(data.get("mode", "joint")),
+            reached_at=data.get("reached_at"),
+            residual_max=float(data.get("fit", {}).get("residual_max", 0.0)),
+            residual_mean=float(data.get("fit", {}).get("residual_mean", 0.0)),
+            name=str(data.get("name", "")),
+            created=str(data.get("created", "")),
+        )
+    except (KeyError, IndexError, TypeError, ValueError) as err:
+        raise DemonstrationError(
+            f"{path} lacks or garbles a field ({err}); re-extract the demonstration.", "bad_file"
+        ) from None
+
+
+def extract_demonstration(
+    recording: Recording | str | os.PathLike[str],
+    t0: float,
+    t1: float,
+    grid: Any = None,
+    mode: str = "joint",
+    goal_from_end: bool = False,
+    *,
+    max_residual: float = MAX_FIT_RESIDUAL_M,
+    fitter: Any = None,
+    retargeter: Any = None,
+    name: str = "",
+) -> Demonstration:
+    """Turn the segment ``[t0, t1]`` of a recording into a demonstration.
+
+    Args:
+        recording: a :class:`Recording` or a path.
+        t0: segment start (s, in the recording's time).
+        t1: segment end (s).
+        grid: the :class:`studio.learning.ArmGrid` (default ``ArmGrid()``, the paper's task).
+        mode: retargeting mode, ``"joint"`` or ``"cartesian"``.
+        goal_from_end: instead of refusing a segment that misses the goal, make its end the goal.
+        max_residual: worst allowed fit residual (m).
+        fitter: an :class:`ArmFitter` to use (default: one for the recording's tape).
+        retargeter: a :class:`Retargeter` to use (default: ``Retargeter(mode, mirror=True)``).
+        name: display name.
+
+    Returns:
+        The demonstration (call :meth:`Demonstration.save` to write it).
+
+    Raises:
+        DemonstrationError: with ``reason`` ``too_short``, ``bad_fit``, ``leaves_joint_range`` or
+            ``never_reaches_goal``, and one sentence saying what to change.
+    """
+    from studio.kinematics import ArmFitter, HumanArm, Retargeter
+    from studio.learning import ArmGrid
+
+    rec = recording if isinstance(recording, Recording) else read_recording(recording)
+    grid = grid if grid is not None else ArmGrid()
+    rows = rec.segment(t0, t1)
+    times = rec.t[rows]
+    if times.shape[0] < MIN_SEGMENT_FRAMES:
+        raise DemonstrationError(
+            f"the segment [{t0:.2f}, {t1:.2f}] s of {rec.path.name} holds {times.shape[0]} frames; choose a longer segment inside 0-{rec.t[-1] if len(rec) else 0:.2f} s.",
+            "too_short",
+        )
+    config = rec.config
+    if fitter is None:
+        fitter = ArmFitter(HumanArm(side=getattr(config, "side", "right")), config)
+    else:
+        fitter.reset()
+    retargeter = retargeter if retargeter is not None else Retargeter(mode, mirror=True)
+    bend, twist = rec.bend[rows], rec.twist[rows]
+    q_human = np.empty((times.shape[0], 7))
+    residual = np.empty(times.shape[0])
+    for i in range(times.shape[0]):
+        fit = fitter.fit((bend[i], twist[i]))
+        q_human[i] = fit.q_human
+        residual[i] = fit.residual if fit.success else np.inf
+    worst = int(np.argmax(residual))
+    if not residual[worst] <= max_residual:
+        raise DemonstrationError(
+            f"the arm fits the tape badly at {times[worst]:.2f} s (residual {residual[worst] * 100:.1f} cm > {max_residual * 100:.1f} cm); check the tape config's shoulder and wrist regions or choose another segment.",
+            "bad_fit",
+        )
+    q_robot = np.array([retargeter.robot_from_human(q) for q in q_human])
+    robot = retargeter.robot
+    at_limit = (q_robot <= robot.lower + LIMIT_TOLERANCE_RAD) | (
+        q_robot >= robot.upper - LIMIT_TOLERANCE_RAD
+    )
+    if at_limit.any():
+        i, j = np.argwhere(at_limit)[0]
+        raise DemonstrationError(
+            f"the motion drives Puma560 joint {j + 1} to its limit at {times[i]:.2f} s; choose a segment that stays inside the robot's range.",
+            "leaves_joint_range",
+        )
+    path = grid.path_from_joints(q_robot)
+    goal_state = grid.goal_state
+    if goal_state in path:
+        cut = path.index(goal_state)
+        path = path[: cut + 1]
+        arrived = int(
+            np.flatnonzero(
+                np.array([grid.state_of_angles(q[: grid.joints]) for q in q_robot]) == goal_state
+            )[0]
+        )
+        reached_at = float(times[arrived])
+    elif goal_from_end:
+        grid = dataclasses.replace(grid, goal=tuple(int(b) for b in grid.bins_of(path[-1])))
+        reached_at = float(times[-1])
+    else:
+        raise DemonstrationError(
+            f"the segment ends in grid bins {tuple(grid.bins_of(path[-1]))} and never reaches the goal {tuple(grid.goal)}; extend the segment, or set the goal from where it ends.",
+            "never_reaches_goal",
+        )
+    if len(path) < 2:
+        raise DemonstrationError(
+            f"the segment [{t0:.2f}, {t1:.2f}] s already starts at the goal; start the segment before the reach.",
+            "too_short",
+        )
+    return Demonstration(
+        recording=rec.path,
+        t0=float(t0),
+        t1=float(t1),
+        times=times.copy(),
+        q_robot=q_robot,
+        grid_path=path,
+        grid=grid.to_dict(),
+        goal=tuple(grid.goal),
+        mode=mode,
+        reached_at=reached_at,
+        residual_max=float(residual.max()),
+        residual_mean=float(residual.mean()),
+        name=name or f"{rec.name} {t0:.2f}-{t1:.2f} s",
+    )
+
+
+def demonstrations_for(recording_path: str | os.PathLike[str]) -> list[Path]:
+    """The ``*.demo.json`` files next to a recording that reference it."""
+    recording_path = Path(recording_path)
+    out = []
+    for demo in sorted(recording_path.parent.glob("*" + DEMO_SUFFIX)):
+        try:
+            data = json.loads(demo.read_text(encoding="utf-8"))
+        except (OSError, ValueError):
+            continue
+        if isinstance(data, dict) and data.get("recording") == recording_path.name:
+            out.append(demo)
+    return out
