@@ -679,12 +679,13 @@ async function deleteRun(id) {
   });
 }
 
-/** Merge an SSE curve piece (episodes from `from`, or the whole curve) into the run's curve. */
-function mergeCurve(id, piece) {
+/** Merge an SSE curve piece into the run's curve: replace everything from its first episode on. */
+function mergeCurve(id, piece, from) {
   if (!piece || !piece.episodes) return;
   let c = S.curves.get(id);
   if (!c) { c = emptyCurve(); S.curves.set(id, c); }
-  const first = piece.from !== undefined ? piece.from : piece.episodes[0];
+  // `from` is the 0-based index of the piece's first episode (episode numbers are 1-based).
+  const first = from !== undefined && from !== null ? from + 1 : piece.episodes[0];
   // Episodes are numbered; drop what we already hold from `first` on, then append.
   let cut = c.episodes.length;
   if (first !== undefined) {
@@ -783,7 +784,7 @@ function renderPolicies() {
   body.replaceChildren(...S.policies.map((p) => el("tr", { "data-name": p.name, testid: "policy-row" },
     el("td", { class: "name", title: p.notes || p.name, text: p.name }),
     el("td", { text: p.planning }),
-    el("td", { class: "muted", text: p.source === "run" ? `run ${p.run}` : "upload" }),
+    el("td", { class: "muted", title: p.run || "", text: p.source === "run" ? "run" : "upload" }),
     el("td", { class: "actions" },
       el("button", { class: "icon", title: "watch", testid: "policy-watch", onclick: () => { selectWatch(p); watch(); } }, "▶"),
       p.source === "upload" ? el("button", { class: "icon", title: "delete", testid: "policy-delete", onclick: () => deletePolicy(p.name) }, "✕") : null,
@@ -864,7 +865,8 @@ function exportFile(kind) {
   }
   if (t.type !== "run") { showError("export-error", "Curves and plots belong to a training run; choose a run, not an uploaded file."); return; }
   const path = { curve: "curve.csv", png: "plot.png", svg: "plot.svg" }[kind];
-  return download(`/api/runs/${enc(t.id)}/${path}`, `${t.id}-${path}`, "export-error");
+  const query = kind === "curve" ? "" : `?log=${$("curve-log").checked}`;
+  return download(`/api/runs/${enc(t.id)}/${path}${query}`, `${t.id}-${path}`, "export-error");
 }
 
 /* ------------------------------------------------------------------ live events */
@@ -885,7 +887,7 @@ function connectEvents() {
     const before = S.runs.find((r) => r.id === d.run.id);
     upsertRun(d.run);
     if (!before && !S.shownTouched) S.shown.add(d.run.id);
-    if (d.curve) mergeCurve(d.run.id, d.curve);
+    if (d.curve) mergeCurve(d.run.id, d.curve, d.from);
     scheduleRunsRender();
     if (before && before.status !== d.run.status && !["running", "queued"].includes(d.run.status)) {
       loadCurve(d.run.id);
@@ -986,7 +988,12 @@ async function main() {
     renderSource();
   }).catch((e) => showError("source-error", e));
   const cap = api("GET", "/api/capture").then((c) => { S.capture = c; renderCaptureButton(); updateMarkButton(); }).catch(() => {});
-  await Promise.all([initial, cap, loadRecordings(), loadDemos(), loadRuns(), loadPolicies()]);
+  const mark = api("GET", "/api/demonstrations/mark").then((m) => {
+    S.marking = !!(m && m.marking);
+    S.markT0 = m && m.t0;
+    updateMarkButton();
+  }).catch(() => {});
+  await Promise.all([initial, cap, mark, loadRecordings(), loadDemos(), loadRuns(), loadPolicies()]);
   if (S.source && S.source.recording) $("source-recording").value = S.source.recording;
   document.body.dataset.ready = "1";
 }
