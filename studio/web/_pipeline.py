@@ -153,6 +153,11 @@ class Pipeline:
             elif self._kin is not None:
                 self._kin["retargeter"].mode = mode
 
+    @property
+    def retarget_mode(self) -> str:
+        """``"joint"`` or ``"cartesian"``: how the arm is mapped onto the robot now."""
+        return self._mode
+
     def status(self) -> dict[str, Any]:
         """The ``SourcePublic`` fields (without playback, which the state adds)."""
         with self._lock:

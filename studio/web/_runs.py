@@ -309,7 +309,7 @@ def prepare_run(
     goal_state = grid.goal_state
     for name in create.demonstrations:
         q_path = np.asarray(demonstration_path(name), dtype=np.float64)
-        path = grid.path_from_joints(q_path)
+        path = grid.path_from_joints(q_path, stop_at_goal=True)
         if path[-1] != goal_state:
             end = np.degrees(q_path[-1, :ROBOT_GOAL_JOINTS])
             raise InvalidError(

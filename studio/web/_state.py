@@ -251,7 +251,7 @@ class Studio:
         Raises:
             InvalidError: the segment is refused (the capture package's reason) or the name is bad.
         """
-        from studio.capture import extract_demonstration, read_recording, save_demonstration
+        from studio.capture import extract_demonstration
 
         if t1 <= t0:
             raise InvalidError(
@@ -264,11 +264,16 @@ class Studio:
                     f"A demonstration named {name!r} already exists; choose another name."
                 )
         path = self.recordings.path(recording)
-        demo = extract_demonstration(read_recording(path), t0, t1, goal_from_end=goal_from_end)
-        final = name or self.demonstrations.new_name(
-            f"{recording}-{t0:.1f}-{t1:.1f}".replace(".", "_")
+        final = name or self.demonstrations.new_name(f"{recording}.{t0:.2f}-{t1:.2f}")
+        demo = extract_demonstration(
+            path,
+            t0,
+            t1,
+            mode=self.pipeline.retarget_mode,
+            goal_from_end=goal_from_end,
+            name=final,
         )
-        save_demonstration(demo, self.settings.recordings_dir / f"{final}{DEMONSTRATION_SUFFIX}")
+        demo.save(self.settings.recordings_dir / f"{final}{DEMONSTRATION_SUFFIX}")
         self.changes.bump("demonstrations")
         if self.scene is not None:
             self.scene.show_path(f"demo-{final}", np.asarray(demo.q_robot))

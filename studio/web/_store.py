@@ -426,19 +426,30 @@ class DemonstrationStore:
         return self._cache.get(path, load_demonstration)
 
     def info(self, name: str) -> dict[str, Any]:
-        """The ``DemonstrationPublic`` fields."""
+        """The ``DemonstrationPublic`` fields.
+
+        ``goal`` is the goal bin's centre in degrees (joints of the demonstration's grid);
+        ``reaches_goal`` says whether that goal is the default one (false when the goal was set
+        from where the demonstration ends).
+        """
         import numpy as np
 
+        from studio.learning import ArmGrid
+
         demo = self.load(name)
+        grid = demo.arm_grid()
+        default = ArmGrid(
+            joints=grid.joints, bins=grid.bins, low_deg=grid.low_deg, high_deg=grid.high_deg
+        )
         return {
             "name": name,
-            "recording": str(demo.recording),
+            "recording": demo.recording.name.removesuffix(RECORDING_SUFFIX),
             "t0": float(demo.t0),
             "t1": float(demo.t1),
             "steps": max(0, len(demo.grid_path) - 1),
-            "goal": [float(x) for x in np.degrees(np.asarray(demo.goal_q, dtype=float))],
-            "reaches_goal": bool(demo.reaches_goal),
-            "created": str(getattr(demo, "created", "") or ""),
+            "goal": [round(float(x), 6) for x in np.degrees(grid.angles_of(grid.goal_state))],
+            "reaches_goal": tuple(grid.goal) == tuple(default.goal),
+            "created": str(demo.created or ""),
         }
 
     def detail(self, name: str) -> dict[str, Any]:
