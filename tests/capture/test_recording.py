@@ -1,0 +1,220 @@
+"""Recordings: exact round trips, crash recovery, malformed files, atomic edits."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from studio.capture import (
+    RecordingError,
+    RecordingWriter,
+    TapeFrame,
+    read_recording,
+    rename_recording,
+    update_recording_meta,
+)
+
+
+def _write(path: Path, frames: list[TapeFrame], **kw) -> Path:
+    with RecordingWriter(path, frames[0].regions, **kw) as writer:
+        writer.write_many(frames)
+    return path
+
+
+def test_round_trip_gives_the_very_same_frames(tmp_path, frames):
+    path = _write(tmp_path / "a.tape.csv", frames, operator="ada", notes="n", source="test")
+    rec = read_recording(path)
+    assert not rec.recovered and rec.problems == []
+    assert len(rec) == len(frames)
+    assert all(a.same_as(b) for a, b in zip(frames, rec.frames(), strict=True))
+    assert rec.meta["operator"] == "ada" and rec.meta["source"] == "test"
+    assert rec.duration == pytest.approx(frames[-1].t - frames[0].t)
+
+
+def test_simulated_capture_round_trip(tmp_path):
+    from studio.capture import simulate
+
+    sim = simulate(2.0, seed=3)
+    path = _write(tmp_path / "sim.tape.csv", sim.frames, config=sim.config, source="simulator")
+    rec = read_recording(path)
+    assert all(a.same_as(b) for a, b in zip(sim.frames, rec.frames(), strict=True))
+    assert rec.config == sim.config
+    assert np.allclose(rec.config.base, sim.config.base)
+
+
+@settings(max_examples=25, deadline=None)
+@given(st.lists(st.floats(allow_nan=False, allow_infinity=False, width=64), min_size=4, max_size=4))
+def test_any_finite_angle_round_trips_exactly(tmp_path_factory, values):
+    path = tmp_path_factory.mktemp("h") / "h.tape.csv"
+    frame = TapeFrame(0.0, 0, np.array(values[:2]), np.array(values[2:]), 0)
+    rec = read_recording(_write(path, [frame]))
+    assert rec.frames()[0].same_as(frame)
+
+
+def test_readable_with_plain_numpy(tmp_path, frames):
+    path = _write(tmp_path / "a.tape.csv", frames)
+    data = np.loadtxt(path, delimiter=",", comments="#", skiprows=2)
+    assert data.shape == (len(frames), 3 + 2 * 16)
+    assert np.array_equal(data[:, 3:19], np.stack([f.bend for f in frames]))
+
+
+def test_never_overwrites(tmp_path, frames):
+    path = _write(tmp_path / "a.tape.csv", frames)
+    with pytest.raises(RecordingError, match="already exists"):
+        RecordingWriter(path, 16)
+
+
+CHILD = r"""
+import sys, numpy as np
+from studio.capture import RecordingWriter, TapeFrame
+w = RecordingWriter(sys.argv[1], 16, flush_seconds=0.05)
+i = 0
+while True:
+    w.write(TapeFrame(i / 110, i, np.full(16, i * 1e-3), np.full(16, -i * 1e-3), 0))
+    i += 1
+    if i % 50 == 0:
+        print(i, flush=True)
+"""
+
+
+def test_kill_9_mid_capture_recovers_every_flushed_frame(tmp_path):
+    path = tmp_path / "killed.tape.csv"
+    child = subprocess.Popen(
+        [sys.executable, "-c", CHILD, str(path)], stdout=subprocess.PIPE, text=True
+    )
+    try:
+        for _ in range(200):  # wait until many frames were written (and so several flushes ran)
+            line = child.stdout.readline()
+            if int(line) >= 5000:
+                break
+        time.sleep(0.2)
+    finally:
+        child.send_signal(signal.SIGKILL)
+        child.wait()
+    raw = path.read_text()
+    complete_rows = raw.count("\n") - 2
+    rec = read_recording(path)
+    assert rec.recovered
+    assert len(rec) == complete_rows >= 5000
+    assert np.array_equal(rec.frame, np.arange(len(rec)))
+    assert np.array_equal(rec.bend[:, 0], rec.frame * 1e-3)
+
+
+def test_interrupted_file_with_half_a_row_is_recovered(tmp_path, frames):
+    path = tmp_path / "a.tape.csv"
+    with RecordingWriter(path, 16) as writer:
+        writer.write_many(frames)
+    text = path.read_text().splitlines(keepends=True)
+    body = "".join(text[:-1])  # drop the '# end' line: an interrupted capture
+    path.write_text(body + text[-2][:40])  # and a row cut short by the crash
+    rec = read_recording(path)
+    assert rec.recovered and len(rec) == len(frames)
+    assert "incomplete last row" in rec.problems[0]
+
+
+def _damage(path: Path, line_number: int, new_line: str) -> None:
+    lines = path.read_text().splitlines()
+    lines[line_number - 1] = new_line
+    path.write_text("\n".join(lines) + "\n")
+
+
+@pytest.mark.parametrize(
+    ("line", "make", "message"),
+    [
+        (10, lambda s: s[: len(s) // 2], "columns where 35 were expected"),
+        (11, lambda s: s + ",1.0", "36 columns"),
+        (12, lambda s: s.replace(s.split(",")[5], "nan", 1), "NaN"),
+        (13, lambda s: s.replace(s.split(",")[5], "abc", 1), "'abc' is not a number"),
+        (1, lambda s: s.replace('"version": 1', '"version": 99'), "unknown recording version 99"),
+        (1, lambda s: "hello,world", "not a Teach Studio recording"),
+        (1, lambda s: s[:-5], "not valid JSON"),
+        (2, lambda s: "a,b,c", "column row"),
+    ],
+)
+def test_malformed_files_name_the_file_line_and_problem(tmp_path, frames, line, make, message):
+    path = _write(tmp_path / "bad.tape.csv", frames)
+    original = path.read_text().splitlines()[line - 1]
+    _damage(path, line, make(original))
+    with pytest.raises(RecordingError) as err:
+        read_recording(path)
+    text = str(err.value)
+    assert str(path) in text and f"line {line}" in text and message in text
+
+
+def test_lenient_read_keeps_the_good_frames(tmp_path, frames):
+    path = _write(tmp_path / "bad.tape.csv", frames)
+    lines = path.read_text().splitlines()
+    _damage(path, 10, lines[9][:30])
+    _damage(path, 20, lines[19].replace(lines[19].split(",")[4], "inf", 1))
+    rec = read_recording(path, strict=False)
+    assert len(rec) == len(frames) - 2
+    assert [p.split(":")[0] for p in rec.problems] == ["line 10", "line 20"]
+    kept = [f for i, f in enumerate(frames) if i + 3 not in (10, 20)]
+    assert all(a.same_as(b) for a, b in zip(kept, rec.frames(), strict=True))
+
+
+def test_binary_and_empty_files_are_refused(tmp_path):
+    (tmp_path / "bin.tape.csv").write_bytes(b"\x89PNG\x00\xff\xfe")
+    (tmp_path / "empty.tape.csv").write_bytes(b"")
+    for name in ("bin.tape.csv", "empty.tape.csv"):
+        with pytest.raises(RecordingError, match="not a recording"):
+            read_recording(tmp_path / name)
+
+
+def test_meta_edit_is_atomic_and_keeps_every_data_byte(tmp_path, frames):
+    path = _write(tmp_path / "a.tape.csv", frames)
+    before = path.read_bytes().split(b"\n", 1)[1]
+    inode = os.stat(path).st_ino
+    meta = update_recording_meta(path, notes="second take", operator="bob")
+    assert path.read_bytes().split(b"\n", 1)[1] == before
+    assert os.stat(path).st_ino != inode  # replaced, not rewritten in place
+    rec = read_recording(path)
+    assert rec.meta["notes"] == "second take" == meta["notes"] and rec.meta["operator"] == "bob"
+    with pytest.raises(RecordingError, match="cannot be edited"):
+        update_recording_meta(path, regions=3)
+
+
+def test_edits_are_refused_while_recording(tmp_path, frames):
+    path = tmp_path / "live.tape.csv"
+    writer = RecordingWriter(path, 16)
+    writer.write_many(frames)
+    with pytest.raises(RecordingError, match="being recorded"):
+        update_recording_meta(path, notes="x")
+    writer.close()
+    update_recording_meta(path, notes="x")
+    assert len(read_recording(path)) == len(frames)
+
+
+def test_rename_moves_the_file_and_its_demonstrations_follow(tmp_path, frames):
+    path = _write(tmp_path / "a.tape.csv", frames)
+    demo = tmp_path / "a.0.00-1.00.demo.json"
+    demo.write_text(json.dumps({"format": "teach-studio-demonstration", "recording": "a.tape.csv"}))
+    new = rename_recording(path, "reach-1")
+    assert new == tmp_path / "reach-1.tape.csv" and not path.exists()
+    assert read_recording(new).meta["name"] == "reach-1"
+    assert json.loads(demo.read_text())["recording"] == "reach-1.tape.csv"
+    other = _write(tmp_path / "b.tape.csv", frames)
+    with pytest.raises(RecordingError, match="already exists"):
+        rename_recording(other, "reach-1")
+
+
+def test_writer_flushes_without_new_frames(tmp_path, frames):
+    path = tmp_path / "slow.tape.csv"
+    writer = RecordingWriter(path, 16, flush_seconds=0.05)
+    writer.write_many(frames[:10])
+    for _ in range(100):  # the background flusher must put them on disk with no further writes
+        if path.read_text().count("\n") >= 12:
+            break
+        time.sleep(0.02)
+    assert len(read_recording(path)) == 10
+    writer.close()

@@ -1,0 +1,266 @@
+"""Sources: playback, network bridge on loopback, serial on an emulated pty, simulator."""
+
+from __future__ import annotations
+
+import socket
+import threading
+import time
+
+import numpy as np
+import pytest
+
+from studio.capture import (
+    Calibration,
+    CaptureError,
+    FrameSender,
+    FrameSource,
+    NetworkSource,
+    PlaybackSource,
+    RecordingWriter,
+    SerialSource,
+    ShapeTapeEmulator,
+    TapeFrame,
+    decode_frame,
+    encode_frame,
+    read_recording,
+    stream_source,
+)
+from studio.capture._shapetape_protocol import ProtocolError, decode_reply, encode_reply
+from studio.capture._wire import WireError
+
+from .conftest import synthetic_frames
+
+WAIT_SECONDS = 10.0
+
+
+def _drain(source, until, timeout=WAIT_SECONDS) -> list[TapeFrame]:
+    """Read until ``until(frames)`` is true, the source stops, or the timeout passes."""
+    out: list[TapeFrame] = []
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline and not until(out):
+        got = source.read(timeout=0.05)
+        out += got
+        if not got and not source.running:
+            break
+    return out
+
+
+def _recording(tmp_path, frames):
+    path = tmp_path / "p.tape.csv"
+    with RecordingWriter(path, 16, rate_hz=110.0) as w:
+        w.write_many(frames)
+    return read_recording(path)
+
+
+def test_playback_as_fast_as_possible_gives_every_frame(tmp_path, frames):
+    source = PlaybackSource(_recording(tmp_path, frames), speed=None, queue_frames=16)
+    assert isinstance(source, FrameSource)
+    source.start()
+    got = _drain(source, lambda f: len(f) >= len(frames))
+    source.stop()
+    assert all(a.same_as(b) for a, b in zip(frames, got, strict=True))
+    assert source.status().dropped == 0 and source.status().frames == len(frames)
+
+
+def test_playback_seek_pause_and_loop(tmp_path, frames):
+    rec = _recording(tmp_path, frames)
+    source = PlaybackSource(rec, speed=None, loop=True, queue_frames=8)
+    source.pause()
+    source.seek(2.0)
+    source.start()
+    time.sleep(0.1)
+    assert source.read() == []  # paused
+    source.resume()
+    got = _drain(source, lambda f: len(f) >= 2 * len(frames))
+    source.stop()
+    first = int(round(2.0 * 110))
+    assert got[0].same_as(frames[first])
+    wrap = len(frames) - first
+    assert got[wrap].frame == len(frames) and np.array_equal(got[wrap].bend, frames[0].bend)
+    assert all(b.t > a.t for a, b in zip(got, got[1:], strict=False))
+
+
+def test_playback_real_time_is_paced_not_dumped(tmp_path, frames):
+    source = PlaybackSource(_recording(tmp_path, frames), speed=1.0)  # 2.7 s of frames
+    source.start()
+    got = _drain(source, lambda f: False, timeout=0.3)
+    source.stop()
+    assert 0 < len(got) < len(frames)
+    assert all(a.same_as(b) for a, b in zip(frames, got, strict=False))
+
+
+def test_wire_format_round_trips_at_float32(frames):
+    frame = frames[7]
+    back = decode_frame(encode_frame(frame))
+    assert back.frame == frame.frame and back.t == frame.t and back.status == frame.status
+    assert np.array_equal(back.bend, frame.bend.astype(np.float32))
+    assert len(encode_frame(frame)) == 22 + 8 * 16
+    for bad in (b"", b"XXXX" + encode_frame(frame)[4:], encode_frame(frame)[:-1]):
+        with pytest.raises(WireError):
+            decode_frame(bad)
+    nan = TapeFrame(0.0, 0, np.full(16, np.nan), np.zeros(16), 0)
+    with pytest.raises(WireError, match="NaN"):
+        decode_frame(encode_frame(nan))
+
+
+def test_network_bridge_on_loopback(tmp_path, frames):
+    receiver = NetworkSource(port=0)
+    receiver.start()
+    host, port = receiver.address
+    try:
+        sent = stream_source(PlaybackSource(_recording(tmp_path, frames), speed=20.0), host, port)
+        with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as raw:
+            raw.sendto(b"not a frame", (host, port))
+            raw.sendto(b"STAP\x09" + bytes(40), (host, port))
+        got = _drain(receiver, lambda f: len(f) >= len(frames))
+        for _ in range(100):
+            if receiver.status().rejected >= 2:
+                break
+            time.sleep(0.02)
+        status = receiver.status()
+    finally:
+        receiver.stop()
+    assert sent == len(frames) == len(got)
+    assert [f.frame for f in got] == [f.frame for f in frames]
+    assert np.allclose(
+        np.stack([f.bend for f in got]), np.stack([f.bend for f in frames]), atol=1e-6
+    )
+    assert status.rejected == 2 and status.dropped == 0 and status.running
+    assert "wire version 9" in status.warning
+
+
+def test_network_counts_gaps_as_dropped(frames):
+    receiver = NetworkSource(port=0)
+    receiver.start()
+    try:
+        with FrameSender(*receiver.address) as sender:
+            for f in frames[:10] + frames[15:20]:
+                sender.send(f)
+        got = _drain(receiver, lambda f: len(f) >= 15)
+    finally:
+        receiver.stop()
+    assert len(got) == 15 and receiver.status().dropped == 5
+
+
+def test_network_port_in_use_is_a_clear_error():
+    first = NetworkSource(port=0)
+    first.start()
+    try:
+        with pytest.raises(CaptureError, match="choose another port"):
+            NetworkSource(port=first.address[1]).start()
+    finally:
+        first.stop()
+
+
+def test_bridge_verb_streams_a_recording(tmp_path, frames):
+    from studio.cli import main
+
+    path = tmp_path / "b.tape.csv"
+    with RecordingWriter(path, 16) as w:
+        w.write_many(frames[:100])
+    receiver = NetworkSource(port=0)
+    receiver.start()
+    try:
+        args = [
+            "bridge",
+            "--source",
+            str(path),
+            "--to",
+            f"127.0.0.1:{receiver.address[1]}",
+            "--speed",
+            "20",
+        ]
+        assert main(args) == 0
+        got = _drain(receiver, lambda f: len(f) >= 100)
+    finally:
+        receiver.stop()
+    assert [f.frame for f in got] == list(range(100))
+
+
+def test_serial_protocol_round_trip_and_checksum():
+    raw = np.arange(32, dtype=np.uint16) * 1000
+    for serial in (1234, 5001):
+        reply = encode_reply(raw, serial, switches=0x30, counter=7, timer=99)
+        frame = decode_reply(reply[:3], reply[3:])
+        assert np.array_equal(frame.raw, raw) and frame.groups == 4 and frame.status & 0x30 == 0x30
+        assert (frame.counter, frame.timer) == ((7, 99) if serial > 4096 else (None, None))
+        bad = encode_reply(raw, serial, corrupt=True)
+        with pytest.raises(ProtocolError, match="checksum"):
+            decode_reply(bad[:3], bad[3:])
+
+
+def _angles(k: int):
+    return (
+        np.linspace(-1, 1, 16) * np.sin(k / 20),
+        np.full(16, 0.01 * (k % 30)),
+        0x20 if k % 2 else 0,
+    )
+
+
+def test_serial_source_on_an_emulated_tape(tmp_path):
+    calibration = Calibration(np.full(32, 30000.0), np.full(32, 2e-4), serial=5001)
+    calibration.save(tmp_path / "cal.json")
+    emulator = ShapeTapeEmulator(_angles, calibration).start()
+    emulator.corrupt = {5, 6, 40}
+    source = SerialSource(emulator.port, calibration=tmp_path / "cal.json", rate_hz=200)
+    source.start()
+    try:
+        got = _drain(source, lambda f: len(f) >= 60)
+        status = source.status()
+    finally:
+        emulator.unplug()
+    assert len(got) >= 60 and status.error is None
+    assert status.dropped == 3 and "checksum" in status.warning
+    # replies 5 and 6 were corrupted: the third frame received is reply 7
+    replies = [k for k in range(70) if k not in emulator.corrupt][: len(got)]
+    for frame, k in zip(got, replies, strict=True):
+        bend, twist, switches = _angles(k)
+        assert np.allclose(frame.bend, bend, atol=1e-4) and np.allclose(
+            frame.twist, twist, atol=1e-4
+        )
+        assert frame.trigger == bool(switches)
+    for _ in range(100):
+        if not source.running:
+            break
+        time.sleep(0.05)
+    source.stop()
+    status = source.status()
+    assert (
+        not status.running and "disconnected" in status.error and "plug it back in" in status.error
+    )
+
+
+def test_serial_port_that_does_not_exist():
+    with pytest.raises(CaptureError, match="cannot open the tape"):
+        SerialSource("/dev/does-not-exist").start()
+
+
+def test_dropped_frames_are_counted_when_the_consumer_stalls():
+    from studio.capture import ThreadedSource
+
+    class Burst(ThreadedSource):
+        kind = "burst"
+
+        def _produce(self):
+            for frame in synthetic_frames(50):
+                self._push(frame)
+
+    source = Burst(queue_frames=10)
+    source.start()
+    time.sleep(0.2)
+    assert len(source.read()) == 10 and source.status().dropped == 40
+
+
+def test_a_crashing_producer_reports_its_error():
+    from studio.capture import ThreadedSource
+
+    class Broken(ThreadedSource):
+        kind = "broken"
+
+        def _produce(self):
+            raise OSError("wire cut")
+
+    source = Broken()
+    source.start()
+    threading.Event().wait(0.2)
+    assert not source.running and "wire cut" in source.status().error
