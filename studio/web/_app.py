@@ -84,8 +84,7 @@ def create_app(settings: Settings | None = None, scene: Any = None) -> FastAPI:
     @app.exception_handler(StudioError)
     async def studio_error(request: Request, err: StudioError) -> JSONResponse:
         status = err.status_code if isinstance(err, WebError) else 422
-        text = str(err)
-        body: dict[str, Any] = {"detail": text[:1].upper() + text[1:]}
+        body: dict[str, Any] = {"detail": str(err)}
         reason = getattr(err, "reason", None)
         if isinstance(reason, str):
             body["reason"] = reason  # e.g. a refused demonstration: "never_reaches_goal"
