@@ -95,6 +95,13 @@ class PlaybackAction(_Body):
     speed: float | None = Field(None, gt=0, le=100)
 
 
+class ReachAction(_Body):
+    """Tell the simulated operator to reach a robot goal (or to go back to random reaching)."""
+
+    action: Literal["reach", "wander"] = "reach"
+    goal_deg: list[float] = Field(default_factory=lambda: list(DEFAULT_GOAL_DEG))
+
+
 class RetargetUpdate(_Body):
     """Change the human-to-robot mapping."""
 

@@ -80,6 +80,13 @@ class Studio:
         """Start the run worker and the pipeline (with the configured source, if any)."""
         self.runs.start()
         self.pipeline.start()
+        if self.scene is not None:
+            from studio.learning import ArmGrid
+
+            grid = ArmGrid()  # the default task's goal, until a watch shows another
+            goal = np.zeros(6)
+            goal[: grid.joints] = grid.angles_of(grid.goal_state)
+            self.scene.set_goal(goal)
         if self.settings.source is not None:
             try:
                 self.start_source(self.settings.source)
@@ -155,6 +162,26 @@ class Studio:
             self.pipeline.set_source(source, kind)
         else:  # the schema allows only the kinds above
             raise InvalidError(f"kind is {kind!r}; give simulator, recording, network or serial.")
+
+    def simulator_reach(self, action: str, goal_deg: list[float]) -> None:
+        """Make the simulator reach a robot goal (``goal_deg``, joints 1-3) or wander again.
+
+        Raises:
+            ConflictError: the live source is not the simulator.
+            InvalidError: the goal is not 3 angles within the Puma560's limits.
+        """
+        source = self.pipeline.source
+        if self.pipeline.kind != "simulator" or source is None:
+            raise ConflictError(
+                "The live source is not the simulator; switch the source to the simulator first."
+            )
+        if action == "wander":
+            source.wander()
+            return
+        q = goal_q_robot(goal_deg)
+        source.reach(q)
+        if self.scene is not None:
+            self.scene.set_goal(q)
 
     def source_public(self) -> dict[str, Any]:
         """``SourcePublic``: the pipeline status plus the playback state."""
@@ -365,3 +392,28 @@ def _playback_state(source: Any) -> dict[str, Any] | None:
         "duration": float(source.duration),
         "loop": bool(source.loop),
     }
+
+
+def goal_q_robot(goal_deg: list[float]) -> np.ndarray:
+    """A Puma560 pose (rad, (6,)) with joints 1-3 at ``goal_deg`` and the wrist at zero.
+
+    Raises:
+        InvalidError: not three finite angles within the robot's limits.
+    """
+    from studio.kinematics import Puma560
+
+    goal = np.asarray(goal_deg, dtype=np.float64)
+    if goal.shape != (3,) or not np.all(np.isfinite(goal)):
+        raise InvalidError(
+            f"goal_deg is {goal_deg!r}; give 3 finite angles in degrees, one per joint 1-3."
+        )
+    robot = Puma560()
+    q = np.zeros(6)
+    q[:3] = np.radians(goal)
+    lower, upper = np.degrees(robot.lower[:3]), np.degrees(robot.upper[:3])
+    for j in range(3):
+        if not lower[j] <= goal[j] <= upper[j]:
+            raise InvalidError(
+                f"goal_deg joint {j + 1} is {goal[j]:g} degrees, which the Puma560 cannot reach; give an angle from {lower[j]:g} to {upper[j]:g}."
+            )
+    return q

@@ -160,3 +160,9 @@ def test_events_report_list_changes(client):
             if line.startswith("data: ") and "changed" in line:
                 seen.append(line)
     assert 'data: {"changed":"runs"}' in seen
+
+
+def test_reach_needs_the_simulator(client):
+    r = client.post("/api/source/reach", json={"goal_deg": [0, 45, -90]})
+    assert r.status_code == 409 and "not the simulator" in r.json()["detail"]
+    assert client.post("/api/source/reach", json={"action": "dance"}).status_code == 422

@@ -6,7 +6,13 @@ from __future__ import annotations
 from fastapi import APIRouter
 
 from .._deps import StudioDep
-from .._schemas import PlaybackAction, RetargetUpdate, SourcePublic, SourceUpdate
+from .._schemas import (
+    PlaybackAction,
+    ReachAction,
+    RetargetUpdate,
+    SourcePublic,
+    SourceUpdate,
+)
 
 router = APIRouter(prefix="/api/source", tags=["source"])
 
@@ -39,4 +45,13 @@ def control_playback(body: PlaybackAction, studio: StudioDep) -> dict:
 def set_retarget(body: RetargetUpdate, studio: StudioDep) -> dict:
     """Map the arm onto the robot joint by joint or by hand position, mirrored or not."""
     studio.pipeline.set_retarget(body.mode, body.mirror)
+    return studio.source_public()
+
+
+@router.post("/reach", response_model=SourcePublic)
+def simulator_reach(body: ReachAction, studio: StudioDep) -> dict:
+    """Make the simulated operator reach the pose that mirrors onto a robot goal (joints 1-3,
+    degrees; the default goal when omitted), or go back to random reaching (409 if the source is
+    not the simulator). Handy for recording demonstrations that end at the goal."""
+    studio.simulator_reach(body.action, body.goal_deg)
     return studio.source_public()
