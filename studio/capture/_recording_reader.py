@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import os
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -230,7 +231,7 @@ def read_recording(path: str | os.PathLike[str], strict: bool = True) -> Recordi
             f"{path}, line 2: the column row does not match {regions} regions (expected '{','.join(expected[:5])},...'); {FIX_HINT}."
         )
     end: dict[str, Any] | None = None
-    rows: list[list[str]] = []
+    rows: list[str] = []
     row_lines: list[int] = []
     width = len(expected)
     last_index = len(lines) - 1
@@ -256,14 +257,14 @@ def read_recording(path: str | os.PathLike[str], strict: bool = True) -> Recordi
             continue
         if not line.strip():
             continue
-        fields = line.split(",")
-        if len(fields) != width:
+        count = line.count(",") + 1
+        if count != width:
             problems.add(
                 number,
-                f"{len(fields)} columns where {width} were expected (a truncated or damaged row)",
+                f"{count} columns where {width} were expected (a truncated or damaged row)",
             )
             continue
-        rows.append(fields)
+        rows.append(line)
         row_lines.append(number)
     data, row_lines = _to_array(rows, row_lines, width, problems)
     if data.shape[0]:
@@ -304,17 +305,26 @@ def read_recording(path: str | os.PathLike[str], strict: bool = True) -> Recordi
 
 
 def _to_array(
-    rows: list[list[str]], row_lines: list[int], width: int, problems: _Problems
+    rows: list[str], row_lines: list[int], width: int, problems: _Problems
 ) -> tuple[np.ndarray, list[int]]:
     if not rows:
         return np.zeros((0, width)), []
-    try:
-        return np.array(rows, dtype=np.float64), row_lines
-    except ValueError:
-        pass
+    # fast path: numpy's C parser over all rows at once, when every row holds only number
+    # characters (else numpy would read 'nan'/'inf' or stop early); any bad row takes the slow path
+    joined = ",".join(rows)
+    if _plain(joined):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", DeprecationWarning)
+            try:
+                flat = np.fromstring(joined, dtype=np.float64, sep=",")
+            except ValueError:
+                flat = np.zeros(0)
+        if flat.size == len(rows) * width:
+            return flat.reshape(len(rows), width), row_lines
     good: list[list[float]] = []
     kept: list[int] = []
-    for fields, number in zip(rows, row_lines, strict=True):
+    for line, number in zip(rows, row_lines, strict=True):
+        fields = line.split(",")
         try:
             good.append([float(x) for x in fields])
             kept.append(number)
@@ -322,6 +332,14 @@ def _to_array(
             bad = next(x for x in fields if not _is_float(x))
             problems.add(number, f"'{bad[:20]}' is not a number")
     return np.array(good, dtype=np.float64).reshape(-1, width), kept
+
+
+_PLAIN = frozenset("0123456789.,-+eE")
+
+
+def _plain(row: str) -> bool:
+    """Whether rows hold only number characters (else numpy may read 'nan', 'inf' or stop)."""
+    return _PLAIN.issuperset(row)
 
 
 def _is_float(text: str) -> bool:
