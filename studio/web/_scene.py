@@ -3,7 +3,8 @@
 The live pipeline runs at the tape's 110 Hz; a browser's websocket may be far slower. So
 :meth:`StudioScene.update_live` only stores the latest values (latest wins) and a scene thread
 pushes them to viser at a bounded rate, one batched message per update. Nothing the pipeline
-calls ever waits on a client.
+calls ever waits on a client, and viser coalesces a node's pending updates per client, so a slow
+browser skips poses instead of queueing behind them.
 
 World frame: Z up, the Puma560's base on the floor at the origin, facing +X. The operator's arm
 is drawn mirrored (as in a mirror held beside the robot, so it moves the way the robot moves) a
@@ -58,7 +59,7 @@ class SceneLayout:
     mirror_axis: int | None = 1
     torso_size: tuple[float, float, float] = (0.22, 0.36, 0.55)
     rate_hz: float = 40.0
-    playback_hold_s: float = 2.0
+    playback_hold_s: float = 5.0
     camera_position: tuple[float, float, float] = (1.95, -0.6, 1.6)
     camera_look_at: tuple[float, float, float] = (0.1, -0.42, 0.9)
     colors: dict[str, tuple[int, int, int]] = field(
@@ -414,12 +415,16 @@ class StudioScene:
             playback = self._playback
             hold = now < self._hold_until
             live_robot = None
+            clear_trace = False
             if playback is not None or hold:
                 self._robot_behind_live = True
-            elif self._robot_behind_live and self._live is not None:
-                # A playback just ended: go back to the newest live pose even if none is new.
+            elif self._robot_behind_live:
+                # A playback just ended: go back to the newest live pose even if none is new,
+                # and take its trace away with it.
                 self._robot_behind_live = False
-                live_robot = self._live[1]
+                clear_trace = True
+                if self._live is not None:
+                    live_robot = self._live[1]
         q_robot: np.ndarray | None = None
         marks_upto = -1
         finished = False
@@ -441,9 +446,12 @@ class StudioScene:
             q_robot = live[1]
         elif live_robot is not None:
             q_robot = live_robot
-        if q_robot is None and live is None and playback is None:
+        if q_robot is None and live is None and playback is None and not clear_trace:
             return
         with self._viser_lock, self.server.atomic():
+            if clear_trace:
+                self._trace_line.visible = False
+                self._trace_marks.visible = False
             if live is not None:
                 self._push_human(live[0], live[2])
             if q_robot is not None:

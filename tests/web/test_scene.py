@@ -75,7 +75,7 @@ def server():
 
 @pytest.fixture
 def scene(server):
-    sc = StudioScene(server, arm=_arm(), layout=SceneLayout(rate_hz=100.0, playback_hold_s=0.2))
+    sc = StudioScene(server, arm=_arm(), layout=SceneLayout(rate_hz=100.0, playback_hold_s=1.0))
     yield sc
     sc.close()
 
@@ -207,7 +207,11 @@ def test_live_resumes_after_playback_hold(scene):
     scene.play_trajectory(np.array([0.0, 0.05]), np.zeros((2, 6)))
     live_q = np.full(6, 0.2)
     scene.update_live(np.zeros(7), live_q, None)
+    assert _wait_until(lambda: not scene.playing, 3.0)
+    assert scene._trace_marks.visible  # the trace stays while the robot holds the last pose
+    assert np.allclose(scene.current_q_robot(), 0.0)
     assert _wait_until(lambda: np.allclose(scene.current_q_robot(), live_q), 3.0)
+    assert _wait_until(lambda: not scene._trace_marks.visible, 1.0)  # and goes with it
 
 
 def test_stop_playback(scene):
