@@ -115,6 +115,12 @@ class Pipeline:
             except OSError as err:
                 self._start_error = f"The {kind} source could not start ({err.strerror or err}); check the device or port and try again."
 
+    def report_error(self, kind: str, message: str) -> None:
+        """Show a source that could not even be built as selected, with its error."""
+        with self._lock:
+            self._stop_source()
+            self._kind, self._recording, self._start_error = kind, None, message
+
     def clear_source(self) -> None:
         """Stop the source and run without one."""
         self.set_source(None, None)  # type: ignore[arg-type]

@@ -10,6 +10,9 @@ from ._settings import Settings
 
 log = logging.getLogger(__name__)
 
+SHUTDOWN_GRACE_S = 3
+"""On Ctrl+C, open event streams (which never end by themselves) are closed after this long."""
+
 
 def start_scene(settings: Settings):  # noqa: ANN201 - returns (ViserServer, StudioScene)
     """Start the viser server (share button hidden) and the studio's scene in it."""
@@ -38,7 +41,12 @@ def serve(settings: Settings, open_browser: bool = True) -> None:
         app = create_app(settings, scene)
         url = f"http://{'127.0.0.1' if settings.host in ('0.0.0.0', '::') else settings.host}:{settings.port}/"
         config = uvicorn.Config(
-            app, host=settings.host, port=settings.port, log_level="warning", access_log=False
+            app,
+            host=settings.host,
+            port=settings.port,
+            log_level="warning",
+            access_log=False,
+            timeout_graceful_shutdown=SHUTDOWN_GRACE_S,
         )
         http = uvicorn.Server(config)
         print(

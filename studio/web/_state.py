@@ -90,8 +90,16 @@ class Studio:
         if self.settings.source is not None:
             try:
                 self.start_source(self.settings.source)
-            except StudioError as err:
+            except Exception as err:  # the studio still starts: the page shows why
                 log.warning("could not start the source %s: %s", self.settings.source, err)
+                message = (
+                    str(err)
+                    if isinstance(err, StudioError)
+                    else f"The {self.settings.source} source could not start ({type(err).__name__}: {err}); choose another source."
+                )
+                self.pipeline.report_error(
+                    "simulator" if self.settings.source == "simulator" else "recording", message
+                )
 
     def close(self) -> None:
         """Stop training (keeping partial curves), close a capture cleanly, stop the source."""
