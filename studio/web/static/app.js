@@ -226,6 +226,18 @@ async function applySource() {
   }, $("source-apply"));
 }
 
+async function simulatorReach(action) {
+  const body = { action };
+  if (action === "reach") {
+    const f = $("train-form").elements;
+    body.goal_deg = [Number(f.goal0.value), Number(f.goal1.value), Number(f.goal2.value)];
+  }
+  await guarded("source-error", async () => {
+    S.source = await api("POST", "/api/source/reach", body);
+    renderSource();
+  }, $(action === "reach" ? "source-reach" : "source-wander"));
+}
+
 async function playback(action, extra = {}) {
   await guarded("source-error", async () => {
     S.source = await api("POST", "/api/source/playback", { action, ...extra });
@@ -940,6 +952,8 @@ function wire() {
   $("playback-loop").addEventListener("change", () => {
     if (S.source && S.source.kind === "recording") applySource();
   });
+  $("source-reach").addEventListener("click", () => simulatorReach("reach"));
+  $("source-wander").addEventListener("click", () => simulatorReach("wander"));
   $("retarget-mode").addEventListener("change", setRetarget);
   $("retarget-mirror").addEventListener("change", setRetarget);
 
