@@ -57,9 +57,9 @@ class Demonstration:
 
     Attributes:
         recording: the recording's path.
-        t0: segment start (s, recording time).
-        t1: segment end (s).
-        times: times of the trajectory samples ``(N,)``.
+        t0: segment start (s after the recording's first frame).
+        t1: segment end (s after the first frame).
+        times: the recording's times of the trajectory samples ``(N,)``.
         q_robot: the Puma560 joint trajectory ``(N, 6)`` (rad).
         grid_path: states of the grid, one action apart, ending at the goal.
         grid: the grid spec (``ArmGrid.to_dict()``), with the goal used.
@@ -213,8 +213,8 @@ def extract_demonstration(
 
     Args:
         recording: a :class:`Recording` or a path.
-        t0: segment start (s, in the recording's time).
-        t1: segment end (s).
+        t0: segment start (s after the recording's first frame, as playback's ``seek``).
+        t1: segment end (s after the first frame).
         grid: the :class:`studio.learning.ArmGrid` (default ``ArmGrid()``, the paper's task).
         mode: retargeting mode, ``"joint"`` or ``"cartesian"``.
         goal_from_end: instead of refusing a segment that misses the goal, make its end the goal.
@@ -239,7 +239,7 @@ def extract_demonstration(
     times = rec.t[rows]
     if times.shape[0] < MIN_SEGMENT_FRAMES:
         raise DemonstrationError(
-            f"the segment [{t0:.2f}, {t1:.2f}] s of {rec.path.name} holds {times.shape[0]} frames; choose a longer segment inside 0-{rec.t[-1] if len(rec) else 0:.2f} s.",
+            f"the segment [{t0:.2f}, {t1:.2f}] s of {rec.path.name} holds {times.shape[0]} frames; choose a longer segment inside 0-{rec.duration:.2f} s.",
             "too_short",
         )
     config = rec.config

@@ -98,9 +98,10 @@ class Recording:
         )
 
     def segment(self, t0: float, t1: float) -> slice:
-        """The rows with ``t0 <= t <= t1``, as a slice."""
-        lo = int(np.searchsorted(self.t, t0, side="left"))
-        hi = int(np.searchsorted(self.t, t1, side="right"))
+        """The rows from ``t0`` to ``t1`` seconds after the first frame (inclusive), as a slice."""
+        start = float(self.t[0]) if len(self) else 0.0
+        lo = int(np.searchsorted(self.t, start + t0, side="left"))
+        hi = int(np.searchsorted(self.t, start + t1, side="right"))
         return slice(lo, hi)
 
     def summary(self) -> dict[str, Any]:
