@@ -1,6 +1,9 @@
 """studio.kinematics (see docs/interfaces.md)."""
 
 from ._errors import KinematicsError as KinematicsError
+from ._fit import ArmFit as ArmFit
+from ._fit import ArmFitter as ArmFitter
+from ._fit import FitConfig as FitConfig
 from ._human import ArmPose as ArmPose
 from ._human import HumanArm as HumanArm
 from ._human import mirror_human_q as mirror_human_q
@@ -12,6 +15,8 @@ from ._puma import IKConfig as IKConfig
 from ._puma import IKResult as IKResult
 from ._puma import LinkVisual as LinkVisual
 from ._puma import Puma560 as Puma560
+from ._retarget import RetargetConfig as RetargetConfig
+from ._retarget import Retargeter as Retargeter
 from ._tape import TapeConfig as TapeConfig
 from ._tape import TapeShape as TapeShape
 from ._tape import reconstruct as reconstruct

@@ -317,7 +317,7 @@ def _walk_chords(
         for k in range(1, S):
             todo = ~found & (seg < k)
             if not np.any(todo):
-                break
+                continue
             w = path[todo, k] - v[todo]
             d = directions[todo, k]
             wd = np.einsum("ij,ij->i", w, d)

@@ -1,0 +1,312 @@
+"""Fit the 7-DOF human arm to a reconstructed tape, frame after frame.
+
+The tape lies along the arm from vertex ``shoulder_region`` (at the shoulder) on, cutting the
+corners at the elbow and the wrist with straight chords (see :func:`tape_from_arm`). Landmarks
+are read from it geometrically, using the operator's limb lengths, so the corner chords do not
+bias them:
+
+- shoulder ``S``: vertex ``shoulder_region``;
+- elbow ``E = S + upper_arm * u``, with ``u`` the direction of the first arm region (it lies on
+  the upper arm whenever the upper arm is longer than one region);
+- wrist ``W = E + forearm * f``, with ``f`` the direction from ``E`` to the first vertex past the
+  elbow (the elbow-corner chord ends on the forearm);
+- hand centre ``H = W + hand * h``, with ``h`` the direction from ``W`` to the first vertex past
+  the wrist (or ``f`` when the tape ends before the hand: a straight wrist is assumed).
+
+Then damped least squares (Pinocchio joint Jacobians) moves the arm's elbow, wrist and hand
+centre onto ``E, W, H``, warm-started from the previous frame; a cold start (the first frame, or
+a failed warm start) is seeded in closed form for the shoulder and elbow.
+
+Observability: the three directions give six numbers for seven joints. Shoulder flexion,
+abduction, humeral rotation and elbow flexion are determined (humeral rotation only when the elbow
+is bent); forearm rotation and the two wrist joints share one unobservable direction (they all
+turn the hand about the forearm), which the damped steps resolve by moving least from the
+previous frame. The residual is the RMS distance from the tape's arm vertices to the fitted arm,
+so a badly placed or mis-configured tape shows up as a number.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+
+from ._errors import KinematicsError
+from ._human import HumanArm
+from ._tape import TapeConfig, TapeShape, reconstruct
+
+
+@dataclass(frozen=True)
+class FitConfig:
+    """Defaults of the arm fit, documented once.
+
+    Attributes:
+        warm_iterations: DLS iterations when starting from the previous frame.
+        cold_iterations: DLS iterations from the closed-form seed.
+        tolerance: stop when the landmark error norm (m, over elbow, wrist, hand) is below this.
+        damping: DLS damping lambda (m); bounds steps in the unobservable wrist direction and
+            near the straight-elbow singularity.
+        max_step: largest joint step per iteration (rad, infinity norm).
+        max_residual: a fit whose residual (m) exceeds this is reported as failed: the tape
+            does not lie along an arm of these lengths.
+        landmark_tolerance: a fit whose landmark error (m) exceeds this is reported as failed.
+    """
+
+    warm_iterations: int = 8
+    cold_iterations: int = 100
+    tolerance: float = 1e-7
+    damping: float = 1e-3
+    max_step: float = 0.5
+    max_residual: float = 0.02
+    landmark_tolerance: float = 1e-3
+
+
+@dataclass(frozen=True)
+class ArmFit:
+    """One fitted frame.
+
+    Attributes:
+        q_human: fitted joint angles (rad, (7,)), within the arm's limits.
+        residual: RMS distance (m) from the tape's arm vertices (shoulder to the first vertex
+            past the wrist) to the fitted arm's shoulder-elbow-wrist-hand polyline.
+        success: landmark error below ``landmark_tolerance`` and residual below
+            ``max_residual``.
+        landmarks: the tape's shoulder, elbow, wrist and hand-centre points, (4, 3) (m).
+        landmark_error: RMS distance (m) between those landmarks and the fitted arm's.
+        iterations: DLS iterations used.
+    """
+
+    q_human: np.ndarray
+    residual: float
+    success: bool
+    landmarks: np.ndarray
+    landmark_error: float
+    iterations: int
+
+
+def _unit(v: np.ndarray) -> np.ndarray:
+    return v / np.linalg.norm(v)
+
+
+def _point_polyline_distance(points: np.ndarray, poly: np.ndarray) -> np.ndarray:
+    """Distance of each point to the polyline ``poly`` whose last segment is a ray."""
+    best = np.full(points.shape[0], np.inf)
+    for k in range(poly.shape[0] - 1):
+        a, d = poly[k], poly[k + 1] - poly[k]
+        t = (points - a) @ d / (d @ d)
+        t = np.maximum(t, 0.0) if k == poly.shape[0] - 2 else np.clip(t, 0.0, 1.0)
+        dist = np.linalg.norm(points - (a + t[:, None] * d), axis=1)
+        best = np.minimum(best, dist)
+    return best
+
+
+class ArmFitter:
+    """Fits ``arm`` to the tape described by ``config``, one frame at a time.
+
+    Args:
+        arm: the operator's arm (its lengths define the landmarks).
+        config: the tape and where it lies on the operator.
+        fit: solver defaults.
+
+    Raises:
+        KinematicsError: the tape's regions cannot see the elbow (upper arm shorter than a
+            region, or too few regions after the shoulder).
+    """
+
+    def __init__(self, arm: HumanArm, config: TapeConfig, fit: FitConfig | None = None) -> None:
+        self.arm = arm
+        self.config = config
+        self.settings = fit or FitConfig()
+        step = config.region_length
+        if arm.upper_arm_length < step:
+            raise KinematicsError(
+                f"The upper arm ({arm.upper_arm_length:.3f} m) is shorter than one tape region "
+                f"({step:.3f} m), so the tape cannot show its direction; use more regions."
+            )
+        s = config.shoulder_region
+        self._first_forearm = s + int(math.floor(arm.upper_arm_length / step + 1e-9)) + 1
+        if self._first_forearm > config.regions:
+            raise KinematicsError(
+                f"The tape ends before it passes the elbow (shoulder_region={s} of "
+                f"{config.regions} regions); lower shoulder_region."
+            )
+        self.model = arm.model
+        self.data = arm.model.createData()
+        self._hand = arm.hand_frame
+        self._lower = np.asarray(arm.lower)
+        self._upper = np.asarray(arm.upper)
+        self._damping = np.eye(arm.nq) * self.settings.damping**2
+        self._q: np.ndarray | None = None
+
+    def reset(self) -> None:
+        """Forget the previous frame: the next fit starts cold."""
+        self._q = None
+
+    # -------------------------------------------------------------------------------- landmarks
+
+    def landmarks(self, positions: np.ndarray) -> tuple[np.ndarray, int]:
+        """Shoulder, elbow, wrist and hand centre from one tape's vertices.
+
+        Args:
+            positions: ``(regions + 1, 3)`` vertices.
+
+        Returns:
+            ``(points (4, 3), last)`` where ``last`` is the index of the last vertex used.
+        """
+        arm, s = self.arm, self.config.shoulder_region
+        S = positions[s]
+        E = S + arm.upper_arm_length * _unit(positions[s + 1] - S)
+        c = self._first_forearm
+        f = positions[c] - E
+        if np.linalg.norm(f) < 1e-9 and c < self.config.regions:
+            f = positions[c + 1] - positions[c]
+        f = _unit(f)
+        W = E + arm.forearm_length * f
+        beyond = np.nonzero((positions[c + 1 :] - E) @ f > arm.forearm_length + 1e-9)[0]
+        if beyond.size:
+            last = c + 1 + int(beyond[0])
+            h = _unit(positions[last] - W)
+        else:
+            last, h = self.config.regions, f
+        return np.stack([S, E, W, W + arm.hand_length * h]), last
+
+    def _seed(self, points: np.ndarray) -> np.ndarray:
+        """Closed-form shoulder and elbow angles from the landmark directions (wrist at zero)."""
+        S, E, W, H = points
+        d = _unit(E - S)
+        q = np.zeros(self.arm.nq)
+        # Upper-arm direction in the base frame: (sin q0 cos q1, -sin q1, -cos q0 cos q1).
+        q[1] = math.asin(float(np.clip(-d[1], -1.0, 1.0)))
+        q[0] = math.atan2(d[0], -d[2])
+        if self.arm.side == "left":
+            # Mirrored axes: the left arm's direction is the right's with y negated.
+            q[1] = -q[1]
+        f = _unit(W - E)
+        q[3] = math.acos(float(np.clip(d @ f, -1.0, 1.0)))
+        pin.forwardKinematics(self.model, self.data, q)
+        A = self.data.oMi[2].rotation  # frame before humeral rotation
+        fA = A.T @ f
+        sign = -1.0 if self.arm.side == "right" else 1.0  # mirrored lateral axes
+        if math.sin(q[3]) > 1e-6:  # humeral rotation is seen only with a bent elbow
+            q[2] = math.atan2(sign * fA[2], fA[0])
+        # Forearm rotation and wrist flexion that point the hand at H, with no deviation:
+        # the hand's direction in the elbow frame is (cos q4 sin q5, -cos q5, -+sin q4 sin q5).
+        q = np.clip(q, self._lower, self._upper)
+        pin.forwardKinematics(self.model, self.data, q)
+        h = self.data.oMi[4].rotation.T @ _unit(H - W)
+        q5 = math.acos(float(np.clip(-h[1], -1.0, 1.0)))
+        q4 = math.atan2(sign * h[2], h[0])
+        for q4_try, q5_try in ((q4, q5), (q4 + math.pi, -q5), (q4 - math.pi, -q5)):
+            if (
+                self._lower[4] <= q4_try <= self._upper[4]
+                and self._lower[5] <= q5_try <= self._upper[5]
+            ):
+                q[4], q[5] = q4_try, q5_try
+                break
+        return np.clip(q, self._lower, self._upper)
+
+    # -------------------------------------------------------------------------------------- IK
+
+    def _solve(
+        self, q: np.ndarray, target: np.ndarray, iterations: int
+    ) -> tuple[np.ndarray, float, int]:
+        model, data, cfg = self.model, self.data, self.settings
+        frame = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+        J = np.empty((9, self.arm.nq))
+        err = np.inf
+        for it in range(iterations + 1):
+            pin.computeJointJacobians(model, data, q)
+            pin.updateFramePlacement(model, data, self._hand)
+            e = target - np.concatenate(
+                [data.oMi[4].translation, data.oMi[6].translation, data.oMf[self._hand].translation]
+            )
+            err = float(np.linalg.norm(e))
+            if err < cfg.tolerance or it == iterations:
+                return q, err, it
+            J[0:3] = pin.getJointJacobian(model, data, 4, frame)[:3]
+            J[3:6] = pin.getJointJacobian(model, data, 6, frame)[:3]
+            J[6:9] = pin.getFrameJacobian(model, data, self._hand, frame)[:3]
+            dq = np.linalg.solve(J.T @ J + self._damping, J.T @ e)
+            largest = np.abs(dq).max()
+            if largest > cfg.max_step:
+                dq *= cfg.max_step / largest
+            q = np.clip(q + dq, self._lower, self._upper)
+        return q, err, iterations  # pragma: no cover - loop always returns
+
+    def fit(self, tape: TapeShape | tuple[object, object]) -> ArmFit:
+        """Fit the arm to one tape frame, warm-started from the previous one.
+
+        Args:
+            tape: a :class:`TapeShape` of one frame, or its ``(bend, twist)`` (rad, (regions,)).
+
+        Returns:
+            An :class:`ArmFit`.
+
+        Raises:
+            KinematicsError: wrong shapes or non-finite values.
+        """
+        regions = self.config.regions
+        if isinstance(tape, TapeShape):
+            positions = np.asarray(tape.positions, dtype=float)
+            if positions.shape != (regions + 1, 3):
+                raise KinematicsError(
+                    f"ArmFitter.fit takes one frame: positions of shape ({regions + 1}, 3); "
+                    f"got {positions.shape}."
+                )
+            if not np.all(np.isfinite(positions)):
+                raise KinematicsError("The tape shape contains NaN or infinite positions.")
+        else:
+            try:
+                bend, twist = tape
+            except (TypeError, ValueError) as err:
+                raise KinematicsError(
+                    "ArmFitter.fit takes a TapeShape or a (bend, twist) pair of arrays."
+                ) from err
+            bend_a = np.asarray(bend, dtype=float)
+            if bend_a.shape != (regions,):
+                raise KinematicsError(
+                    f"ArmFitter.fit takes one frame: bend of shape ({regions},); got {bend_a.shape}."
+                )
+            positions = reconstruct(bend_a, twist, self.config).positions
+
+        points, last = self.landmarks(positions)
+        target = (points[1:] - points[0]).reshape(-1)  # the arm's shoulder is at the origin
+        cfg = self.settings
+        iterations = 0
+        q, err = None, np.inf
+        if self._q is not None:
+            q, err, iterations = self._solve(self._q.copy(), target, cfg.warm_iterations)
+        if q is None or err > cfg.landmark_tolerance:
+            q_cold, err_cold, it = self._solve(
+                self._seed(points - points[0]), target, cfg.cold_iterations
+            )
+            iterations += it
+            if err_cold < err:
+                q, err = q_cold, err_cold
+        self._q = q
+
+        # Residual: tape's arm vertices against the fitted arm, in the arm base frame.
+        pin.forwardKinematics(self.model, self.data, q)
+        pin.updateFramePlacement(self.model, self.data, self._hand)
+        arm_points = np.stack(
+            [
+                np.zeros(3),
+                self.data.oMi[4].translation,
+                self.data.oMi[6].translation,
+                self.data.oMf[self._hand].translation,
+            ]
+        )
+        vertices = positions[self.config.shoulder_region : last + 1]
+        residual = float(np.sqrt(np.mean(_point_polyline_distance(vertices, arm_points) ** 2)))
+        landmark_error = float(np.sqrt(np.mean(np.sum((points - arm_points) ** 2, axis=1))))
+        success = landmark_error <= cfg.landmark_tolerance and residual <= cfg.max_residual
+        return ArmFit(
+            q_human=q.copy(),
+            residual=residual,
+            success=bool(success),
+            landmarks=points,
+            landmark_error=landmark_error,
+            iterations=iterations,
+        )

@@ -1,0 +1,222 @@
+"""Retargeting: the operator's arm angles to Puma560 joint angles, mirrored by default.
+
+The paper mirrors the operator (for ergonomics): facing the robot, the operator moves as in
+front of a mirror. In the robot's base frame (x forward, z up, like the arm base frame) mirroring
+is the reflection y -> -y: the operator's right arm reaching out to their right drives the robot
+to *its* left, i.e. the same side as seen by the operator.
+
+Two modes, switchable at run time (``retargeter.mode = "cartesian"``):
+
+*joint* - each Puma joint follows one human joint, ``q_robot[j] = offset[j] + sign[j] *
+q_human[i]``, then is clamped at the Puma's limits (:data:`JOINT_MAP`):
+
+====  ===================================  ======  =========  ==========================
+Puma  human joint                           sign    offset     why
+====  ===================================  ======  =========  ==========================
+J1    shoulder_X (abduction)               -1 (*)  0          swings the arm sideways;
+                                                              with the arm raised it is yaw
+J2    shoulder_Z (flexion)                 +1      -pi/2      arm hanging = J2 -90 deg
+J3    elbow_Z (flexion)                    +1      -pi/2      straight arm = J3 -90 deg
+J4    elbow_Y (forearm rotation)           +1 (*)  0          both roll the forearm
+J5    wrist_Z (wrist flexion)              +1      0          both bend the wrist
+J6    wrist_X (wrist deviation)            +1 (*)  0          the remaining wrist DOF
+====  ===================================  ======  =========  ==========================
+
+(*) lateral joints: their sign flips when mirroring, and again for a left arm (whose angles
+already describe the mirror image). Humeral rotation (shoulder_Y) has no Puma counterpart and is
+dropped; :meth:`Retargeter.human_from_robot` sets it to zero.
+
+*cartesian* - the hand-centre pose relative to the shoulder is mirrored, scaled by the ratio of
+the robot's reach to the arm's (times ``reach_fraction``), placed at the Puma's shoulder and
+solved by :meth:`Puma560.inverse`, warm-started from the previous solution; when the full pose is
+out of reach of the Puma's wrist, the position alone is solved.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+
+from ._errors import KinematicsError
+from ._human import SAGITTAL_MIRROR, HumanArm, _as_q
+from ._puma import IKConfig, Puma560
+
+Mode = Literal["joint", "cartesian"]
+
+JOINT_MAP = (
+    # (human joint index, sign, robot offset rad, lateral: flips with mirroring)
+    (1, -1.0, 0.0, True),
+    (0, 1.0, -math.pi / 2, False),
+    (3, 1.0, -math.pi / 2, False),
+    (4, 1.0, 0.0, True),
+    (5, 1.0, 0.0, False),
+    (6, 1.0, 0.0, True),
+)
+"""Joint-mode mapping, Puma joint by Puma joint (see the module docstring)."""
+
+DROPPED_HUMAN_JOINT = 2
+"""shoulder_Y (humeral rotation): no Puma counterpart."""
+
+URDF_LATERAL_MIRROR = np.diag([1.0, 1.0, -1.0])
+"""Reflection of ``human.urdf``'s local frames (their z is lateral), used to mirror hand frames."""
+
+HAND_TO_TOOL = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])
+"""Tool axes in the hand frame: tool z (approach) along the fingers (hand -y), tool x = hand x."""
+
+
+@dataclass(frozen=True)
+class RetargetConfig:
+    """Defaults of the retargeting, documented once.
+
+    Attributes:
+        reach_fraction: the arm's full reach maps to this fraction of the robot's, keeping
+            cartesian targets off the Puma's outstretched singularity.
+        ik_iterations: Puma IK iterations per attempt on the live path (warm starts need few).
+    """
+
+    reach_fraction: float = 0.95
+    ik_iterations: int = 20
+
+
+class Retargeter:
+    """Human arm angles to Puma560 angles, in joint or cartesian mode.
+
+    Args:
+        mode: ``"joint"`` or ``"cartesian"``; switchable later through ``.mode``.
+        mirror: mirror the operator (the paper's choice).
+        robot: the Puma560 (default: one whose IK is capped at ``ik_iterations``).
+        arm: the operator's arm (default: the right arm of default size).
+        config: defaults.
+    """
+
+    def __init__(
+        self,
+        mode: Mode = "joint",
+        mirror: bool = True,
+        robot: Puma560 | None = None,
+        arm: HumanArm | None = None,
+        config: RetargetConfig | None = None,
+    ) -> None:
+        self.config = config or RetargetConfig()
+        self.robot = robot or Puma560(ik=IKConfig(max_iterations=self.config.ik_iterations))
+        self.arm = arm or HumanArm()
+        self.mirror = bool(mirror)
+        self.mode = mode
+        self._q_prev: np.ndarray | None = None
+
+    # ---------------------------------------------------------------------------- settings
+
+    @property
+    def mode(self) -> Mode:
+        """``"joint"`` or ``"cartesian"``."""
+        return self._mode
+
+    @mode.setter
+    def mode(self, value: str) -> None:
+        if value not in ("joint", "cartesian"):
+            raise KinematicsError(f'Retarget mode must be "joint" or "cartesian"; got {value!r}.')
+        self._mode = value  # type: ignore[assignment]
+
+    @property
+    def mirror(self) -> bool:
+        """Whether the robot mirrors the operator."""
+        return self._mirror
+
+    @mirror.setter
+    def mirror(self, value: bool) -> None:
+        self._mirror = bool(value)
+        # Lateral joints flip when mirroring, and again for a left arm (already a mirror image).
+        flip = self._mirror != (self.arm.side == "left")
+        self._signs = np.array([s * (-1.0 if lat and flip else 1.0) for _, s, _, lat in JOINT_MAP])
+
+    def reset(self) -> None:
+        """Forget the previous cartesian solution (the next IK starts cold)."""
+        self._q_prev = None
+
+    # ---------------------------------------------------------------------------- mapping
+
+    def robot_from_human(self, q_human: object) -> np.ndarray:
+        """Puma joint angles for the operator's arm angles.
+
+        Args:
+            q_human: arm angles (rad), shape (7,).
+
+        Returns:
+            ``q_robot`` (rad, shape (6,)), within the Puma's limits.
+
+        Raises:
+            KinematicsError: wrong shape or non-finite angles.
+        """
+        q = _as_q(q_human, self.arm.nq, "q_human")
+        if q.shape != (self.arm.nq,):
+            raise KinematicsError(f"q_human must have shape (7,); got shape {q.shape}.")
+        q_robot = self._joint(q) if self._mode == "joint" else self._cartesian(q)
+        return q_robot
+
+    def _joint(self, q_human: np.ndarray) -> np.ndarray:
+        signs = self._signs
+        q_robot = np.array(
+            [offset + signs[j] * q_human[i] for j, (i, _, offset, _) in enumerate(JOINT_MAP)]
+        )
+        return np.minimum(np.maximum(q_robot, self.robot.lower), self.robot.upper)
+
+    def hand_target(self, q_human: object) -> np.ndarray:
+        """The Puma tool pose (4x4, robot base frame) that cartesian mode aims at.
+
+        Args:
+            q_human: arm angles (rad), shape (7,).
+
+        Returns:
+            ``oMdes``: the mirrored (if set), scaled hand-centre pose placed at the Puma's
+            shoulder, with the tool's approach axis along the fingers.
+        """
+        pose = self.arm.forward(q_human).hand
+        p, R = pose[:3, 3], pose[:3, :3]
+        if self._mirror:
+            p = SAGITTAL_MIRROR @ p
+            R = SAGITTAL_MIRROR @ R @ URDF_LATERAL_MIRROR
+        arm = self.arm
+        human_reach = arm.upper_arm_length + arm.forearm_length + arm.hand_length
+        scale = self.config.reach_fraction * self.robot.reach / human_reach
+        oMdes = np.eye(4)
+        oMdes[:3, :3] = R @ HAND_TO_TOOL
+        oMdes[:3, 3] = np.array([0.0, 0.0, self.robot.dh[0].d]) + scale * p
+        return oMdes
+
+    def _cartesian(self, q_human: np.ndarray) -> np.ndarray:
+        oMdes = self.hand_target(q_human)
+        result = self.robot.inverse(oMdes, q0=self._q_prev)
+        if not result.success:
+            position = self.robot.inverse(oMdes[:3, 3], q0=result.q, position_only=True)
+            if position.success or position.error < result.error:
+                result = position
+        self._q_prev = result.q.copy()
+        return result.q.copy()
+
+    def human_from_robot(self, q_robot: object) -> np.ndarray:
+        """Operator arm angles that joint mode maps onto ``q_robot``: its inverse.
+
+        Exact (``robot_from_human(human_from_robot(q)) == q``) wherever the result lies within the
+        human limits; humeral rotation, which joint mode ignores, is zero. The simulator uses it
+        to drive the operator's arm towards a robot goal.
+
+        Args:
+            q_robot: Puma angles (rad), shape (6,).
+
+        Returns:
+            ``q_human`` (rad, shape (7,)), clipped to the arm's limits.
+
+        Raises:
+            KinematicsError: wrong shape or non-finite angles.
+        """
+        q = _as_q(q_robot, 6, "q_robot")
+        if q.shape != (6,):
+            raise KinematicsError(f"q_robot must have shape (6,); got shape {q.shape}.")
+        signs = self._signs
+        q_human = np.zeros(self.arm.nq)
+        for j, (i, _, offset, _) in enumerate(JOINT_MAP):
+            q_human[i] = (q[j] - offset) * signs[j]
+        return np.minimum(np.maximum(q_human, self.arm.lower), self.arm.upper)
