@@ -1,0 +1,99 @@
+"""The studio drives the scene: watch plays rollouts, previews draw paths, in-use checks."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from fastapi.testclient import TestClient
+
+from studio.learning import ArmGrid
+from studio.web import create_app
+from tests.web.conftest import make_settings
+from tests.web.test_demonstrations import save_demo
+from tests.web.test_policies import policy_bytes, upload
+
+
+class FakeScene:
+    """Records the calls the studio makes on ``StudioScene`` (same method names)."""
+
+    def __init__(self) -> None:
+        self.calls: list[tuple[str, tuple]] = []
+        self.playing = False
+        self.q_robot = np.zeros(6)
+
+    def update_live(self, q_human, q_robot, tape_positions=None) -> None:
+        self.calls.append(("update_live", (q_human, q_robot)))
+
+    def set_goal(self, q_robot_goal) -> None:
+        self.calls.append(("set_goal", (q_robot_goal,)))
+
+    def show_path(self, name, q_robot_path) -> None:
+        self.calls.append(("show_path", (name, q_robot_path)))
+
+    def clear_path(self, name=None) -> None:
+        self.calls.append(("clear_path", (name,)))
+
+    def play_trajectory(self, times, q_robot, states=None) -> None:
+        self.playing = True
+        self.calls.append(("play_trajectory", (times, q_robot, states)))
+
+    def stop_playback(self) -> None:
+        self.playing = False
+        self.calls.append(("stop_playback", ()))
+
+    def current_q_robot(self):
+        return self.q_robot.copy()
+
+    def named(self, name: str) -> list[tuple]:
+        return [args for call, args in self.calls if call == name]
+
+
+@pytest.fixture
+def scene_client(tmp_path):
+    scene = FakeScene()
+    with TestClient(create_app(make_settings(tmp_path), scene)) as client:
+        yield client, scene
+
+
+def test_the_default_goal_is_shown_at_start(scene_client):
+    _, scene = scene_client
+    (goal,) = scene.named("set_goal")[0]
+    grid = ArmGrid()
+    assert np.allclose(goal[:3], grid.angles_of(grid.goal_state)) and np.allclose(goal[3:], 0)
+
+
+def test_watch_plays_the_rollout_and_blocks_deleting_the_policy(scene_client, tmp_path):
+    client, scene = scene_client
+    upload(client, "reach.policy.npz", policy_bytes(tmp_path))
+    w = client.post("/api/watch", json={"policy": "reach", "seed": 1}).json()
+    times, q, states = scene.named("play_trajectory")[-1]
+    assert np.allclose(times, w["times"]) and np.allclose(q, w["q_robot"], atol=1e-6)
+    assert list(states) == w["states"]
+    r = client.delete("/api/policies/reach")
+    assert r.status_code == 409 and "stop watching" in r.json()["detail"]
+    assert client.post("/api/watch/stop").status_code == 204
+    assert scene.named("stop_playback")
+    assert client.delete("/api/policies/reach").status_code == 204
+
+
+def test_watch_from_the_current_pose_starts_in_its_bin(scene_client, tmp_path):
+    client, scene = scene_client
+    upload(client, "reach.policy.npz", policy_bytes(tmp_path))
+    scene.q_robot = np.radians([100.0, -60.0, 20.0, 10.0, 20.0, 30.0])
+    w = client.post("/api/watch", json={"policy": "reach", "start": "current"}).json()
+    grid = ArmGrid(bins=5)
+    assert w["states"][0] == grid.state_of_angles(scene.q_robot[:3])
+    # the wrist holds where it was
+    assert np.allclose(np.asarray(w["q_robot"])[:, 3:], scene.q_robot[3:], atol=1e-6)
+
+
+def test_preview_and_delete_a_demonstration(scene_client, tmp_path):
+    client, scene = scene_client
+    demo = save_demo(tmp_path / "recordings", "reach-1")
+    assert client.post("/api/demonstrations/reach-1/preview").status_code == 202
+    name, path = scene.named("show_path")[-1]
+    assert name == "demo-reach-1" and np.allclose(path, demo.q_robot)
+    times, q, _ = scene.named("play_trajectory")[-1]
+    assert np.allclose(times, demo.times)
+    assert client.delete("/api/demonstrations/reach-1").status_code == 204
+    assert scene.named("clear_path")[-1] == ("demo-reach-1",)
