@@ -1,0 +1,100 @@
+"""The verbs (record, info, import-raw) and the raw import with a calibration."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from studio.capture import Calibration, CaptureError, RecordingError, import_raw, read_recording
+from studio.cli import main
+
+
+def _raw_file(path, calibration, n=40, seed=0):
+    rng = np.random.default_rng(seed)
+    bend, twist = rng.normal(0, 0.2, (n, 16)), rng.normal(0, 0.2, (n, 16))
+    raw = calibration.raw(bend, twist)
+    lines = [f"{k} {k / 110:.6f} " + " ".join(map(str, row)) for k, row in enumerate(raw)]
+    path.write_text("# measurand raw\n" + "\n".join(lines) + "\n")
+    return bend, twist
+
+
+def test_import_raw_applies_the_calibration(tmp_path):
+    cal = Calibration(np.linspace(30000, 34000, 32), np.full(32, 1.5e-4))
+    bend, twist = _raw_file(tmp_path / "take.txt", cal)
+    out = import_raw(tmp_path / "take.txt", cal, tmp_path / "take.tape.csv")
+    rec = read_recording(out)
+    assert len(rec) == 40 and rec.rate_hz == pytest.approx(110, rel=1e-3)
+    half_count = 1.5e-4 / 2 + 1e-12
+    assert (
+        np.abs(rec.bend - bend).max() <= half_count
+        and np.abs(rec.twist - twist).max() <= half_count
+    )
+    assert rec.meta["calibration"]["gains"][0] == 1.5e-4
+
+
+def test_calibration_from_flat_and_file_round_trip(tmp_path):
+    flat = 32768 + np.random.default_rng(0).normal(0, 3, (200, 32))
+    cal = Calibration.from_flat(flat, gains=2e-4, notes="desk")
+    assert np.allclose(cal.offsets, flat.mean(axis=0))
+    path = cal.save(tmp_path / "c.calibration.json")
+    from studio.capture import load_calibration
+
+    back = load_calibration(path)
+    assert np.array_equal(back.offsets, cal.offsets) and back.notes == "desk"
+    (tmp_path / "bad.json").write_text(json.dumps({"format": "other"}))
+    with pytest.raises(CaptureError, match="not a calibration"):
+        load_calibration(tmp_path / "bad.json")
+
+
+def test_raw_file_with_too_few_channels_names_the_line(tmp_path):
+    (tmp_path / "short.txt").write_text("0 0.0 1 2 3\n")
+    with pytest.raises(RecordingError, match=r"short.txt, line 1: 3 raw channels"):
+        import_raw(tmp_path / "short.txt", Calibration.identity(), tmp_path / "o.tape.csv")
+
+
+def test_record_info_and_import_verbs(tmp_path, capsys):
+    out = tmp_path / "x.tape.csv"
+    assert (
+        main(
+            [
+                "record",
+                "--source",
+                "simulator",
+                "--seconds",
+                "0.5",
+                "--out",
+                str(out),
+                "--operator",
+                "ada",
+            ]
+        )
+        == 0
+    )
+    rec = read_recording(out)
+    assert len(rec) == 55 and not rec.recovered and rec.meta["operator"] == "ada"
+    assert main(["info", str(out), "--json"]) == 0
+    summary = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+    assert summary["frames"] == 55
+    cal = Calibration.identity()
+    cal.save(tmp_path / "cal.json")
+    _raw_file(tmp_path / "raw.txt", cal)
+    assert (
+        main(
+            [
+                "import-raw",
+                str(tmp_path / "raw.txt"),
+                "--calibration",
+                str(tmp_path / "cal.json"),
+                "--out",
+                str(tmp_path / "r.tape.csv"),
+            ]
+        )
+        == 0
+    )
+    assert len(read_recording(tmp_path / "r.tape.csv")) == 40
+    # a user error is one sentence on stderr and exit code 2, never a traceback
+    (tmp_path / "junk.tape.csv").write_text("hello\n")
+    assert main(["info", str(tmp_path / "junk.tape.csv")]) == 2
+    assert "line 1: not a Teach Studio recording" in capsys.readouterr().err
