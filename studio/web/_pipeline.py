@@ -29,7 +29,7 @@ log = logging.getLogger(__name__)
 
 READ_TIMEOUT_S = 0.05
 """How long one read waits for frames, so the thread notices a stop or a source switch quickly."""
-MAX_FITS_PER_BATCH = 4
+MAX_FITS_PER_BATCH = 32
 """At most this many frames of one batch are fitted (the newest); the rest only get recorded."""
 IDLE_SLEEP_S = 0.05
 """Sleep between polls when there is no source or it failed."""
