@@ -34,3 +34,39 @@ def test_switching_sources_stops_the_old_one(open_client):
     assert r.status_code == 200 and r.json()["kind"] == "simulator"
     assert not old.status().running
     assert wait_for(lambda: client.get("/api/source").json()["frames"] > 0)
+
+
+def test_the_network_bridge_feeds_the_pipeline(client):
+    import socket
+
+    from studio.capture import FrameSender, simulate
+
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as probe:
+        probe.bind(("127.0.0.1", 0))
+        port = probe.getsockname()[1]
+    r = client.put("/api/source", json={"kind": "network", "port": port})
+    assert r.status_code == 200 and r.json()["kind"] == "network" and r.json()["error"] is None
+    frames = simulate(0.5, seed=2).frames
+    with FrameSender("127.0.0.1", port) as sender:
+        for frame in frames:
+            sender.send(frame)
+            time.sleep(0.002)
+    assert wait_for(lambda: client.get("/api/source").json()["frames"] >= len(frames) * 0.9)
+    assert wait_for(lambda: client.get("/api/source").json()["fit_residual_mm"] is not None)
+    # a second studio source on the same port cannot bind: the error shows, nothing crashes
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as squatter:
+        squatter.bind(("127.0.0.1", 0))
+        taken = squatter.getsockname()[1]
+        r = client.put("/api/source", json={"kind": "network", "port": taken})
+        assert r.status_code == 200 and r.json()["error"]
+    assert client.get("/api/config").status_code == 200
+
+
+def test_capture_events_while_recording(open_client):
+    client = open_client(source="simulator")
+    client.post("/api/capture/start", json={"name": "evented"})
+    with client.stream("GET", "/api/events?max_seconds=0.8") as r:
+        text = r.read().decode()
+    client.post("/api/capture/stop")
+    assert text.count("event: capture") >= 2
+    assert '"active":true' in text and '"name":"evented"' in text

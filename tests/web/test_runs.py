@@ -227,7 +227,7 @@ def test_run_events_stream_the_curve_while_training(client):
                 events.append(json.loads(line[6:]))
     client.post(f"/api/runs/{run['id']}/stop")
     wait_run(client, run["id"])
-    assert len(events) >= 5
+    assert len(events) >= 7  # at least 5 per second over the 1.5 s stream
     assert all(e["run"]["id"] == run["id"] for e in events)
     assert events[0]["from"] == 0
     # replaying the partial updates rebuilds the curve the API serves at that moment
