@@ -2,7 +2,8 @@
 
 A segment ``[t0, t1]`` of a recording runs through the kinematics (reconstruct + fit the human
 arm, retarget onto the Puma560), then onto the learning task's :class:`ArmGrid` as a path of
-valid consecutive actions, with pauses removed, ending at the goal. A segment that never reaches
+valid consecutive actions, with pauses and loops (bin-boundary flicker) removed, ending at the
+goal. A segment that never reaches
 the goal, drives the robot into a joint limit, or fits the arm badly is refused with the reason;
 with ``goal_from_end=True`` the goal becomes wherever the segment ends.
 
@@ -254,7 +255,9 @@ def extract_demonstration(
     for i in range(times.shape[0]):
         fit = fitter.fit((bend[i], twist[i]))
         q_human[i] = fit.q_human
-        residual[i] = fit.residual if fit.success else np.inf
+        # the residual (tape against the fitted arm) is the fit's quality; ``success`` also asks
+        # for millimetre landmark agreement, which sensor noise alone can exceed
+        residual[i] = fit.residual if np.isfinite(fit.residual) else np.inf
     worst = int(np.argmax(residual))
     if not residual[worst] <= max_residual:
         raise DemonstrationError(
@@ -272,7 +275,7 @@ def extract_demonstration(
             f"the motion drives Puma560 joint {j + 1} to its limit at {times[i]:.2f} s; choose a segment that stays inside the robot's range.",
             "leaves_joint_range",
         )
-    path = grid.path_from_joints(q_robot)
+    path = erase_loops(grid.path_from_joints(q_robot))
     goal_state = grid.goal_state
     if goal_state in path:
         cut = path.index(goal_state)
@@ -311,6 +314,28 @@ def extract_demonstration(
         residual_mean=float(residual.mean()),
         name=name or f"{rec.name} {t0:.2f}-{t1:.2f} s",
     )
+
+
+def erase_loops(path: list[int]) -> list[int]:
+    """The path with every loop cut out (a state visited twice keeps only its last visit's future).
+
+    Tremor and sensor noise make a hand resting on a bin boundary flicker between two states;
+    those back-and-forth steps (and any wider detour back to a visited state) teach nothing, so a
+    demonstration keeps the loop-free path. Consecutive states stay one action apart, since each
+    kept step is a step of the original path.
+    """
+    out: list[int] = []
+    index: dict[int, int] = {}
+    for state in path:
+        if state in index:
+            cut = index[state]
+            for dropped in out[cut + 1 :]:
+                del index[dropped]
+            del out[cut + 1 :]
+            continue
+        index[state] = len(out)
+        out.append(state)
+    return out
 
 
 def demonstrations_for(recording_path: str | os.PathLike[str]) -> list[Path]:

@@ -3,9 +3,11 @@
 The operator moves between poses along minimum-jerk paths (Flash & Hogan's model of human
 reaching), pauses now and then, and trembles slightly (physiological tremor, 8-12 Hz). The tape
 strapped along the arm (:func:`studio.kinematics.tape_from_arm`) turns each pose into bend/twist
-angles, plus sensor noise. Poses are drawn uniformly within a fraction of the arm's joint ranges
-(about their middle); :meth:`OperatorMotion.reach` ends the motion at the pose that the
-joint-mode :class:`Retargeter` maps onto a given Puma560 goal.
+angles, plus sensor noise. Poses are drawn as Puma560 configurations (within a fraction of its
+joint ranges) mapped back onto the human arm by the joint-mode :class:`Retargeter`, so the
+operator's motion, mirrored onto the robot, stays inside the robot's range (any segment can become
+a demonstration); :meth:`OperatorMotion.reach` ends the motion at the pose that maps onto a given
+robot goal.
 
 Two ways to run it: :class:`SimulatorSource` (a live source paced at 110 Hz with absolute
 deadlines) and :func:`simulate` (as fast as possible, for tests, samples and benchmarks). Both
@@ -38,8 +40,9 @@ class OperatorConfig:
         move_seconds: range of a reaching movement's duration (s).
         pause_seconds: range of a pause's duration (s).
         pause_probability: chance of a pause after each movement.
-        range_fraction: targets are drawn within this fraction of the arm's joint ranges, about
-            their middle (natural reaches, away from the anatomical limits).
+        robot_range_fraction: targets are drawn within this fraction of the Puma560's ranges of
+            joints 1-3 (about their middle), so retargeted motion keeps off the robot's limits.
+        wrist_range_fraction: the same for the robot's wrist joints 4-6.
         tremor_rad: amplitude of the tremor per joint (rad).
         tremor_hz: frequency range of the tremor (physiological tremor is 8-12 Hz).
         noise_rad: standard deviation of the tape's sensor noise per angle (rad).
@@ -49,7 +52,8 @@ class OperatorConfig:
     move_seconds: tuple[float, float] = (1.0, 2.0)
     pause_seconds: tuple[float, float] = (0.2, 0.8)
     pause_probability: float = 0.5
-    range_fraction: float = 0.5
+    robot_range_fraction: float = 0.6
+    wrist_range_fraction: float = 0.3
     tremor_rad: float = 0.002
     tremor_hz: tuple[float, float] = (8.0, 12.0)
     noise_rad: float = 0.002
@@ -70,8 +74,8 @@ class OperatorMotion:
         rate_hz: frames per second.
         operator: motion settings.
         arm: the operator's :class:`studio.kinematics.HumanArm` (default: a right arm).
-        retargeter: the joint-mode :class:`studio.kinematics.Retargeter` used by :meth:`reach`
-            (made on first use if omitted).
+        retargeter: the joint-mode :class:`studio.kinematics.Retargeter` that maps robot poses
+            onto the arm (default: mirrored, for ``arm``).
     """
 
     def __init__(
@@ -82,12 +86,13 @@ class OperatorMotion:
         arm: Any = None,
         retargeter: Any = None,
     ) -> None:
-        from studio.kinematics import HumanArm
+        from studio.kinematics import HumanArm, Retargeter
 
         self.operator = operator or OperatorConfig()
         self.rate_hz = float(rate_hz)
         self.arm = arm if arm is not None else HumanArm("right")
-        self.retargeter = retargeter
+        self.retargeter = retargeter or Retargeter("joint", mirror=True, arm=self.arm)
+        self.robot = self.retargeter.robot
         self._rng = np.random.default_rng(seed)
         op = self.operator
         self._tremor_freq = self._rng.uniform(*op.tremor_hz, size=(2, self.arm.nq))
@@ -101,16 +106,16 @@ class OperatorMotion:
 
     # targets -----------------------------------------------------------------------------------
     def _random_target(self) -> np.ndarray:
-        lower, upper = self.arm.lower, self.arm.upper
+        op = self.operator
+        lower, upper = self.robot.lower, self.robot.upper
         mid, half = (lower + upper) / 2, (upper - lower) / 2
-        return mid + self._rng.uniform(-1.0, 1.0, self.arm.nq) * self.operator.range_fraction * half
+        fraction = np.full(self.robot.nq, op.wrist_range_fraction)
+        fraction[:3] = op.robot_range_fraction
+        q_robot = mid + self._rng.uniform(-1.0, 1.0, self.robot.nq) * fraction * half
+        return self.human_of(q_robot)
 
     def human_of(self, q_robot: np.ndarray) -> np.ndarray:
         """The human pose whose joint-mode retargeting is ``q_robot`` (within the arm's limits)."""
-        if self.retargeter is None:
-            from studio.kinematics import Retargeter
-
-            self.retargeter = Retargeter("joint", mirror=True)
         q_human = np.asarray(self.retargeter.human_from_robot(np.asarray(q_robot, dtype=float)))
         return np.clip(q_human, self.arm.lower, self.arm.upper)
 
