@@ -37,6 +37,8 @@ from ._errors import KinematicsError
 from ._human import HumanArm
 from ._tape import TapeConfig, TapeShape, reconstruct
 
+_SEEN = 1e-6  # sine of a bend below which the rotation about the limb is not observable
+
 
 @dataclass(frozen=True)
 class FitConfig:
@@ -92,14 +94,13 @@ def _unit(v: np.ndarray) -> np.ndarray:
 
 def _point_polyline_distance(points: np.ndarray, poly: np.ndarray) -> np.ndarray:
     """Distance of each point to the polyline ``poly`` whose last segment is a ray."""
-    best = np.full(points.shape[0], np.inf)
-    for k in range(poly.shape[0] - 1):
-        a, d = poly[k], poly[k + 1] - poly[k]
-        t = (points - a) @ d / (d @ d)
-        t = np.maximum(t, 0.0) if k == poly.shape[0] - 2 else np.clip(t, 0.0, 1.0)
-        dist = np.linalg.norm(points - (a + t[:, None] * d), axis=1)
-        best = np.minimum(best, dist)
-    return best
+    a, d = poly[:-1], np.diff(poly, axis=0)  # (k, 3) segment starts and vectors
+    rel = points[:, None, :] - a[None]  # (n, k, 3)
+    t = np.einsum("nkj,kj->nk", rel, d) / np.einsum("kj,kj->k", d, d)
+    t = np.maximum(t, 0.0)
+    t[:, :-1] = np.minimum(t[:, :-1], 1.0)
+    gap = rel - t[..., None] * d[None]
+    return np.sqrt(np.einsum("nkj,nkj->nk", gap, gap).min(axis=1))
 
 
 class ArmFitter:
@@ -138,6 +139,8 @@ class ArmFitter:
         self._lower = np.asarray(arm.lower)
         self._upper = np.asarray(arm.upper)
         self._damping = np.eye(arm.nq) * self.settings.damping**2
+        self._J = np.empty((9, arm.nq))  # scratch: landmark Jacobian and error
+        self._e = np.empty(9)
         self._q: np.ndarray | None = None
 
     def reset(self) -> None:
@@ -189,7 +192,7 @@ class ArmFitter:
         A = self.data.oMi[2].rotation  # frame before humeral rotation
         fA = A.T @ f
         sign = -1.0 if self.arm.side == "right" else 1.0  # mirrored lateral axes
-        if math.sin(q[3]) > 1e-6:  # humeral rotation is seen only with a bent elbow
+        if math.sin(q[3]) > _SEEN:  # humeral rotation is seen only with a bent elbow
             q[2] = math.atan2(sign * fA[2], fA[0])
         # Forearm rotation and wrist flexion that point the hand at H, with no deviation:
         # the hand's direction in the elbow frame is (cos q4 sin q5, -cos q5, -+sin q4 sin q5).
@@ -197,7 +200,8 @@ class ArmFitter:
         pin.forwardKinematics(self.model, self.data, q)
         h = self.data.oMi[4].rotation.T @ _unit(H - W)
         q5 = math.acos(float(np.clip(-h[1], -1.0, 1.0)))
-        q4 = math.atan2(sign * h[2], h[0])
+        # A straight wrist leaves forearm rotation unseen: keep it at zero then.
+        q4 = math.atan2(sign * h[2], h[0]) if math.sin(q5) > _SEEN else 0.0
         for q4_try, q5_try in ((q4, q5), (q4 + math.pi, -q5), (q4 - math.pi, -q5)):
             if (
                 self._lower[4] <= q4_try <= self._upper[4]
@@ -212,27 +216,28 @@ class ArmFitter:
     def _solve(
         self, q: np.ndarray, target: np.ndarray, iterations: int
     ) -> tuple[np.ndarray, float, int]:
-        model, data, cfg = self.model, self.data, self.settings
+        """Projected DLS from ``q``; leaves ``self.data`` at the returned ``q``."""
+        model, data, cfg, hand = self.model, self.data, self.settings, self._hand
         frame = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
-        J = np.empty((9, self.arm.nq))
-        err = np.inf
+        J, e = self._J, self._e
+        lower, upper = self._lower, self._upper
+        err = math.inf
         for it in range(iterations + 1):
             pin.computeJointJacobians(model, data, q)
-            pin.updateFramePlacement(model, data, self._hand)
-            e = target - np.concatenate(
-                [data.oMi[4].translation, data.oMi[6].translation, data.oMf[self._hand].translation]
-            )
-            err = float(np.linalg.norm(e))
+            e[0:3] = target[0:3] - data.oMi[4].translation
+            e[3:6] = target[3:6] - data.oMi[6].translation
+            e[6:9] = target[6:9] - pin.updateFramePlacement(model, data, hand).translation
+            err = math.sqrt(float(e @ e))
             if err < cfg.tolerance or it == iterations:
                 return q, err, it
             J[0:3] = pin.getJointJacobian(model, data, 4, frame)[:3]
             J[3:6] = pin.getJointJacobian(model, data, 6, frame)[:3]
-            J[6:9] = pin.getFrameJacobian(model, data, self._hand, frame)[:3]
+            J[6:9] = pin.getFrameJacobian(model, data, hand, frame)[:3]
             dq = np.linalg.solve(J.T @ J + self._damping, J.T @ e)
-            largest = np.abs(dq).max()
+            largest = max(float(dq.max()), -float(dq.min()))
             if largest > cfg.max_step:
                 dq *= cfg.max_step / largest
-            q = np.clip(q + dq, self._lower, self._upper)
+            q = np.minimum(np.maximum(q + dq, lower), upper)
         return q, err, iterations  # pragma: no cover - loop always returns
 
     def fit(self, tape: TapeShape | tuple[object, object]) -> ArmFit:
@@ -275,9 +280,9 @@ class ArmFitter:
         target = (points[1:] - points[0]).reshape(-1)  # the arm's shoulder is at the origin
         cfg = self.settings
         iterations = 0
-        q, err = None, np.inf
+        q, err = None, math.inf
         if self._q is not None:
-            q, err, iterations = self._solve(self._q.copy(), target, cfg.warm_iterations)
+            q, err, iterations = self._solve(self._q, target, cfg.warm_iterations)
         if q is None or err > cfg.landmark_tolerance:
             q_cold, err_cold, it = self._solve(
                 self._seed(points - points[0]), target, cfg.cold_iterations
@@ -285,11 +290,12 @@ class ArmFitter:
             iterations += it
             if err_cold < err:
                 q, err = q_cold, err_cold
+            else:  # the warm attempt was better: put the scratch data back at its pose
+                pin.forwardKinematics(self.model, self.data, q)
+                pin.updateFramePlacement(self.model, self.data, self._hand)
         self._q = q
 
         # Residual: tape's arm vertices against the fitted arm, in the arm base frame.
-        pin.forwardKinematics(self.model, self.data, q)
-        pin.updateFramePlacement(self.model, self.data, self._hand)
         arm_points = np.stack(
             [
                 np.zeros(3),

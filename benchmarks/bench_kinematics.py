@@ -1,0 +1,134 @@
+"""Kinematics speed: the live path per frame, and batch reconstruction of a recording.
+
+(a) Live path, per 110 Hz frame: ``reconstruct`` -> ``ArmFitter.fit`` (warm) ->
+    ``Retargeter.robot_from_human`` (joint mode, the default; cartesian mode is timed too).
+    Target: median under 0.3 ms. Baseline: a naive per-frame path, a pure-NumPy loop
+    reconstruction (one 3x3 rotation product per region, as in the tapeAPI's description) and
+    the same fitter restarted cold every frame.
+(b) Batch reconstruction of a whole recording. Target: over 100,000 frames/s. Baseline: the
+    naive loop, frame by frame.
+
+Run: ``python benchmarks/bench_kinematics.py`` (about 20 s; ``--frames`` sets the live frames).
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import time
+
+import numpy as np
+
+from studio.kinematics import (
+    ArmFitter,
+    HumanArm,
+    Retargeter,
+    TapeConfig,
+    reconstruct,
+    tape_from_arm,
+)
+
+LIVE_TARGET_S = 0.3e-3
+BATCH_TARGET_FPS = 100_000
+RATE_HZ = 110.0
+
+
+def naive_reconstruct(bend: np.ndarray, twist: np.ndarray, config: TapeConfig) -> np.ndarray:
+    """Per-region rotation matrices, multiplied one by one (the straightforward transcription)."""
+    F = config.base[:3, :3].copy()
+    p = config.base[:3, 3].copy()
+    positions = [p.copy()]
+    step = config.region_length
+    for k, t in zip(bend, twist, strict=True):
+        ct, st, ck, sk = math.cos(t), math.sin(t), math.cos(k), math.sin(k)
+        Rx = np.array([[1.0, 0.0, 0.0], [0.0, ct, -st], [0.0, st, ct]])
+        Rz = np.array([[ck, -sk, 0.0], [sk, ck, 0.0], [0.0, 0.0, 1.0]])
+        F = F @ Rx @ Rz
+        p = p + step * F[:, 0]
+        positions.append(p)
+    return np.array(positions)
+
+
+def demo_motion(arm: HumanArm, frames: int, seed: int) -> np.ndarray:
+    """A smooth operator motion within the arm's limits: random sinusoids per joint."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(frames) / RATE_HZ
+    lo, hi = np.asarray(arm.lower), np.asarray(arm.upper)
+    lo, hi = np.maximum(lo, -1.2), np.minimum(hi, 1.2)
+    mid, amp = (lo + hi) / 2, (hi - lo) / 2 * 0.8
+    freq = rng.uniform(0.1, 0.5, arm.nq)
+    phase = rng.uniform(0, 2 * math.pi, arm.nq)
+    return mid + amp * np.sin(2 * math.pi * freq * t[:, None] + phase)
+
+
+def time_live(bend, twist, config, fitter, retargeter, cold: bool, naive: bool) -> np.ndarray:
+    times = np.empty(len(bend))
+    fitter.reset()
+    retargeter.reset()
+    for k in range(len(bend)):
+        t0 = time.perf_counter()
+        if naive:
+            naive_reconstruct(bend[k], twist[k], config)
+            fit = fitter.fit((bend[k], twist[k]))  # (the fitter needs our shape object)
+        else:
+            fit = fitter.fit(reconstruct(bend[k], twist[k], config))
+        retargeter.robot_from_human(fit.q_human)
+        times[k] = time.perf_counter() - t0
+        if cold:
+            fitter.reset()
+    return times
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--frames", type=int, default=3000, help="live-path frames")
+    parser.add_argument("--batch", type=int, default=200_000, help="frames in the batch recording")
+    args = parser.parse_args()
+
+    config = TapeConfig()
+    arm = HumanArm()
+    fitter = ArmFitter(arm, config)
+    retargeter = Retargeter(arm=arm)
+    q = demo_motion(arm, args.frames, seed=0)
+    bend, twist = tape_from_arm(arm, q, config)
+    reconstruct(bend[:2], twist[:2], config)  # compile (or load) the kernel first
+
+    print(f"(a) live path per frame, {args.frames} frames of a smooth motion at {RATE_HZ:.0f} Hz")
+    ours = time_live(bend, twist, config, fitter, retargeter, cold=False, naive=False)
+    base = time_live(bend, twist, config, fitter, retargeter, cold=True, naive=True)
+    retargeter.mode = "cartesian"
+    cart = time_live(bend, twist, config, fitter, retargeter, cold=False, naive=False)
+    retargeter.mode = "joint"
+    med, base_med = float(np.median(ours)), float(np.median(base))
+    verdict = "PASS" if med < LIVE_TARGET_S else "FAIL"
+    print(f"  ours (compiled reconstruct, warm fit, joint retarget): median {med * 1e3:.3f} ms,")
+    print(f"      p90 {np.percentile(ours, 90) * 1e3:.3f} ms  [{verdict}: target < 0.3 ms]")
+    print(f"  naive (NumPy-loop reconstruct, cold fit every frame): median {base_med * 1e3:.3f} ms")
+    print(f"  speed-up: {base_med / med:.2f}x")
+    print(
+        f"  cartesian retarget instead (Puma IK per frame): median {np.median(cart) * 1e3:.3f} ms"
+    )
+
+    print(f"(b) batch reconstruction of a {args.batch}-frame recording")
+    rng = np.random.default_rng(1)
+    rows = rng.integers(0, args.frames, args.batch)
+    big_b, big_t = bend[rows], twist[rows]
+    best = math.inf
+    for _ in range(3):
+        t0 = time.perf_counter()
+        reconstruct(big_b, big_t, config)
+        best = min(best, time.perf_counter() - t0)
+    fps = args.batch / best
+    sample = min(2000, args.batch)
+    t0 = time.perf_counter()
+    for k in range(sample):
+        naive_reconstruct(big_b[k], big_t[k], config)
+    naive_fps = sample / (time.perf_counter() - t0)
+    verdict = "PASS" if fps > BATCH_TARGET_FPS else "FAIL"
+    print(f"  ours: {fps:,.0f} frames/s  [{verdict}: target > {BATCH_TARGET_FPS:,}]")
+    print(f"  naive per-frame loop: {naive_fps:,.0f} frames/s (timed on {sample} frames)")
+    print(f"  speed-up: {fps / naive_fps:.0f}x")
+
+
+if __name__ == "__main__":
+    main()
