@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import argparse
 import csv
+import multiprocessing
 import os
 import tempfile
 import time
@@ -103,6 +104,16 @@ def pipeline():
                 retargeter.robot_from_human(fit.q_human)
 
     return run, "+".join(steps)
+
+
+def emulate_tape(conn, recording_path: Path) -> None:
+    """Child process: a ShapeTape emulator replaying a recording until told to stop."""
+    replay = read_recording(recording_path)
+    n = len(replay)
+    emulator = ShapeTapeEmulator(lambda k: (replay.bend[k % n], replay.twist[k % n], 0)).start()
+    conn.send(emulator.port)
+    conn.recv()
+    emulator.unplug()
 
 
 def live(source, seconds: float, per_frame, before=None) -> tuple[float, int, int]:
@@ -205,10 +216,16 @@ def main() -> None:
         daemon=True,
     )
     results["network"] = live(receiver, secs, per_frame, before=sender.start)
-    replay = rec.frames()
-    emulator = ShapeTapeEmulator(lambda k: (replay[k % n].bend, replay[k % n].twist, 0)).start()
-    results["serial"] = live(SerialSource(emulator.port, rate_hz=REAL_TIME_HZ), secs, per_frame)
-    emulator.unplug()
+    # the emulated tape runs in its own process, as a real tape is its own hardware
+    parent, child = multiprocessing.Pipe()
+    device = multiprocessing.get_context("fork").Process(
+        target=emulate_tape, args=(child, path), daemon=True
+    )
+    device.start()
+    port = parent.recv()
+    results["serial"] = live(SerialSource(port, rate_hz=REAL_TIME_HZ), secs, per_frame)
+    parent.send("stop")
+    device.join(5)
     for name, (rate, count, dropped) in results.items():
         print(f"  {name:10s} {rate:6.1f} Hz  {count:5d} frames  dropped {dropped}")
 

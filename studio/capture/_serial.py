@@ -23,6 +23,9 @@ DEFAULT_RATE_HZ = 110.0
 """Polling rate (the paper's 110 Hz)."""
 REPLY_TIMEOUT_SECONDS = 0.05
 """How long to wait for one reply before counting the frame lost."""
+MAX_BACKLOG_SECONDS = 0.25
+"""A poll this late is caught up by polling at once (a short stall costs no frames); a longer
+stall resynchronises the schedule instead of bursting requests at the tape."""
 SILENT_SECONDS = 1.0
 """No valid reply for this long: the tape is off or unplugged (the source stops with an error)."""
 
@@ -109,7 +112,7 @@ class SerialSource(ThreadedSource):
                     self._stop_event.wait(delay)
                 tick += 1
                 now = time.monotonic()
-                if now - due > period:  # fell behind: skip missed deadlines, don't burst
+                if now - due > MAX_BACKLOG_SECONDS:  # stalled long: resynchronise, don't burst
                     tick = int((now - start) / period) + 1
                 port.write(REQUEST)
                 frame = self._read_reply(port)
