@@ -53,7 +53,8 @@ class FitConfig:
         max_step: largest joint step per iteration (rad, infinity norm).
         max_residual: a fit whose residual (m) exceeds this is reported as failed: the tape
             does not lie along an arm of these lengths.
-        landmark_tolerance: a fit whose landmark error (m) exceeds this is reported as failed.
+        landmark_tolerance: a fit whose IK error (m, elbow/wrist/hand from the tape's shoulder)
+            exceeds this is reported as failed.
     """
 
     warm_iterations: int = 8
@@ -73,10 +74,11 @@ class ArmFit:
         q_human: fitted joint angles (rad, (7,)), within the arm's limits.
         residual: RMS distance (m) from the tape's arm vertices (shoulder to the first vertex
             past the wrist) to the fitted arm's shoulder-elbow-wrist-hand polyline.
-        success: landmark error below ``landmark_tolerance`` and residual below
-            ``max_residual``.
+        success: the IK met the landmarks (taken relative to the tape's shoulder vertex) to
+            ``landmark_tolerance`` and the residual is below ``max_residual``.
         landmarks: the tape's shoulder, elbow, wrist and hand-centre points, (4, 3) (m).
-        landmark_error: RMS distance (m) between those landmarks and the fitted arm's.
+        landmark_error: RMS distance (m) between those landmarks and the fitted arm's (the
+            tape's shoulder vertex against the arm's shoulder at the origin included).
         iterations: DLS iterations used.
     """
 
@@ -307,7 +309,8 @@ class ArmFitter:
         vertices = positions[self.config.shoulder_region : last + 1]
         residual = float(np.sqrt(np.mean(_point_polyline_distance(vertices, arm_points) ** 2)))
         landmark_error = float(np.sqrt(np.mean(np.sum((points - arm_points) ** 2, axis=1))))
-        success = landmark_error <= cfg.landmark_tolerance and residual <= cfg.max_residual
+        # The IK error is measured from the tape's shoulder; an offset shoulder shows in residual.
+        success = err <= cfg.landmark_tolerance and residual <= cfg.max_residual
         return ArmFit(
             q_human=q.copy(),
             residual=residual,

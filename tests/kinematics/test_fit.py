@@ -1,0 +1,143 @@
+"""The arm fit recovers known poses from tapes of those poses, and flags bad tapes.
+
+Tolerance (stated in the fitter's docstring): on noise-free tapes from ``tape_from_arm`` the
+landmarks (elbow, wrist, hand centre) are recovered to 1e-9 m and the fitted arm meets them to
+1e-4 m; shoulder flexion, abduction, humeral rotation and elbow flexion come back to 1e-4 rad when
+the elbow is bent (>= 0.3 rad) and away from the shoulder's gimbal (|abduction| < 1.3 rad).
+Forearm rotation and the two wrist joints are not individually observable (one direction of the
+three is unseen), so only the hand centre they produce is checked.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from studio.kinematics import (
+    ArmFitter,
+    HumanArm,
+    KinematicsError,
+    TapeConfig,
+    reconstruct,
+    tape_from_arm,
+)
+
+ARMS = {side: HumanArm(side) for side in ("right", "left")}
+CONFIGS = {side: TapeConfig(side=side) for side in ("right", "left")}
+OBSERVED = slice(0, 4)
+
+
+def observable_q():
+    arm = ARMS["right"]
+    lo, hi = np.array(arm.lower), np.array(arm.upper)
+    lo[0], hi[0] = -2.5, 2.5  # shoulder flexion
+    lo[1], hi[1] = -1.0, 1.3  # abduction, away from the gimbal at pi/2
+    lo[2], hi[2] = -1.5, 2.5  # humeral rotation
+    lo[3], hi[3] = 0.3, 2.4  # a bent elbow shows the humeral rotation
+    return st.tuples(*[st.floats(a, b) for a, b in zip(lo, hi, strict=True)]).map(np.array)
+
+
+@settings(max_examples=40, deadline=None)
+@given(q=observable_q(), side=st.sampled_from(["right", "left"]))
+def test_cold_fit_recovers_landmarks_and_observable_joints(q, side):
+    arm, config = ARMS[side], CONFIGS[side]
+    fitter = ArmFitter(arm, config)
+    bend, twist = tape_from_arm(arm, q, config)
+    fit = fitter.fit(reconstruct(bend, twist, config))
+    truth = arm.points(q)
+    np.testing.assert_allclose(fit.landmarks, truth, atol=1e-9)
+    np.testing.assert_allclose(arm.points(fit.q_human), truth, atol=1e-4)
+    np.testing.assert_allclose(fit.q_human[OBSERVED], q[OBSERVED], atol=1e-4)
+    assert fit.success and fit.residual < 1e-4 and fit.landmark_error < 1e-4
+    assert np.all(fit.q_human >= arm.lower) and np.all(fit.q_human <= arm.upper)
+
+
+def test_warm_fit_follows_a_smooth_motion_with_few_iterations():
+    arm, config = ARMS["right"], CONFIGS["right"]
+    rng = np.random.default_rng(11)
+    t = np.linspace(0.0, 3.0, 330)[:, None]  # 3 s at 110 Hz
+    start = np.array([0.4, 0.3, 0.5, 1.0, 0.8, 0.2, 0.1])
+    q = start + 0.3 * np.sin(2 * np.pi * rng.uniform(0.2, 0.6, 7) * t)
+    bend, twist = tape_from_arm(arm, q, config)
+    fitter = ArmFitter(arm, config)
+    iterations = []
+    for k in range(len(q)):
+        fit = fitter.fit((bend[k], twist[k]))
+        assert fit.success, k
+        np.testing.assert_allclose(arm.points(fit.q_human), arm.points(q[k]), atol=1e-4)
+        np.testing.assert_allclose(fit.q_human[OBSERVED], q[k, OBSERVED], atol=1e-4)
+        iterations.append(fit.iterations)
+    assert np.median(iterations[1:]) <= 3  # warm starts need few iterations
+    # Warm starting keeps the unobservable wrist direction continuous (no jumps between frames).
+    fitter.reset()
+    qs = np.array([fitter.fit((bend[k], twist[k])).q_human for k in range(len(q))])
+    assert np.abs(np.diff(qs, axis=0)).max() < 0.1
+
+
+def test_reset_forgets_the_previous_frame():
+    arm, config = ARMS["right"], CONFIGS["right"]
+    fitter = ArmFitter(arm, config)
+    q = np.array([0.5, 0.2, 0.3, 1.2, 0.5, 0.3, 0.1])
+    tape = tape_from_arm(arm, q, config)
+    first = fitter.fit(tape)
+    again = fitter.fit(tape)
+    assert again.iterations == 0  # warm start from the solution itself
+    fitter.reset()
+    cold = fitter.fit(tape)
+    np.testing.assert_allclose(cold.q_human, first.q_human)
+
+
+def test_a_misplaced_or_crumpled_tape_shows_up_in_the_residual():
+    arm, config = ARMS["right"], CONFIGS["right"]
+    q = np.array([0.5, 0.2, 0.3, 1.2, 0.5, 0.3, 0.1])
+    bend, twist = tape_from_arm(arm, q, config)
+    shifted_base = config.base.copy()
+    shifted_base[:3, 3] += [0.0, 0.0, 0.05]  # strapped 5 cm too high
+    shifted = TapeConfig(base=shifted_base)
+    fit = ArmFitter(arm, shifted).fit((bend, twist))
+    assert not fit.success
+    assert fit.residual == pytest.approx(0.05, rel=0.2)
+    crumpled = bend.copy()
+    crumpled[config.shoulder_region + 1 :] += 0.3  # not lying along the arm
+    fit = ArmFitter(arm, config).fit((crumpled, twist))
+    assert not fit.success and fit.residual > 0.02
+    noisy = tape_from_arm(arm, q, config, rng=np.random.default_rng(0), noise=0.002)
+    fit = ArmFitter(arm, config).fit(noisy)
+    assert 0 < fit.residual < 0.02 and fit.success
+
+
+@pytest.mark.parametrize(
+    "tape",
+    [
+        (np.zeros(15), np.zeros(15)),
+        (np.zeros((2, 16)), np.zeros((2, 16))),
+        (np.full(16, np.nan), np.zeros(16)),
+        "not a tape",
+    ],
+)
+def test_bad_frames_raise_one_clear_error(tape):
+    fitter = ArmFitter(ARMS["right"], CONFIGS["right"])
+    with pytest.raises(KinematicsError):
+        fitter.fit(tape)
+
+
+def test_a_batch_shape_is_refused_and_nan_shapes_too():
+    config = CONFIGS["right"]
+    fitter = ArmFitter(ARMS["right"], config)
+    batch = reconstruct(np.zeros((3, 16)), np.zeros((3, 16)), config)
+    with pytest.raises(KinematicsError, match="one frame"):
+        fitter.fit(batch)
+    one = reconstruct(np.zeros(16), np.zeros(16), config)
+    broken = type(one)(positions=one.positions * np.nan, frames=one.frames)
+    with pytest.raises(KinematicsError, match="NaN"):
+        fitter.fit(broken)
+
+
+def test_configs_that_cannot_see_the_arm_are_refused():
+    arm = ARMS["right"]
+    with pytest.raises(KinematicsError, match="more regions"):
+        ArmFitter(arm, TapeConfig(regions=4, shoulder_region=1, wrist_region=4))
+    with pytest.raises(KinematicsError, match="elbow"):
+        ArmFitter(arm, TapeConfig(shoulder_region=14, wrist_region=16))

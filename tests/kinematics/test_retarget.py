@@ -1,0 +1,143 @@
+"""Retargeting laws: the joint map and its inverse, mirroring, clamping, cartesian IK, bad input."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from studio.kinematics import HumanArm, KinematicsError, Puma560, Retargeter
+from studio.kinematics._retarget import DROPPED_HUMAN_JOINT, JOINT_MAP
+
+RIGHT = HumanArm("right")
+LEFT = HumanArm("left")
+ROBOT = Puma560()
+LATERAL = [j for j, (_, _, _, lateral) in enumerate(JOINT_MAP) if lateral]
+
+
+def human_q():
+    return st.tuples(
+        *[st.floats(lo, hi) for lo, hi in zip(RIGHT.lower, RIGHT.upper, strict=True)]
+    ).map(np.array)
+
+
+def robot_q():
+    return st.tuples(
+        *[st.floats(lo, hi) for lo, hi in zip(ROBOT.lower, ROBOT.upper, strict=True)]
+    ).map(np.array)
+
+
+def test_neutral_arm_hangs_the_robot_arm_down():
+    q_robot = Retargeter(robot=ROBOT).robot_from_human(RIGHT.neutral)
+    np.testing.assert_allclose(q_robot, [0, -math.pi / 2, -math.pi / 2, 0, 0, 0])
+
+
+@settings(max_examples=60, deadline=None)
+@given(q_robot=robot_q(), mirror=st.booleans(), side=st.sampled_from(["right", "left"]))
+def test_joint_mode_human_from_robot_is_the_exact_inverse(q_robot, mirror, side):
+    arm = RIGHT if side == "right" else LEFT
+    retargeter = Retargeter(mirror=mirror, robot=ROBOT, arm=arm)
+    q_human = retargeter.human_from_robot(q_robot)
+    assert q_human[DROPPED_HUMAN_JOINT] == 0.0
+    clipped = np.any(q_human <= arm.lower) or np.any(q_human >= arm.upper)
+    if not clipped:
+        np.testing.assert_allclose(retargeter.robot_from_human(q_human), q_robot, atol=1e-12)
+
+
+@settings(max_examples=60, deadline=None)
+@given(q_human=human_q(), mirror=st.booleans())
+def test_joint_mode_robot_from_human_round_trips_where_not_clamped(q_human, mirror):
+    retargeter = Retargeter(mirror=mirror, robot=ROBOT, arm=RIGHT)
+    q_robot = retargeter.robot_from_human(q_human)
+    assert np.all(q_robot >= ROBOT.lower) and np.all(q_robot <= ROBOT.upper)
+    if np.all(q_robot > ROBOT.lower) and np.all(q_robot < ROBOT.upper):
+        expected = q_human.copy()
+        expected[DROPPED_HUMAN_JOINT] = 0.0
+        np.testing.assert_allclose(retargeter.human_from_robot(q_robot), expected, atol=1e-12)
+
+
+@settings(max_examples=40, deadline=None)
+@given(q_human=human_q())
+def test_mirroring_flips_exactly_the_lateral_joints(q_human):
+    mirrored = Retargeter(mirror=True, robot=ROBOT, arm=RIGHT).robot_from_human(q_human)
+    plain = Retargeter(mirror=False, robot=ROBOT, arm=RIGHT).robot_from_human(q_human)
+    lateral = np.zeros(6, dtype=bool)
+    lateral[LATERAL] = True
+    np.testing.assert_array_equal(mirrored[~lateral], plain[~lateral])
+    # Puma limits are symmetric, so the flip survives clamping.
+    np.testing.assert_allclose(mirrored[lateral], -plain[lateral])
+    # A left arm is already a mirror image: mirroring it equals not mirroring the right arm.
+    left = Retargeter(mirror=True, robot=ROBOT, arm=LEFT).robot_from_human(q_human)
+    np.testing.assert_array_equal(left, plain)
+
+
+def test_mirrored_abduction_moves_the_robot_to_the_operators_side():
+    # Facing the robot, the operator swings the right arm out to their right (-y in their
+    # frame). Mirrored, the robot's tool goes to its left (+y), the same side seen by the
+    # operator; unmirrored it copies the motion in its own frame (-y).
+    forward = np.zeros(7)
+    forward[0] = math.pi / 2
+    out = forward.copy()
+    out[1] = 0.5
+    assert RIGHT.forward(out).wrist[1, 3] < RIGHT.forward(forward).wrist[1, 3]
+    for mirror, sign in ((True, 1.0), (False, -1.0)):
+        retargeter = Retargeter(mirror=mirror, robot=ROBOT, arm=RIGHT)
+        dy = (
+            ROBOT.forward(retargeter.robot_from_human(out))[1, 3]
+            - ROBOT.forward(retargeter.robot_from_human(forward))[1, 3]
+        )
+        assert math.copysign(1.0, dy) == sign and abs(dy) > 0.1
+
+
+def test_joint_mode_clamps_at_the_puma_limits():
+    q = np.zeros(7)
+    q[0] = -math.pi  # shoulder extended far back: J2 would be -270 deg
+    q_robot = Retargeter(robot=ROBOT).robot_from_human(q)
+    assert q_robot[1] == ROBOT.lower[1]
+
+
+def test_cartesian_mode_reaches_the_mirrored_scaled_hand_pose():
+    rng = np.random.default_rng(5)
+    retargeter = Retargeter(mode="cartesian", robot=ROBOT, arm=RIGHT)
+    plain = Retargeter(mode="cartesian", mirror=False, robot=ROBOT, arm=RIGHT)
+    start = np.array([0.8, 0.3, 0.2, 1.0, 0.3, 0.2, 0.1])
+    reached = 0
+    for q in start + 0.3 * rng.uniform(-1, 1, (30, 7)):
+        q = np.clip(q, RIGHT.lower, RIGHT.upper)
+        target = retargeter.hand_target(q)
+        other = plain.hand_target(q)
+        np.testing.assert_allclose(target[:3, 3] * [1, -1, 1], other[:3, 3], atol=1e-12)
+        np.testing.assert_allclose(np.linalg.det(target[:3, :3]), 1.0)
+        q_robot = retargeter.robot_from_human(q)
+        assert np.all(q_robot >= ROBOT.lower) and np.all(q_robot <= ROBOT.upper)
+        if np.linalg.norm(ROBOT.forward(q_robot)[:3, 3] - target[:3, 3]) < 1e-4:
+            reached += 1
+    assert reached >= 25  # positions reached (the full orientation when the Puma's wrist can)
+
+
+def test_mode_switches_at_run_time_and_is_validated():
+    retargeter = Retargeter(robot=ROBOT)
+    q = np.array([0.9, 0.2, 0.1, 1.0, 0.2, 0.1, 0.0])
+    joint = retargeter.robot_from_human(q)
+    retargeter.mode = "cartesian"
+    cartesian = retargeter.robot_from_human(q)
+    assert not np.allclose(joint, cartesian)
+    with pytest.raises(KinematicsError, match="mode"):
+        retargeter.mode = "telepathy"
+    with pytest.raises(KinematicsError, match="mode"):
+        Retargeter(mode="both")  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize("bad", [np.zeros(6), np.full(7, np.nan), "q"])
+def test_bad_human_angles_raise(bad):
+    with pytest.raises(KinematicsError):
+        Retargeter(robot=ROBOT).robot_from_human(bad)
+
+
+@pytest.mark.parametrize("bad", [np.zeros(7), np.full(6, np.inf)])
+def test_bad_robot_angles_raise(bad):
+    with pytest.raises(KinematicsError):
+        Retargeter(robot=ROBOT).human_from_robot(bad)
