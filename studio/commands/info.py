@@ -32,7 +32,7 @@ def run(args: argparse.Namespace) -> int:
 
             summary = load_demonstration(path).summary()
             text = "\n".join(
-                [str(path), *(f"  {k:<10}{v}" for k, v in summary.items() if k != "path")]
+                [str(path), *(f"  {k:<13} {v}" for k, v in summary.items() if k != "path")]
             )
         else:
             summary = read_recording(path, strict=not args.lenient).summary()

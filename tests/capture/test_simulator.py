@@ -61,3 +61,27 @@ def test_live_source_keeps_110_hz_without_drops():
     assert status.dropped == 0 and status.error is None
     assert [f.frame for f in got] == list(range(len(got)))
     assert 60 < len(got) < 160  # paced near 110 Hz, not dumped
+
+
+def test_live_source_gives_the_generator_frames():
+    source = SimulatorSource(seed=7)
+    source.start()
+    got = []
+    deadline = time.monotonic() + 5.0
+    while len(got) < 40 and time.monotonic() < deadline:
+        got += source.read(timeout=0.05)
+    source.stop()
+    expected = simulate(1.0, seed=7).frames
+    assert len(got) >= 40
+    assert all(a.same_as(b) for a, b in zip(got, expected, strict=False))
+
+
+def test_reach_ends_where_the_robot_goal_mirrors_to():
+    from studio.kinematics import Retargeter
+
+    goal = np.array([0.3, 0.4, -1.2, 0.1, 0.2, 0.0])
+    sim = simulate(4.0, seed=3, goal=goal)
+    retarget = Retargeter("joint", mirror=True)
+    assert np.allclose(retarget.robot_from_human(sim.q_human[-1]), goal, atol=0.01)
+    assert sim.reach_start < sim.reach_end <= len(sim.frames)
+    assert sim.frames[-1].trigger and not sim.frames[0].trigger  # the trigger marks the reach
