@@ -46,6 +46,7 @@ from ._recording_reader import read_header as read_header
 from ._recording_reader import read_recording as read_recording
 from ._recording_writer import RecordingWriter as RecordingWriter
 from ._recording_writer import recording_meta as recording_meta
+from ._segments import trigger_segments as trigger_segments
 from ._serial import SerialSource as SerialSource
 from ._simulator import OperatorConfig as OperatorConfig
 from ._simulator import OperatorMotion as OperatorMotion

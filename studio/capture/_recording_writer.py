@@ -224,10 +224,15 @@ class RecordingWriter:
 
     def _flush_locked(self) -> None:
         if self._buffer:
-            self._file.write("".join(self._buffer))
+            try:
+                self._file.write("".join(self._buffer))
+                self._file.flush()
+                os.fsync(self._file.fileno())
+            except OSError as err:
+                raise RecordingError(
+                    f"cannot write {self.path} ({err.strerror}); free disk space or record elsewhere (the frames flushed so far are safe)."
+                ) from None
             self._buffer.clear()
-            self._file.flush()
-            os.fsync(self._file.fileno())
         self._last_flush = time.monotonic()
 
     def _flush_loop(self) -> None:
@@ -236,4 +241,7 @@ class RecordingWriter:
                 if self._closed:
                     return
                 if self._buffer and time.monotonic() - self._last_flush >= self.flush_seconds / 2:
-                    self._flush_locked()
+                    try:
+                        self._flush_locked()
+                    except RecordingError:
+                        return  # the next write() or close() retries and raises it to the caller

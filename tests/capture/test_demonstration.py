@@ -135,3 +135,12 @@ def test_erase_loops_keeps_a_loop_free_subpath(path):
     assert out[0] == path[0] and out[-1] == path[-1]
     steps = set(zip(path, path[1:], strict=False))
     assert all(step in steps for step in zip(out, out[1:], strict=False))
+
+
+def test_trigger_marks_the_reach_as_a_segment(reach):
+    from studio.capture import trigger_segments
+
+    rec, sim, grid = reach
+    [(t0, t1)] = trigger_segments(rec)
+    assert t0 == pytest.approx(sim.reach_start / 110) and t1 == pytest.approx(rec.duration)
+    assert extract_demonstration(rec, t0, t1, grid=grid).grid_path[-1] == grid.goal_state
