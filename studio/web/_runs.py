@@ -63,12 +63,13 @@ def curve_of(steps: np.ndarray, start: int = 0) -> dict[str, list]:
     Episodes are listed from index ``start`` up to the last episode that at least one experiment
     finished; each statistic is over the experiments that finished that episode.
     """
-    done = steps >= 0
-    count = done.sum(axis=0)
-    last = int(np.flatnonzero(count)[-1]) + 1 if count.any() else 0
+    count = (steps >= 0).sum(axis=0)
+    nonzero = np.flatnonzero(count)
+    last = int(nonzero[-1]) + 1 if nonzero.size else 0
     start = max(0, min(start, last))
     sl = slice(start, last)
-    d, s, c = done[:, sl], steps[:, sl].astype(np.float64), count[sl]
+    done = steps[:, sl] >= 0
+    d, s, c = done, steps[:, sl].astype(np.float64), count[sl]
     with np.errstate(invalid="ignore", divide="ignore"):
         mean = np.where(d, s, 0.0).sum(axis=0) / np.maximum(c, 1)
         var = np.where(d, (s - mean) ** 2, 0.0).sum(axis=0) / np.maximum(c, 1)
@@ -76,11 +77,11 @@ def curve_of(steps: np.ndarray, start: int = 0) -> dict[str, list]:
     high = np.where(d, s, -np.inf).max(axis=0) if d.size else np.zeros(0)
     return {
         "episodes": list(range(start + 1, last + 1)),
-        "mean": [round(float(x), 3) for x in mean],
-        "std": [round(float(x), 3) for x in np.sqrt(var)],
-        "min": [float(x) for x in low],
-        "max": [float(x) for x in high],
-        "count": [int(x) for x in c],
+        "mean": np.round(mean, 3).tolist(),
+        "std": np.round(np.sqrt(var), 3).tolist(),
+        "min": low.astype(np.float64).tolist(),
+        "max": high.astype(np.float64).tolist(),
+        "count": c.astype(np.int64).tolist(),
     }
 
 

@@ -216,6 +216,10 @@ def test_run_events_stream_the_curve_while_training(client):
     run = client.post(
         "/api/runs", json={"planning": "full", "experiments": 1, "episodes": 100_000}
     ).json()
+    for _ in range(400):  # wait until training is under way (the kernels load first)
+        if client.get(f"/api/runs/{run['id']}").json()["episodes_done"] > 0:
+            break
+        client.app.state.studio.runs.wait_idle(0.05)
     events = []
     with client.stream("GET", "/api/events?max_seconds=1.5") as r:
         assert r.headers["content-type"].startswith("text/event-stream")

@@ -13,6 +13,7 @@ import json
 import time
 from collections.abc import AsyncIterator
 
+import numpy as np
 from fastapi import APIRouter, Request
 from fastapi.responses import StreamingResponse
 
@@ -49,7 +50,7 @@ async def stream_events(
     """
     start = time.monotonic()
     versions = studio.changes.versions()
-    run_counts: dict[str, list[int]] = {}
+    run_counts: dict[str, np.ndarray] = {}
     last = {"source": -1e9, "run": -1e9, "keepalive": start, "capture": -1e9}
     capture_was_active = False
     yield "retry: 2000\n\n"
@@ -86,21 +87,25 @@ async def stream_events(
         await asyncio.sleep(TICK_S)
 
 
-def run_event(run, counts: dict[str, list[int]]) -> dict:  # noqa: ANN001 - a _runs.Run
-    """A ``run`` event: the run and its curve from the first episode that changed for this client."""
+def run_event(run, counts: dict[str, np.ndarray]) -> dict:  # noqa: ANN001 - a _runs.Run
+    """A ``run`` event: the run and its curve from the first episode that changed for this client.
+
+    Only the changed tail is computed and sent, so a long run costs the same per event at
+    episode 10 and at episode 50 000.
+    """
     steps = run.steps()
-    curve = curve_of(steps)
-    previous = counts.get(run.id, [])
-    now = curve["count"]
-    start = 0
-    while start < len(previous) and start < len(now) and previous[start] == now[start]:
-        start += 1
+    now = (steps >= 0).sum(axis=0)
+    previous = counts.get(run.id)
+    if previous is None or previous.shape != now.shape:
+        start = 0
+    else:
+        changed = np.flatnonzero(previous != now)
+        start = int(changed[0]) if changed.size else int(now.shape[0])
     counts[run.id] = now
-    part = {key: values[start:] for key, values in curve.items()}
-    return {"run": run.public(steps), "curve": part, "from": start}
+    return {"run": run.public(steps), "curve": curve_of(steps, start), "from": start}
 
 
-def _final_run(studio: Studio, run_id: str, counts: dict[str, list[int]]) -> dict | None:
+def _final_run(studio: Studio, run_id: str, counts: dict[str, np.ndarray]) -> dict | None:
     """The last event of a run that stopped training since the previous tick."""
     try:
         run = studio.runs.get(run_id)
