@@ -4,6 +4,8 @@ A small device-side program (or ``studio bridge``) sends one datagram per frame 
 :mod:`._wire`. UDP suits a 110 Hz stream on a LAN: no head-of-line blocking, and a lost frame is
 better late than never. Lost frames show up as gaps in the frame counter and are counted as
 dropped; malformed datagrams are counted as rejected, with the reason in ``status().warning``.
+UDP has no connection to lose: while no datagram arrives for :data:`SILENCE_SECONDS`, the
+source keeps listening and ``status().error`` says so; the first datagram clears it.
 """
 
 from __future__ import annotations
@@ -90,10 +92,13 @@ class NetworkSource(ThreadedSource):
                 data, sender = sock.recvfrom(MAX_DATAGRAM_BYTES)
             except TimeoutError:
                 quiet = time.monotonic() - last_datagram
-                if quiet > SILENCE_SECONDS and self._frames:
+                if quiet > SILENCE_SECONDS:
+                    host, port = self.address
+                    waited = "no frames yet" if self._last_counter is None else "no frames"
                     with self._lock:
-                        self._warning = (
-                            f"no frames for {quiet:.0f} s; check that the sender is running."
+                        self._error = (
+                            f"{waited} on UDP {host}:{port} for {quiet:.0f} s; check that the "
+                            "device or `studio bridge` is running and sends to this address."
                         )
                 continue
             except OSError as err:
@@ -103,6 +108,9 @@ class NetworkSource(ThreadedSource):
                     f"the UDP socket failed ({err.strerror}); restart the network source."
                 ) from None
             last_datagram = time.monotonic()
+            if self._error is not None:
+                with self._lock:
+                    self._error = None  # the sender is back
             try:
                 frame = decode_frame(data)
             except WireError as err:

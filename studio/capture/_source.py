@@ -36,7 +36,8 @@ class SourceStatus:
         rate_hz: measured frame rate over the last second of frames (0 before two frames).
         frames: frames produced so far.
         dropped: frames lost (queue full, checksum errors, gaps in the device's counter).
-        error: why the source stopped (one sentence with the fix), or ``None``.
+        error: why the source stopped or delivers no frames (one sentence with the fix), or
+            ``None``. A network source keeps listening and clears it when frames come back.
         rejected: malformed input ignored (network datagrams that failed to decode).
         warning: the last non-fatal problem (for example why a datagram was rejected), or ``None``.
     """

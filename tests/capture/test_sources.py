@@ -264,3 +264,22 @@ def test_a_crashing_producer_reports_its_error():
     source.start()
     threading.Event().wait(0.2)
     assert not source.running and "wire cut" in source.status().error
+
+
+def test_a_silent_network_sender_is_a_status_error_that_clears(monkeypatch, frames):
+    from studio.capture import _network
+
+    monkeypatch.setattr(_network, "SILENCE_SECONDS", 0.2)
+    receiver = NetworkSource(port=0)
+    receiver.start()
+    try:
+        time.sleep(0.5)
+        silent = receiver.status()
+        with FrameSender(*receiver.address) as sender:
+            sender.send(frames[0])
+        _drain(receiver, lambda f: len(f) >= 1)
+        back = receiver.status()
+    finally:
+        receiver.stop()
+    assert silent.running and "no frames yet on UDP" in silent.error
+    assert back.running and back.error is None
