@@ -25,6 +25,7 @@ from .._errors import StudioError
 from ._errors import NotFoundError, WebError
 from ._settings import Settings, get_settings
 from ._state import Studio
+from ._store import human_bytes
 from .routers import (
     capture,
     config,
@@ -166,7 +167,7 @@ class UploadLimitMiddleware:
                     if size > self.limit + MULTIPART_OVERHEAD_BYTES:
                         response = JSONResponse(
                             {
-                                "detail": f"The upload is {size / 1e6:.1f} MB, over the limit of {self.limit / 1e6:.0f} MB; upload a smaller file or start the studio with a larger limit."
+                                "detail": f"The upload is {human_bytes(size)}, over the limit of {human_bytes(self.limit)}; upload a smaller file or start the studio with a larger limit."
                             },
                             status_code=413,
                         )

@@ -12,7 +12,7 @@ from pathlib import Path
 
 from pydantic import BaseModel, ConfigDict, Field
 
-DEFAULT_UPLOAD_LIMIT_BYTES = 50 * 1024 * 1024
+DEFAULT_UPLOAD_LIMIT_BYTES = 50_000_000
 """Largest accepted upload (recordings, policies): 50 MB, about 40 minutes of 110 Hz tape frames."""
 
 LOOPBACK_NAMES = ("127.0.0.1", "localhost", "::1", "[::1]")

@@ -38,6 +38,15 @@ UPLOAD_CHUNK_BYTES = 1024 * 1024
 T = TypeVar("T")
 
 
+def human_bytes(n: float) -> str:
+    """A size as people read it: ``50 MB``, ``1.5 MB``, ``900 kB``, ``120 bytes``."""
+    if n >= 1e6:
+        return f"{n / 1e6:.3g} MB"
+    if n >= 1e3:
+        return f"{n / 1e3:.3g} kB"
+    return f"{int(n)} bytes"
+
+
 def check_name(name: str, what: str = "name") -> str:
     """Return ``name`` if it is a plain file stem, else raise a 422 naming the rule."""
     if not isinstance(name, str) or ".." in name or "/" in name or "\\" in name:
@@ -109,7 +118,7 @@ async def receive_upload(upload: UploadFile, folder: Path, limit: int) -> Path:
                 size += len(chunk)
                 if size > limit:
                     raise TooLargeError(
-                        f"The upload is larger than the limit of {limit / 1e6:.0f} MB; upload a smaller file or start the studio with a larger limit."
+                        f"The upload is larger than the limit of {human_bytes(limit)}; upload a smaller file or start the studio with a larger limit."
                     )
                 out.write(chunk)
     except BaseException:

@@ -16,7 +16,7 @@ from tests.web.conftest import make_settings
 def test_config_tells_the_page_the_scene_url_and_limit(client, tmp_path):
     config = client.get("/api/config").json()
     assert config["viser_url"] == "http://127.0.0.1:8080"
-    assert config["upload_limit_bytes"] == 50 * 1024 * 1024
+    assert config["upload_limit_bytes"] == 50_000_000
     assert Path(config["data_dir"]) == tmp_path.resolve()
 
 

@@ -163,3 +163,10 @@ def test_trajectory_before_any_watch_is_409(client):
 def test_policy_names_are_checked(client):
     assert client.delete("/api/policies/a..b").status_code == 422
     assert client.get("/api/policies/.hidden/file").status_code == 422
+
+
+def test_an_announced_oversized_body_is_refused_before_it_is_read(open_client, tmp_path):
+    client = open_client(upload_limit_bytes=1000)
+    r = upload(client, "huge.policy.npz", b"\0" * 200_000)
+    assert r.status_code == 413 and "over the limit of" in r.json()["detail"]
+    assert not list((tmp_path / "policies").iterdir())
