@@ -69,6 +69,11 @@ class PlaybackSource(ThreadedSource):
         return self.recording.config
 
     @property
+    def rate_hz(self) -> float:
+        """The recording's nominal frame rate."""
+        return self.recording.rate_hz
+
+    @property
     def duration(self) -> float:
         """The recording's duration in seconds."""
         return self.recording.duration
