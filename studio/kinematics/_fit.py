@@ -14,8 +14,12 @@ bias them:
   the wrist (or ``f`` when the tape ends before the hand: a straight wrist is assumed).
 
 Then damped least squares (Pinocchio joint Jacobians) moves the arm's elbow, wrist and hand
-centre onto ``E, W, H``, warm-started from the previous frame; a cold start (the first frame, or
-a failed warm start) is seeded in closed form for the shoulder and elbow.
+centre onto ``E, W, H``, warm-started from the previous frame. The first frame, and any frame
+whose warm start stalls (the unseen wrist direction running into a joint limit), start from a
+closed-form solution instead: shoulder and elbow from the limb directions, the wrist from the
+hand's direction given the previous forearm rotation (or, failing that, zero wrist deviation).
+The tape's landmarks are taken relative to its shoulder vertex, so the arm's angles survive a
+tape strapped slightly off; the offset shows in the residual.
 
 Observability: the three directions give six numbers for seven joints. Shoulder flexion,
 abduction, humeral rotation and elbow flexion are determined (humeral rotation only when the elbow
@@ -177,41 +181,49 @@ class ArmFitter:
             last, h = self.config.regions, f
         return np.stack([S, E, W, W + arm.hand_length * h]), last
 
-    def _seed(self, points: np.ndarray) -> np.ndarray:
-        """Closed-form shoulder and elbow angles from the landmark directions (wrist at zero)."""
+    def _seed(self, points: np.ndarray, forearm_rotation: float | None = None) -> np.ndarray:
+        """Closed-form arm angles from the landmark directions.
+
+        Shoulder and elbow angles follow from the upper-arm and forearm directions. The hand's
+        direction fixes two of forearm rotation and the two wrist joints: given
+        ``forearm_rotation`` (the previous frame's, for continuity) the wrist follows; without
+        it, wrist deviation is taken as zero.
+        """
         S, E, W, H = points
         d = _unit(E - S)
         q = np.zeros(self.arm.nq)
-        # Upper-arm direction in the base frame: (sin q0 cos q1, -sin q1, -cos q0 cos q1).
-        q[1] = math.asin(float(np.clip(-d[1], -1.0, 1.0)))
+        sign = -1.0 if self.arm.side == "right" else 1.0  # mirrored lateral axes
+        # Upper-arm direction in the base frame: (sin q0 cos q1, sign sin q1, -cos q0 cos q1).
+        q[1] = math.asin(float(np.clip(sign * d[1], -1.0, 1.0)))
         q[0] = math.atan2(d[0], -d[2])
-        if self.arm.side == "left":
-            # Mirrored axes: the left arm's direction is the right's with y negated.
-            q[1] = -q[1]
         f = _unit(W - E)
         q[3] = math.acos(float(np.clip(d @ f, -1.0, 1.0)))
         pin.forwardKinematics(self.model, self.data, q)
-        A = self.data.oMi[2].rotation  # frame before humeral rotation
-        fA = A.T @ f
-        sign = -1.0 if self.arm.side == "right" else 1.0  # mirrored lateral axes
+        fA = self.data.oMi[2].rotation.T @ f  # forearm in the frame before humeral rotation
         if math.sin(q[3]) > _SEEN:  # humeral rotation is seen only with a bent elbow
             q[2] = math.atan2(sign * fA[2], fA[0])
-        # Forearm rotation and wrist flexion that point the hand at H, with no deviation:
-        # the hand's direction in the elbow frame is (cos q4 sin q5, -cos q5, -+sin q4 sin q5).
-        q = np.clip(q, self._lower, self._upper)
+        q = np.minimum(np.maximum(q, self._lower), self._upper)
+        lower, upper = self._lower, self._upper
+        if forearm_rotation is not None:
+            # Hand direction after forearm rotation: (sin q5 cos q6, -cos q5 cos q6, -sign sin q6).
+            q[4] = min(max(forearm_rotation, lower[4]), upper[4])
+            pin.forwardKinematics(self.model, self.data, q)
+            h = self.data.oMi[5].rotation.T @ _unit(H - W)
+            q[6] = math.asin(float(np.clip(sign * h[2], -1.0, 1.0)))
+            q[5] = math.atan2(h[0], -h[1])
+            return np.minimum(np.maximum(q, lower), upper)
+        # No deviation: the hand's direction in the elbow frame is
+        # (cos q4 sin q5, -cos q5, sign sin q4 sin q5).
         pin.forwardKinematics(self.model, self.data, q)
         h = self.data.oMi[4].rotation.T @ _unit(H - W)
         q5 = math.acos(float(np.clip(-h[1], -1.0, 1.0)))
         # A straight wrist leaves forearm rotation unseen: keep it at zero then.
         q4 = math.atan2(sign * h[2], h[0]) if math.sin(q5) > _SEEN else 0.0
         for q4_try, q5_try in ((q4, q5), (q4 + math.pi, -q5), (q4 - math.pi, -q5)):
-            if (
-                self._lower[4] <= q4_try <= self._upper[4]
-                and self._lower[5] <= q5_try <= self._upper[5]
-            ):
+            if lower[4] <= q4_try <= upper[4] and lower[5] <= q5_try <= upper[5]:
                 q[4], q[5] = q4_try, q5_try
                 break
-        return np.clip(q, self._lower, self._upper)
+        return np.minimum(np.maximum(q, lower), upper)
 
     # -------------------------------------------------------------------------------------- IK
 
@@ -279,22 +291,30 @@ class ArmFitter:
             positions = reconstruct(bend_a, twist, self.config).positions
 
         points, last = self.landmarks(positions)
-        target = (points[1:] - points[0]).reshape(-1)  # the arm's shoulder is at the origin
+        relative = points - points[0]  # the arm's shoulder is at the origin
+        target = relative[1:].reshape(-1)
         cfg = self.settings
         iterations = 0
         q, err = None, math.inf
         if self._q is not None:
             q, err, iterations = self._solve(self._q, target, cfg.warm_iterations)
-        if q is None or err > cfg.landmark_tolerance:
-            q_cold, err_cold, it = self._solve(
-                self._seed(points - points[0]), target, cfg.cold_iterations
-            )
-            iterations += it
-            if err_cold < err:
-                q, err = q_cold, err_cold
-            else:  # the warm attempt was better: put the scratch data back at its pose
-                pin.forwardKinematics(self.model, self.data, q)
-                pin.updateFramePlacement(self.model, self.data, self._hand)
+        if q is None or err > cfg.tolerance:
+            # Cold, or the warm start stalled (the unseen wrist direction ran into a limit):
+            # solve in closed form, keeping the previous forearm rotation when there is one.
+            previous = None if self._q is None else float(self._q[4])
+            seeds = [self._seed(relative, previous)]
+            if previous is not None:
+                seeds.append(self._seed(relative))
+            for seed in seeds:
+                q_seed, err_seed, it = self._solve(seed, target, cfg.cold_iterations)
+                iterations += it
+                if err_seed < err:
+                    q, err = q_seed, err_seed
+                if err <= cfg.tolerance:
+                    break
+            # Leave the scratch data at the chosen pose for the residual below.
+            pin.forwardKinematics(self.model, self.data, q)
+            pin.updateFramePlacement(self.model, self.data, self._hand)
         self._q = q
 
         # Residual: tape's arm vertices against the fitted arm, in the arm base frame.
