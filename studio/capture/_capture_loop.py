@@ -74,7 +74,7 @@ def capture(
             status = source.status()
             if on_progress is not None:
                 on_progress(writer.frames, status)
-            if status.error:
+            if status.error and not status.running:  # a running source may recover (network)
                 raise CaptureError(f"{status.error} ({writer.frames} frames kept in {writer.path})")
             if (
                 seconds is not None

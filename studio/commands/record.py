@@ -7,12 +7,15 @@ from __future__ import annotations
 
 import argparse
 import sys
+import time
 from pathlib import Path
 
 from studio.capture import SOURCE_SPECS, SourceStatus, capture, read_recording, source_from_spec
 from studio.capture._capture_loop import describe
 from studio.capture._recording_format import DEFAULT_RATE_HZ
 
+PROGRESS_SECONDS = 0.2
+"""How often the progress line is redrawn."""
 NAME = "record"
 HELP = "Record tape frames (simulator, recording, UDP or serial) into a *.tape.csv file."
 
@@ -46,10 +49,17 @@ def run(args: argparse.Namespace) -> int:
     total = f"/{args.seconds:g} s" if args.seconds else ""
     nominal = float(getattr(source, "rate_hz", 0.0) or DEFAULT_RATE_HZ)
 
+    last = [0.0]
+
     def progress(frames: int, status: SourceStatus) -> None:
+        now = time.monotonic()
+        if now - last[0] < PROGRESS_SECONDS:
+            return
+        last[0] = now
+        note = f"  ({status.error})" if status.error else ""
         print(
             f"\rrecording {frames} frames ({frames / nominal:.1f} s{total}) "
-            f"{status.rate_hz:6.1f} Hz, dropped {status.dropped}",
+            f"{status.rate_hz:6.1f} Hz, dropped {status.dropped}{note}",
             end="",
             file=sys.stderr,
             flush=True,
