@@ -4,7 +4,7 @@ See ``docs/interfaces.md`` for the contract and :mod:`._recording_format` for th
 
     from studio.capture import SimulatorSource, RecordingWriter, read_recording
 
-    with SimulatorSource(seed=0) as source, RecordingWriter("recordings/x.tape.csv", 16) as out:
+    with SimulatorSource(seed=0) as source, RecordingWriter("recordings/x.tape.csv", config=source.config) as out:
         for _ in range(100):
             out.write_many(source.read(timeout=0.1))
     recording = read_recording("recordings/x.tape.csv")

@@ -27,6 +27,7 @@ from typing import Any
 import numpy as np
 
 from ._errors import CaptureError
+from ._recording_format import DEFAULT_REGIONS
 
 CALIBRATION_FORMAT = "teach-studio-calibration"
 """The ``format`` value of calibration files."""
@@ -79,7 +80,7 @@ class Calibration:
         return self.channels // 2
 
     @classmethod
-    def identity(cls, regions: int = 16, gain: float = DEFAULT_GAIN) -> Calibration:
+    def identity(cls, regions: int = DEFAULT_REGIONS, gain: float = DEFAULT_GAIN) -> Calibration:
         """Mid-scale offsets and one gain for every channel (before a real calibration exists)."""
         return cls(np.full(2 * regions, float(RAW_CENTRE)), np.full(2 * regions, float(gain)))
 

@@ -8,7 +8,7 @@ from pathlib import Path
 from typing import Any
 
 from ._errors import CaptureError
-from ._recording_format import DEFAULT_RATE_HZ
+from ._recording_format import DEFAULT_RATE_HZ, DEFAULT_REGIONS
 from ._recording_writer import RecordingWriter
 from ._source import SourceStatus, ThreadedSource
 
@@ -49,7 +49,7 @@ def capture(
         CaptureError: the source failed (the frames up to then are kept in the file).
     """
     config = getattr(source, "config", None)
-    regions = int(getattr(config, "regions", 16)) if config is not None else 16
+    regions = int(getattr(config, "regions", DEFAULT_REGIONS) or DEFAULT_REGIONS)
     rate = float(getattr(source, "rate_hz", DEFAULT_RATE_HZ) or DEFAULT_RATE_HZ)
     writer = RecordingWriter(
         out,

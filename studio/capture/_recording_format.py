@@ -36,6 +36,8 @@ RECORDING_SUFFIX = ".tape.csv"
 """File name ending of recordings."""
 DEFAULT_RATE_HZ = 110.0
 """The paper's ShapeTape sample rate."""
+DEFAULT_REGIONS = 16
+"""Regions of the paper's tape (and of ``TapeConfig()``), used when no config says otherwise."""
 FIXED_COLUMNS = ("t", "frame", "status")
 """Columns before the angles."""
 

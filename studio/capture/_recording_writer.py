@@ -19,6 +19,7 @@ from ._errors import RecordingError
 from ._frames import TapeFrame
 from ._recording_format import (
     DEFAULT_RATE_HZ,
+    DEFAULT_REGIONS,
     FORMAT_NAME,
     FORMAT_VERSION,
     RECORDING_SUFFIX,
@@ -100,7 +101,7 @@ class RecordingWriter:
     ) -> None:
         self.path = Path(path)
         if regions is None:
-            regions = int(config.regions) if config is not None else 16
+            regions = int(config.regions) if config is not None else DEFAULT_REGIONS
         self.regions = int(regions)
         if flush_seconds <= 0:
             raise RecordingError(f"flush_seconds is {flush_seconds}; give a positive number.")
