@@ -36,6 +36,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import pinocchio as pin
+from numba import njit
 
 from ._errors import KinematicsError
 from ._human import HumanArm
@@ -98,15 +99,61 @@ def _unit(v: np.ndarray) -> np.ndarray:
     return v / np.linalg.norm(v)
 
 
-def _point_polyline_distance(points: np.ndarray, poly: np.ndarray) -> np.ndarray:
-    """Distance of each point to the polyline ``poly`` whose last segment is a ray."""
-    a, d = poly[:-1], np.diff(poly, axis=0)  # (k, 3) segment starts and vectors
-    rel = points[:, None, :] - a[None]  # (n, k, 3)
-    t = np.einsum("nkj,kj->nk", rel, d) / np.einsum("kj,kj->k", d, d)
-    t = np.maximum(t, 0.0)
-    t[:, :-1] = np.minimum(t[:, :-1], 1.0)
-    gap = rel - t[..., None] * d[None]
-    return np.sqrt(np.einsum("nkj,nkj->nk", gap, gap).min(axis=1))
+@njit(nogil=True, cache=True)
+def _landmarks_kernel(
+    positions: np.ndarray,
+    shoulder: int,
+    first_forearm: int,
+    lengths: np.ndarray,
+    out: np.ndarray,
+) -> int:  # pragma: no cover - compiled
+    """Fill ``out (4, 3)`` with S, E, W, H (see the module docstring); return the last vertex."""
+    regions = positions.shape[0] - 1
+    upper, fore, hand = lengths[0], lengths[1], lengths[2]
+    d = positions[shoulder + 1] - positions[shoulder]
+    d = d / np.sqrt(np.sum(d * d))
+    S = positions[shoulder]
+    E = S + upper * d
+    f = positions[first_forearm] - E
+    norm = np.sqrt(np.sum(f * f))
+    if norm < 1e-9 and first_forearm < regions:
+        f = positions[first_forearm + 1] - positions[first_forearm]
+        norm = np.sqrt(np.sum(f * f))
+    f = f / norm
+    W = E + fore * f
+    last = regions
+    h = f
+    for j in range(first_forearm + 1, regions + 1):
+        if np.sum((positions[j] - E) * f) > fore + 1e-9:
+            last = j
+            h = positions[j] - W
+            h = h / np.sqrt(np.sum(h * h))
+            break
+    out[0] = S
+    out[1] = E
+    out[2] = W
+    out[3] = W + hand * h
+    return last
+
+
+@njit(nogil=True, cache=True)
+def _rms_polyline_distance(points: np.ndarray, poly: np.ndarray) -> float:  # pragma: no cover
+    """RMS distance of ``points`` to the polyline ``poly``, whose last segment is a ray."""
+    total = 0.0
+    segments = poly.shape[0] - 1
+    for i in range(points.shape[0]):
+        best = np.inf
+        for k in range(segments):
+            d = poly[k + 1] - poly[k]
+            rel = points[i] - poly[k]
+            t = np.sum(rel * d) / np.sum(d * d)
+            t = max(t, 0.0)
+            if k < segments - 1:
+                t = min(t, 1.0)
+            gap = rel - t * d
+            best = min(best, np.sum(gap * gap))
+        total += best
+    return np.sqrt(total / points.shape[0])
 
 
 class ArmFitter:
@@ -145,6 +192,7 @@ class ArmFitter:
         self._lower = np.asarray(arm.lower)
         self._upper = np.asarray(arm.upper)
         self._damping = np.eye(arm.nq) * self.settings.damping**2
+        self._lengths = np.array([arm.upper_arm_length, arm.forearm_length, arm.hand_length])
         self._J = np.empty((9, arm.nq))  # scratch: landmark Jacobian and error
         self._e = np.empty(9)
         self._q: np.ndarray | None = None
@@ -164,22 +212,15 @@ class ArmFitter:
         Returns:
             ``(points (4, 3), last)`` where ``last`` is the index of the last vertex used.
         """
-        arm, s = self.arm, self.config.shoulder_region
-        S = positions[s]
-        E = S + arm.upper_arm_length * _unit(positions[s + 1] - S)
-        c = self._first_forearm
-        f = positions[c] - E
-        if np.linalg.norm(f) < 1e-9 and c < self.config.regions:
-            f = positions[c + 1] - positions[c]
-        f = _unit(f)
-        W = E + arm.forearm_length * f
-        beyond = np.nonzero((positions[c + 1 :] - E) @ f > arm.forearm_length + 1e-9)[0]
-        if beyond.size:
-            last = c + 1 + int(beyond[0])
-            h = _unit(positions[last] - W)
-        else:
-            last, h = self.config.regions, f
-        return np.stack([S, E, W, W + arm.hand_length * h]), last
+        points = np.empty((4, 3))
+        last = _landmarks_kernel(
+            np.ascontiguousarray(positions, dtype=np.float64),
+            self.config.shoulder_region,
+            self._first_forearm,
+            self._lengths,
+            points,
+        )
+        return points, int(last)
 
     def _seed(self, points: np.ndarray, forearm_rotation: float | None = None) -> np.ndarray:
         """Closed-form arm angles from the landmark directions.
@@ -318,17 +359,14 @@ class ArmFitter:
         self._q = q
 
         # Residual: tape's arm vertices against the fitted arm, in the arm base frame.
-        arm_points = np.stack(
-            [
-                np.zeros(3),
-                self.data.oMi[4].translation,
-                self.data.oMi[6].translation,
-                self.data.oMf[self._hand].translation,
-            ]
-        )
+        arm_points = np.zeros((4, 3))  # shoulder at the origin
+        arm_points[1] = self.data.oMi[4].translation
+        arm_points[2] = self.data.oMi[6].translation
+        arm_points[3] = self.data.oMf[self._hand].translation
         vertices = positions[self.config.shoulder_region : last + 1]
-        residual = float(np.sqrt(np.mean(_point_polyline_distance(vertices, arm_points) ** 2)))
-        landmark_error = float(np.sqrt(np.mean(np.sum((points - arm_points) ** 2, axis=1))))
+        residual = float(_rms_polyline_distance(vertices, arm_points))
+        gap = points - arm_points
+        landmark_error = math.sqrt(float(np.einsum("ij,ij->", gap, gap)) / 4)
         # The IK error is measured from the tape's shoulder; an offset shoulder shows in residual.
         success = err <= cfg.landmark_tolerance and residual <= cfg.max_residual
         return ArmFit(
