@@ -73,6 +73,7 @@ def make_sample(seed: int, out_dir: Path, grid: ArmGrid) -> tuple[Path, Path]:
         status,
         np.round(bend, ANGLE_DECIMALS),
         np.round(twist, ANGLE_DECIMALS),
+        closed=CREATED,
     )
     t0 = sim.reach_start / RATE_HZ
     demo = extract_demonstration(path, t0, t[-1] - t[0], grid=grid, name=name)

@@ -49,7 +49,8 @@ LIMIT_TOLERANCE_RAD = 1e-6
 MIN_SEGMENT_FRAMES = 2
 """Fewest frames a segment needs."""
 TRAJECTORY_DECIMALS = 6
-"""Radians and seconds are stored to a micro-unit: small files, far below the grid's resolution."""
+"""Radians, seconds and metres are stored to a micro-unit: small files, far below the grid's
+resolution and the fit's accuracy."""
 
 
 @dataclass(eq=False)
@@ -115,8 +116,8 @@ class Demonstration:
             "grid_path": list(self.grid_path),
             "reached_at": self.reached_at,
             "fit": {
-                "residual_max": self.residual_max,
-                "residual_mean": self.residual_mean,
+                "residual_max": round(self.residual_max, TRAJECTORY_DECIMALS),
+                "residual_mean": round(self.residual_mean, TRAJECTORY_DECIMALS),
                 "max_allowed": MAX_FIT_RESIDUAL_M,
             },
             "trajectory": {

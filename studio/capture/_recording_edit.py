@@ -149,8 +149,12 @@ def write_recording(
     twist: np.ndarray,
     *,
     overwrite: bool = False,
+    closed: str | None = None,
 ) -> Path:
     """Write a whole recording at once (imports, cuts), atomically, with its ``# end`` line.
+
+    ``closed`` (ISO time, default now) goes into the ``# end`` line; a fixed value makes
+    regenerated files byte-identical.
 
     Raises:
         RecordingError: the target exists and ``overwrite`` is false, or the arrays disagree.
@@ -173,7 +177,7 @@ def write_recording(
     parts = [header_line(meta), ",".join(columns(regions)) + "\n"]
     parts.extend(format_row(t[i], frame[i], status[i], bend[i], twist[i]) for i in range(n))
     duration = float(t[-1] - t[0]) if n >= 2 else 0.0
-    parts.append(end_line(n, duration, datetime.now(UTC).isoformat(timespec="seconds")))
+    parts.append(end_line(n, duration, closed or datetime.now(UTC).isoformat(timespec="seconds")))
     return atomic_write_text(path, "".join(parts))
 
 
