@@ -295,7 +295,7 @@ def simulate(
             poses.append(q)
         reach_start = len(frames)
         sim.motion.reach(np.asarray(goal, dtype=float))
-        reach_end = reach_start + sim.motion.frames_to_goal()
+        reach_end = min(n, reach_start + sim.motion.frames_to_goal())
     rest = n - len(frames)
     if rest:
         f, q = sim.next(rest)
@@ -339,7 +339,12 @@ class SimulatorSource(ThreadedSource):
         self.config = self._sim.config
 
     def reach(self, q_robot_goal: np.ndarray) -> None:
-        """Make the operator reach (and hold) the pose that mirrors onto this Puma560 goal."""
+        """Make the operator reach (and hold) the pose that mirrors onto this Puma560 goal.
+
+        A goal the human arm cannot mirror exactly (say the robot's elbow bent backwards past
+        straight) is approached as closely as the arm's limits allow. The trigger bit is set from
+        now until :meth:`wander`, marking the demonstration in the recording.
+        """
         self._sim.motion.reach(np.asarray(q_robot_goal, dtype=float))
 
     def wander(self) -> None:
