@@ -84,7 +84,8 @@ async def stream_events(
         if now - last["keepalive"] >= KEEPALIVE_EVERY_S:
             last["keepalive"] = now
             yield ": keep-alive\n\n"
-        await asyncio.sleep(TICK_S)
+        # sleep to the next tick of a fixed schedule, so slow ticks do not lower the rate
+        await asyncio.sleep(max(0.0, TICK_S - (time.monotonic() - now)))
 
 
 def run_event(run, counts: dict[str, np.ndarray]) -> dict:  # noqa: ANN001 - a _runs.Run
