@@ -105,6 +105,7 @@ def _landmarks_kernel(
     shoulder: int,
     first_forearm: int,
     lengths: np.ndarray,
+    step: float,
     out: np.ndarray,
 ) -> int:  # pragma: no cover - compiled
     """Fill ``out (4, 3)`` with S, E, W, H (see the module docstring); return the last vertex."""
@@ -119,16 +120,18 @@ def _landmarks_kernel(
     if norm < 1e-9 and first_forearm < regions:
         f = positions[first_forearm + 1] - positions[first_forearm]
         norm = np.sqrt(np.sum(f * f))
+    along = np.sum((positions[first_forearm] - E) * f) / norm  # first vertex's distance from E
     f = f / norm
     W = E + fore * f
-    last = regions
+    # Whole regions follow along the forearm; the first vertex past the wrist ends the chord
+    # that cuts the wrist's corner (whatever the hand's angle).
+    last = first_forearm + int(np.floor((fore - along) / step + 1e-9)) + 1
     h = f
-    for j in range(first_forearm + 1, regions + 1):
-        if np.sum((positions[j] - E) * f) > fore + 1e-9:
-            last = j
-            h = positions[j] - W
-            h = h / np.sqrt(np.sum(h * h))
-            break
+    if last <= regions:
+        h = positions[last] - W
+        h = h / np.sqrt(np.sum(h * h))
+    else:
+        last = regions
     out[0] = S
     out[1] = E
     out[2] = W
@@ -218,17 +221,22 @@ class ArmFitter:
             self.config.shoulder_region,
             self._first_forearm,
             self._lengths,
+            self.config.region_length,
             points,
         )
         return points, int(last)
 
-    def _seed(self, points: np.ndarray, forearm_rotation: float | None = None) -> np.ndarray:
+    def _seed(
+        self, points: np.ndarray, forearm_rotation: float | None = None, overhead: bool = False
+    ) -> np.ndarray:
         """Closed-form arm angles from the landmark directions.
 
         Shoulder and elbow angles follow from the upper-arm and forearm directions. The hand's
         direction fixes two of forearm rotation and the two wrist joints: given
         ``forearm_rotation`` (the previous frame's, for continuity) the wrist follows; without
-        it, wrist deviation is taken as zero.
+        it, wrist deviation is taken as zero. ``overhead`` picks the other shoulder branch
+        (abduction beyond 90 degrees, flexion turned by 180), the one an arm raised sideways
+        over the head needs.
         """
         S, E, W, H = points
         d = _unit(E - S)
@@ -237,6 +245,9 @@ class ArmFitter:
         # Upper-arm direction in the base frame: (sin q0 cos q1, sign sin q1, -cos q0 cos q1).
         q[1] = math.asin(float(np.clip(sign * d[1], -1.0, 1.0)))
         q[0] = math.atan2(d[0], -d[2])
+        if overhead:  # same upper-arm direction: (q0 + pi, pi - q1)
+            q[1] = math.pi - q[1]
+            q[0] = q[0] - math.copysign(math.pi, q[0])
         f = _unit(W - E)
         q[3] = math.acos(float(np.clip(d @ f, -1.0, 1.0)))
         pin.forwardKinematics(self.model, self.data, q)
@@ -343,9 +354,22 @@ class ArmFitter:
             # Cold, or the warm start stalled (the unseen wrist direction ran into a limit):
             # solve in closed form, keeping the previous forearm rotation when there is one.
             previous = None if self._q is None else float(self._q[4])
-            seeds = [self._seed(relative, previous)]
-            if previous is not None:
-                seeds.append(self._seed(relative))
+            rotations = [previous, None] if previous is not None else [None]
+            seeds = [
+                self._seed(relative, r, overhead) for overhead in (False, True) for r in rotations
+            ]
+            # Exact seeds first (nearest to the previous frame among them), then the closest.
+            errors = [self._solve(seed, target, 0)[1] for seed in seeds]
+            previous_q = self._q if self._q is not None else seeds[0]
+
+            def order(k: int) -> tuple[bool, float]:
+                exact = errors[k] <= cfg.tolerance
+                return (
+                    not exact,
+                    float(np.abs(seeds[k] - previous_q).sum()) if exact else errors[k],
+                )
+
+            seeds = [seeds[k] for k in sorted(range(len(seeds)), key=order)]
             for seed in seeds:
                 q_seed, err_seed, it = self._solve(seed, target, cfg.cold_iterations)
                 iterations += it

@@ -42,7 +42,7 @@ import numpy as np
 
 from ._errors import KinematicsError
 from ._human import SAGITTAL_MIRROR, HumanArm, _as_q
-from ._puma import IKConfig, Puma560
+from ._puma import IKConfig, IKResult, Puma560
 
 Mode = Literal["joint", "cartesian"]
 
@@ -106,6 +106,10 @@ class Retargeter:
         self.mirror = bool(mirror)
         self.mode = mode
         self._q_prev: np.ndarray | None = None
+        self.last_ik: IKResult | None = None
+        """The last cartesian-mode IK result (``success``, ``error``, ``message``): an
+        unreachable hand pose is reported here, while ``robot_from_human`` returns the closest
+        configuration within the limits."""
 
     # ---------------------------------------------------------------------------- settings
 
@@ -194,6 +198,7 @@ class Retargeter:
             if position.success or position.error < result.error:
                 result = position
         self._q_prev = result.q.copy()
+        self.last_ik = result
         return result.q.copy()
 
     def human_from_robot(self, q_robot: object) -> np.ndarray:

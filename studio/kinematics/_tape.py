@@ -67,7 +67,7 @@ def _back_angles(regions_before_shoulder: int) -> tuple[np.ndarray, np.ndarray]:
     return bend, np.zeros(regions_before_shoulder)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class TapeConfig:
     """How the tape is made and where it lies on the operator.
 
@@ -92,7 +92,7 @@ class TapeConfig:
 
     length: float = DEFAULT_LENGTH
     regions: int = DEFAULT_REGIONS
-    base: np.ndarray | None = field(default=None, compare=False)
+    base: np.ndarray | None = field(default=None, compare=False)  # compared in __eq__
     shoulder_region: int = DEFAULT_SHOULDER_REGION
     wrist_region: int = DEFAULT_WRIST_REGION
     side: Literal["right", "left"] = "right"
@@ -129,6 +129,24 @@ class TapeConfig:
                 )
             object.__setattr__(self, "base", base)
         self.base.setflags(write=False)
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, TapeConfig):
+            return NotImplemented
+        return self._key() == other._key()
+
+    def __hash__(self) -> int:
+        return hash(self._key())
+
+    def _key(self) -> tuple:
+        return (
+            self.length,
+            self.regions,
+            self.shoulder_region,
+            self.wrist_region,
+            self.side,
+            self.base.tobytes(),
+        )
 
     @property
     def region_length(self) -> float:

@@ -54,6 +54,24 @@ def test_cold_fit_recovers_landmarks_and_observable_joints(q, side):
     assert np.all(fit.q_human >= arm.lower) and np.all(fit.q_human <= arm.upper)
 
 
+def any_q():
+    arm = ARMS["right"]
+    return st.tuples(*[st.floats(a, b) for a, b in zip(arm.lower, arm.upper, strict=True)]).map(
+        np.array
+    )
+
+
+@settings(max_examples=40, deadline=None)
+@given(q=any_q(), side=st.sampled_from(["right", "left"]))
+def test_cold_fit_meets_the_landmarks_anywhere_within_the_limits(q, side):
+    # Arms raised overhead, straight elbows, wrists at their limits: the joints may come back
+    # on another branch, but the arm lies where the tape says.
+    arm, config = ARMS[side], CONFIGS[side]
+    fit = ArmFitter(arm, config).fit(tape_from_arm(arm, q, config))
+    np.testing.assert_allclose(arm.points(fit.q_human), arm.points(q), atol=1e-4)
+    assert fit.success
+
+
 def test_warm_fit_follows_a_smooth_motion_with_few_iterations():
     arm, config = ARMS["right"], CONFIGS["right"]
     rng = np.random.default_rng(11)

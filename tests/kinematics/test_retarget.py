@@ -116,6 +116,12 @@ def test_cartesian_mode_reaches_the_mirrored_scaled_hand_pose():
         if np.linalg.norm(ROBOT.forward(q_robot)[:3, 3] - target[:3, 3]) < 1e-4:
             reached += 1
     assert reached >= 25  # positions reached (the full orientation when the Puma's wrist can)
+    # An unreachable hand pose is reported, and the answer stays within the limits.
+    far = Retargeter(mode="cartesian", robot=ROBOT, arm=RIGHT)
+    far.config = type(far.config)(reach_fraction=3.0)
+    q_robot = far.robot_from_human(np.zeros(7))
+    assert far.last_ik is not None and not far.last_ik.success
+    assert np.all(q_robot >= ROBOT.lower) and np.all(q_robot <= ROBOT.upper)
 
 
 def test_mode_switches_at_run_time_and_is_validated():

@@ -208,3 +208,12 @@ def test_tape_angles_rejects_bad_input():
     frames[3, 0, 0] = np.nan
     with pytest.raises(KinematicsError, match="NaN"):
         tape_angles(frames)
+
+
+def test_configs_compare_by_value_including_the_base():
+    assert TapeConfig() == TapeConfig()
+    assert hash(TapeConfig()) == hash(TapeConfig())
+    moved = CONFIG.base.copy()
+    moved[2, 3] += 0.01
+    assert TapeConfig(base=moved) != TapeConfig()
+    assert TapeConfig(side="left") != TapeConfig()
