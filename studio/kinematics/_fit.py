@@ -168,8 +168,8 @@ class ArmFitter:
         fit: solver defaults.
 
     Raises:
-        KinematicsError: the tape's regions cannot see the elbow (upper arm shorter than a
-            region, or too few regions after the shoulder).
+        KinematicsError: the tape's regions cannot see the arm (upper arm shorter than a
+            region, or the configured arm regions shorter than the arm).
     """
 
     def __init__(self, arm: HumanArm, config: TapeConfig, fit: FitConfig | None = None) -> None:
@@ -183,12 +183,15 @@ class ArmFitter:
                 f"({step:.3f} m), so the tape cannot show its direction; use more regions."
             )
         s = config.shoulder_region
-        self._first_forearm = s + int(math.floor(arm.upper_arm_length / step + 1e-9)) + 1
-        if self._first_forearm > config.regions:
+        arm_regions = config.wrist_region - s
+        if arm_regions * step < arm.upper_arm_length + arm.forearm_length - 1e-9:
             raise KinematicsError(
-                f"The tape ends before it passes the elbow (shoulder_region={s} of "
-                f"{config.regions} regions); lower shoulder_region."
+                f"The tape's arm regions ({s}..{config.wrist_region - 1}, "
+                f"{arm_regions * step:.3f} m) are shorter than the arm "
+                f"({arm.upper_arm_length + arm.forearm_length:.3f} m shoulder to wrist); "
+                "raise wrist_region or lower shoulder_region."
             )
+        self._first_forearm = s + int(math.floor(arm.upper_arm_length / step + 1e-9)) + 1
         self.model = arm.model
         self.data = arm.model.createData()
         self._hand = arm.hand_frame

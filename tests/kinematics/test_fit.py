@@ -157,5 +157,8 @@ def test_configs_that_cannot_see_the_arm_are_refused():
     arm = ARMS["right"]
     with pytest.raises(KinematicsError, match="more regions"):
         ArmFitter(arm, TapeConfig(regions=4, shoulder_region=1, wrist_region=4))
-    with pytest.raises(KinematicsError, match="elbow"):
+    with pytest.raises(KinematicsError, match="shorter than the arm"):
         ArmFitter(arm, TapeConfig(shoulder_region=14, wrist_region=16))
+    with pytest.raises(KinematicsError, match="raise wrist_region"):
+        ArmFitter(arm, TapeConfig(shoulder_region=9, wrist_region=13))
+    ArmFitter(HumanArm(upper_arm=0.25, forearm=0.2), TapeConfig(shoulder_region=9, wrist_region=13))
