@@ -5,7 +5,8 @@
  */
 "use strict";
 
-const CURVE_FPS = 10;
+const CURVE_FPS = 10; // chart redraws per second at most
+const RUNS_TABLE_MS = 250; // the run list (progress, CPU time) refreshes at most this often
 const PALETTE = ["#2a62b8", "#d9822b", "#23874b", "#b83280", "#6b4fbb", "#0f8b8d", "#a0522d", "#7a7a7a"];
 const $ = (id) => document.getElementById(id);
 
@@ -713,14 +714,39 @@ function mergeCurve(id, piece, from) {
 /* ------------------------------------------------------------------ the chart */
 function markCurvesDirty() { S.curveDirty = true; }
 
+/**
+ * At most MAX_PLOT_POINTS points per run: longer curves are averaged in equal buckets of episodes
+ * (band: the buckets' lowest low and highest high), so a 100 000-episode run draws as fast as a
+ * short one and the chart never slows the page down.
+ */
+const MAX_PLOT_POINTS = 600;
+function decimate(c) {
+  const n = c.episodes.length;
+  if (n <= MAX_PLOT_POINTS) return c;
+  const k = Math.ceil(n / MAX_PLOT_POINTS);
+  const out = emptyCurve();
+  for (let i = 0; i < n; i += k) {
+    const j = Math.min(n, i + k);
+    let m = 0; let sd = 0; let lo = Infinity; let hi = -Infinity;
+    for (let t = i; t < j; t++) {
+      m += c.mean[t]; sd += c.std[t] || 0;
+      lo = Math.min(lo, c.min[t]); hi = Math.max(hi, c.max[t]);
+    }
+    out.episodes.push(c.episodes[j - 1]);
+    out.mean.push(m / (j - i)); out.std.push(sd / (j - i)); out.min.push(lo); out.max.push(hi);
+  }
+  return out;
+}
+
 function curveTraces() {
   const band = $("curve-band").value;
   const log = $("curve-log").checked;
   const traces = [];
   for (const r of [...S.runs].reverse()) {
     if (!S.shown.has(r.id)) continue;
-    const c = S.curves.get(r.id);
-    if (!c || !c.episodes.length) continue;
+    const full = S.curves.get(r.id);
+    if (!full || !full.episodes.length) continue;
+    const c = decimate(full);
     const color = runColor(r.id);
     if (band !== "none") {
       let lo; let hi;
@@ -917,7 +943,7 @@ let runsRenderPending = false;
 function scheduleRunsRender() {
   if (runsRenderPending) return;
   runsRenderPending = true;
-  setTimeout(() => { runsRenderPending = false; renderRuns(); }, 1000 / CURVE_FPS);
+  setTimeout(() => { runsRenderPending = false; renderRuns(); }, RUNS_TABLE_MS);
 }
 
 /* ------------------------------------------------------------------ start-up */
