@@ -22,6 +22,7 @@ import numpy as np
 from studio.capture import (
     extract_demonstration,
     frames_to_arrays,
+    goal_configuration,
     recording_meta,
     simulate,
     write_recording,
@@ -39,13 +40,6 @@ ANGLE_DECIMALS = 4
 CREATED = "2026-11-22T00:00:00+00:00"
 """Fixed creation time, so regenerating gives identical files."""
 HERE = Path(__file__).resolve().parent
-
-
-def goal_configuration(grid: ArmGrid) -> np.ndarray:
-    """The Puma560 configuration at the centre of the grid's goal (wrist joints at zero)."""
-    q = np.zeros(6)
-    q[: grid.joints] = grid.angles_of(grid.goal_state)
-    return q
 
 
 def make_sample(seed: int, out_dir: Path, grid: ArmGrid) -> tuple[Path, Path]:

@@ -52,6 +52,7 @@ from ._simulator import OperatorConfig as OperatorConfig
 from ._simulator import OperatorMotion as OperatorMotion
 from ._simulator import Simulated as Simulated
 from ._simulator import SimulatorSource as SimulatorSource
+from ._simulator import goal_configuration as goal_configuration
 from ._simulator import simulate as simulate
 from ._source import FrameSource as FrameSource
 from ._source import SourceStatus as SourceStatus

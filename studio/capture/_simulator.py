@@ -112,7 +112,8 @@ class OperatorMotion:
         fraction = np.full(self.robot.nq, op.wrist_range_fraction)
         fraction[:3] = op.robot_range_fraction
         q_robot = mid + self._rng.uniform(-1.0, 1.0, self.robot.nq) * fraction * half
-        return self.human_of(q_robot)
+        margin = GOAL_MARGIN_RAD  # keep off the arm's limits, where the fit is singular
+        return np.clip(self.human_of(q_robot), self.arm.lower + margin, self.arm.upper - margin)
 
     def human_of(self, q_robot: np.ndarray) -> np.ndarray:
         """The human pose whose joint-mode retargeting is ``q_robot`` (within the arm's limits)."""
@@ -362,3 +363,37 @@ class SimulatorSource(ThreadedSource):
                 if delay > 0 and self._stop_event.wait(delay):
                     return
                 self._push(frame)
+
+
+GOAL_MARGIN_RAD = np.radians(4.0)
+"""How far inside the arm's joint limits :func:`goal_configuration` keeps the mirrored pose: a
+joint at its limit is a singular pose for the fit (a straight elbow hides the arm's plane)."""
+
+
+def goal_configuration(grid: Any, retargeter: Any = None) -> np.ndarray:
+    """A Puma560 configuration in the grid's goal bin that the operator can mirror comfortably.
+
+    The goal bins' centres, with joints beyond ``grid.joints`` at zero, moved (within the bin) so
+    that the mirrored arm pose keeps :data:`GOAL_MARGIN_RAD` from every arm limit. With the default
+    ``ArmGrid`` this bends the elbow slightly (joint 3 at -86 instead of -98 degrees, which the
+    human elbow cannot mirror), so :meth:`SimulatorSource.reach` and the samples end in the goal.
+
+    Args:
+        grid: the :class:`studio.learning.ArmGrid`.
+        retargeter: the joint-mode retargeter (default: mirrored, right arm).
+
+    Returns:
+        ``q_robot`` (6,), radians.
+    """
+    from studio.kinematics import Retargeter
+
+    retargeter = retargeter or Retargeter("joint", mirror=True)
+    arm = retargeter.arm
+    q_robot = np.zeros(6)
+    q_robot[: grid.joints] = grid.angles_of(grid.goal_state)
+    q_human = retargeter.human_from_robot(q_robot)
+    q_human = np.clip(q_human, arm.lower + GOAL_MARGIN_RAD, arm.upper - GOAL_MARGIN_RAD)
+    moved = retargeter.robot_from_human(q_human)
+    if grid.state_of_angles(moved[: grid.joints]) == grid.goal_state:
+        return moved
+    return q_robot

@@ -23,9 +23,9 @@ SECONDS = 5.0
 
 
 def _goal_q(grid: ArmGrid) -> np.ndarray:
-    q = np.zeros(6)
-    q[:3] = grid.angles_of(grid.goal_state)
-    return q
+    from studio.capture import goal_configuration
+
+    return goal_configuration(grid)
 
 
 @pytest.fixture(scope="module")
