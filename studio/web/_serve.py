@@ -5,8 +5,14 @@ from __future__ import annotations
 import logging
 import threading
 import webbrowser
+from typing import TYPE_CHECKING
 
 from ._settings import Settings
+
+if TYPE_CHECKING:
+    import viser
+
+    from ._scene import StudioScene
 
 log = logging.getLogger(__name__)
 
@@ -14,7 +20,7 @@ SHUTDOWN_GRACE_S = 3
 """On Ctrl+C, open event streams (which never end by themselves) are closed after this long."""
 
 
-def start_scene(settings: Settings):  # noqa: ANN201 - returns (ViserServer, StudioScene)
+def start_scene(settings: Settings) -> tuple[viser.ViserServer, StudioScene]:
     """Start the viser server (share button hidden) and the studio's scene in it."""
     import viser
 

@@ -18,7 +18,7 @@ from fastapi import APIRouter, Request
 from fastapi.responses import StreamingResponse
 
 from .._deps import StudioDep
-from .._runs import curve_of
+from .._runs import Run, curve_of
 from .._state import Studio
 
 router = APIRouter(prefix="/api/events", tags=["events"])
@@ -88,7 +88,7 @@ async def stream_events(
         await asyncio.sleep(max(0.0, TICK_S - (time.monotonic() - now)))
 
 
-def run_event(run, counts: dict[str, np.ndarray]) -> dict:  # noqa: ANN001 - a _runs.Run
+def run_event(run: Run, counts: dict[str, np.ndarray]) -> dict:
     """A ``run`` event: the run and its curve from the first episode that changed for this client.
 
     Only the changed tail is computed and sent, so a long run costs the same per event at

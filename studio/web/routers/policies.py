@@ -9,6 +9,7 @@ from fastapi.responses import FileResponse
 
 from .._deps import SettingsDep, StudioDep
 from .._errors import ConflictError
+from .._runs import Run
 from .._state import Studio
 from .._store import policy_summary, receive_upload
 
@@ -26,7 +27,7 @@ def _public(studio: Studio, name: str) -> dict:
     }
 
 
-def _run_public(run) -> dict:  # noqa: ANN001 - a studio.web._runs.Run
+def _run_public(run: Run) -> dict:
     from studio.learning import load_policy
 
     return {

@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-import io
+import tempfile
+from pathlib import Path
 
 import numpy as np
 from fastapi import APIRouter, Response
@@ -74,13 +75,14 @@ def download_trajectory(studio: StudioDep) -> Response:
     if last is None:
         raise ConflictError("Nothing has been watched yet; watch a policy first, then download.")
     times, q = last
-    buffer = io.StringIO()
-    header = ",".join(["time", *(f"q{j + 1}" for j in range(q.shape[1]))])
-    np.savetxt(
-        buffer, np.column_stack([times, q]), delimiter=",", header=header, comments="", fmt="%.6f"
-    )
+    from studio.learning import save_trajectory_csv
+
+    with tempfile.TemporaryDirectory() as folder:  # the learning package's CSV format, as is
+        path = Path(folder) / "rollout.csv"
+        save_trajectory_csv(path, times, q)
+        text = path.read_text()
     return Response(
-        buffer.getvalue(),
+        text,
         media_type="text/csv",
         headers={"Content-Disposition": 'attachment; filename="rollout.csv"'},
     )
