@@ -347,6 +347,9 @@ def _as_pose(value: object, what: str, check_rotation: bool) -> np.ndarray:
     return pose
 
 
+#: How far (rad) a closed-form angle may lie beyond a limit through rounding alone.
+_LIMIT_SLACK = 1e-9
+
 _TURNS = tuple(k * 2 * math.pi for k in (0, -1, 1, -2, 2))
 
 
@@ -357,7 +360,13 @@ def _wrap_into_limits(
     some angle fits no turn (joints 4 and 6 span more than one turn, so several may fit)."""
     out = []
     for angle, ref, low, high in zip(q, q_ref, lower, upper, strict=True):
-        options = [angle + turn for turn in _TURNS if low <= angle + turn <= high]
+        # A target made at a joint limit comes back from the trigonometry a rounding error
+        # beyond it: accept that, and clip it onto the limit.
+        options = [
+            min(max(angle + turn, low), high)
+            for turn in _TURNS
+            if low - _LIMIT_SLACK <= angle + turn <= high + _LIMIT_SLACK
+        ]
         if not options:
             return None
         out.append(min(options, key=lambda v, ref=ref: abs(v - ref)))

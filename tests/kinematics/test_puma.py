@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pinocchio as pin
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from studio import StudioError
@@ -141,6 +141,8 @@ def assert_within_limits(q: np.ndarray) -> None:
 
 @FAST
 @given(q=within_limits())
+# Joint 5 exactly at its limit: the closed form returns it a rounding error beyond.
+@example(q=np.array([0.0, -1.25, 0.0, 3.0, np.deg2rad(100.0), 0.0]))
 def test_full_pose_ik_round_trip(q: np.ndarray) -> None:
     oMdes = ROBOT.forward(q)
     result = ROBOT.inverse(oMdes)
