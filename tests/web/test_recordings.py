@@ -198,6 +198,9 @@ def test_capture_from_a_recording_source(recordings, client):
     assert r.status_code == 409 and "stop the recording" in r.json()["detail"]
     r = client.delete("/api/recordings/take-1")
     assert r.status_code == 409 and "being captured" in r.json()["detail"]
+    r = client.patch("/api/recordings/take-1", json={"notes": "x"})
+    assert r.status_code == 409 and "being captured" in r.json()["detail"]
+    assert "take-1" not in [x["name"] for x in client.get("/api/recordings").json()]
     for _ in range(200):
         if client.get("/api/capture").json()["frames"] >= 30:
             break

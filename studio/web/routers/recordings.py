@@ -17,8 +17,12 @@ router = APIRouter(prefix="/api/recordings", tags=["recordings"])
 
 @router.get("", response_model=list[RecordingPublic])
 def list_recordings(studio: StudioDep) -> list[dict]:
-    """Every recording, shipped samples first (an unreadable one is listed with its error)."""
-    return studio.recordings.list()
+    """Every recording, shipped samples first (an unreadable one is listed with its error).
+
+    The file a capture is writing appears once the capture stops.
+    """
+    capturing = studio.pipeline.capture_name
+    return [r for r in studio.recordings.list() if r["name"] != capturing]
 
 
 @router.post("", response_model=RecordingPublic, status_code=201)
@@ -53,6 +57,8 @@ def download_recording(name: str, studio: StudioDep) -> FileResponse:
 def update_recording(name: str, body: RecordingUpdate, studio: StudioDep) -> dict:
     """Rename (409 if in use or the name is taken) and/or set the operator and notes."""
     studio.recordings.path(name)
+    if studio.pipeline.capture_name == name:
+        raise ConflictError(f"Recording {name!r} is being captured; stop the recording first.")
     if body.name is not None and body.name != name:
         reason = studio.recording_in_use(name)
         if reason:
