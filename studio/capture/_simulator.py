@@ -100,7 +100,10 @@ class OperatorMotion:
         self._lock = threading.Lock()
         self.k = 0  # next frame index
         start = self._random_target()
-        self._segment = (start, start, 0, 0)  # (from, to, start frame, frames)
+        # the current segment: (from pose, to pose, start frame, length in frames), where a
+        # positive length is a minimum-jerk movement, a negative one a pause of that many frames,
+        # and zero a hold at a reach's goal
+        self._segment = (start, start, 0, 0)
         self._goal: np.ndarray | None = None
         self._holding = False
 
