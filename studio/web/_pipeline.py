@@ -182,6 +182,8 @@ class Pipeline:
                 "frames": int(st.frames) if st is not None else 0,
                 "dropped": int(st.dropped) if st is not None else 0,
                 "error": error,
+                "warning": getattr(st, "warning", None),
+                "rejected": int(getattr(st, "rejected", 0) or 0),
                 "recording": self._recording,
                 "retarget": {"mode": self._mode, "mirror": self._mirror},
                 "fit_residual_mm": None if self._residual is None else self._residual * 1000.0,

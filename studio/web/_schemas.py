@@ -67,6 +67,8 @@ class SourcePublic(BaseModel):
     frames: int
     dropped: int
     error: str | None
+    warning: str | None = None
+    rejected: int = 0
     recording: str | None
     playback: PlaybackPublic | None
     retarget: RetargetPublic

@@ -70,3 +70,18 @@ def test_capture_events_while_recording(open_client):
     client.post("/api/capture/stop")
     assert text.count("event: capture") >= 2
     assert '"active":true' in text and '"name":"evented"' in text
+
+
+def test_malformed_bridge_datagrams_are_counted_not_fatal(client):
+    import socket
+
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as probe:
+        probe.bind(("127.0.0.1", 0))
+        port = probe.getsockname()[1]
+    client.put("/api/source", json={"kind": "network", "port": port})
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sender:
+        for _ in range(3):
+            sender.sendto(b"garbage", ("127.0.0.1", port))
+    assert wait_for(lambda: client.get("/api/source").json()["rejected"] == 3)
+    source = client.get("/api/source").json()
+    assert source["warning"] and source["running"]
