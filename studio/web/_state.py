@@ -270,8 +270,18 @@ class Studio:
     # ------------------------------------------------------------------ demonstrations
 
     def demonstration_path(self, name: str) -> np.ndarray:
-        """The Puma560 joint path ``(N, 6)`` (rad) of a demonstration, for training runs."""
-        return np.asarray(self.demonstrations.load(name).q_robot, dtype=np.float64)
+        """The Puma560 joint path ``(N, 6)`` (rad) of a demonstration, for training runs.
+
+        Raises:
+            InvalidError: no such demonstration (a bad run parameter, so 422 rather than 404).
+        """
+        try:
+            demo = self.demonstrations.load(name)
+        except NotFoundError:
+            raise InvalidError(
+                f"demonstrations names {name!r}, which does not exist; pick demonstrations from the list."
+            ) from None
+        return np.asarray(demo.q_robot, dtype=np.float64)
 
     def cut_demonstration(
         self,
