@@ -261,3 +261,31 @@ def test_csv_of_curve_is_parseable(client):
         io.StringIO(client.get(f"/api/runs/{run['id']}/curve.csv").text), delimiter=",", skiprows=1
     )
     assert data.shape == (4, 6) and list(data[:, 0]) == [1, 2, 3, 4]
+
+
+def test_a_failing_run_shows_why_and_the_queue_goes_on(client, monkeypatch):
+    import studio.learning
+    from studio.learning import LearningError
+
+    real = studio.learning.run_experiments
+    calls = []
+
+    def flaky(*args, **kwargs):
+        calls.append(1)
+        if len(calls) == 1:
+            raise LearningError("the kernel ran out of luck; try again.")
+        if len(calls) == 2:
+            raise RuntimeError("boom")
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(studio.learning, "run_experiments", flaky)
+    first = client.post("/api/runs", json=TINY_RUN).json()
+    second = client.post("/api/runs", json=TINY_RUN).json()
+    third = client.post("/api/runs", json=TINY_RUN).json()
+    wait_run(client, third["id"])
+    one = client.get(f"/api/runs/{first['id']}").json()
+    assert one["status"] == "failed" and one["error"] == "the kernel ran out of luck; try again."
+    two = client.get(f"/api/runs/{second['id']}").json()
+    assert two["status"] == "failed" and "RuntimeError: boom" in two["error"]
+    assert client.get(f"/api/runs/{third['id']}").json()["status"] == "done"
+    assert client.get(f"/api/runs/{first['id']}/policy").status_code == 409
