@@ -558,10 +558,13 @@ class RunQueue:
 
         thread = threading.Thread(target=train, name=f"studio-run-{run.id}", daemon=True)
         thread.start()
+        saved = 0
         while thread.is_alive():
             thread.join(CHECKPOINT_SECONDS)
-            if thread.is_alive():
+            done = live.completed
+            if thread.is_alive() and done != saved:  # only when the curve moved
                 run.save_steps(live.steps.copy())
+                saved = done
         result = outcome.get("result")
         steps = live.steps.copy()
         run._steps = steps

@@ -380,8 +380,6 @@ class Studio:
 
     def load_policy(self, run: str | None, policy: str | None) -> tuple[Any, str]:
         """Load the policy of a run or an uploaded policy; returns it and its key."""
-        from studio.learning import load_policy
-
         if (run is None) == (policy is None):
             raise InvalidError("Give either run or policy (exactly one) to choose what to watch.")
         if run is not None:
@@ -390,7 +388,7 @@ class Studio:
                 raise ConflictError(
                     f"Run {run} has no policy yet; wait until it has finished episodes, then try again."
                 )
-            return load_policy(r.policy_path), f"run:{run}"
+            return self.policies.load_file(r.policy_path), f"run:{run}"
         assert policy is not None
         if not self.policies.exists(policy):
             try:
@@ -398,7 +396,7 @@ class Studio:
             except (NotFoundError, InvalidError):
                 r = None
             if r is not None and r.has_policy:
-                return load_policy(r.policy_path), f"run:{policy}"
+                return self.policies.load_file(r.policy_path), f"run:{policy}"
         return self.policies.load(policy), f"policy:{policy}"
 
 

@@ -342,9 +342,13 @@ class PolicyStore:
 
     def load(self, name: str) -> Any:
         """The policy as :func:`studio.learning.load_policy` returns it (cached)."""
+        return self.load_file(self.path(name))
+
+    def load_file(self, path: Path) -> Any:
+        """Any policy file (a run's too), cached until the file changes."""
         from studio.learning import load_policy
 
-        return self._cache.get(self.path(name), load_policy)
+        return self._cache.get(path, load_policy)
 
     def delete(self, name: str) -> None:
         """Delete an uploaded policy."""

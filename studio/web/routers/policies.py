@@ -27,14 +27,12 @@ def _public(studio: Studio, name: str) -> dict:
     }
 
 
-def _run_public(run: Run) -> dict:
-    from studio.learning import load_policy
-
+def _run_public(studio: Studio, run: Run) -> dict:
     return {
         "name": run.id,
         "source": "run",
         "run": run.id,
-        **policy_summary(load_policy(run.policy_path)),
+        **policy_summary(studio.policies.load_file(run.policy_path)),
         "size_bytes": run.policy_path.stat().st_size,
     }
 
@@ -51,7 +49,7 @@ def list_policies(studio: StudioDep) -> list[dict]:
     for run in studio.runs.list():
         if run.has_policy and run.status != "running":
             try:
-                out.append(_run_public(run))
+                out.append(_run_public(studio, run))
             except Exception:
                 continue
     return out

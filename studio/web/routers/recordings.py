@@ -65,6 +65,8 @@ def update_recording(name: str, body: RecordingUpdate, studio: StudioDep) -> dic
             raise ConflictError(reason)
     new = studio.recordings.update(name, body.name, body.notes, body.operator)
     studio.changes.bump("recordings")
+    if new != name:
+        studio.changes.bump("demonstrations")  # their "recording" follows the rename
     return studio.recordings.info(new)
 
 
