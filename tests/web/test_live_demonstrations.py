@@ -19,13 +19,16 @@ def test_record_and_mark_a_demonstration_live(open_client, tmp_path):
         == 200
     )
     assert client.get("/api/source").json()["recording_active"] is True
-    assert wait_for(lambda: client.get("/api/capture").json()["seconds"] > 0.2)
+    simulator = client.app.state.studio.pipeline.source
+    # start from a known pose, so the segment never wanders to a joint limit
+    assert client.post("/api/source/reach", json={"goal_deg": [40, 10, -40]}).status_code == 200
+    assert wait_for(lambda: simulator._sim.motion.frames_to_goal() == 0, timeout=10)
+    time.sleep(0.2)
     r = client.post("/api/demonstrations/mark", json={"action": "start"})
     assert r.status_code == 200 and r.json()["marking"] is True and r.json()["t0"] > 0
     assert client.get("/api/demonstrations/mark").json()["marking"] is True
     r = client.post("/api/source/reach", json={"goal_deg": [0, 45, -90]})
     assert r.status_code == 200
-    simulator = client.app.state.studio.pipeline.source
     assert wait_for(lambda: simulator._sim.motion.frames_to_goal() == 0, timeout=10)
     time.sleep(0.3)
     r = client.post("/api/demonstrations/mark", json={"action": "stop", "name": "live-reach"})
