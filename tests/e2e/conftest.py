@@ -1,0 +1,176 @@
+"""Browser-test set-up: the real ``studio serve`` in a subprocess and Debian's Chromium.
+
+The server gets random free ports and a temporary data directory (with the repo's sample
+recordings copied in); one browser and one page serve the whole session, so the stories run in
+order like a user's visit. Screenshots of each step go to ``test-artifacts/e2e/``.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import socket
+import subprocess
+import sys
+import time
+import urllib.error
+import urllib.request
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from tests.conftest import require
+
+REPO = Path(__file__).resolve().parents[2]
+ARTIFACTS = REPO / "test-artifacts" / "e2e"
+CHROMIUM = "/usr/bin/chromium"
+CHROMIUM_FLAGS = [
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+    "--use-angle=swiftshader",
+    "--enable-unsafe-swiftshader",
+]
+SERVER_START_TIMEOUT_S = 90.0
+
+
+def free_port() -> int:
+    """A TCP port nobody listens on now (the OS picks it)."""
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+class Studio:
+    """A running ``studio serve`` and small helpers to ask its API directly."""
+
+    def __init__(self, base: str, data_dir: Path, proc: subprocess.Popen[bytes], log: Path) -> None:
+        self.base = base
+        self.data_dir = data_dir
+        self.proc = proc
+        self.log = log
+
+    def get(self, path: str) -> Any:
+        with urllib.request.urlopen(self.base + path, timeout=10) as r:
+            return json.loads(r.read() or b"null")
+
+    def send(self, method: str, path: str, body: Any = None) -> Any:
+        data = None if body is None else json.dumps(body).encode()
+        req = urllib.request.Request(
+            self.base + path, data=data, method=method, headers={"Content-Type": "application/json"}
+        )
+        with urllib.request.urlopen(req, timeout=30) as r:
+            raw = r.read()
+            return json.loads(raw) if raw else None
+
+    def log_tail(self, n: int = 40) -> str:
+        try:
+            return "\n".join(self.log.read_text(errors="replace").splitlines()[-n:])
+        except OSError:
+            return ""
+
+
+@pytest.fixture(scope="session")
+def studio_server(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Studio]:
+    """``studio serve`` on random free ports with a fresh data directory."""
+    data_dir = tmp_path_factory.mktemp("studio-data")
+    (data_dir / "recordings").mkdir()
+    for sample in sorted((REPO / "recordings").glob("sample-*")):
+        shutil.copy(sample, data_dir / "recordings" / sample.name)
+    port, viser_port = free_port(), free_port()
+    while viser_port == port:
+        viser_port = free_port()
+    log = data_dir / "server.log"
+    cmd = [
+        sys.executable,
+        "-m",
+        "studio",
+        "serve",
+        "--data-dir",
+        str(data_dir),
+        "--port",
+        str(port),
+        "--viser-port",
+        str(viser_port),
+        "--no-browser",
+    ]
+    env = {**os.environ, "PYTHONUNBUFFERED": "1"}
+    with log.open("wb") as out:
+        proc = subprocess.Popen(cmd, stdout=out, stderr=subprocess.STDOUT, cwd=data_dir, env=env)
+    studio = Studio(f"http://127.0.0.1:{port}", data_dir, proc, log)
+    deadline = time.monotonic() + SERVER_START_TIMEOUT_S
+    while True:
+        if proc.poll() is not None:
+            pytest.fail(f"studio serve exited with {proc.returncode}:\n{studio.log_tail()}")
+        try:
+            studio.get("/api/config")
+            break
+        except (urllib.error.URLError, ConnectionError, TimeoutError):
+            if time.monotonic() > deadline:
+                proc.kill()
+                pytest.fail(
+                    f"studio serve did not answer in {SERVER_START_TIMEOUT_S} s:\n{studio.log_tail()}"
+                )
+            time.sleep(0.25)
+    try:
+        yield studio
+    finally:
+        proc.terminate()
+        try:
+            proc.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.wait()
+
+
+@pytest.fixture(scope="session")
+def browser() -> Iterator[Any]:
+    """Debian's Chromium, headless, driven by Playwright (never ``playwright install``)."""
+    require(
+        os.path.exists(CHROMIUM), f"Chromium is not installed at {CHROMIUM} (apt install chromium)"
+    )
+    try:
+        from playwright.sync_api import sync_playwright
+    except ImportError:  # pragma: no cover - the test extra installs it
+        require(False, "playwright is not installed (pip install -e .[test])")
+        raise
+    with sync_playwright() as p:
+        b = p.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_FLAGS, headless=True)
+        try:
+            yield b
+        finally:
+            b.close()
+
+
+@pytest.fixture(scope="session")
+def page(browser: Any, studio_server: Studio) -> Iterator[Any]:
+    """The studio page, loaded once for the whole session (stories follow one another)."""
+    ARTIFACTS.mkdir(parents=True, exist_ok=True)
+    context = browser.new_context(viewport={"width": 1440, "height": 900}, accept_downloads=True)
+    pg = context.new_page()
+    errors: list[str] = []
+    pg.on("pageerror", lambda e: errors.append(str(e)))
+    pg.goto(studio_server.base + "/")
+    pg.wait_for_selector("body[data-ready='1']", timeout=30_000)
+    pg.errors = errors  # type: ignore[attr-defined]
+    try:
+        yield pg
+    finally:
+        context.close()
+
+
+def shot(page: Any, name: str, section: str | None = None) -> Path:
+    """Save a screenshot of the page under ``test-artifacts/e2e/``, ``section`` scrolled into view."""
+    ARTIFACTS.mkdir(parents=True, exist_ok=True)
+    if section:
+        page.locator(f"#{section}").scroll_into_view_if_needed()
+    path = ARTIFACTS / f"{name}.png"
+    page.screenshot(path=str(path))
+    return path
