@@ -31,12 +31,19 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="NAME",
         help="also accept this Host name (when serving beyond loopback); repeatable",
     )
+    parser.add_argument(
+        "--upload-limit-mb",
+        type=float,
+        default=None,
+        metavar="MB",
+        help="largest recording or policy upload, in MB (default: 50)",
+    )
     parser.add_argument("--no-browser", action="store_true", help="do not open a browser")
 
 
 def run(args: argparse.Namespace) -> int:
     from studio.web import Settings, serve
-    from studio.web._settings import is_loopback
+    from studio.web._settings import DEFAULT_UPLOAD_LIMIT_BYTES, is_loopback
 
     source = args.source
     data_dir: Path = args.data_dir
@@ -57,7 +64,15 @@ def run(args: argparse.Namespace) -> int:
         import socket
 
         allowed += [socket.gethostname(), socket.getfqdn()]
+    limit_mb = (
+        args.upload_limit_mb
+        if args.upload_limit_mb is not None
+        else DEFAULT_UPLOAD_LIMIT_BYTES / 1e6
+    )
+    if not limit_mb > 0:
+        raise StudioError(f"--upload-limit-mb is {limit_mb}; give a positive size in MB.")
     settings = Settings(
+        upload_limit_bytes=round(limit_mb * 1e6),
         data_dir=data_dir,
         host=args.host,
         port=args.port,

@@ -31,8 +31,15 @@ def test_defaults_bind_loopback(served, capsys):
     ((settings, open_browser),) = served
     assert settings.host == "127.0.0.1" and settings.port == 8000 and settings.viser_port == 8080
     assert settings.data_dir == Path(".") and settings.source == "simulator"
-    assert open_browser is False
+    assert open_browser is False and settings.upload_limit_bytes == 50_000_000
     assert "WARNING" not in capsys.readouterr().err
+
+
+def test_upload_limit_flag(served, capsys):
+    assert main(["serve", "--upload-limit-mb", "2.5"]) == 0
+    assert served[0][0].upload_limit_bytes == 2_500_000
+    assert main(["serve", "--upload-limit-mb", "0"]) == 2
+    assert "positive size" in capsys.readouterr().err
 
 
 def test_serve_is_the_default_verb(served):
