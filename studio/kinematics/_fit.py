@@ -17,7 +17,12 @@ Then damped least squares (Pinocchio joint Jacobians) moves the arm's elbow, wri
 centre onto ``E, W, H``, warm-started from the previous frame. The first frame, and any frame
 whose warm start stalls (the unseen wrist direction running into a joint limit), start from a
 closed-form solution instead: shoulder and elbow from the limb directions, the wrist from the
-hand's direction given the previous forearm rotation (or, failing that, zero wrist deviation).
+hand's direction given the previous forearm rotation (or, failing that, zero wrist deviation),
+on both shoulder branches. The shoulder's two branches, ``(Z, X, Y)`` and ``(Z - pi, pi - X,
+Y + pi)``, give the same arm; the fit stays on the previous frame's branch (on a cold start, the
+anatomical one, abduction within 90 degrees) unless the other one meets the landmarks better by
+more than ``FitConfig.branch_slack``, and among equivalent solutions takes the one nearest the
+previous frame (or the neutral arm), so the retargeted robot never jumps between branches.
 The tape's landmarks are taken relative to its shoulder vertex, so the arm's angles survive a
 tape strapped slightly off; the offset shows in the residual.
 
@@ -60,6 +65,14 @@ class FitConfig:
             does not lie along an arm of these lengths.
         landmark_tolerance: a fit whose IK error (m, elbow/wrist/hand from the tape's shoulder)
             exceeds this is reported as failed.
+        branch_slack: the other shoulder branch is taken only when it meets the landmarks
+            better than the current one by more than this (m, error norm): near a straight
+            elbow or at the elbow's limit, sensor noise makes it fit a few mm better while the
+            true pose stays on the current branch.
+        equivalent_error: candidates whose landmark error is within this (m) of the best one
+            on the chosen branch count as equivalent; the one nearest the previous frame wins.
+        branch_jump: a shoulder flexion change (rad) beyond this between frames is a switch
+            of branch (a switch turns flexion by pi; continuous motion by little per frame).
     """
 
     warm_iterations: int = 8
@@ -69,6 +82,9 @@ class FitConfig:
     max_step: float = 0.5
     max_residual: float = 0.02
     landmark_tolerance: float = 1e-3
+    branch_slack: float = 0.02
+    equivalent_error: float = 1e-6
+    branch_jump: float = math.pi / 2
 
 
 @dataclass(frozen=True)
@@ -309,6 +325,63 @@ class ArmFitter:
             q = np.minimum(np.maximum(q + dq, lower), upper)
         return q, err, iterations  # pragma: no cover - loop always returns
 
+    def _reseed(
+        self, relative: np.ndarray, target: np.ndarray, warm: np.ndarray | None
+    ) -> tuple[np.ndarray, float, int]:
+        """Solve from every closed-form seed (and the stalled warm start); pick one branch.
+
+        The shoulder has two equivalent branches, ``(Z, X, Y)`` and ``(Z - 180, 180 - X,
+        Y + 180)``, which put the arm in the same pose; retargeted, the second drives the Puma's
+        joints 1-2 to their limits. Candidates on the reference's branch (the previous frame's, or
+        on a cold start the anatomical one, abduction within 90 degrees) are kept unless the other
+        branch meets the landmarks better by more than ``branch_slack``: near a straight elbow, or
+        at the elbow's limit, sensor noise alone can make the other branch fit a few millimetres
+        better. Within the chosen branch, the candidates that meet the landmarks as well as the
+        best one (to ``equivalent_error``) are equivalent, and the one nearest the previous frame
+        (or the neutral arm) wins, so the unobservable directions move least.
+
+        Args:
+            relative: the landmarks relative to the tape's shoulder, (4, 3).
+            target: elbow, wrist and hand centre stacked, (9,).
+            warm: where the warm start stalled (``None`` on a cold start).
+
+        Returns:
+            ``(q, error, iterations)``.
+        """
+        cfg = self.settings
+        previous = self._q
+        rotations = [None] if previous is None else [float(previous[4]), None]
+        seeds = [self._seed(relative, r, overhead) for overhead in (False, True) for r in rotations]
+        if warm is not None:
+            seeds.insert(0, warm)
+        reference = self.arm.neutral if previous is None else previous
+        candidates = []
+        iterations = 0
+        for seed in seeds:
+            q, err, it = self._solve(seed, target, cfg.cold_iterations)
+            iterations += it
+            candidates.append((q, err, self._same_branch(q, previous)))
+        same = [c for c in candidates if c[2]]
+        other = [c for c in candidates if not c[2]]
+        best_same = min((c[1] for c in same), default=math.inf)
+        best_other = min((c[1] for c in other), default=math.inf)
+        pool = same if best_same <= best_other + cfg.branch_slack else other
+        best = min(c[1] for c in pool)
+        equivalent = [c for c in pool if c[1] <= best + cfg.equivalent_error]
+        q, err, _ = min(equivalent, key=lambda c: float(np.linalg.norm(c[0] - reference)))
+        return q, err, iterations
+
+    def _same_branch(self, q: np.ndarray, previous: np.ndarray | None) -> bool:
+        """Whether ``q``'s shoulder lies on the branch of ``previous`` (cold: the anatomical one).
+
+        Switching branch turns shoulder flexion by 180 degrees at once; moving continuously it
+        turns little between frames. Without a previous frame, the anatomical branch (abduction
+        within 90 degrees, the one a retargeted Puma can follow) is the reference.
+        """
+        if previous is None:
+            return abs(float(q[1])) <= math.pi / 2
+        return abs(float(q[0] - previous[0])) <= self.settings.branch_jump
+
     def fit(self, tape: TapeShape | tuple[object, object]) -> ArmFit:
         """Fit the arm to one tape frame, warm-started from the previous one.
 
@@ -354,32 +427,8 @@ class ArmFitter:
         if self._q is not None:
             q, err, iterations = self._solve(self._q, target, cfg.warm_iterations)
         if q is None or err > cfg.tolerance:
-            # Cold, or the warm start stalled (the unseen wrist direction ran into a limit):
-            # solve in closed form, keeping the previous forearm rotation when there is one.
-            previous = None if self._q is None else float(self._q[4])
-            rotations = [previous, None] if previous is not None else [None]
-            seeds = [
-                self._seed(relative, r, overhead) for overhead in (False, True) for r in rotations
-            ]
-            # Exact seeds first (nearest to the previous frame among them), then the closest.
-            errors = [self._solve(seed, target, 0)[1] for seed in seeds]
-            previous_q = self._q if self._q is not None else seeds[0]
-
-            def order(k: int) -> tuple[bool, float]:
-                exact = errors[k] <= cfg.tolerance
-                return (
-                    not exact,
-                    float(np.abs(seeds[k] - previous_q).sum()) if exact else errors[k],
-                )
-
-            seeds = [seeds[k] for k in sorted(range(len(seeds)), key=order)]
-            for seed in seeds:
-                q_seed, err_seed, it = self._solve(seed, target, cfg.cold_iterations)
-                iterations += it
-                if err_seed < err:
-                    q, err = q_seed, err_seed
-                if err <= cfg.tolerance:
-                    break
+            q, err, used = self._reseed(relative, target, q)
+            iterations += used
             # Leave the scratch data at the chosen pose for the residual below.
             pin.forwardKinematics(self.model, self.data, q)
             pin.updateFramePlacement(self.model, self.data, self._hand)

@@ -19,6 +19,7 @@ from studio.kinematics import (
     ArmFitter,
     HumanArm,
     KinematicsError,
+    Retargeter,
     TapeConfig,
     reconstruct,
     tape_from_arm,
@@ -162,3 +163,50 @@ def test_configs_that_cannot_see_the_arm_are_refused():
     with pytest.raises(KinematicsError, match="raise wrist_region"):
         ArmFitter(arm, TapeConfig(shoulder_region=9, wrist_region=13))
     ArmFitter(HumanArm(upper_arm=0.25, forearm=0.2), TapeConfig(shoulder_region=9, wrist_region=13))
+
+
+def _reach_and_hold(elbow_end: float, frames: int = 330) -> np.ndarray:
+    """The arm raised forward (the Puma's J2 near 0.57 rad), the elbow straightening (or
+    bending to its limit) along a minimum-jerk path in 1.5 s, then held: a reach to a goal."""
+    s = np.clip(np.linspace(0.0, 2.0, frames), 0.0, 1.0)[:, None]
+    s = s**3 * (10.0 - 15.0 * s + 6.0 * s * s)
+    start = np.array([2.14, 0.0, 0.0, 1.2, 0.0, 0.0, 0.0])
+    end = start.copy()
+    end[3] = elbow_end
+    return start + s * (end - start)
+
+
+@pytest.mark.parametrize("elbow_end", [0.0, 0.01, float(ARMS["right"].upper[3])])
+def test_warm_fit_stays_on_its_branch_through_a_straight_or_limit_elbow(elbow_end):
+    # Near a straight elbow (or at its 150 degree limit) sensor noise lets the other shoulder
+    # branch (Z - pi, pi - X, Y + pi) fit a few mm better; it is the same pose, but retargeted
+    # it throws the Puma's joints 1-2 to their limits. The fit must follow the motion instead.
+    arm, config = ARMS["right"], CONFIGS["right"]
+    q = _reach_and_hold(elbow_end)
+    noise = tape_from_arm(arm, q, config, rng=np.random.default_rng(3), noise=0.002)
+    fitter = ArmFitter(arm, config)
+    fits = [fitter.fit((bend, twist)) for bend, twist in zip(*noise, strict=True)]
+    qs = np.array([fit.q_human for fit in fits])
+    assert max(fit.residual for fit in fits) < 0.02
+    # Flexion and abduction follow the true pose (the other branch is pi away).
+    np.testing.assert_allclose(qs[:, :2], q[:, :2], atol=0.05)
+    # Every joint but humeral rotation (unseen at a straight elbow, and not retargeted) moves
+    # continuously: no frame-to-frame jump anywhere near a branch switch (pi).
+    seen = [0, 1, 3, 4, 5, 6]
+    assert np.abs(np.diff(qs[:, seen], axis=0)).max() < 0.5
+    retargeter = Retargeter("joint", mirror=True, arm=arm)
+    q_robot = np.array([retargeter.robot_from_human(qh) for qh in qs])
+    assert np.abs(np.diff(q_robot, axis=0)).max() < 0.5
+    robot = retargeter.robot
+    assert np.all((q_robot[:, :2] > robot.lower[:2]) & (q_robot[:, :2] < robot.upper[:2]))
+
+
+def test_a_cold_start_takes_the_anatomical_branch_nearest_the_neutral_arm():
+    # Both shoulder branches meet these landmarks exactly; the cold fit keeps abduction within
+    # 90 degrees (the branch the Puma can follow), whatever frame the recording starts on.
+    arm, config = ARMS["right"], CONFIGS["right"]
+    for q in _reach_and_hold(0.0)[::30]:
+        fit = ArmFitter(arm, config).fit(tape_from_arm(arm, q, config))
+        np.testing.assert_allclose(arm.points(fit.q_human), arm.points(q), atol=1e-4)
+        assert abs(fit.q_human[1]) <= np.pi / 2
+        np.testing.assert_allclose(fit.q_human[:2], q[:2], atol=1e-3)
