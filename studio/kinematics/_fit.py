@@ -326,7 +326,10 @@ class ArmFitter:
         return q, err, iterations  # pragma: no cover - loop always returns
 
     def _reseed(
-        self, relative: np.ndarray, target: np.ndarray, warm: np.ndarray | None
+        self,
+        relative: np.ndarray,
+        target: np.ndarray,
+        warm: tuple[np.ndarray, float] | None,
     ) -> tuple[np.ndarray, float, int]:
         """Solve from every closed-form seed (and the stalled warm start); pick one branch.
 
@@ -343,7 +346,7 @@ class ArmFitter:
         Args:
             relative: the landmarks relative to the tape's shoulder, (4, 3).
             target: elbow, wrist and hand centre stacked, (9,).
-            warm: where the warm start stalled (``None`` on a cold start).
+            warm: where the warm start stalled and its error (``None`` on a cold start).
 
         Returns:
             ``(q, error, iterations)``.
@@ -352,23 +355,41 @@ class ArmFitter:
         previous = self._q
         rotations = [None] if previous is None else [float(previous[4]), None]
         seeds = [self._seed(relative, r, overhead) for overhead in (False, True) for r in rotations]
+        # (q, error, refine): a seed's error as it stands; the stalled warm start is not refined
+        # again (it had its iterations), the closed-form seeds may be.
+        candidates = [(seed, self._solve(seed, target, 0)[1], True) for seed in seeds]
         if warm is not None:
-            seeds.insert(0, warm)
+            candidates.insert(0, (warm[0], warm[1], False))
+        same = [c for c in candidates if self._same_branch(c[0], previous)]
+        other = [c for c in candidates if not self._same_branch(c[0], previous)]
         reference = self.arm.neutral if previous is None else previous
-        candidates = []
         iterations = 0
-        for seed in seeds:
-            q, err, it = self._solve(seed, target, cfg.cold_iterations)
-            iterations += it
-            candidates.append((q, err, self._same_branch(q, previous)))
-        same = [c for c in candidates if c[2]]
-        other = [c for c in candidates if not c[2]]
-        best_same = min((c[1] for c in same), default=math.inf)
-        best_other = min((c[1] for c in other), default=math.inf)
-        pool = same if best_same <= best_other + cfg.branch_slack else other
+
+        def distance(c: tuple[np.ndarray, float, bool]) -> float:
+            return float(np.linalg.norm(c[0] - reference))
+
+        def settle(pool: list) -> list:
+            """Nearest first, refine the seeds until one meets the landmarks exactly."""
+            nonlocal iterations
+            settled = []
+            for q, err, refine in sorted(pool, key=distance):
+                if refine and err > cfg.tolerance:
+                    q, err, it = self._solve(q, target, cfg.cold_iterations)
+                    iterations += it
+                settled.append((q, err, False))
+                if err <= cfg.tolerance:
+                    break
+            return settled
+
+        pool = settle(same) if same else []
+        best_same = min((c[1] for c in pool), default=math.inf)
+        if best_same > cfg.branch_slack and other:  # the other branch may be needed
+            other = settle(other)
+            if min(c[1] for c in other) < best_same - cfg.branch_slack:
+                pool = other
         best = min(c[1] for c in pool)
         equivalent = [c for c in pool if c[1] <= best + cfg.equivalent_error]
-        q, err, _ = min(equivalent, key=lambda c: float(np.linalg.norm(c[0] - reference)))
+        q, err, _ = min(equivalent, key=distance)
         return q, err, iterations
 
     def _same_branch(self, q: np.ndarray, previous: np.ndarray | None) -> bool:
@@ -427,7 +448,7 @@ class ArmFitter:
         if self._q is not None:
             q, err, iterations = self._solve(self._q, target, cfg.warm_iterations)
         if q is None or err > cfg.tolerance:
-            q, err, used = self._reseed(relative, target, q)
+            q, err, used = self._reseed(relative, target, None if q is None else (q, err))
             iterations += used
             # Leave the scratch data at the chosen pose for the residual below.
             pin.forwardKinematics(self.model, self.data, q)
