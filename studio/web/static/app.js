@@ -781,18 +781,20 @@ function renderCurves() {
   if (!S.curveDirty || typeof Plotly === "undefined") return;
   S.curveDirty = false;
   const traces = curveTraces();
-  $("curve-empty").hidden = traces.length > 0;
+  const empty = traces.length === 0;
+  $("curve-empty").hidden = !empty;
   const layout = {
     margin: { l: 52, r: 10, t: 6, b: 32 },
-    xaxis: { title: { text: "episode", standoff: 4 }, zeroline: false },
+    xaxis: { title: { text: "episode", standoff: 4 }, zeroline: false, visible: !empty },
     yaxis: $("curve-log").checked
-      ? { title: { text: "steps", standoff: 4 }, type: "log", dtick: 1, zeroline: false }
-      : { title: { text: "steps", standoff: 4 }, type: "linear", rangemode: "tozero", zeroline: false },
+      ? { title: { text: "steps", standoff: 4 }, type: "log", dtick: 1, zeroline: false, visible: !empty }
+      : { title: { text: "steps", standoff: 4 }, type: "linear", rangemode: "tozero", zeroline: false, visible: !empty },
     legend: { orientation: "h", x: 1, xanchor: "right", y: 1, font: { size: 10 }, bgcolor: "rgba(255,255,255,0.7)" },
     font: { size: 11, family: "system-ui, sans-serif" },
     paper_bgcolor: "#fff", plot_bgcolor: "#fff",
     uirevision: "keep",
   };
+  S.curveRenders = (S.curveRenders || 0) + 1; // chart redraws with new data (benchmarks read it)
   Plotly.react("curve-plot", traces, layout, { displaylogo: false, responsive: true, modeBarButtonsToRemove: ["lasso2d", "select2d"] });
 }
 
@@ -962,7 +964,24 @@ async function loadConfig() {
     $("scene-msg").hidden = false;
     return;
   }
-  $("scene").src = url;
+  $("scene").src = sceneUrl(url);
+}
+
+/**
+ * The scene's URL, moved to another site when both servers are on this machine's loopback.
+ *
+ * Pages on one site share a renderer process and its main thread in Chromium, so a busy 3D scene
+ * (software WebGL, a fast live stream) would delay the page's own work: curves, buttons, lists.
+ * 127.0.0.1 and localhost are different sites, so swapping one for the other gives the scene its
+ * own process. Any other host is left alone.
+ */
+function sceneUrl(url) {
+  const u = new URL(url, location.href);
+  const loopback = ["127.0.0.1", "localhost"];
+  if (loopback.includes(u.hostname) && u.hostname === location.hostname) {
+    u.hostname = u.hostname === "localhost" ? "127.0.0.1" : "localhost";
+  }
+  return u.toString();
 }
 
 function wire() {
