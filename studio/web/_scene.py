@@ -49,6 +49,8 @@ class SceneLayout:
             None to draw it as is.
         torso_size: torso box (depth, width, height) in m, hanging below the shoulder.
         rate_hz: most scene pushes per second (latest values win in between).
+        floor_half_size: the floor plate reaches this far from its centre (m).
+        floor_cell: spacing of the floor's grid lines (m).
         playback_hold_s: how long the robot keeps the last pose of a finished playback before
             following the live pose again.
         camera_position: initial camera position (m).
@@ -59,6 +61,8 @@ class SceneLayout:
     mirror_axis: int | None = 1
     torso_size: tuple[float, float, float] = (0.22, 0.36, 0.55)
     rate_hz: float = 40.0
+    floor_half_size: float = 2.0
+    floor_cell: float = 0.25
     playback_hold_s: float = 5.0
     camera_position: tuple[float, float, float] = (1.95, -0.6, 1.6)
     camera_look_at: tuple[float, float, float] = (0.1, -0.42, 0.9)
@@ -219,23 +223,26 @@ class StudioScene:
         cam.look_at = lay.camera_look_at
         cam.up = (0.0, 0.0, 1.0)
         s.set_up_direction("+z")
-        s.add_grid(
-            "/floor",
-            width=6.0,
-            height=6.0,
-            cell_size=0.25,
-            section_size=1.0,
-            position=(0.0, -0.5, 0.0),
-            plane_color=(238, 240, 243),
-            plane_opacity=1.0,
+        # A static floor: a plate and line segments. (viser's shader grid and text labels keep
+        # the browser redrawing while nothing moves, which costs a core with software WebGL.)
+        half, step = lay.floor_half_size, lay.floor_cell
+        centre = np.array([0.0, lay.human_origin[1] / 2, 0.0])
+        s.add_box(
+            "/floor/plate",
+            color=(236, 238, 241),
+            dimensions=(2 * half, 2 * half, 0.01),
+            position=centre - np.array([0.0, 0.0, 0.006]),
+            cast_shadow=False,
         )
-        s.add_label("/labels/robot", "Puma560", position=(0.0, 0.3, 0.05))
-        s.add_label(
-            "/labels/human",
-            "operator (mirrored)",
-            position=(lay.human_origin[0], lay.human_origin[1] - 0.2, 0.05),
+        ticks = np.arange(-half, half + 1e-9, step)
+        lines = [((t, -half, 0.0), (t, half, 0.0)) for t in ticks]
+        lines += [((-half, t, 0.0), (half, t, 0.0)) for t in ticks]
+        s.add_line_segments(
+            "/floor/lines",
+            points=np.array(lines) + centre,
+            colors=(196, 200, 206),
+            thickness=0.004,
         )
-
         self._robot_handles = self._add_robot("/robot", opacity=None)
         self._ghost_handles = self._add_robot("/goal/ghost", opacity=0.22, visible=False)
         self._goal_marker = s.add_icosphere(
