@@ -60,7 +60,7 @@ class SceneLayout:
     human_origin: tuple[float, float, float] = (0.0, -0.95, 1.38)
     mirror_axis: int | None = 1
     torso_size: tuple[float, float, float] = (0.22, 0.36, 0.55)
-    rate_hz: float = 40.0
+    rate_hz: float = 30.0
     floor_half_size: float = 2.0
     floor_cell: float = 0.25
     playback_hold_s: float = 5.0
