@@ -161,6 +161,32 @@ def test_story4_cut_demonstration(page: Any, studio_server: Studio) -> None:
     time.sleep(0.5)
     assert not page.is_visible("[data-testid='demo-error']")
 
+    # Mark one live while recording: the simulated operator reaches the goal between the marks.
+    # The page either keeps it or shows why it was refused, beside the Mark button.
+    before = len(studio_server.get("/api/demonstrations"))
+    page.fill("[data-testid='capture-name']", "e2e-live")
+    page.click("[data-testid='capture-toggle']")
+    page.wait_for_selector("[data-testid='capture-toggle'][data-active='1']", timeout=T)
+    page.wait_for_selector("[data-testid='demo-mark']:enabled", timeout=T)
+    page.fill("[data-testid='demo-name']", "e2e-live-demo")
+    page.click("[data-testid='demo-mark']")
+    page.wait_for_selector("[data-testid='demo-mark']:has-text('Mark stop')", timeout=T)
+    page.click("[data-testid='source-reach']")
+    time.sleep(3.0)
+    page.click("[data-testid='demo-mark']")
+    page.wait_for_selector(
+        "[data-testid='demo-ok']:visible, [data-testid='demo-error']:visible", timeout=T
+    )
+    shot(page, "04-demo-marked-live", "sec-demos")
+    kept = page.is_visible("[data-testid='demo-ok']")
+    after = len(studio_server.get("/api/demonstrations"))
+    assert after == before + (1 if kept else 0)
+    if not kept:
+        assert page.inner_text("[data-testid='demo-error']").strip()
+    page.click("[data-testid='source-wander']")
+    page.click("[data-testid='capture-toggle']")
+    page.wait_for_selector("[data-testid='capture-toggle'][data-active='0']", timeout=T)
+
 
 def _hold_source_still(page: Any, recording: str) -> None:
     """Switch the live source to a paused recording (story 2's controls), so nothing else moves."""
