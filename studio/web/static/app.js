@@ -177,9 +177,8 @@ function renderSource() {
   $("src-dropped").textContent = s.dropped ?? "–";
   $("src-residual").textContent = fmt(s.fit_residual_mm, 1);
   $("src-q").textContent = (s.q_robot || []).map((v) => ((v * 180) / Math.PI).toFixed(0).padStart(4)).join(" ") + " °";
-  if (s.error) showError("source-error", s.error);
-  else if ($("source-error").dataset.fromStatus === "1") showError("source-error", null);
-  $("source-error").dataset.fromStatus = s.error ? "1" : "";
+  // The source's own trouble (no device, a dropped bridge) stays apart from a refused action.
+  showError("source-status-error", s.error ? `Source: ${s.error}` : null);
   if (document.activeElement !== $("retarget-mode") && s.retarget) $("retarget-mode").value = s.retarget.mode;
   if (s.retarget) $("retarget-mirror").checked = !!s.retarget.mirror;
   const pb = s.playback;
