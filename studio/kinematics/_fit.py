@@ -43,11 +43,13 @@ import numpy as np
 import pinocchio as pin
 from numba import njit
 
+from ._checks import positive_number, real_array, whole_number
 from ._errors import KinematicsError
 from ._human import HumanArm
 from ._tape import TapeConfig, TapeShape, reconstruct
 
 _SEEN = 1e-6  # sine of a bend below which the rotation about the limb is not observable
+_DEGENERATE = 1e-12  # m: two tape points closer than this give no direction
 
 
 @dataclass(frozen=True)
@@ -85,6 +87,21 @@ class FitConfig:
     branch_slack: float = 0.02
     equivalent_error: float = 1e-6
     branch_jump: float = math.pi / 2
+
+    def __post_init__(self) -> None:
+        whole_number(self.warm_iterations, "FitConfig.warm_iterations", 0)
+        whole_number(self.cold_iterations, "FitConfig.cold_iterations", 1)
+        for name in (
+            "tolerance",
+            "damping",
+            "max_step",
+            "max_residual",
+            "landmark_tolerance",
+            "branch_slack",
+            "equivalent_error",
+            "branch_jump",
+        ):
+            positive_number(getattr(self, name), f"FitConfig.{name}")
 
 
 @dataclass(frozen=True)
@@ -124,18 +141,29 @@ def _landmarks_kernel(
     step: float,
     out: np.ndarray,
 ) -> int:  # pragma: no cover - compiled
-    """Fill ``out (4, 3)`` with S, E, W, H (see the module docstring); return the last vertex."""
+    """Fill ``out (4, 3)`` with S, E, W, H (see the module docstring); return the last vertex.
+
+    Returns -1 (and ``out`` filled with S) when the vertices give no upper-arm or forearm
+    direction (coincident points: not a tape's shape).
+    """
     regions = positions.shape[0] - 1
     upper, fore, hand = lengths[0], lengths[1], lengths[2]
-    d = positions[shoulder + 1] - positions[shoulder]
-    d = d / np.sqrt(np.sum(d * d))
     S = positions[shoulder]
+    for k in range(4):
+        out[k] = S
+    d = positions[shoulder + 1] - S
+    norm = np.sqrt(np.sum(d * d))
+    if not norm > _DEGENERATE:
+        return -1
+    d = d / norm
     E = S + upper * d
     f = positions[first_forearm] - E
     norm = np.sqrt(np.sum(f * f))
     if norm < 1e-9 and first_forearm < regions:
         f = positions[first_forearm + 1] - positions[first_forearm]
         norm = np.sqrt(np.sum(f * f))
+    if not norm > _DEGENERATE:
+        return -1
     along = np.sum((positions[first_forearm] - E) * f) / norm  # first vertex's distance from E
     f = f / norm
     W = E + fore * f
@@ -145,10 +173,10 @@ def _landmarks_kernel(
     h = f
     if last <= regions:
         h = positions[last] - W
-        h = h / np.sqrt(np.sum(h * h))
+        norm = np.sqrt(np.sum(h * h))
+        h = h / norm if norm > _DEGENERATE else f  # vertex on the wrist: take a straight wrist
     else:
         last = regions
-    out[0] = S
     out[1] = E
     out[2] = W
     out[3] = W + hand * h
@@ -189,6 +217,17 @@ class ArmFitter:
     """
 
     def __init__(self, arm: HumanArm, config: TapeConfig, fit: FitConfig | None = None) -> None:
+        for value, kind, name in ((arm, HumanArm, "arm"), (config, TapeConfig, "config")):
+            if not isinstance(value, kind):
+                raise KinematicsError(
+                    f"ArmFitter's {name} must be a {kind.__name__}, got {type(value).__name__}; "
+                    f"pass {kind.__name__}(...)."
+                )
+        if fit is not None and not isinstance(fit, FitConfig):
+            raise KinematicsError(
+                f"ArmFitter's fit must be a FitConfig, got {type(fit).__name__}; "
+                "pass FitConfig(...)."
+            )
         self.arm = arm
         self.config = config
         self.settings = fit or FitConfig()
@@ -417,29 +456,37 @@ class ArmFitter:
         """
         regions = self.config.regions
         if isinstance(tape, TapeShape):
-            positions = np.asarray(tape.positions, dtype=float)
+            positions = real_array(
+                tape.positions, "The tape shape's positions", "pass reconstruct(...)"
+            )
             if positions.shape != (regions + 1, 3):
                 raise KinematicsError(
                     f"ArmFitter.fit takes one frame: positions of shape ({regions + 1}, 3); "
-                    f"got {positions.shape}."
+                    f"got {positions.shape}; fit a batch frame by frame."
                 )
             if not np.all(np.isfinite(positions)):
-                raise KinematicsError("The tape shape contains NaN or infinite positions.")
+                raise KinematicsError(
+                    "The tape shape contains NaN or infinite positions; reconstruct it from "
+                    "finite bend and twist."
+                )
         else:
             try:
                 bend, twist = tape
             except (TypeError, ValueError) as err:
                 raise KinematicsError(
-                    "ArmFitter.fit takes a TapeShape or a (bend, twist) pair of arrays."
+                    "ArmFitter.fit takes one frame; pass a TapeShape or a (bend, twist) pair."
                 ) from err
-            bend_a = np.asarray(bend, dtype=float)
+            bend_a = real_array(bend, "bend", "pass one angle in radians per region")
             if bend_a.shape != (regions,):
                 raise KinematicsError(
-                    f"ArmFitter.fit takes one frame: bend of shape ({regions},); got {bend_a.shape}."
+                    f"ArmFitter.fit takes one frame: bend of shape ({regions},); got {bend_a.shape}; "
+                    "fit a batch frame by frame."
                 )
             positions = reconstruct(bend_a, twist, self.config).positions
 
         points, last = self.landmarks(positions)
+        if last < 0:
+            return self._no_directions(positions, points)
         relative = points - points[0]  # the arm's shoulder is at the origin
         target = relative[1:].reshape(-1)
         cfg = self.settings
@@ -455,15 +502,7 @@ class ArmFitter:
             pin.updateFramePlacement(self.model, self.data, self._hand)
         self._q = q
 
-        # Residual: tape's arm vertices against the fitted arm, in the arm base frame.
-        arm_points = np.zeros((4, 3))  # shoulder at the origin
-        arm_points[1] = self.data.oMi[4].translation
-        arm_points[2] = self.data.oMi[6].translation
-        arm_points[3] = self.data.oMf[self._hand].translation
-        vertices = positions[self.config.shoulder_region : last + 1]
-        residual = float(_rms_polyline_distance(vertices, arm_points))
-        gap = points - arm_points
-        landmark_error = math.sqrt(float(np.einsum("ij,ij->", gap, gap)) / 4)
+        residual, landmark_error = self._quality(positions, points, last)
         # The IK error is measured from the tape's shoulder; an offset shoulder shows in residual.
         success = err <= cfg.landmark_tolerance and residual <= cfg.max_residual
         return ArmFit(
@@ -473,4 +512,36 @@ class ArmFitter:
             landmarks=points,
             landmark_error=landmark_error,
             iterations=iterations,
+        )
+
+    def _quality(self, positions: np.ndarray, points: np.ndarray, last: int) -> tuple[float, float]:
+        """(residual, landmark error) of the arm at ``self.data``'s pose against the tape."""
+        arm_points = np.zeros((4, 3))  # shoulder at the origin of the arm base frame
+        arm_points[1] = self.data.oMi[4].translation
+        arm_points[2] = self.data.oMi[6].translation
+        arm_points[3] = self.data.oMf[self._hand].translation
+        vertices = positions[self.config.shoulder_region : last + 1]
+        residual = float(_rms_polyline_distance(vertices, arm_points))
+        gap = points - arm_points
+        return residual, math.sqrt(float(np.einsum("ij,ij->", gap, gap)) / 4)
+
+    def _no_directions(self, positions: np.ndarray, points: np.ndarray) -> ArmFit:
+        """A failed fit for a shape whose arm vertices coincide: no direction to fit to.
+
+        The arm stays where it was (the previous frame, or the neutral arm) and the warm start is
+        kept for the next frame. The residual measures the shape against that arm; as vertices
+        bunched on one point of the arm lie *on* it, it is at least the landmark error (the
+        arm's elbow, wrist and hand against that point), so it shows the failure as a number.
+        """
+        q = self.arm.neutral if self._q is None else self._q
+        pin.forwardKinematics(self.model, self.data, q)
+        pin.updateFramePlacement(self.model, self.data, self._hand)
+        residual, landmark_error = self._quality(positions, points, self.config.wrist_region)
+        return ArmFit(
+            q_human=np.array(q, dtype=float),
+            residual=max(residual, landmark_error),
+            success=False,
+            landmarks=points,
+            landmark_error=landmark_error,
+            iterations=0,
         )

@@ -27,6 +27,7 @@ from typing import Literal
 import numpy as np
 import pinocchio as pin
 
+from ._checks import positive_number, real_array
 from ._errors import KinematicsError
 
 URDF_RELATIVE = Path(
@@ -71,10 +72,8 @@ def find_human_urdf() -> Path:
 
 
 def _as_q(value: object, size: int, what: str) -> np.ndarray:
-    try:
-        q = np.asarray(value, dtype=float)
-    except (TypeError, ValueError) as err:
-        raise KinematicsError(f"{what} must be an array of {size} numbers; got {value!r}.") from err
+    """``value`` as finite joint angles of shape ``(..., size)``, or a KinematicsError."""
+    q = real_array(value, what, f"pass {size} angles in radians")
     if q.shape[-1:] != (size,):
         raise KinematicsError(f"{what} must have shape (..., {size}); got shape {q.shape}.")
     if not np.all(np.isfinite(q)):
@@ -180,8 +179,8 @@ class HumanArm:
         for key, value in lengths.items():
             if value is None:
                 lengths[key] = float(defaults[key])
-            elif not (np.isfinite(value) and value > 0):
-                raise KinematicsError(f"{key} must be a positive length in metres; got {value!r}.")
+            else:
+                lengths[key] = positive_number(value, f"{key} (a length in metres)")
         self.upper_arm_length = float(lengths["upper_arm"])
         self.forearm_length = float(lengths["forearm"])
         self.hand_length = float(lengths["hand"])

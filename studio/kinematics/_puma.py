@@ -21,6 +21,7 @@ from typing import Literal
 import numpy as np
 import pinocchio as pin
 
+from ._checks import positive_number, real_array, whole_number
 from ._errors import KinematicsError
 
 __all__ = [
@@ -109,6 +110,12 @@ class IKConfig:
     max_step: float = 0.5
     stall_steps: int = 10
     stall_ratio: float = 1e-3
+
+    def __post_init__(self) -> None:
+        whole_number(self.max_iterations, "IKConfig.max_iterations", 1)
+        whole_number(self.stall_steps, "IKConfig.stall_steps", 1)
+        for name in ("tolerance", "damping", "max_step", "stall_ratio"):
+            positive_number(getattr(self, name), f"IKConfig.{name}")
 
 
 @dataclass(frozen=True)
@@ -294,17 +301,12 @@ def _build_visuals(dh: Sequence[DHRow], style: VisualStyle) -> tuple[LinkVisual,
 
 def _as_vector(value: object, size: int, what: str) -> np.ndarray:
     """``value`` as a finite float vector of ``size``, or a KinematicsError naming ``what``."""
-    try:
-        array = np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
-        raise KinematicsError(
-            f"{what} must be {size} numbers, got {type(value).__name__}; pass a numeric array."
-        ) from None
+    array = real_array(value, what, f"pass {size} numbers")
     if array.shape != (size,):
         raise KinematicsError(
             f"{what} must have shape ({size},), got {array.shape}; pass one value per joint."
             if what.startswith("q")
-            else f"{what} must have shape ({size},), got {array.shape}."
+            else f"{what} must have shape ({size},), got {array.shape}; pass {size} numbers."
         )
     if not np.isfinite(array).all():
         raise KinematicsError(f"{what} contains NaN or infinite values; pass finite numbers.")
@@ -323,12 +325,7 @@ def _as_pose(value: object, what: str, check_rotation: bool) -> np.ndarray:
     """``value`` (4x4 array or ``pin.SE3``) as a finite homogeneous pose, or a KinematicsError."""
     if isinstance(value, pin.SE3):
         value = value.homogeneous
-    try:
-        pose = np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
-        raise KinematicsError(
-            f"{what} must be a 4x4 homogeneous pose, got {type(value).__name__}."
-        ) from None
+    pose = real_array(value, what, "pass a 4x4 homogeneous pose")
     if pose.shape != (4, 4):
         raise KinematicsError(f"{what} must be a 4x4 homogeneous pose, got shape {pose.shape}.")
     if not np.isfinite(pose).all():
@@ -606,17 +603,15 @@ class Puma560:
             KinematicsError: a malformed target, ``q0`` or setting.
         """
         cfg = self.ik
-        iterations_per_attempt = cfg.max_iterations if max_iterations is None else max_iterations
-        tol = cfg.tolerance if tolerance is None else tolerance
-        if int(iterations_per_attempt) != iterations_per_attempt or iterations_per_attempt < 1:
-            raise KinematicsError(
-                f"max_iterations must be a positive integer, got {iterations_per_attempt!r}."
-            )
-        if not (math.isfinite(tol) and tol > 0):
-            raise KinematicsError(f"tolerance must be a positive number, got {tol!r}.")
-        iterations_per_attempt = int(iterations_per_attempt)
+        iterations_per_attempt = whole_number(
+            cfg.max_iterations if max_iterations is None else max_iterations, "max_iterations", 1
+        )
+        tol = positive_number(cfg.tolerance if tolerance is None else tolerance, "tolerance")
 
-        if position_only and np.shape(oMdes) == (3,):
+        if isinstance(oMdes, pin.SE3):
+            oMdes = oMdes.homogeneous
+        oMdes = real_array(oMdes, "oMdes", "pass a 4x4 pose (or a 3-vector with position_only)")
+        if position_only and oMdes.shape == (3,):
             target_p = _as_vector(oMdes, 3, "the target position")
             target_R = np.eye(3)
         else:

@@ -40,6 +40,7 @@ from typing import Literal
 
 import numpy as np
 
+from ._checks import positive_number, whole_number
 from ._errors import KinematicsError
 from ._human import SAGITTAL_MIRROR, HumanArm, _as_q
 from ._puma import IKConfig, IKResult, Puma560
@@ -80,6 +81,10 @@ class RetargetConfig:
     reach_fraction: float = 0.95
     ik_iterations: int = 20
 
+    def __post_init__(self) -> None:
+        positive_number(self.reach_fraction, "RetargetConfig.reach_fraction")
+        whole_number(self.ik_iterations, "RetargetConfig.ik_iterations", 1)
+
 
 class Retargeter:
     """Human arm angles to Puma560 angles, in joint or cartesian mode.
@@ -100,6 +105,16 @@ class Retargeter:
         arm: HumanArm | None = None,
         config: RetargetConfig | None = None,
     ) -> None:
+        for value, kind, name in (
+            (robot, Puma560, "robot"),
+            (arm, HumanArm, "arm"),
+            (config, RetargetConfig, "config"),
+        ):
+            if value is not None and not isinstance(value, kind):
+                raise KinematicsError(
+                    f"Retargeter's {name} must be a {kind.__name__}, got {type(value).__name__}; "
+                    f"pass {kind.__name__}(...) or leave it out."
+                )
         self.config = config or RetargetConfig()
         self.robot = robot or Puma560(ik=IKConfig(max_iterations=self.config.ik_iterations))
         self.arm = arm or HumanArm()

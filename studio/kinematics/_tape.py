@@ -22,6 +22,7 @@ from typing import TYPE_CHECKING, Literal
 import numpy as np
 from numba import njit
 
+from ._checks import positive_number, real_array, whole_number
 from ._errors import KinematicsError
 
 if TYPE_CHECKING:
@@ -39,15 +40,15 @@ wrist), and the last two regions lie over the hand."""
 DEFAULT_SHOULDER_ARC_REGIONS = 2
 """Regions of the fixed arc that takes the tape from the back over the top of the shoulder."""
 
+FRAME_ATOL = 1e-6
+"""How far from orthonormal (and from a twist-then-bend) tape frames may be through rounding."""
+
 _STRAIGHT = 1e-12  # sin(bend) below this is a straight region; its twist is set to zero
 
 
 def _validate_angles(bend: object, twist: object, regions: int) -> tuple[np.ndarray, np.ndarray]:
-    try:
-        bend_a = np.asarray(bend, dtype=float)
-        twist_a = np.asarray(twist, dtype=float)
-    except (TypeError, ValueError) as err:
-        raise KinematicsError("bend and twist must be numeric arrays of radians.") from err
+    bend_a = real_array(bend, "bend", "pass one angle in radians per region")
+    twist_a = real_array(twist, "twist", "pass one angle in radians per region")
     if bend_a.shape != twist_a.shape or bend_a.shape[-1:] != (regions,):
         raise KinematicsError(
             f"bend and twist must both have shape (..., {regions}) for a {regions}-region tape; "
@@ -56,6 +57,13 @@ def _validate_angles(bend: object, twist: object, regions: int) -> tuple[np.ndar
     if not (np.all(np.isfinite(bend_a)) and np.all(np.isfinite(twist_a))):
         raise KinematicsError("bend or twist contains NaN or infinite angles; pass finite radians.")
     return bend_a, twist_a
+
+
+def _check_config(config: object) -> None:
+    if not isinstance(config, TapeConfig):
+        raise KinematicsError(
+            f"config must be a TapeConfig, got {type(config).__name__}; pass TapeConfig(...)."
+        )
 
 
 def _back_angles(regions_before_shoulder: int) -> tuple[np.ndarray, np.ndarray]:
@@ -98,15 +106,20 @@ class TapeConfig:
     side: Literal["right", "left"] = "right"
 
     def __post_init__(self) -> None:
-        if not (isinstance(self.length, int | float) and math.isfinite(self.length)) or (
-            self.length <= 0
+        object.__setattr__(self, "length", positive_number(self.length, "The tape length (m)"))
+        if (
+            isinstance(self.regions, bool)
+            or not isinstance(self.regions, int | np.integer)
+            or self.regions < 1
         ):
-            raise KinematicsError(f"Tape length must be positive metres; got {self.length!r}.")
-        if not isinstance(self.regions, int | np.integer) or self.regions < 1:
             raise KinematicsError(f"Tape regions must be a positive integer; got {self.regions!r}.")
         if self.side not in ("right", "left"):
             raise KinematicsError(f'Tape side must be "right" or "left"; got {self.side!r}.')
-        s, w = self.shoulder_region, self.wrist_region
+        s = whole_number(self.shoulder_region, "The tape's shoulder_region", 0)
+        w = whole_number(self.wrist_region, "The tape's wrist_region", 1)
+        object.__setattr__(self, "regions", int(self.regions))
+        object.__setattr__(self, "shoulder_region", s)
+        object.__setattr__(self, "wrist_region", w)
         if not (0 <= s < w <= self.regions):
             raise KinematicsError(
                 f"The tape's arm regions (shoulder_region={s}, wrist_region={w}) must satisfy "
@@ -116,7 +129,7 @@ class TapeConfig:
         if self.base is None:
             object.__setattr__(self, "base", self._default_base())
         else:
-            base = np.array(self.base, dtype=float)
+            base = np.array(real_array(self.base, "The tape base", "pass a 4x4 rigid transform"))
             ok = base.shape == (4, 4) and np.all(np.isfinite(base))
             if ok:
                 R = base[:3, :3]
@@ -232,8 +245,9 @@ def _chain(
     """Positions and frames from angles, over any leading dims (one compiled pass per frame)."""
     lead = bend.shape[:-1]
     regions = bend.shape[-1]
-    flat_b = np.ascontiguousarray(bend, dtype=np.float64).reshape(-1, regions)
-    flat_t = np.ascontiguousarray(twist, dtype=np.float64).reshape(-1, regions)
+    count = math.prod(lead)  # explicit: reshape(-1, 0) is ambiguous for a tape with no regions
+    flat_b = np.ascontiguousarray(bend, dtype=np.float64).reshape(count, regions)
+    flat_t = np.ascontiguousarray(twist, dtype=np.float64).reshape(count, regions)
     positions = np.empty((flat_b.shape[0], regions + 1, 3))
     frames = np.empty((flat_b.shape[0], regions + 1, 3, 3))
     _chain_kernel(
@@ -256,6 +270,7 @@ def reconstruct(bend: object, twist: object, config: TapeConfig) -> TapeShape:
     Raises:
         KinematicsError: wrong shapes or non-finite angles.
     """
+    _check_config(config)
     bend_a, twist_a = _validate_angles(bend, twist, config.regions)
     positions, frames = _chain(bend_a, twist_a, config.base, config.region_length)
     return TapeShape(positions=positions, frames=frames)
@@ -275,22 +290,36 @@ def tape_angles(frames: object) -> tuple[np.ndarray, np.ndarray]:
         ``(bend, twist)``, each of shape ``(..., regions)``.
 
     Raises:
-        KinematicsError: wrong shape or non-finite values.
+        KinematicsError: wrong shape or non-finite values, frames that are not rotations, or
+            consecutive frames that no twist-then-bend turns into each other (not a tape's).
     """
-    try:
-        F = np.asarray(frames, dtype=float)
-    except (TypeError, ValueError) as err:
-        raise KinematicsError("frames must be a numeric array of shape (..., k, 3, 3).") from err
+    F = real_array(frames, "frames", "pass reconstruct(...).frames, shape (..., regions + 1, 3, 3)")
     if F.ndim < 3 or F.shape[-2:] != (3, 3) or F.shape[-3] < 2:
-        raise KinematicsError(f"frames must have shape (..., regions + 1, 3, 3); got {F.shape}.")
+        raise KinematicsError(
+            f"frames must have shape (..., regions + 1, 3, 3); got {F.shape}; "
+            "pass reconstruct(...).frames."
+        )
     if not np.all(np.isfinite(F)):
         raise KinematicsError("frames contain NaN or infinite values; pass finite rotations.")
+    gram = np.einsum("...ji,...jk->...ik", F, F)
+    if np.abs(gram - np.eye(3)).max() > FRAME_ATOL or np.any(np.linalg.det(F) <= 0):
+        raise KinematicsError(
+            "frames are not all rotation matrices (orthonormal columns u, n, b); "
+            "pass reconstruct(...).frames."
+        )
     A, B = F[..., :-1, :, :], F[..., 1:, :, :]
     # R[r, c] = A[:, r] . B[:, c]
     r00 = np.einsum("...k,...k->...", A[..., :, 0], B[..., :, 0])
     r01 = np.einsum("...k,...k->...", A[..., :, 0], B[..., :, 1])
+    r02 = np.einsum("...k,...k->...", A[..., :, 0], B[..., :, 2])
     r12 = np.einsum("...k,...k->...", A[..., :, 1], B[..., :, 2])
     r22 = np.einsum("...k,...k->...", A[..., :, 2], B[..., :, 2])
+    # Rx(twist) @ Rz(bend) never moves b out of the n-b plane: R[0, 2] is zero for a tape.
+    if r02.size and np.abs(r02).max() > FRAME_ATOL:
+        raise KinematicsError(
+            "consecutive frames differ by a turn that no twist-then-bend makes, so they are not a "
+            "tape's; pass reconstruct(...).frames."
+        )
     return np.arctan2(-r01, r00), np.arctan2(-r12, r22)
 
 
@@ -442,6 +471,13 @@ def tape_from_arm(
     from ._human import _as_q
 
     q = _as_q(q_human, arm.nq, "q_human")
+    if isinstance(noise, bool) or not isinstance(noise, int | float | np.integer | np.floating):
+        raise KinematicsError(f"noise must be a number of radians; got {noise!r}.")
+    if not (math.isfinite(noise) and noise >= 0):
+        raise KinematicsError(
+            f"noise must be a standard deviation in radians, finite and >= 0; got {noise!r}."
+        )
+    _check_config(config)
     lead = q.shape[:-1]
     flat = q.reshape(-1, arm.nq)
     s, step = config.shoulder_region, config.region_length
@@ -461,7 +497,7 @@ def tape_from_arm(
     bend = np.concatenate([np.broadcast_to(back_bend, (flat.shape[0], s)), arm_bend], axis=1)
     twist = np.concatenate([np.broadcast_to(back_twist, (flat.shape[0], s)), arm_twist], axis=1)
     if noise:
-        if rng is None:
+        if not isinstance(rng, np.random.Generator):
             raise KinematicsError("tape_from_arm with noise needs rng=np.random.default_rng(seed).")
         bend = bend + rng.normal(0.0, noise, bend.shape)
         twist = twist + rng.normal(0.0, noise, twist.shape)

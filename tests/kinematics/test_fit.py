@@ -10,17 +10,22 @@ three is unseen), so only the hand centre they produce is checked.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from hypothesis.extra.numpy import arrays
 
 from studio.kinematics import (
     ArmFitter,
+    FitConfig,
     HumanArm,
     KinematicsError,
     Retargeter,
     TapeConfig,
+    TapeShape,
     reconstruct,
     tape_from_arm,
 )
@@ -152,6 +157,61 @@ def test_a_batch_shape_is_refused_and_nan_shapes_too():
     broken = type(one)(positions=one.positions * np.nan, frames=one.frames)
     with pytest.raises(KinematicsError, match="NaN"):
         fitter.fit(broken)
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    bend=arrays(np.float64, (16,), elements=st.floats(-3.2, 3.2)),
+    twist=arrays(np.float64, (16,), elements=st.floats(-3.2, 3.2)),
+)
+def test_any_tape_gives_an_arm_within_the_limits_or_a_reported_failure(bend, twist):
+    # Crumpled or random tapes: the fit never returns NaN or leaves the limits, a success is
+    # a tape lying along the arm, and the fitter is not left broken for the next frame.
+    arm, config = ARMS["right"], CONFIGS["right"]
+    fitter = ArmFitter(arm, config)
+    fit = fitter.fit((bend, twist))
+    assert np.all(np.isfinite(fit.q_human))
+    assert np.all(fit.q_human >= arm.lower) and np.all(fit.q_human <= arm.upper)
+    assert math.isfinite(fit.residual) and math.isfinite(fit.landmark_error)
+    if fit.success:
+        assert fit.residual <= fitter.settings.max_residual
+    q = np.array([0.5, 0.2, 0.3, 1.2, 0.5, 0.3, 0.1])
+    after = fitter.fit(tape_from_arm(arm, q, config))
+    assert after.success
+    np.testing.assert_allclose(arm.points(after.q_human), arm.points(q), atol=1e-4)
+
+
+def test_a_shape_without_directions_is_a_reported_failure_that_keeps_the_last_arm():
+    # Hand-made shapes whose arm vertices coincide give no direction to fit: the fit fails,
+    # keeps the previous frame's arm, and the next good frame fits as if nothing happened.
+    arm, config = ARMS["right"], CONFIGS["right"]
+    fitter = ArmFitter(arm, config)
+    q = np.array([0.5, 0.2, 0.3, 1.2, 0.5, 0.3, 0.1])
+    good = reconstruct(*tape_from_arm(arm, q, config), config)
+    first = fitter.fit(good)
+    for positions in (np.zeros((17, 3)), np.repeat(good.positions[:1], 17, axis=0)):
+        bad = fitter.fit(TapeShape(positions=positions, frames=good.frames))
+        assert not bad.success and bad.iterations == 0
+        np.testing.assert_array_equal(bad.q_human, first.q_human)
+        assert math.isfinite(bad.residual) and bad.residual > fitter.settings.max_residual
+    again = fitter.fit(good)
+    assert again.success and again.iterations == 0  # warm start intact
+    np.testing.assert_allclose(again.q_human, first.q_human)
+    cold = ArmFitter(arm, config).fit(TapeShape(positions=np.zeros((17, 3)), frames=good.frames))
+    np.testing.assert_array_equal(cold.q_human, arm.neutral)
+
+
+def test_bad_fitter_settings_are_one_clear_error():
+    arm, config = ARMS["right"], CONFIGS["right"]
+    with pytest.raises(KinematicsError, match="TapeConfig"):
+        ArmFitter(arm, "16 regions")  # type: ignore[arg-type]
+    with pytest.raises(KinematicsError, match="HumanArm"):
+        ArmFitter(None, config)  # type: ignore[arg-type]
+    with pytest.raises(KinematicsError, match="FitConfig"):
+        ArmFitter(arm, config, {"tolerance": 1e-7})  # type: ignore[arg-type]
+    for bad in (dict(tolerance=-1.0), dict(max_residual=math.nan), dict(cold_iterations=0.5)):
+        with pytest.raises(KinematicsError, match="FitConfig"):
+            FitConfig(**bad)
 
 
 def test_configs_that_cannot_see_the_arm_are_refused():

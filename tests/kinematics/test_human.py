@@ -6,6 +6,7 @@ import importlib.metadata
 import math
 
 import numpy as np
+import pinocchio as pin
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -85,6 +86,34 @@ def test_left_arm_is_the_right_arm_mirrored_through_the_sagittal_plane(q):
         np.testing.assert_allclose(l_[:3, :3], S @ r[:3, :3] @ S_URDF, atol=1e-12)
 
 
+FULL = pin.buildModelFromUrdf(str(_human.find_human_urdf()))
+FULL_DATA = FULL.createData()
+
+
+@settings(max_examples=40, deadline=None)
+@given(q=q_in_limits(), side=st.sampled_from(["right", "left"]))
+def test_reduced_arm_moves_like_the_arm_of_the_full_human_urdf(q, side):
+    # The same seven angles set in the full 36-DOF human.urdf (everything else neutral) put the
+    # elbow, wrist and hand where HumanArm does, seen from the shoulder and turned Z-up.
+    arm = RIGHT if side == "right" else LEFT
+    full_q = pin.neutral(FULL)
+    for value, name in zip(q, arm.joint_names, strict=True):
+        full_q[FULL.idx_qs[FULL.getJointId(name)]] = value
+    pin.forwardKinematics(FULL, FULL_DATA, full_q)
+    oMi = [FULL_DATA.oMi[FULL.getJointId(name)] for name in arm.joint_names]
+    wrist = oMi[-1]
+    # The hand centre lies along the hand's axis at the depth of its centre of mass.
+    hand = np.array([0.0, FULL.inertias[FULL.getJointId(arm.joint_names[-1])].lever[1], 0.0])
+    expected = np.stack(
+        [oMi[2].translation, oMi[3].translation, oMi[5].translation, wrist.act(hand)]
+    )
+    expected = (expected - oMi[0].translation) @ _human.YUP_TO_ZUP.T
+    np.testing.assert_allclose(arm.points(q), expected, atol=1e-12)
+    pose = arm.forward(q)
+    for got, joint in ((pose.shoulder, oMi[2]), (pose.elbow, oMi[4]), (pose.wrist, oMi[6])):
+        np.testing.assert_allclose(got[:3, :3], _human.YUP_TO_ZUP @ joint.rotation, atol=1e-12)
+
+
 @settings(max_examples=30, deadline=None)
 @given(q=q_in_limits())
 def test_mirroring_twice_is_the_identity(q):
@@ -121,6 +150,13 @@ def test_bad_construction_is_one_clear_error():
         HumanArm(upper_arm=-0.2)
     with pytest.raises(KinematicsError, match="NaN|finite"):
         mirror_human_q([np.inf] * 7)
+    for bad in ("long", math.nan, math.inf, 0.0, True):
+        with pytest.raises(KinematicsError, match="forearm"):
+            HumanArm(forearm=bad)  # type: ignore[arg-type]
+    for q in ("abcdefg", np.zeros(7) + 1j, [0, 0, 0, None, 0, 0, 0]):
+        with pytest.raises(KinematicsError) as err:
+            RIGHT.forward(q)
+        assert str(err.value).endswith(".") and "\n" not in str(err.value)
 
 
 def test_missing_example_robot_data_names_the_package(monkeypatch, tmp_path):

@@ -17,6 +17,7 @@ from studio.kinematics import (
     PUMA_QR,
     PUMA_QS,
     PUMA_QZ,
+    IKConfig,
     IKResult,
     KinematicsError,
     LinkVisual,
@@ -252,7 +253,16 @@ def test_ik_result_is_frozen() -> None:
 
 @pytest.mark.parametrize(
     "q",
-    [np.zeros(5), np.zeros((6, 1)), [0, 0, 0, 0, 0, math.nan], [0, 0, math.inf, 0, 0, 0], "abc"],
+    [
+        np.zeros(5),
+        np.zeros((6, 1)),
+        [0, 0, 0, 0, 0, math.nan],
+        [0, 0, math.inf, 0, 0, 0],
+        "abc",
+        None,
+        np.zeros(6) + 0.1j,  # a cast would drop the imaginary part silently
+        [[0, 0, 0], [0, 0]],
+    ],
 )
 def test_bad_joint_angles_raise_one_clear_error(q: object) -> None:
     for method in (ROBOT.forward, ROBOT.jacobian, ROBOT.joint_frames, ROBOT.visual_poses):
@@ -287,12 +297,34 @@ def test_bad_ik_input_raises_one_clear_error() -> None:
         dict(oMdes=good, tolerance=math.nan),
         dict(oMdes=good, max_iterations=0),
         dict(oMdes=good, max_iterations=2.5),
+        dict(oMdes=good, max_iterations="many"),
+        dict(oMdes=good, max_iterations=math.inf),
+        dict(oMdes=good, max_iterations=math.nan),
+        dict(oMdes=good, tolerance="tight"),
+        dict(oMdes="home"),
+        dict(oMdes=[[1, 0], [0]], position_only=True),
+        dict(oMdes=good + 0j),
     ]
     for kwargs in cases:
         with pytest.raises(KinematicsError) as err:
             ROBOT.inverse(**kwargs)
         message = str(err.value)
         assert message.endswith(".") and "\n" not in message, kwargs
+
+
+def test_bad_ik_settings_are_one_clear_error() -> None:
+    for bad in (
+        dict(max_iterations=0),
+        dict(max_iterations=1.5),
+        dict(tolerance=0.0),
+        dict(damping=math.nan),
+        dict(max_step=-1.0),
+        dict(stall_steps="ten"),
+    ):
+        with pytest.raises(KinematicsError, match="IKConfig") as err:
+            IKConfig(**bad)
+        assert str(err.value).endswith(".")
+    assert Puma560(ik=IKConfig(max_iterations=20.0)).inverse(ROBOT.forward(PUMA_QR)).success
 
 
 def test_an_improper_rotation_is_fine_when_only_the_position_matters() -> None:

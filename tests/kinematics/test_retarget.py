@@ -9,7 +9,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from studio.kinematics import HumanArm, KinematicsError, Puma560, Retargeter
+from studio.kinematics import HumanArm, KinematicsError, Puma560, RetargetConfig, Retargeter
 from studio.kinematics._retarget import DROPPED_HUMAN_JOINT, JOINT_MAP
 
 RIGHT = HumanArm("right")
@@ -118,10 +118,34 @@ def test_cartesian_mode_reaches_the_mirrored_scaled_hand_pose():
     assert reached >= 25  # positions reached (the full orientation when the Puma's wrist can)
     # An unreachable hand pose is reported, and the answer stays within the limits.
     far = Retargeter(mode="cartesian", robot=ROBOT, arm=RIGHT)
-    far.config = type(far.config)(reach_fraction=3.0)
+    far.config = RetargetConfig(reach_fraction=3.0)
     q_robot = far.robot_from_human(np.zeros(7))
     assert far.last_ik is not None and not far.last_ik.success
     assert np.all(q_robot >= ROBOT.lower) and np.all(q_robot <= ROBOT.upper)
+
+
+@settings(max_examples=40, deadline=None)
+@given(q_human=human_q())
+def test_mirroring_a_mirror_image_gives_back_the_unmirrored_hand_target(q_human):
+    # The left arm at q is the right arm at q reflected; reflecting it again (mirror=True) must
+    # give exactly the right arm's unmirrored target: the cartesian mirror applied twice is the
+    # identity, on positions and on the tool's orientation.
+    for mirrored, plain in ((LEFT, RIGHT), (RIGHT, LEFT)):
+        twice = Retargeter("cartesian", mirror=True, robot=ROBOT, arm=mirrored)
+        once = Retargeter("cartesian", mirror=False, robot=ROBOT, arm=plain)
+        np.testing.assert_allclose(
+            twice.hand_target(q_human), once.hand_target(q_human), atol=1e-12
+        )
+
+
+def test_bad_retarget_settings_are_one_clear_error():
+    for bad in (dict(reach_fraction=-0.5), dict(reach_fraction=math.nan), dict(ik_iterations=0)):
+        with pytest.raises(KinematicsError, match="RetargetConfig"):
+            RetargetConfig(**bad)
+    with pytest.raises(KinematicsError, match="Puma560"):
+        Retargeter(robot=RIGHT)  # type: ignore[arg-type]
+    with pytest.raises(KinematicsError, match="HumanArm"):
+        Retargeter(arm="right")  # type: ignore[arg-type]
 
 
 def test_mode_switches_at_run_time_and_is_validated():

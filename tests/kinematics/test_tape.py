@@ -184,6 +184,16 @@ def test_config_is_frozen_and_validated():
         TapeConfig(base=np.ones((4, 4)))
     with pytest.raises(KinematicsError, match="base"):
         TapeConfig(base=np.eye(3))
+    with pytest.raises(KinematicsError, match="base"):
+        TapeConfig(base="identity")  # type: ignore[arg-type]
+    with pytest.raises(KinematicsError, match="shoulder_region"):
+        TapeConfig(shoulder_region=9.5)  # type: ignore[arg-type]
+    with pytest.raises(KinematicsError, match="wrist_region"):
+        TapeConfig(wrist_region="14")  # type: ignore[arg-type]
+    with pytest.raises(KinematicsError, match="length"):
+        TapeConfig(length="long")  # type: ignore[arg-type]
+    # Whole numbers read back from JSON as floats are fine.
+    assert TapeConfig(shoulder_region=9.0, wrist_region=14.0) == TapeConfig()
 
 
 @pytest.mark.parametrize(
@@ -193,12 +203,20 @@ def test_config_is_frozen_and_validated():
         (np.zeros(R), np.zeros((2, R)), "shape"),
         (np.full(R, np.nan), np.zeros(R), "NaN"),
         (np.zeros(R), np.full(R, np.inf), "NaN"),
-        ("abc", np.zeros(R), "numeric"),
+        ("abc", np.zeros(R), "real numbers"),
+        (np.zeros(R) + 1j, np.zeros(R), "complex"),
+        ([[0.0] * R, [0.0] * (R - 1)], np.zeros(R), "numeric"),
     ],
 )
 def test_reconstruct_rejects_bad_input(bend, twist, match):
     with pytest.raises(KinematicsError, match=match):
         reconstruct(bend, twist, CONFIG)
+
+
+def test_reconstruct_needs_a_tape_config():
+    for config in (None, "16 regions", {"regions": 16}):
+        with pytest.raises(KinematicsError, match="TapeConfig"):
+            reconstruct(np.zeros(R), np.zeros(R), config)  # type: ignore[arg-type]
 
 
 def test_tape_angles_rejects_bad_input():
@@ -208,6 +226,39 @@ def test_tape_angles_rejects_bad_input():
     frames[3, 0, 0] = np.nan
     with pytest.raises(KinematicsError, match="NaN"):
         tape_angles(frames)
+    # Not rotations: no angles would rebuild them, so none are returned.
+    with pytest.raises(KinematicsError, match="rotation"):
+        tape_angles(np.ones((R + 1, 3, 3)))
+    # Rotations, but one step turns about n (a twist-then-bend never does): not a tape's frames.
+    frames = reconstruct(np.full(R, 0.2), np.full(R, 0.1), CONFIG).frames.copy()
+    c, s_ = math.cos(0.3), math.sin(0.3)
+    frames[5:] = frames[5:] @ np.array([[c, 0, s_], [0, 1, 0], [-s_, 0, c]])
+    with pytest.raises(KinematicsError, match="not a tape"):
+        tape_angles(frames)
+
+
+@settings(max_examples=20, deadline=None)
+@given(q=st.tuples(*[st.floats(-1.0, 1.0)] * 7).map(np.array))
+def test_a_tape_that_starts_at_the_shoulder_has_no_back_path(q):
+    # shoulder_region = 0 is allowed: the tape starts on the shoulder, at its base.
+    arm = HumanArm()
+    q = np.clip(q, arm.lower, arm.upper)
+    config = TapeConfig(shoulder_region=0, wrist_region=5, base=np.eye(4))
+    bend, twist = tape_from_arm(arm, q, config)
+    shape = reconstruct(bend, twist, config)
+    np.testing.assert_allclose(shape.positions[0], 0.0)
+    d = arm.points(q)[1] / arm.upper_arm_length
+    np.testing.assert_allclose(shape.positions[2], 2 * config.region_length * d, atol=1e-12)
+
+
+def test_tape_from_arm_rejects_bad_noise():
+    arm = HumanArm()
+    rng = np.random.default_rng(0)
+    for noise in (-0.01, math.nan, math.inf, "loud"):
+        with pytest.raises(KinematicsError, match="noise"):
+            tape_from_arm(arm, np.zeros(7), CONFIG, rng=rng, noise=noise)  # type: ignore[arg-type]
+    with pytest.raises(KinematicsError, match="default_rng"):
+        tape_from_arm(arm, np.zeros(7), CONFIG, rng=7, noise=0.01)  # type: ignore[arg-type]
 
 
 def test_configs_compare_by_value_including_the_base():

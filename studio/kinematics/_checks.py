@@ -1,0 +1,72 @@
+"""Input checks shared by the kinematics models, so that bad values never reach Pinocchio.
+
+Every public function of the package turns its array and number arguments into plain float
+arrays here first: text, ``None``, ragged lists and complex numbers (whose imaginary part a cast
+would silently drop) become one :class:`KinematicsError` sentence instead of a NumPy or Pinocchio
+exception further down.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ._errors import KinematicsError
+
+#: NumPy dtype kinds that hold real numbers (bool, signed and unsigned integers, floats).
+_REAL_KINDS = "biuf"
+
+
+def real_array(value: object, what: str, hint: str = "pass an array of real numbers") -> np.ndarray:
+    """``value`` as a float64 array, or a KinematicsError naming ``what``.
+
+    Args:
+        value: anything array-like.
+        what: the argument's name, for the message.
+        hint: the fix the message suggests.
+
+    Returns:
+        A float64 array (a view of ``value`` when it already is one).
+
+    Raises:
+        KinematicsError: ``value`` is not an array of real numbers.
+    """
+    try:
+        raw = np.asarray(value)
+    except (TypeError, ValueError):  # ragged nested lists
+        raise KinematicsError(f"{what} is not a numeric array; {hint}.") from None
+    if raw.dtype.kind not in _REAL_KINDS:
+        if raw.dtype.kind == "O":  # e.g. a list mixing numbers and None
+            try:
+                return raw.astype(float)
+            except (TypeError, ValueError):
+                pass
+        kind = {"c": "complex numbers", "U": "text", "S": "bytes"}.get(
+            raw.dtype.kind, f"{raw.dtype} values"
+        )
+        raise KinematicsError(f"{what} holds {kind}, not real numbers; {hint}.")
+    return raw.astype(float, copy=False)
+
+
+def positive_number(value: object, what: str) -> float:
+    """``value`` as a finite float above zero, or a KinematicsError naming ``what``."""
+    if isinstance(value, bool) or not isinstance(value, int | float | np.integer | np.floating):
+        raise KinematicsError(f"{what} must be a positive number; got {value!r}.")
+    number = float(value)
+    if not (math.isfinite(number) and number > 0):
+        raise KinematicsError(f"{what} must be a positive number; got {value!r}.")
+    return number
+
+
+def whole_number(value: object, what: str, minimum: int) -> int:
+    """``value`` as an int of at least ``minimum``, or a KinematicsError naming ``what``.
+
+    Floats with a whole value (``20.0``) are accepted; ``2.5``, ``inf``, NaN, text and bools are
+    not.
+    """
+    if isinstance(value, bool) or not isinstance(value, int | float | np.integer | np.floating):
+        raise KinematicsError(f"{what} must be a whole number >= {minimum}; got {value!r}.")
+    if not (math.isfinite(value) and int(value) == value and value >= minimum):
+        raise KinematicsError(f"{what} must be a whole number >= {minimum}; got {value!r}.")
+    return int(value)
