@@ -40,16 +40,58 @@ def test_urdf_is_well_formed_xml_with_the_joint_limits() -> None:
     assert len(list(root.iter("visual"))) == len(ROBOT.visuals())
 
 
+def dimensions(shape: str, sizes: tuple[float, ...]) -> tuple[str, tuple[float, ...]]:
+    """A solid as (kind, full sizes): cylinder (r, length), box (x, y, z), sphere (r,)."""
+    return shape, tuple(float(v) for v in sizes)
+
+
 def test_pinocchio_loads_it_back_with_the_same_kinematics() -> None:
     model = pin.buildModelFromXML(TEXT)
     data = model.createData()
     tool = model.getFrameId("tool")
     assert model.nq == 6
+    assert list(model.names)[1:] == [f"joint{i}" for i in range(1, 7)]
     np.testing.assert_array_equal(model.lowerPositionLimit, ROBOT.lower)
     np.testing.assert_array_equal(model.upperPositionLimit, ROBOT.upper)
     for q in random_q():
         pin.framesForwardKinematics(model, data, q)
         np.testing.assert_allclose(data.oMf[tool].homogeneous, ROBOT.forward(q), atol=1e-12)
+        # Every joint, not only the tool: joint i turns about z of DH frame i-1.
+        pin.forwardKinematics(ROBOT.model, ROBOT.data, q)
+        for i in range(1, 7):
+            np.testing.assert_allclose(
+                data.oMi[i].homogeneous, ROBOT.data.oMi[i].homogeneous, atol=1e-12
+            )
+
+
+def test_pinocchio_loads_back_the_same_visuals() -> None:
+    # Pinocchio renames visuals after their link, so they are matched in file order (grouped
+    # by joint, as visuals() lists them) by kind, size, colour and pose.
+    model = pin.buildModelFromXML(TEXT)
+    geometry = pin.buildGeomFromUrdfString(model, TEXT, pin.GeometryType.VISUAL)
+    visuals = ROBOT.visuals()
+    assert [v.joint for v in visuals] == sorted(v.joint for v in visuals)
+    assert geometry.ngeoms == len(visuals)
+    for obj, visual in zip(geometry.geometryObjects, visuals, strict=True):
+        solid = obj.geometry
+        kind = type(solid).__name__.lower()
+        if kind == "cylinder":
+            loaded = dimensions(kind, (solid.radius, 2 * solid.halfLength))
+        elif kind == "box":
+            loaded = dimensions(kind, tuple(2 * solid.halfSide))
+        else:
+            loaded = dimensions(kind, (solid.radius,))
+        expected = dimensions(visual.shape, visual.dimensions)
+        assert loaded[0] == expected[0], visual.name
+        np.testing.assert_allclose(loaded[1], expected[1], rtol=1e-12, err_msg=visual.name)
+        assert obj.parentJoint == visual.joint  # DH frame i moves with joint i (0: the base)
+        np.testing.assert_allclose(obj.meshColor, (*visual.rgb, 1.0), atol=1e-7)  # float32
+    data, geometry_data = model.createData(), geometry.createData()
+    for q in random_q(10):
+        pin.forwardKinematics(model, data, q)
+        pin.updateGeometryPlacements(model, data, geometry, geometry_data)
+        placed = np.stack([oMg.homogeneous for oMg in geometry_data.oMg])
+        np.testing.assert_allclose(placed, ROBOT.visual_poses(q), atol=1e-12)
 
 
 def test_yourdfpy_loads_it_back_with_the_same_kinematics_and_visuals() -> None:
@@ -81,6 +123,21 @@ def test_yourdfpy_loads_it_back_with_the_same_kinematics_and_visuals() -> None:
                 )
                 seen += 1
         assert seen == len(names)
+    # ... and is the same solid, in the same colour.
+    for visual in ROBOT.visuals():
+        (loaded,) = [
+            v for link in urdf.link_map.values() for v in link.visuals if v.name == visual.name
+        ]
+        geometry = loaded.geometry
+        if visual.shape == "cylinder":
+            sizes = (geometry.cylinder.radius, geometry.cylinder.length)
+        elif visual.shape == "box":
+            sizes = tuple(geometry.box.size)
+        else:
+            sizes = (geometry.sphere.radius,)
+        assert getattr(geometry, visual.shape) is not None, visual.name
+        assert sizes == visual.dimensions, visual.name
+        assert tuple(loaded.material.color.rgba) == (*visual.rgb, 1.0), visual.name
 
 
 def test_export_urdf_writes_the_file(tmp_path: Path) -> None:
