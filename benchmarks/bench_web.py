@@ -172,7 +172,7 @@ def main() -> int:
         baseline_url = start_baseline()
         with sync_playwright() as p:
             browser = p.chromium.launch(executable_path=CHROMIUM, args=FLAGS, headless=True)
-            paint_times(browser, base + "/", scene=True)  # warm caches (plotly, numba) once
+            paint_times(browser, base + "/", scene=True)  # warm caches (page files, numba) once
             paint_times(browser, baseline_url, scene=False)
             studio = [paint_times(browser, base + "/", scene=True) for _ in range(args.loads)]
             basic = [paint_times(browser, baseline_url, scene=False) for _ in range(args.loads)]

@@ -1,4 +1,4 @@
-"""The FastAPI app: the API routers, the page, plotly served locally, and the host guard.
+"""The FastAPI app: the API routers, the page and its vendored libraries, and the host guard.
 
 :func:`create_app` builds the app for given :class:`Settings`; the studio state (stores, live
 pipeline, run queue) is created when the app starts and closed when it stops, so tests get a
@@ -43,13 +43,6 @@ log = logging.getLogger(__name__)
 STATIC_DIR = Path(__file__).parent / "static"
 MULTIPART_OVERHEAD_BYTES = 64 * 1024
 """Room for the multipart framing around an upload at the size limit."""
-
-
-def plotly_js_path() -> Path:
-    """``plotly.min.js`` as shipped inside the installed ``plotly`` Python package."""
-    import plotly
-
-    return Path(plotly.__file__).parent / "package_data" / "plotly.min.js"
 
 
 def create_app(settings: Settings | None = None, scene: Any = None) -> FastAPI:
@@ -116,10 +109,6 @@ def create_app(settings: Settings | None = None, scene: Any = None) -> FastAPI:
                 f"The page is missing from {STATIC_DIR}; reinstall Teach Studio (the API still works at /docs)."
             )
         return FileResponse(page, headers={"Cache-Control": "no-cache"})
-
-    @app.get("/vendor/plotly.min.js", include_in_schema=False)
-    def plotly_js() -> FileResponse:
-        return FileResponse(plotly_js_path(), media_type="text/javascript")
 
     app.mount("/static", StaticFiles(directory=STATIC_DIR, check_dir=False), name="static")
     return app

@@ -223,6 +223,12 @@ class StudioScene:
         cam.look_at = lay.camera_look_at
         cam.up = (0.0, 0.0, 1.0)
         s.set_up_direction("+z")
+        # Plain lights: no shadow maps and no image-based lighting. Both re-render every frame,
+        # and in software WebGL (a machine without a GPU) they cost most of a core even while
+        # the scene stands still, taken from training; without them the colours also read
+        # clearer (the default environment map washed the scene out to near white).
+        s.configure_default_lights(enabled=True, cast_shadow=False)
+        s.configure_environment_map(hdri=None)
         # A static floor: a plate and line segments. (viser's shader grid and text labels keep
         # the browser redrawing while nothing moves, which costs a core with software WebGL.)
         half, step = lay.floor_half_size, lay.floor_cell

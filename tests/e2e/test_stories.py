@@ -260,10 +260,13 @@ def test_story5_training_curve_updates_live(page: Any, studio_server: Studio) ->
     page.click("[data-testid='curve-log']")
     time.sleep(0.3)
     shot(page, "05-two-runs", "sec-train")
-    shown = page.evaluate(
-        "() => document.getElementById('curve-plot').data.filter(t => t.meta.kind === 'mean').map(t => t.meta.run)"
-    )
+    shown = page.evaluate("() => window.studio.plottedRuns()")
     assert {run_id, second_id} <= set(shown)
+    # The chart draws both: its canvas is not blank, and it has a legend row per run.
+    legend = page.locator("#curve-plot .u-legend .u-series:visible")
+    assert legend.count() >= 3  # the episode readout and one row per plotted run
+    plot = _pixels(page.locator("#curve-plot canvas").first.screenshot())
+    assert len(np.unique(plot.reshape(-1, 3).round(-1), axis=0)) > 8
 
     # A supervised run replays the demonstration cut in story 4 (its goal is the demo's end).
     demo = studio_server.get("/api/demonstrations/e2e-demo")

@@ -1,14 +1,15 @@
-"""The app shell: config, the host guard, the page and plotly served locally, error shapes."""
+"""The app shell: config, the host guard, the page and its vendored libraries served locally, error shapes."""
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import pytest
 from fastapi.testclient import TestClient
 
 from studio.web import Settings, create_app
-from studio.web._app import STATIC_DIR, plotly_js_path
+from studio.web._app import STATIC_DIR
 from studio.web._settings import get_settings, is_loopback
 from tests.web.conftest import make_settings
 
@@ -63,11 +64,18 @@ def test_loopback_detection():
     assert Settings().is_loopback and not Settings(host="0.0.0.0").is_loopback
 
 
-def test_plotly_is_served_from_the_installed_package(client):
-    r = client.get("/vendor/plotly.min.js")
-    assert r.status_code == 200
-    assert r.content == plotly_js_path().read_bytes()
-    assert "javascript" in r.headers["content-type"]
+def test_the_page_loads_only_local_files_and_they_are_served(client):
+    """Every script and stylesheet of the page is served by the studio: nothing from a CDN."""
+    html = (STATIC_DIR / "index.html").read_text()
+    refs = re.findall(r'<(?:script|link)[^>]*\b(?:src|href)="([^"]+)"', html)
+    assert any("uPlot" in ref for ref in refs), "the chart library is not loaded"
+    for ref in refs:
+        if ref.startswith("data:"):
+            continue
+        assert ref.startswith("/"), f"{ref} is not served by the studio"
+        r = client.get(ref)
+        assert r.status_code == 200, ref
+        assert r.content == (STATIC_DIR / ref.removeprefix("/static/")).read_bytes()
 
 
 def test_the_page_and_static_files(client):

@@ -1,7 +1,7 @@
 /* Teach Studio page: talks to the API in docs/api.md, renders lists, live status and curves.
  *
  * Plain JS, no build step. Live data arrives over one EventSource('/api/events'); the curve chart
- * is redrawn with Plotly.react at most CURVE_FPS times a second, whatever the event rate.
+ * (uPlot) gets new data at most CURVE_FPS times a second, whatever the event rate.
  */
 "use strict";
 
@@ -711,64 +711,65 @@ function mergeCurve(id, piece, from) {
 }
 
 /* ------------------------------------------------------------------ the chart */
+// uPlot (vendored from npm, see static/vendor/README.md) draws on a canvas: a redraw with new data
+// takes about a millisecond, so live curves at CURVE_FPS never compete with training for the CPU.
 function markCurvesDirty() { S.curveDirty = true; }
 
 /**
- * At most MAX_PLOT_POINTS points per run: longer curves are averaged in equal buckets of episodes
- * (band: the buckets' lowest low and highest high), so a 100 000-episode run draws as fast as a
- * short one and the chart never slows the page down.
+ * At most MAX_PLOT_POINTS points per run: longer curves are averaged in equal buckets of episodes,
+ * the same buckets for every run (band: the buckets' lowest low and highest high), so a 100 000-
+ * episode run draws as fast as a short one and the chart never slows the page down.
  */
 const MAX_PLOT_POINTS = 600;
-function decimate(c) {
-  const n = c.episodes.length;
-  if (n <= MAX_PLOT_POINTS) return c;
-  const k = Math.ceil(n / MAX_PLOT_POINTS);
-  const out = emptyCurve();
-  for (let i = 0; i < n; i += k) {
-    const j = Math.min(n, i + k);
-    let m = 0; let sd = 0; let lo = Infinity; let hi = -Infinity;
-    for (let t = i; t < j; t++) {
-      m += c.mean[t]; sd += c.std[t] || 0;
-      lo = Math.min(lo, c.min[t]); hi = Math.max(hi, c.max[t]);
-    }
-    out.episodes.push(c.episodes[j - 1]);
-    out.mean.push(m / (j - i)); out.std.push(sd / (j - i)); out.min.push(lo); out.max.push(hi);
-  }
-  return out;
+
+/** The runs to plot, oldest first (so colours and legend order stay put as runs are added). */
+function plottedRuns() {
+  return [...S.runs].reverse().filter((r) => {
+    const c = S.curves.get(r.id);
+    return S.shown.has(r.id) && c && c.episodes.length > 0;
+  });
 }
 
-function curveTraces() {
-  const band = $("curve-band").value;
-  const log = $("curve-log").checked;
-  const traces = [];
-  for (const r of [...S.runs].reverse()) {
-    if (!S.shown.has(r.id)) continue;
-    const full = S.curves.get(r.id);
-    if (!full || !full.episodes.length) continue;
-    const c = decimate(full);
-    const color = runColor(r.id);
-    if (band !== "none") {
-      let lo; let hi;
-      if (band === "minmax") { lo = c.min; hi = c.max; } else {
-        lo = c.mean.map((m, i) => Math.max(m - (c.std[i] || 0), log ? Math.max(c.min[i] || 1, 1) : 0));
-        hi = c.mean.map((m, i) => m + (c.std[i] || 0));
-      }
-      traces.push({
-        x: c.episodes.concat([...c.episodes].reverse()),
-        y: hi.concat([...lo].reverse()),
-        fill: "toself", fillcolor: hexAlpha(color, 0.16), line: { width: 0 },
-        hoverinfo: "skip", showlegend: false, type: "scatter", mode: "lines", name: `${r.id} band`,
-        meta: { run: r.id, kind: "band" },
-      });
-    }
-    traces.push({
-      x: c.episodes, y: c.mean, type: "scatter", mode: c.episodes.length < 40 ? "lines+markers" : "lines",
-      line: { color, width: 1.8 }, marker: { size: 4 }, name: runLabel(r),
-      hovertemplate: "episode %{x}<br>%{y:.1f} steps<extra>" + (r.name || r.id) + "</extra>",
-      meta: { run: r.id, kind: "mean" },
-    });
+/**
+ * The chart's columns: the episode axis, then per run its mean and, with a band, its low and high
+ * edges. Missing episodes are null (a gap); on a log axis nothing below one step is drawn.
+ */
+function chartData(runs, band, log) {
+  let last = 0;
+  for (const r of runs) {
+    const e = S.curves.get(r.id).episodes;
+    last = Math.max(last, e[e.length - 1]);
   }
-  return traces;
+  const k = Math.max(1, Math.ceil(last / MAX_PLOT_POINTS));
+  const n = Math.ceil(last / k);
+  const x = Array.from({ length: n }, (_, b) => Math.min(last, (b + 1) * k));
+  const cols = [x];
+  const floor = (v) => (log && v < 1 ? null : v);
+  for (const r of runs) {
+    const c = S.curves.get(r.id);
+    const sum = new Float64Array(n); const sd = new Float64Array(n); const cnt = new Uint32Array(n);
+    const lo = new Float64Array(n).fill(Infinity); const hi = new Float64Array(n).fill(-Infinity);
+    for (let i = 0; i < c.episodes.length; i++) {
+      const b = Math.floor((c.episodes[i] - 1) / k);
+      sum[b] += c.mean[i]; sd[b] += c.std[i] || 0; cnt[b] += 1;
+      lo[b] = Math.min(lo[b], c.min[i]); hi[b] = Math.max(hi[b], c.max[i]);
+    }
+    const mean = new Array(n).fill(null); const low = new Array(n).fill(null); const high = new Array(n).fill(null);
+    for (let b = 0; b < n; b++) {
+      if (!cnt[b]) continue;
+      const m = sum[b] / cnt[b];
+      mean[b] = floor(m);
+      if (band === "minmax") {
+        low[b] = floor(lo[b]); high[b] = floor(hi[b]);
+      } else {
+        const s = sd[b] / cnt[b];
+        low[b] = floor(Math.max(m - s, log ? Math.max(lo[b], 1) : 0)); high[b] = floor(m + s);
+      }
+    }
+    cols.push(mean);
+    if (band !== "none") cols.push(low, high);
+  }
+  return cols;
 }
 
 function hexAlpha(hex, a) {
@@ -776,33 +777,101 @@ function hexAlpha(hex, a) {
   return `rgba(${(n >> 16) & 255},${(n >> 8) & 255},${n & 255},${a})`;
 }
 
-function renderCurves() {
-  if (!S.curveDirty || typeof Plotly === "undefined") return;
-  S.curveDirty = false;
-  const traces = curveTraces();
-  const empty = traces.length === 0;
-  $("curve-empty").hidden = !empty;
-  const layout = {
-    margin: { l: 52, r: 10, t: 6, b: 32 },
-    xaxis: { title: { text: "episode", standoff: 4 }, zeroline: false, visible: !empty },
-    yaxis: $("curve-log").checked
-      ? { title: { text: "steps", standoff: 4 }, type: "log", dtick: 1, zeroline: false, visible: !empty }
-      : { title: { text: "steps", standoff: 4 }, type: "linear", rangemode: "tozero", zeroline: false, visible: !empty },
-    legend: { orientation: "h", x: 1, xanchor: "right", y: 1, font: { size: 10 }, bgcolor: "rgba(255,255,255,0.7)" },
-    font: { size: 11, family: "system-ui, sans-serif" },
-    paper_bgcolor: "#fff", plot_bgcolor: "#fff",
-    uirevision: "keep",
+/** uPlot options for these runs: a mean line per run and, with a band, two unlabelled edges filled. */
+function chartOptions(runs, band, log, width, height) {
+  const series = [{ label: "episode", value: (u, v) => (v == null ? "–" : String(v)) }];
+  const bands = [];
+  for (const r of runs) {
+    const color = runColor(r.id);
+    const meanIdx = series.length;
+    series.push({
+      label: runLabel(r), stroke: color, width: 1.8, spanGaps: false,
+      value: (u, v) => (v == null ? "–" : `${v.toFixed(1)} steps`),
+    });
+    if (band !== "none") {
+      for (const edge of ["low", "high"]) {
+        series.push({ label: `${runLabel(r)} ${edge}`, class: "band-edge", stroke: "transparent", width: 0, points: { show: false } });
+      }
+      bands.push({ series: [meanIdx + 2, meanIdx + 1], fill: hexAlpha(color, 0.16) });
+    }
+  }
+  const axis = { stroke: "#555", grid: { stroke: "#eceef1", width: 1 }, ticks: { stroke: "#d6d9de", width: 1 }, font: "11px system-ui, sans-serif", labelFont: "11px system-ui, sans-serif" };
+  return {
+    width, height, series, bands,
+    scales: {
+      x: { time: false },
+      y: log ? { distr: 3, log: 10 } : { range: (u, min, max) => [0, max > 0 ? max * 1.05 : 1] },
+    },
+    axes: [
+      { ...axis, label: "episode", labelSize: 16, size: 30 },
+      { ...axis, label: "steps", labelSize: 16, size: 48 },
+    ],
+    legend: { live: true },
+    cursor: { drag: { x: true, y: false } },
+    hooks: {
+      init: [(u) => {
+        // Drag to zoom into episodes (the zoom then survives live updates); double-click resets.
+        u.over.addEventListener("dblclick", () => { S.chartZoomed = false; });
+      }],
+      setSelect: [(u) => { if (u.select.width > 0) S.chartZoomed = true; }],
+    },
   };
-  S.curveRenders = (S.curveRenders || 0) + 1; // chart redraws with new data (benchmarks read it)
-  Plotly.react("curve-plot", traces, layout, { displaylogo: false, responsive: true, modeBarButtonsToRemove: ["lasso2d", "select2d"] });
 }
 
-/** Number of plotted mean-curve points of a run (used by the browser tests). */
+let chart = null;
+let chartKey = "";
+let chartRuns = []; // run ids of the chart's mean columns, in order
+let chartStride = 1; // columns per run: mean, or mean, low and high
+
+/** Size the chart to its pane, leaving room for the legend under it. */
+function fitChart() {
+  if (!chart) return;
+  const box = $("curve-plot");
+  const legend = chart.root.querySelector(".u-legend");
+  const height = Math.max(80, box.clientHeight - (legend ? legend.offsetHeight : 0) - 2);
+  chart.setSize({ width: box.clientWidth, height });
+}
+
+function renderCurves() {
+  if (!S.curveDirty || typeof uPlot === "undefined") return;
+  S.curveDirty = false;
+  const band = $("curve-band").value;
+  const log = $("curve-log").checked;
+  const runs = plottedRuns();
+  $("curve-empty").hidden = runs.length > 0;
+  if (!runs.length) {
+    if (chart) { chart.destroy(); chart = null; chartKey = ""; chartRuns = []; }
+    return;
+  }
+  const key = JSON.stringify([runs.map((r) => [r.id, runLabel(r), runColor(r.id)]), band, log]);
+  const data = chartData(runs, band, log);
+  if (chart && key === chartKey) {
+    chart.setData(data, !S.chartZoomed);
+  } else {
+    if (chart) chart.destroy();
+    const box = $("curve-plot");
+    chart = new uPlot(chartOptions(runs, band, log, box.clientWidth, box.clientHeight), data, box);
+    chartKey = key;
+    chartRuns = runs.map((r) => r.id);
+    chartStride = band === "none" ? 1 : 3;
+    S.chartZoomed = false;
+    fitChart();
+  }
+  S.chart = chart;
+  S.curveRenders = (S.curveRenders || 0) + 1; // chart redraws with new data (benchmarks read it)
+}
+
+/** Ids of the runs in the chart, in legend order (used by the browser tests). */
+S.plottedRuns = () => (chart ? [...chartRuns] : []);
+
+/** Number of plotted mean-curve points of a run, or of all runs (used by the browser tests). */
 S.curvePoints = (id) => {
-  const div = $("curve-plot");
-  const data = (div && div.data) || [];
-  return data.filter((t) => t.meta && t.meta.kind === "mean" && (id === undefined || t.meta.run === id))
-    .reduce((n, t) => n + t.x.length, 0);
+  if (!chart) return 0;
+  let n = 0;
+  chartRuns.forEach((run, i) => {
+    if (id === undefined || run === id) n += chart.data[1 + i * chartStride].filter((v) => v !== null).length;
+  });
+  return n;
 };
 
 /* ------------------------------------------------------------------ policies, watch, export */
@@ -1037,6 +1106,7 @@ async function main() {
   updateMarkButton();
   renderCaptureButton();
   setInterval(renderCurves, 1000 / CURVE_FPS);
+  new ResizeObserver(fitChart).observe($("curve-plot"));
   connectEvents();
   await loadConfig();
   const initial = api("GET", "/api/source").then((s) => {
