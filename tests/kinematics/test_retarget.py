@@ -15,7 +15,20 @@ from studio.kinematics._retarget import DROPPED_HUMAN_JOINT, JOINT_MAP
 RIGHT = HumanArm("right")
 LEFT = HumanArm("left")
 ROBOT = Puma560()
-LATERAL = [j for j, (_, _, _, lateral) in enumerate(JOINT_MAP) if lateral]
+TABLE_D1 = 0.67183  # the Puma's pedestal: its shoulder height (DESIGN.md's DH table)
+#: The Puma joints whose sign flips with mirroring, as the module docstring's table documents
+#: them (J1 swings the arm sideways, J4 rolls the forearm, J6 is the wrist's sideways joint):
+#: written out here, not read from JOINT_MAP, so a changed flag in the code fails the tests.
+LATERAL = [0, 3, 5]
+#: (human joint, sign, offset) per Puma joint, for the right arm unmirrored, as documented.
+DOCUMENTED_MAP = [
+    (1, -1.0, 0.0),
+    (0, 1.0, -math.pi / 2),
+    (3, 1.0, -math.pi / 2),
+    (4, 1.0, 0.0),
+    (5, 1.0, 0.0),
+    (6, 1.0, 0.0),
+]
 
 
 def human_q():
@@ -28,6 +41,15 @@ def robot_q():
     return st.tuples(
         *[st.floats(lo, hi) for lo, hi in zip(ROBOT.lower, ROBOT.upper, strict=True)]
     ).map(np.array)
+
+
+@settings(max_examples=40, deadline=None)
+@given(q_human=human_q())
+def test_joint_mode_is_the_documented_table(q_human):
+    plain = Retargeter(mirror=False, robot=ROBOT, arm=RIGHT).robot_from_human(q_human)
+    expected = [offset + sign * q_human[i] for i, sign, offset in DOCUMENTED_MAP]
+    np.testing.assert_allclose(plain, np.clip(expected, ROBOT.lower, ROBOT.upper), atol=1e-15)
+    assert [i for i, *_ in DOCUMENTED_MAP] == [i for i, *_ in JOINT_MAP]
 
 
 def test_neutral_arm_hangs_the_robot_arm_down():
@@ -136,6 +158,31 @@ def test_mirroring_a_mirror_image_gives_back_the_unmirrored_hand_target(q_human)
         np.testing.assert_allclose(
             twice.hand_target(q_human), once.hand_target(q_human), atol=1e-12
         )
+
+
+@settings(max_examples=40, deadline=None)
+@given(q_human=human_q(), mirror=st.booleans(), fraction=st.floats(0.5, 1.0))
+def test_cartesian_target_is_the_hand_mirrored_scaled_to_the_robots_reach(
+    q_human, mirror, fraction
+):
+    # Position: the shoulder-to-hand vector, reflected y -> -y when mirroring, scaled so that
+    # the stretched arm reaches reach_fraction of the Puma's reach, from the Puma's shoulder.
+    # Orientation: the tool's approach axis (z) along the fingers (hand -y), tool x = hand x.
+    retargeter = Retargeter(
+        "cartesian", mirror=mirror, robot=ROBOT, arm=RIGHT, config=RetargetConfig(fraction)
+    )
+    hand = RIGHT.forward(q_human).hand
+    reflect = np.diag([1.0, -1.0 if mirror else 1.0, 1.0])
+    human_reach = RIGHT.upper_arm_length + RIGHT.forearm_length + RIGHT.hand_length
+    scale = fraction * ROBOT.reach / human_reach
+    target = retargeter.hand_target(q_human)
+    shoulder = np.array([0.0, 0.0, TABLE_D1])
+    np.testing.assert_allclose(target[:3, 3], shoulder + scale * reflect @ hand[:3, 3], atol=1e-12)
+    np.testing.assert_allclose(target[:3, 2], -reflect @ hand[:3, 1], atol=1e-12)
+    np.testing.assert_allclose(target[:3, 0], reflect @ hand[:3, 0], atol=1e-12)
+    stretched = retargeter.hand_target(RIGHT.neutral)
+    distance = np.linalg.norm(stretched[:3, 3] - shoulder)
+    assert distance == pytest.approx(fraction * ROBOT.reach, rel=1e-12)
 
 
 def test_bad_retarget_settings_are_one_clear_error():
