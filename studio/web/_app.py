@@ -17,6 +17,7 @@ from fastapi import FastAPI, Request
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import FileResponse, JSONResponse
 from fastapi.staticfiles import StaticFiles
+from fastapi_offline import FastAPIOffline
 from starlette.middleware.trustedhost import TrustedHostMiddleware
 from starlette.types import ASGIApp, Receive, Scope, Send
 
@@ -64,7 +65,9 @@ def create_app(settings: Settings | None = None, scene: Any = None) -> FastAPI:
         finally:
             studio.close()
 
-    app = FastAPI(
+    # FastAPI's own /docs and /redoc load Swagger UI and ReDoc from a CDN, which leaves the API
+    # page blank without internet; FastAPIOffline serves the same pages from its package.
+    app = FastAPIOffline(
         title="Teach Studio",
         version=__version__,
         description="Teach a robot arm by showing it a motion: capture, demonstrations, "

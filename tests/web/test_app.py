@@ -90,6 +90,21 @@ def test_the_page_and_static_files(client):
     assert client.get("/static/no-such-file.js").status_code == 404
 
 
+@pytest.mark.parametrize("page", ["/docs", "/redoc"])
+def test_the_api_docs_work_offline(client, page):
+    """The API pages load their scripts and styles from the studio, not from a CDN."""
+    html = client.get(page).text
+    refs = re.findall(r"""(?:src|href|url)\s*[=:(]\s*['"]([^'"]+)['"]""", html)
+    assert any(ref.endswith(".js") for ref in refs), refs
+    for ref in refs:
+        assert not ref.startswith(("http:", "https:", "//")), (
+            f"{page} loads {ref} from the internet"
+        )
+        if ref.endswith((".js", ".css")):
+            r = client.get(ref)
+            assert r.status_code == 200 and len(r.content) > 10_000, ref
+
+
 def test_openapi_docs_list_every_resource(client):
     assert client.get("/docs").status_code == 200
     paths = client.get("/openapi.json").json()["paths"]
