@@ -435,7 +435,7 @@ def tape_from_arm(
     q_human: object,
     config: TapeConfig,
     rng: np.random.Generator | None = None,
-    noise: float = 0.0,
+    noise: float | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Bend and twist of a tape strapped on ``arm`` at pose ``q_human``: the forward model.
 
@@ -460,7 +460,8 @@ def tape_from_arm(
         q_human: arm pose(s) (rad), shape ``(..., 7)``.
         config: the tape.
         rng: random generator for ``noise`` (required when ``noise > 0``).
-        noise: standard deviation of Gaussian sensor noise added to every angle (rad).
+        noise: standard deviation of Gaussian sensor noise added to every angle (rad); None
+            or 0 for none.
 
     Returns:
         ``(bend, twist)``, each of shape ``(..., regions)``.
@@ -471,6 +472,7 @@ def tape_from_arm(
     from ._human import _as_q
 
     q = _as_q(q_human, arm.nq, "q_human")
+    noise = 0.0 if noise is None else noise
     if isinstance(noise, bool) or not isinstance(noise, int | float | np.integer | np.floating):
         raise KinematicsError(f"noise must be a number of radians; got {noise!r}.")
     if not (math.isfinite(noise) and noise >= 0):

@@ -164,6 +164,7 @@ def test_tape_from_arm_noise_needs_a_generator_and_is_reproducible():
     b = tape_from_arm(arm, np.zeros(7), CONFIG, rng=np.random.default_rng(1), noise=0.01)
     np.testing.assert_array_equal(a[0], b[0])
     clean = tape_from_arm(arm, np.zeros(7), CONFIG)
+    np.testing.assert_array_equal(tape_from_arm(arm, np.zeros(7), CONFIG, noise=None)[0], clean[0])
     assert 0 < np.abs(a[0] - clean[0]).max() < 0.1
 
 
