@@ -271,7 +271,9 @@ class ArmFitter:
             positions: ``(regions + 1, 3)`` vertices.
 
         Returns:
-            ``(points (4, 3), last)`` where ``last`` is the index of the last vertex used.
+            ``(points (4, 3), last)`` where ``last`` is the index of the last vertex used, or
+            -1 when coincident vertices give no limb direction (``points`` are then all the
+            shoulder vertex).
         """
         points = np.empty((4, 3))
         last = _landmarks_kernel(
