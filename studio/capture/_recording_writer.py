@@ -3,10 +3,16 @@
 The writer holds an advisory ``flock`` on the file while it records, so the editors in
 :mod:`._recording_edit` refuse to replace a file under a running capture (the lock dies with the
 process, so a killed capture never leaves the file locked).
+
+Rows go straight to the file descriptor (``os.write``, no hidden library buffer), so when the disk
+fills up or fails the writer knows exactly which bytes reached the file. It then stops for good:
+the file keeps every row written so far and reads back as a recovered recording, and the error
+(one sentence with the number of frames kept) is raised once to the caller.
 """
 
 from __future__ import annotations
 
+import contextlib
 import fcntl
 import os
 import threading
@@ -32,6 +38,8 @@ from ._recording_format import (
 
 DEFAULT_FLUSH_SECONDS = 0.5
 """Longest time a captured frame waits in memory before it is on disk (issue: <= 0.5 s)."""
+HEADER_LINES = 2
+"""The JSON header line and the column row come before the frames."""
 
 
 def recording_meta(
@@ -119,7 +127,7 @@ class RecordingWriter:
         )
         try:
             self.path.parent.mkdir(parents=True, exist_ok=True)
-            self._file = open(self.path, "x", encoding="utf-8", newline="\n")  # noqa: SIM115
+            self._fd = os.open(self.path, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_APPEND, 0o644)
         except FileExistsError:
             raise RecordingError(
                 f"{self.path} already exists; choose another file name (recordings are never overwritten)."
@@ -128,15 +136,27 @@ class RecordingWriter:
             raise RecordingError(
                 f"cannot create {self.path} ({err.strerror}); choose a writable folder."
             ) from None
-        fcntl.flock(self._file.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
+        fcntl.flock(self._fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         self._lock = threading.Lock()
         self._buffer: list[str] = [header_line(self.meta), ",".join(columns(self.regions)) + "\n"]
         self._frames = 0
+        self._lines_on_disk = 0
         self._first_t: float | None = None
         self._last_t: float | None = None
         self._closed = False
+        self._error: str | None = None
+        self._error_cause = ""
+        self._error_reported = False
         self._last_flush = time.monotonic()
         self._flush_locked()
+        if self._error is not None:
+            if self._lines_on_disk < HEADER_LINES:  # not even the header fits: leave no file
+                self.path.unlink(missing_ok=True)
+                self._error = (
+                    f"cannot start {self.path} ({self._error_cause}); free disk space or record "
+                    "to another disk."
+                )
+            self._check()
         self._stop = threading.Event()
         self._flusher = threading.Thread(
             target=self._flush_loop, name="studio-recorder", daemon=True
@@ -160,6 +180,16 @@ class RecordingWriter:
         """Whether :meth:`close` ran."""
         return self._closed
 
+    @property
+    def frames_on_disk(self) -> int:
+        """Frames whose rows are completely written to the file (the rest are still buffered)."""
+        return min(max(0, self._lines_on_disk - HEADER_LINES), self._frames)
+
+    @property
+    def error(self) -> str | None:
+        """Why writing stopped (a full or failing disk), or ``None``."""
+        return self._error
+
     def write(self, frame: TapeFrame) -> None:
         """Append one frame."""
         self.write_many((frame,))
@@ -168,7 +198,8 @@ class RecordingWriter:
         """Append frames in order (flushing to disk when the last flush is ``flush_seconds`` old).
 
         Raises:
-            RecordingError: the writer is closed, or a frame has the wrong number of regions.
+            RecordingError: the writer is closed, a frame has the wrong number of regions, or the
+                disk is full or failing (the frames written before are kept in the file).
         """
         if not frames:
             return
@@ -180,6 +211,7 @@ class RecordingWriter:
                 )
             rows.append(format_row(frame.t, frame.frame, frame.status, frame.bend, frame.twist))
         with self._lock:
+            self._check()
             if self._closed:
                 raise RecordingError(
                     f"{self.path} is closed; open a new RecordingWriter to record more."
@@ -191,30 +223,47 @@ class RecordingWriter:
             self._last_t = frames[-1].t
             if time.monotonic() - self._last_flush >= self.flush_seconds:
                 self._flush_locked()
+                self._check()
 
     def flush(self) -> None:
-        """Write, flush and fsync everything buffered now."""
+        """Write and fsync everything buffered now.
+
+        Raises:
+            RecordingError: the disk is full or failing (the frames written before are kept).
+        """
         with self._lock:
             if not self._closed:
                 self._flush_locked()
+            self._check()
 
     def close(self) -> Path:
         """Flush, write the ``# end`` line and close. Idempotent.
 
+        After a write failure the file is left as it is (it reads back as a recovered recording);
+        the failure is raised here only if no earlier call reported it (it happened in the
+        background flusher), so the caller hears of it exactly once.
+
         Returns:
             The recording's path.
+
+        Raises:
+            RecordingError: the disk is full or failing, and no earlier call said so.
         """
         self._stop.set()
         with self._lock:
             if self._closed:
                 return self.path
-            closed_at = datetime.now(UTC).isoformat(timespec="seconds")
-            self._buffer.append(end_line(self._frames, self.duration, closed_at))
-            self._flush_locked()
+            if self._error is None:
+                closed_at = datetime.now(UTC).isoformat(timespec="seconds")
+                self._buffer.append(end_line(self._frames, self.duration, closed_at))
+                self._flush_locked()
             self._closed = True
-            self._file.close()
+            self._release()
         if self._flusher is not threading.current_thread():
             self._flusher.join(self.flush_seconds * 4)
+        if self._error is not None and not self._error_reported:
+            self._error_reported = True
+            raise RecordingError(self._error)
         return self.path
 
     def __enter__(self) -> RecordingWriter:
@@ -223,17 +272,40 @@ class RecordingWriter:
     def __exit__(self, *exc: object) -> None:
         self.close()
 
+    def _check(self) -> None:
+        """Raise the write failure, if any, to the caller (who has now been told)."""
+        if self._error is not None:
+            self._error_reported = True
+            raise RecordingError(self._error)
+
+    def _release(self) -> None:
+        if self._fd >= 0:
+            with contextlib.suppress(OSError):  # the lock goes with the descriptor
+                os.close(self._fd)
+            self._fd = -1
+
     def _flush_locked(self) -> None:
-        if self._buffer:
-            try:
-                self._file.write("".join(self._buffer))
-                self._file.flush()
-                os.fsync(self._file.fileno())
-            except OSError as err:
-                raise RecordingError(
-                    f"cannot write {self.path} ({err.strerror}); free disk space or record elsewhere (the frames flushed so far are safe)."
-                ) from None
+        """Write and fsync the buffer; on failure stop for good and keep the message in ``_error``."""
+        if self._buffer and self._error is None:
+            data = "".join(self._buffer).encode("utf-8")
             self._buffer.clear()
+            view = memoryview(data)
+            written = 0
+            try:
+                while written < len(data):
+                    n = os.write(self._fd, view[written:])
+                    self._lines_on_disk += data.count(b"\n", written, written + n)
+                    written += n
+                os.fsync(self._fd)
+            except OSError as err:
+                self._release()
+                self._error_cause = err.strerror or str(err)
+                kept = self.frames_on_disk
+                self._error = (
+                    f"cannot write {self.path} ({self._error_cause}); recording stopped with its "
+                    f"first {kept} frames on disk ({self._frames - kept} not written): free disk "
+                    "space or record to another disk (the file opens as a recovered recording)."
+                )
         self._last_flush = time.monotonic()
 
     def _flush_loop(self) -> None:
@@ -242,7 +314,6 @@ class RecordingWriter:
                 if self._closed:
                     return
                 if self._buffer and time.monotonic() - self._last_flush >= self.flush_seconds / 2:
-                    try:
-                        self._flush_locked()
-                    except RecordingError:
-                        return  # the next write() or close() retries and raises it to the caller
+                    self._flush_locked()  # a failure waits for the caller's next call
+                if self._error is not None:
+                    return

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import errno
 import json
 import os
 import signal
@@ -218,3 +219,160 @@ def test_writer_flushes_without_new_frames(tmp_path, frames):
         time.sleep(0.02)
     assert len(read_recording(path)) == 10
     writer.close()
+
+
+class _DiskThatFillsUp:
+    """The ``os`` module, except that the disk is full once ``room`` more bytes are written."""
+
+    def __init__(self, room: int) -> None:
+        self.room = room
+        self.events: list[str] = []
+
+    def __getattr__(self, name: str):
+        return getattr(os, name)
+
+    def write(self, fd: int, data) -> int:
+        if self.room <= 0:
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+        n = os.write(fd, bytes(data[: self.room]))  # a partial write, as a filling disk does
+        self.room -= n
+        self.events.append("write")
+        return n
+
+    def fsync(self, fd: int) -> None:
+        os.fsync(fd)
+        self.events.append("fsync")
+
+
+def test_a_full_disk_stops_the_writer_with_one_message_and_keeps_what_was_written(
+    tmp_path, monkeypatch, frames
+):
+    from studio.capture import _recording_writer
+
+    disk = _DiskThatFillsUp(room=40_000)  # the header and some 50 rows, the last one cut
+    monkeypatch.setattr(_recording_writer, "os", disk)
+    path = tmp_path / "full.tape.csv"
+    writer = RecordingWriter(path, 16, flush_seconds=1e-9)  # every write flushes
+    with pytest.raises(RecordingError) as err:
+        for frame in frames:
+            writer.write(frame)
+    message = str(err.value)
+    assert str(path) in message and "No space left on device" in message
+    assert "free disk space" in message
+    kept = writer.frames_on_disk
+    assert 0 < kept < len(frames) and f"first {kept} frames on disk" in message
+    with pytest.raises(RecordingError, match="No space left"):  # it stays stopped
+        writer.write(frames[0])
+    writer.close()  # already reported: closing is quiet
+    rec = read_recording(path, strict=False)
+    assert rec.recovered and len(rec) == kept
+    assert all(a.same_as(b) for a, b in zip(frames, rec.frames(), strict=False))
+    assert "incomplete last row" in rec.problems[0]
+
+
+def test_a_full_disk_met_by_the_background_flusher_is_raised_once_by_close(
+    tmp_path, monkeypatch, frames
+):
+    from studio.capture import _recording_writer
+
+    monkeypatch.setattr(_recording_writer, "os", _DiskThatFillsUp(room=2_000))
+    path = tmp_path / "full.tape.csv"
+    writer = RecordingWriter(path, 16, flush_seconds=0.05)
+    writer.write_many(frames[:20])  # buffered; the flusher meets the full disk
+    for _ in range(100):
+        if writer.error:
+            break
+        time.sleep(0.02)
+    with pytest.raises(RecordingError, match="No space left on device") as err:
+        writer.close()
+    assert writer.close() == path  # told once
+    kept = writer.frames_on_disk
+    assert f"first {kept} frames on disk ({20 - kept} not written)" in str(err.value)
+    rec = read_recording(path, strict=False)
+    assert rec.recovered and len(rec) == kept < 20
+
+
+def test_a_disk_too_full_for_the_header_leaves_no_file(tmp_path, monkeypatch):
+    from studio.capture import _recording_writer
+
+    monkeypatch.setattr(_recording_writer, "os", _DiskThatFillsUp(room=0))
+    path = tmp_path / "none.tape.csv"
+    with pytest.raises(RecordingError, match=r"cannot start .*\(No space left on device\)"):
+        RecordingWriter(path, 16)
+    assert not path.exists()
+
+
+def test_record_verb_on_a_full_disk_prints_one_sentence(tmp_path, monkeypatch, capsys):
+    from studio.capture import _recording_writer
+    from studio.cli import main
+
+    monkeypatch.setattr(_recording_writer, "os", _DiskThatFillsUp(room=20_000))
+    out = tmp_path / "full.tape.csv"
+    args = ["record", "--source", "simulator", "--seconds", "20", "--out", str(out)]
+    assert main(args) == 2
+    err = capsys.readouterr().err
+    [line] = [x for x in err.splitlines() if "No space left" in x]
+    assert line.startswith("studio record: cannot write") and "Traceback" not in err
+    assert read_recording(out, strict=False).recovered
+
+
+def test_every_flush_ends_with_an_fsync(tmp_path, monkeypatch, frames):
+    from studio.capture import _recording_writer
+
+    disk = _DiskThatFillsUp(room=10**9)
+    monkeypatch.setattr(_recording_writer, "os", disk)
+    writer = RecordingWriter(tmp_path / "a.tape.csv", 16, flush_seconds=3600)
+    for batch in (frames[:10], frames[10:20]):
+        writer.write_many(batch)
+        writer.flush()
+        assert disk.events[-1] == "fsync"
+    writer.close()
+    assert disk.events[-1] == "fsync"
+    assert disk.events.count("fsync") == 4  # the header, two flushes, the close
+
+
+def test_damaged_bytes_in_a_row_name_that_line(tmp_path, frames):
+    path = _write(tmp_path / "d.tape.csv", frames)
+    lines = path.read_bytes().split(b"\n")
+    lines[40] = lines[40][:30] + b"\xff\xfe\x00" + lines[40][33:]  # a damaged disk block
+    path.write_bytes(b"\n".join(lines))
+    with pytest.raises(RecordingError, match=r"d.tape.csv, line 41: bytes that are not text"):
+        read_recording(path)
+    rec = read_recording(path, strict=False)
+    assert len(rec) == len(frames) - 1 and rec.problems[0].startswith("line 41")
+    kept = frames[:38] + frames[39:]
+    assert all(a.same_as(b) for a, b in zip(kept, rec.frames(), strict=True))
+
+
+@pytest.mark.parametrize("field", ["1_000", " 0.5", "0x1p3", "1e", "--1", "1.2.3", "", "½"])
+def test_only_decimal_numbers_are_numbers(tmp_path, frames, field):
+    path = _write(tmp_path / "f.tape.csv", frames[:20])
+    lines = path.read_text().split("\n")
+    fields = lines[9].split(",")
+    fields[7] = field
+    lines[9] = ",".join(fields)
+    path.write_text("\n".join(lines))
+    with pytest.raises(RecordingError, match=r"line 10: '.*' is not a number"):
+        read_recording(path)
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.text(alphabet="0123456789.+-eE", min_size=1, max_size=8))
+def test_the_bulk_parser_reads_a_field_as_float_would(tmp_path_factory, field):
+    path = tmp_path_factory.mktemp("p") / "p.tape.csv"
+    frame = TapeFrame(0.0, 0, np.zeros(2), np.zeros(2), 0)
+    _write(path, [frame, frame])
+    lines = path.read_text().split("\n")
+    fields = lines[2].split(",")
+    fields[3] = field
+    lines[2] = ",".join(fields)
+    path.write_text("\n".join(lines))
+    rec = read_recording(path, strict=False)
+    try:
+        value = float(field)
+    except ValueError:
+        value = None
+    if value is None or not np.isfinite(value):
+        assert len(rec) == 1 and rec.problems[0].startswith("line 3")
+    else:
+        assert rec.bend[0, 0] == value and len(rec) == 2
