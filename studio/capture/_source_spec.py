@@ -90,3 +90,18 @@ def parse_host_port(text: str, default_port: int = DEFAULT_PORT) -> tuple[str, i
         raise CaptureError(
             f"'{text}' has no valid port; write HOST:PORT, e.g. 127.0.0.1:{default_port}."
         ) from None
+
+
+def cli_speed(speed: float) -> float | None:
+    """A ``--speed`` option as :class:`PlaybackSource` takes it: 0 means as fast as possible.
+
+    Raises:
+        CaptureError: a negative or non-finite speed.
+    """
+    if speed == 0:
+        return None
+    if not 0 < speed < float("inf"):
+        raise CaptureError(
+            f"--speed is {speed:g}; give a positive speed (2 is twice real time), or 0 for as fast as possible."
+        )
+    return speed

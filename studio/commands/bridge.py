@@ -9,7 +9,9 @@ from __future__ import annotations
 import argparse
 import sys
 
+from studio import StudioError
 from studio.capture import DEFAULT_PORT, parse_host_port, source_from_spec, stream_source
+from studio.capture._source_spec import cli_speed
 
 NAME = "bridge"
 HELP = "Stream the simulator or a recording to a Teach Studio network source over UDP."
@@ -33,13 +35,21 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="stop after this long (default: until the source ends or Ctrl-C)",
     )
     parser.add_argument("--seed", type=int, default=0, help="simulator seed (default: 0)")
-    parser.add_argument("--speed", type=float, default=1.0, help="playback speed for a recording")
+    parser.add_argument(
+        "--speed",
+        type=float,
+        default=1.0,
+        help="playback speed for a recording: 1 real time, 2 twice as fast, "
+        "0 as fast as possible (default: 1)",
+    )
     parser.add_argument("--loop", action="store_true", help="loop a recording")
 
 
 def run(args: argparse.Namespace) -> int:
     host, port = parse_host_port(args.to)
-    source = source_from_spec(args.source, seed=args.seed, speed=args.speed, loop=args.loop)
+    source = source_from_spec(
+        args.source, seed=args.seed, speed=cli_speed(args.speed), loop=args.loop
+    )
     sent = [0]
 
     def progress(frames: list) -> None:
@@ -50,5 +60,9 @@ def run(args: argparse.Namespace) -> int:
         total = stream_source(source, host, port, args.seconds, on_frames=progress)
     except KeyboardInterrupt:
         total = sent[0]
+    except StudioError:
+        if sent[0]:  # end the progress line, so the error starts a line of its own
+            print(file=sys.stderr)
+        raise
     print(f"\nsent {total} frames to {host}:{port}.", file=sys.stderr)
     return 0

@@ -10,9 +10,11 @@ import sys
 import time
 from pathlib import Path
 
+from studio import StudioError
 from studio.capture import SOURCE_SPECS, SourceStatus, capture, read_recording, source_from_spec
 from studio.capture._capture_loop import describe
 from studio.capture._recording_format import DEFAULT_RATE_HZ
+from studio.capture._source_spec import cli_speed
 
 PROGRESS_SECONDS = 0.2
 """How often the progress line is redrawn."""
@@ -36,7 +38,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--seed", type=int, default=0, help="simulator seed (default: 0)")
     parser.add_argument("--calibration", type=Path, help="calibration JSON for serial:PORT")
     parser.add_argument(
-        "--speed", type=float, default=1.0, help="playback speed for a recording source"
+        "--speed",
+        type=float,
+        default=1.0,
+        help="playback speed for a recording source: 1 real time, 2 twice as fast, "
+        "0 as fast as possible (default: 1)",
     )
     parser.add_argument("--operator", default="", help="who wore the tape")
     parser.add_argument("--notes", default="", help="free text stored in the header")
@@ -44,7 +50,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     source = source_from_spec(
-        args.source, seed=args.seed, speed=args.speed, calibration=args.calibration
+        args.source,
+        seed=args.seed,
+        speed=cli_speed(args.speed),
+        calibration=args.calibration,
     )
     total = f"/{args.seconds:g} s" if args.seconds else ""
     nominal = float(getattr(source, "rate_hz", 0.0) or DEFAULT_RATE_HZ)
@@ -78,6 +87,10 @@ def run(args: argparse.Namespace) -> int:
     except KeyboardInterrupt:
         print(f"\nstopped: every captured frame is kept in {args.out}.", file=sys.stderr)
         path = args.out
+    except StudioError:
+        if last[0]:  # end the progress line, so the error starts a line of its own
+            print(file=sys.stderr)
+        raise
     print(file=sys.stderr)
     print(describe(read_recording(path).summary()))
     return 0

@@ -122,3 +122,20 @@ def test_ctrl_c_during_record_keeps_every_frame(tmp_path):
     rec = read_recording(out)
     assert not rec.recovered and len(rec) > 50  # closed cleanly with its '# end' line
     assert "every captured frame is kept" in err
+
+
+def test_record_a_recording_as_fast_as_possible_copies_its_frames(tmp_path, capsys):
+    from studio.capture import RecordingWriter, simulate
+
+    source = tmp_path / "src.tape.csv"
+    frames = simulate(3.0, seed=1).frames  # 3 s: real-time playback would take that long
+    with RecordingWriter(source, 16) as w:
+        w.write_many(frames)
+    copy = tmp_path / "copy.tape.csv"
+    args = ["record", "--source", str(source), "--speed", "0", "--out", str(copy)]
+    assert main(args) == 0
+    got = read_recording(copy).frames()
+    assert all(a.same_as(b) for a, b in zip(frames, got, strict=True))
+    args = ["record", "--source", str(source), "--speed", "-1", "--out", str(tmp_path / "n")]
+    assert main(args) == 2
+    assert "--speed is -1; give a positive speed" in capsys.readouterr().err
