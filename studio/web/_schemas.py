@@ -84,6 +84,11 @@ class SourceUpdate(_Body):
     recording: str | None = None
     port: int | None = Field(None, ge=1, le=65535)
     device: str | None = None
+    calibration: str | None = Field(
+        None,
+        description="serial only: path of the tape's calibration JSON on the studio's machine "
+        "(flat-pose offsets and gains; see studio/capture); none reads raw counts as radians",
+    )
     speed: float | None = Field(None, gt=0, le=100)
     loop: bool | None = None
     seed: int | None = Field(None, ge=0)

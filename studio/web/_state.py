@@ -129,6 +129,7 @@ class Studio:
         recording: str | None = None,
         port: int | None = None,
         device: str | None = None,
+        calibration: str | None = None,
         speed: float | None = None,
         loop: bool | None = None,
         seed: int | None = None,
@@ -166,7 +167,9 @@ class Studio:
                 )
             from studio.capture import SerialSource
 
-            source = SerialSource(device)
+            # A missing or malformed calibration file is refused here, before the old source stops.
+            path = calibration.strip() if calibration else ""
+            source = SerialSource(device, calibration=path or None)
             self.pipeline.set_source(source, kind)
         else:  # the schema allows only the kinds above
             raise InvalidError(f"kind is {kind!r}; give simulator, recording, network or serial.")

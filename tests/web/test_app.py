@@ -189,3 +189,16 @@ def test_reach_needs_the_simulator(client):
     r = client.post("/api/source/reach", json={"goal_deg": [0, 45, -90]})
     assert r.status_code == 409 and "not the simulator" in r.json()["detail"]
     assert client.post("/api/source/reach", json={"action": "dance"}).status_code == 422
+
+
+def test_the_page_listens_where_the_bridge_sends_by_default():
+    """`studio bridge --to HOST:PORT` and the page's network source agree on the default port."""
+    import inspect
+
+    from studio.capture import NetworkSource
+
+    html = (STATIC_DIR / "index.html").read_text()
+    field = re.search(r'<input id="source-port"[^>]*>', html)
+    assert field is not None
+    default = inspect.signature(NetworkSource).parameters["port"].default
+    assert re.search(r'value="(\d+)"', field.group(0)).group(1) == str(default)

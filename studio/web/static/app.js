@@ -214,9 +214,10 @@ async function applySource() {
     body.speed = Number($("playback-speed").value);
     body.loop = $("playback-loop").checked;
   } else if (kind === "network") {
-    body.port = Number($("source-port").value);
+    if ($("source-port").value !== "") body.port = Number($("source-port").value);
   } else if (kind === "serial") {
     body.device = $("source-device").value.trim();
+    if ($("source-calibration").value.trim()) body.calibration = $("source-calibration").value.trim();
   } else if ($("source-seed").value !== "") {
     body.seed = Number($("source-seed").value);
   }

@@ -1,0 +1,73 @@
+"""The serial source through the API: a calibrated tape on a pty, and a bad calibration file."""
+
+from __future__ import annotations
+
+import shutil
+import time
+from pathlib import Path
+
+import numpy as np
+
+from studio.capture import Calibration, ShapeTapeEmulator, read_recording
+
+SAMPLE = Path(__file__).resolve().parents[2] / "recordings" / "sample-reach-1.tape.csv"
+GAIN = 2e-4
+"""rad per count: the calibration's resolution, so angles come back within one count."""
+
+
+def _angles(k: int) -> tuple[np.ndarray, np.ndarray, int]:
+    return np.linspace(-0.6, 0.6, 16) * np.cos(k / 25), np.full(16, 0.002 * (k % 40)), 0
+
+
+def _wait(cond, timeout: float) -> bool:
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        if cond():
+            return True
+        time.sleep(0.05)
+    return bool(cond())
+
+
+def test_a_serial_tape_with_its_calibration_is_captured_in_radians(client, tmp_path):
+    calibration = Calibration(np.full(32, 30000.0), np.full(32, GAIN), serial=5001)
+    calibration.save(tmp_path / "tape.calibration.json")
+    emulator = ShapeTapeEmulator(_angles, calibration).start()
+    try:
+        r = client.put(
+            "/api/source",
+            json={
+                "kind": "serial",
+                "device": emulator.port,
+                "calibration": f" {tmp_path / 'tape.calibration.json'} ",
+            },
+        )
+        assert r.status_code == 200, r.text
+        assert r.json()["kind"] == "serial" and r.json()["error"] is None
+        assert _wait(lambda: client.get("/api/source").json()["frames"] > 10, 10)
+        assert client.post("/api/capture/start", json={"name": "serial-take"}).status_code == 200
+        time.sleep(1.0)
+        assert client.post("/api/capture/stop").status_code == 200
+    finally:
+        emulator.unplug()
+    rec = read_recording(client.app.state.studio.recordings.path("serial-take"))
+    assert len(rec.frame) > 20
+    for k, bend, twist in zip(rec.frame, rec.bend, rec.twist, strict=True):
+        want_bend, want_twist, _ = _angles(int(k))  # the tape's own counter numbers the frames
+        assert np.allclose(bend, want_bend, atol=GAIN) and np.allclose(twist, want_twist, atol=GAIN)
+    # Unplugged: the source says so, and the studio goes on.
+    assert _wait(lambda: client.get("/api/source").json()["error"] is not None, 10)
+    assert "disconnected" in client.get("/api/source").json()["error"]
+
+
+def test_a_missing_calibration_file_is_refused_and_the_source_keeps_running(client, tmp_path):
+    (tmp_path / "recordings").mkdir(exist_ok=True)
+    shutil.copy(SAMPLE, tmp_path / "recordings" / "take.tape.csv")
+    assert client.put("/api/source", json={"kind": "recording", "recording": "take"}).is_success
+    r = client.put(
+        "/api/source",
+        json={"kind": "serial", "device": "/dev/ttyUSB0", "calibration": "/nowhere/cal.json"},
+    )
+    assert r.status_code == 422
+    assert "/nowhere/cal.json" in r.json()["detail"]
+    source = client.get("/api/source").json()
+    assert source["kind"] == "recording" and source["error"] is None
