@@ -31,6 +31,7 @@ class ShapeTapeEmulator:
         angles: ``f(k) -> (bend, twist, switches)`` for the k-th reply.
         calibration: how angles become raw counts (default identity for 16 regions).
         serial: the serial number it reports.
+        counter_start: its 16-bit frame counter's first value (start near 65535 to test the wrap).
     """
 
     def __init__(
@@ -38,10 +39,12 @@ class ShapeTapeEmulator:
         angles: Callable[[int], tuple[np.ndarray, np.ndarray, int]],
         calibration: Calibration | None = None,
         serial: int = DEFAULT_SERIAL,
+        counter_start: int = 0,
     ) -> None:
         self.angles = angles
         self.calibration = calibration or Calibration.identity()
         self.serial = serial
+        self.counter_start = counter_start
         self.master, self._slave = os.openpty()
         tty.setraw(self._slave)
         self.port = os.ttyname(self._slave)
@@ -58,7 +61,8 @@ class ShapeTapeEmulator:
     def unplug(self) -> None:
         """Close the device side, as if the cable were pulled."""
         self._stop.set()
-        self._thread.join(1.0)
+        if self._thread.ident is not None:  # started
+            self._thread.join(1.0)
         for fd in (self.master, self._slave):
             with contextlib.suppress(OSError):
                 os.close(fd)
@@ -83,7 +87,7 @@ class ShapeTapeEmulator:
                     self.calibration.raw(bend, twist),
                     self.serial,
                     switches,
-                    counter=k,
+                    counter=self.counter_start + k,
                     timer=k,
                     corrupt=k in self.corrupt,
                 )

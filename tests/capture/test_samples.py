@@ -27,3 +27,28 @@ def test_every_sample_demo_reaches_the_default_goal_of_arm_grid():
         assert np.all(np.abs(np.diff(bins, axis=0)) <= 1)
         assert 0 <= demo.t0 < demo.t1 <= rec.duration + 1e-9
     assert total < 500_000  # small enough to ship
+
+
+def test_the_committed_script_regenerates_the_samples(tmp_path):
+    import json
+    import runpy
+    import sys
+
+    script = runpy.run_path(str(RECORDINGS / "make_samples.py"))
+    argv = sys.argv
+    sys.argv = ["make_samples.py", "--out", str(tmp_path)]
+    try:
+        script["main"]()
+    finally:
+        sys.argv = argv
+    shipped = sorted(p.name for p in RECORDINGS.glob("sample-*"))
+    assert shipped == sorted(p.name for p in tmp_path.glob("sample-*"))
+    for name in shipped:
+        new, old = tmp_path / name, RECORDINGS / name
+        if name.endswith(".tape.csv"):
+            assert new.read_bytes() == old.read_bytes(), name
+        else:  # demonstrations: the same path; the fit's trajectory to its stored micro-radian
+            a, b = json.loads(new.read_text()), json.loads(old.read_text())
+            ta, tb = a.pop("trajectory"), b.pop("trajectory")
+            assert a == b, name
+            assert np.allclose(ta["q_robot"], tb["q_robot"], atol=2e-6) and ta["t"] == tb["t"]

@@ -5,6 +5,7 @@ from __future__ import annotations
 import time
 
 import numpy as np
+import pytest
 
 from studio.capture import SimulatorSource, simulate
 from studio.capture._simulator import OperatorConfig, minimum_jerk
@@ -85,3 +86,50 @@ def test_reach_ends_where_the_robot_goal_mirrors_to():
     assert np.allclose(retarget.robot_from_human(sim.q_human[-1]), goal, atol=0.01)
     assert sim.reach_start < sim.reach_end <= len(sim.frames)
     assert sim.frames[-1].trigger and not sim.frames[0].trigger  # the trigger marks the reach
+
+
+def test_tremor_is_a_small_8_to_12_hz_oscillation_on_the_motion():
+    still = simulate(4.0, seed=5, operator=OperatorConfig(tremor_rad=0.0))
+    shaky = simulate(4.0, seed=5)
+    tremor = shaky.q_human - still.q_human  # same seed: the same motion, plus the tremor
+    amplitude = OperatorConfig().tremor_rad
+    assert 0.3 * amplitude < np.abs(tremor).max() <= amplitude + 1e-12
+    window = np.hanning(tremor.shape[0])[:, None]
+    spectrum = (np.abs(np.fft.rfft(tremor * window, axis=0)) ** 2).sum(axis=1)  # power
+    freqs = np.fft.rfftfreq(tremor.shape[0], 1 / 110)
+    band = (freqs >= 7.5) & (freqs <= 12.5)
+    assert spectrum[band].sum() > 0.95 * spectrum.sum()
+
+
+def _still_runs(q: np.ndarray) -> list[int]:
+    """Lengths (frames) of the runs of identical consecutive poses."""
+    same = np.all(np.diff(q, axis=0) == 0, axis=1)
+    edges = np.diff(np.concatenate([[0], same.astype(np.int8), [0]]))
+    return list(np.flatnonzero(edges == -1) - np.flatnonzero(edges == 1) + 1)
+
+
+def test_the_operator_pauses_between_movements_as_configured():
+    op = OperatorConfig(tremor_rad=0.0, pause_probability=1.0, pause_seconds=(0.3, 0.5))
+    runs = _still_runs(simulate(10.0, seed=2, operator=op).q_human)
+    long_runs = [r for r in runs if r > 2]
+    assert len(long_runs) >= 3  # a pause after every movement
+    assert all(0.3 * 110 - 2 <= r <= 0.5 * 110 + 2 for r in long_runs)
+    never = OperatorConfig(tremor_rad=0.0, pause_probability=0.0)
+    assert max(_still_runs(simulate(10.0, seed=2, operator=never).q_human), default=0) <= 2
+
+
+@pytest.mark.parametrize("goal", [(5, 6, 2), (3, 7, 4)])
+def test_goal_configuration_is_in_the_goal_bin_and_mirrors_off_the_arm_limits(goal):
+    from studio.capture import goal_configuration
+    from studio.capture._simulator import GOAL_MARGIN_RAD
+    from studio.kinematics import Retargeter
+    from studio.learning import ArmGrid
+
+    grid = ArmGrid(goal=goal)
+    q_robot = goal_configuration(grid)
+    assert grid.state_of_angles(q_robot[:3]) == grid.goal_state
+    retargeter = Retargeter("joint", mirror=True)
+    q_human = retargeter.human_from_robot(q_robot)
+    arm = retargeter.arm
+    assert np.all(q_human >= arm.lower + GOAL_MARGIN_RAD - 1e-9)
+    assert np.all(q_human <= arm.upper - GOAL_MARGIN_RAD + 1e-9)

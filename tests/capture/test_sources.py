@@ -284,3 +284,49 @@ def test_a_silent_network_sender_is_a_status_error_that_clears(monkeypatch, fram
         receiver.stop()
     assert silent.running and "no frames yet on UDP" in silent.error
     assert back.running and back.error is None
+
+
+def test_network_counts_single_lost_datagrams_and_the_counter_wrap():
+    receiver = NetworkSource(port=0)
+    receiver.start()
+    counters = [2**32 - 3, 2**32 - 2, 0, 1, 3, 4]  # 2**32 - 1 and 2 lost; the counter wraps
+    try:
+        with FrameSender(*receiver.address) as sender:
+            for c in counters:
+                sender.send(TapeFrame(0.0, c, np.zeros(16), np.zeros(16)))
+        got = _drain(receiver, lambda f: len(f) >= len(counters))
+    finally:
+        receiver.stop()
+    assert [f.frame for f in got] == counters and receiver.status().dropped == 2
+
+
+def test_serial_frame_numbers_keep_counting_across_the_tape_counter_wrap():
+    emulator = ShapeTapeEmulator(_angles, counter_start=65530).start()
+    source = SerialSource(emulator.port)
+    source.start()
+    try:
+        got = _drain(source, lambda f: len(f) >= 12)
+    finally:
+        source.stop()
+        emulator.unplug()
+    assert [f.frame for f in got[:12]] == list(range(65530, 65542))
+
+
+def test_a_silent_tape_stops_the_serial_source_with_a_reason(monkeypatch):
+    from studio.capture import _serial
+
+    monkeypatch.setattr(_serial, "SILENT_SECONDS", 0.3)
+    mute = ShapeTapeEmulator(_angles)  # a port that never answers: tape off, cable loose
+    source = SerialSource(mute.port)
+    source.start()
+    try:
+        for _ in range(100):
+            if not source.running:
+                break
+            time.sleep(0.05)
+        status = source.status()
+    finally:
+        source.stop()
+        mute.unplug()
+    assert not status.running and status.frames == 0 and status.dropped >= 1
+    assert "no valid reply" in status.error and "check its power and cable" in status.error
