@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import time
 
 from studio.learning import reproduce
 from studio.learning._reproduce import DEFAULT_EPISODES, DEFAULT_EXPERIMENTS, DEFAULT_SEED
@@ -36,6 +37,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    start = time.perf_counter()
     result = reproduce(
         args.out,
         experiments=args.experiments,
@@ -49,6 +51,7 @@ def run(args: argparse.Namespace) -> int:
     for i, claim in enumerate(result.claims, 1):
         print(f"{'reproduced    ' if claim.reproduced else 'NOT reproduced'}  {i}. {claim.claim}")
     print(
-        f"\nWrote {', '.join(p.name for p in result.files)} to {result.out_dir}/ (see REPORT.md)."
+        f"\nWrote {', '.join(p.name for p in result.files)} to {result.out_dir}/ (see REPORT.md) "
+        f"in {time.perf_counter() - start:.1f} s."
     )
     return 0

@@ -27,6 +27,7 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -50,6 +51,8 @@ CONVERGENCE_WINDOW = 5
 """Episodes in the moving mean used to call a curve converged."""
 CONVERGENCE_FACTOR = 10.0
 """A curve has converged once its moving mean is within this factor of the mean shortest path."""
+BAND_FLOOR_STEPS = 0.5
+"""Lower clip of the figures' error bands: below any episode's length, so the log axis keeps its range."""
 PAPER_MATLAB_SECONDS = {
     "SV-ZPL": 14.6,
     "SV-FPL": 708.0,
@@ -63,6 +66,11 @@ PAPER_FIRST_EPISODE_STEPS = 2500
 """Paper, Fig. 8 caption: the unsupervised agent took about 2500 steps in its first trial."""
 PAPER_RELEASE_STEPS = {"ZPL": 200, "FPL": 40, "SPL": 40}
 """Paper, Section V: after release, zero planning jumps to about 200 steps, planners to about 40."""
+
+FULL_ZERO_RANGE = (25.0, 100.0)
+"""Full/zero cost ratios counted as the paper's "about 50 times"."""
+SOFT_FULL_RANGE = (0.2, 0.7)
+"""Soft/full cost ratios counted as the paper's "a third to half" (its 0.33 and 0.52, with margin)."""
 
 CONFIGURATIONS = {
     name: (supervised, planning)
@@ -167,6 +175,21 @@ def _run_with_progress(
     return box["result"]  # type: ignore[return-value]
 
 
+def _standard_error(values: np.ndarray, axis: int = 0) -> np.ndarray:
+    """Standard error of the mean over ``axis`` (NaN for a single experiment)."""
+    n = values.shape[axis]
+    if n < 2:
+        return np.full(np.delete(values.shape, axis), np.nan)
+    return values.std(axis=axis, ddof=1) / np.sqrt(n)
+
+
+def _pm(mean: float, se: float, digits: int = 0) -> str:
+    """``mean +- se`` for the report, or just the mean when the error is unknown."""
+    if not np.isfinite(se):
+        return f"{mean:.{digits}f}"
+    return f"{mean:.{digits}f} ± {se:.{digits}f}"
+
+
 def _percentiles(steps: np.ndarray) -> dict[str, np.ndarray]:
     values = steps.astype(np.float64)
     return {
@@ -215,6 +238,16 @@ def _write_timing(path: Path, results: dict[str, ExperimentResult], wall: dict[s
             )
 
 
+def _curve(ax: Any, x: np.ndarray, steps: np.ndarray, **style: Any) -> None:
+    """Mean steps per episode, with a band of one standard error either side."""
+    mean = steps.mean(axis=0)
+    se = _standard_error(steps.astype(np.float64))
+    ax.plot(x, mean, **style)
+    if np.all(np.isfinite(se)):  # an episode lasts at least one step: keep the band on the log axis
+        low = np.maximum(mean - se, BAND_FLOOR_STEPS)
+        ax.fill_between(x, low, mean + se, color=style["color"], alpha=0.15, linewidth=0)
+
+
 def _plot(out_dir: Path, results: dict[str, ExperimentResult], demos: int) -> list[Path]:
     """Fig. 5 and Fig. 8 analogues as PNG and SVG (object-oriented matplotlib, no global state)."""
     from matplotlib.figure import Figure
@@ -233,37 +266,42 @@ def _plot(out_dir: Path, results: dict[str, ExperimentResult], demos: int) -> li
     axes = fig5.subplots(1, 2, sharey=True)
     for ax, prefix, title in zip(axes, ("SV", "US"), ("Supervised", "Unsupervised"), strict=True):
         for short, colour in colours.items():
-            ax.plot(
-                x,
-                results[f"{prefix}-{short}"].steps.mean(axis=0),
-                color=colour,
-                label=labels[short],
-            )
+            _curve(ax, x, results[f"{prefix}-{short}"].steps, color=colour, label=labels[short])
         if prefix == "SV":
-            ax.axvline(demos + 0.5, color="grey", linestyle=":", label="released")
+            ax.axvline(demos + 0.5, color="grey", linestyle=":", label="demonstrations end")
+            ax.text(
+                0.02,
+                0.62,
+                f"episodes 1-{demos}:\nall three replay\nthe same\ndemonstrations,\nso the curves\ncoincide",
+                transform=ax.transAxes,
+                verticalalignment="top",
+                fontsize="small",
+                color="dimgrey",
+            )
         ax.set_yscale("log")
         ax.set_xlabel("episode")
         ax.set_title(f"{title} ({results[f'{prefix}-ZPL'].steps.shape[0]} experiments)")
         ax.grid(True, which="both", alpha=0.3)
         ax.legend()
-    axes[0].set_ylabel("mean steps per episode")
+    axes[0].set_ylabel("mean steps per episode (band: ± 1 standard error)")
     fig5.suptitle("Fig. 5 analogue: steps per episode on the 1331-state arm grid")
 
     fig8 = Figure(figsize=(6.5, 4.2), layout="constrained")
     ax = fig8.subplots()
     for short, style in (("FPL", "-"), ("ZPL", "--")):
         for prefix, colour in (("SV", "tab:purple"), ("US", "tab:orange")):
-            ax.plot(
+            _curve(
+                ax,
                 x,
-                results[f"{prefix}-{short}"].steps.mean(axis=0),
+                results[f"{prefix}-{short}"].steps,
                 linestyle=style,
                 color=colour,
                 label=f"{'supervised' if prefix == 'SV' else 'unsupervised'}, {labels[short]}",
             )
-    ax.axvline(demos + 0.5, color="grey", linestyle=":")
+    ax.axvline(demos + 0.5, color="grey", linestyle=":", label="demonstrations end")
     ax.set_yscale("log")
     ax.set_xlabel("episode")
-    ax.set_ylabel("mean steps per episode")
+    ax.set_ylabel("mean steps per episode (band: ± 1 s.e.)")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend()
     fig8.suptitle("Fig. 8 analogue: supervised vs unsupervised")
@@ -274,6 +312,10 @@ def _plot(out_dir: Path, results: dict[str, ExperimentResult], demos: int) -> li
             figure.savefig(path, dpi=120)
             written.append(path)
     return written
+
+
+def _within(value: float, bounds: tuple[float, float]) -> bool:
+    return bounds[0] <= value <= bounds[1]
 
 
 def _fmt_episode(k: int | None, episodes: int) -> str:
@@ -290,12 +332,15 @@ def judge_claims(results: dict[str, ExperimentResult], grid: ArmGrid, demos: int
     claims = []
 
     first = {p: mean[f"US-{p}"][0] for p in ("ZPL", "FPL", "SPL")}
+    first_se = {p: _standard_error(results[f"US-{p}"].steps[:, :1])[0] for p in first}
     claims.append(
         Claim(
             f"An unsupervised agent needs thousands of steps in its first episode (paper: about {PAPER_FIRST_EPISODE_STEPS}).",
-            "Mean first-episode steps: "
-            + ", ".join(f"US-{p} {v:.0f}" for p, v in first.items())
-            + ".",
+            "Mean first-episode steps ± standard error: "
+            + ", ".join(f"US-{p} {_pm(v, first_se[p])}" for p, v in first.items())
+            + ". A first episode is a search for a goal not yet seen; its length spreads about as "
+            "widely as its mean, so 20 experiments pin the mean down to about ± 20 %. Counted as "
+            "reproduced when every mean is at least 1000.",
             bool(min(first.values()) >= 1000),
         )
     )
@@ -338,12 +383,16 @@ def judge_claims(results: dict[str, ExperimentResult], grid: ArmGrid, demos: int
 
     if episodes > demos:
         jump = {p: float(mean[f"SV-{p}"][demos]) for p in ("ZPL", "FPL", "SPL")}
+        jump_se = {
+            p: _standard_error(results[f"SV-{p}"].steps[:, demos : demos + 1])[0] for p in jump
+        }
         claims.append(
             Claim(
                 "On release the supervised zero-planning agent jumps to about 200 steps per episode, the planning agents to about 40.",
-                f"Mean steps in episode {demos + 1}, the first after release: "
+                f"Mean steps ± standard error in episode {demos + 1}, the first after release: "
                 + ", ".join(
-                    f"SV-{p} {v:.0f} (paper ~{PAPER_RELEASE_STEPS[p]})" for p, v in jump.items()
+                    f"SV-{p} {_pm(v, jump_se[p])} (paper ~{PAPER_RELEASE_STEPS[p]})"
+                    for p, v in jump.items()
                 )
                 + ". Counted as reproduced when zero planning jumps at least twice as high as both planners.",
                 bool(jump["ZPL"] >= 2 * max(jump["FPL"], jump["SPL"])),
@@ -351,12 +400,27 @@ def judge_claims(results: dict[str, ExperimentResult], grid: ArmGrid, demos: int
         )
     if episodes >= 35 and demos < 35:
         window = slice(demos, 35)
-        sv = float(mean["SV-FPL"][window].mean())
-        us = float(mean["US-FPL"][window].mean())
+        sv_runs = results["SV-FPL"].steps[:, window].mean(axis=1)  # one value per experiment
+        us_runs = results["US-FPL"].steps[:, window].mean(axis=1)
+        sv, us = float(sv_runs.mean()), float(us_runs.mean())
+        diff_se = float(
+            np.hypot(_standard_error(sv_runs[:, None])[0], _standard_error(us_runs[:, None])[0])
+        )
+        if not np.isfinite(diff_se):
+            noise = ""
+        elif sv - us > 2 * diff_se:
+            noise = " The difference is more than twice its standard error."
+        else:
+            noise = (
+                " The difference is within twice its standard error: the direction matches the "
+                "paper, but this many experiments cannot tell the two apart."
+            )
         claims.append(
             Claim(
                 "Between the 20th and 35th episode the unsupervised agent performs a little better than the supervised one (Fig. 8).",
-                f"Mean steps over episodes {demos + 1}-35 with full planning: supervised {sv:.1f}, unsupervised {us:.1f}.",
+                f"Mean steps over episodes {demos + 1}-35 with full planning: supervised {_pm(sv, _standard_error(sv_runs[:, None])[0], 1)}, "
+                f"unsupervised {_pm(us, _standard_error(us_runs[:, None])[0], 1)}; difference {_pm(sv - us, diff_se, 1)}."
+                + noise,
                 bool(us < sv),
             )
         )
@@ -379,10 +443,13 @@ def judge_claims(results: dict[str, ExperimentResult], grid: ArmGrid, demos: int
             + ", ".join(f"{p} {ratios[p]:.1f}x (paper {paper[p]:.1f}x)" for p in ratios)
             + "; Q updates full/zero: "
             + ", ".join(f"{p} {upd[p]:.1f}x" for p in upd)
-            + ". Counted as reproduced for a CPU ratio between 25x and 100x. The work itself (Q updates) "
-            f"grows only {min(upd.values()):.0f}-{max(upd.values()):.0f}x, so the paper's 50x reflects Matlab's costly planning loop; in our kernel "
-            "a planning update costs a fraction of a real step (action choice, model bookkeeping).",
-            all(25 <= r <= 100 for r in ratios.values()),
+            + f". Counted as reproduced when both ratios, of CPU and of Q updates, lie between "
+            f"{FULL_ZERO_RANGE[0]:g}x and {FULL_ZERO_RANGE[1]:g}x (CPU times of hundredths of a "
+            "second vary by about 10 % between runs on a busy machine; update counts are exact). "
+            f"The work itself grows only {min(upd.values()):.0f}-{max(upd.values()):.0f}x, so the "
+            "paper's 50x also reflects Matlab's costly planning loop; in our kernel a planning "
+            "update costs a fraction of a real step (action choice, model bookkeeping).",
+            all(_within(r, FULL_ZERO_RANGE) for r in (*ratios.values(), *upd.values())),
         )
     )
     soft = {
@@ -403,9 +470,10 @@ def judge_claims(results: dict[str, ExperimentResult], grid: ArmGrid, demos: int
             + ", ".join(f"{p} {soft[p]:.2f} (paper {paper_soft[p]:.2f})" for p in soft)
             + "; Q updates soft/full: "
             + ", ".join(f"{p} {soft_updates[p]:.2f}" for p in soft_updates)
-            + ". Counted as reproduced for a CPU ratio between 0.2 and 0.7; most planning happens "
-            "in the long early episodes, where soft still plans almost as much as full.",
-            all(0.2 <= r <= 0.7 for r in soft.values()),
+            + f". Counted as reproduced when both ratios, of CPU and of Q updates, lie between "
+            f"{SOFT_FULL_RANGE[0]:g} and {SOFT_FULL_RANGE[1]:g}. Most planning happens in the long "
+            "early episodes, where soft still plans almost as much as full.",
+            all(_within(r, SOFT_FULL_RANGE) for r in (*soft.values(), *soft_updates.values())),
         )
     )
     return claims
@@ -423,8 +491,9 @@ def _table(results: dict[str, ExperimentResult], wall: dict[str, float]) -> str:
             f"{name:<14}{ours:>12.3f}{wall[name]:>12.3f}{paper:>18.1f}{paper / max(ours, 1e-9):>11.0f}x"
         )
     total = sum(float(r.cpu_seconds.sum()) for r in results.values())
+    total_wall = sum(wall[name] for name in results)
     lines.append(
-        f"{'total':<14}{total:>12.3f}{sum(wall.values()):>12.3f}{sum(PAPER_MATLAB_SECONDS.values()):>18.1f}"
+        f"{'total':<14}{total:>12.3f}{total_wall:>12.3f}{sum(PAPER_MATLAB_SECONDS.values()):>18.1f}"
         f"{sum(PAPER_MATLAB_SECONDS.values()) / max(total, 1e-9):>11.0f}x"
     )
     return "\n".join(lines)
@@ -474,6 +543,7 @@ def _extension_section(
     level = CONVERGENCE_FACTOR * grid.mean_shortest_steps()
     episodes = next(iter(results.values())).steps.shape[1]
     lines = [
+        "",
         "## Beyond the paper: prioritized sweeping",
         "",
         "The paper closes by proposing other planners (Section V). Prioritized sweeping (Sutton & Barto "
@@ -489,6 +559,21 @@ def _extension_section(
             f"{_fmt_episode(episodes_to_converge(mean, level), episodes)} | "
             f"{int(result.updates.sum()):,} | {result.cpu_seconds.sum():.3f} |"
         )
+    full = results["US-FPL"]
+    for name, result in extensions.items():
+        per_update = (result.cpu_seconds.sum() / max(int(result.updates.sum()), 1)) / (
+            full.cpu_seconds.sum() / max(int(full.updates.sum()), 1)
+        )
+        lines += [
+            "",
+            f"{name} does {result.updates.sum() / max(full.updates.sum(), 1):.2f} times the Q "
+            f"updates of full planning, but each costs {per_update:.0f} times as much CPU here "
+            "(a priority queue and predecessor lists instead of one uniform draw). Its first "
+            "episode matches US-ZPL's: sweeping draws no random numbers, and before the goal is "
+            "first found both agents choose among the same untried actions (every tried one is "
+            "below 0), so from the same seed they walk the same path unless a state runs out of "
+            "untried actions.",
+        ]
     return "\n".join(lines) + "\n"
 
 

@@ -39,8 +39,14 @@ def test_reproduce_tiny_budget(tmp_path, capsys) -> None:
     assert int(timing["US-FPL"]["updates"]) > int(timing["US-ZPL"]["updates"])
     report = (out / "REPORT.md").read_text()
     assert "thousands of steps" in report and "| 7 |" in report and "| US-PSW |" in report
+    assert "± " in report  # means come with their standard errors
     printed = capsys.readouterr().out
     assert "paper Matlab" in printed and "1435.4" in printed
+    # the table's total is over the six configurations of the paper, not the extension
+    total = next(line for line in printed.splitlines() if line.startswith("total")).split()
+    six = sum(float(row["wall_seconds"]) for row in timing.values())
+    assert abs(float(total[2]) - six) < 0.002 + 1e-9
+    assert abs(float(total[1]) - sum(float(r["cpu_seconds"]) for r in timing.values())) < 0.002
 
 
 def test_train_then_export(tmp_path, capsys) -> None:
