@@ -376,3 +376,25 @@ def test_the_bulk_parser_reads_a_field_as_float_would(tmp_path_factory, field):
         assert len(rec) == 1 and rec.problems[0].startswith("line 3")
     else:
         assert rec.bend[0, 0] == value and len(rec) == 2
+
+
+def test_kill_9_of_studio_record_leaves_a_recovered_recording(tmp_path):
+    out = tmp_path / "killed.tape.csv"
+    child = subprocess.Popen(
+        [sys.executable, "-m", "studio.cli", "record", "--out", str(out)],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
+    try:
+        seen = 0
+        deadline = time.monotonic() + 60
+        while seen < 120 and time.monotonic() < deadline:  # two flushes of the default 0.5 s
+            time.sleep(0.05)
+            seen = out.read_text().count("\n") - 2 if out.exists() else 0
+    finally:
+        child.send_signal(signal.SIGKILL)
+        child.wait()
+    rec = read_recording(out, strict=False)
+    assert rec.recovered and len(rec) >= seen >= 120
+    assert np.array_equal(rec.frame, np.arange(len(rec)))  # every flushed frame, in order
+    assert rec.meta["source"] == "simulator"

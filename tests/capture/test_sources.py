@@ -330,3 +330,21 @@ def test_a_silent_tape_stops_the_serial_source_with_a_reason(monkeypatch):
         mute.unplug()
     assert not status.running and status.frames == 0 and status.dropped >= 1
     assert "no valid reply" in status.error and "check its power and cable" in status.error
+
+
+def test_a_datagram_built_from_the_readme_layout_decodes():
+    import struct
+
+    rng = np.random.default_rng(3)
+    bend, twist = rng.normal(0, 1, 16), rng.normal(0, 1, 16)
+    # the README's recipe, written independently of the encoder
+    datagram = (
+        struct.pack("!4sBBHIdH", b"STAP", 1, 0, 16, 4242, 1.25, 0x20)
+        + np.concatenate([bend, twist]).astype(">f4").tobytes()
+    )
+    assert len(datagram) == 150
+    frame = decode_frame(datagram)
+    assert (frame.frame, frame.t, frame.status, frame.trigger) == (4242, 1.25, 0x20, True)
+    assert np.array_equal(frame.bend, bend.astype(np.float32))
+    assert np.array_equal(frame.twist, twist.astype(np.float32))
+    assert encode_frame(frame) == datagram
