@@ -36,6 +36,14 @@ IDLE_SLEEP_S = 0.05
 ROBOT_JOINTS = 6
 
 
+def fit_warning(residual_m: float) -> str:
+    """What to tell the user when the arm model cannot follow the tape."""
+    return (
+        f"The arm model misses the tape by {residual_m * 1000.0:.0f} mm (RMS); check that the "
+        "tape lies along the arm and that its shoulder and wrist regions fit this operator."
+    )
+
+
 class Pipeline:
     """The live source, its kinematics, the capture writer, and live demonstration marking.
 
@@ -64,6 +72,7 @@ class Pipeline:
         self._capture_t0: float | None = None
         self._capture_last_t: float | None = None
         self._kin_error: str | None = None
+        self._fit_warning: str | None = None
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
 
@@ -105,6 +114,7 @@ class Pipeline:
             self._start_error = None
             self._kin = None
             self._kin_error = None
+            self._fit_warning = None
             self._residual = None
             if source is None:
                 return
@@ -182,7 +192,7 @@ class Pipeline:
                 "frames": int(st.frames) if st is not None else 0,
                 "dropped": int(st.dropped) if st is not None else 0,
                 "error": error,
-                "warning": getattr(st, "warning", None),
+                "warning": getattr(st, "warning", None) or self._fit_warning,
                 "rejected": int(getattr(st, "rejected", 0) or 0),
                 "recording": self._recording,
                 "retarget": {"mode": self._mode, "mirror": self._mirror},
@@ -346,11 +356,11 @@ class Pipeline:
         kin = self._kin
         if kin is None:
             config = self.tape_config()
-            arm = HumanArm()
+            arm = HumanArm(side=config.side)  # the arm the tape is strapped to
             kin = {
                 "config": config,
                 "fitter": ArmFitter(arm, config),
-                "retargeter": Retargeter(mode=self._mode, mirror=self._mirror),
+                "retargeter": Retargeter(mode=self._mode, mirror=self._mirror, arm=arm),
             }
             self._kin = kin
         return kin
@@ -370,6 +380,7 @@ class Pipeline:
                     self._residual = float(fit.residual)
                     self._last_t = float(frame.t)
                     self._kin_error = None
+                    self._fit_warning = None if fit.success else fit_warning(fit.residual)
             if self.scene is not None:
                 self.scene.update_live(self._q_human, self._q_robot, shape.positions)
         except StudioError as err:

@@ -107,6 +107,13 @@ def test_story2_switch_sources(page: Any, studio_server: Studio, tmp_path: Path)
     # The bridge went quiet: the page says so and how to fix it.
     page.wait_for_selector("[data-testid='source-status-error']:visible", timeout=T)
     assert "studio bridge" in page.inner_text("[data-testid='source-status-error']")
+    # Something that is not a tape frame is counted and named, and the source keeps listening.
+    import socket
+
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sender:
+        sender.sendto(b"not a tape frame", ("127.0.0.1", port))
+    page.wait_for_selector("[data-testid='source-warning']:visible", timeout=T)
+    assert "1 datagram rejected" in page.inner_text("[data-testid='source-warning']")
     shot(page, "02-network-silent", "sec-source")
 
     # Serial: a ShapeTape (emulated on a pseudo-terminal) read at 110 Hz, then unplugged.

@@ -85,3 +85,37 @@ def test_malformed_bridge_datagrams_are_counted_not_fatal(client):
     assert wait_for(lambda: client.get("/api/source").json()["rejected"] == 3)
     source = client.get("/api/source").json()
     assert source["warning"] and source["running"]
+
+
+def _play(open_client, tmp_path, frames, config):
+    """A studio whose live source plays ``frames`` (looped) from a recording in its data dir."""
+    from studio.capture import RecordingWriter
+
+    (tmp_path / "recordings").mkdir(exist_ok=True)
+    with RecordingWriter(tmp_path / "recordings" / "take.tape.csv", config=config) as writer:
+        writer.write_many(frames)
+    client = open_client()
+    r = client.put("/api/source", json={"kind": "recording", "recording": "take", "loop": True})
+    assert r.status_code == 200, r.text
+    assert wait_for(lambda: client.get("/api/source").json()["fit_residual_mm"] is not None)
+    time.sleep(0.5)  # several fits, warm-started
+    return client
+
+
+def test_a_tape_the_arm_cannot_follow_is_reported(open_client, tmp_path):
+    import numpy as np
+
+    from studio.capture import TapeFrame
+    from studio.kinematics import TapeConfig
+
+    config = TapeConfig()
+    rng = np.random.default_rng(0)
+    frames = [
+        TapeFrame(t=i / 110, frame=i, bend=rng.uniform(-1.5, 1.5, 16), twist=rng.uniform(-1, 1, 16))
+        for i in range(220)
+    ]
+    client = _play(open_client, tmp_path, frames, config)
+    assert wait_for(lambda: client.get("/api/source").json()["warning"] is not None, 5)
+    source = client.get("/api/source").json()
+    assert "misses the tape" in source["warning"] and source["error"] is None
+    assert source["running"]  # shown, not fatal

@@ -179,6 +179,10 @@ function renderSource() {
   $("src-q").textContent = (s.q_robot || []).map((v) => ((v * 180) / Math.PI).toFixed(0).padStart(4)).join(" ") + " °";
   // The source's own trouble (no device, a dropped bridge) stays apart from a refused action.
   showError("source-status-error", s.error ? `Source: ${s.error}` : null);
+  const rejected = s.rejected ? `${s.rejected} datagram${s.rejected === 1 ? "" : "s"} rejected` : "";
+  const warning = [s.warning, rejected].filter(Boolean).join(" · ");
+  $("source-warning").hidden = !warning;
+  $("source-warning").textContent = warning;
   if (document.activeElement !== $("retarget-mode") && s.retarget) $("retarget-mode").value = s.retarget.mode;
   if (s.retarget) $("retarget-mirror").checked = !!s.retarget.mirror;
   const pb = s.playback;
