@@ -101,10 +101,18 @@ def describe(summary: dict[str, Any]) -> str:
         f"  source    {summary['source']}",
         f"  operator  {summary['operator'] or '-'}",
         f"  created   {summary['created']}",
-        f"  recovered {'yes (the capture was interrupted; every flushed frame is here)' if summary['recovered'] else 'no'}",
+        f"  recovered {_recovered_text(summary)}",
     ]
     if summary["notes"]:
         lines.append(f"  notes     {summary['notes']}")
     for problem in summary["problems"]:
         lines.append(f"  problem   {problem}")
     return "\n".join(lines)
+
+
+def _recovered_text(summary: dict[str, Any]) -> str:
+    if summary.get("live"):
+        return "no (still being recorded: the frames flushed so far are shown)"
+    if summary["recovered"]:
+        return "yes (the capture was interrupted; every flushed frame is here)"
+    return "no"

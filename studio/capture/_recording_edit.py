@@ -49,18 +49,32 @@ def atomic_write_text(path: str | os.PathLike[str], text: str) -> Path:
     return path
 
 
-def _check_not_recording(path: Path) -> None:
+def being_recorded(path: str | os.PathLike[str]) -> bool:
+    """Whether a :class:`RecordingWriter` is appending to ``path`` right now (it holds the lock).
+
+    Such a file has no ``# end`` line yet, which a reader alone would take for an interrupted
+    capture.
+
+    Raises:
+        RecordingError: the file does not exist.
+    """
     try:
         with open(path, "rb") as f:
             try:
                 fcntl.flock(f.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
             except BlockingIOError:
-                raise RecordingError(
-                    f"{path} is being recorded right now; stop the capture before editing it."
-                ) from None
+                return True
             fcntl.flock(f.fileno(), fcntl.LOCK_UN)
+            return False
     except FileNotFoundError:
         raise RecordingError(f"{path} does not exist; check the path.") from None
+
+
+def _check_not_recording(path: Path) -> None:
+    if being_recorded(path):
+        raise RecordingError(
+            f"{path} is being recorded right now; stop the capture before editing it."
+        )
 
 
 def update_recording_meta(path: str | os.PathLike[str], **changes: Any) -> dict[str, Any]:

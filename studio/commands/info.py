@@ -8,6 +8,7 @@ from pathlib import Path
 
 from studio.capture import read_recording
 from studio.capture._capture_loop import describe
+from studio.capture._recording_edit import being_recorded
 
 NAME = "info"
 HELP = "Show a recording's or demonstration's metadata, length and any problems."
@@ -36,6 +37,10 @@ def run(args: argparse.Namespace) -> int:
             )
         else:
             summary = read_recording(path, strict=not args.lenient).summary()
+            # a file still being captured has no '# end' line yet, but it was not interrupted
+            summary["live"] = summary["recovered"] and being_recorded(path)
+            if summary["live"]:
+                summary["recovered"] = False
             text = describe(summary)
         print(json.dumps(summary) if args.json else text)
     return 0

@@ -139,3 +139,21 @@ def test_record_a_recording_as_fast_as_possible_copies_its_frames(tmp_path, caps
     args = ["record", "--source", str(source), "--speed", "-1", "--out", str(tmp_path / "n")]
     assert main(args) == 2
     assert "--speed is -1; give a positive speed" in capsys.readouterr().err
+
+
+def test_info_tells_a_capture_in_progress_from_an_interrupted_one(tmp_path, capsys):
+    from studio.capture import RecordingWriter, TapeFrame
+
+    path = tmp_path / "live.tape.csv"
+    writer = RecordingWriter(path, 16)
+    writer.write_many([TapeFrame(i / 110, i, np.zeros(16), np.zeros(16)) for i in range(30)])
+    writer.flush()
+    assert main(["info", "--json", str(path)]) == 0
+    live = json.loads(capsys.readouterr().out)
+    assert live["live"] and not live["recovered"] and live["frames"] == 30
+    killed = tmp_path / "killed.tape.csv"  # the same bytes with no writer: an interrupted capture
+    killed.write_bytes(path.read_bytes())
+    writer.close()
+    assert main(["info", "--json", str(killed)]) == 0
+    gone = json.loads(capsys.readouterr().out)
+    assert gone["recovered"] and not gone["live"]
