@@ -22,6 +22,9 @@ DEFAULT_QUEUE_FRAMES = 4096
 """Frames a source buffers before it drops (37 s at 110 Hz: a consumer may stall that long)."""
 RATE_WINDOW_FRAMES = 110
 """Frames over which the measured rate is averaged (one second at 110 Hz)."""
+RATE_WINDOW_SECONDS = 1.0
+"""Only frames that arrived this recently count towards the rate, so a source that goes quiet
+(a paused recording, a silent bridge, a stalled device) reads 0 Hz within a second."""
 STOP_JOIN_SECONDS = 2.0
 """How long :meth:`ThreadedSource.stop` waits for the producer thread to end."""
 
@@ -33,7 +36,7 @@ class SourceStatus:
     Args:
         kind: ``"simulator"``, ``"playback"``, ``"network"`` or ``"serial"``.
         running: whether the producer thread is running.
-        rate_hz: measured frame rate over the last second of frames (0 before two frames).
+        rate_hz: measured frame rate over the frames of the last second (0 with fewer than two).
         frames: frames produced so far.
         dropped: frames lost (queue full, checksum errors, gaps in the device's counter).
         error: why the source stopped or delivers no frames (one sentence with the fix), or
@@ -171,9 +174,10 @@ class ThreadedSource:
             arrivals = list(self._arrivals)
             frames, dropped, rejected = self._frames, self._dropped, self._rejected
             error, warning = self._error, self._warning
+        recent = [t for t in arrivals if t >= time.monotonic() - RATE_WINDOW_SECONDS]
         rate = 0.0
-        if len(arrivals) >= 2 and arrivals[-1] > arrivals[0]:
-            rate = (len(arrivals) - 1) / (arrivals[-1] - arrivals[0])
+        if len(recent) >= 2 and recent[-1] > recent[0]:
+            rate = (len(recent) - 1) / (recent[-1] - recent[0])
         return SourceStatus(
             self.kind, self.running, rate, frames, dropped, error, rejected, warning
         )

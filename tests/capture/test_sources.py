@@ -252,6 +252,35 @@ def test_dropped_frames_are_counted_when_the_consumer_stalls():
     assert len(source.read()) == 10 and source.status().dropped == 40
 
 
+def test_the_rate_falls_to_zero_when_frames_stop():
+    """A paused recording or a silent bridge must not keep showing its last rate."""
+    from studio.capture import ThreadedSource
+
+    go_quiet = threading.Event()
+
+    class Paced(ThreadedSource):
+        kind = "paced"
+
+        def _produce(self):
+            for frame in synthetic_frames(10_000):
+                if go_quiet.is_set() or self._stop_event.wait(0.01):
+                    break
+                self._push(frame)
+            self._stop_event.wait()
+
+    source = Paced()
+    source.start()
+    try:
+        time.sleep(0.5)
+        assert source.status().rate_hz > 20  # about 100 Hz while frames flow
+        go_quiet.set()
+        time.sleep(1.2)
+        status = source.status()
+        assert status.running and status.rate_hz == 0.0 and status.frames > 20
+    finally:
+        source.stop()
+
+
 def test_a_crashing_producer_reports_its_error():
     from studio.capture import ThreadedSource
 
