@@ -8,10 +8,14 @@ from __future__ import annotations
 
 import argparse
 import sys
+import time
 
 from studio import StudioError
 from studio.capture import DEFAULT_PORT, parse_host_port, source_from_spec, stream_source
 from studio.capture._source_spec import cli_speed
+
+PROGRESS_SECONDS = 0.2
+"""How often the progress line is redrawn."""
 
 NAME = "bridge"
 HELP = "Stream the simulator or a recording to a Teach Studio network source over UDP."
@@ -51,9 +55,14 @@ def run(args: argparse.Namespace) -> int:
         args.source, seed=args.seed, speed=cli_speed(args.speed), loop=args.loop
     )
     sent = [0]
+    last = [0.0]
 
     def progress(frames: list) -> None:
         sent[0] += len(frames)
+        now = time.monotonic()
+        if now - last[0] < PROGRESS_SECONDS:  # a few updates a second, not one per frame
+            return
+        last[0] = now
         print(f"\rsent {sent[0]} frames to {host}:{port}", end="", file=sys.stderr, flush=True)
 
     try:
