@@ -1,5 +1,6 @@
 from __future__ import annotations
 
+import dataclasses
 import threading
 
 import numpy as np
@@ -55,6 +56,34 @@ def test_planning_update_counts(two_way_corridor, planning: str, n: int) -> None
     }[planning]
     assert np.all(result.steps > 0)
     np.testing.assert_array_equal(result.updates, result.steps * (1 + per_step))
+
+
+@pytest.mark.parametrize(
+    ("planning", "n", "episodes"),
+    [("zero", 5, 3), ("full", 7, 3), ("full", 0, 2), ("soft", 6, 9), ("prioritized", 4, 3)],
+)
+def test_planning_updates_really_applied(planning: str, n: int, episodes: int) -> None:
+    # One state, one action, straight into the terminal state: the model holds a single pair, so
+    # every update, real or planned, is Eq. 1 on it, q <- q + alpha (r - q). Q after the run
+    # therefore counts the updates actually applied, not just the ones reported.
+    alpha, reward = 0.5, 1.0
+    mdp = TabularMDP(
+        np.array([[1], [1]]), np.array([[reward], [0.0]]), np.array([False, True]), [0]
+    )
+    config = DynaQConfig(planning=planning, planning_steps=n, alpha=alpha, priority_threshold=0.0)
+    result = run_experiments(mdp, config, 1, episodes, seed=0)
+    per_episode = {
+        "zero": [0] * episodes,
+        "full": [n] * episodes,
+        "soft": [max(n - k, 0) for k in range(episodes)],
+        "prioritized": [n] * episodes,  # the pair keeps a remaining error above threshold 0
+    }[planning]
+    q = 0.0
+    for planned in per_episode:
+        for _ in range(1 + planned):
+            q = q + alpha * (reward + config.gamma * 0.0 - q)
+    assert result.q[0, 0, 0] == q
+    np.testing.assert_array_equal(result.updates[0], [1 + p for p in per_episode])
 
 
 def test_demonstrations_are_replayed_exactly() -> None:
@@ -140,6 +169,30 @@ def test_prioritized_reaches_the_optimal_greedy_policy_of_full_with_fewer_update
         for result in runs.values():
             np.testing.assert_array_equal(_greedy_steps(grid, result.q[0]), shortest)
         assert runs["prioritized"].updates.sum() < 0.6 * runs["full"].updates.sum()
+
+
+def test_prioritized_sweeps_the_goal_back_to_the_start_in_one_episode() -> None:
+    # A one-way corridor walked once with alpha = 1: when the last real step learns the goal's
+    # reward, sweeping must queue that state's predecessor, update it, queue its predecessor, and so
+    # on back to the start, all within that step's planning budget. Q then holds the corridor's
+    # exact values, V(s) = -1 + gamma V(s + 1) from V(last) = 10. Q-learning alone knows only the
+    # last step.
+    length, gamma = 8, 0.9
+    mdp = corridor(length, actions=1)
+    values = [GOAL_REWARD]
+    for _ in range(length - 2):
+        values.insert(0, -1.0 + gamma * values[0])
+    config = DynaQConfig(alpha=1.0, gamma=gamma, planning="prioritized", planning_steps=length)
+    swept = run_experiments(mdp, config, 1, 1, seed=0)
+    np.testing.assert_allclose(swept.q[0, :-1, 0], values, rtol=0, atol=1e-12)
+    alone = run_experiments(mdp, DynaQConfig(alpha=1.0, gamma=gamma), 1, 1, seed=0)
+    np.testing.assert_array_equal(alone.q[0, :-1, 0], [-1.0] * (length - 2) + [GOAL_REWARD])
+    # Cut one step short of the goal, the sweeps carry falling values back just as well: the k
+    # states walked are worth -(1 + gamma + ... ) up to the cut, where nothing is known yet.
+    k = length - 2
+    short = run_experiments(mdp, dataclasses.replace(config, max_steps_per_episode=k), 1, 1, seed=0)
+    expected = [-sum(gamma**i for i in range(k - s)) for s in range(k)] + [0.0, 0.0]
+    np.testing.assert_allclose(short.q[0, :, 0], expected, rtol=0, atol=1e-12)
 
 
 def test_prioritized_without_planning_is_q_learning() -> None:
