@@ -5,7 +5,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from studio.learning import MAX_TABLE_ENTRIES, ArmGrid, LearningError
+from studio.learning import MAX_TABLE_ENTRIES, ArmGrid, DynaQConfig, LearningError, run_experiments
 
 grids = st.builds(
     ArmGrid,
@@ -100,6 +100,23 @@ def test_six_joints_where_memory_allows_and_a_clear_refusal_beyond() -> None:
         ArmGrid(goal=(11, 0, 0))
     with pytest.raises(LearningError, match="empty"):
         ArmGrid(low_deg=10, high_deg=-10)
+
+
+def test_a_six_joint_grid_moves_every_joint_and_learns() -> None:
+    grid = ArmGrid(joints=6, bins=3, goal=(1, 1, 1, 1, 1, 1))
+    mdp = grid.mdp()
+    assert mdp.next_state.shape == (3**6, 3**6)
+    rng = np.random.default_rng(0)
+    deltas = grid.action_deltas()
+    for state, action in zip(
+        rng.integers(0, grid.n_states, 50), rng.integers(0, 729, 50), strict=True
+    ):
+        moved = np.asarray(grid.bins_of(int(state))) + deltas[action]
+        stays = (moved < 0) | (moved >= grid.bins)  # out of range: that joint stays
+        moved[stays] = np.asarray(grid.bins_of(int(state)))[stays]
+        assert grid.bins_of(int(mdp.next_state[state, action])) == tuple(moved)
+    result = run_experiments(mdp, DynaQConfig(planning="full", planning_steps=5), 2, 3, seed=0)
+    assert np.all(result.steps >= 1) and np.all(result.q[:, grid.goal_state] == 0)
 
 
 def test_shortest_steps_is_the_chebyshev_distance() -> None:
