@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import shutil
 import socket
 import statistics
@@ -154,10 +155,27 @@ def wall(run: dict[str, Any]) -> float:
     return run["wall"]
 
 
+def chromium_cpu_seconds() -> float:
+    """CPU seconds used so far by every Chromium process on this machine (Linux /proc)."""
+    tick = os.sysconf("SC_CLK_TCK")
+    total = 0.0
+    for pid in filter(str.isdigit, os.listdir("/proc")):
+        try:
+            with open(f"/proc/{pid}/cmdline", "rb") as f:
+                if b"chromium" not in f.read():
+                    continue
+            with open(f"/proc/{pid}/stat") as f:
+                fields = f.read().rsplit(")", 1)[1].split()
+        except OSError:  # the process ended meanwhile
+            continue
+        total += (int(fields[11]) + int(fields[12])) / tick
+    return total
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--loads", type=int, default=3, help="cold page loads per page")
-    parser.add_argument("--runs", type=int, default=2, help="training runs per condition")
+    parser.add_argument("--runs", type=int, default=3, help="training runs per condition")
     args = parser.parse_args()
     if not Path(CHROMIUM).exists():
         raise SystemExit(f"needs Chromium at {CHROMIUM}")
@@ -203,12 +221,16 @@ def main() -> int:
         w0 = statistics.median(without)
         print(f"== training ({TRAIN}, median of {args.runs} runs each, s of wall time)")
         print(f"  no page open            {w0:6.2f}")
-        for label, (walls, rates) in (("page, scene still", idle), ("page, live simulator", live)):
+        for label, (walls, rates, cores) in (
+            ("page, scene still", idle),
+            ("page, live simulator", live),
+        ):
             w1 = statistics.median(walls)
             rate = statistics.median(rates) if rates else float("nan")
             print(
                 f"  {label:<22}  {w1:6.2f}   slowdown {w1 / w0:5.2f}x (goal <= 1.10)"
                 f"   curve updates {rate:5.1f}/s (goal >= 5)"
+                f"   browser used {statistics.median(cores):4.2f} of {os.cpu_count()} cores"
             )
     finally:
         proc.terminate()
@@ -222,22 +244,25 @@ def main() -> int:
 
 def measure_with_page(
     browser: Any, base: str, tag: str, runs: int
-) -> tuple[list[float], list[float]]:
-    """Train ``runs`` times with the page open; wall times and curve updates per second seen."""
+) -> tuple[list[float], list[float], list[float]]:
+    """Train ``runs`` times with the page open: wall times, curve updates per second seen, and
+    the cores the browser used meanwhile (it competes with training for this machine's CPU)."""
     ctx = browser.new_context(viewport={"width": 1440, "height": 900})
     page = ctx.new_page()
     page.goto(base + "/")
     page.wait_for_selector("body[data-ready='1']", timeout=30_000)
     time.sleep(2.0)  # the scene connects and settles
-    walls, rates = [], []
+    walls, rates, cores = [], [], []
     for i in range(runs):
         before = page.evaluate("() => window.studio.curveRenders || 0")
+        cpu = chromium_cpu_seconds()
         run = train(base, f"{tag}-page-{i}")
+        cores.append((chromium_cpu_seconds() - cpu) / wall(run))
         renders = page.evaluate("() => window.studio.curveRenders || 0") - before
         walls.append(wall(run))
         rates.append(renders / wall(run))
     ctx.close()
-    return walls, rates
+    return walls, rates, cores
 
 
 if __name__ == "__main__":
