@@ -862,7 +862,6 @@ function renderCurves() {
     S.chartZoomed = false;
     fitChart();
   }
-  S.chart = chart;
   S.curveRenders = (S.curveRenders || 0) + 1; // chart redraws with new data (benchmarks read it)
 }
 
