@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
 
@@ -46,6 +47,16 @@ def open_client(tmp_path: Path) -> Iterator[Callable[..., TestClient]]:
 def client(open_client: Callable[..., TestClient]) -> TestClient:
     """A studio client on a fresh temporary data directory."""
     return open_client()
+
+
+def wait_for(predicate: Callable[[], object], timeout: float = 20.0, step: float = 0.05) -> bool:
+    """Poll ``predicate`` until it is true or ``timeout`` seconds pass; whether it became true."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        if predicate():
+            return True
+        time.sleep(step)
+    return False
 
 
 def wait_run(client: TestClient, run_id: str, timeout: float = 60.0) -> dict:

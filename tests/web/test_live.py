@@ -4,14 +4,7 @@ from __future__ import annotations
 
 import time
 
-
-def wait_for(predicate, timeout: float = 20.0, step: float = 0.05) -> bool:
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        if predicate():
-            return True
-        time.sleep(step)
-    return False
+from tests.web.conftest import wait_for
 
 
 def test_the_simulator_drives_the_robot(open_client):

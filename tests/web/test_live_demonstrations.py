@@ -8,7 +8,7 @@ import numpy as np
 
 from studio.capture import read_recording
 from studio.learning import ArmGrid
-from tests.web.test_live import wait_for
+from tests.web.conftest import wait_for
 
 
 def test_record_and_mark_a_demonstration_live(open_client, tmp_path):

@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from studio.capture import Calibration, ShapeTapeEmulator, read_recording
+from tests.web.conftest import wait_for
 
 SAMPLE = Path(__file__).resolve().parents[2] / "recordings" / "sample-reach-1.tape.csv"
 GAIN = 2e-4
@@ -17,15 +18,6 @@ GAIN = 2e-4
 
 def _angles(k: int) -> tuple[np.ndarray, np.ndarray, int]:
     return np.linspace(-0.6, 0.6, 16) * np.cos(k / 25), np.full(16, 0.002 * (k % 40)), 0
-
-
-def _wait(cond, timeout: float) -> bool:
-    end = time.monotonic() + timeout
-    while time.monotonic() < end:
-        if cond():
-            return True
-        time.sleep(0.05)
-    return bool(cond())
 
 
 def test_a_serial_tape_with_its_calibration_is_captured_in_radians(client, tmp_path):
@@ -43,7 +35,7 @@ def test_a_serial_tape_with_its_calibration_is_captured_in_radians(client, tmp_p
         )
         assert r.status_code == 200, r.text
         assert r.json()["kind"] == "serial" and r.json()["error"] is None
-        assert _wait(lambda: client.get("/api/source").json()["frames"] > 10, 10)
+        assert wait_for(lambda: client.get("/api/source").json()["frames"] > 10, 10)
         assert client.post("/api/capture/start", json={"name": "serial-take"}).status_code == 200
         time.sleep(1.0)
         assert client.post("/api/capture/stop").status_code == 200
@@ -55,7 +47,7 @@ def test_a_serial_tape_with_its_calibration_is_captured_in_radians(client, tmp_p
         want_bend, want_twist, _ = _angles(int(k))  # the tape's own counter numbers the frames
         assert np.allclose(bend, want_bend, atol=GAIN) and np.allclose(twist, want_twist, atol=GAIN)
     # Unplugged: the source says so, and the studio goes on.
-    assert _wait(lambda: client.get("/api/source").json()["error"] is not None, 10)
+    assert wait_for(lambda: client.get("/api/source").json()["error"] is not None, 10)
     assert "disconnected" in client.get("/api/source").json()["error"]
 
 
