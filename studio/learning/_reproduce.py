@@ -405,9 +405,9 @@ def judge_claims(results: dict[str, ExperimentResult], grid: ArmGrid, demos: int
         sv_runs = results["SV-FPL"].steps[:, window].mean(axis=1)  # one value per experiment
         us_runs = results["US-FPL"].steps[:, window].mean(axis=1)
         sv, us = float(sv_runs.mean()), float(us_runs.mean())
-        diff_se = float(
-            np.hypot(_standard_error(sv_runs[:, None])[0], _standard_error(us_runs[:, None])[0])
-        )
+        sv_se = float(_standard_error(sv_runs))
+        us_se = float(_standard_error(us_runs))
+        diff_se = float(np.hypot(sv_se, us_se))
         if not np.isfinite(diff_se):
             noise = ""
         elif sv - us > 2 * diff_se:
@@ -420,9 +420,8 @@ def judge_claims(results: dict[str, ExperimentResult], grid: ArmGrid, demos: int
         claims.append(
             Claim(
                 "Between the 20th and 35th episode the unsupervised agent performs a little better than the supervised one (Fig. 8).",
-                f"Mean steps over episodes {demos + 1}-35 with full planning: supervised {_pm(sv, _standard_error(sv_runs[:, None])[0], 1)}, "
-                f"unsupervised {_pm(us, _standard_error(us_runs[:, None])[0], 1)}; difference {_pm(sv - us, diff_se, 1)}."
-                + noise,
+                f"Mean steps over episodes {demos + 1}-35 with full planning: supervised {_pm(sv, sv_se, 1)}, "
+                f"unsupervised {_pm(us, us_se, 1)}; difference {_pm(sv - us, diff_se, 1)}." + noise,
                 bool(us < sv),
             )
         )
