@@ -1,11 +1,13 @@
 """Demonstrations: a recording segment turned into a Puma560 trajectory and a grid path to the goal.
 
 A segment ``[t0, t1]`` of a recording runs through the kinematics (reconstruct + fit the human
-arm, retarget onto the Puma560), then onto the learning task's :class:`ArmGrid` as a path of
-valid consecutive actions, with pauses and loops (bin-boundary flicker) removed, ending at the
-goal. A segment that never reaches
-the goal, drives the robot into a joint limit, or fits the arm badly is refused with the reason;
-with ``goal_from_end=True`` the goal becomes wherever the segment ends.
+arm, retarget onto the Puma560), then onto the learning task's :class:`ArmGrid` with
+:meth:`ArmGrid.path_from_joints` (the one demonstration-to-grid-path function, which the page's
+run queue and ``studio train`` replay too): valid consecutive actions, cut at the first visit to
+the goal (a reach-and-return motion keeps its reach), pauses and loops (bin-boundary flicker)
+removed. A segment that never reaches the goal, drives the robot into a joint limit, or fits the
+arm badly is refused with the reason; with ``goal_from_end=True`` the goal becomes wherever the
+segment ends, and a ``grid`` with another goal cuts at that goal.
 
 File (``*.demo.json``, next to its recording)::
 
@@ -16,7 +18,9 @@ File (``*.demo.json``, next to its recording)::
      "fit": {"residual_max": m, "residual_mean": m, "max_allowed": m},
      "trajectory": {"t": [...], "q_robot": [[6 angles], ...]}, "name": "...", "created": "..."}
 
-``grid_path`` is what ``studio train --demos`` and the learning engine replay.
+``grid_path`` is what ``studio train --demos`` and the learning engine replay: it is
+``ArmGrid(**grid).path_from_joints(trajectory.q_robot)``, recomputed on load, so a file written by
+older code (which erased loops before cutting at the goal) replays today's path.
 """
 
 from __future__ import annotations
@@ -30,6 +34,8 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+
+from studio.learning import ArmGrid, LearningError
 
 from ._errors import DemonstrationError
 from ._recording_edit import DEMO_SUFFIX, atomic_write_text
@@ -89,10 +95,8 @@ class Demonstration:
     name: str = ""
     created: str = field(default_factory=lambda: datetime.now(UTC).isoformat(timespec="seconds"))
 
-    def arm_grid(self) -> Any:
+    def arm_grid(self) -> ArmGrid:
         """The :class:`studio.learning.ArmGrid` this demonstration's path lives on."""
-        from studio.learning import ArmGrid
-
         return ArmGrid(**{**self.grid, "goal": tuple(self.grid["goal"])})
 
     def default_path(self) -> Path:
@@ -176,7 +180,7 @@ def load_demonstration(path: str | os.PathLike[str]) -> Demonstration:
         )
     try:
         trajectory = data["trajectory"]
-        return Demonstration(
+        demo = Demonstration(
             recording=path.with_name(data["recording"]),
             t0=float(data["segment"][0]),
             t1=float(data["segment"][1]),
@@ -196,13 +200,27 @@ def load_demonstration(path: str | os.PathLike[str]) -> Demonstration:
         raise DemonstrationError(
             f"{path} lacks or garbles a field ({err}); re-extract the demonstration.", "bad_file"
         ) from None
+    if demo.q_robot.shape[0] > 0:
+        # The grid path is derived from the trajectory by the one path function; a file written
+        # by older code (which erased loops before cutting at the goal) gets today's path, so
+        # the listing, the page and the CLI replay the same steps.
+        try:
+            trace = demo.arm_grid().trace_joints(demo.q_robot, stop_at_goal=True)
+        except (LearningError, TypeError) as err:
+            raise DemonstrationError(
+                f"{path} has a bad grid or trajectory ({err}); re-extract the demonstration.",
+                "bad_file",
+            ) from None
+        if trace.reaches_goal and trace.steps >= 1:
+            demo.grid_path = trace.states
+    return demo
 
 
 def extract_demonstration(
     recording: Recording | str | os.PathLike[str],
     t0: float,
     t1: float,
-    grid: Any = None,
+    grid: ArmGrid | None = None,
     mode: str = "joint",
     goal_from_end: bool = False,
     *,
@@ -217,7 +235,8 @@ def extract_demonstration(
         recording: a :class:`Recording` or a path.
         t0: segment start (s after the recording's first frame, as playback's ``seek``).
         t1: segment end (s after the first frame).
-        grid: the :class:`studio.learning.ArmGrid` (default ``ArmGrid()``, the paper's task).
+        grid: the :class:`studio.learning.ArmGrid` (default ``ArmGrid()``, the paper's task);
+            its goal is where the path is cut (the first visit).
         mode: retargeting mode, ``"joint"`` or ``"cartesian"``.
         goal_from_end: instead of refusing a segment that misses the goal, make its end the goal.
         max_residual: worst allowed fit residual (m).
@@ -233,7 +252,6 @@ def extract_demonstration(
             ``never_reaches_goal``, and one sentence saying what to change.
     """
     from studio.kinematics import ArmFitter, HumanArm, Retargeter
-    from studio.learning import ArmGrid
 
     rec = recording if isinstance(recording, Recording) else read_recording(recording)
     grid = grid if grid is not None else ArmGrid()
@@ -276,37 +294,33 @@ def extract_demonstration(
             f"the motion drives Puma560 joint {j + 1} to its limit at {times[i]:.2f} s; choose a segment that stays inside the robot's range.",
             "leaves_joint_range",
         )
-    path = erase_loops(grid.path_from_joints(q_robot))
-    goal_state = grid.goal_state
-    if goal_state in path:
-        cut = path.index(goal_state)
-        path = path[: cut + 1]
-        arrived = int(
-            np.flatnonzero(
-                np.array([grid.state_of_angles(q[: grid.joints]) for q in q_robot]) == goal_state
-            )[0]
-        )
-        reached_at = float(times[arrived])
-    elif goal_from_end:
-        grid = dataclasses.replace(grid, goal=tuple(int(b) for b in grid.bins_of(path[-1])))
-        reached_at = float(times[-1])
-    else:
-        raise DemonstrationError(
-            f"the segment ends in grid bins {tuple(grid.bins_of(path[-1]))} and never reaches the goal {tuple(grid.goal)}; extend the segment, or set the goal from where it ends.",
-            "never_reaches_goal",
-        )
-    if len(path) < 2:
+    # the demonstration holds what its file holds, so a path traced again from the saved
+    # trajectory (the page's run queue does) is this very path
+    q_robot = np.round(q_robot, TRAJECTORY_DECIMALS)
+    trace = grid.trace_joints(q_robot, stop_at_goal=True)
+    if not trace.reaches_goal:
+        if not goal_from_end:
+            end = tuple(int(b) for b in grid.bins_of_angles(q_robot[-1, : grid.joints]))
+            raise DemonstrationError(
+                f"the segment ends in grid bins {end} and never reaches the goal {tuple(grid.goal)}; extend the segment, or set the goal from where it ends.",
+                "never_reaches_goal",
+            )
+        end = grid.bins_of_angles(q_robot[-1, : grid.joints])
+        grid = dataclasses.replace(grid, goal=tuple(int(b) for b in end))
+        trace = grid.trace_joints(q_robot, stop_at_goal=True)
+    if trace.steps < 1:
         raise DemonstrationError(
             f"the segment [{t0:.2f}, {t1:.2f}] s already starts at the goal; start the segment before the reach.",
             "too_short",
         )
+    reached_at = float(times[trace.samples[-1]])
     return Demonstration(
         recording=rec.path,
         t0=float(t0),
         t1=float(t1),
         times=times.copy(),
         q_robot=q_robot,
-        grid_path=path,
+        grid_path=trace.states,
         grid=grid.to_dict(),
         goal=tuple(grid.goal),
         mode=mode,
@@ -315,28 +329,6 @@ def extract_demonstration(
         residual_mean=float(residual.mean()),
         name=name or f"{rec.name} {t0:.2f}-{t1:.2f} s",
     )
-
-
-def erase_loops(path: list[int]) -> list[int]:
-    """The path with every loop cut out (a state visited twice keeps only its last visit's future).
-
-    Tremor and sensor noise make a hand resting on a bin boundary flicker between two states;
-    those back-and-forth steps (and any wider detour back to a visited state) teach nothing, so a
-    demonstration keeps the loop-free path. Consecutive states stay one action apart, since each
-    kept step is a step of the original path.
-    """
-    out: list[int] = []
-    index: dict[int, int] = {}
-    for state in path:
-        if state in index:
-            cut = index[state]
-            for dropped in out[cut + 1 :]:
-                del index[dropped]
-            del out[cut + 1 :]
-            continue
-        index[state] = len(out)
-        out.append(state)
-    return out
 
 
 def demonstrations_for(recording_path: str | os.PathLike[str]) -> list[Path]:

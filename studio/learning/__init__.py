@@ -13,6 +13,8 @@ from __future__ import annotations
 
 from ._arm import MAX_TABLE_ENTRIES as MAX_TABLE_ENTRIES
 from ._arm import ArmGrid as ArmGrid
+from ._arm import GridPath as GridPath
+from ._arm import erase_loops as erase_loops
 from ._config import MAX_EPISODE_RUNS as MAX_EPISODE_RUNS
 from ._config import MAX_EPISODES as MAX_EPISODES
 from ._config import MAX_EXPERIMENTS as MAX_EXPERIMENTS

@@ -236,24 +236,53 @@ class ArmGrid:
         return float(dist[dist > 0].mean()) if np.any(dist > 0) else 0.0
 
     def path_from_joints(
-        self, q_path_rad: np.ndarray | Sequence[Sequence[float]], *, stop_at_goal: bool = False
+        self, q_path_rad: np.ndarray | Sequence[Sequence[float]], *, stop_at_goal: bool = True
     ) -> list[int]:
-        """A valid grid path (consecutive states one action apart) following a joint trajectory.
+        """The grid path a demonstration replays: :meth:`trace_joints`'s states.
 
-        Each row is mapped to its nearest bins, repeats are dropped (pauses), and jumps of more
-        than one bin are filled in by moving every lagging joint one bin per step toward the next
-        sample at the same time (a diagonal, then straight, walk).
+        This is the one demonstration-to-grid-path function: the demonstration cutter, the
+        page's run queue and ``studio train`` all replay what it returns, so a demonstration
+        trains alike everywhere.
+
+        Args:
+            q_path_rad: joint angles in radians, ``(N, joints)`` or wider (see
+                :meth:`trace_joints`).
+            stop_at_goal: end the path at its first visit to the goal (see :meth:`trace_joints`).
+
+        Returns:
+            State numbers, consecutive ones one action apart, no state twice.
+        """
+        return self.trace_joints(q_path_rad, stop_at_goal=stop_at_goal).states
+
+    def trace_joints(
+        self, q_path_rad: np.ndarray | Sequence[Sequence[float]], *, stop_at_goal: bool = True
+    ) -> GridPath:
+        """A loop-free grid path (consecutive states one action apart) following a trajectory.
+
+        Each row is mapped to its nearest bins. Between two samples whose bins differ by more
+        than one step (a fast motion, or frames dropped), every lagging joint moves one bin per
+        step toward the later sample at the same time (a diagonal, then straight, walk: a
+        shortest grid path), so the path stays one action per step even when the arm jumps
+        over the goal between two samples. Then:
+
+        1. with ``stop_at_goal``, the walk is cut at its first visit to the goal, as an episode
+           would end there. A reach-and-return motion (out to the goal, back to rest) keeps
+           its reach; a hand wobbling in and out of the goal bin keeps its first arrival.
+        2. loops are erased (:func:`erase_loops`): pauses, bin-boundary flicker and detours back
+           to a visited state teach nothing.
 
         Args:
             q_path_rad: joint angles in radians, ``(N, joints)``; wider rows (for example the
                 Puma560's six joints) use their first ``joints`` columns.
-            stop_at_goal: end the path at its first visit to the goal, as an episode would; a
-                human motion often wobbles in and out of the goal bin before it settles, and a
-                demonstration must not go on past the goal.
+            stop_at_goal: end the path at its first visit to the goal.
 
         Returns:
-            State numbers, the first nearest to the first sample, the last to the last (or the
-            goal, with ``stop_at_goal`` when the path reaches it).
+            A :class:`GridPath`: the states (the first nearest to the first sample; the last
+            the goal when cut there, else nearest to the last sample) and, per state, the
+            sample by which the arm got there.
+
+        Raises:
+            LearningError: not an ``(N >= 1, joints or more)`` array of finite angles.
         """
         q = np.asarray(q_path_rad, dtype=np.float64)
         if q.ndim != 2 or q.shape[0] < 1 or q.shape[1] < self.joints:
@@ -261,14 +290,78 @@ class ArmGrid:
                 f"The joint path has shape {q.shape}; give an (N, {self.joints}) or wider array of angles in radians with N >= 1."
             )
         bins = self.bins_of_angles(q[:, : self.joints])
-        path = [bins[0]]
-        for target in bins[1:]:
-            current = path[-1]
-            while np.any(current != target):
-                current = current + np.sign(target - current)
-                path.append(current)
+        walk = [bins[0]]
+        samples = [0]
+        for i in range(1, bins.shape[0]):
+            current, target = walk[-1], bins[i]
+            steps = int(np.max(np.abs(target - current)))
+            if steps == 0:
+                continue
+            # the diagonal-then-straight walk: each joint moves one bin per step until it arrives
+            k = np.arange(1, steps + 1)[:, None]
+            walk.extend(
+                current + np.sign(target - current) * np.minimum(k, np.abs(target - current))
+            )
+            samples.extend([i] * steps)
         shape = (self.bins,) * self.joints
-        states = [int(s) for s in np.ravel_multi_index(tuple(np.array(path).T), shape)]
-        if stop_at_goal and self.goal_state in states:
-            states = states[: states.index(self.goal_state) + 1]
-        return states
+        states = [int(s) for s in np.ravel_multi_index(tuple(np.array(walk).T), shape)]
+        goal = self.goal_state
+        reaches_goal = goal in states
+        if stop_at_goal and reaches_goal:
+            end = states.index(goal) + 1
+            states, samples = states[:end], samples[:end]
+        states, samples = _erase_loops(states, samples)
+        return GridPath(states=states, samples=samples, reaches_goal=reaches_goal)
+
+
+@dataclass(frozen=True)
+class GridPath:
+    """A grid path traced from a joint trajectory by :meth:`ArmGrid.trace_joints`.
+
+    Attributes:
+        states: the states, consecutive ones one action apart, none twice.
+        samples: per state, the index of the trajectory sample by which the arm reached it
+            (non-decreasing; a state filled in between two samples belongs to the later one).
+        reaches_goal: whether the trajectory passes through the goal bin at all (between two
+            samples counts).
+    """
+
+    states: list[int]
+    samples: list[int]
+    reaches_goal: bool
+
+    @property
+    def steps(self) -> int:
+        """Actions along the path (states - 1)."""
+        return max(0, len(self.states) - 1)
+
+
+def erase_loops(path: Sequence[int]) -> list[int]:
+    """The path with every loop cut out (a state visited twice keeps only its last visit's future).
+
+    Tremor and sensor noise make a hand resting on a bin boundary flicker between two states;
+    those back-and-forth steps (and any wider detour back to a visited state) teach nothing, so a
+    demonstration keeps the loop-free path. Consecutive states stay one action apart, since each
+    kept step is a step of the original path.
+    """
+    return _erase_loops(list(path), [0] * len(path))[0]
+
+
+def _erase_loops(states: list[int], samples: list[int]) -> tuple[list[int], list[int]]:
+    """:func:`erase_loops`, carrying each state's sample index (a revisit takes the later one)."""
+    out: list[int] = []
+    out_samples: list[int] = []
+    index: dict[int, int] = {}
+    for state, sample in zip(states, samples, strict=True):
+        if state in index:
+            cut = index[state]
+            for dropped in out[cut + 1 :]:
+                del index[dropped]
+            del out[cut + 1 :]
+            del out_samples[cut + 1 :]
+            out_samples[cut] = sample  # the arm leaves from its latest visit
+            continue
+        index[state] = len(out)
+        out.append(state)
+        out_samples.append(sample)
+    return out, out_samples

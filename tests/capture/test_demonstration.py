@@ -2,9 +2,13 @@
 
 from __future__ import annotations
 
+import json
+import tempfile
+from pathlib import Path
+
 import numpy as np
 import pytest
-from hypothesis import given
+from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 from studio.capture import (
@@ -16,7 +20,6 @@ from studio.capture import (
     read_recording,
     simulate,
 )
-from studio.capture._demonstration import erase_loops
 from studio.learning import ArmGrid
 
 SECONDS = 5.0
@@ -128,15 +131,6 @@ def test_too_short_segment(reach):
     assert err.value.reason == "too_short"
 
 
-@given(st.lists(st.integers(0, 6), min_size=1, max_size=40))
-def test_erase_loops_keeps_a_loop_free_subpath(path):
-    out = erase_loops(path)
-    assert len(set(out)) == len(out)
-    assert out[0] == path[0] and out[-1] == path[-1]
-    steps = set(zip(path, path[1:], strict=False))
-    assert all(step in steps for step in zip(out, out[1:], strict=False))
-
-
 def test_trigger_marks_the_reach_as_a_segment(reach):
     from studio.capture import trigger_segments
 
@@ -144,3 +138,117 @@ def test_trigger_marks_the_reach_as_a_segment(reach):
     [(t0, t1)] = trigger_segments(rec)
     assert t0 == pytest.approx(sim.reach_start / 110) and t1 == pytest.approx(rec.duration)
     assert extract_demonstration(rec, t0, t1, grid=grid).grid_path[-1] == grid.goal_state
+
+
+def _write(path, config, bend, twist, times):
+    with RecordingWriter(path, config=config) as writer:
+        writer.write_many([TapeFrame(float(t), i, bend[i], twist[i]) for i, t in enumerate(times)])
+    return path
+
+
+def test_a_reach_and_return_is_accepted_and_cut_at_the_first_goal_visit(reach, tmp_path):
+    """Issue 9: reaching out to the goal and coming back to rest is the natural demonstration."""
+    rec, sim, grid = reach
+    out = np.arange(rec.t.shape[0])[rec.segment(sim.reach_start / 110, rec.duration)]
+    back = out[::-1]  # the same motion played backwards: back to where the reach started
+    rows = np.concatenate([out, back])
+    times = np.arange(rows.shape[0]) / 110.0
+    path = _write(tmp_path / "return.tape.csv", rec.config, rec.bend[rows], rec.twist[rows], times)
+    demo = extract_demonstration(path, 0.0, times[-1], grid=grid)
+    assert demo.grid_path[-1] == grid.goal_state and len(demo.grid_path) >= 2
+    assert _one_action_apart(grid, demo.grid_path)
+    assert len(set(demo.grid_path)) == len(demo.grid_path)
+    assert demo.reached_at <= times[len(out)]  # reached on the way out, not on the way back
+    # it ends back at rest, outside the goal: the whole segment is kept as recorded
+    assert grid.state_of_angles(demo.q_robot[-1, :3]) != grid.goal_state
+    assert demo.q_robot.shape[0] == rows.shape[0]
+    # the one path function, on the saved trajectory, gives this very path (the page and the
+    # CLI replay it)
+    saved = load_demonstration(demo.save(tmp_path / "return.demo.json"))
+    assert saved.grid_path == demo.grid_path == grid.path_from_joints(saved.q_robot)
+    # the reach alone gives the same path
+    alone = extract_demonstration(path, 0.0, times[len(out) - 1], grid=grid)
+    assert alone.grid_path == demo.grid_path
+
+
+ROBOT_BOX = ((3, 7), (4, 7), (2, 6))
+"""Grid bins (per joint, inclusive) whose centres the mirrored operator reaches without touching
+a human or Puma560 joint limit, so the tape's fit gives back the bin."""
+
+
+@settings(max_examples=12, deadline=None)
+@given(data=st.data())
+def test_a_jump_over_the_goal_between_two_frames_is_cut_at_the_goal(reach, data):
+    """Issue 13 item 9: a grid path that jumps over the goal between two samples answered 500."""
+    from studio.kinematics import HumanArm, Retargeter, tape_from_arm
+
+    rec, _, _ = reach
+    start = np.array([data.draw(st.integers(lo, hi)) for lo, hi in ROBOT_BOX])
+    end = np.array([data.draw(st.integers(lo, hi)) for lo, hi in ROBOT_BOX])
+    steps = int(np.max(np.abs(end - start)))
+    assume(steps >= 2)
+    k = data.draw(st.integers(1, steps - 1))
+    goal = start + np.sign(end - start) * np.minimum(k, np.abs(end - start))
+    grid = ArmGrid(goal=tuple(int(b) for b in goal))
+    q_robot = np.zeros((2, 6))
+    q_robot[:, :3] = [grid.angles_of(grid.state_of(b)) for b in (start, end)]
+    arm = HumanArm()
+    retarget = Retargeter("joint", mirror=True, arm=arm)
+    q_human = np.array([retarget.human_from_robot(q) for q in q_robot])
+    bend, twist = tape_from_arm(arm, q_human, rec.config)
+    with tempfile.TemporaryDirectory() as folder:
+        path = _write(Path(folder) / "jump.tape.csv", rec.config, bend, twist, [0.0, 0.5])
+        demo = extract_demonstration(path, 0.0, 0.5, grid=grid)
+    assert [grid.state_of_angles(q[:3]) for q in demo.q_robot] == [
+        grid.state_of(start),
+        grid.state_of(end),
+    ]  # neither frame lies in the goal bin
+    assert demo.grid_path[-1] == grid.goal_state and len(demo.grid_path) == k + 1
+    assert _one_action_apart(grid, demo.grid_path)
+    assert demo.reached_at == 0.5
+
+
+def test_a_file_written_by_older_code_still_loads(tmp_path):
+    """Version 1 files replayed the path erased before the goal cut; they load with today's path."""
+    grid = ArmGrid(goal=(7, 5, 5))
+    bins = [(5, 5, 5), (6, 5, 5), (5, 5, 5), (6, 5, 5), (7, 5, 5), (6, 5, 5)]
+    q = np.zeros((len(bins), 6))
+    q[:, :3] = [grid.angles_of(grid.state_of(b)) for b in bins]
+    old = {
+        "format": "teach-studio-demonstration",
+        "version": 1,
+        "name": "old",
+        "created": "2026-11-01T00:00:00+00:00",
+        "recording": "take.tape.csv",
+        "segment": [1.0, 3.5],
+        "mode": "joint",
+        "mirror": True,
+        "grid": grid.to_dict(),
+        "goal": list(grid.goal),
+        # old code: no loops erased before the cut, here a flicker kept
+        "grid_path": [grid.state_of(b) for b in bins[:5]],
+        "reached_at": 3.0,
+        "fit": {"residual_max": 0.001, "residual_mean": 0.0005, "max_allowed": 0.03},
+        "trajectory": {"t": [1.0 + 0.5 * i for i in range(len(bins))], "q_robot": q.tolist()},
+    }
+    path = tmp_path / "old.demo.json"
+    path.write_text(json.dumps(old))
+    demo = load_demonstration(path)
+    assert demo.grid_path == [grid.state_of(b) for b in [(5, 5, 5), (6, 5, 5), (7, 5, 5)]]
+    assert demo.grid_path == grid.path_from_joints(demo.q_robot)
+    assert (demo.name, demo.reached_at, demo.goal, demo.t0) == ("old", 3.0, (7, 5, 5), 1.0)
+    assert demo.summary()["steps"] == 2
+    # a file whose grid is garbled is refused with one sentence, not a traceback
+    path.write_text(json.dumps({**old, "grid": {**old["grid"], "bins": -1}}))
+    with pytest.raises(DemonstrationError, match="re-extract") as err:
+        load_demonstration(path)
+    assert err.value.reason == "bad_file"
+
+
+def test_the_shipped_samples_replay_what_their_files_say():
+    """The sample demonstrations' stored paths are what the one path function gives."""
+    folder = Path(__file__).resolve().parents[2] / "recordings"
+    for demo_path in sorted(folder.glob("sample-reach-*.demo.json")):
+        stored = json.loads(demo_path.read_text())["grid_path"]
+        demo = load_demonstration(demo_path)
+        assert demo.grid_path == stored == demo.arm_grid().path_from_joints(demo.q_robot)
