@@ -1,0 +1,275 @@
+"""Meshes to draw the two bodies: Gepetto's whole human and the Puma560's Toolbox link meshes.
+
+Both come from installed data packages, never from the network:
+
+- ``human.urdf``'s own meshes (example-robot-data's ``human_description``, BSD-2), posed by the
+  full 36-joint Pinocchio model of the same file the arm fit uses. The taped arm's seven joints
+  take the fitted ``q_human``; every other joint stays at its neutral (the other arm hangs).
+  Poses are given in the taped arm's *arm base frame* (see :mod:`studio.kinematics._human`: Z
+  up, shoulder at the origin), the frame the fit and the tape live in.
+- The Puma560 link meshes of ``rtb-data`` (MIT, Peter Corke; the data files of the Robotics
+  Toolbox for Python), which the Toolbox attaches as ``link{j}.stl`` to DH frame ``j`` of its
+  standard-DH Puma560 (``link0`` to the base). Our :meth:`Puma560.joint_frames` are the same
+  frames, so each mesh is drawn at ``joint_frames(q)[j]`` unchanged.
+
+Meshes are simplified by vertex clustering (one vertex per cubic cell of
+:attr:`MeshConfig.cell_m`), which keeps the shape to within a cell and cuts the triangle count
+several times, so the scene stays smooth under software WebGL.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+
+from ._errors import KinematicsError
+from ._human import ARM_JOINTS, YUP_TO_ZUP, find_human_urdf
+
+PUMA_MESH_DIR = Path("meshes/UNIMATE/puma560")
+"""Where ``rtb-data`` keeps the Puma560 link meshes, relative to its package folder."""
+
+PUMA_LINK_COLORS = (
+    (0.55, 0.56, 0.60),
+    (0.80, 0.80, 0.82),
+    (0.86, 0.86, 0.88),
+    (0.80, 0.80, 0.82),
+    (0.40, 0.42, 0.46),
+    (0.40, 0.42, 0.46),
+    (0.25, 0.26, 0.30),
+)
+"""Link colours (rgb in [0, 1]): the Unimate's grey castings, a darker wrist."""
+
+HUMAN_COLORS = {
+    "skin": (0.89, 0.72, 0.60),
+    "shirt": (0.28, 0.44, 0.64),
+    "trousers": (0.30, 0.31, 0.36),
+}
+"""Colours of the operator: skin, shirt, trousers (rgb in [0, 1])."""
+
+
+@dataclass(frozen=True)
+class MeshConfig:
+    """How the meshes are simplified.
+
+    Attributes:
+        cell_m: vertex-clustering cell (m); 0 keeps the meshes whole. The default keeps every
+            feature larger than a centimetre and cuts the triangles about 5x.
+    """
+
+    cell_m: float = 0.01
+
+
+@dataclass(frozen=True)
+class MeshPart:
+    """One mesh, ready to draw: vertices already expressed in the frame it moves with.
+
+    Attributes:
+        name: a unique name (``"link3"``, ``"right_upperarm/upperarm_mesh"``).
+        frame: where it is attached: an index into ``Puma560.joint_frames`` (robot), or a link
+            name of ``human.urdf`` (operator).
+        vertices: ``(V, 3)`` float32, metres, in that frame.
+        faces: ``(F, 3)`` uint32 vertex indices.
+        rgb: colour, floats in [0, 1].
+    """
+
+    name: str
+    frame: int | str
+    vertices: np.ndarray
+    faces: np.ndarray
+    rgb: tuple[float, float, float]
+
+
+def simplify(
+    vertices: np.ndarray, faces: np.ndarray, cell_m: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """Vertex clustering: merge the vertices of each ``cell_m`` cube, drop collapsed triangles.
+
+    Args:
+        vertices: ``(V, 3)`` positions (m).
+        faces: ``(F, 3)`` indices.
+        cell_m: cell size (m); 0 or less returns the mesh unchanged.
+
+    Returns:
+        The simplified ``(vertices float32, faces uint32)``; every vertex is the mean of the
+        vertices it replaces, so the shape moves by less than one cell.
+    """
+    v = np.asarray(vertices, dtype=np.float64)
+    f = np.asarray(faces, dtype=np.int64)
+    if cell_m <= 0 or len(v) == 0:
+        return v.astype(np.float32), f.astype(np.uint32)
+    keys = np.floor((v - v.min(axis=0)) / cell_m).astype(np.int64)
+    _, cluster, counts = np.unique(keys, axis=0, return_inverse=True, return_counts=True)
+    cluster = cluster.reshape(-1)
+    sums = np.zeros((len(counts), 3))
+    np.add.at(sums, cluster, v)
+    merged = sums / counts[:, None]
+    g = cluster[f]
+    keep = (g[:, 0] != g[:, 1]) & (g[:, 1] != g[:, 2]) & (g[:, 0] != g[:, 2])
+    g = g[keep]
+    # Two triangles of opposite winding on the same three clusters cancel: keep one.
+    _, first = np.unique(np.sort(g, axis=1), axis=0, return_index=True)
+    g = g[np.sort(first)]
+    used, g = np.unique(g, return_inverse=True)
+    return merged[used].astype(np.float32), g.reshape(-1, 3).astype(np.uint32)
+
+
+def _load_stl(path: Path) -> tuple[np.ndarray, np.ndarray]:
+    import trimesh
+
+    mesh = trimesh.load(str(path), force="mesh", process=True)
+    return np.asarray(mesh.vertices, dtype=np.float64), np.asarray(mesh.faces, dtype=np.int64)
+
+
+def puma560_mesh_dir() -> Path:
+    """The folder of the installed ``rtb-data`` Puma560 link meshes.
+
+    Raises:
+        KinematicsError: ``rtb-data`` is not installed.
+    """
+    spec = importlib.util.find_spec("rtbdata")
+    if spec is None or spec.origin is None:
+        raise KinematicsError(
+            "The Puma560 meshes (rtb-data) are not installed; install them with `pip install rtb-data`."
+        )
+    folder = Path(spec.origin).parent / PUMA_MESH_DIR
+    if not (folder / "link0.stl").is_file():
+        raise KinematicsError(
+            f"The Puma560 meshes are missing from {folder}; reinstall them with `pip install --force-reinstall rtb-data`."
+        )
+    return folder
+
+
+def puma560_meshes(config: MeshConfig | None = None) -> list[MeshPart]:
+    """The seven Puma560 link meshes (base and links 1-6), each in its DH frame.
+
+    Args:
+        config: simplification (default :class:`MeshConfig`).
+
+    Returns:
+        Parts whose ``frame`` ``j`` indexes ``Puma560.joint_frames(q)``.
+    """
+    config = config if config is not None else MeshConfig()
+    folder = puma560_mesh_dir()
+    parts = []
+    for j, rgb in enumerate(PUMA_LINK_COLORS):
+        v, f = simplify(*_load_stl(folder / f"link{j}.stl"), config.cell_m)
+        parts.append(MeshPart(f"link{j}", j, v, f, rgb))
+    return parts
+
+
+def _human_color(link: str) -> tuple[float, float, float]:
+    if any(k in link for k in ("head", "hand", "lowerarm")):
+        return HUMAN_COLORS["skin"]
+    if any(k in link for k in ("leg", "foot", "pelvis")):
+        return HUMAN_COLORS["trousers"]
+    return HUMAN_COLORS["shirt"]
+
+
+class HumanBody:
+    """Gepetto's whole human, posed with one arm following ``q_human`` and the rest at neutral.
+
+    Args:
+        side: the taped arm (``"right"`` or ``"left"``); poses are in its arm base frame.
+        config: simplification (default :class:`MeshConfig`).
+
+    Attributes:
+        parts: the meshes, each attached to a ``human.urdf`` link.
+        moving: indices into ``parts`` of the meshes that move with the taped arm.
+        floor_z: height of the lowest vertex in the neutral pose (arm base frame, m): the body
+            stands on a floor at this height.
+        model, data: the full Pinocchio model (immutable) and its scratch data (not thread-safe).
+    """
+
+    def __init__(self, side: str = "right", config: MeshConfig | None = None) -> None:
+        if side not in ("right", "left"):
+            raise KinematicsError(f'side must be "right" or "left"; got {side!r}.')
+        import yourdfpy
+
+        config = config if config is not None else MeshConfig()
+        urdf = find_human_urdf()
+        self.side = side
+        self.model = pin.buildModelFromUrdf(str(urdf))
+        self.data = self.model.createData()
+        self._q0 = pin.neutral(self.model)
+        joints = [self.model.getJointId(f"{side}_{name}") for name in ARM_JOINTS]
+        self._arm_idx_q = np.array([self.model.joints[j].idx_q for j in joints])
+        # The arm base frame: Z up, origin at the taped side's shoulder at neutral (as HumanArm).
+        pin.forwardKinematics(self.model, self.data, self._q0)
+        shoulder = self.data.oMi[joints[0]].translation.copy()
+        self._baseMurdf = np.eye(4)
+        self._baseMurdf[:3, :3] = YUP_TO_ZUP
+        self._baseMurdf[:3, 3] = -YUP_TO_ZUP @ shoulder
+
+        root = urdf.parents[1]  # .../robots/human_description
+        description = yourdfpy.URDF.load(str(urdf), load_meshes=False, build_scene_graph=False)
+        parts: list[MeshPart] = []
+        frame_ids: list[int] = []
+        for link in description.robot.links:
+            for visual in link.visuals:
+                mesh = visual.geometry.mesh if visual.geometry is not None else None
+                if mesh is None:
+                    continue
+                path = root / "meshes" / Path(mesh.filename).name
+                v, f = _load_stl(path)
+                if mesh.scale is not None:
+                    v = v * np.asarray(mesh.scale, dtype=float)
+                if visual.origin is not None:
+                    v = v @ visual.origin[:3, :3].T + visual.origin[:3, 3]
+                v, f = simplify(v, f, config.cell_m)
+                name = f"{link.name}/{path.stem}"
+                parts.append(MeshPart(name, link.name, v, f, _human_color(link.name)))
+                frame_ids.append(self.model.getFrameId(link.name, pin.FrameType.BODY))
+        self.parts = parts
+        self._frame_ids = frame_ids
+        first_arm_joint = joints[0]
+        self.moving = [
+            i
+            for i, fid in enumerate(frame_ids)
+            if self._below(self.model.frames[fid].parentJoint, first_arm_joint)
+        ]
+        rest = self.poses(None)
+        self.floor_z = float(
+            min(
+                (p.vertices @ m[:3, :3].T + m[:3, 3])[:, 2].min()
+                for p, m in zip(self.parts, rest, strict=True)
+            )
+        )
+
+    def _below(self, joint: int, ancestor: int) -> bool:
+        while joint > 0:
+            if joint == ancestor:
+                return True
+            joint = self.model.parents[joint]
+        return False
+
+    def full_q(self, q_human: np.ndarray | None) -> np.ndarray:
+        """The full model's configuration: the taped arm at ``q_human``, the rest at neutral."""
+        q = self._q0.copy()
+        if q_human is not None:
+            q[self._arm_idx_q] = np.asarray(q_human, dtype=float).reshape(len(ARM_JOINTS))
+        return q
+
+    def poses(self, q_human: np.ndarray | None) -> np.ndarray:
+        """Poses ``(len(parts), 4, 4)`` of every part in the arm base frame.
+
+        Args:
+            q_human: the taped arm's seven joints (rad), or None for the neutral pose.
+        """
+        q = self.full_q(q_human)
+        pin.framesForwardKinematics(self.model, self.data, q)
+        out = np.empty((len(self.parts), 4, 4))
+        for k, fid in enumerate(self._frame_ids):
+            out[k] = self._baseMurdf @ self.data.oMf[fid].homogeneous
+        return out
+
+    def link_pose(self, link: str, q_human: np.ndarray | None) -> np.ndarray:
+        """The pose (4x4, arm base frame) of a ``human.urdf`` link."""
+        pin.framesForwardKinematics(self.model, self.data, self.full_q(q_human))
+        fid = self.model.getFrameId(link, pin.FrameType.BODY)
+        if fid >= len(self.model.frames):
+            raise KinematicsError(f"human.urdf has no link {link!r}; give a link of the model.")
+        return self._baseMurdf @ self.data.oMf[fid].homogeneous
