@@ -1,7 +1,8 @@
 """Kinematics speed: the live path per frame, and batch reconstruction of a recording.
 
-(a) Live path, per 110 Hz frame: ``reconstruct`` -> ``ArmFitter.fit`` (warm) ->
-    ``Retargeter.robot_from_human`` (joint mode, the default; cartesian mode is timed too).
+(a) Live path, per 110 Hz frame: ``ArmTracker.track`` (``reconstruct`` -> ``ArmFitter.fit``
+    (warm) -> ``Retargeter.robot_from_human``, joint mode, the default; cartesian mode is timed
+    too), the chain the live pipeline and demonstration extraction run.
     Target: median under 0.3 ms. Baseline: a naive per-frame path, a pure-NumPy loop
     reconstruction (one 3x3 rotation product per region, as in the tapeAPI's description) and
     a generic Pinocchio DLS fit started from the neutral pose every frame (no closed-form seed,
@@ -25,8 +26,8 @@ import pinocchio as pin
 
 from studio.kinematics import (
     ArmFitter,
+    ArmTracker,
     HumanArm,
-    Retargeter,
     TapeConfig,
     reconstruct,
     tape_from_arm,
@@ -101,25 +102,27 @@ def demo_motion(arm: HumanArm, frames: int, seed: int) -> np.ndarray:
 
 
 def time_live(
-    bend, twist, config, arm, fitter, retargeter, naive: bool, cold: bool = False
+    bend, twist, tracker: ArmTracker, naive: bool, cold: bool = False
 ) -> tuple[np.ndarray, np.ndarray]:
     """Per-frame times and the fitted arms, ``(times (N,), q_human (N, 7))``.
 
-    ``cold`` resets our fitter before every frame (no warm start), to show what it buys.
+    Ours is ``tracker.track``; the naive path replaces its reconstruction and fit and keeps its
+    retargeter. ``cold`` resets our tracker before every frame (no warm start), to show what it
+    buys.
     """
+    arm, config, retargeter = tracker.arm, tracker.tape, tracker.retargeter
     times = np.empty(len(bend))
     fitted = np.empty((len(bend), arm.nq))
-    fitter.reset()
-    retargeter.reset()
+    tracker.reset()
     for k in range(len(bend)):
         if cold:
-            fitter.reset()
+            tracker.reset()
         t0 = time.perf_counter()
         if naive:
-            q_human = naive_fit(arm, fitter, naive_reconstruct(bend[k], twist[k], config))
+            q_human = naive_fit(arm, tracker.fitter, naive_reconstruct(bend[k], twist[k], config))
+            retargeter.robot_from_human(q_human)
         else:
-            q_human = fitter.fit(reconstruct(bend[k], twist[k], config)).q_human
-        retargeter.robot_from_human(q_human)
+            q_human = tracker.track(bend[k], twist[k]).q_human
         times[k] = time.perf_counter() - t0
         fitted[k] = q_human
     return times, fitted
@@ -137,28 +140,25 @@ def main() -> None:
     args = parser.parse_args()
 
     config = TapeConfig()
-    arm = HumanArm()
-    fitter = ArmFitter(arm, config)
-    retargeter = Retargeter(arm=arm)
+    tracker = ArmTracker(config)
+    arm = tracker.arm
     q = demo_motion(arm, args.frames, seed=0)
     bend, twist = tape_from_arm(arm, q, config)
     reconstruct(bend[:2], twist[:2], config)  # compile (or load) the kernel first
 
     print(f"(a) live path per frame, {args.frames} frames of a smooth motion at {RATE_HZ:.0f} Hz")
-    ours, ours_q = time_live(bend, twist, config, arm, fitter, retargeter, naive=False)
+    ours, ours_q = time_live(bend, twist, tracker, naive=False)
     sample = slice(0, min(len(bend), NAIVE_FRAMES))
-    base, base_q = time_live(
-        bend[sample], twist[sample], config, arm, fitter, retargeter, naive=True
-    )
-    cold, _ = time_live(
-        bend[sample], twist[sample], config, arm, fitter, retargeter, naive=False, cold=True
-    )
-    retargeter.mode = "cartesian"
-    cart, _ = time_live(bend, twist, config, arm, fitter, retargeter, naive=False)
-    retargeter.mode = "joint"
+    base, base_q = time_live(bend[sample], twist[sample], tracker, naive=True)
+    cold, _ = time_live(bend[sample], twist[sample], tracker, naive=False, cold=True)
+    tracker.mode = "cartesian"
+    cart, _ = time_live(bend, twist, tracker, naive=False)
+    tracker.mode = "joint"
     med, base_med = float(np.median(ours)), float(np.median(base))
     verdict = "PASS" if med < LIVE_TARGET_S else "FAIL"
-    print(f"  ours (compiled reconstruct, warm fit, joint retarget): median {med * 1e3:.3f} ms,")
+    print(
+        f"  ours (ArmTracker: compiled reconstruct, warm fit, joint retarget): median {med * 1e3:.3f} ms,"
+    )
     print(f"      p90 {np.percentile(ours, 90) * 1e3:.3f} ms  [{verdict}: target < 0.3 ms]")
     print(
         f"  naive (NumPy-loop reconstruct, generic DLS from neutral every frame, "

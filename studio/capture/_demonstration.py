@@ -35,6 +35,7 @@ from typing import Any
 
 import numpy as np
 
+from studio.kinematics import ArmTracker, TrackerConfig
 from studio.learning import ArmGrid, LearningError
 
 from ._errors import DemonstrationError
@@ -225,8 +226,7 @@ def extract_demonstration(
     goal_from_end: bool = False,
     *,
     max_residual: float = MAX_FIT_RESIDUAL_M,
-    fitter: Any = None,
-    retargeter: Any = None,
+    tracker: ArmTracker | None = None,
     name: str = "",
 ) -> Demonstration:
     """Turn the segment ``[t0, t1]`` of a recording into a demonstration.
@@ -240,8 +240,9 @@ def extract_demonstration(
         mode: retargeting mode, ``"joint"`` or ``"cartesian"``.
         goal_from_end: instead of refusing a segment that misses the goal, make its end the goal.
         max_residual: worst allowed fit residual (m).
-        fitter: an :class:`ArmFitter` to use (default: one for the recording's tape).
-        retargeter: a :class:`Retargeter` to use (default: ``Retargeter(mode, mirror=True)``).
+        tracker: the :class:`studio.kinematics.ArmTracker` to track the frames with, for this
+            recording's tape (default: a mirroring one for the recording's tape); it is reset
+            and set to ``mode`` first.
         name: display name.
 
     Returns:
@@ -251,8 +252,6 @@ def extract_demonstration(
         DemonstrationError: with ``reason`` ``too_short``, ``bad_fit``, ``leaves_joint_range`` or
             ``never_reaches_goal``, and one sentence saying what to change.
     """
-    from studio.kinematics import ArmFitter, HumanArm, Retargeter
-
     rec = recording if isinstance(recording, Recording) else read_recording(recording)
     grid = grid if grid is not None else ArmGrid()
     rows = rec.segment(t0, t1)
@@ -262,29 +261,31 @@ def extract_demonstration(
             f"the segment [{t0:.2f}, {t1:.2f}] s of {rec.path.name} holds {times.shape[0]} frames; choose a longer segment inside 0-{rec.duration:.2f} s.",
             "too_short",
         )
-    config = rec.config
-    if fitter is None:
-        fitter = ArmFitter(HumanArm(side=getattr(config, "side", "right")), config)
-    else:
-        fitter.reset()
-    retargeter = retargeter if retargeter is not None else Retargeter(mode, mirror=True)
+    if tracker is None:
+        tracker = ArmTracker(TrackerConfig(tape=rec.config, mode=mode))
+    elif tracker.tape != rec.config:
+        raise DemonstrationError(
+            f"the tracker follows another tape than {rec.path.name}'s; pass a tracker built for the recording's tape config, or none.",
+            "bad_fit",
+        )
+    tracker.reset()
+    tracker.mode = mode
     bend, twist = rec.bend[rows], rec.twist[rows]
-    q_human = np.empty((times.shape[0], 7))
+    q_robot = np.empty((times.shape[0], 6))
     residual = np.empty(times.shape[0])
     for i in range(times.shape[0]):
-        fit = fitter.fit((bend[i], twist[i]))
-        q_human[i] = fit.q_human
+        tracked = tracker.track(bend[i], twist[i])
+        q_robot[i] = tracked.q_robot
         # the residual (tape against the fitted arm) is the fit's quality; ``success`` also asks
         # for millimetre landmark agreement, which sensor noise alone can exceed
-        residual[i] = fit.residual if np.isfinite(fit.residual) else np.inf
+        residual[i] = tracked.residual if np.isfinite(tracked.residual) else np.inf
     worst = int(np.argmax(residual))
     if not residual[worst] <= max_residual:
         raise DemonstrationError(
             f"the arm fits the tape badly at {times[worst]:.2f} s (residual {residual[worst] * 100:.1f} cm > {max_residual * 100:.1f} cm); check the tape config's shoulder and wrist regions or choose another segment.",
             "bad_fit",
         )
-    q_robot = np.array([retargeter.robot_from_human(q) for q in q_human])
-    robot = retargeter.robot
+    robot = tracker.robot
     at_limit = (q_robot <= robot.lower + LIMIT_TOLERANCE_RAD) | (
         q_robot >= robot.upper - LIMIT_TOLERANCE_RAD
     )

@@ -1,8 +1,9 @@
 """The live pipeline: frames from the current source through the kinematics into the scene.
 
 One thread reads the current :class:`studio.capture.FrameSource`; every raw frame goes to the
-capture writer (when recording), and frames are turned into poses with
-``reconstruct -> ArmFitter.fit -> Retargeter.robot_from_human`` (warm-started frame to frame).
+capture writer (when recording), and frames are turned into poses by the kinematics package's
+:class:`studio.kinematics.ArmTracker` (warm-started frame to frame), the same chain demonstration
+extraction uses.
 The newest pose goes to the scene with ``update_live`` (latest wins, never blocks). When the
 kinematics fall behind the stream, only the newest frames of a batch are fitted: the recording
 still gets every frame, the scene the newest pose.
@@ -21,6 +22,8 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+
+from studio.kinematics import ArmTracker, TapeConfig, TrackerConfig
 
 from .._errors import StudioError
 from ._errors import ConflictError
@@ -60,7 +63,7 @@ class Pipeline:
         self._start_error: str | None = None
         self._mode = "joint"
         self._mirror = True
-        self._kin: dict[str, Any] | None = None  # config, fitter, retargeter for the source
+        self._tracker: ArmTracker | None = None  # the live chain for the source's tape
         self._q_human: np.ndarray | None = None
         self._q_robot = np.zeros(ROBOT_JOINTS)
         self._residual: float | None = None
@@ -112,7 +115,7 @@ class Pipeline:
             self._stop_source()
             self._kind, self._recording, self._source = kind, recording, source
             self._start_error = None
-            self._kin = None
+            self._tracker = None
             self._kin_error = None
             self._fit_warning = None
             self._residual = None
@@ -163,11 +166,11 @@ class Pipeline:
         """Switch the human-to-robot mapping (applies from the next frame)."""
         with self._lock:
             self._mode = mode
-            if mirror is not None and mirror != self._mirror:
-                self._mirror = mirror
-                self._kin = None  # a new retargeter with the new mirroring
-            elif self._kin is not None:
-                self._kin["retargeter"].mode = mode
+            if mirror is not None:
+                self._mirror = bool(mirror)
+            if self._tracker is not None:
+                self._tracker.mode = mode
+                self._tracker.mirror = self._mirror
 
     @property
     def retarget_mode(self) -> str:
@@ -201,14 +204,10 @@ class Pipeline:
                 "recording_active": self._writer is not None,
             }
 
-    def tape_config(self) -> Any:
+    def tape_config(self) -> TapeConfig:
         """The tape config of the current source (the default tape when the source has none)."""
         config = getattr(self._source, "config", None)
-        if config is None:
-            from studio.kinematics import TapeConfig
-
-            config = TapeConfig()
-        return config
+        return config if config is not None else TapeConfig()
 
     def source_label(self) -> str:
         """Where frames come from, for a recording's header (``serial:/dev/ttyUSB0``, ...)."""
@@ -350,39 +349,30 @@ class Pipeline:
             self._capture_last_t = float(frames[-1].t)
             self._capture_frames += len(frames)
 
-    def _kinematics(self, source: Any) -> dict[str, Any]:
-        from studio.kinematics import ArmFitter, HumanArm, Retargeter
-
-        kin = self._kin
-        if kin is None:
-            config = self.tape_config()
-            arm = HumanArm(side=config.side)  # the arm the tape is strapped to
-            kin = {
-                "config": config,
-                "fitter": ArmFitter(arm, config),
-                "retargeter": Retargeter(mode=self._mode, mirror=self._mirror, arm=arm),
-            }
-            self._kin = kin
-        return kin
+    def _live_tracker(self) -> ArmTracker:
+        """The tracker for the current source's tape, built on its first frame."""
+        tracker = self._tracker
+        if tracker is None:
+            config = TrackerConfig(tape=self.tape_config(), mode=self._mode, mirror=self._mirror)
+            tracker = ArmTracker(config)  # the arm the tape is strapped to
+            self._tracker = tracker
+        return tracker
 
     def _fit(self, source: Any, frames: list[Any]) -> None:
         try:
-            from studio.kinematics import reconstruct
-
-            kin = self._kinematics(source)
+            tracker = self._live_tracker()
+            tracked = None
             for frame in frames:
-                shape = reconstruct(frame.bend, frame.twist, kin["config"])
-                fit = kin["fitter"].fit(shape)
-                q_robot = kin["retargeter"].robot_from_human(fit.q_human)
+                tracked = tracker.track(frame.bend, frame.twist)
                 with self._lock:
-                    self._q_human = np.asarray(fit.q_human, dtype=float)
-                    self._q_robot = np.asarray(q_robot, dtype=float)
-                    self._residual = float(fit.residual)
+                    self._q_human = tracked.q_human
+                    self._q_robot = tracked.q_robot
+                    self._residual = tracked.residual
                     self._last_t = float(frame.t)
                     self._kin_error = None
-                    self._fit_warning = None if fit.success else fit_warning(fit.residual)
-            if self.scene is not None:
-                self.scene.update_live(self._q_human, self._q_robot, shape.positions)
+                    self._fit_warning = None if tracked.success else fit_warning(tracked.residual)
+            if self.scene is not None and tracked is not None:
+                self.scene.update_live(tracked.q_human, tracked.q_robot, tracked.tape_points)
         except StudioError as err:
             with self._lock:
                 self._kin_error = str(err)

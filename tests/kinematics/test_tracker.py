@@ -1,0 +1,128 @@
+"""The live chain as one object: tracking a tape of a known arm gives that arm and its robot pose."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from studio.kinematics import (
+    ArmFitter,
+    ArmTracker,
+    FitConfig,
+    HumanArm,
+    KinematicsError,
+    Retargeter,
+    TapeConfig,
+    Tracked,
+    TrackerConfig,
+    reconstruct,
+    tape_from_arm,
+)
+from tests.kinematics.test_fit import observable_q
+
+TRACKERS = {side: ArmTracker(TapeConfig(side=side)) for side in ("right", "left")}
+
+
+@settings(max_examples=30, deadline=None)
+@given(
+    q=st.lists(observable_q(), min_size=1, max_size=4),
+    side=st.sampled_from(["right", "left"]),
+    mode=st.sampled_from(["joint", "cartesian"]),
+)
+def test_tracking_the_tape_of_an_arm_recovers_the_arm_and_retargets_it(q, side, mode):
+    tracker = TRACKERS[side]
+    tracker.reset()
+    tracker.mode = mode
+    arm = tracker.arm
+    retargeter = Retargeter(mode, mirror=True, arm=arm)  # the reference, fed the same arms
+    for q_true in q:
+        bend, twist = tape_from_arm(arm, q_true, tracker.tape)
+        tracked = tracker.track(bend, twist)
+        assert isinstance(tracked, Tracked)
+        np.testing.assert_allclose(arm.points(tracked.q_human), arm.points(q_true), atol=1e-4)
+        assert tracked.success and tracked.residual < 1e-4
+        np.testing.assert_array_equal(tracked.q_robot, retargeter.robot_from_human(tracked.q_human))
+        np.testing.assert_array_equal(
+            tracked.tape_points, reconstruct(bend, twist, tracker.tape).positions
+        )
+        assert (tracked.ik is not None) == (mode == "cartesian")
+
+
+def test_it_composes_the_fitter_and_the_retargeter_exactly():
+    config = TrackerConfig(tape=TapeConfig(), mode="joint", fit=FitConfig(warm_iterations=3))
+    tracker = ArmTracker(config)
+    arm = HumanArm()
+    fitter = ArmFitter(arm, config.tape, config.fit)
+    retargeter = Retargeter("joint", mirror=True, arm=arm)
+    rng = np.random.default_rng(0)
+    base = np.array([0.4, 0.2, 0.3, 1.0, 0.1, 0.1, 0.0])
+    for _ in range(5):
+        q = base + rng.normal(0, 0.05, 7)
+        bend, twist = tape_from_arm(arm, q, config.tape)
+        tracked = tracker.track(bend, twist)
+        fit = fitter.fit(reconstruct(bend, twist, config.tape))
+        np.testing.assert_array_equal(tracked.q_human, fit.q_human)
+        assert tracked.fit.iterations == fit.iterations and tracked.residual == fit.residual
+        np.testing.assert_array_equal(tracked.q_robot, retargeter.robot_from_human(fit.q_human))
+
+
+def test_reset_forgets_the_warm_start():
+    tracker = ArmTracker(TrackerConfig(mode="cartesian"))
+    arm = tracker.arm
+    first = np.array([0.3, 0.2, 0.4, 1.2, 0.3, 0.2, 0.1])
+    second = first + 0.05
+    frames = [tape_from_arm(arm, q, tracker.tape) for q in (first, second)]
+    fresh = ArmTracker(TrackerConfig(mode="cartesian")).track(*frames[1])
+    tracker.track(*frames[0])
+    warm = tracker.track(*frames[1])
+    # warm-started from the first frame, the unseen wrist direction keeps that frame's forearm
+    # rotation; a cold start takes the closed-form one
+    assert not np.array_equal(warm.q_human, fresh.q_human)
+    np.testing.assert_allclose(arm.points(warm.q_human), arm.points(fresh.q_human), atol=1e-6)
+    tracker.track(*frames[0])
+    tracker.reset()
+    again = tracker.track(*frames[1])
+    assert again.fit.iterations == fresh.fit.iterations
+    np.testing.assert_array_equal(again.q_human, fresh.q_human)
+    np.testing.assert_array_equal(again.q_robot, fresh.q_robot)
+
+
+def test_the_retarget_mode_and_mirror_switch_at_run_time():
+    tracker = ArmTracker(TapeConfig())
+    q = np.array([0.5, 0.4, 0.2, 1.0, 0.0, 0.1, 0.0])
+    bend, twist = tape_from_arm(tracker.arm, q, tracker.tape)
+    joint = tracker.track(bend, twist).q_robot
+    tracker.mode = "cartesian"
+    assert tracker.mode == tracker.retargeter.mode == "cartesian"
+    cartesian = tracker.track(bend, twist)
+    assert cartesian.ik is not None and not np.allclose(cartesian.q_robot, joint)
+    tracker.mode = "joint"
+    tracker.mirror = False
+    unmirrored = tracker.track(bend, twist).q_robot
+    assert unmirrored[0] == pytest.approx(-joint[0])  # joint 1 is lateral: it flips
+    np.testing.assert_allclose(unmirrored[1:3], joint[1:3])
+    with pytest.raises(KinematicsError, match="joint"):
+        tracker.mode = "sideways"
+
+
+def test_a_left_tape_tracks_the_left_arm():
+    tracker = ArmTracker(TapeConfig(side="left"))
+    assert tracker.arm.side == "left" and tracker.retargeter.arm is tracker.arm
+
+
+def test_bad_input_is_one_sentence():
+    tracker = ArmTracker()
+    with pytest.raises(KinematicsError, match="one frame"):
+        tracker.track(np.zeros((2, 16)), np.zeros((2, 16)))
+    with pytest.raises(KinematicsError):
+        tracker.track(np.zeros(3), np.zeros(3))
+    with pytest.raises(KinematicsError):
+        tracker.track(np.full(16, np.nan), np.zeros(16))
+    with pytest.raises(KinematicsError, match="TrackerConfig"):
+        ArmTracker("tape")  # type: ignore[arg-type]
+    with pytest.raises(KinematicsError, match="mode"):
+        TrackerConfig(mode="sideways")  # type: ignore[arg-type]
+    with pytest.raises(KinematicsError, match="tape"):
+        TrackerConfig(tape=None)  # type: ignore[arg-type]
