@@ -7,6 +7,10 @@ from ._fit import FitConfig as FitConfig
 from ._human import ArmPose as ArmPose
 from ._human import HumanArm as HumanArm
 from ._human import mirror_human_q as mirror_human_q
+from ._meshes import HumanBody as HumanBody
+from ._meshes import MeshConfig as MeshConfig
+from ._meshes import MeshPart as MeshPart
+from ._meshes import puma560_meshes as puma560_meshes
 from ._puma import PUMA_QN as PUMA_QN
 from ._puma import PUMA_QR as PUMA_QR
 from ._puma import PUMA_QS as PUMA_QS
