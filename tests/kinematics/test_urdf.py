@@ -159,3 +159,38 @@ def test_export_urdf_to_an_unwritable_place_is_one_clear_error(
         err = capsys.readouterr().err.strip()
         assert err.startswith("studio export-urdf: ") and err.endswith(".")
         assert "\n" not in err
+
+
+def _kinematics_imports() -> dict[str, set[str]]:
+    """Module -> the package modules it imports anywhere (functions and TYPE_CHECKING included)."""
+    import ast
+
+    import studio.kinematics
+
+    folder = Path(studio.kinematics.__file__).parent
+    graph: dict[str, set[str]] = {}
+    for path in folder.glob("_*.py"):
+        names = set()
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.ImportFrom) and node.level == 1 and node.module:
+                names.add(node.module)
+        graph[path.stem] = names
+    return graph
+
+
+def test_the_kinematics_modules_import_one_way() -> None:
+    """Issue 9: ``_puma`` imported ``_urdf`` inside a function while ``_urdf`` imported ``_puma``."""
+    graph = _kinematics_imports()
+    assert "_puma" not in graph["_urdf"] and "_urdf" in graph["_puma"]
+    done: set[str] = set()
+
+    def visit(module: str, stack: tuple[str, ...]) -> None:
+        assert module not in stack, f"import cycle: {' -> '.join((*stack, module))}"
+        if module in done:
+            return
+        for imported in graph.get(module, ()):
+            visit(imported, (*stack, module))
+        done.add(module)
+
+    for module in graph:
+        visit(module, ())
