@@ -10,6 +10,7 @@ from studio._errors import StudioError
 
 NAME = "serve"
 HELP = "Start the studio in the browser (the default verb)."
+MAX_PORT = 65535
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -71,6 +72,9 @@ def run(args: argparse.Namespace) -> int:
     )
     if not limit_mb > 0:
         raise StudioError(f"--upload-limit-mb is {limit_mb}; give a positive size in MB.")
+    for flag, port in (("--port", args.port), ("--viser-port", args.viser_port)):
+        if not 1 <= port <= MAX_PORT:
+            raise StudioError(f"{flag} {port} is not a port number; give one from 1 to {MAX_PORT}.")
     settings = Settings(
         upload_limit_bytes=round(limit_mb * 1e6),
         data_dir=data_dir,

@@ -36,6 +36,8 @@ class ConfigPublic(BaseModel):
     version: str
     upload_limit_bytes: int
     data_dir: str
+    scene_instance: str | None = None
+    """The id the scene at ``viser_url`` answers at ``/studio-instance`` (None: not checked)."""
 
 
 # ----------------------------------------------------------------------------- source

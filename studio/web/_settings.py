@@ -35,6 +35,12 @@ class Settings(BaseModel):
             ``host`` (the DNS-rebinding guard refuses every other name).
         viser_url: the scene URL the page embeds; default ``http://<host>:<viser_port>``.
         run_workers: threads one training run uses (``None``: one per CPU core).
+        scene_instance: the id the running scene server answers at ``/studio-instance``; the
+            page checks it so that it never embeds another program's scene (set by
+            :func:`studio.web.serve`; None: no scene, or not checked).
+        token: when set, the scene answers only requests carrying it (``?token=`` or the cookie
+            it sets); required when ``host`` is not loopback. The API's own check reads the
+            same field.
     """
 
     model_config = ConfigDict(frozen=True)
@@ -48,6 +54,8 @@ class Settings(BaseModel):
     allowed_hosts: tuple[str, ...] = ()
     viser_url: str | None = None
     run_workers: int | None = Field(None, ge=1)
+    scene_instance: str | None = None
+    token: str | None = None
 
     @property
     def recordings_dir(self) -> Path:
@@ -83,7 +91,8 @@ class Settings(BaseModel):
         host = "127.0.0.1" if self.host in ("0.0.0.0", "::", "") else self.host
         if ":" in host and not host.startswith("["):
             host = f"[{host}]"
-        return f"http://{host}:{self.viser_port}"
+        url = f"http://{host}:{self.viser_port}"
+        return f"{url}/?token={self.token}" if self.token else url
 
 
 def is_loopback(host: str) -> bool:

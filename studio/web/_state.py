@@ -147,6 +147,20 @@ class Studio:
                 )
             from studio.capture import PlaybackSource
 
+            current = self.pipeline.source
+            if (
+                self.pipeline.kind == "recording"
+                and self.pipeline.recording == recording
+                and current is not None
+                and current.running
+            ):
+                # The recording already playing: change its speed and loop in place, so that
+                # ticking "loop" never restarts it from 0.
+                if speed is not None:
+                    current.speed = speed
+                if loop is not None:
+                    current.loop = loop
+                return
             path = self.recordings.path(recording)
             source = PlaybackSource(
                 path, speed=speed if speed is not None else 1.0, loop=True if loop is None else loop

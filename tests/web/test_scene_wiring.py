@@ -97,3 +97,26 @@ def test_preview_and_delete_a_demonstration(scene_client, tmp_path):
     assert np.allclose(times, demo.times)
     assert client.delete("/api/demonstrations/reach-1").status_code == 204
     assert scene.named("clear_path")[-1] == ("demo-reach-1",)
+
+
+def test_ticking_loop_changes_the_playing_recording_in_place(tmp_path):
+    """The page's "loop" box on a playing recording: same source, same position, new loop."""
+    from tests.web.conftest import wait_for
+    from tests.web.test_recordings import write_recording
+
+    (tmp_path / "recordings").mkdir()
+    write_recording(tmp_path / "recordings" / "take.tape.csv", frames=440)
+    with TestClient(create_app(make_settings(tmp_path))) as client:
+        body = {"kind": "recording", "recording": "take", "speed": 1.0, "loop": True}
+        assert client.put("/api/source", json=body).status_code == 200
+        studio = client.app.state.studio
+        source = studio.pipeline.source
+        assert wait_for(lambda: source.position > 0.5, timeout=10)
+        before = source.position
+        answer = client.put("/api/source", json={**body, "loop": False}).json()
+        assert studio.pipeline.source is source  # not restarted
+        assert answer["playback"]["loop"] is False and source.loop is False
+        assert answer["playback"]["t"] >= before  # not back to 0
+        answer = client.put("/api/source", json={**body, "loop": True, "speed": 2.0}).json()
+        assert studio.pipeline.source is source and source.loop and source.speed == 2.0
+        assert answer["playback"]["loop"] is True

@@ -98,7 +98,7 @@ def test_the_real_server_starts_answers_and_stops(tmp_path):
                 with urllib.request.urlopen(url, timeout=2) as r:
                     config = r.read().decode()
                 break
-            except (urllib.error.URLError, ConnectionError):
+            except (urllib.error.URLError, OSError):  # refused, or queued until the app is up
                 time.sleep(0.2)
         assert config is not None and f":{viser_port}" in config
         with urllib.request.urlopen(f"http://127.0.0.1:{viser_port}/", timeout=5) as r:
@@ -110,3 +110,87 @@ def test_the_real_server_starts_answers_and_stops(tmp_path):
     finally:
         proc.terminate()
         proc.wait(timeout=20)
+
+
+def test_a_taken_port_is_one_sentence(capsys, tmp_path):
+    with socket.socket() as taken:
+        taken.bind(("127.0.0.1", 0))
+        taken.listen(1)
+        port = taken.getsockname()[1]
+        code = main(["serve", "--no-browser", "--data-dir", str(tmp_path), "--port", str(port)])
+    out, err = capsys.readouterr()
+    assert code != 0
+    assert "open http" not in out
+    lines = [line for line in err.splitlines() if line.strip()]
+    assert len(lines) == 1 and f"Port {port}" in lines[0] and "--port" in lines[0]
+    assert "Errno" not in err and "Traceback" not in err
+
+
+@pytest.mark.parametrize(
+    ("flags", "words"),
+    [
+        (["--port", "99999"], ("--port 99999", "65535")),
+        (["--viser-port", "0"], ("--viser-port 0", "65535")),
+        (["--data-dir", "/proc/x/y"], ("/proc/x/y", "--data-dir")),
+    ],
+)
+def test_bad_flags_are_one_sentence(capsys, flags, words):
+    assert main(["serve", "--no-browser", *flags]) == 2
+    out, err = capsys.readouterr()
+    lines = [line for line in err.splitlines() if line.strip()]
+    assert len(lines) == 1 and all(w in lines[0] for w in words), err
+    assert "Traceback" not in err and "open http" not in out
+
+
+def _start(tmp_path: Path, port: int, viser_port: int) -> subprocess.Popen[bytes]:
+    return subprocess.Popen(
+        [sys.executable, "-m", "studio", "serve", "--no-browser", "--data-dir", str(tmp_path),
+         "--port", str(port), "--viser-port", str(viser_port)],
+        stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+    )  # fmt: skip
+
+
+def _config(port: int, proc: subprocess.Popen[bytes]) -> dict:
+    import json
+
+    deadline = time.monotonic() + 90
+    while time.monotonic() < deadline:
+        try:
+            with urllib.request.urlopen(f"http://127.0.0.1:{port}/api/config", timeout=2) as r:
+                return json.loads(r.read())
+        except (urllib.error.URLError, OSError):  # refused, or queued until the app is up
+            assert proc.poll() is None, proc.stdout.read().decode() if proc.stdout else ""
+            time.sleep(0.2)
+    raise AssertionError("the studio did not start")
+
+
+def test_two_studios_each_embed_their_own_scene(tmp_path):
+    """The second studio's scene port is taken by the first: it reports the port it really
+    bound, and each scene answers its own studio's instance id."""
+    import json
+
+    viser_port = free_port()
+    procs = []
+    try:
+        configs = []
+        for k in range(2):
+            folder = tmp_path / f"studio{k}"
+            folder.mkdir()
+            port = free_port()
+            procs.append(_start(folder, port, viser_port))
+            configs.append((port, _config(port, procs[-1])))
+        scene_ports = set()
+        for port, config in configs:
+            scene = config["viser_url"].rstrip("/")
+            scene_ports.add(int(scene.rsplit(":", 1)[1]))
+            page = f"http://127.0.0.1:{port}"
+            req = urllib.request.Request(f"{scene}/studio-instance", headers={"Origin": page})
+            with urllib.request.urlopen(req, timeout=5) as r:
+                assert json.loads(r.read())["instance"] == config["scene_instance"]
+        assert len(scene_ports) == 2 and viser_port in scene_ports
+        assert configs[0][1]["scene_instance"] != configs[1][1]["scene_instance"]
+    finally:
+        for proc in procs:
+            proc.terminate()
+        for proc in procs:
+            proc.wait(timeout=20)

@@ -19,4 +19,5 @@ def read_config(settings: SettingsDep) -> ConfigPublic:
         version=__version__,
         upload_limit_bytes=settings.upload_limit_bytes,
         data_dir=str(settings.data_dir.resolve()),
+        scene_instance=settings.scene_instance,
     )

@@ -198,7 +198,7 @@ function renderSource() {
       const sp = String(pb.speed);
       if ([...$("playback-speed").options].some((o) => o.value === sp)) $("playback-speed").value = sp;
     }
-    $("playback-loop").checked = !!pb.loop;
+    if (!$("playback-loop").dataset.pending) $("playback-loop").checked = !!pb.loop;
   }
   renderCaptureButton();
   updateMarkButton();
@@ -1036,7 +1036,28 @@ async function loadConfig() {
     $("scene-msg").hidden = false;
     return;
   }
-  $("scene").src = sceneUrl(url);
+  const src = sceneUrl(url);
+  if (S.config.scene_instance && !(await sceneIsOurs(src, S.config.scene_instance))) {
+    $("scene-msg").textContent = `The 3D scene at ${new URL(src).host} does not belong to this studio (another studio or program answers there); restart this studio so that it starts its own scene.`;
+    $("scene-msg").hidden = false;
+    return;
+  }
+  $("scene").src = src;
+}
+
+/** Whether the scene server at `src` is this studio's: it answers our instance id. */
+async function sceneIsOurs(src, instance) {
+  const u = new URL(src);
+  u.pathname = "/studio-instance";
+  u.hash = "";
+  try {
+    const r = await fetch(u.toString(), { cache: "no-store" });
+    if (!r.ok) return false;
+    const body = await r.json();
+    return body.instance === instance;
+  } catch (e) {
+    return false;
+  }
 }
 
 /**
@@ -1066,8 +1087,13 @@ function wire() {
   $("playback-speed").addEventListener("change", () => {
     if (S.source && S.source.kind === "recording") playback(S.source.playback && S.source.playback.playing ? "play" : "pause", { speed: Number($("playback-speed").value) });
   });
-  $("playback-loop").addEventListener("change", () => {
-    if (S.source && S.source.kind === "recording") applySource();
+  $("playback-loop").addEventListener("change", async () => {
+    if (!(S.source && S.source.kind === "recording")) return;
+    // Live updates must not flip the box back while the change is on its way; the server
+    // changes the loop of the recording playing in place (no restart).
+    const box = $("playback-loop");
+    box.dataset.pending = "1";
+    try { await applySource(); } finally { delete box.dataset.pending; }
   });
   $("source-reach").addEventListener("click", () => simulatorReach("reach"));
   $("source-wander").addEventListener("click", () => simulatorReach("wander"));
