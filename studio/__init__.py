@@ -11,5 +11,14 @@ Subpackages, each usable alone:
 from __future__ import annotations
 
 from ._errors import StudioError as StudioError
+from ._files import FileLimitError as FileLimitError
+from ._files import human_size as human_size
+from ._files import open_regular as open_regular
+from ._files import read_bytes_bounded as read_bytes_bounded
+from ._json import MAX_JSON_BYTES as MAX_JSON_BYTES
+from ._json import MAX_JSON_DEPTH as MAX_JSON_DEPTH
+from ._json import JSONFileError as JSONFileError
+from ._json import loads_json as loads_json
+from ._json import read_json as read_json
 
 __version__ = "0.1.0"

@@ -42,8 +42,11 @@ from ._recording_edit import write_recording as write_recording
 from ._recording_format import FORMAT_VERSION as FORMAT_VERSION
 from ._recording_format import RECORDING_SUFFIX as RECORDING_SUFFIX
 from ._recording_reader import Recording as Recording
+from ._recording_reader import RecordingBytes as RecordingBytes
 from ._recording_reader import read_header as read_header
 from ._recording_reader import read_recording as read_recording
+from ._recording_reader import recording_bytes as recording_bytes
+from ._recording_reader import summarize_recording as summarize_recording
 from ._recording_writer import RecordingWriter as RecordingWriter
 from ._recording_writer import recording_meta as recording_meta
 from ._segments import trigger_segments as trigger_segments

@@ -26,8 +26,10 @@ from typing import Any
 
 import numpy as np
 
+from studio import StudioError, read_json
+
 from ._errors import CaptureError
-from ._recording_format import DEFAULT_REGIONS
+from ._recording_format import DEFAULT_REGIONS, MAX_REGIONS
 
 CALIBRATION_FORMAT = "teach-studio-calibration"
 """The ``format`` value of calibration files."""
@@ -37,6 +39,8 @@ RAW_CENTRE = 32768
 """A uint16 channel's mid-scale count: the flat reading of an uncalibrated channel."""
 DEFAULT_GAIN = 1.0e-4
 """Radians per count when no gain is known (the full uint16 range spans about +-3.3 rad)."""
+MAX_CALIBRATION_BYTES = 1024 * 1024
+"""Largest calibration file read (one of the largest tape's is about 20 kB)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -61,6 +65,10 @@ class Calibration:
         if offsets.ndim != 1 or offsets.shape != gains.shape or offsets.size % 2:
             raise CaptureError(
                 f"calibration offsets {offsets.shape} and gains {gains.shape} must be two equal even-length lists (two channels per region)."
+            )
+        if not 2 <= offsets.size <= 2 * MAX_REGIONS:
+            raise CaptureError(
+                f"the calibration has {offsets.size} channels; a tape has 2 to {2 * MAX_REGIONS} (two per region)."
             )
         if not (np.isfinite(offsets).all() and np.isfinite(gains).all()):
             raise CaptureError(
@@ -142,21 +150,16 @@ def load_calibration(path: str | os.PathLike[str] | Calibration) -> Calibration:
     """Read a calibration JSON file (a :class:`Calibration` passes through).
 
     Raises:
-        CaptureError: the file is missing or not a calibration (the message says which).
+        CaptureError: the file is missing, not a regular file, over
+            :data:`MAX_CALIBRATION_BYTES`, or not a calibration (the message says which).
     """
     if isinstance(path, Calibration):
         return path
     path = Path(path)
-    try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except OSError as err:
-        raise CaptureError(
-            f"cannot open calibration {path} ({err.strerror}); check the path."
-        ) from None
-    except ValueError:
-        raise CaptureError(
-            f"{path} is not valid JSON; give a calibration file (see the capture docs)."
-        ) from None
+    try:  # bounded: a device such as /dev/zero, a FIFO or a huge file is refused unread
+        data = read_json(path, f"calibration {path}", max_bytes=MAX_CALIBRATION_BYTES)
+    except StudioError as err:
+        raise CaptureError(str(err)) from None
     if not isinstance(data, dict) or data.get("format") != CALIBRATION_FORMAT:
         raise CaptureError(
             f"{path} is not a calibration (no format '{CALIBRATION_FORMAT}'); give a calibration file."

@@ -36,6 +36,7 @@ from typing import Any
 import numpy as np
 
 from studio.kinematics import ArmTracker, TrackerConfig
+from studio import StudioError, read_json
 from studio.learning import ArmGrid, LearningError
 
 from ._errors import DemonstrationError
@@ -160,15 +161,9 @@ def load_demonstration(path: str | os.PathLike[str]) -> Demonstration:
     """
     path = Path(path)
     try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except OSError as err:
-        raise DemonstrationError(
-            f"cannot open {path} ({err.strerror}); check the path.", "bad_file"
-        ) from None
-    except ValueError:
-        raise DemonstrationError(
-            f"{path} is not valid JSON; give a *.demo.json file.", "bad_file"
-        ) from None
+        data = read_json(path)  # bounded: size, nesting depth, regular files only
+    except StudioError as err:
+        raise DemonstrationError(str(err), "bad_file") from None
     if not isinstance(data, dict) or data.get("format") != DEMO_FORMAT:
         raise DemonstrationError(
             f"{path} is not a demonstration (no format '{DEMO_FORMAT}'); give a *.demo.json file.",
@@ -338,8 +333,8 @@ def demonstrations_for(recording_path: str | os.PathLike[str]) -> list[Path]:
     out = []
     for demo in sorted(recording_path.parent.glob("*" + DEMO_SUFFIX)):
         try:
-            data = json.loads(demo.read_text(encoding="utf-8"))
-        except (OSError, ValueError):
+            data = read_json(demo)
+        except StudioError:
             continue
         if isinstance(data, dict) and data.get("recording") == recording_path.name:
             out.append(demo)

@@ -4,6 +4,9 @@ A small device-side program (or ``studio bridge``) sends one datagram per frame 
 :mod:`._wire`. UDP suits a 110 Hz stream on a LAN: no head-of-line blocking, and a lost frame is
 better late than never. Lost frames show up as gaps in the frame counter and are counted as
 dropped; malformed datagrams are counted as rejected, with the reason in ``status().warning``.
+So is a well-formed datagram of another tape: the stream's region count is fixed by the config
+(when given) or by its first frame, so one stray sender can never end a capture whose recording
+has a fixed width.
 UDP has no connection to lose: while no datagram arrives for :data:`SILENCE_SECONDS`, the
 source keeps listening and ``status().error`` says so; the first datagram clears it.
 """
@@ -34,7 +37,8 @@ class NetworkSource(ThreadedSource):
     Args:
         host: address to listen on (loopback by default; ``"0.0.0.0"`` for a device on the LAN).
         port: UDP port (0 picks a free one; see :attr:`address`).
-        config: the tape config the frames belong to (informational).
+        config: the tape config the frames belong to; its ``regions`` fixes the region count
+            every datagram must have (default: the first datagram's count).
         queue_frames: frames buffered before dropping.
 
     Raises:
@@ -55,6 +59,7 @@ class NetworkSource(ThreadedSource):
         self.config = config
         self._sock: socket.socket | None = None
         self._last_counter: int | None = None
+        self._regions: int | None = None
 
     @property
     def address(self) -> tuple[str, int]:
@@ -63,7 +68,14 @@ class NetworkSource(ThreadedSource):
             return self._sock.getsockname()[:2]
         return self.host, self.port
 
+    @property
+    def regions(self) -> int | None:
+        """The region count every datagram must have (``None`` until the first frame fixes it)."""
+        configured = getattr(self.config, "regions", None)
+        return int(configured) if configured is not None else self._regions
+
     def _open(self) -> None:
+        self._regions = None  # a restarted stream may come from another tape
         if self._sock is not None:
             return
         sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
@@ -115,6 +127,15 @@ class NetworkSource(ThreadedSource):
                 frame = decode_frame(data)
             except WireError as err:
                 self._reject(f"rejected a datagram from {sender[0]}:{sender[1]}: {err}.")
+                continue
+            regions, expected = frame.bend.shape[0], self.regions
+            if expected is None:
+                self._regions = regions
+            elif regions != expected:
+                self._reject(
+                    f"rejected a datagram from {sender[0]}:{sender[1]}: {regions} regions where "
+                    f"this stream has {expected}; send each tape to its own port."
+                )
                 continue
             if self._last_counter is not None:
                 gap = (frame.frame - self._last_counter - 1) & 0xFFFFFFFF

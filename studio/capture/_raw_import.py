@@ -8,6 +8,8 @@ from typing import Any
 
 import numpy as np
 
+from studio import FileLimitError, human_size, open_regular
+
 from ._calibration import Calibration, load_calibration
 from ._errors import RecordingError
 from ._recording_edit import write_recording
@@ -16,6 +18,12 @@ from ._recording_writer import recording_meta
 
 MIN_FIELDS = 2
 """``frame`` and ``time`` come before the channels."""
+MAX_RAW_BYTES = 2 * 1024**3
+"""Largest raw export read (about 20 hours of a 16-region tape at 110 Hz)."""
+MAX_RAW_LINE_BYTES = 64 * 1024
+"""Longest raw line (a 256-region tape's line is under 8 kB)."""
+BLOCK_LINES = 10_000
+"""Lines parsed into one numpy block."""
 
 
 def read_raw_text(
@@ -24,46 +32,73 @@ def read_raw_text(
     """Parse a raw file into ``(frame (N,), time (N,), raw (N, channels))``.
 
     Blank lines and lines starting with ``#`` are skipped. Lines may carry more channels than
-    the calibration uses (the extra are ignored).
+    the calibration uses (the extra are ignored). The file is read line by line into arrays of
+    :data:`BLOCK_LINES` rows, so memory holds the numbers and one block; a device, a FIFO, a
+    file over :data:`MAX_RAW_BYTES` or a line over :data:`MAX_RAW_LINE_BYTES` is refused.
 
     Raises:
-        RecordingError: naming the file and line of the first bad line.
+        RecordingError: naming the file (and the line) of the first problem.
     """
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8", errors="strict")
-    except OSError as err:
-        raise RecordingError(f"cannot open {path} ({err.strerror}); check the path.") from None
-    except UnicodeDecodeError:
-        raise RecordingError(
-            f"{path} is not a text file; give Measurand's raw text export."
-        ) from None
-    frames, times, raws = [], [], []
-    for number, line in enumerate(text.splitlines(), start=1):
-        line = line.strip()
-        if not line or line.startswith("#"):
-            continue
-        fields = line.replace(",", " ").split()
-        if len(fields) < MIN_FIELDS + channels:
+        stream = open_regular(path)
+    except FileLimitError as err:
+        raise RecordingError(str(err)) from None
+    with stream:
+        size = os.fstat(stream.fileno()).st_size
+        if size > MAX_RAW_BYTES:
             raise RecordingError(
-                f"{path}, line {number}: {len(fields) - MIN_FIELDS} raw channels where the calibration needs {channels}; use the calibration of this tape."
+                f"{path} is {human_size(size)}, more than the {human_size(MAX_RAW_BYTES)} a raw "
+                "export can hold; split it into shorter files."
             )
-        try:
-            values = [float(x) for x in fields[: MIN_FIELDS + channels]]
-        except ValueError:
-            raise RecordingError(
-                f"{path}, line {number}: a value is not a number; fix or re-export the file."
-            ) from None
-        if not np.isfinite(values).all():
-            raise RecordingError(
-                f"{path}, line {number}: a NaN or infinite value; fix or re-export the file."
-            )
-        frames.append(values[0])
-        times.append(values[1])
-        raws.append(values[MIN_FIELDS:])
-    if not frames:
+        blocks: list[np.ndarray] = []
+        block: list[list[float]] = []
+        number = 0
+        while line_bytes := stream.readline(MAX_RAW_LINE_BYTES + 1):
+            number += 1
+            if len(line_bytes) > MAX_RAW_LINE_BYTES:
+                raise RecordingError(
+                    f"{path}, line {number}: longer than {MAX_RAW_LINE_BYTES:,} bytes, so not "
+                    "Measurand's raw text; give its raw text export."
+                )
+            try:
+                line = line_bytes.decode("utf-8").strip()
+            except UnicodeDecodeError:
+                raise RecordingError(
+                    f"{path} is not a text file; give Measurand's raw text export."
+                ) from None
+            if not line or line.startswith("#"):
+                continue
+            block.append(_raw_values(path, number, line, channels))
+            if len(block) == BLOCK_LINES:
+                blocks.append(np.array(block))
+                block = []
+        if block:
+            blocks.append(np.array(block))
+    if not blocks:
         raise RecordingError(f"{path} holds no frames; give Measurand's raw text export.")
-    return np.array(frames, dtype=np.int64), np.array(times), np.array(raws)
+    data = np.concatenate(blocks)
+    return data[:, 0].astype(np.int64), data[:, 1].copy(), data[:, MIN_FIELDS:].copy()
+
+
+def _raw_values(path: Path, number: int, line: str, channels: int) -> list[float]:
+    """``frame, time, raw0 .. raw{channels-1}`` of one line, checked."""
+    fields = line.replace(",", " ").split()
+    if len(fields) < MIN_FIELDS + channels:
+        raise RecordingError(
+            f"{path}, line {number}: {len(fields) - MIN_FIELDS} raw channels where the calibration needs {channels}; use the calibration of this tape."
+        )
+    try:
+        values = [float(x) for x in fields[: MIN_FIELDS + channels]]
+    except ValueError:
+        raise RecordingError(
+            f"{path}, line {number}: a value is not a number; fix or re-export the file."
+        ) from None
+    if not np.isfinite(values).all():
+        raise RecordingError(
+            f"{path}, line {number}: a NaN or infinite value; fix or re-export the file."
+        )
+    return values
 
 
 def import_raw(

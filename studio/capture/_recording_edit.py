@@ -10,12 +10,16 @@ from __future__ import annotations
 import fcntl
 import json
 import os
+import shutil
 import tempfile
+from collections.abc import Callable
 from datetime import UTC, datetime
 from pathlib import Path
-from typing import Any
+from typing import Any, BinaryIO
 
 import numpy as np
+
+from studio import StudioError, read_json
 
 from ._errors import RecordingError
 from ._recording_format import (
@@ -25,7 +29,7 @@ from ._recording_format import (
     format_row,
     header_line,
 )
-from ._recording_reader import Recording, _parse_header
+from ._recording_reader import READ_BLOCK_BYTES, Recording, _first_line, _open, _parse_header
 
 EDITABLE_KEYS = ("name", "operator", "notes")
 """Header keys :func:`update_recording_meta` may change (the rest describe the data)."""
@@ -33,13 +37,13 @@ DEMO_SUFFIX = ".demo.json"
 """File name ending of demonstrations (they reference their recording by file name)."""
 
 
-def atomic_write_text(path: str | os.PathLike[str], text: str) -> Path:
-    """Write ``text`` to ``path`` through a fsynced temporary file and ``os.replace``."""
+def atomic_write(path: str | os.PathLike[str], write: Callable[[BinaryIO], None]) -> Path:
+    """Let ``write`` fill a temporary file next to ``path``, fsync it, and ``os.replace`` it in."""
     path = Path(path)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as f:
-            f.write(text)
+        with os.fdopen(fd, "wb") as f:
+            write(f)
             f.flush()
             os.fsync(f.fileno())
         os.replace(tmp, path)
@@ -47,6 +51,12 @@ def atomic_write_text(path: str | os.PathLike[str], text: str) -> Path:
         Path(tmp).unlink(missing_ok=True)
         raise
     return path
+
+
+def atomic_write_text(path: str | os.PathLike[str], text: str) -> Path:
+    """Write ``text`` to ``path`` through a fsynced temporary file and ``os.replace``."""
+    data = text.encode("utf-8")
+    return atomic_write(path, lambda f: f.write(data))
 
 
 def being_recorded(path: str | os.PathLike[str]) -> bool:
@@ -102,13 +112,17 @@ def update_recording_meta(path: str | os.PathLike[str], **changes: Any) -> dict[
         if not isinstance(value, str):
             raise RecordingError(f"{key} must be text, got {type(value).__name__}; give a string.")
     _check_not_recording(path)
-    raw = path.read_bytes()
-    first, sep, rest = raw.partition(b"\n")
-    meta = _parse_header(path, first.decode("utf-8", errors="replace"))
-    meta.update(changes)
-    meta["edited"] = datetime.now(UTC).isoformat(timespec="seconds")
-    text = header_line(meta) + rest.decode("utf-8")
-    atomic_write_text(path, text)
+    with _open(path) as source:
+        meta = _parse_header(path, _first_line(path, source))
+        meta.update(changes)
+        meta["edited"] = datetime.now(UTC).isoformat(timespec="seconds")
+        header = header_line(meta).encode("utf-8")
+
+        def write(out: BinaryIO) -> None:  # the frames are copied as bytes, block by block
+            out.write(header)
+            shutil.copyfileobj(source, out, READ_BLOCK_BYTES)
+
+        atomic_write(path, write)
     return meta
 
 
@@ -144,8 +158,8 @@ def rename_recording(path: str | os.PathLike[str], new_name: str) -> Path:
     path.unlink()
     for demo in path.parent.glob("*" + DEMO_SUFFIX):
         try:
-            data = json.loads(demo.read_text(encoding="utf-8"))
-        except (OSError, ValueError):
+            data = read_json(demo)
+        except StudioError:  # an unreadable demonstration is left as it is
             continue
         if isinstance(data, dict) and data.get("recording") == path.name:
             data["recording"] = target.name

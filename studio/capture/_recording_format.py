@@ -14,6 +14,11 @@ Header keys: ``format``, ``version``, ``regions``, ``tape`` (the :class:`TapeCon
 are radians, written with Python's shortest exact float repr so a read gives back the very same
 numbers. Rows are appended and flushed at least every 0.5 s; a missing ``# end`` line marks a
 recording whose capture was interrupted (it is read back as *recovered*).
+
+Bounds (checked by the reader before anything is allocated, so a hostile header cannot make it
+allocate more than the file's own size justifies): the header line is at most
+:data:`MAX_HEADER_BYTES`, ``regions`` at most :data:`MAX_REGIONS`, ``rate_hz`` at most
+:data:`MAX_RATE_HZ`, and no data line is longer than :func:`max_line_bytes`.
 """
 
 from __future__ import annotations
@@ -23,6 +28,8 @@ import json
 from typing import Any
 
 import numpy as np
+
+from ._errors import RecordingError
 
 FORMAT_NAME = "teach-studio-recording"
 """The ``format`` value and the first line's tag."""
@@ -40,6 +47,25 @@ DEFAULT_REGIONS = 16
 """Regions of the paper's tape (and of ``TapeConfig()``), used when no config says otherwise."""
 FIXED_COLUMNS = ("t", "frame", "status")
 """Columns before the angles."""
+MAX_REGIONS = 256
+"""Most regions a tape may have (the paper's has 16): a sanity bound against damaged or hostile
+headers and datagrams."""
+MAX_RATE_HZ = 100_000.0
+"""Highest nominal sample rate a header may state (the paper's tape runs at 110 Hz)."""
+MAX_HEADER_BYTES = 1024 * 1024
+"""Longest header line (free-text notes included)."""
+MAX_FIELD_BYTES = 32
+"""Longest field a row can hold: a float64 repr is at most 24 characters, an int64 20."""
+MIN_LINE_BYTES = 64 * 1024
+"""Comment lines may be longer than a row, up to this."""
+
+
+def max_line_bytes(regions: int) -> int:
+    """The longest line a recording of ``regions`` regions can hold after its header.
+
+    A longer line is damage (a hole of zero bytes, a binary blob), so the reader never buffers more.
+    """
+    return max(MIN_LINE_BYTES, (len(FIXED_COLUMNS) + 2 * regions) * MAX_FIELD_BYTES)
 
 
 def columns(regions: int) -> list[str]:
@@ -52,8 +78,18 @@ def columns(regions: int) -> list[str]:
 
 
 def header_line(meta: dict[str, Any]) -> str:
-    """Line 1 of a recording (with its newline)."""
-    return HEADER_PREFIX + json.dumps(meta, separators=(", ", ": ")) + "\n"
+    """Line 1 of a recording (with its newline).
+
+    Raises:
+        RecordingError: the header would be longer than :data:`MAX_HEADER_BYTES` (long notes).
+    """
+    line = HEADER_PREFIX + json.dumps(meta, separators=(", ", ": ")) + "\n"
+    if len(line.encode("utf-8")) > MAX_HEADER_BYTES:
+        raise RecordingError(
+            f"the recording's header would be {len(line.encode('utf-8')):,} bytes, over the limit "
+            f"of {MAX_HEADER_BYTES:,}; shorten the notes."
+        )
+    return line
 
 
 def end_line(frames: int, duration: float, closed: str) -> str:

@@ -8,22 +8,37 @@ incomplete last line (a write cut short) is dropped, and the recording is marked
 
 from __future__ import annotations
 
-import json
 import os
 import re
 import warnings
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, BinaryIO
 
 import numpy as np
 
+from studio import FileLimitError, JSONFileError, loads_json, open_regular
+
 from ._errors import RecordingError
 from ._frames import TapeFrame
-from ._recording_format import END_PREFIX, FORMAT_NAME, FORMAT_VERSION, HEADER_PREFIX, columns
+from ._recording_format import (
+    END_PREFIX,
+    FIXED_COLUMNS,
+    FORMAT_NAME,
+    FORMAT_VERSION,
+    HEADER_PREFIX,
+    MAX_HEADER_BYTES,
+    MAX_RATE_HZ,
+    MAX_REGIONS,
+    columns,
+    max_line_bytes,
+)
 
 FIX_HINT = "fix or re-export the file, or read it with strict=False to keep the good frames"
 """Second half of every strict-mode error sentence."""
+READ_BLOCK_BYTES = 1024 * 1024
+"""Bytes read at a time: memory beyond the frames themselves stays about this size."""
 
 
 @dataclass(eq=False)
@@ -107,20 +122,9 @@ class Recording:
 
     def summary(self) -> dict[str, Any]:
         """JSON-ready facts for listings (``studio info``, the web page)."""
-        return {
-            "path": str(self.path),
-            "name": self.name,
-            "frames": len(self),
-            "duration": self.duration,
-            "regions": self.regions,
-            "rate_hz": self.rate_hz,
-            "source": self.meta.get("source", ""),
-            "operator": self.meta.get("operator", ""),
-            "notes": self.meta.get("notes", ""),
-            "created": self.meta.get("created", ""),
-            "recovered": self.recovered,
-            "problems": list(self.problems),
-        }
+        return _summary(
+            self.path, self.meta, len(self), self.duration, self.recovered, self.problems
+        )
 
 
 class _Problems:
@@ -134,130 +138,240 @@ class _Problems:
 
 
 def read_header(path: str | os.PathLike[str]) -> dict[str, Any]:
-    """Only the header of a recording (cheap: for listings).
+    """Only the header of a recording (cheap: for listings; reads at most one bounded line).
 
     Raises:
         RecordingError: the file is not a readable recording.
     """
     path = Path(path)
+    with _open(path) as stream:
+        return _parse_header(path, _first_line(path, stream))
+
+
+def _open(path: Path) -> BinaryIO:
     try:
-        with open(path, "rb") as f:
-            first = f.readline()
-    except OSError as err:
-        raise RecordingError(f"cannot open {path} ({err.strerror}); check the path.") from None
-    return _parse_header(path, first.decode("utf-8", errors="replace").rstrip("\n"))
+        return open_regular(path)
+    except FileLimitError as err:
+        raise RecordingError(str(err)) from None
+
+
+def _first_line(path: Path, stream: BinaryIO) -> str:
+    """Line 1 (without its newline), read without ever buffering more than the header limit."""
+    first = stream.readline(MAX_HEADER_BYTES + 1)
+    if not first:
+        raise RecordingError(
+            f"{path}, line 1: the file is empty, so not a recording; open a *.tape.csv file."
+        )
+    if len(first) > MAX_HEADER_BYTES:
+        raise RecordingError(
+            f"{path}, line 1: the header is longer than {MAX_HEADER_BYTES:,} bytes, so the file is "
+            "damaged or not a recording; open a *.tape.csv file."
+        )
+    try:
+        return first.decode("utf-8").rstrip("\n")
+    except UnicodeDecodeError:
+        raise RecordingError(
+            f"{path}, line 1: binary data, so not a recording; open a *.tape.csv file."
+        ) from None
 
 
 def _parse_header(path: Path, line: str) -> dict[str, Any]:
+    """The header of line 1, every field checked against its bound before anything uses it."""
     if not line.startswith(HEADER_PREFIX):
         raise RecordingError(
             f"{path}, line 1: not a Teach Studio recording (it should start with '{HEADER_PREFIX.strip()}'); open a *.tape.csv file."
         )
     try:
-        meta = json.loads(line[len(HEADER_PREFIX) :])
-    except json.JSONDecodeError as err:
-        raise RecordingError(
-            f"{path}, line 1: the header is not valid JSON ({err.msg}); {FIX_HINT}."
-        ) from None
+        meta = loads_json(line[len(HEADER_PREFIX) :], "the header", max_bytes=MAX_HEADER_BYTES)
+    except JSONFileError as err:
+        raise RecordingError(f"{path}, line 1: {err}") from None
     if not isinstance(meta, dict) or meta.get("format") != FORMAT_NAME:
         raise RecordingError(
             f"{path}, line 1: the header does not say format '{FORMAT_NAME}'; open a *.tape.csv file."
         )
     version = meta.get("version")
-    if not isinstance(version, int) or version < 1 or version > FORMAT_VERSION:
+    if not _whole(version) or version < 1 or version > FORMAT_VERSION:
         raise RecordingError(
             f"{path}, line 1: unknown recording version {version!r} (this studio reads 1 to {FORMAT_VERSION}); update Teach Studio."
         )
     regions = meta.get("regions")
-    if not isinstance(regions, int) or regions < 1:
+    if not _whole(regions) or not 1 <= regions <= MAX_REGIONS:
         raise RecordingError(
-            f"{path}, line 1: the header's regions is {regions!r}; it must be a positive integer."
+            f"{path}, line 1: the header's regions is {_short(regions)}; it must be a whole number from 1 to {MAX_REGIONS}."
+        )
+    rate = meta.get("rate_hz", 0.0)
+    if (
+        isinstance(rate, bool)
+        or not isinstance(rate, int | float)
+        or not 0.0 <= rate <= MAX_RATE_HZ
+    ):
+        raise RecordingError(
+            f"{path}, line 1: the header's rate_hz is {_short(rate)}; it must be a number from 0 to {MAX_RATE_HZ:g}."
+        )
+    for key in TEXT_KEYS:
+        if meta.get(key) is not None and not isinstance(meta[key], str):
+            raise RecordingError(
+                f"{path}, line 1: the header's {key} is {_short(meta[key])}; it must be text."
+            )
+    tape = meta.get("tape")
+    if tape is not None and (not isinstance(tape, dict) or tape.get("regions", regions) != regions):
+        raise RecordingError(
+            f"{path}, line 1: the header's tape is {_short(tape)}; it must describe a tape of {regions} regions."
         )
     return meta
 
 
-def read_recording(path: str | os.PathLike[str], strict: bool = True) -> Recording:
-    """Read a ``*.tape.csv`` recording.
+TEXT_KEYS = ("name", "operator", "notes", "source", "created")
+"""Header keys that hold text (a listing shows them as they are)."""
 
-    Args:
-        path: the file.
-        strict: raise on the first problem (``True``), or keep the good frames and list the
-            problems in :attr:`Recording.problems` (``False``).
 
-    Returns:
-        The recording; ``recovered`` is true when the capture was interrupted.
+def _whole(value: Any) -> bool:
+    return isinstance(value, int) and not isinstance(value, bool)
 
-    Raises:
-        RecordingError: naming the file, the line and the problem (header problems always raise,
-            since without a header no frame can be read).
+
+def _short(value: Any) -> str:
+    text = repr(value)
+    return text if len(text) <= 40 else text[:37] + "..."
+
+
+@dataclass
+class _Scan:
+    """What one pass over a recording's lines found (rows kept only when asked)."""
+
+    meta: dict[str, Any]
+    keep_rows: bool = True
+    blocks: list[np.ndarray] = field(default_factory=list)
+    count: int = 0
+    first_t: float | None = None
+    last_t: float | None = None
+    end: dict[str, Any] | None = None
+    problems: list[str] = field(default_factory=list)
+
+    @property
+    def duration(self) -> float:
+        if self.count < 2 or self.first_t is None or self.last_t is None:
+            return 0.0
+        return self.last_t - self.first_t
+
+
+def _scan(path: Path, strict: bool, keep_rows: bool) -> _Scan:
+    """Read a recording line by line in blocks, checking each line as :func:`read_recording` says.
+
+    Memory stays bounded by one block plus (when ``keep_rows``) the parsed frames: nothing is
+    allocated from what the header claims, and a line longer than any row can be (a hole of zero
+    bytes in a sparse file, a binary blob) is skipped without being buffered.
     """
-    path = Path(path)
+    with _open(path) as stream:
+        meta = _parse_header(path, _first_line(path, stream))
+        regions = int(meta["regions"])
+        expected = columns(regions)
+        column_row = ",".join(expected).encode("ascii")
+        scan = _Scan(meta, keep_rows)
+        second = stream.readline(len(column_row) + 2)
+        if not second.endswith(b"\n") and not stream.read(1):
+            return scan  # the capture died before the column row was complete
+        if second.rstrip(b"\n") != column_row:
+            raise RecordingError(
+                f"{path}, line 2: the column row does not match {regions} regions (expected '{','.join(expected[:5])},...'); {FIX_HINT}."
+            )
+        problems = _Problems(path, strict)
+        lines = _Lines(stream, max_line_bytes(regions), problems)
+        for block, first_number, last_complete in lines:
+            _scan_block(block, first_number, last_complete, len(expected), scan, problems)
+    frames = scan.end.get("frames") if isinstance(scan.end, dict) else None
+    if _whole(frames) and frames != scan.count and not problems.items:
+        problems.add(
+            lines.number, f"the '# end' line counts {frames} frames but {scan.count} were read"
+        )
+    scan.problems = problems.items
+    return scan
+
+
+class _Lines:
+    """The data lines of an open recording, in blocks of whole lines, never buffering a line
+    longer than ``max_line`` bytes (such a line is a problem, skipped as it streams past)."""
+
+    def __init__(self, stream: BinaryIO, max_line: int, problems: _Problems) -> None:
+        self.stream, self.max_line, self.problems = stream, max_line, problems
+        self.number = 2  # lines before the first data line
+
+    def _overlong(self, size: int) -> None:
+        self.number += 1
+        self.problems.add(
+            self.number,
+            f"a line of {size:,} bytes, longer than any row can be (damaged, e.g. a hole of zero bytes)",
+        )
+
+    def __iter__(self) -> Iterator[tuple[list[bytes], int, bool]]:
+        """Yields ``(lines, number of the first, whether the last one ended with a newline)``."""
+        pending = b""
+        skipping = 0  # bytes of an overlong line dropped so far
+        while True:
+            chunk = self.stream.read(READ_BLOCK_BYTES)
+            if not chunk:
+                break
+            if skipping:
+                cut = chunk.find(b"\n")
+                if cut < 0:
+                    skipping += len(chunk)
+                    continue
+                self._overlong(skipping + cut)
+                skipping, chunk = 0, chunk[cut + 1 :]
+            data = pending + chunk
+            cut = data.rfind(b"\n")
+            pending = data[cut + 1 :]
+            if cut >= 0:
+                lines = data[:cut].split(b"\n")
+                yield lines, self.number + 1, True
+                self.number += len(lines)
+            if len(pending) > self.max_line:
+                skipping, pending = len(pending), b""
+        if skipping:
+            self._overlong(skipping)
+        elif pending:
+            yield [pending], self.number + 1, False
+            self.number += 1
+
+
+def _scan_block(
+    block: list[bytes],
+    first_number: int,
+    last_complete: bool,
+    width: int,
+    scan: _Scan,
+    problems: _Problems,
+) -> None:
+    """Check and parse one block of lines into ``scan`` (the rules of :func:`read_recording`)."""
+    joined = b"\n".join(block)
     try:
-        raw = path.read_bytes()
-    except OSError as err:
-        raise RecordingError(f"cannot open {path} ({err.strerror}); check the path.") from None
-    try:
-        text = raw.decode("utf-8")
+        lines = joined.decode("utf-8").split("\n")
         damaged = False
     except UnicodeDecodeError:
         # bytes that are not text: a damaged disk block or a binary file; each line holding
         # them is a problem of its own (U+FFFD cannot occur in a written recording, all ASCII)
-        text = raw.decode("utf-8", errors="replace")
+        lines = joined.decode("utf-8", errors="replace").split("\n")
         damaged = True
-    lines = text.split("\n")
-    complete_last = lines[-1] == ""
-    if complete_last:
-        lines.pop()
-    if not lines:
-        raise RecordingError(
-            f"{path}, line 1: the file is empty, so not a recording; open a *.tape.csv file."
-        )
-    if damaged and NOT_TEXT in lines[0]:
-        raise RecordingError(
-            f"{path}, line 1: binary data, so not a recording; open a *.tape.csv file."
-        )
-    meta = _parse_header(path, lines[0])
-    regions = int(meta["regions"])
-    expected = columns(regions)
-    problems = _Problems(path, strict)
-    if len(lines) < 2 or (len(lines) == 2 and not complete_last):
-        # the capture died before the column row was complete
-        empty = np.zeros((0, regions))
-        return Recording(
-            path,
-            meta,
-            np.zeros(0),
-            np.zeros(0, np.int64),
-            np.zeros(0, np.int64),
-            empty,
-            empty.copy(),
-            True,
-            [],
-        )
-    if lines[1].split(",") != expected:
-        raise RecordingError(
-            f"{path}, line 2: the column row does not match {regions} regions (expected '{','.join(expected[:5])},...'); {FIX_HINT}."
-        )
-    end: dict[str, Any] | None = None
     rows: list[str] = []
     row_lines: list[int] = []
-    width = len(expected)
     last_index = len(lines) - 1
-    for index in range(2, len(lines)):
-        line = lines[index]
-        number = index + 1
+    for index, line in enumerate(lines):
+        number = first_number + index
         if line.startswith("#"):
             if line.startswith(END_PREFIX):
                 try:
-                    end = json.loads(line[len(END_PREFIX) :])
-                except json.JSONDecodeError:
+                    scan.end = loads_json(
+                        line[len(END_PREFIX) :], "the '# end' line", max_bytes=MAX_HEADER_BYTES
+                    )
+                except JSONFileError:
+                    scan.end = None
+                if not isinstance(scan.end, dict):
                     problems.add(number, "the '# end' line is not valid JSON")
-                    end = {}
+                    scan.end = {}
             continue
-        if end is not None:
+        if scan.end is not None:
             problems.add(number, "data after the '# end' line")
             continue
-        if index == last_index and not complete_last:
+        if index == last_index and not last_complete:
             # a row whose write was cut short by a crash: expected in an interrupted capture
             problems.items.append(
                 f"line {number}: incomplete last row (the capture was interrupted); dropped"
@@ -290,29 +404,150 @@ def read_recording(path: str | os.PathLike[str], strict: bool = True) -> Recordi
             )
             problems.add(row_lines[i], what)
         data = data[good]
-    if (
-        end is not None
-        and isinstance(end.get("frames"), int)
-        and end["frames"] != data.shape[0]
-        and not problems.items
-    ):
-        problems.add(
-            len(lines),
-            f"the '# end' line counts {end['frames']} frames but {data.shape[0]} were read",
-        )
+    if data.shape[0]:
+        if scan.first_t is None:
+            scan.first_t = float(data[0, 0])
+        scan.last_t = float(data[-1, 0])
+        scan.count += int(data.shape[0])
+        if scan.keep_rows:
+            scan.blocks.append(data)
+
+
+def read_recording(path: str | os.PathLike[str], strict: bool = True) -> Recording:
+    """Read a ``*.tape.csv`` recording.
+
+    The file is read in blocks: memory holds the frames and one block, whatever the file holds
+    (a header's claims are checked against their bounds before anything is allocated).
+
+    Args:
+        path: the file.
+        strict: raise on the first problem (``True``), or keep the good frames and list the
+            problems in :attr:`Recording.problems` (``False``).
+
+    Returns:
+        The recording; ``recovered`` is true when the capture was interrupted.
+
+    Raises:
+        RecordingError: naming the file, the line and the problem (header problems always raise,
+            since without a header no frame can be read).
+    """
+    path = Path(path)
+    scan = _scan(path, strict, keep_rows=True)
+    regions = int(scan.meta["regions"])
+    width = len(FIXED_COLUMNS) + 2 * regions
+    data = np.concatenate(scan.blocks) if scan.blocks else np.zeros((0, width))
+    scan.blocks.clear()
     r = regions
     return Recording(
         path=path,
-        meta=meta,
+        meta=scan.meta,
         t=data[:, 0].copy(),
         frame=data[:, 1].astype(np.int64),
         status=data[:, 2].astype(np.int64),
         bend=data[:, 3 : 3 + r].copy(),
         twist=data[:, 3 + r : 3 + 2 * r].copy(),
-        recovered=end is None,
-        problems=problems.items,
-        end=end,
+        recovered=scan.end is None,
+        problems=scan.problems,
+        end=scan.end,
     )
+
+
+def summarize_recording(path: str | os.PathLike[str], strict: bool = True) -> dict[str, Any]:
+    """:meth:`Recording.summary` of a file, streamed: memory stays one block, however long the file.
+
+    For ``studio info`` and listings, which need the counts but not the frames.
+
+    Raises:
+        RecordingError: as :func:`read_recording`.
+    """
+    path = Path(path)
+    scan = _scan(path, strict, keep_rows=False)
+    return _summary(path, scan.meta, scan.count, scan.duration, scan.end is None, scan.problems)
+
+
+class RecordingBytes:
+    """A consistent prefix of a recording file, for downloads: every complete line, no partial one.
+
+    A file under capture grows while it is sent, and its last row may be half written; a
+    download that trusts ``stat`` then sends more bytes than it announced, or a torn row. This
+    fixes the length when it is opened (up to and including the last newline) and reads from the
+    same open file, so a concurrent append or an atomic header edit (a new inode) cannot change
+    what is sent. Iterate it once for the bytes; it closes itself at the end.
+
+    Attributes:
+        path: the recording.
+        size: bytes that will be yielded (the announced ``Content-Length``).
+    """
+
+    def __init__(self, path: Path, stream: BinaryIO, size: int) -> None:
+        self.path, self._stream, self.size = path, stream, size
+
+    def __iter__(self) -> Iterator[bytes]:
+        try:
+            self._stream.seek(0)
+            left = self.size
+            while left > 0:
+                chunk = self._stream.read(min(READ_BLOCK_BYTES, left))
+                if not chunk:  # truncated under us (cannot happen to a recording): stop short
+                    return
+                left -= len(chunk)
+                yield chunk
+        finally:
+            self.close()
+
+    def close(self) -> None:
+        """Release the file (also done when iteration ends)."""
+        self._stream.close()
+
+
+def recording_bytes(path: str | os.PathLike[str]) -> RecordingBytes:
+    """The bytes of a recording up to its last complete line, fixed at this moment (see
+    :class:`RecordingBytes`); works on finished and live recordings alike.
+
+    Raises:
+        RecordingError: the file is missing or not a regular file.
+    """
+    path = Path(path)
+    stream = _open(path)
+    try:
+        end = os.fstat(stream.fileno()).st_size
+        while end > 0:  # back off to the last newline, a block at a time
+            start = max(0, end - READ_BLOCK_BYTES)
+            stream.seek(start)
+            cut = stream.read(end - start).rfind(b"\n")
+            if cut >= 0:
+                end = start + cut + 1
+                break
+            end = start
+    except BaseException:
+        stream.close()
+        raise
+    return RecordingBytes(path, stream, end)
+
+
+def _summary(
+    path: Path,
+    meta: dict[str, Any],
+    frames: int,
+    duration: float,
+    recovered: bool,
+    problems: list[str],
+) -> dict[str, Any]:
+    """The JSON-ready facts of a recording (one definition for both readers)."""
+    return {
+        "path": str(path),
+        "name": str(meta.get("name") or path.name),
+        "frames": frames,
+        "duration": duration,
+        "regions": int(meta["regions"]),
+        "rate_hz": float(meta.get("rate_hz", 0.0)),
+        "source": meta.get("source", ""),
+        "operator": meta.get("operator", ""),
+        "notes": meta.get("notes", ""),
+        "created": meta.get("created", ""),
+        "recovered": recovered,
+        "problems": list(problems),
+    }
 
 
 def _to_array(

@@ -28,6 +28,7 @@ from ._recording_format import (
     DEFAULT_REGIONS,
     FORMAT_NAME,
     FORMAT_VERSION,
+    MAX_REGIONS,
     RECORDING_SUFFIX,
     columns,
     end_line,
@@ -54,7 +55,16 @@ def recording_meta(
     created: str | None = None,
     **extra: Any,
 ) -> dict[str, Any]:
-    """The header dict of a new recording (see :mod:`._recording_format`)."""
+    """The header dict of a new recording (see :mod:`._recording_format`).
+
+    Raises:
+        RecordingError: ``regions`` is outside 1 to :data:`MAX_REGIONS` (no reader would open
+            the file).
+    """
+    if isinstance(regions, bool) or not 1 <= int(regions) <= MAX_REGIONS:
+        raise RecordingError(
+            f"a tape of {regions!r} regions cannot be recorded; give 1 to {MAX_REGIONS} regions."
+        )
     return {
         "format": FORMAT_NAME,
         "version": FORMAT_VERSION,

@@ -24,6 +24,7 @@ import struct
 import numpy as np
 
 from ._frames import TapeFrame
+from ._recording_format import MAX_REGIONS
 
 MAGIC = b"STAP"
 """First four bytes of every datagram."""
@@ -31,8 +32,6 @@ WIRE_VERSION = 1
 """The version this code writes and the newest it reads."""
 HEADER = struct.Struct("!4sBBHIdH")
 """Everything before the angles."""
-MAX_REGIONS = 256
-"""Largest region count accepted (a sanity bound against garbage)."""
 DEFAULT_PORT = 47110
 """UDP port of the network source unless told otherwise."""
 

@@ -6,7 +6,7 @@ import argparse
 import json
 from pathlib import Path
 
-from studio.capture import read_recording
+from studio.capture import summarize_recording
 from studio.capture._capture_loop import describe
 from studio.capture._recording_edit import being_recorded
 
@@ -36,7 +36,8 @@ def run(args: argparse.Namespace) -> int:
                 [str(path), *(f"  {k:<13} {v}" for k, v in summary.items() if k != "path")]
             )
         else:
-            summary = read_recording(path, strict=not args.lenient).summary()
+            # streamed: memory stays one block however long (or damaged) the file is
+            summary = summarize_recording(path, strict=not args.lenient)
             # a file still being captured has no '# end' line yet, but it was not interrupted
             summary["live"] = summary["recovered"] and being_recorded(path)
             if summary["live"]:

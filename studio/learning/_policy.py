@@ -27,17 +27,22 @@ the one they know.
 
 from __future__ import annotations
 
+import io
 import json
+import math
 import zipfile
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
 from pathlib import Path
-from typing import Any
+from typing import IO, Any
 
 import numpy as np
+from numpy.lib import format as npy_format
+
+from studio import JSONFileError, loads_json
 
 from ._arm import ArmGrid
-from ._config import DynaQConfig
+from ._config import MAX_EPISODES, DynaQConfig
 from ._errors import LearningError, PolicyFileError
 
 FORMAT_NAME = "teach-studio-policy"
@@ -50,6 +55,177 @@ DEFAULT_SECONDS_PER_STEP = 0.5
 """Default time the arm takes to move one grid step."""
 DEFAULT_MAX_STEPS = 1_000
 """Default cap on greedy steps in a rollout."""
+MAX_NPY_HEADER_BYTES = 10_000
+"""Longest ``.npy`` member header read (numpy's own safe limit)."""
+MAX_NPZ_BYTES = 256 * 1024 * 1024
+"""Most bytes decompressed from one ``.npz`` file, all members together (the largest arm grid's
+Q table is 96 MB)."""
+MAX_HEADER_CHARS = 64 * (MAX_EPISODES + 10_000)
+"""Longest policy JSON header: a curve of :data:`MAX_EPISODES` values and the settings."""
+NPZ_READ_BYTES = 1024 * 1024
+"""Bytes decompressed at a time."""
+
+
+@dataclass(frozen=True)
+class NpyHeader:
+    """What a ``.npy`` member's header says its data is (read before any data is)."""
+
+    shape: tuple[int, ...]
+    dtype: np.dtype
+    fortran_order: bool
+
+    @property
+    def nbytes(self) -> int:
+        """Bytes of data the header promises."""
+        return math.prod(self.shape) * self.dtype.itemsize
+
+
+class BoundedNpz:
+    """A ``.npz`` archive read member by member, each checked by its header before it is inflated.
+
+    ``np.load`` decompresses a member whole before its shape can be judged, so a small zip bomb
+    inflates to gigabytes. Here each member's ``.npy`` header (shape, dtype) is read first, from
+    the start of the compressed stream; the data is decompressed only when the caller's expected
+    shape and dtype kinds match, never more than the header promises, and never more than
+    ``max_bytes`` for the whole archive. No pickles are ever loaded.
+
+    Args:
+        path: the ``.npz`` file.
+        name: the file as error sentences name it.
+        max_bytes: cap on decompressed bytes over all members.
+
+    Raises:
+        PolicyFileError: the file is not a readable zip archive.
+
+    Example::
+
+        with BoundedNpz(path, path.name) as npz:
+            header = npz.read_text("header", MAX_HEADER_CHARS)
+            q = npz.read("q", (n_states, n_actions), kinds="f")
+    """
+
+    def __init__(self, path: str | Path, name: str, max_bytes: int = MAX_NPZ_BYTES) -> None:
+        self.name, self.budget = name, int(max_bytes)
+        try:
+            self._zip = zipfile.ZipFile(path)
+        except (OSError, zipfile.BadZipFile, ValueError, EOFError) as err:
+            raise PolicyFileError(
+                f"{name} is corrupt or not a policy file ({type(err).__name__}); export the policy again."
+            ) from None
+        self.files = [n.removesuffix(".npy") for n in self._zip.namelist() if n.endswith(".npy")]
+
+    def __enter__(self) -> BoundedNpz:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def close(self) -> None:
+        """Release the file."""
+        self._zip.close()
+
+    def _refuse(self, what: str) -> PolicyFileError:
+        return PolicyFileError(f"{self.name} {what}; export the policy again.")
+
+    def _open(self, key: str) -> tuple[IO[bytes], NpyHeader]:
+        if key not in self.files:
+            raise self._refuse(f"has no {key!r} array")
+        try:
+            stream = self._zip.open(key + ".npy")
+            try:
+                version = npy_format.read_magic(stream)
+                if version not in ((1, 0), (2, 0)):
+                    raise ValueError(f"npy version {version}")
+                length_field = stream.read(2 if version == (1, 0) else 4)
+                length = int.from_bytes(length_field, "little")
+                if length > MAX_NPY_HEADER_BYTES:  # numpy would read it all before checking
+                    raise ValueError(f"a {length}-byte array header")
+                header_bytes = length_field + stream.read(length)
+                reader = (
+                    npy_format.read_array_header_1_0
+                    if version == (1, 0)
+                    else npy_format.read_array_header_2_0
+                )
+                shape, fortran_order, dtype = reader(
+                    io.BytesIO(header_bytes), max_header_size=MAX_NPY_HEADER_BYTES
+                )
+            except BaseException:
+                stream.close()
+                raise
+        except PolicyFileError:
+            raise
+        except (
+            OSError,
+            ValueError,
+            EOFError,
+            RuntimeError,
+            RecursionError,
+            zipfile.BadZipFile,
+        ) as err:
+            raise self._refuse(f"has a damaged {key!r} array ({err})") from None
+        if dtype.hasobject:
+            stream.close()
+            raise self._refuse(f"holds Python objects in {key!r}, which are never loaded")
+        return stream, NpyHeader(tuple(int(n) for n in shape), dtype, bool(fortran_order))
+
+    def header(self, key: str) -> NpyHeader:
+        """Member ``key``'s shape and dtype, from its header alone (no data is decompressed)."""
+        stream, header = self._open(key)
+        stream.close()
+        return header
+
+    def read(
+        self, key: str, shape: tuple[int, ...] | None, kinds: str, max_bytes: int | None = None
+    ) -> np.ndarray:
+        """Member ``key``, decompressed only if its header matches what the caller expects.
+
+        Args:
+            key: the member's name (without ``.npy``).
+            shape: the exact shape required (``None``: any shape within ``max_bytes``).
+            kinds: accepted ``dtype.kind`` letters (``"f"``, ``"iu"``, ``"U"``...).
+            max_bytes: cap on this member's data (the archive's remaining budget applies too).
+
+        Raises:
+            PolicyFileError: the header does not match, the data is larger than allowed, is
+                truncated, holds more than its header says, or fails its CRC.
+        """
+        stream, header = self._open(key)
+        with stream:
+            if header.dtype.kind not in kinds:
+                raise self._refuse(f"stores {key!r} as {header.dtype}, not the expected kind")
+            if shape is not None and header.shape != tuple(shape):
+                raise self._refuse(
+                    f"says its {key!r} array has shape {header.shape} where {tuple(shape)} was expected"
+                )
+            limit = self.budget if max_bytes is None else min(self.budget, max_bytes)
+            if header.nbytes > limit:
+                raise self._refuse(
+                    f"says its {key!r} array holds {header.nbytes:,} bytes, more than the "
+                    f"{limit:,} allowed"
+                )
+            count = math.prod(header.shape)
+            flat = np.empty(count, dtype=header.dtype)  # justified by the checks above
+            raw = flat.view(np.uint8)
+            done = 0
+            try:
+                while done < header.nbytes:
+                    chunk = stream.read(min(NPZ_READ_BYTES, header.nbytes - done))
+                    if not chunk:
+                        raise self._refuse(f"has a truncated {key!r} array")
+                    raw[done : done + len(chunk)] = np.frombuffer(chunk, dtype=np.uint8)
+                    done += len(chunk)
+                if stream.read(1):  # reading to the end also checks the CRC
+                    raise self._refuse(f"holds more {key!r} data than its header says")
+            except (OSError, EOFError, zipfile.BadZipFile, RuntimeError) as err:
+                raise self._refuse(f"has a damaged {key!r} array ({err})") from None
+            self.budget -= header.nbytes
+        order = "F" if header.fortran_order else "C"
+        return flat.reshape(header.shape, order=order)
+
+    def read_text(self, key: str, max_chars: int) -> str:
+        """A 0-d unicode member (as ``np.savez`` stores a ``str``) of at most ``max_chars``."""
+        array = self.read(key, (), "U", max_bytes=4 * max_chars)
+        return str(array[()])
 
 
 @dataclass(frozen=True, eq=False)
@@ -163,22 +339,45 @@ def load_policy(path: str | Path) -> PolicyFile:
         raise PolicyFileError(
             f"Policy file {name} does not exist; give the path of a .policy.npz file."
         )
-    try:
-        with np.load(path, allow_pickle=False) as archive:
-            missing = {"header", "q", "greedy"} - set(archive.files)
-            if missing:
-                raise PolicyFileError(
-                    f"{name} lacks {', '.join(sorted(missing))}; it is not a Teach Studio policy file, export one again."
-                )
-            header = json.loads(str(archive["header"]))
-            q = np.asarray(archive["q"], dtype=np.float64)
-            greedy = np.asarray(archive["greedy"], dtype=np.int64)
-    except PolicyFileError:
-        raise
-    except (OSError, ValueError, EOFError, zipfile.BadZipFile, KeyError, TypeError) as err:
-        raise PolicyFileError(
-            f"{name} is corrupt or not a policy file ({type(err).__name__}); export the policy again."
-        ) from None
+    # Bounded: the JSON header is read (size and depth limited) and checked first; the tables
+    # are decompressed only when their .npy headers have exactly the shapes its grid implies.
+    with BoundedNpz(path, name) as archive:
+        missing = {"header", "q", "greedy"} - set(archive.files)
+        if missing:
+            raise PolicyFileError(
+                f"{name} lacks {', '.join(sorted(missing))}; it is not a Teach Studio policy file, export one again."
+            )
+        try:
+            header = loads_json(
+                archive.read_text("header", MAX_HEADER_CHARS),
+                f"{name}'s header",
+                max_bytes=MAX_HEADER_CHARS,
+            )
+        except JSONFileError as err:
+            raise PolicyFileError(str(err)) from None
+        grid, config, mean_steps, experiments = _check_header(name, header)
+        q = archive.read("q", (grid.n_states, grid.n_actions), "fiu").astype(np.float64, copy=False)
+        greedy = archive.read("greedy", (grid.n_states,), "iu").astype(np.int64, copy=False)
+    if not np.all(np.isfinite(q)) or greedy.min() < 0 or greedy.max() >= grid.n_actions:
+        raise PolicyFileError(f"{name} holds invalid Q values or actions; export the policy again.")
+    return PolicyFile(
+        grid=grid,
+        q=q,
+        greedy=greedy,
+        config=config,
+        mean_steps=mean_steps,
+        experiments=experiments,
+        created=str(header.get("created", "")),
+        notes=str(header.get("notes", "")),
+    )
+
+
+def _check_header(name: str, header: Any) -> tuple[ArmGrid, DynaQConfig, np.ndarray, int]:
+    """The grid, settings, curve and experiment count of a policy's JSON header, all validated.
+
+    Raises:
+        PolicyFileError: not a policy header, a newer version, or a damaged field.
+    """
     if not isinstance(header, dict) or header.get("format") != FORMAT_NAME:
         raise PolicyFileError(f"{name} is not a Teach Studio policy file; export the policy again.")
     version = header.get("version")
@@ -198,26 +397,15 @@ def load_policy(path: str | Path) -> PolicyFile:
             [np.nan if x is None else x for x in curve.get("mean_steps", [])], dtype=np.float64
         )
         experiments = int(curve.get("experiments", 1))
-    except (KeyError, TypeError, ValueError, LearningError) as err:
+    except (KeyError, TypeError, ValueError, AttributeError, LearningError) as err:
         raise PolicyFileError(
             f"{name} has a damaged header ({err}); export the policy again."
         ) from None
-    if q.shape != (grid.n_states, grid.n_actions) or greedy.shape != (grid.n_states,):
+    if mean_steps.ndim != 1:
         raise PolicyFileError(
-            f"{name} holds tables of shape {q.shape} and {greedy.shape}, which do not match its grid; export the policy again."
+            f"{name} has a damaged header (its curve is not a list of numbers); export the policy again."
         )
-    if not np.all(np.isfinite(q)) or greedy.min() < 0 or greedy.max() >= grid.n_actions:
-        raise PolicyFileError(f"{name} holds invalid Q values or actions; export the policy again.")
-    return PolicyFile(
-        grid=grid,
-        q=q,
-        greedy=greedy,
-        config=config,
-        mean_steps=mean_steps,
-        experiments=experiments,
-        created=str(header.get("created", "")),
-        notes=str(header.get("notes", "")),
-    )
+    return grid, config, mean_steps, experiments
 
 
 def greedy_path(

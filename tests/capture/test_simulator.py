@@ -50,18 +50,38 @@ def test_minimum_jerk_profile():
     assert abs(v[0]) < 1e-3 and abs(v[-1]) < 1e-3  # starts and ends at rest
 
 
+def _read_with_times(source, count: int) -> tuple[list, list[float]]:
+    """Read ``count`` frames (or give up after a generous wait); each with a time it was read."""
+    got: list = []
+    read_at: list[float] = []
+    deadline = time.monotonic() + 30.0  # only a hung source reaches this
+    while len(got) < count and time.monotonic() < deadline:
+        frames = source.read(timeout=0.05)
+        now = time.monotonic()  # after the frames were released: an upper bound on their release
+        got += frames
+        read_at += [now] * len(frames)
+    return got, read_at
+
+
 def test_live_source_keeps_110_hz_without_drops():
+    """Paced on absolute deadlines (frame k no earlier than start + k / 110 s), every frame, in
+    order, stamped with its own time k / 110. A busy machine can only make frames late, which
+    the deadlines catch up without drops; nothing here depends on how fast the machine is."""
     source = SimulatorSource(seed=0)
+    before = time.monotonic()
     source.start()
-    got = []
-    deadline = time.monotonic() + 1.0
-    while time.monotonic() < deadline:
-        got += source.read(timeout=0.05)
-    source.stop()
+    try:
+        got, read_at = _read_with_times(source, 165)  # 1.5 s of frames
+    finally:
+        source.stop()
     status = source.status()
     assert status.dropped == 0 and status.error is None
-    assert [f.frame for f in got] == list(range(len(got)))
-    assert 60 < len(got) < 160  # paced near 110 Hz, not dumped
+    assert [f.frame for f in got] == list(range(165))
+    assert [f.t for f in got] == pytest.approx([k / 110 for k in range(165)], abs=1e-12)
+    # paced, not dumped: no frame is out before its deadline (to the clock's resolution)
+    early = [k for k, at in enumerate(read_at) if at - before < k / 110 - 1e-6]
+    assert early == []
+    assert read_at[-1] - before >= 164 / 110  # 1.5 s of frames took at least 1.5 s
 
 
 def test_live_source_gives_the_generator_frames():

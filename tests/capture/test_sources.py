@@ -45,6 +45,14 @@ def _drain(source, until, timeout=WAIT_SECONDS) -> list[TapeFrame]:
     return out
 
 
+def _wait(predicate, timeout=WAIT_SECONDS) -> None:
+    """Poll ``predicate`` until it holds (fails after ``timeout`` s: only a hung source)."""
+    deadline = time.monotonic() + timeout
+    while not predicate():
+        assert time.monotonic() < deadline, "timed out waiting for the source"
+        time.sleep(0.01)
+
+
 def _recording(tmp_path, frames):
     path = tmp_path / "p.tape.csv"
     with RecordingWriter(path, 16, rate_hz=110.0) as w:
@@ -81,12 +89,32 @@ def test_playback_seek_pause_and_loop(tmp_path, frames):
 
 
 def test_playback_real_time_is_paced_not_dumped(tmp_path, frames):
-    source = PlaybackSource(_recording(tmp_path, frames), speed=1.0)  # 2.7 s of frames
+    """Frame i comes out no earlier than (t_i - t_0) / speed after the start: the recording's own
+    time stamps set the pace. A busy machine can only make frames late, never early."""
+    speed = 2.0
+    source = PlaybackSource(_recording(tmp_path, frames), speed=speed)  # 1.4 s at speed 2
+    count = 110
+    got: list[TapeFrame] = []
+    read_at: list[float] = []
+    before = time.monotonic()
     source.start()
-    got = _drain(source, lambda f: False, timeout=0.3)
-    source.stop()
-    assert 0 < len(got) < len(frames)
+    try:
+        deadline = before + WAIT_SECONDS
+        while len(got) < count and time.monotonic() < deadline:
+            batch = source.read(timeout=0.05)
+            now = time.monotonic()  # after the batch was released
+            got += batch
+            read_at += [now] * len(batch)
+    finally:
+        source.stop()
+    assert len(got) >= count
     assert all(a.same_as(b) for a, b in zip(frames, got, strict=False))
+    early = [
+        i
+        for i, (frame, at) in enumerate(zip(got, read_at, strict=True))
+        if at - before < (frame.t - frames[0].t) / speed - 1e-6
+    ]
+    assert early == []
 
 
 def test_wire_format_round_trips_at_float32(frames):
@@ -248,35 +276,55 @@ def test_dropped_frames_are_counted_when_the_consumer_stalls():
 
     source = Burst(queue_frames=10)
     source.start()
-    time.sleep(0.2)
+    _wait(lambda: not source.running)  # the producer pushed all 50 frames and returned
     assert len(source.read()) == 10 and source.status().dropped == 40
 
 
-def test_the_rate_falls_to_zero_when_frames_stop():
-    """A paused recording or a silent bridge must not keep showing its last rate."""
-    from studio.capture import ThreadedSource
+class _FakeClock:
+    """``time.monotonic`` for a module under test, moved by the test alone."""
 
-    go_quiet = threading.Event()
+    def __init__(self) -> None:
+        self.now = 1000.0
 
-    class Paced(ThreadedSource):
-        kind = "paced"
+    def monotonic(self) -> float:
+        return self.now
+
+
+def test_the_rate_is_measured_over_the_last_second_and_falls_to_zero_when_frames_stop(
+    monkeypatch,
+):
+    """A paused recording or a silent bridge must not keep showing its last rate.
+
+    The rate is measured on a fake clock, so the test checks the arithmetic (frames per second
+    over the last second) exactly, whatever the machine is doing.
+    """
+    from studio.capture import ThreadedSource, _source
+
+    clock = _FakeClock()
+    monkeypatch.setattr(_source, "time", clock)
+
+    class Pushed(ThreadedSource):
+        kind = "pushed"
 
         def _produce(self):
-            for frame in synthetic_frames(10_000):
-                if go_quiet.is_set() or self._stop_event.wait(0.01):
-                    break
-                self._push(frame)
             self._stop_event.wait()
 
-    source = Paced()
+    source = Pushed()
     source.start()
     try:
-        time.sleep(0.5)
-        assert source.status().rate_hz > 20  # about 100 Hz while frames flow
-        go_quiet.set()
-        time.sleep(1.2)
+        for frame in synthetic_frames(300):  # 3 s at 100 Hz
+            clock.now += 0.01
+            source._push(frame)
         status = source.status()
-        assert status.running and status.rate_hz == 0.0 and status.frames > 20
+        assert status.rate_hz == pytest.approx(100.0)  # only the last second's frames count
+        assert status.frames == 300
+        clock.now += 0.5  # half a second of silence: the frames of the last half second remain
+        assert source.status().rate_hz == pytest.approx(100.0)
+        clock.now += 0.6  # over a second of silence
+        status = source.status()
+        assert status.running and status.rate_hz == 0.0 and status.frames == 300
+        source._push(synthetic_frames(1)[0])  # one frame alone gives no rate yet
+        assert source.status().rate_hz == 0.0
     finally:
         source.stop()
 
@@ -303,7 +351,7 @@ def test_a_silent_network_sender_is_a_status_error_that_clears(monkeypatch, fram
     receiver = NetworkSource(port=0)
     receiver.start()
     try:
-        time.sleep(0.5)
+        _wait(lambda: receiver.status().error is not None)
         silent = receiver.status()
         with FrameSender(*receiver.address) as sender:
             sender.send(frames[0])

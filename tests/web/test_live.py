@@ -13,8 +13,12 @@ def test_the_simulator_drives_the_robot(open_client):
     first = client.get("/api/source").json()
     assert first["kind"] == "simulator" and first["running"] and first["error"] is None
     assert wait_for(lambda: client.get("/api/source").json()["q_robot"] != first["q_robot"])
+    # the page shows a live rate; its value is the source's own measurement (tested against a
+    # fake clock in tests/capture/test_sources.py), and the pacing against the simulator's
+    # deadlines in tests/capture/test_simulator.py, neither of which a busy machine can flake
+    assert wait_for(lambda: client.get("/api/source").json()["rate_hz"] > 0)
     later = client.get("/api/source").json()
-    assert later["frames"] > first["frames"] and later["rate_hz"] > 50
+    assert later["frames"] > first["frames"]
     assert later["fit_residual_mm"] < 30  # the simulated tape fits the arm model
     assert later["dropped"] == 0
 
@@ -91,7 +95,8 @@ def _play(open_client, tmp_path, frames, config):
     r = client.put("/api/source", json={"kind": "recording", "recording": "take", "loop": True})
     assert r.status_code == 200, r.text
     assert wait_for(lambda: client.get("/api/source").json()["fit_residual_mm"] is not None)
-    time.sleep(0.5)  # several fits, warm-started
+    # several fits, warm-started: the second pass over the frames has begun
+    assert wait_for(lambda: client.get("/api/source").json()["frames"] > len(frames))
     return client
 
 

@@ -5,7 +5,9 @@ from __future__ import annotations
 from typing import Annotated
 
 from fastapi import APIRouter, File, Response, UploadFile
-from fastapi.responses import FileResponse
+from fastapi.responses import StreamingResponse
+
+from studio.capture import recording_bytes
 
 from .._deps import SettingsDep, StudioDep
 from .._errors import ConflictError
@@ -46,10 +48,17 @@ def read_recording(name: str, studio: StudioDep) -> dict:
 
 
 @router.get("/{name}/file")
-def download_recording(name: str, studio: StudioDep) -> FileResponse:
-    """The ``.tape.csv`` file."""
-    return FileResponse(
-        studio.recordings.path(name), media_type="text/csv", filename=f"{name}{RECORDING_SUFFIX}"
+def download_recording(name: str, studio: StudioDep) -> StreamingResponse:
+    """The ``.tape.csv`` file, up to its last complete line (a capture in progress may be
+    downloaded: its length is fixed when the download starts, so it is a valid recovered file)."""
+    snapshot = recording_bytes(studio.recordings.path(name))
+    return StreamingResponse(
+        snapshot,
+        media_type="text/csv",
+        headers={
+            "Content-Length": str(snapshot.size),
+            "Content-Disposition": f'attachment; filename="{name}{RECORDING_SUFFIX}"',
+        },
     )
 
 

@@ -1,0 +1,101 @@
+"""Bounded file reading: every file the studio reads is checked before anything is allocated.
+
+A path a user names (a calibration, a recording, a policy, a demonstration) may point at a device
+(``/dev/zero`` never ends), a FIFO (blocks forever), or a file far larger than anything the studio
+writes. :func:`open_regular` refuses all of these before a byte is read, and
+:func:`read_bytes_bounded` reads a regular file only when its size is within the caller's limit,
+never reading past it even if the file grows meanwhile.
+"""
+
+from __future__ import annotations
+
+import os
+import stat
+from pathlib import Path
+from typing import BinaryIO
+
+from ._errors import StudioError
+
+
+class FileLimitError(StudioError, ValueError):
+    """A file that is not a regular file, cannot be opened, or is larger than its kind allows.
+
+    It is also a :class:`ValueError`, so code that already treats unreadable file contents as a
+    ``ValueError`` keeps doing so.
+    """
+
+
+def human_size(n: float) -> str:
+    """A byte count as people read it (``50 MB``, ``1.5 kB``, ``120 bytes``)."""
+    if n >= 1e9:
+        return f"{n / 1e9:.3g} GB"
+    if n >= 1e6:
+        return f"{n / 1e6:.3g} MB"
+    if n >= 1e3:
+        return f"{n / 1e3:.3g} kB"
+    return f"{int(n)} bytes"
+
+
+def open_regular(path: str | os.PathLike[str], what: str | None = None) -> BinaryIO:
+    """Open ``path`` for binary reading, refusing anything but a regular file.
+
+    The file is opened with ``O_NONBLOCK`` so that a FIFO cannot block the open itself, and its
+    type is checked on the open descriptor (no race between the check and the read).
+
+    Args:
+        path: the file.
+        what: the file as the error sentence names it (default: its path).
+
+    Raises:
+        FileLimitError: the file is missing, unreadable, or a device, FIFO, socket or folder.
+    """
+    path = Path(path)
+    what = what or str(path)
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
+    except OSError as err:
+        raise FileLimitError(f"cannot open {what} ({err.strerror}); check the path.") from None
+    try:
+        mode = os.fstat(fd).st_mode
+        if not stat.S_ISREG(mode):
+            kind = "a folder" if stat.S_ISDIR(mode) else "a device, pipe or socket"
+            raise FileLimitError(f"{what} is {kind}, not a regular file; give a file.")
+        os.set_blocking(fd, True)
+        return os.fdopen(fd, "rb")
+    except BaseException:
+        os.close(fd)
+        raise
+
+
+def read_bytes_bounded(
+    path: str | os.PathLike[str], max_bytes: int, what: str | None = None
+) -> bytes:
+    """The whole content of a regular file of at most ``max_bytes`` bytes.
+
+    Args:
+        path: the file.
+        max_bytes: the largest size this kind of file can sanely have.
+        what: the file as the error sentence names it (default: its path).
+
+    Raises:
+        FileLimitError: not a regular file, unreadable, or larger than ``max_bytes``.
+    """
+    what = what or str(Path(path))
+    with open_regular(path, what) as stream:
+        size = os.fstat(stream.fileno()).st_size
+        if size > max_bytes:
+            raise FileLimitError(_too_large(what, size, max_bytes))
+        try:
+            data = stream.read(max_bytes + 1)  # never more, even if the file grew meanwhile
+        except OSError as err:
+            raise FileLimitError(f"cannot read {what} ({err.strerror}); check the disk.") from None
+    if len(data) > max_bytes:
+        raise FileLimitError(_too_large(what, len(data), max_bytes))
+    return data
+
+
+def _too_large(what: str, size: int, limit: int) -> str:
+    return (
+        f"{what} is {human_size(size)}, more than the {human_size(limit)} such a file can "
+        "hold; check that it is the right file."
+    )

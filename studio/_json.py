@@ -1,0 +1,126 @@
+"""The one bounded JSON reader: every JSON text the studio reads goes through :func:`loads_json`.
+
+Python's ``json`` parser recurses once per nesting level, so ``[[[...]]]`` 50,000 deep raises a
+``RecursionError`` (a 500 in the API, a traceback in the CLI), and a file of any size is parsed
+whole. Before parsing, this module refuses a text longer than its limit and measures the nesting
+depth without recursion (strings blanked out by one regular expression, then a running count of
+brackets in numpy), so a hostile file costs one linear scan and one clear sentence.
+
+No studio file nests deeper than a handful of levels (a recording header's ``tape.base`` 4x4
+matrix is the deepest, at four), so :data:`MAX_JSON_DEPTH` leaves ample room.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ._errors import StudioError
+from ._files import human_size, read_bytes_bounded
+
+MAX_JSON_BYTES = 64 * 1024 * 1024
+"""Largest JSON file read (a demonstration of a long recording is a few MB)."""
+MAX_JSON_DEPTH = 64
+"""Deepest nesting of arrays and objects accepted (studio files use at most four or five)."""
+
+_STRING = re.compile(rb'"[^"\\]*(?:\\.[^"\\]*)*"', re.DOTALL)
+"""A JSON string literal (escapes included), blanked before brackets are counted."""
+_BRACKET_STEP = np.zeros(256, dtype=np.int8)
+_BRACKET_STEP[[ord("["), ord("{")]] = 1
+_BRACKET_STEP[[ord("]"), ord("}")]] = -1
+
+
+class JSONFileError(StudioError, ValueError):
+    """JSON that is too large, nested too deeply, or not valid; the message names the file.
+
+    It is also a :class:`ValueError` (as ``json.JSONDecodeError`` is), so existing handlers of
+    bad JSON keep working.
+    """
+
+
+def nesting_depth(text: str | bytes) -> int:
+    """The deepest nesting of ``[]``/``{}`` in a JSON text, outside string literals, without recursion."""
+    data = text.encode("utf-8", errors="surrogatepass") if isinstance(text, str) else bytes(text)
+    steps = _BRACKET_STEP[np.frombuffer(_STRING.sub(b'""', data), dtype=np.uint8)]
+    moves = steps[np.flatnonzero(steps)]
+    if moves.size == 0:
+        return 0
+    return int(np.cumsum(moves, dtype=np.int64).max())
+
+
+def loads_json(
+    text: str | bytes,
+    what: str = "the JSON text",
+    *,
+    max_bytes: int = MAX_JSON_BYTES,
+    max_depth: int = MAX_JSON_DEPTH,
+) -> Any:
+    """Parse JSON after checking its size and nesting depth.
+
+    Args:
+        text: the JSON text (``bytes`` are decoded as UTF-8).
+        what: what the text is (``"recording x.tape.csv, line 1"``), for the error sentence.
+        max_bytes: the longest text accepted.
+        max_depth: the deepest nesting accepted.
+
+    Returns:
+        The parsed value.
+
+    Raises:
+        JSONFileError: the text is too long, too deeply nested, not UTF-8 or not valid JSON.
+    """
+    if len(text) > max_bytes:
+        raise JSONFileError(
+            f"{what} holds {human_size(len(text))} of JSON, more than the {human_size(max_bytes)} "
+            "allowed; check that it is the right file."
+        )
+    depth = nesting_depth(text)
+    if depth > max_depth:
+        raise JSONFileError(
+            f"{what} nests JSON {depth} levels deep, more than the {max_depth} allowed; it is "
+            "damaged or not a Teach Studio file."
+        )
+    try:
+        return json.loads(text)
+    except UnicodeDecodeError:
+        raise JSONFileError(f"{what} is not UTF-8 text; it is damaged or not JSON.") from None
+    except json.JSONDecodeError as err:
+        raise JSONFileError(
+            f"{what} is not valid JSON ({err.msg} at line {err.lineno} column {err.colno}); "
+            "fix or re-export it."
+        ) from None
+    except (ValueError, RecursionError) as err:  # e.g. an integer of more than 4300 digits
+        raise JSONFileError(f"{what} is not usable JSON ({err}); fix or re-export it.") from None
+
+
+def read_json(
+    path: str | os.PathLike[str],
+    what: str | None = None,
+    *,
+    max_bytes: int = MAX_JSON_BYTES,
+    max_depth: int = MAX_JSON_DEPTH,
+) -> Any:
+    """Read a JSON file: a regular file of at most ``max_bytes``, nested at most ``max_depth`` deep.
+
+    Args:
+        path: the file.
+        what: what the file is, for error sentences (default: its path).
+        max_bytes: the largest file accepted.
+        max_depth: the deepest nesting accepted.
+
+    Raises:
+        FileLimitError: missing, not a regular file, or too large (nothing is read then).
+        JSONFileError: not UTF-8, too deep or not valid JSON.
+    """
+    label = what or str(Path(path))
+    return loads_json(
+        read_bytes_bounded(path, max_bytes, label),
+        label,
+        max_bytes=max_bytes,
+        max_depth=max_depth,
+    )
