@@ -15,6 +15,7 @@ from __future__ import annotations
 from ._calibration import Calibration as Calibration
 from ._calibration import load_calibration as load_calibration
 from ._capture_loop import capture as capture
+from ._capture_loop import describe as describe
 from ._demonstration import MAX_FIT_RESIDUAL_M as MAX_FIT_RESIDUAL_M
 from ._demonstration import Demonstration as Demonstration
 from ._demonstration import demonstrations_for as demonstrations_for
@@ -35,10 +36,13 @@ from ._network import stream_source as stream_source
 from ._playback import PlaybackSource as PlaybackSource
 from ._raw_import import import_raw as import_raw
 from ._raw_import import read_raw_text as read_raw_text
+from ._recording_edit import DEMO_SUFFIX as DEMO_SUFFIX
+from ._recording_edit import being_recorded as being_recorded
 from ._recording_edit import copy_recording as copy_recording
 from ._recording_edit import rename_recording as rename_recording
 from ._recording_edit import update_recording_meta as update_recording_meta
 from ._recording_edit import write_recording as write_recording
+from ._recording_format import DEFAULT_RATE_HZ as DEFAULT_RATE_HZ
 from ._recording_format import FORMAT_VERSION as FORMAT_VERSION
 from ._recording_format import RECORDING_SUFFIX as RECORDING_SUFFIX
 from ._recording_reader import Recording as Recording
@@ -61,6 +65,7 @@ from ._source import FrameSource as FrameSource
 from ._source import SourceStatus as SourceStatus
 from ._source import ThreadedSource as ThreadedSource
 from ._source_spec import SOURCE_SPECS as SOURCE_SPECS
+from ._source_spec import cli_speed as cli_speed
 from ._source_spec import parse_host_port as parse_host_port
 from ._source_spec import source_from_spec as source_from_spec
 from ._wire import DEFAULT_PORT as DEFAULT_PORT

@@ -11,8 +11,7 @@ import sys
 import time
 
 from studio import StudioError
-from studio.capture import DEFAULT_PORT, parse_host_port, source_from_spec, stream_source
-from studio.capture._source_spec import cli_speed
+from studio.capture import DEFAULT_PORT, cli_speed, parse_host_port, source_from_spec, stream_source
 
 PROGRESS_SECONDS = 0.2
 """How often the progress line is redrawn."""

@@ -5,8 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from studio.capture import import_raw, read_recording
-from studio.capture._capture_loop import describe
+from studio.capture import describe, import_raw, read_recording
 
 NAME = "import-raw"
 HELP = "Import a Measurand raw text file with a calibration JSON into a *.tape.csv recording."

@@ -6,9 +6,7 @@ import argparse
 import json
 from pathlib import Path
 
-from studio.capture import summarize_recording
-from studio.capture._capture_loop import describe
-from studio.capture._recording_edit import being_recorded
+from studio.capture import being_recorded, describe, summarize_recording
 
 NAME = "info"
 HELP = "Show a recording's or demonstration's metadata, length and any problems."

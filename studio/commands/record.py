@@ -11,10 +11,16 @@ import time
 from pathlib import Path
 
 from studio import StudioError
-from studio.capture import SOURCE_SPECS, SourceStatus, capture, read_recording, source_from_spec
-from studio.capture._capture_loop import describe
-from studio.capture._recording_format import DEFAULT_RATE_HZ
-from studio.capture._source_spec import cli_speed
+from studio.capture import (
+    DEFAULT_RATE_HZ,
+    SOURCE_SPECS,
+    SourceStatus,
+    capture,
+    cli_speed,
+    describe,
+    read_recording,
+    source_from_spec,
+)
 
 PROGRESS_SECONDS = 0.2
 """How often the progress line is redrawn."""

@@ -38,3 +38,7 @@ from ._policy import save_trajectory_csv as save_trajectory_csv
 from ._reproduce import ReproduceResult as ReproduceResult
 from ._reproduce import generate_demonstrations as generate_demonstrations
 from ._reproduce import reproduce as reproduce
+from ._summary import POLICY_SUFFIX as POLICY_SUFFIX
+from ._summary import goal_degrees as goal_degrees
+from ._summary import has_default_goal as has_default_goal
+from ._summary import policy_summary as policy_summary

@@ -155,6 +155,12 @@ class RecordingPublic(BaseModel):
     error: str | None = None
 
 
+class RecordingCopy(_Body):
+    """Copy a recording (a shipped sample, typically) into the user's recordings."""
+
+    name: str | None = None
+
+
 class RecordingUpdate(_Body):
     """Rename or annotate a recording."""
 
@@ -195,6 +201,8 @@ class DemonstrationPublic(BaseModel):
     goal: list[float]
     reaches_goal: bool
     created: str
+    sample: bool = False
+    error: str | None = None
 
 
 class DemonstrationDetail(DemonstrationPublic):
@@ -278,6 +286,7 @@ class PolicyPublic(BaseModel):
     created: str
     notes: str
     size_bytes: int
+    error: str | None = None
 
 
 class WatchCreate(_Body):

@@ -23,10 +23,9 @@ from ._settings import Settings
 from ._store import (
     DEMONSTRATION_SUFFIX,
     RECORDING_SUFFIX,
-    DemonstrationStore,
-    PolicyStore,
-    RecordingStore,
-    check_name,
+    demonstration_store,
+    policy_store,
+    recording_store,
 )
 
 log = logging.getLogger(__name__)
@@ -65,9 +64,9 @@ class Studio:
         for folder in (settings.recordings_dir, settings.runs_dir, settings.policies_dir):
             folder.mkdir(parents=True, exist_ok=True)
         self.changes = ListChanges()
-        self.recordings = RecordingStore(settings.recordings_dir)
-        self.policies = PolicyStore(settings.policies_dir)
-        self.demonstrations = DemonstrationStore(settings.recordings_dir)
+        self.recordings = recording_store(settings.recordings_dir)
+        self.policies = policy_store(settings.policies_dir)
+        self.demonstrations = demonstration_store(settings.recordings_dir)
         self.runs = RunQueue(settings.runs_dir, self.changes.bump, settings.run_workers)
         self.scene = scene
         self.pipeline = Pipeline(scene)
@@ -258,11 +257,7 @@ class Studio:
             raise ConflictError("There is no live source to record; choose a source first.")
         base = name or f"capture-{datetime.now(UTC):%Y%m%d-%H%M%S}"
         if name is not None:
-            check_name(name, "recording name")
-            if self.recordings.exists(name):
-                raise ConflictError(
-                    f"A recording named {name!r} already exists; choose another name."
-                )
+            self.recordings.check_new_name(name)
         final = self.recordings.new_name(base)
         path = self.settings.recordings_dir / f"{final}{RECORDING_SUFFIX}"
         writer = RecordingWriter(
@@ -320,11 +315,7 @@ class Studio:
                 f"The segment ends at {t1:g} s, not after its start at {t0:g} s; give t1 > t0."
             )
         if name is not None:
-            check_name(name, "demonstration name")
-            if self.demonstrations.exists(name):
-                raise ConflictError(
-                    f"A demonstration named {name!r} already exists; choose another name."
-                )
+            self.demonstrations.check_new_name(name)
         path = self.recordings.path(recording)
         final = name or self.demonstrations.new_name(f"{recording}.{t0:.2f}-{t1:.2f}")
         demo = extract_demonstration(

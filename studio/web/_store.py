@@ -1,39 +1,59 @@
-"""The on-disk stores under the data directory: names, uploads, recordings and policies.
+"""The on-disk stores under the data directory: one mechanism for recordings, demonstrations and
+policies.
 
 Everything a user makes lives in plain files so it survives a restart and can be used without the
-studio: ``recordings/*.tape.csv`` (edits of the operator and notes replace the header line
-atomically, the frames are never rewritten), ``recordings/*.demo.json``,
-``policies/*.policy.npz``. Training runs have their own store in :mod:`studio.web._runs`.
+studio: ``recordings/*.tape.csv``, ``recordings/*.demo.json``, ``policies/*.policy.npz``. Each
+kind is a :class:`FolderStore`: a folder, a file suffix and the owning package's reader
+(:mod:`studio.capture` for recordings and demonstrations, :mod:`studio.learning` for policies).
+Training runs have their own store in :mod:`studio.web._runs`.
 
 Names are plain file stems (letters, digits, ``-``, ``_``, ``.``; no separators, no ``..``), so a
 name from a request can never point outside its folder. New files never replace old ones: an
 upload or a new capture whose name is taken gets ``-2``, ``-3``, ... appended.
+
+The shipped samples (:data:`studio.samples.SAMPLES_DIR`) are offered by every data folder as a
+read-only group: names starting with ``sample-`` belong to it, can be played, trained on and
+copied, never changed or deleted.
 """
 
 from __future__ import annotations
 
+import logging
 import os
 import re
+import shutil
 import threading
 import uuid
 from collections.abc import Callable
+from dataclasses import dataclass
 from datetime import UTC, datetime
 from pathlib import Path
-from typing import Any, TypeVar
+from typing import Any, Generic, TypeVar
 
 from fastapi import UploadFile
+
+from studio.capture import (
+    DEMO_SUFFIX,
+    RECORDING_SUFFIX,
+    Demonstration,
+    load_demonstration,
+    read_recording,
+)
+from studio.learning import POLICY_SUFFIX, PolicyFile, load_policy
+from studio.samples import SAMPLES_DIR
 
 from .._errors import StudioError
 from ._errors import ConflictError, InvalidError, NotFoundError, TooLargeError
 
+log = logging.getLogger(__name__)
+
 NAME_PATTERN = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.-]{0,99}$")
 """A valid name: 1-100 characters, letters, digits, ``-``, ``_``, ``.``, not starting with ``.``."""
-RECORDING_SUFFIX = ".tape.csv"
-DEMONSTRATION_SUFFIX = ".demo.json"
-POLICY_SUFFIX = ".policy.npz"
 SAMPLE_PREFIX = "sample-"
-"""Recordings shipped with the repository start with this prefix."""
+"""Names of the shipped samples start with this prefix; users' files never do."""
 UPLOAD_CHUNK_BYTES = 1024 * 1024
+DEMONSTRATION_SUFFIX = DEMO_SUFFIX
+"""Demonstrations lie next to their recordings: ``<name>.demo.json`` (the capture package's)."""
 
 T = TypeVar("T")
 
@@ -64,7 +84,8 @@ def clean_upload_name(filename: str | None, suffix: str, fallback: str) -> str:
     """The store name for an uploaded file: its stem with odd characters replaced by ``-``.
 
     A file name holding a path separator or ``..`` is refused (422): browsers send bare names,
-    so such a name is a crafted request.
+    so such a name is a crafted request. The samples' prefix is dropped, so an uploaded copy of a
+    sample becomes the user's own file.
     """
     filename = filename or ""
     if "/" in filename or "\\" in filename or ".." in filename:
@@ -75,7 +96,14 @@ def clean_upload_name(filename: str | None, suffix: str, fallback: str) -> str:
     for extra in (".tape", ".policy", ".demo"):
         stem = stem.removesuffix(extra)
     stem = re.sub(r"[^A-Za-z0-9_.-]+", "-", stem).strip("-.")[:80]
-    return stem or fallback
+    return _user_name(stem) or fallback
+
+
+def _user_name(name: str) -> str:
+    """``name`` without the samples' prefix (and the separators that then lead it)."""
+    while name.startswith(SAMPLE_PREFIX):
+        name = name.removeprefix(SAMPLE_PREFIX).lstrip("-.")
+    return name
 
 
 def unique_name(base: str, taken: Callable[[str], bool]) -> str:
@@ -130,365 +158,314 @@ async def receive_upload(upload: UploadFile, folder: Path, limit: int) -> Path:
     return tmp
 
 
+@dataclass(frozen=True)
+class StoredFile(Generic[T]):
+    """One file of a store as a listing shows it: read by its owner, or damaged with the reason.
+
+    Attributes:
+        name: the file's name in the store (its stem).
+        path: where it lies.
+        size_bytes: its size.
+        sample: whether it is one of the read-only shipped samples.
+        value: what the store's reader returned (None when damaged).
+        error: why the reader refused it (None when readable).
+    """
+
+    name: str
+    path: Path
+    size_bytes: int
+    sample: bool
+    value: T | None = None
+    error: str | None = None
+
+
 class _FileCache:
-    """Parsed file summaries, re-read only when a file's size or modification time changes."""
+    """What a reader made of each file, its value or its refusal, read again only when the
+    file's size or mtime changes (so a damaged file is not parsed again at every listing)."""
 
     def __init__(self) -> None:
         self._lock = threading.Lock()
-        self._entries: dict[Path, tuple[tuple[int, int], Any]] = {}
+        self._entries: dict[Path, tuple[tuple[int, int], Any, StudioError | None]] = {}
 
     def get(self, path: Path, load: Callable[[Path], T]) -> T:
         stat = path.stat()
         key = (stat.st_mtime_ns, stat.st_size)
         with self._lock:
             hit = self._entries.get(path)
-        if hit is not None and hit[0] == key:
-            return hit[1]
-        value = load(path)
-        with self._lock:
-            self._entries[path] = (key, value)
-        return value
+        if hit is None or hit[0] != key:
+            value, error = None, None
+            try:
+                value = load(path)
+            except StudioError as err:
+                error = err
+            hit = (key, value, error)
+            with self._lock:
+                self._entries[path] = hit
+        if hit[2] is not None:
+            raise hit[2]
+        return hit[1]
 
 
-class RecordingStore:
-    """Recordings ``<data_dir>/recordings/<name>.tape.csv`` with their editable operator and notes."""
+class FolderStore(Generic[T]):
+    """Files ``<folder>/<name><suffix>`` of one kind, plus the shipped samples of that kind.
 
-    def __init__(self, folder: Path) -> None:
+    Args:
+        folder: the user's folder (created by the studio at start).
+        suffix: the file suffix, e.g. ``.tape.csv``.
+        what: the kind in messages, e.g. ``"recording"``.
+        plural: the list's name in messages, e.g. ``"recordings"``.
+        load: the owning package's reader of one file; it raises :class:`studio.StudioError`
+            with one sentence for a damaged file. Its result is cached per file until the file
+            changes.
+        samples: a read-only folder of shipped samples (names starting with ``sample-``), or None.
+    """
+
+    def __init__(
+        self,
+        folder: Path,
+        *,
+        suffix: str,
+        what: str,
+        plural: str,
+        load: Callable[[Path], T],
+        samples: Path | None = None,
+    ) -> None:
         self.folder = folder
+        self.suffix = suffix
+        self.what = what
+        self.plural = plural
+        self.samples = samples
+        self._load = load
         self._cache = _FileCache()
+        self._claim_lock = threading.Lock()  # choosing a free name and taking it are one step
+
+    # ------------------------------------------------------------------ names and paths
+
+    def _stems(self, folder: Path | None) -> list[str]:
+        if folder is None or not folder.is_dir():
+            return []
+        stems = (p.name[: -len(self.suffix)] for p in folder.glob(f"*{self.suffix}"))
+        return [s for s in stems if NAME_PATTERN.match(s)]
+
+    def _find(self, name: str) -> Path | None:
+        for folder in (self.folder, self.samples):
+            if folder is not None and (folder / f"{name}{self.suffix}").is_file():
+                return folder / f"{name}{self.suffix}"
+        return None
+
+    def names(self) -> list[str]:
+        """Every name: the samples first, then the user's files, each group alphabetical."""
+        samples = [s for s in self._stems(self.samples) if s.startswith(SAMPLE_PREFIX)]
+        names = set(self._stems(self.folder)) | set(samples)
+        return sorted(names, key=lambda n: (not self.is_sample(n), n))
+
+    def exists(self, name: str) -> bool:
+        """Whether ``name`` is taken, by a user's file or a sample."""
+        return NAME_PATTERN.match(name) is not None and self._find(name) is not None
+
+    @staticmethod
+    def is_sample(name: str) -> bool:
+        """Whether ``name`` is a read-only shipped sample."""
+        return name.startswith(SAMPLE_PREFIX)
 
     def path(self, name: str) -> Path:
-        """The file of recording ``name`` (404 if it does not exist)."""
-        path = self.folder / f"{check_name(name, 'recording name')}{RECORDING_SUFFIX}"
-        if not path.is_file():
+        """The file of ``name``, a user's file or a sample (422 for a bad name, 404 if none)."""
+        path = self._find(check_name(name, f"{self.what} name"))
+        if path is None:
             raise NotFoundError(
-                f"There is no recording named {name!r}; pick one from the recordings list."
+                f"There is no {self.what} named {name!r}; pick one from the {self.plural} list."
             )
         return path
 
-    def exists(self, name: str) -> bool:
-        """Whether a recording of that name exists."""
-        return (self.folder / f"{name}{RECORDING_SUFFIX}").exists()
-
-    def names(self) -> list[str]:
-        """Every recording's name, samples first, then alphabetical."""
-        if not self.folder.is_dir():
-            return []
-        names = [
-            p.name[: -len(RECORDING_SUFFIX)]
-            for p in self.folder.glob(f"*{RECORDING_SUFFIX}")
-            if NAME_PATTERN.match(p.name[: -len(RECORDING_SUFFIX)])
-        ]
-        return sorted(names, key=lambda n: (not n.startswith(SAMPLE_PREFIX), n))
-
-    def read(self, name: str) -> Any:
-        """The recording as :func:`studio.capture.read_recording` returns it."""
-        from studio.capture import read_recording
-
-        return read_recording(self.path(name))
-
-    def info(self, name: str) -> dict[str, Any]:
-        """The ``RecordingPublic`` fields of one recording."""
+    def writable_path(self, name: str) -> Path:
+        """The file of ``name`` for a change or a delete (404 if none, 409 for a sample)."""
         path = self.path(name)
-        return {
-            "name": name,
-            **self._cache.get(path, _recording_summary),
-            "size_bytes": path.stat().st_size,
-            "sample": name.startswith(SAMPLE_PREFIX),
-        }
+        if self.is_sample(name):
+            raise ConflictError(
+                f"The {self.what} {name!r} is a shipped sample, which cannot be changed or deleted; copy it to make your own."
+            )
+        return path
 
-    def list(self) -> list[dict[str, Any]]:
-        """Every recording's summary (an unreadable file is listed with its error)."""
+    def check_new_name(self, name: str) -> str:
+        """Return ``name`` if a new user file may take it (422 for a bad or sample name, 409 if taken)."""
+        check_name(name, f"{self.what} name")
+        if self.is_sample(name):
+            raise InvalidError(
+                f"The {self.what} name {name!r} starts with {SAMPLE_PREFIX!r}, which is kept for the shipped samples; choose another name."
+            )
+        if self.exists(name):
+            raise ConflictError(
+                f"A {self.what} named {name!r} already exists; choose another name."
+            )
+        return name
+
+    def new_name(self, base: str) -> str:
+        """A free name for a new user file starting with ``base`` (the samples' prefix dropped)."""
+        check_name(base, f"{self.what} name")
+        return unique_name(_user_name(base) or self.what, self.exists)
+
+    # ------------------------------------------------------------------ reading
+
+    def load(self, name: str) -> T:
+        """What the owning package's reader returns for ``name`` (cached until the file changes)."""
+        return self.load_file(self.path(name))
+
+    def load_file(self, path: Path) -> T:
+        """What the reader returns for any file of this kind (a run's policy too), cached.
+
+        Raises:
+            StudioError: the reader's one sentence about a damaged file; a failure the reader
+                did not foresee becomes an :class:`InvalidError` naming the file.
+        """
+        return self._cache.get(path, self._read)
+
+    def _read(self, path: Path) -> T:
+        try:
+            return self._load(path)
+        except (StudioError, FileNotFoundError):
+            raise
+        except Exception as err:  # a damage the reader did not foresee must not hide the others
+            log.warning("could not read %s: %s: %s", path, type(err).__name__, err)
+            raise InvalidError(
+                f"{path.name} could not be read as a {self.what} ({type(err).__name__}); replace or delete the file."
+            ) from None
+
+    def entry(self, name: str) -> StoredFile[T]:
+        """``name`` as a listing shows it (404 if it does not exist)."""
+        return self.entry_at(name, self.path(name))
+
+    def entry_at(self, name: str, path: Path) -> StoredFile[T]:
+        """The file at ``path`` as a listing shows it under ``name`` (e.g. a run's policy)."""
+        size = path.stat().st_size
+        sample = self.is_sample(name)
+        try:
+            value = self.load_file(path)
+        except StudioError as err:
+            return StoredFile(name, path, size, sample, error=str(err))
+        return StoredFile(name, path, size, sample, value=value)
+
+    def entries(self) -> list[StoredFile[T]]:
+        """Every file, samples first: each read, or listed as damaged with the reason."""
         out = []
         for name in self.names():
+            path = self._find(name)
+            if path is None:
+                continue
             try:
-                out.append(self.info(name))
-            except StudioError as err:
-                path = self.folder / f"{name}{RECORDING_SUFFIX}"
-                out.append(_broken_recording(name, path, str(err)))
+                out.append(self.entry_at(name, path))
             except FileNotFoundError:  # deleted meanwhile
                 continue
         return out
 
-    def update(
+    # ------------------------------------------------------------------ changing
+
+    def delete(self, name: str) -> None:
+        """Delete a user's file (404 if none, 409 for a sample)."""
+        self.writable_path(name).unlink()
+
+    def adopt(
+        self, tmp: Path, filename: str | None, taken: Callable[[str], bool] | None = None
+    ) -> str:
+        """Check an uploaded temporary file with the owner's reader and give it a free name.
+
+        Args:
+            tmp: the received file (see :func:`receive_upload`), in this store's folder.
+            filename: the name the browser sent.
+            taken: whether a name is used (default: :meth:`exists`).
+
+        Returns:
+            The new file's name.
+
+        Raises:
+            InvalidError: a bad file name, or the reader refuses the file (the temporary file is
+                removed either way).
+        """
+        label = filename or "the upload"
+        try:
+            base = clean_upload_name(filename, self.suffix, self.what)
+            try:
+                self._read(tmp)
+            except StudioError as err:
+                message = str(err).replace(str(tmp), label).replace(tmp.name, label)
+                raise InvalidError(
+                    f"{label} is not a valid Teach Studio {self.what}: {message}"
+                ) from None
+            return self._claim(tmp, base, taken or self.exists)
+        finally:
+            tmp.unlink(missing_ok=True)
+
+    def copy(
         self,
         name: str,
         new_name: str | None = None,
-        notes: str | None = None,
-        operator: str | None = None,
+        prepare: Callable[[Path, str], None] | None = None,
     ) -> str:
-        """Rename and/or annotate a recording; returns its (new) name.
+        """Copy ``name`` (a sample or a user's file) into the user's folder; returns the copy's name.
 
-        The header is changed by an atomic replace, the frames are never touched
-        (:func:`studio.capture.update_recording_meta`); a rename also updates the demonstrations
-        that reference the file (:func:`studio.capture.rename_recording`).
+        Args:
+            name: the file to copy.
+            new_name: the copy's name (default: ``name`` without the samples' prefix, made free).
+            prepare: called with the temporary copy and its final name before it appears, e.g.
+                to write the new name into the file's header.
         """
-        from studio.capture import rename_recording, update_recording_meta
-
-        path = self.path(name)
-        if new_name is not None and new_name != name:
-            check_name(new_name, "new recording name")
-            if self.exists(new_name):
-                raise ConflictError(
-                    f"A recording named {new_name!r} already exists; choose another name."
-                )
-        changes = {k: v for k, v in (("notes", notes), ("operator", operator)) if v is not None}
-        if changes:
-            update_recording_meta(path, **changes)
-        if new_name is not None and new_name != name:
-            rename_recording(path, new_name)
-            return new_name
-        return name
-
-    def delete(self, name: str) -> None:
-        """Delete a recording."""
-        self.path(name).unlink()
-
-    def adopt(self, tmp: Path, filename: str | None) -> str:
-        """Validate an uploaded temporary file as a recording and give it a free name.
-
-        Raises:
-            InvalidError: a bad file name, or the file is not a readable recording (the
-                temporary file is removed either way).
-        """
-        from studio.capture import read_recording
-
+        source = self.path(name)
+        if new_name is not None:
+            self.check_new_name(new_name)
+        self.folder.mkdir(parents=True, exist_ok=True)
+        tmp = self.folder / f".copy-{uuid.uuid4().hex}.tmp"
         try:
-            base = clean_upload_name(filename, RECORDING_SUFFIX, "upload")
-            try:
-                read_recording(tmp)
-            except StudioError as err:
-                message = str(err).replace(str(tmp), filename or "the upload")
-                message = message.replace(tmp.name, filename or "the upload")
-                raise InvalidError(
-                    f"{filename or 'The upload'} is not a valid Teach Studio recording: {message}"
-                ) from None
-            except Exception as err:  # a file the reader did not anticipate
-                raise InvalidError(
-                    f"{filename or 'The upload'} is not a readable Teach Studio recording ({type(err).__name__}); upload a .tape.csv file."
-                ) from None
-            name = unique_name(base, self.exists)
-            os.replace(tmp, self.folder / f"{name}{RECORDING_SUFFIX}")
-            return name
+            shutil.copyfile(source, tmp)
+            with self._claim_lock:
+                final = new_name or self.new_name(name)
+                if self.exists(final):
+                    raise ConflictError(
+                        f"A {self.what} named {final!r} already exists; choose another name."
+                    )
+                if prepare is not None:
+                    prepare(tmp, final)
+                os.replace(tmp, self.folder / f"{final}{self.suffix}")
+            return final
         finally:
             tmp.unlink(missing_ok=True)
 
-    def new_name(self, base: str) -> str:
-        """A free recording name starting with ``base``."""
-        return unique_name(check_name(base, "recording name"), self.exists)
+    def _claim(self, tmp: Path, base: str, taken: Callable[[str], bool]) -> str:
+        with self._claim_lock:
+            name = unique_name(base, lambda n: taken(n) or self.exists(n))
+            os.replace(tmp, self.folder / f"{name}{self.suffix}")
+        return name
 
 
 def _recording_summary(path: Path) -> dict[str, Any]:
-    from studio.capture import read_recording
-
-    summary = read_recording(path).summary()
-    return {
-        "frames": int(summary["frames"]),
-        "duration": float(summary["duration"]),
-        "rate_hz": float(summary["rate_hz"]) if summary.get("rate_hz") else None,
-        "created": str(summary.get("created") or ""),
-        "operator": str(summary.get("operator") or ""),
-        "notes": str(summary.get("notes") or ""),
-        "source": str(summary.get("source") or ""),
-        "recovered": bool(summary["recovered"]),
-        "error": None,
-    }
+    """The capture package's listing facts of a recording (read whole, so damage shows)."""
+    return read_recording(path).summary()
 
 
-def _broken_recording(name: str, path: Path, error: str) -> dict[str, Any]:
-    return {
-        "name": name,
-        "frames": 0,
-        "duration": 0.0,
-        "rate_hz": None,
-        "created": "",
-        "operator": "",
-        "notes": "",
-        "source": "",
-        "recovered": False,
-        "error": error,
-        "size_bytes": path.stat().st_size if path.exists() else 0,
-        "sample": name.startswith(SAMPLE_PREFIX),
-    }
+def recording_store(folder: Path) -> FolderStore[dict[str, Any]]:
+    """Recordings ``<folder>/<name>.tape.csv`` (each cached as its :meth:`Recording.summary`)."""
+    return FolderStore(
+        folder,
+        suffix=RECORDING_SUFFIX,
+        what="recording",
+        plural="recordings",
+        load=_recording_summary,
+        samples=SAMPLES_DIR,
+    )
 
 
-class PolicyStore:
-    """Uploaded policy files ``<data_dir>/policies/<name>.policy.npz``."""
-
-    def __init__(self, folder: Path) -> None:
-        self.folder = folder
-        self._cache = _FileCache()
-
-    def path(self, name: str) -> Path:
-        """The file of uploaded policy ``name`` (404 if it does not exist)."""
-        path = self.folder / f"{check_name(name, 'policy name')}{POLICY_SUFFIX}"
-        if not path.is_file():
-            raise NotFoundError(f"There is no policy named {name!r}; pick one from the list.")
-        return path
-
-    def exists(self, name: str) -> bool:
-        """Whether an uploaded policy of that name exists."""
-        return (self.folder / f"{name}{POLICY_SUFFIX}").exists()
-
-    def names(self) -> list[str]:
-        """Every uploaded policy's name, alphabetical."""
-        if not self.folder.is_dir():
-            return []
-        return sorted(
-            p.name[: -len(POLICY_SUFFIX)]
-            for p in self.folder.glob(f"*{POLICY_SUFFIX}")
-            if NAME_PATTERN.match(p.name[: -len(POLICY_SUFFIX)])
-        )
-
-    def load(self, name: str) -> Any:
-        """The policy as :func:`studio.learning.load_policy` returns it (cached)."""
-        return self.load_file(self.path(name))
-
-    def load_file(self, path: Path) -> Any:
-        """Any policy file (a run's too), cached until the file changes."""
-        from studio.learning import load_policy
-
-        return self._cache.get(path, load_policy)
-
-    def delete(self, name: str) -> None:
-        """Delete an uploaded policy."""
-        self.path(name).unlink()
-
-    def adopt(self, tmp: Path, filename: str | None, taken: Callable[[str], bool]) -> str:
-        """Validate an uploaded temporary file as a policy and give it a free name.
-
-        Args:
-            tmp: the received file.
-            filename: the name the browser sent.
-            taken: whether a name is used (by an uploaded policy or a run).
-
-        Raises:
-            InvalidError: the file is not a readable policy (the temporary file is removed).
-        """
-        from studio.learning import load_policy
-
-        try:
-            base = clean_upload_name(filename, POLICY_SUFFIX, "policy")
-            try:
-                load_policy(tmp)
-            except StudioError as err:
-                raise InvalidError(str(err).replace(tmp.name, filename or "The upload")) from None
-            name = unique_name(base, taken)
-            os.replace(tmp, self.folder / f"{name}{POLICY_SUFFIX}")
-            return name
-        finally:
-            tmp.unlink(missing_ok=True)
+def demonstration_store(folder: Path) -> FolderStore[Demonstration]:
+    """Demonstrations ``<folder>/<name>.demo.json``, next to the recordings they were cut from."""
+    return FolderStore(
+        folder,
+        suffix=DEMONSTRATION_SUFFIX,
+        what="demonstration",
+        plural="demonstrations",
+        load=load_demonstration,
+        samples=SAMPLES_DIR,
+    )
 
 
-def policy_summary(policy: Any) -> dict[str, Any]:
-    """The learning-side fields of ``PolicyPublic`` from a loaded policy file."""
-    grid = policy.grid
-    goal_deg = [float(x) for x in _degrees(grid.angles_of(grid.goal_state))]
-    return {
-        "grid": grid.to_dict(),
-        "goal_deg": goal_deg,
-        "planning": policy.config.planning,
-        "episodes": int(len(policy.mean_steps)),
-        "experiments": int(policy.experiments),
-        "created": policy.created,
-        "notes": policy.notes,
-    }
-
-
-def _degrees(rad: Any) -> list[float]:
-    import numpy as np
-
-    return [round(float(x), 6) for x in np.degrees(rad)]
-
-
-class DemonstrationStore:
-    """Demonstrations ``<data_dir>/recordings/<name>.demo.json`` (next to their recordings)."""
-
-    def __init__(self, folder: Path) -> None:
-        self.folder = folder
-        self._cache = _FileCache()
-
-    def path(self, name: str) -> Path:
-        """The file of demonstration ``name`` (404 if it does not exist)."""
-        path = self.folder / f"{check_name(name, 'demonstration name')}{DEMONSTRATION_SUFFIX}"
-        if not path.is_file():
-            raise NotFoundError(
-                f"There is no demonstration named {name!r}; pick one from the demonstrations list."
-            )
-        return path
-
-    def exists(self, name: str) -> bool:
-        """Whether a demonstration of that name exists."""
-        return (self.folder / f"{name}{DEMONSTRATION_SUFFIX}").exists()
-
-    def names(self) -> list[str]:
-        """Every demonstration's name, alphabetical."""
-        if not self.folder.is_dir():
-            return []
-        return sorted(
-            p.name[: -len(DEMONSTRATION_SUFFIX)]
-            for p in self.folder.glob(f"*{DEMONSTRATION_SUFFIX}")
-            if NAME_PATTERN.match(p.name[: -len(DEMONSTRATION_SUFFIX)])
-        )
-
-    def load(self, name: str) -> Any:
-        """The demonstration as :mod:`studio.capture` reads it (cached)."""
-        path = self.path(name)
-        from studio.capture import load_demonstration
-
-        return self._cache.get(path, load_demonstration)
-
-    def info(self, name: str) -> dict[str, Any]:
-        """The ``DemonstrationPublic`` fields.
-
-        ``goal`` is the goal bin's centre in degrees (joints of the demonstration's grid);
-        ``reaches_goal`` says whether that goal is the default one (false when the goal was set
-        from where the demonstration ends).
-        """
-        import numpy as np
-
-        from studio.learning import ArmGrid
-
-        demo = self.load(name)
-        grid = demo.arm_grid()
-        default = ArmGrid(
-            joints=grid.joints, bins=grid.bins, low_deg=grid.low_deg, high_deg=grid.high_deg
-        )
-        return {
-            "name": name,
-            "recording": demo.recording.name.removesuffix(RECORDING_SUFFIX),
-            "t0": float(demo.t0),
-            "t1": float(demo.t1),
-            "steps": max(0, len(demo.grid_path) - 1),
-            "goal": [round(float(x), 6) for x in np.degrees(grid.angles_of(grid.goal_state))],
-            "reaches_goal": tuple(grid.goal) == tuple(default.goal),
-            "created": str(demo.created or ""),
-        }
-
-    def detail(self, name: str) -> dict[str, Any]:
-        """``DemonstrationDetail``: the summary plus the robot and grid paths."""
-        demo = self.load(name)
-        return {
-            **self.info(name),
-            "times": [round(float(t), 6) for t in demo.times],
-            "q_robot": [[round(float(x), 6) for x in row] for row in demo.q_robot],
-            "grid_path": [int(s) for s in demo.grid_path],
-        }
-
-    def list(self) -> list[dict[str, Any]]:
-        """Every readable demonstration's summary, newest first."""
-        out = []
-        for name in self.names():
-            try:
-                out.append(self.info(name))
-            except StudioError:
-                continue
-        return sorted(out, key=lambda d: (d["created"], d["name"]), reverse=True)
-
-    def delete(self, name: str) -> None:
-        """Delete a demonstration file."""
-        self.path(name).unlink()
-
-    def new_name(self, base: str) -> str:
-        """A free demonstration name starting with ``base``."""
-        return unique_name(check_name(base, "demonstration name"), self.exists)
+def policy_store(folder: Path) -> FolderStore[PolicyFile]:
+    """Uploaded policies ``<folder>/<name>.policy.npz`` (runs keep theirs in their run folder)."""
+    return FolderStore(
+        folder, suffix=POLICY_SUFFIX, what="policy", plural="policies", load=load_policy
+    )

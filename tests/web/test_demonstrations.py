@@ -38,11 +38,17 @@ def save_demo(folder: Path, name: str, start_bins=(0, 0, 0), goal=None) -> Demon
     return demo
 
 
+def mine(listed: list[dict]) -> list[dict]:
+    """The user's own demonstrations of a listing (every data folder also lists the samples)."""
+    return [d for d in listed if not d["sample"]]
+
+
 def test_list_and_detail(client, tmp_path):
     demo = save_demo(tmp_path / "recordings", "reach-1")
     listed = client.get("/api/demonstrations").json()
-    assert [d["name"] for d in listed] == ["reach-1"]
-    one = listed[0]
+    assert [d["name"] for d in listed if not d["sample"]] == ["reach-1"]
+    one = listed[-1]
+    assert one["sample"] is False and one["error"] is None
     assert one["recording"] == "take" and one["t0"] == 1.0
     assert one["steps"] == len(demo.grid_path) - 1
     assert one["reaches_goal"] is True
@@ -57,7 +63,7 @@ def test_list_and_detail(client, tmp_path):
 
 def test_a_goal_set_from_the_end_is_not_the_default_goal(client, tmp_path):
     save_demo(tmp_path / "recordings", "elsewhere", goal=(1, 1, 1))
-    (one,) = client.get("/api/demonstrations").json()
+    (one,) = mine(client.get("/api/demonstrations").json())
     assert one["reaches_goal"] is False
 
 
@@ -134,3 +140,26 @@ def test_marking_needs_a_capture(client):
         r = client.post("/api/demonstrations/mark", json={"action": action})
         assert r.status_code == 409 and "press Record" in r.json()["detail"]
     assert client.post("/api/demonstrations/mark", json={"action": "pause"}).status_code == 422
+
+
+DEEP = 50_000
+"""Nesting depth of the damaged JSON file (issue 13: far past Python's recursion limit)."""
+
+
+def test_damaged_demonstrations_are_listed_with_the_reason_and_hide_nothing(client, tmp_path):
+    folder = tmp_path / "recordings"
+    save_demo(folder, "good")
+    (folder / "deep.demo.json").write_text("[" * DEEP + "]" * DEEP)
+    (folder / "badjson.demo.json").write_text("{not json")
+    (folder / "other.demo.json").write_text('{"format": "something-else", "version": 1}')
+    r = client.get("/api/demonstrations")
+    assert r.status_code == 200
+    listed = {d["name"]: d for d in mine(r.json())}
+    assert set(listed) == {"good", "deep", "badjson", "other"}
+    for name in ("deep", "badjson", "other"):
+        assert listed[name]["error"] and listed[name]["steps"] == 0, name
+    assert listed["good"]["error"] is None and listed["good"]["steps"] > 0
+    assert client.get("/api/demonstrations/deep").status_code == 422
+    r = client.post("/api/runs", json={**TINY_RUN, "demonstrations": ["badjson"]})
+    assert r.status_code == 422
+    assert client.delete("/api/demonstrations/deep").status_code == 204  # damaged files can go

@@ -170,3 +170,34 @@ def test_an_announced_oversized_body_is_refused_before_it_is_read(open_client, t
     r = upload(client, "huge.policy.npz", b"\0" * 200_000)
     assert r.status_code == 413 and "over the limit of" in r.json()["detail"]
     assert not list((tmp_path / "policies").iterdir())
+
+
+def deep_policy_bytes(depth: int = 50_000) -> bytes:
+    """A policy archive whose JSON header nests ``depth`` lists deep (issue 13)."""
+    out = io.BytesIO()
+    np.savez(out, header=np.array("[" * depth + "]" * depth), q=np.zeros((2, 2)))
+    return out.getvalue()
+
+
+def test_a_deeply_nested_policy_upload_is_422(client, tmp_path):
+    r = upload(client, "deep.policy.npz", deep_policy_bytes())
+    assert r.status_code == 422 and "deep.policy.npz" in r.json()["detail"]
+    assert not list((tmp_path / "policies").iterdir())
+
+
+def test_damaged_policies_are_listed_with_the_reason_and_hide_nothing(client, tmp_path):
+    assert upload(client, "good.policy.npz", policy_bytes(tmp_path)).status_code == 201
+    folder = tmp_path / "policies"
+    (folder / "deep.policy.npz").write_bytes(deep_policy_bytes())
+    (folder / "junk.policy.npz").write_bytes(b"PK\x03\x04 not a zip")
+    r = client.get("/api/policies")
+    assert r.status_code == 200
+    listed = {p["name"]: p for p in r.json()}
+    assert set(listed) == {"good", "deep", "junk"}
+    assert listed["good"]["error"] is None and listed["good"]["episodes"] == 2
+    for name in ("deep", "junk"):
+        assert listed[name]["error"] and listed[name]["episodes"] == 0, name
+        assert listed[name]["size_bytes"] == (folder / f"{name}.policy.npz").stat().st_size
+    r = client.post("/api/watch", json={"policy": "junk"})
+    assert r.status_code == 422
+    assert client.delete("/api/policies/junk").status_code == 204

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from studio.capture import RecordingWriter, TapeFrame, read_recording
+from studio.samples import SAMPLES_DIR
 
 REGIONS = 16
 RATE_HZ = 110.0
@@ -40,8 +41,9 @@ def upload(client, name: str, content: bytes):
 
 def test_list_shows_samples_first_with_their_facts(recordings, client):
     listed = client.get("/api/recordings").json()
-    assert [r["name"] for r in listed] == ["sample-reach", "mine"]
-    sample, mine = listed
+    shipped = sorted(p.name.removesuffix(".tape.csv") for p in SAMPLES_DIR.glob("*.tape.csv"))
+    assert [r["name"] for r in listed] == sorted(["sample-reach", *shipped]) + ["mine"]
+    sample, mine = listed[0], listed[-1]
     assert sample["sample"] is True and mine["sample"] is False
     assert sample["frames"] == 220 and mine["frames"] == 111
     assert mine["duration"] == pytest.approx(110 / RATE_HZ)
@@ -228,3 +230,35 @@ def test_a_capture_is_closed_cleanly_when_the_studio_stops(recordings, open_clie
     client.__exit__(None, None, None)
     rec = read_recording(recordings / "cut-short.tape.csv")
     assert rec.recovered is False
+
+
+DEEP = 50_000
+"""Nesting depth of the damaged JSON headers (issue 13: far past Python's recursion limit)."""
+
+
+def test_damaged_recordings_are_listed_with_the_reason_and_hide_nothing(recordings, client):
+    (recordings / "deep.tape.csv").write_text(
+        "# teach-studio-recording " + "[" * DEEP + "]" * DEEP + "\nt,frame\n"
+    )
+    (recordings / "badjson.tape.csv").write_text("# teach-studio-recording {oops\nt,frame\n")
+    (recordings / "binary.tape.csv").write_bytes(bytes(range(256)) * 4)
+    r = client.get("/api/recordings")
+    assert r.status_code == 200
+    listed = {rec["name"]: rec for rec in r.json()}
+    for name in ("deep", "badjson", "binary"):
+        assert listed[name]["error"], name
+        assert listed[name]["frames"] == 0 and listed[name]["sample"] is False
+    assert listed["mine"]["error"] is None and listed["mine"]["frames"] == 111
+    assert listed["sample-reach-1"]["error"] is None
+    assert r.json()[-1]["name"] == "mine"  # the user's files, alphabetical, after the samples
+    assert client.get("/api/recordings/deep").json()["error"]
+
+
+def test_uploaded_copies_of_samples_become_the_users_own(recordings, client):
+    content = (recordings / "mine.tape.csv").read_bytes()
+    r = upload(client, "sample-reach-1.tape.csv", content)
+    assert r.status_code == 201 and r.json()["name"] == "reach-1" and not r.json()["sample"]
+    r = client.patch("/api/recordings/reach-1", json={"name": "sample-mine"})
+    assert r.status_code == 422 and "sample-" in r.json()["detail"]
+    r = client.post("/api/capture/start", json={"name": "sample-take"})
+    assert r.status_code in (409, 422)  # no source here; a sample name is never accepted

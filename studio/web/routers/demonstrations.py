@@ -1,9 +1,16 @@
 """``/api/demonstrations``: cut demonstrations out of recordings (or mark them live), list,
-preview on the robot and delete them."""
+preview on the robot and delete them.
+
+The shipped samples' demonstrations are listed too: they can be previewed and trained on, never
+deleted.
+"""
 
 from __future__ import annotations
 
 from fastapi import APIRouter, Response
+
+from studio.capture import RECORDING_SUFFIX, Demonstration
+from studio.learning import goal_degrees, has_default_goal
 
 from .._deps import StudioDep
 from .._errors import ConflictError
@@ -14,47 +21,98 @@ from .._schemas import (
     DemonstrationPublic,
     MarkPublic,
 )
+from .._state import Studio
+from .._store import StoredFile
 
 router = APIRouter(prefix="/api/demonstrations", tags=["demonstrations"])
 
 
-@router.get("", response_model=list[DemonstrationPublic])
-def list_demonstrations(studio: StudioDep) -> list[dict]:
-    """Every demonstration, newest first."""
-    return studio.demonstrations.list()
+def demonstration_public(entry: StoredFile[Demonstration]) -> DemonstrationPublic:
+    """The list entry of one demonstration (a damaged file: its name, flags and the reason).
+
+    ``goal`` is the goal bin's centre in degrees; ``reaches_goal`` says whether that goal is the
+    grid's default one (false when the goal was set from where the demonstration ends).
+    """
+    demo = entry.value
+    if demo is None:
+        return DemonstrationPublic(
+            name=entry.name,
+            recording="",
+            t0=0.0,
+            t1=0.0,
+            steps=0,
+            goal=[],
+            reaches_goal=False,
+            created="",
+            sample=entry.sample,
+            error=entry.error,
+        )
+    grid = demo.arm_grid()
+    return DemonstrationPublic(
+        name=entry.name,
+        recording=demo.recording.name.removesuffix(RECORDING_SUFFIX),
+        t0=demo.t0,
+        t1=demo.t1,
+        steps=max(0, len(demo.grid_path) - 1),
+        goal=goal_degrees(grid),
+        reaches_goal=has_default_goal(grid),
+        created=demo.created or "",
+        sample=entry.sample,
+    )
 
 
-@router.post("", response_model=DemonstrationPublic, status_code=201)
-def create_demonstration(body: DemonstrationCreate, studio: StudioDep) -> dict:
+def read_public(studio: Studio, name: str) -> DemonstrationPublic:
+    """One demonstration's list entry by name (404 if none)."""
+    return demonstration_public(studio.demonstrations.entry(name))
+
+
+@router.get("")
+def list_demonstrations(studio: StudioDep) -> list[DemonstrationPublic]:
+    """Every demonstration: the shipped samples, then yours newest first; a damaged file is
+    listed with the reason."""
+    listed = [demonstration_public(e) for e in studio.demonstrations.entries()]
+    samples = [d for d in listed if d.sample]
+    mine = sorted((d for d in listed if not d.sample), key=lambda d: (d.created, d.name))
+    return samples + mine[::-1]
+
+
+@router.post("", status_code=201)
+def create_demonstration(body: DemonstrationCreate, studio: StudioDep) -> DemonstrationPublic:
     """Cut ``[t0, t1]`` out of a recording (422 with the reason when it is refused)."""
     name = studio.cut_demonstration(body.recording, body.t0, body.t1, body.goal_from_end, body.name)
-    return studio.demonstrations.info(name)
+    return read_public(studio, name)
 
 
-@router.get("/mark", response_model=MarkPublic)
-def read_mark(studio: StudioDep) -> dict:
+@router.get("/mark")
+def read_mark(studio: StudioDep) -> MarkPublic:
     """Whether a live demonstration is being marked, and since when (recording time, s)."""
-    return {"marking": studio.mark_t0 is not None, "t0": studio.mark_t0}
+    return MarkPublic(marking=studio.mark_t0 is not None, t0=studio.mark_t0)
 
 
-@router.post("/mark", response_model=MarkPublic)
-def mark_demonstration(body: DemonstrationMark, studio: StudioDep) -> dict:
+@router.post("/mark")
+def mark_demonstration(body: DemonstrationMark, studio: StudioDep) -> MarkPublic:
     """Mark the start, then the end, of a demonstration while a capture runs.
 
     On ``stop`` the segment is cut from the recording being captured and returned as
     ``demonstration`` (422 with the reason when it is refused; 409 without a running capture).
     """
     if body.action == "start":
-        t0 = studio.mark_start()
-        return {"marking": True, "t0": t0}
+        return MarkPublic(marking=True, t0=studio.mark_start())
     name = studio.mark_stop(body.goal_from_end, body.name)
-    return {"marking": False, "t0": None, "demonstration": studio.demonstrations.info(name)}
+    return MarkPublic(marking=False, t0=None, demonstration=read_public(studio, name))
 
 
-@router.get("/{name}", response_model=DemonstrationDetail)
-def read_demonstration(name: str, studio: StudioDep) -> dict:
+@router.get("/{name}")
+def read_demonstration(name: str, studio: StudioDep) -> DemonstrationDetail:
     """One demonstration with its robot path (radians) and grid path."""
-    return studio.demonstrations.detail(name)
+    demo = studio.demonstrations.load(name)  # a damaged file answers with the reader's sentence
+    entry = studio.demonstrations.entry(name)
+    return DemonstrationDetail(
+        **demonstration_public(entry).model_dump(),
+        times=demo.times.tolist(),
+        q_robot=demo.q_robot.tolist(),
+        grid_path=[int(s) for s in demo.grid_path],
+    )
 
 
 @router.post("/{name}/preview", status_code=202)
@@ -66,8 +124,8 @@ def preview_demonstration(name: str, studio: StudioDep) -> Response:
 
 @router.delete("/{name}", status_code=204)
 def delete_demonstration(name: str, studio: StudioDep) -> Response:
-    """Delete a demonstration (409 while a queued or running training run replays it)."""
-    studio.demonstrations.path(name)
+    """Delete a demonstration (409 for a sample, or while a queued or running run replays it)."""
+    studio.demonstrations.writable_path(name)
     run = studio.runs.uses_demonstration(name)
     if run is not None:
         raise ConflictError(

@@ -12,6 +12,7 @@ import asyncio
 import json
 import time
 from collections.abc import AsyncIterator
+from typing import Any
 
 import numpy as np
 from fastapi import APIRouter, Request
@@ -88,7 +89,7 @@ async def stream_events(
         await asyncio.sleep(max(0.0, TICK_S - (time.monotonic() - now)))
 
 
-def run_event(run: Run, counts: dict[str, np.ndarray]) -> dict:
+def run_event(run: Run, counts: dict[str, np.ndarray]) -> dict[str, Any]:
     """A ``run`` event: the run and its curve from the first episode that changed for this client.
 
     Only the changed tail is computed and sent, so a long run costs the same per event at
@@ -106,7 +107,7 @@ def run_event(run: Run, counts: dict[str, np.ndarray]) -> dict:
     return {"run": run.public(steps), "curve": curve_of(steps, start), "from": start}
 
 
-def _final_run(studio: Studio, run_id: str, counts: dict[str, np.ndarray]) -> dict | None:
+def _final_run(studio: Studio, run_id: str, counts: dict[str, np.ndarray]) -> dict[str, Any] | None:
     """The last event of a run that stopped training since the previous tick."""
     try:
         run = studio.runs.get(run_id)
@@ -120,8 +121,10 @@ def _final_run(studio: Studio, run_id: str, counts: dict[str, np.ndarray]) -> di
     return event
 
 
-@router.get("")
-async def events(request: Request, studio: StudioDep, max_seconds: float | None = None):
+@router.get("", response_class=StreamingResponse)
+async def events(
+    request: Request, studio: StudioDep, max_seconds: float | None = None
+) -> StreamingResponse:
     """Server-Sent Events: ``source`` (~4/s), ``capture``, ``run`` (>= 5/s while training), ``lists``.
 
     ``max_seconds`` ends the stream after that long (scripts, tests); browsers leave it out.

@@ -2,55 +2,63 @@
 
 from __future__ import annotations
 
-from typing import Annotated
+from typing import Annotated, Literal
 
 from fastapi import APIRouter, File, Response, UploadFile
 from fastapi.responses import FileResponse
 
+from studio.learning import POLICY_SUFFIX, PolicyFile, policy_summary
+
 from .._deps import SettingsDep, StudioDep
 from .._errors import ConflictError
-from .._runs import Run
-from .._state import Studio
-from .._store import policy_summary, receive_upload
+from .._schemas import PolicyPublic
+from .._store import StoredFile, receive_upload
 
 router = APIRouter(prefix="/api/policies", tags=["policies"])
 
 
-def _public(studio: Studio, name: str) -> dict:
-    path = studio.policies.path(name)
-    return {
-        "name": name,
-        "source": "upload",
-        "run": None,
-        **policy_summary(studio.policies.load(name)),
-        "size_bytes": path.stat().st_size,
-    }
+def policy_public(
+    entry: StoredFile[PolicyFile], source: Literal["upload", "run"] = "upload"
+) -> PolicyPublic:
+    """The list entry of one policy file, from the learning package's summary of it.
 
-
-def _run_public(studio: Studio, run: Run) -> dict:
-    return {
-        "name": run.id,
-        "source": "run",
-        "run": run.id,
-        **policy_summary(studio.policies.load_file(run.policy_path)),
-        "size_bytes": run.policy_path.stat().st_size,
-    }
+    A damaged file keeps its name and size and says why it cannot be used.
+    """
+    summary = (
+        policy_summary(entry.value)
+        if entry.value is not None
+        else {
+            "grid": {},
+            "goal_deg": [],
+            "planning": "",
+            "episodes": 0,
+            "experiments": 0,
+            "created": "",
+            "notes": "",
+        }
+    )
+    return PolicyPublic(
+        name=entry.name,
+        source=source,
+        run=entry.name if source == "run" else None,
+        size_bytes=entry.size_bytes,
+        error=entry.error,
+        **summary,
+    )
 
 
 @router.get("")
-def list_policies(studio: StudioDep) -> list[dict]:
-    """Uploaded policies, then the policy of every run that has one (newest run first)."""
-    out = []
-    for name in studio.policies.names():
-        try:
-            out.append(_public(studio, name))
-        except Exception:  # an unreadable file is not listed; it stays on disk untouched
-            continue
+def list_policies(studio: StudioDep) -> list[PolicyPublic]:
+    """Uploaded policies, then the policy of every run that has one (newest run first).
+
+    A damaged file is listed with the reason; it stays on disk untouched.
+    """
+    out = [policy_public(entry) for entry in studio.policies.entries()]
     for run in studio.runs.list():
         if run.has_policy and run.status != "running":
             try:
-                out.append(_run_public(studio, run))
-            except Exception:
+                out.append(policy_public(studio.policies.entry_at(run.id, run.policy_path), "run"))
+            except FileNotFoundError:  # the run was deleted meanwhile
                 continue
     return out
 
@@ -58,16 +66,17 @@ def list_policies(studio: StudioDep) -> list[dict]:
 @router.post("", status_code=201)
 async def upload_policy(
     studio: StudioDep, settings: SettingsDep, file: Annotated[UploadFile, File()]
-) -> dict:
+) -> PolicyPublic:
     """Upload a ``.policy.npz`` (413 over the limit, 422 if it is not a policy file).
 
-    The name comes from the file name; a taken name gets ``-2``, ``-3``, ... appended.
+    The name comes from the file name; a taken name (by a policy or a run) gets ``-2``, ``-3``,
+    ... appended.
     """
     tmp = await receive_upload(file, studio.policies.folder, settings.upload_limit_bytes)
     taken = studio.policy_names()
     name = studio.policies.adopt(tmp, file.filename, lambda n: n in taken)
     studio.changes.bump("policies")
-    return _public(studio, name)
+    return policy_public(studio.policies.entry(name))
 
 
 @router.get("/{name}/file")
@@ -76,7 +85,7 @@ def download_policy(name: str, studio: StudioDep) -> FileResponse:
     return FileResponse(
         studio.policies.path(name),
         media_type="application/octet-stream",
-        filename=f"{name}.policy.npz",
+        filename=f"{name}{POLICY_SUFFIX}",
     )
 
 

@@ -1,36 +1,72 @@
-"""``/api/recordings``: list, upload, download, rename, annotate and delete recordings."""
+"""``/api/recordings``: list, upload, download, copy, rename, annotate and delete recordings.
+
+The shipped samples are listed first; they can be played, cut and copied, never changed.
+"""
 
 from __future__ import annotations
 
-from typing import Annotated
+from pathlib import Path
+from typing import Annotated, Any
 
 from fastapi import APIRouter, File, Response, UploadFile
 from fastapi.responses import StreamingResponse
 
-from studio.capture import recording_bytes
+from studio.capture import (
+    RECORDING_SUFFIX,
+    recording_bytes,
+    rename_recording,
+    update_recording_meta,
+)
 
 from .._deps import SettingsDep, StudioDep
 from .._errors import ConflictError
-from .._schemas import RecordingPublic, RecordingUpdate
-from .._store import RECORDING_SUFFIX, receive_upload
+from .._schemas import RecordingCopy, RecordingPublic, RecordingUpdate
+from .._state import Studio
+from .._store import StoredFile, receive_upload
 
 router = APIRouter(prefix="/api/recordings", tags=["recordings"])
 
 
-@router.get("", response_model=list[RecordingPublic])
-def list_recordings(studio: StudioDep) -> list[dict]:
-    """Every recording, shipped samples first (an unreadable one is listed with its error).
+def recording_public(entry: StoredFile[dict[str, Any]]) -> RecordingPublic:
+    """The list entry of one recording, from the capture package's summary of it."""
+    summary = entry.value or {}
+    return RecordingPublic(
+        name=entry.name,
+        frames=summary.get("frames", 0),
+        duration=summary.get("duration", 0.0),
+        rate_hz=summary.get("rate_hz") or None,
+        created=summary.get("created") or "",
+        operator=summary.get("operator") or "",
+        notes=summary.get("notes") or "",
+        source=summary.get("source") or "",
+        recovered=summary.get("recovered", False),
+        size_bytes=entry.size_bytes,
+        sample=entry.sample,
+        error=entry.error,
+    )
+
+
+def read_public(studio: Studio, name: str) -> RecordingPublic:
+    """One recording's list entry by name (404 if none)."""
+    return recording_public(studio.recordings.entry(name))
+
+
+@router.get("")
+def list_recordings(studio: StudioDep) -> list[RecordingPublic]:
+    """Every recording, the shipped samples first; a damaged file is listed with the reason.
 
     The file a capture is writing appears once the capture stops.
     """
     capturing = studio.pipeline.capture_name
-    return [r for r in studio.recordings.list() if r["name"] != capturing]
+    return [
+        recording_public(entry) for entry in studio.recordings.entries() if entry.name != capturing
+    ]
 
 
-@router.post("", response_model=RecordingPublic, status_code=201)
+@router.post("", status_code=201)
 async def upload_recording(
     studio: StudioDep, settings: SettingsDep, file: Annotated[UploadFile, File()]
-) -> dict:
+) -> RecordingPublic:
     """Upload a ``.tape.csv`` (413 over the limit, 422 if it is not a recording).
 
     The name comes from the file name; a taken name gets ``-2``, ``-3``, ... appended.
@@ -38,13 +74,13 @@ async def upload_recording(
     tmp = await receive_upload(file, studio.recordings.folder, settings.upload_limit_bytes)
     name = studio.recordings.adopt(tmp, file.filename)
     studio.changes.bump("recordings")
-    return studio.recordings.info(name)
+    return read_public(studio, name)
 
 
-@router.get("/{name}", response_model=RecordingPublic)
-def read_recording(name: str, studio: StudioDep) -> dict:
+@router.get("/{name}")
+def read_recording(name: str, studio: StudioDep) -> RecordingPublic:
     """One recording's summary."""
-    return studio.recordings.info(name)
+    return read_public(studio, name)
 
 
 @router.get("/{name}/file")
@@ -62,27 +98,57 @@ def download_recording(name: str, studio: StudioDep) -> StreamingResponse:
     )
 
 
-@router.patch("/{name}", response_model=RecordingPublic)
-def update_recording(name: str, body: RecordingUpdate, studio: StudioDep) -> dict:
-    """Rename (409 if in use or the name is taken) and/or set the operator and notes."""
-    studio.recordings.path(name)
+@router.post("/{name}/copy", status_code=201)
+def copy_recording(
+    name: str, studio: StudioDep, body: RecordingCopy | None = None
+) -> RecordingPublic:
+    """Copy a recording (a shipped sample, typically) into your own recordings, to rename and annotate.
+
+    The copy is named ``body.name`` (409 if taken), else the original's name without
+    ``sample-``, made free with ``-2``, ``-3``, ...
+    """
+
+    def retitle(tmp: Path, final: str) -> None:
+        update_recording_meta(tmp, name=final)
+
+    new = studio.recordings.copy(name, body.name if body else None, prepare=retitle)
+    studio.changes.bump("recordings")
+    return read_public(studio, new)
+
+
+@router.patch("/{name}")
+def update_recording(name: str, body: RecordingUpdate, studio: StudioDep) -> RecordingPublic:
+    """Rename (409 if in use or the name is taken) and/or set the operator and notes.
+
+    The header is changed by an atomic replace, the frames are never touched; a rename also
+    updates the demonstrations cut from the recording. Samples are refused (409).
+    """
+    path = studio.recordings.writable_path(name)
     if studio.pipeline.capture_name == name:
         raise ConflictError(f"Recording {name!r} is being captured; stop the recording first.")
-    if body.name is not None and body.name != name:
+    renaming = body.name is not None and body.name != name
+    if renaming:
+        studio.recordings.check_new_name(body.name)
         reason = studio.recording_in_use(name)
         if reason:
             raise ConflictError(reason)
-    new = studio.recordings.update(name, body.name, body.notes, body.operator)
+    changes = {
+        k: v for k, v in (("notes", body.notes), ("operator", body.operator)) if v is not None
+    }
+    if changes:
+        update_recording_meta(path, **changes)
     studio.changes.bump("recordings")
-    if new != name:
+    if renaming:
+        rename_recording(path, body.name)
         studio.changes.bump("demonstrations")  # their "recording" follows the rename
-    return studio.recordings.info(new)
+        return read_public(studio, body.name)
+    return read_public(studio, name)
 
 
 @router.delete("/{name}", status_code=204)
 def delete_recording(name: str, studio: StudioDep) -> Response:
-    """Delete a recording (409 while it is the live source or being captured)."""
-    studio.recordings.path(name)
+    """Delete a recording (409 while it is the live source or being captured, or a sample)."""
+    studio.recordings.writable_path(name)
     reason = studio.recording_in_use(name)
     if reason:
         raise ConflictError(reason)

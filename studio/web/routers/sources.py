@@ -17,41 +17,41 @@ from .._schemas import (
 router = APIRouter(prefix="/api/source", tags=["source"])
 
 
-@router.get("", response_model=SourcePublic)
-def read_source(studio: StudioDep) -> dict:
+@router.get("")
+def read_source(studio: StudioDep) -> SourcePublic:
     """The live source: kind, rate, frames, dropped frames, error, fit residual, robot pose."""
-    return studio.source_public()
+    return SourcePublic.model_validate(studio.source_public())
 
 
-@router.put("", response_model=SourcePublic)
-def set_source(body: SourceUpdate, studio: StudioDep) -> dict:
+@router.put("")
+def set_source(body: SourceUpdate, studio: StudioDep) -> SourcePublic:
     """Switch the live source; the old one is stopped first (409 while recording).
 
     A source that cannot start (no such serial device, port in use) is still selected and shows
     its error in ``error``, so the page can show it next to the source.
     """
     studio.set_source(**body.model_dump())
-    return studio.source_public()
+    return SourcePublic.model_validate(studio.source_public())
 
 
-@router.post("/playback", response_model=SourcePublic)
-def control_playback(body: PlaybackAction, studio: StudioDep) -> dict:
+@router.post("/playback")
+def control_playback(body: PlaybackAction, studio: StudioDep) -> SourcePublic:
     """Play, pause or seek the recording source (409 if the source is not a recording)."""
     studio.playback(body.action, body.t, body.speed)
-    return studio.source_public()
+    return SourcePublic.model_validate(studio.source_public())
 
 
-@router.put("/retarget", response_model=SourcePublic)
-def set_retarget(body: RetargetUpdate, studio: StudioDep) -> dict:
+@router.put("/retarget")
+def set_retarget(body: RetargetUpdate, studio: StudioDep) -> SourcePublic:
     """Map the arm onto the robot joint by joint or by hand position, mirrored or not."""
     studio.pipeline.set_retarget(body.mode, body.mirror)
-    return studio.source_public()
+    return SourcePublic.model_validate(studio.source_public())
 
 
-@router.post("/reach", response_model=SourcePublic)
-def simulator_reach(body: ReachAction, studio: StudioDep) -> dict:
+@router.post("/reach")
+def simulator_reach(body: ReachAction, studio: StudioDep) -> SourcePublic:
     """Make the simulated operator reach the pose that mirrors onto a robot goal (joints 1-3,
     degrees; the default goal when omitted), or go back to random reaching (409 if the source is
     not the simulator). Handy for recording demonstrations that end at the goal."""
     studio.simulator_reach(body.action, body.goal_deg)
-    return studio.source_public()
+    return SourcePublic.model_validate(studio.source_public())

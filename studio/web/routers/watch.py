@@ -8,6 +8,8 @@ from pathlib import Path
 import numpy as np
 from fastapi import APIRouter, Response
 
+from studio.learning import greedy_path, rollout, save_trajectory_csv
+
 from .._deps import StudioDep
 from .._errors import ConflictError
 from .._schemas import WatchCreate, WatchPublic
@@ -16,13 +18,13 @@ router = APIRouter(prefix="/api/watch", tags=["watch"])
 
 ROLLOUT_RATE_HZ = 50.0
 """Samples per second of a watched rollout (the scene interpolates between them)."""
+ROUND_DECIMALS = 6
+"""Seconds and radians are sent to a micro-unit: far below what the scene can show."""
 
 
-@router.post("", response_model=WatchPublic)
-def watch(body: WatchCreate, studio: StudioDep) -> dict:
+@router.post("")
+def watch(body: WatchCreate, studio: StudioDep) -> WatchPublic:
     """Roll the greedy policy out from a random or the current pose and play it in the scene."""
-    from studio.learning import greedy_path, rollout
-
     policy, key = studio.load_policy(body.run, body.policy)
     grid = policy.grid
     if body.start == "current":
@@ -49,12 +51,12 @@ def watch(body: WatchCreate, studio: StudioDep) -> dict:
         goal[: grid.joints] = grid.angles_of(grid.goal_state)
         studio.scene.set_goal(goal)
         studio.scene.play_trajectory(times, q, states)
-    return {
-        "states": states,
-        "times": [round(float(t), 6) for t in times],
-        "q_robot": [[round(float(x), 6) for x in row] for row in q],
-        "reached_goal": states[-1] == grid.goal_state,
-    }
+    return WatchPublic(
+        states=states,
+        times=np.round(times, ROUND_DECIMALS).tolist(),
+        q_robot=np.round(q, ROUND_DECIMALS).tolist(),
+        reached_goal=states[-1] == grid.goal_state,
+    )
 
 
 @router.post("/stop", status_code=204)
@@ -75,8 +77,6 @@ def download_trajectory(studio: StudioDep) -> Response:
     if last is None:
         raise ConflictError("Nothing has been watched yet; watch a policy first, then download.")
     times, q = last
-    from studio.learning import save_trajectory_csv
-
     with tempfile.TemporaryDirectory() as folder:  # the learning package's CSV format, as is
         path = Path(folder) / "rollout.csv"
         save_trajectory_csv(path, times, q)

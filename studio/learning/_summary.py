@@ -1,0 +1,56 @@
+"""Listing facts about grids and policy files: the one place they are computed.
+
+The web page, the CLI and scripts list policies and demonstrations; what a listing says about a
+goal (its angles in degrees, whether it is the grid's default) or about a policy file (its
+planner, how many episodes its curve holds) is computed here, next to the formats it reads.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from ._arm import ArmGrid
+from ._policy import PolicyFile
+
+POLICY_SUFFIX = ".policy.npz"
+"""The file suffix of policy files (the format is in :mod:`._policy`)."""
+GOAL_DECIMALS = 6
+"""Goal angles are reported to a micro-degree: exact enough to compare, short enough to read."""
+
+
+def goal_degrees(grid: ArmGrid) -> list[float]:
+    """The centre of ``grid``'s goal bin, one angle in degrees per joint."""
+    return [round(float(x), GOAL_DECIMALS) for x in np.degrees(grid.angles_of(grid.goal_state))]
+
+
+def has_default_goal(grid: ArmGrid) -> bool:
+    """Whether ``grid``'s goal is the default goal of a grid with the same joints, bins and range.
+
+    A demonstration whose goal was set from where it ends (``goal_from_end``) answers false: it
+    trains a different task than the paper's.
+    """
+    default = ArmGrid(
+        joints=grid.joints, bins=grid.bins, low_deg=grid.low_deg, high_deg=grid.high_deg
+    )
+    return tuple(grid.goal) == tuple(default.goal)
+
+
+def policy_summary(policy: PolicyFile) -> dict[str, Any]:
+    """JSON-ready facts about a policy file for listings (the page, scripts).
+
+    Returns:
+        ``grid`` (the :meth:`ArmGrid.to_dict` spec), ``goal_deg`` (see :func:`goal_degrees`),
+        ``planning`` (the planner it was trained with), ``episodes`` (length of its learning
+        curve), ``experiments`` (how many the curve averages), ``created`` and ``notes``.
+    """
+    return {
+        "grid": policy.grid.to_dict(),
+        "goal_deg": goal_degrees(policy.grid),
+        "planning": policy.config.planning,
+        "episodes": int(len(policy.mean_steps)),
+        "experiments": int(policy.experiments),
+        "created": policy.created,
+        "notes": policy.notes,
+    }
