@@ -70,3 +70,25 @@ def whole_number(value: object, what: str, minimum: int) -> int:
     if not (math.isfinite(value) and int(value) == value and value >= minimum):
         raise KinematicsError(f"{what} must be a whole number >= {minimum}; got {value!r}.")
     return int(value)
+
+
+def instance_of(value: object, kind: type, what: str, *, optional: bool = False) -> None:
+    """Refuse a ``value`` that is not a ``kind`` (or None, when ``optional``) in one sentence.
+
+    Args:
+        value: the argument.
+        kind: the class it must be.
+        what: the argument's name, for the message (``"ArmFitter's arm"``).
+        optional: None is allowed (the caller then builds a default).
+
+    Raises:
+        KinematicsError: naming ``what``, the type given and the fix.
+    """
+    if value is None and optional:
+        return
+    if not isinstance(value, kind):
+        fix = " or leave it out" if optional else ""
+        raise KinematicsError(
+            f"{what} must be a {kind.__name__}, got {type(value).__name__}; "
+            f"pass {kind.__name__}(...){fix}."
+        )

@@ -43,7 +43,7 @@ import numpy as np
 import pinocchio as pin
 from numba import njit
 
-from ._checks import positive_number, real_array, whole_number
+from ._checks import instance_of, positive_number, real_array, whole_number
 from ._errors import KinematicsError
 from ._human import HumanArm
 from ._tape import TapeConfig, TapeShape, reconstruct
@@ -217,17 +217,9 @@ class ArmFitter:
     """
 
     def __init__(self, arm: HumanArm, config: TapeConfig, fit: FitConfig | None = None) -> None:
-        for value, kind, name in ((arm, HumanArm, "arm"), (config, TapeConfig, "config")):
-            if not isinstance(value, kind):
-                raise KinematicsError(
-                    f"ArmFitter's {name} must be a {kind.__name__}, got {type(value).__name__}; "
-                    f"pass {kind.__name__}(...)."
-                )
-        if fit is not None and not isinstance(fit, FitConfig):
-            raise KinematicsError(
-                f"ArmFitter's fit must be a FitConfig, got {type(fit).__name__}; "
-                "pass FitConfig(...)."
-            )
+        instance_of(arm, HumanArm, "ArmFitter's arm")
+        instance_of(config, TapeConfig, "ArmFitter's config")
+        instance_of(fit, FitConfig, "ArmFitter's fit", optional=True)
         self.arm = arm
         self.config = config
         self.settings = fit or FitConfig()

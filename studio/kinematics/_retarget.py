@@ -40,7 +40,7 @@ from typing import Literal
 
 import numpy as np
 
-from ._checks import positive_number, whole_number
+from ._checks import instance_of, positive_number, whole_number
 from ._errors import KinematicsError
 from ._human import SAGITTAL_MIRROR, HumanArm, _as_q
 from ._puma import IKConfig, IKResult, Puma560
@@ -105,16 +105,9 @@ class Retargeter:
         arm: HumanArm | None = None,
         config: RetargetConfig | None = None,
     ) -> None:
-        for value, kind, name in (
-            (robot, Puma560, "robot"),
-            (arm, HumanArm, "arm"),
-            (config, RetargetConfig, "config"),
-        ):
-            if value is not None and not isinstance(value, kind):
-                raise KinematicsError(
-                    f"Retargeter's {name} must be a {kind.__name__}, got {type(value).__name__}; "
-                    f"pass {kind.__name__}(...) or leave it out."
-                )
+        instance_of(robot, Puma560, "Retargeter's robot", optional=True)
+        instance_of(arm, HumanArm, "Retargeter's arm", optional=True)
+        instance_of(config, RetargetConfig, "Retargeter's config", optional=True)
         self.config = config or RetargetConfig()
         self.robot = robot or Puma560(ik=IKConfig(max_iterations=self.config.ik_iterations))
         self.arm = arm or HumanArm()

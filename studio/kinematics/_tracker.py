@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ._checks import instance_of
 from ._errors import KinematicsError
 from ._fit import ArmFit, ArmFitter, FitConfig
 from ._human import HumanArm
@@ -46,17 +47,8 @@ class TrackerConfig:
     retarget: RetargetConfig = field(default_factory=RetargetConfig)
 
     def __post_init__(self) -> None:
-        for name, kind in (
-            ("tape", TapeConfig),
-            ("fit", FitConfig),
-            ("retarget", RetargetConfig),
-        ):
-            value = getattr(self, name)
-            if not isinstance(value, kind):
-                raise KinematicsError(
-                    f"TrackerConfig.{name} must be a {kind.__name__}, got {type(value).__name__}; "
-                    f"pass {kind.__name__}(...) or leave it out."
-                )
+        for name, kind in (("tape", TapeConfig), ("fit", FitConfig), ("retarget", RetargetConfig)):
+            instance_of(getattr(self, name), kind, f"TrackerConfig.{name}")
         if self.mode not in ("joint", "cartesian"):
             raise KinematicsError(
                 f'TrackerConfig.mode must be "joint" or "cartesian"; got {self.mode!r}.'
@@ -121,11 +113,7 @@ class ArmTracker:
                 f"ArmTracker's config must be a TrackerConfig or a TapeConfig, got "
                 f"{type(config).__name__}; pass TrackerConfig(tape=...)."
             )
-        if arm is not None and not isinstance(arm, HumanArm):
-            raise KinematicsError(
-                f"ArmTracker's arm must be a HumanArm, got {type(arm).__name__}; "
-                "pass HumanArm(...) or leave it out."
-            )
+        instance_of(arm, HumanArm, "ArmTracker's arm", optional=True)
         self.config = config
         self.arm = arm if arm is not None else HumanArm(side=config.tape.side)
         self.fitter = ArmFitter(self.arm, config.tape, config.fit)
