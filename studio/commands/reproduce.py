@@ -5,13 +5,13 @@ from __future__ import annotations
 import argparse
 import time
 
-from studio.learning import reproduce
-from studio.learning._reproduce import DEFAULT_EPISODES, DEFAULT_EXPERIMENTS, DEFAULT_SEED
+from studio.learning import DEFAULT_EPISODES, DEFAULT_EXPERIMENTS, DEFAULT_SEED, reproduce
 
 NAME = "reproduce"
 HELP = (
     "Rerun the paper's six Dyna-Q experiments (supervised/unsupervised x zero/full/soft planning) "
-    "and write curves, Fig. 5/8/9 analogues and a claim-by-claim REPORT.md."
+    "and write a run folder per configuration, curves, Fig. 5/8/9 analogues and a claim-by-claim "
+    "REPORT.md (--out runs/NAME in a data folder lists the runs in the page)."
 )
 
 
@@ -31,7 +31,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         default=DEFAULT_EPISODES,
         help=f"episodes per experiment (default: {DEFAULT_EPISODES})",
     )
-    parser.add_argument("--seed", type=int, default=DEFAULT_SEED, help="random seed (default: 0)")
+    parser.add_argument(
+        "--seed", type=int, default=DEFAULT_SEED, help=f"random seed (default: {DEFAULT_SEED})"
+    )
     parser.add_argument("--workers", type=int, default=None, help="threads (default: all cores)")
     parser.add_argument("--no-progress", action="store_true", help="hide the progress bar")
 

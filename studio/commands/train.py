@@ -1,10 +1,14 @@
-"""``studio train``: train Dyna-Q on the arm grid from the terminal into a run directory.
+"""``studio train``: train Dyna-Q on the arm grid from the terminal into a run folder.
 
-The run directory holds ``config.json`` (everything needed to repeat the run), ``curves.csv``
-(mean and spread of steps per episode), ``steps.csv`` (every experiment's steps per episode) and
-``policy.policy.npz`` (the best experiment's Q table, see :mod:`studio.learning._policy`).
+The run folder is the same one the page makes (:class:`studio.learning.RunFolder`): started in a
+data folder, ``studio train --out runs/my-run`` shows up in the page's run list, where it can be
+plotted, watched and exported. It holds ``config.json`` (everything needed to repeat the run),
+``status.json``, ``steps.csv`` (checkpointed every second while training), ``curves.csv`` and
+``policy.policy.npz`` (written at the end, also after Ctrl-C).
 
-Settings come from ``--config FILE.json`` and/or flags (flags win). The file looks like::
+Settings come from ``--config FILE.json`` and/or flags (flags win); anything left out takes the
+learning package's defaults (``DynaQConfig``, ``ArmGrid``, ``DEFAULT_EXPERIMENTS`` ...). The file
+is a run's ``config.json`` (to repeat a run) or looks like::
 
     {"grid": {"joints": 3, "bins": 11, "low_deg": -180, "high_deg": 180, "goal": [5, 6, 2]},
      "config": {"planning": "full", "planning_steps": 100, "alpha": 0.1},
@@ -19,46 +23,79 @@ a ``"demonstrations"`` list, or a ``*.demo.json`` with a ``"grid_path"``; or be 
 from __future__ import annotations
 
 import argparse
-import csv
 import json
 import time
-from datetime import UTC, datetime
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from studio.learning import (
+    DEFAULT_EPISODES,
+    DEFAULT_EXPERIMENTS,
+    DEFAULT_SEED,
     PLANNERS,
     ArmGrid,
+    ConfigError,
     DynaQConfig,
     LearningError,
     LiveProgress,
-    check_budget,
+    RunFolder,
+    RunRecord,
     generate_demonstrations,
-    run_experiments,
-    save_policy,
+    grid_for_goal,
+    raise_problems,
+    run_problems,
 )
-from studio.learning._reproduce import _percentiles, _run_with_progress
 
 NAME = "train"
-HELP = "Train Dyna-Q on the arm grid: a config in, a run directory with curves and a policy out."
+HELP = "Train Dyna-Q on the arm grid: a config in, a run folder with curves and a policy out."
+_DYNAQ = DynaQConfig()
+_GRID = ArmGrid()
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """The flags; each default named in its help is the learning package's."""
     parser.add_argument("--config", type=Path, help="JSON file with grid, config and run settings")
-    parser.add_argument("--out", type=Path, help="run directory (default: runs/<time>-<planning>)")
-    parser.add_argument("--planning", choices=PLANNERS, help="planner (default: full)")
-    parser.add_argument("--planning-steps", type=int, help="planning updates per real step")
-    parser.add_argument("--alpha", type=float, help="learning rate")
-    parser.add_argument("--gamma", type=float, help="discount factor")
-    parser.add_argument("--epsilon", type=float, help="exploration probability")
-    parser.add_argument("--experiments", type=int, help="independent experiments (default: 20)")
-    parser.add_argument("--episodes", type=int, help="episodes per experiment (default: 100)")
-    parser.add_argument("--seed", type=int, help="random seed (default: 0)")
-    parser.add_argument("--joints", type=int, help="grid joints (default: 3)")
-    parser.add_argument("--bins", type=int, help="bins per joint (default: 11)")
-    parser.add_argument("--goal", help="goal bins, comma-separated, e.g. 5,6,2")
+    parser.add_argument(
+        "--out", type=Path, help="run folder (default: runs/<time>-<planning>-<id>)"
+    )
+    parser.add_argument("--name", help="a label for the run (shown in the page's run list)")
+    parser.add_argument(
+        "--planning", choices=PLANNERS, help=f"planner (default: {_DYNAQ.planning})"
+    )
+    parser.add_argument(
+        "--planning-steps",
+        type=int,
+        help=f"planning updates per real step (default: {_DYNAQ.planning_steps})",
+    )
+    parser.add_argument("--alpha", type=float, help=f"learning rate (default: {_DYNAQ.alpha})")
+    parser.add_argument("--gamma", type=float, help=f"discount factor (default: {_DYNAQ.gamma})")
+    parser.add_argument(
+        "--epsilon", type=float, help=f"exploration probability (default: {_DYNAQ.epsilon})"
+    )
+    parser.add_argument(
+        "--experiments",
+        type=int,
+        help=f"independent experiments (default: {DEFAULT_EXPERIMENTS})",
+    )
+    parser.add_argument(
+        "--episodes", type=int, help=f"episodes per experiment (default: {DEFAULT_EPISODES})"
+    )
+    parser.add_argument("--seed", type=int, help=f"random seed (default: {DEFAULT_SEED})")
+    parser.add_argument("--joints", type=int, help=f"grid joints (default: {_GRID.joints})")
+    parser.add_argument("--bins", type=int, help=f"bins per joint (default: {_GRID.bins})")
+    goal = parser.add_mutually_exclusive_group()
+    goal.add_argument(
+        "--goal",
+        help=f"goal bins, comma-separated (default: {','.join(map(str, _GRID.goal))})",
+    )
+    goal.add_argument(
+        "--goal-deg",
+        help="goal as joint 1-3 angles in degrees, comma-separated, checked against the Puma560's "
+        "limits as the page does; write --goal-deg=-30,45,-90 when the first is negative",
+    )
     parser.add_argument("--demos", type=Path, help="JSON file of demonstrations (grid state lists)")
     parser.add_argument("--generated-demos", type=int, help="replay N generated demonstrations")
     parser.add_argument("--workers", type=int, default=None, help="threads (default: all cores)")
@@ -70,7 +107,7 @@ def _read_json(path: Path, what: str) -> Any:
         return json.loads(path.read_text())
     except FileNotFoundError:
         raise LearningError(f"The {what} file {path} does not exist; check the path.") from None
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as err:
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError, RecursionError) as err:
         raise LearningError(
             f"The {what} file {path} is not valid JSON ({err}); fix or replace it."
         ) from None
@@ -89,45 +126,105 @@ def _demos_from(data: Any, source: str) -> list[list[int]]:
     return data
 
 
-def _goal(text: str) -> tuple[int, ...]:
+def _numbers(text: str, flag: str, kind: type, example: str) -> list[Any]:
     try:
-        return tuple(int(v) for v in text.split(","))
+        return [kind(v) for v in text.split(",")]
     except ValueError:
         raise LearningError(
-            f"--goal is {text!r}; give bin indices separated by commas, e.g. 5,6,2."
+            f"{flag} is {text!r}; give numbers separated by commas, e.g. {example}."
         ) from None
 
 
-def run(args: argparse.Namespace) -> int:
-    spec: dict[str, Any] = {}
-    if args.config is not None:
-        spec = _read_json(args.config, "config")
-        if not isinstance(spec, dict):
-            raise LearningError(
-                f"The config file {args.config} holds no JSON object; give an object with 'grid' and 'config'."
-            )
+@dataclass(frozen=True)
+class TrainSettings:
+    """What ``studio train`` will run: flags over the config file over the learning defaults."""
+
+    grid: ArmGrid
+    config: DynaQConfig
+    experiments: int
+    episodes: int
+    seed: int
+    demonstrations: list[list[int]]
+
+
+def _spec_of(args: argparse.Namespace) -> dict[str, Any]:
+    if args.config is None:
+        return {}
+    spec = _read_json(args.config, "config")
+    if not isinstance(spec, dict):
+        raise LearningError(
+            f"The config file {args.config} holds no JSON object; give an object with 'grid' and 'config'."
+        )
+    if "task" in spec or "format" in spec:  # a run's own config.json: repeat that run
+        record = RunRecord.from_dict(spec)
+        spec = {
+            "grid": {k: v for k, v in record.task.items() if k != "kind"},
+            "config": record.config,
+            "experiments": record.experiments,
+            "episodes": record.episodes,
+            "seed": record.seed,
+            "demonstrations": record.demonstrations,
+        }
+    return spec
+
+
+def resolve(args: argparse.Namespace) -> TrainSettings:
+    """The run's settings, every bad one reported at once.
+
+    Raises:
+        LearningError: a bad file or flag (a :class:`ConfigError` lists every bad field).
+    """
+    spec = _spec_of(args)
+    problems: list[tuple[str, str]] = []
     grid_spec = dict(spec.get("grid", {}))
     for key in ("joints", "bins"):
         if getattr(args, key) is not None:
             grid_spec[key] = getattr(args, key)
     if args.goal is not None:
-        grid_spec["goal"] = _goal(args.goal)
+        grid_spec["goal"] = _numbers(args.goal, "--goal", int, "5,6,2")
     if grid_spec.get("goal") is not None:
         grid_spec["goal"] = tuple(grid_spec["goal"])
+    grid: ArmGrid | None = None
     try:
-        grid = ArmGrid(**grid_spec)
+        if args.goal_deg is not None:
+            extra = set(grid_spec) - {"bins", "joints", "goal"}
+            if extra or grid_spec.get("joints", 3) != 3:
+                raise LearningError(
+                    "--goal-deg sets a goal on the paper's 3-joint grid; give --goal bins for another grid."
+                )
+            degrees = _numbers(args.goal_deg, "--goal-deg", float, "0,45,-90")
+            grid = grid_for_goal(degrees, grid_spec.get("bins", ArmGrid.bins))
+        else:
+            grid = ArmGrid(**grid_spec)
+    except ConfigError as err:
+        problems += list(err.by_field.items())
     except TypeError as err:
-        raise LearningError(
-            f"The grid settings are wrong ({err}); use joints, bins, low_deg, high_deg and goal."
-        ) from None
-    config_spec = {"planning": "full", **spec.get("config", {})}
+        problems.append(
+            (
+                "grid",
+                f"The grid settings are wrong ({err}); use joints, bins, low_deg, high_deg and goal.",
+            )
+        )
+    except LearningError as err:
+        problems.append(("grid", str(err)))
+    config_spec = dict(spec.get("config", {}))
     for key in ("planning", "planning_steps", "alpha", "gamma", "epsilon"):
         if getattr(args, key) is not None:
             config_spec[key] = getattr(args, key)
-    config = DynaQConfig.from_dict(config_spec)
-    experiments = args.experiments if args.experiments is not None else spec.get("experiments", 20)
-    episodes = args.episodes if args.episodes is not None else spec.get("episodes", 100)
-    seed = args.seed if args.seed is not None else spec.get("seed", 0)
+    config: DynaQConfig | None = None
+    try:
+        config = DynaQConfig.from_dict(config_spec)
+    except ConfigError as err:
+        problems += list(err.by_field.items())
+    experiments = args.experiments if args.experiments is not None else spec.get("experiments")
+    episodes = args.episodes if args.episodes is not None else spec.get("episodes")
+    seed = args.seed if args.seed is not None else spec.get("seed")
+    experiments = DEFAULT_EXPERIMENTS if experiments is None else experiments
+    episodes = DEFAULT_EPISODES if episodes is None else episodes
+    seed = DEFAULT_SEED if seed is None else seed
+    problems += run_problems(experiments, episodes, seed, args.name or "", grid)
+    raise_problems(problems)
+    assert grid is not None and config is not None
     demos = (
         _demos_from(spec["demonstrations"], str(args.config)) if "demonstrations" in spec else []
     )
@@ -137,84 +234,64 @@ def run(args: argparse.Namespace) -> int:
         demos = generate_demonstrations(
             grid, args.generated_demos, np.random.default_rng([seed, 1])
         )
+    return TrainSettings(grid, config, experiments, episodes, seed, demos)
 
-    check_budget(experiments, episodes, grid.n_states, grid.n_actions)
-    out = args.out or Path("runs") / f"{datetime.now(UTC):%Y%m%d-%H%M%S}-{config.planning}"
-    live = LiveProgress(experiments, episodes)
+
+def run(args: argparse.Namespace) -> int:
+    """Train into a new run folder; Ctrl-C stops at the next episode and keeps what was learnt."""
+    settings = resolve(args)
+    record = RunRecord.for_arm_grid(
+        settings.grid,
+        settings.config,
+        settings.experiments,
+        settings.episodes,
+        settings.seed,
+        settings.demonstrations,
+        name=args.name or "",
+        origin="cli",
+    )
+    if args.out is None:
+        folder = RunFolder.create(Path("runs"), record, status="running")
+    else:
+        folder = RunFolder.create(args.out.parent, record, name=args.out.name, status="running")
+    live = LiveProgress(settings.experiments, settings.episodes)
     bar = None
     if not args.no_progress:
         from tqdm import tqdm
 
         bar = tqdm(total=live.total, unit="episode", desc="train")
+    shown = [0]
+
+    def progress(live: LiveProgress) -> None:
+        if bar is not None:
+            done = live.completed
+            bar.update(done - shown[0])
+            shown[0] = done
+
     start = time.perf_counter()
     try:
-        result = _run_with_progress(
-            lambda live: run_experiments(
-                grid.mdp(),
-                config,
-                experiments,
-                episodes,
-                seed,
-                demos,
-                workers=args.workers,
-                live=live,
-            ),
-            live,
-            bar,
-        )
-    finally:
+        result = folder.train(live, workers=args.workers, on_checkpoint=progress)
+    except KeyboardInterrupt:
         if bar is not None:
             bar.close()
+        print(
+            f"Stopped: {live.completed} of {live.total} episodes kept in {folder.path}/ "
+            f"(curve{' and policy' if folder.has_policy else ''})."
+        )
+        return 130
+    if bar is not None:
+        progress(live)
+        bar.close()
+    if result is None:
+        raise LearningError(folder.error or f"The run in {folder.path} did not train.")
     wall = time.perf_counter() - start
-
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError as err:
-        raise LearningError(
-            f"Cannot create the run directory {out} ({err.strerror}); choose another --out."
-        ) from None
-    record = {
-        "grid": grid.to_dict(),
-        "config": config.to_dict(),
-        "experiments": experiments,
-        "episodes": episodes,
-        "seed": seed,
-        "demonstrations": demos,
-    }
-    (out / "config.json").write_text(json.dumps(record, indent=1))
-    stats = _percentiles(result.steps)
-    with (out / "curves.csv").open("w", newline="") as stream:
-        writer = csv.writer(stream)
-        writer.writerow(["episode", "mean", "std", "median", "p10", "p90"])
-        for k in range(episodes):
-            writer.writerow(
-                [
-                    k + 1,
-                    *(f"{stats[key][k]:.6g}" for key in ("mean", "std", "median", "p10", "p90")),
-                ]
-            )
-    np.savetxt(
-        out / "steps.csv",
-        result.steps,
-        fmt="%d",
-        delimiter=",",
-        header="steps per episode; one row per experiment",
-    )
-    best = result.best_experiment()
-    save_policy(
-        out / "policy.policy.npz",
-        grid,
-        result.q[best],
-        config,
-        result.mean_steps(),
-        experiments=experiments,
-        notes=f"experiment {best} of {experiments}, seed {seed}, {len(demos)} demonstrations",
-    )
     mean = result.mean_steps()
     print(
-        f"Trained {experiments} x {episodes} episodes ({config.planning} planning) in {wall:.2f} s "
+        f"Trained {settings.experiments} x {settings.episodes} episodes ({settings.config.planning} planning) in {wall:.2f} s "
         f"({result.cpu_seconds.sum():.2f} CPU s): mean steps {mean[0]:.0f} in episode 1, "
-        f"{mean[-1]:.1f} in episode {episodes}."
+        f"{mean[-1]:.1f} in episode {settings.episodes}."
     )
-    print(f"Wrote config.json, curves.csv, steps.csv and policy.policy.npz to {out}/")
+    print(
+        f"Wrote config.json, status.json, steps.csv, curves.csv and policy.policy.npz to {folder.path}/"
+    )
     return 0

@@ -11,10 +11,14 @@ The public names (see ``docs/interfaces.md`` and this package's ``README.md``)::
 
 from __future__ import annotations
 
+from ._arm import DEFAULT_GOAL_DEG as DEFAULT_GOAL_DEG
 from ._arm import MAX_TABLE_ENTRIES as MAX_TABLE_ENTRIES
 from ._arm import ArmGrid as ArmGrid
 from ._arm import GridPath as GridPath
 from ._arm import erase_loops as erase_loops
+from ._config import DEFAULT_EPISODES as DEFAULT_EPISODES
+from ._config import DEFAULT_EXPERIMENTS as DEFAULT_EXPERIMENTS
+from ._config import DEFAULT_SEED as DEFAULT_SEED
 from ._config import MAX_EPISODE_RUNS as MAX_EPISODE_RUNS
 from ._config import MAX_EPISODES as MAX_EPISODES
 from ._config import MAX_EXPERIMENTS as MAX_EXPERIMENTS
@@ -28,6 +32,11 @@ from ._dynaq import warm_up as warm_up
 from ._errors import ConfigError as ConfigError
 from ._errors import LearningError as LearningError
 from ._errors import PolicyFileError as PolicyFileError
+from ._goal import DEFAULT_GOAL_JOINTS_DEG as DEFAULT_GOAL_JOINTS_DEG
+from ._goal import GOAL_JOINTS as GOAL_JOINTS
+from ._goal import check_goal_deg as check_goal_deg
+from ._goal import goal_problems as goal_problems
+from ._goal import grid_for_goal as grid_for_goal
 from ._mdp import TabularMDP as TabularMDP
 from ._policy import PolicyFile as PolicyFile
 from ._policy import greedy_path as greedy_path
@@ -38,6 +47,19 @@ from ._policy import save_trajectory_csv as save_trajectory_csv
 from ._reproduce import ReproduceResult as ReproduceResult
 from ._reproduce import generate_demonstrations as generate_demonstrations
 from ._reproduce import reproduce as reproduce
+from ._runs import CHECKPOINT_SECONDS as CHECKPOINT_SECONDS
+from ._runs import CURVE_COLUMNS as CURVE_COLUMNS
+from ._runs import FIGURE_POINTS as FIGURE_POINTS
+from ._runs import RunFolder as RunFolder
+from ._runs import RunRecord as RunRecord
+from ._runs import curve_figure as curve_figure
+from ._runs import curve_statistics as curve_statistics
+from ._runs import curves_csv as curves_csv
+from ._runs import downsample_curve as downsample_curve
+from ._runs import find_runs as find_runs
+from ._runs import raise_problems as raise_problems
+from ._runs import run_problems as run_problems
+from ._runs import write_curves_csv as write_curves_csv
 from ._summary import POLICY_SUFFIX as POLICY_SUFFIX
 from ._summary import goal_degrees as goal_degrees
 from ._summary import has_default_goal as has_default_goal

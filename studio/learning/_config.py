@@ -33,6 +33,12 @@ MAX_EPISODES = 100_000
 """Upper bound on episodes per experiment."""
 MAX_EPISODE_RUNS = 2_000_000
 """Upper bound on experiments x episodes: about an hour of learning on the arm grid."""
+DEFAULT_EXPERIMENTS = 20
+"""Independent experiments averaged per run (the paper averaged 20)."""
+DEFAULT_EPISODES = 100
+"""Episodes per experiment; the paper's figures span about this many."""
+DEFAULT_SEED = 0
+"""Seed of a run when none is given (every random draw derives from it)."""
 MAX_Q_ENTRIES = 200_000_000
 """Upper bound on experiments x states x actions: the final Q tables (8 bytes each, 1.6 GB)."""
 
@@ -45,7 +51,10 @@ class DynaQConfig:
         alpha: learning rate of the Q-learning update (paper: 0.1).
         gamma: discount factor (paper: 0.95).
         epsilon: probability of a uniformly random action; otherwise greedy, ties broken at random.
-        planning: ``"zero"``, ``"full"``, ``"soft"`` or ``"prioritized"``.
+        planning: ``"zero"``, ``"full"``, ``"soft"`` or ``"prioritized"``. The default is
+            ``"full"``: the paper's Dyna-Q agent makes 100 planning updates per real step (its
+            FPL agents), which is also what ``planning_steps``' default of 100 means; ``"zero"``
+            is plain Q-learning, the paper's baseline rather than its method.
         planning_steps: planning updates per real step (``"full"``, ``"prioritized"``) or in the
             first episode (``"soft"``, falling by one per episode to 0); ignored for ``"zero"``.
         max_steps_per_episode: an episode that has not reached a terminal state after this many
@@ -58,7 +67,7 @@ class DynaQConfig:
     alpha: float = 0.1
     gamma: float = 0.95
     epsilon: float = 0.1
-    planning: str = "zero"
+    planning: str = "full"
     planning_steps: int = 100
     max_steps_per_episode: int = 100_000
     priority_threshold: float = 1e-4

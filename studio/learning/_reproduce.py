@@ -4,7 +4,11 @@ Six configurations, supervised (SV) and unsupervised (US) x zero (ZPL), full (FP
 planning, each run ``experiments`` times for ``episodes`` episodes on the paper's arm grid. The
 outputs in ``out_dir``:
 
-- ``curves.csv``: configuration, episode, mean, std, median, p10 and p90 of steps over experiments;
+- one run folder per configuration (``SV-ZPL/`` ...; :class:`~studio.learning.RunFolder`, group
+  ``out_dir``'s name, origin ``reproduce``), so ``studio reproduce --out runs/paper`` in a data
+  folder puts every configuration in the page's run list; a rerun replaces them;
+- ``curves.csv``: every configuration's curve in the one layout (``CURVE_COLUMNS``), after a
+  leading ``configuration`` column;
 - ``fig5.png``/``.svg``: steps per episode, supervised left, unsupervised right (paper Fig. 5);
 - ``fig8.png``/``.svg``: supervised against unsupervised (paper Fig. 8);
 - ``timing.csv``: CPU seconds per configuration beside the paper's Matlab seconds (paper Fig. 9);
@@ -22,9 +26,9 @@ The result is shortest-ish, slightly wandering paths, like a person's.
 from __future__ import annotations
 
 import csv
-import threading
+import json
+import shutil
 import time
-from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -32,15 +36,11 @@ from typing import Any
 import numpy as np
 
 from ._arm import ArmGrid
-from ._config import DynaQConfig, check_budget
-from ._dynaq import ExperimentResult, LiveProgress, run_experiments, warm_up
+from ._config import DEFAULT_EPISODES, DEFAULT_EXPERIMENTS, DEFAULT_SEED, DynaQConfig, check_budget
+from ._dynaq import ExperimentResult, LiveProgress, warm_up
 from ._errors import LearningError
+from ._runs import CONFIG_FILE, RunFolder, RunRecord, curve_statistics, write_curves_csv
 
-DEFAULT_EXPERIMENTS = 20
-"""The paper averaged 20 independent experiments."""
-DEFAULT_EPISODES = 100
-"""Episodes per experiment; the paper's figures span about this many."""
-DEFAULT_SEED = 0
 DEMONSTRATIONS = 20
 """Demonstrated trajectories replayed by the supervised agents (paper: 20)."""
 DEMO_NOISE = 0.25
@@ -142,39 +142,6 @@ def episodes_to_converge(mean_steps: np.ndarray, level: float, start: int = 0) -
     return int(hits[0]) + start + 1 if hits.size else None
 
 
-def _run_with_progress(
-    run: Callable[[LiveProgress], ExperimentResult], live: LiveProgress, bar: object | None
-) -> ExperimentResult:
-    """Run in a thread and move the progress bar as episodes end."""
-    box: dict[str, object] = {}
-
-    def target() -> None:
-        try:
-            box["result"] = run(live)
-        except BaseException as err:  # re-raised in the caller's thread
-            box["error"] = err
-
-    thread = threading.Thread(target=target, name="reproduce", daemon=True)
-    thread.start()
-    shown = 0
-    try:
-        while thread.is_alive():
-            thread.join(0.05)
-            if bar is not None:
-                done = live.completed
-                bar.update(done - shown)  # type: ignore[attr-defined]
-                shown = done
-    except KeyboardInterrupt:
-        live.stop()
-        thread.join()
-        raise
-    if "error" in box:
-        raise box["error"]  # type: ignore[misc]
-    if bar is not None:
-        bar.update(live.completed - shown)  # type: ignore[attr-defined]
-    return box["result"]  # type: ignore[return-value]
-
-
 def _standard_error(values: np.ndarray, axis: int = 0) -> np.ndarray:
     """Standard error of the mean over ``axis`` (NaN for a single experiment)."""
     n = values.shape[axis]
@@ -188,36 +155,6 @@ def _pm(mean: float, se: float, digits: int = 0) -> str:
     if not np.isfinite(se):
         return f"{mean:.{digits}f}"
     return f"{mean:.{digits}f} ± {se:.{digits}f}"
-
-
-def _percentiles(steps: np.ndarray) -> dict[str, np.ndarray]:
-    values = steps.astype(np.float64)
-    return {
-        "mean": values.mean(axis=0),
-        "std": values.std(axis=0),
-        "median": np.median(values, axis=0),
-        "p10": np.percentile(values, 10, axis=0),
-        "p90": np.percentile(values, 90, axis=0),
-    }
-
-
-def _write_curves(path: Path, results: dict[str, ExperimentResult]) -> None:
-    with path.open("w", newline="") as stream:
-        writer = csv.writer(stream)
-        writer.writerow(["configuration", "episode", "mean", "std", "median", "p10", "p90"])
-        for name, result in results.items():
-            stats = _percentiles(result.steps)
-            for k in range(result.steps.shape[1]):
-                writer.writerow(
-                    [
-                        name,
-                        k + 1,
-                        *(
-                            f"{stats[key][k]:.6g}"
-                            for key in ("mean", "std", "median", "p10", "p90")
-                        ),
-                    ]
-                )
 
 
 def _write_timing(path: Path, results: dict[str, ExperimentResult], wall: dict[str, float]) -> None:
@@ -578,6 +515,16 @@ def _extension_section(
     return "\n".join(lines) + "\n"
 
 
+def _remove_earlier_run(path: Path) -> None:
+    """Delete a configuration's run folder left by an earlier ``studio reproduce`` (only that)."""
+    try:
+        record = json.loads((path / CONFIG_FILE).read_text())
+    except (OSError, ValueError):
+        return
+    if isinstance(record, dict) and record.get("origin") == "reproduce":
+        shutil.rmtree(path, ignore_errors=True)
+
+
 def reproduce(
     out_dir: str | Path,
     experiments: int = DEFAULT_EXPERIMENTS,
@@ -609,7 +556,6 @@ def reproduce(
         raise LearningError(
             f"Cannot create the output directory {out} ({err.strerror}); choose another --out."
         ) from None
-    mdp = grid.mdp()
     demos = generate_demonstrations(grid, DEMONSTRATIONS, np.random.default_rng([seed, 1]))
     n_demos = min(DEMONSTRATIONS, episodes)
     warm_up()  # so the first configuration's CPU time is learning, not loading the kernels
@@ -628,24 +574,34 @@ def reproduce(
         for name, (supervised, planning) in {**CONFIGURATIONS, **EXTENSIONS}.items():
             if bar is not None:
                 bar.set_postfix_str(name)
-            config = DynaQConfig(planning=planning)
-            live = LiveProgress(experiments, episodes)
-            start = time.perf_counter()
-            results[name] = _run_with_progress(
-                lambda live, config=config, supervised=supervised: run_experiments(
-                    mdp,
-                    config,
-                    experiments,
-                    episodes,
-                    seed,
-                    demos[:n_demos] if supervised else None,
-                    workers=workers,
-                    live=live,
-                ),
-                live,
-                bar,
+            record = RunRecord.for_arm_grid(
+                grid,
+                DynaQConfig(planning=planning),
+                experiments,
+                episodes,
+                seed,
+                demos[:n_demos] if supervised else [],
+                name=name,
+                origin="reproduce",
+                group=out.resolve().name,
             )
+            _remove_earlier_run(out / name)
+            folder = RunFolder.create(out, record, name=name, status="running")
+            live = LiveProgress(experiments, episodes)
+            shown = [0]
+
+            def progress(live: LiveProgress, shown: list[int] = shown) -> None:
+                if bar is not None:
+                    bar.update(live.completed - shown[0])  # type: ignore[attr-defined]
+                    shown[0] = live.completed
+
+            start = time.perf_counter()
+            result = folder.train(live, workers=workers, on_checkpoint=progress)
             wall[name] = time.perf_counter() - start
+            progress(live)
+            if result is None:
+                raise LearningError(folder.error or f"The {name} run in {folder.path} failed.")
+            results[name] = result
     finally:
         if bar is not None:
             bar.close()
@@ -653,7 +609,10 @@ def reproduce(
     claims = judge_claims(results, grid, n_demos)
     table = _table(results, wall)
     files = [out / "curves.csv", out / "timing.csv", out / "REPORT.md"]
-    _write_curves(files[0], results)
+    with files[0].open("w", newline="") as stream:
+        write_curves_csv(
+            stream, [(name, curve_statistics(result.steps)) for name, result in results.items()]
+        )
     _write_timing(files[1], results, wall)
     files += _plot(out, results, n_demos)
     _write_report(files[2], claims, table, grid, experiments, episodes, seed)

@@ -85,6 +85,10 @@ def create_app(settings: Settings | None = None, scene: Any = None) -> FastAPI:
         reason = getattr(err, "reason", None)
         if isinstance(reason, str):
             body["reason"] = reason  # e.g. a refused demonstration: "never_reaches_goal"
+        problems = getattr(err, "problems", None)
+        if isinstance(problems, list) and problems:  # every bad field of a form, by field
+            body["problems"] = problems
+            body["by_field"] = getattr(err, "by_field", {})
         return JSONResponse(body, status_code=status)
 
     @app.exception_handler(RequestValidationError)

@@ -1,336 +1,274 @@
-"""Training runs: validated, queued, executed one at a time in a worker thread, kept on disk.
+"""The page's run queue: runs wait in line and train one at a time in a worker thread.
 
-Each run lives in ``<data_dir>/runs/<id>/``:
+Every run is a :class:`studio.learning.RunFolder` under ``<data_dir>/runs/``; the queue only adds
+the waiting line, the live progress of the run training now, and the list the page shows. The
+list holds every run folder there, whatever made it (the page, ``studio train --out runs/x``,
+``studio reproduce --out runs/paper``, a sweep): folders appear as they are written, also while
+the studio runs. A run inside a group folder (``runs/paper/SV-ZPL``) has the id ``paper~SV-ZPL``.
 
-- ``config.json``: the ``RunCreate`` body, the grid and Dyna-Q settings it resolved to, and the
-  demonstrations' grid paths (so a run can be repeated without the demonstration files);
-- ``status.json``: status, times, CPU seconds, error;
-- ``steps.csv``: steps per episode, one row per experiment, -1 where not done (written every few
-  seconds while training, so a crash keeps the partial curve);
-- ``curves.csv``: mean, std, min and max steps per episode over the experiments that finished it;
-- ``policy.policy.npz``: the best experiment's Q table (also for a stopped run that finished
-  episodes).
-
-The worker calls :func:`studio.learning.run_experiments` with a
-:class:`~studio.learning.LiveProgress`; the numba kernels release the GIL, so the API keeps
-answering and the SSE stream polls the live arrays for curves. A run that was queued or running
-when the process died is listed as ``stopped`` after a restart, with its partial curve.
+The worker trains through :meth:`RunFolder.train`, which checkpoints the curve and saves the
+policy and status; the kernels release the GIL, so the API keeps answering and the event stream
+polls the live arrays.
 """
 
 from __future__ import annotations
 
 import contextlib
-import csv
-import io
-import json
 import logging
-import os
-import secrets
+import re
 import shutil
 import threading
 import time
 from collections import deque
 from collections.abc import Callable
-from datetime import UTC, datetime
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
-from .._errors import StudioError
+from studio.learning import (
+    DEFAULT_GOAL_JOINTS_DEG,
+    ArmGrid,
+    ConfigError,
+    DynaQConfig,
+    LearningError,
+    LiveProgress,
+    RunFolder,
+    RunRecord,
+    find_runs,
+    goal_problems,
+    grid_for_goal,
+    raise_problems,
+    run_problems,
+)
+from studio.learning import curve_statistics as curve_of  # the events stream's name for it
+
 from ._errors import ConflictError, InvalidError, NotFoundError
-from ._schemas import RunCreate
-from ._store import NAME_PATTERN, atomic_write_text, now_iso
+from ._schemas import RunCreate, RunPublic
+from ._store import now_iso
+
+__all__ = ["Run", "RunQueue", "curve_of", "prepare_run"]
 
 log = logging.getLogger(__name__)
 
-CHECKPOINT_SECONDS = 2.0
-"""How often a running run's partial curve is written to disk."""
 CURVE_CACHE_SECONDS = 0.05
 """A live curve is recomputed at most this often, however many clients ask."""
-ROBOT_GOAL_JOINTS = 3
-"""The arm grid covers joints 1-3 of the Puma560 (the paper's task)."""
-POLICY_FILE = "policy.policy.npz"
-STEPS_FILE = "steps.csv"
-CURVES_FILE = "curves.csv"
-CONFIG_FILE = "config.json"
-STATUS_FILE = "status.json"
+GROUP_SEPARATOR = "~"
+"""Joins a group folder's name and a run folder's name into a run id (``paper~SV-ZPL``)."""
+RUN_ID = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.-]{0,99}(~[A-Za-z0-9_][A-Za-z0-9_.-]{0,99})?$")
+"""A run id: a folder name, or a group folder's and a run folder's names joined by ``~``."""
+TRAINING_THREADS = ("studio-train-", "dynaq")
+"""Name prefixes of the threads a training run uses (RunFolder.train's and the kernels' pool)."""
 
 
-def curve_of(steps: np.ndarray, start: int = 0) -> dict[str, list]:
-    """Learning-curve statistics from an ``(experiments, episodes)`` array with -1 for not done.
-
-    Episodes are listed from index ``start`` up to the last episode that at least one experiment
-    finished; each statistic is over the experiments that finished that episode.
-    """
-    count = (steps >= 0).sum(axis=0)
-    nonzero = np.flatnonzero(count)
-    last = int(nonzero[-1]) + 1 if nonzero.size else 0
-    start = max(0, min(start, last))
-    sl = slice(start, last)
-    done = steps[:, sl] >= 0
-    d, s, c = done, steps[:, sl].astype(np.float64), count[sl]
-    with np.errstate(invalid="ignore", divide="ignore"):
-        mean = np.where(d, s, 0.0).sum(axis=0) / np.maximum(c, 1)
-        var = np.where(d, (s - mean) ** 2, 0.0).sum(axis=0) / np.maximum(c, 1)
-    low = np.where(d, s, np.inf).min(axis=0) if d.size else np.zeros(0)
-    high = np.where(d, s, -np.inf).max(axis=0) if d.size else np.zeros(0)
-    return {
-        "episodes": list(range(start + 1, last + 1)),
-        "mean": np.round(mean, 3).tolist(),
-        "std": np.round(np.sqrt(var), 3).tolist(),
-        "min": low.astype(np.float64).tolist(),
-        "max": high.astype(np.float64).tolist(),
-        "count": c.astype(np.int64).tolist(),
-    }
-
-
-def _utc_now() -> str:
-    return now_iso()
+def _training_cpu_seconds() -> float:
+    """CPU seconds of the threads training right now (the queue trains one run at a time)."""
+    total = 0.0
+    for thread in threading.enumerate():
+        if thread.ident is None or not thread.name.startswith(TRAINING_THREADS):
+            continue
+        with contextlib.suppress(OSError, AttributeError, OverflowError):
+            total += time.clock_gettime(time.pthread_getcpuclockid(thread.ident))
+    return total
 
 
 class Run:
-    """One training run: its settings, its state, and its live or saved progress."""
+    """A run in the list: its folder, and its live progress while this studio trains it."""
 
-    def __init__(self, folder: Path, create: RunCreate, record: dict[str, Any]) -> None:
+    def __init__(self, run_id: str, folder: RunFolder, live: LiveProgress | None = None) -> None:
+        self.id = run_id
         self.folder = folder
-        self.id = folder.name
-        self.create = create
-        self.record = record  # config.json: the resolved grid, Dyna-Q settings, demo paths
-        self.status = "queued"
-        self.created = record.get("created", _utc_now())
-        self.started: str | None = None
-        self.finished: str | None = None
-        self.error: str | None = None
-        self.cpu_seconds = 0.0
-        self.live: Any = None  # LiveProgress while running
-        self._cpu_start = 0.0
-        self._steps: np.ndarray | None = None  # saved or final steps
-        self._lock = threading.Lock()
+        self.live = live  # set from submission on, so a Stop is never lost
         self._curve_cache: tuple[float, np.ndarray] | None = None
+        self._mtime = _status_mtime(folder.path)
 
-    # ------------------------------------------------------------------ views
+    @property
+    def status(self) -> str:
+        """``queued``, ``running``, ``done``, ``stopped`` or ``failed``."""
+        return self.folder.status
 
     @property
     def name(self) -> str:
-        """The run's label: the user's name, else planner and size."""
-        if self.create.name:
-            return self.create.name
-        demos = len(self.create.demonstrations)
-        extra = f", {demos} demos" if demos else ""
-        return f"{self.create.planning} x{self.create.experiments}{extra}"
+        """The run's label: its name, else planner and size."""
+        return self.folder.record.label()
 
     @property
     def has_policy(self) -> bool:
         """Whether the run saved a policy file."""
-        return (self.folder / POLICY_FILE).is_file()
+        return self.folder.has_policy
 
     @property
     def policy_path(self) -> Path:
         """Where the run's policy is (or will be) saved."""
-        return self.folder / POLICY_FILE
+        return self.folder.policy_path
+
+    @property
+    def demonstrations(self) -> list[str]:
+        """Names of the demonstrations the page asked for (none for other origins)."""
+        request = self.folder.record.request or {}
+        return list(request.get("demonstrations") or [])
 
     def steps(self) -> np.ndarray:
-        """Steps per episode ``(experiments, episodes)``, -1 where not done (live while running)."""
+        """Steps per episode ``(experiments, episodes)``, -1 where not done (live while training)."""
         live = self.live
-        if live is not None:
+        if live is not None and self.status == "running":
             now = time.monotonic()
             cache = self._curve_cache
             if cache is None or now - cache[0] > CURVE_CACHE_SECONDS:
                 cache = (now, live.steps.copy())
                 self._curve_cache = cache
             return cache[1]
-        if self._steps is not None:
-            return self._steps
-        return np.full((self.create.experiments, self.create.episodes), -1, np.int64)
-
-    def episodes_done(self) -> int:
-        """Episodes finished over all experiments."""
-        return int(np.count_nonzero(self.steps() >= 0))
+        return self.folder.steps()
 
     def curve(self, start: int = 0) -> dict[str, list]:
-        """The learning curve (see :func:`curve_of`)."""
+        """The learning curve (:func:`studio.learning.curve_statistics`)."""
         return curve_of(self.steps(), start)
 
-    def public(self, steps: np.ndarray | None = None) -> dict[str, Any]:
-        """The ``RunPublic`` fields (``episodes_done`` from ``steps`` when given)."""
+    def public(self, steps: np.ndarray | None = None) -> dict[str, object]:
+        """:meth:`model` as JSON-ready values (the event stream sends it inside its events)."""
+        return self.model(steps).model_dump()
+
+    def model(self, steps: np.ndarray | None = None) -> RunPublic:
+        """The run as the API shows it (``episodes_done`` from ``steps`` when given)."""
         steps = self.steps() if steps is None else steps
-        cpu = self.cpu_seconds
-        if self.status == "running":
-            cpu = time.process_time() - self._cpu_start
-        return {
-            "id": self.id,
-            "name": self.name,
-            "status": self.status,
-            "config": self.create.model_dump(),
-            "created": self.created,
-            "started": self.started,
-            "finished": self.finished,
-            "episodes_done": int(np.count_nonzero(steps >= 0)),
-            "episodes_total": self.create.experiments * self.create.episodes,
-            "cpu_seconds": round(float(cpu), 3),
-            "error": self.error,
-            "has_policy": self.has_policy,
-        }
-
-    # ------------------------------------------------------------------ disk
-
-    def save_status(self) -> None:
-        """Write ``status.json`` atomically."""
-        atomic_write_text(
-            self.folder / STATUS_FILE,
-            json.dumps(
-                {
-                    "status": self.status,
-                    "created": self.created,
-                    "started": self.started,
-                    "finished": self.finished,
-                    "cpu_seconds": self.cpu_seconds,
-                    "error": self.error,
-                },
-                indent=1,
-            ),
+        folder, record = self.folder, self.folder.record
+        cpu = folder.cpu_seconds
+        if self.status == "running" and self.live is not None:
+            cpu = _training_cpu_seconds()
+        return RunPublic(
+            id=self.id,
+            name=self.name,
+            status=folder.status,  # type: ignore[arg-type]
+            config=run_create_of(record),
+            created=folder.created,
+            started=folder.started,
+            finished=folder.finished,
+            episodes_done=int(np.count_nonzero(steps >= 0)),
+            episodes_total=record.experiments * record.episodes,
+            cpu_seconds=round(float(cpu), 3),
+            error=folder.error,
+            has_policy=folder.has_policy,
+            origin=record.origin,
+            group=record.group,
         )
 
-    def save_steps(self, steps: np.ndarray) -> None:
-        """Write ``steps.csv`` and ``curves.csv`` atomically."""
-        buffer = io.StringIO()
-        np.savetxt(
-            buffer,
-            steps,
-            fmt="%d",
-            delimiter=",",
-            header="steps per episode; one row per experiment; -1 = not done",
-        )
-        atomic_write_text(self.folder / STEPS_FILE, buffer.getvalue())
-        atomic_write_text(self.folder / CURVES_FILE, curve_csv(curve_of(steps)))
 
-    @classmethod
-    def load(cls, folder: Path) -> Run:
-        """Read a run folder back; a run caught queued or running by a crash becomes ``stopped``."""
-        record = json.loads((folder / CONFIG_FILE).read_text())
-        run = cls(folder, RunCreate.model_validate(record["request"]), record)
-        try:
-            status = json.loads((folder / STATUS_FILE).read_text())
-        except (OSError, ValueError):
-            status = {"status": "stopped"}
-        run.status = status.get("status", "stopped")
-        run.created = status.get("created", run.created)
-        run.started = status.get("started")
-        run.finished = status.get("finished")
-        run.cpu_seconds = float(status.get("cpu_seconds") or 0.0)
-        run.error = status.get("error")
-        steps_path = folder / STEPS_FILE
-        if steps_path.is_file():
-            try:
-                steps = np.loadtxt(steps_path, delimiter=",", dtype=np.int64, ndmin=2)
-                if steps.shape == (run.create.experiments, run.create.episodes):
-                    run._steps = steps
-            except ValueError:
-                log.warning("run %s: unreadable %s, curve dropped", run.id, steps_path)
-        if run.status in ("queued", "running"):
-            was = run.status
-            run.status = "stopped"
-            run.finished = run.finished or _utc_now()
-            run.error = (
-                "The studio stopped while this run was training; its curve so far is kept, start it again to finish."
-                if was == "running"
-                else "The studio stopped before this run started; start it again."
-            )
-            run.save_status()
-        return run
+def _status_mtime(path: Path) -> float:
+    try:
+        return max((path / name).stat().st_mtime for name in ("status.json", "steps.csv"))
+    except (OSError, ValueError):
+        with contextlib.suppress(OSError):
+            return (path / "status.json").stat().st_mtime
+        return 0.0
 
 
-def curve_csv(curve: dict[str, list]) -> str:
-    """A curve as CSV text: ``episode,mean,std,min,max,experiments``."""
-    out = io.StringIO()
-    writer = csv.writer(out, lineterminator="\n")
-    writer.writerow(["episode", "mean", "std", "min", "max", "experiments"])
-    for row in zip(
-        curve["episodes"], curve["mean"], curve["std"], curve["min"], curve["max"], curve["count"],
-        strict=True,
-    ):  # fmt: skip
-        writer.writerow(row)
-    return out.getvalue()
+def run_create_of(record: RunRecord) -> RunCreate:
+    """The page's form values of a run, whatever made it (the page keeps what the user typed)."""
+    if record.request is not None:
+        with contextlib.suppress(ValueError):
+            return RunCreate.model_validate(record.request)
+    config = record.config
+    grid_spec = record.task
+    goal_deg: list[float] = []
+    with contextlib.suppress(LearningError, TypeError, ValueError):
+        grid = record.arm_grid()
+        goal_deg = [round(float(a), 6) for a in np.degrees(grid.angles_of(grid.goal_state))]
+    defaults = DynaQConfig()
+    return RunCreate(
+        name=record.name or None,
+        planning=config.get("planning", defaults.planning),
+        planning_steps=config.get("planning_steps", defaults.planning_steps),
+        epsilon=config.get("epsilon", defaults.epsilon),
+        alpha=config.get("alpha", defaults.alpha),
+        gamma=config.get("gamma", defaults.gamma),
+        episodes=record.episodes,
+        experiments=record.experiments,
+        bins=int(grid_spec.get("bins", ArmGrid.bins)),
+        goal_deg=goal_deg or list(DEFAULT_GOAL_JOINTS_DEG),
+        demonstrations=[],
+        seed=record.seed,
+    )
 
 
-def prepare_run(
-    create: RunCreate, demonstration_path: Callable[[str], np.ndarray]
-) -> tuple[Any, Any, list[list[int]]]:
-    """Check a ``RunCreate`` against the learning package's rules before anything is queued.
+def prepare_run(create: RunCreate, demonstration_path: Callable[[str], np.ndarray]) -> RunRecord:
+    """Check a ``RunCreate`` with the learning package's rules, reporting every bad field at once.
 
     Args:
         create: the request.
         demonstration_path: the Puma560 joint path (N, 6), radians, of a demonstration by name.
 
     Returns:
-        ``(grid, config, demonstration grid paths)``.
+        The run's record (grid, Dyna-Q settings, demonstrations' grid paths).
 
     Raises:
-        StudioError: one sentence naming the bad field and its allowed values (answered as 422).
+        ConfigError: one sentence per bad field, keyed by field (answered as 422).
     """
-    from studio.kinematics import Puma560
-    from studio.learning import ArmGrid, DynaQConfig, check_budget
-
-    config = DynaQConfig(
-        alpha=create.alpha,
-        gamma=create.gamma,
-        epsilon=create.epsilon,
-        planning=create.planning,
-        planning_steps=create.planning_steps,
+    problems: list[tuple[str, str]] = []
+    config = None
+    try:
+        config = DynaQConfig(
+            alpha=create.alpha,
+            gamma=create.gamma,
+            epsilon=create.epsilon,
+            planning=create.planning,
+            planning_steps=create.planning_steps,
+        )
+    except ConfigError as err:
+        problems += list(err.by_field.items())
+    grid = None
+    goal = goal_problems(create.goal_deg)
+    if goal:
+        problems += [("goal_deg", text) for text in goal]
+    try:
+        grid = (
+            grid_for_goal(create.goal_deg, create.bins) if not goal else ArmGrid(bins=create.bins)
+        )
+    except ConfigError as err:
+        problems += list(err.by_field.items())
+    except LearningError as err:
+        problems.append(("bins", str(err)))
+    problems += run_problems(
+        create.experiments, create.episodes, create.seed, create.name or "", grid
     )
-    grid0 = ArmGrid(bins=create.bins)  # validates bins alone first: its message is the clearest
-    goal = np.asarray(create.goal_deg, dtype=np.float64)
-    if goal.shape != (ROBOT_GOAL_JOINTS,) or not np.all(np.isfinite(goal)):
-        raise InvalidError(
-            f"goal_deg is {create.goal_deg!r}; give {ROBOT_GOAL_JOINTS} finite angles in degrees, one per joint 1-3."
-        )
-    robot = Puma560()
-    lower = np.degrees(robot.lower[:ROBOT_GOAL_JOINTS])
-    upper = np.degrees(robot.upper[:ROBOT_GOAL_JOINTS])
-    for j in range(ROBOT_GOAL_JOINTS):
-        if not lower[j] <= goal[j] <= upper[j]:
-            raise InvalidError(
-                f"goal_deg joint {j + 1} is {goal[j]:g} degrees, which the Puma560 cannot reach; give an angle from {lower[j]:g} to {upper[j]:g}."
-            )
-    bins = tuple(int(b) for b in grid0.bins_of_angles(np.radians(goal)))
-    grid = ArmGrid(bins=create.bins, goal=bins)
-    centre = np.degrees(grid.angles_of(grid.goal_state))
-    for j in range(ROBOT_GOAL_JOINTS):
-        if not lower[j] <= centre[j] <= upper[j]:
-            raise InvalidError(
-                f"goal_deg joint {j + 1} falls in the bin centred at {centre[j]:.1f} degrees, beyond the Puma560's limit of {upper[j] if centre[j] > 0 else lower[j]:g}; choose a goal nearer the middle of the range or another number of bins."
-            )
-    check_budget(create.experiments, create.episodes, grid.n_states, grid.n_actions)
-    if not isinstance(create.seed, int) or not 0 <= create.seed < 2**63:
-        raise InvalidError(f"seed is {create.seed!r}; give a whole number from 0 to 2**63 - 1.")
-    if create.name is not None and (not create.name.strip() or len(create.name) > 100):
-        raise InvalidError("name must be 1 to 100 characters; give a shorter label or none.")
     paths: list[list[int]] = []
-    goal_state = grid.goal_state
-    for name in create.demonstrations:
-        q_path = np.asarray(demonstration_path(name), dtype=np.float64)
-        path = grid.path_from_joints(q_path, stop_at_goal=True)
-        if path[-1] != goal_state:
-            end = np.degrees(q_path[-1, :ROBOT_GOAL_JOINTS])
-            raise InvalidError(
-                f"Demonstration {name!r} ends at joints ({end[0]:.0f}, {end[1]:.0f}, {end[2]:.0f}) degrees, not in the goal bin; choose demonstrations that reach this run's goal or set the goal where they end."
-            )
-        paths.append(path)
-    if len(paths) > create.episodes:
-        raise InvalidError(
-            f"The run replays {len(paths)} demonstrations but has only {create.episodes} episodes; give at least as many episodes as demonstrations."
-        )
-    return grid, config, paths
+    if grid is not None and not goal:
+        for name in create.demonstrations:
+            q_path = np.asarray(demonstration_path(name), dtype=np.float64)
+            path = grid.path_from_joints(q_path, stop_at_goal=True)
+            if path[-1] != grid.goal_state:
+                end = np.degrees(q_path[-1, :3])
+                problems.append(
+                    (
+                        "demonstrations",
+                        f"Demonstration {name!r} ends at joints ({end[0]:.0f}, {end[1]:.0f}, {end[2]:.0f}) degrees, not in the goal bin; choose demonstrations that reach this run's goal or set the goal where they end.",
+                    )
+                )
+            paths.append(list(path))
+    raise_problems(problems)
+    assert grid is not None and config is not None
+    return RunRecord.for_arm_grid(
+        grid,
+        config,
+        create.experiments,
+        create.episodes,
+        create.seed,
+        paths,
+        name=create.name or "",
+        origin="page",
+        request=create.model_dump(),
+    )
 
 
 class RunQueue:
-    """The runs on disk and the worker thread that trains them one at a time.
+    """The runs under ``<data_dir>/runs`` and the worker thread that trains the page's, in turn.
 
     Args:
         folder: ``<data_dir>/runs``.
         on_change: called with ``"runs"`` or ``"policies"`` whenever a list changes.
         workers: threads per run (``None``: one per CPU core).
+
+    Attributes:
+        before_train: called in the worker with a run just marked running, before it trains
+            (tests act in that window, e.g. to stop it; a Stop there is never lost).
     """
 
     def __init__(
@@ -342,25 +280,53 @@ class RunQueue:
         self.folder = folder
         self.on_change = on_change
         self.workers = workers
+        self.before_train: Callable[[Run], None] | None = None
         self._runs: dict[str, Run] = {}
         self._queue: deque[str] = deque()
         self._cond = threading.Condition()
         self._closing = False
         self._thread: threading.Thread | None = None
-        self._load()
+        self._scan()
 
-    def _load(self) -> None:
-        if not self.folder.is_dir():
-            return
-        for folder in sorted(self.folder.iterdir()):
-            if not folder.is_dir() or not (folder / CONFIG_FILE).is_file():
-                continue
-            try:
-                run = Run.load(folder)
-            except (OSError, ValueError, KeyError, StudioError) as err:
-                log.warning("skipping unreadable run folder %s: %s", folder, err)
-                continue
-            self._runs[run.id] = run
+    def _id_of(self, path: Path) -> str:
+        rel = path.relative_to(self.folder)
+        return GROUP_SEPARATOR.join(rel.parts)
+
+    def _scan(self) -> bool:
+        """Add run folders written since the last scan (by the CLI, say) and refresh runs that
+        another process trains; forget folders deleted by hand. Whether anything changed."""
+        changed = False
+        found = {self._id_of(p): p for p in find_runs(self.folder)}
+        found = {k: p for k, p in found.items() if RUN_ID.match(k)}
+        with self._cond:
+            known = dict(self._runs)
+        for run_id, path in found.items():
+            run = known.get(run_id)
+            if run is None:
+                try:
+                    run = Run(run_id, RunFolder.load(path))
+                except (OSError, LearningError) as err:
+                    log.warning("skipping unreadable run folder %s: %s", path, err)
+                    continue
+                if run.folder.interrupted:  # say so on disk too, once
+                    with contextlib.suppress(LearningError):
+                        run.folder.save_status()
+                with self._cond:
+                    self._runs.setdefault(run_id, run)
+                changed = True
+            elif run.live is None and run.status in ("running", "queued"):
+                mtime = _status_mtime(path)
+                if mtime != run._mtime:  # another process wrote its progress
+                    run._mtime = mtime
+                    with contextlib.suppress(OSError, LearningError):
+                        run.folder.reload()
+                    changed = True
+        with self._cond:
+            for run_id, run in list(self._runs.items()):
+                if run_id not in found and run.live is None and not run.folder.path.exists():
+                    del self._runs[run_id]
+                    changed = True
+        return changed
 
     # ------------------------------------------------------------------ lifecycle
 
@@ -371,7 +337,7 @@ class RunQueue:
             self._thread.start()
 
     def close(self, timeout: float = 10.0) -> None:
-        """Stop the running run (its partial curve is saved) and the worker thread."""
+        """Stop the running run (its partial curve and policy are saved) and the worker thread."""
         with self._cond:
             self._closing = True
             for run in self._runs.values():
@@ -385,109 +351,105 @@ class RunQueue:
     # ------------------------------------------------------------------ API
 
     def list(self) -> list[Run]:
-        """Every run, newest first."""
+        """Every run, newest first (run folders written by other tools included)."""
+        if self._scan():
+            self.on_change("runs")
         with self._cond:
             runs = list(self._runs.values())
-        return sorted(runs, key=lambda r: (r.created, r.id), reverse=True)
+        return sorted(runs, key=lambda r: (r.folder.created, r.id), reverse=True)
 
     def get(self, run_id: str) -> Run:
         """The run with that id (404 otherwise)."""
-        if not isinstance(run_id, str) or not NAME_PATTERN.match(run_id) or ".." in run_id:
+        if not isinstance(run_id, str) or not RUN_ID.match(run_id) or ".." in run_id:
             raise InvalidError(f"The run id {run_id!r} is not valid; use an id from the runs list.")
         with self._cond:
             run = self._runs.get(run_id)
+        if run is None and self._scan():
+            with self._cond:
+                run = self._runs.get(run_id)
         if run is None:
             raise NotFoundError(f"There is no run {run_id!r}; pick one from the runs list.")
         return run
 
     def running(self) -> list[Run]:
-        """Runs training now (at most one)."""
+        """Runs this studio is training now (at most one)."""
         with self._cond:
-            return [r for r in self._runs.values() if r.status == "running"]
+            return [r for r in self._runs.values() if r.status == "running" and r.live is not None]
 
     def uses_demonstration(self, name: str) -> Run | None:
         """A queued or running run that replays demonstration ``name``, if any."""
         with self._cond:
             for run in self._runs.values():
-                if run.status in ("queued", "running") and name in run.create.demonstrations:
+                if run.status in ("queued", "running") and name in run.demonstrations:
                     return run
         return None
 
     def submit(self, create: RunCreate, demonstration_path: Callable[[str], np.ndarray]) -> Run:
-        """Validate a run, write its folder and queue it."""
-        grid, config, paths = prepare_run(create, demonstration_path)
-        created = _utc_now()
-        stamp = datetime.now(UTC).strftime("%Y%m%d-%H%M%S")
-        self.folder.mkdir(parents=True, exist_ok=True)
-        while True:
-            run_id = f"{stamp}-{create.planning}-{secrets.token_hex(2)}"
-            folder = self.folder / run_id
-            try:
-                folder.mkdir()
-                break
-            except FileExistsError:
-                continue
-        record = {
-            "id": run_id,
-            "created": created,
-            "request": create.model_dump(),
-            "grid": grid.to_dict(),
-            "config": config.to_dict(),
-            "experiments": create.experiments,
-            "episodes": create.episodes,
-            "seed": create.seed,
-            "demonstrations": paths,
-        }
-        atomic_write_text(folder / CONFIG_FILE, json.dumps(record, indent=1))
-        run = Run(folder, create, record)
-        run.created = created
-        run.save_status()
+        """Validate a run, write its folder (atomically) and queue it."""
+        record = prepare_run(create, demonstration_path)
+        folder = RunFolder.create(self.folder, record)
+        run = Run(folder.id, folder, LiveProgress(record.experiments, record.episodes))
         with self._cond:
-            self._runs[run_id] = run
-            self._queue.append(run_id)
+            self._runs[run.id] = run
+            self._queue.append(run.id)
             self._cond.notify_all()
         self.on_change("runs")
         return run
 
     def stop(self, run_id: str) -> Run:
-        """Stop a queued run (it never starts) or a running one (at its next episode boundary)."""
+        """Stop a queued run (it never starts) or a running one (at its next episode boundary).
+
+        Raises:
+            ConflictError: the run is not this studio's to stop (another process trains it).
+        """
         run = self.get(run_id)
         changed = False
         with self._cond:
+            if run.live is None and run.status in ("queued", "running"):
+                raise ConflictError(
+                    f"Run {run_id} is trained by another process; stop it there (Ctrl-C)."
+                )
+            if run.live is not None:
+                run.live.stop()  # obeyed even if the worker is about to start it
             if run.status == "queued":
                 with contextlib.suppress(ValueError):
                     self._queue.remove(run_id)
-                run.status = "stopped"
-                run.finished = _utc_now()
-                run.error = "Stopped before it started."
-                run.save_status()
+                folder = run.folder
+                folder.status, folder.finished = "stopped", now_iso()
+                folder.error = "Stopped before it started."
+                folder.save_status()
+                run.live = None
                 changed = True
-            elif run.status == "running" and run.live is not None:
-                run.live.stop()
         if changed:
             self.on_change("runs")
         return run
 
     def delete(self, run_id: str) -> None:
-        """Delete a run and its folder (409 while it is running)."""
+        """Delete a run and its folder (409 while it is training)."""
         run = self.get(run_id)
         with self._cond:
+            if run.status in ("running", "queued") and run.live is None:
+                raise ConflictError(
+                    f"Run {run_id} is being trained by another process; stop it there first."
+                )
             if run.status == "running":
                 raise ConflictError(f"Run {run_id} is training; stop it first, then delete it.")
             with contextlib.suppress(ValueError):
                 self._queue.remove(run_id)
             del self._runs[run_id]
         had_policy = run.has_policy
-        shutil.rmtree(run.folder, ignore_errors=True)
+        shutil.rmtree(run.folder.path, ignore_errors=True)
         self.on_change("runs")
         if had_policy:
             self.on_change("policies")
 
     def wait_idle(self, timeout: float) -> bool:
-        """Block until nothing is queued or running (for scripts and tests)."""
+        """Block until nothing is queued or running here (for scripts and tests)."""
         deadline = time.monotonic() + timeout
         with self._cond:
-            while self._queue or any(r.status == "running" for r in self._runs.values()):
+            while self._queue or any(
+                r.status == "running" and r.live is not None for r in self._runs.values()
+            ):
                 left = deadline - time.monotonic()
                 if left <= 0:
                     return False
@@ -504,100 +466,25 @@ class RunQueue:
                 if self._closing:
                     return
                 run = self._runs[self._queue.popleft()]
-                run.status = "running"
+                run.folder.status = "running"
             try:
-                self._train(run)
+                if self.before_train is not None:
+                    self.before_train(run)
+                self.on_change("runs")
+                run.folder.train(run.live, workers=self.workers)
+                if self._closing and run.status == "stopped":
+                    run.folder.error = "The studio was shut down during this run; its curve so far is kept, start it again to finish."
+                    run.folder.save_status()
             except Exception as err:  # a bug must not kill the queue: the run shows it
                 log.exception("run %s failed", run.id)
-                run.status = "failed"
-                run.error = f"The run failed unexpectedly ({type(err).__name__}: {err}); see the server log."
-                run.finished = _utc_now()
-                run.live = None
-                run.save_status()
+                run.folder.status = "failed"
+                run.folder.error = f"The run failed unexpectedly ({type(err).__name__}: {err}); see the server log."
+                run.folder.finished = now_iso()
+                with contextlib.suppress(LearningError):
+                    run.folder.save_status()
             with self._cond:
+                run.live = None
                 self._cond.notify_all()
             self.on_change("runs")
             if run.has_policy:
                 self.on_change("policies")
-
-    def _train(self, run: Run) -> None:
-        from studio.learning import (
-            ArmGrid,
-            DynaQConfig,
-            LiveProgress,
-            run_experiments,
-            save_policy,
-        )
-
-        record = run.record
-        grid = ArmGrid(**{**record["grid"], "goal": tuple(record["grid"]["goal"])})
-        config = DynaQConfig.from_dict(record["config"])
-        experiments, episodes = run.create.experiments, run.create.episodes
-        live = LiveProgress(experiments, episodes)
-        run._cpu_start = time.process_time()
-        run.started = _utc_now()
-        run.live = live
-        run.save_status()
-        self.on_change("runs")
-        outcome: dict[str, Any] = {}
-
-        def train() -> None:
-            try:
-                outcome["result"] = run_experiments(
-                    grid.mdp(),
-                    config,
-                    experiments,
-                    episodes,
-                    run.create.seed,
-                    record["demonstrations"],
-                    workers=self.workers,
-                    live=live,
-                )
-            except BaseException as err:  # handed to the worker below
-                outcome["error"] = err
-
-        thread = threading.Thread(target=train, name=f"studio-run-{run.id}", daemon=True)
-        thread.start()
-        saved = 0
-        while thread.is_alive():
-            thread.join(CHECKPOINT_SECONDS)
-            done = live.completed
-            if thread.is_alive() and done != saved:  # only when the curve moved
-                run.save_steps(live.steps.copy())
-                saved = done
-        result = outcome.get("result")
-        steps = live.steps.copy()
-        run._steps = steps
-        run.save_steps(steps)
-        run.finished = _utc_now()
-        if result is None:
-            err = outcome.get("error")
-            run.status = "failed"
-            run.error = (
-                str(err)
-                if isinstance(err, StudioError)
-                else f"The run failed unexpectedly ({type(err).__name__}: {err}); see the server log."
-            )
-            if not isinstance(err, StudioError):
-                log.error("run %s failed", run.id, exc_info=err)
-            run.cpu_seconds = time.process_time() - run._cpu_start
-        else:
-            run.cpu_seconds = float(result.cpu_seconds.sum())
-            if result.completed.any():
-                best = result.best_experiment()
-                tmp = run.folder / f".{POLICY_FILE}.tmp.npz"
-                save_policy(
-                    tmp,
-                    grid,
-                    result.q[best],
-                    config,
-                    result.mean_steps(),
-                    experiments=experiments,
-                    notes=f"run {run.id}: experiment {best} of {experiments}, seed {run.create.seed}, {len(record['demonstrations'])} demonstrations",
-                )
-                os.replace(tmp, run.policy_path)
-            run.status = "stopped" if result.stopped else "done"
-            if result.stopped and self._closing:
-                run.error = "The studio was shut down during this run; its curve so far is kept, start it again to finish."
-        run.live = None
-        run.save_status()

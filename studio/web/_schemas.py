@@ -12,12 +12,23 @@ from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
+from studio.learning import (
+    DEFAULT_EPISODES,
+    DEFAULT_EXPERIMENTS,
+    DEFAULT_GOAL_JOINTS_DEG,
+    DEFAULT_SEED,
+    ArmGrid,
+    DynaQConfig,
+)
+
 PlanningName = Literal["zero", "full", "soft", "prioritized"]
 RunStatus = Literal["queued", "running", "done", "stopped", "failed"]
 SourceKind = Literal["simulator", "recording", "network", "serial"]
 
-DEFAULT_GOAL_DEG = (0.0, 45.0, -90.0)
+DEFAULT_GOAL_DEG = DEFAULT_GOAL_JOINTS_DEG
 """The learning package's default goal for joints 1-3 (an arm reaching forward and down)."""
+_DYNAQ = DynaQConfig()
+"""The learning package's training defaults: ``RunCreate`` takes each of its defaults from here."""
 
 
 class _Body(BaseModel):
@@ -36,6 +47,10 @@ class ConfigPublic(BaseModel):
     version: str
     upload_limit_bytes: int
     data_dir: str
+    training: RunCreate | None = Field(
+        None, description="the train form's defaults: the learning package's, served once"
+    )
+    planners: list[str] = Field(default_factory=list, description="the planning modes")
     scene_instance: str | None = None
     """The id the scene at ``viser_url`` answers at ``/studio-instance`` (None: not checked)."""
 
@@ -225,20 +240,21 @@ class MarkPublic(BaseModel):
 
 
 class RunCreate(_Body):
-    """A training run (defaults are the paper's)."""
+    """A training run. Every default is the learning package's (``DynaQConfig``, ``ArmGrid``, the
+    run defaults), which also checks every value and reports all bad fields at once."""
 
     name: str | None = None
-    planning: PlanningName = "full"
-    planning_steps: int = 100
-    epsilon: float = 0.1
-    alpha: float = 0.1
-    gamma: float = 0.95
-    episodes: int = 100
-    experiments: int = 20
-    bins: int = 11
+    planning: PlanningName = _DYNAQ.planning  # type: ignore[assignment]
+    planning_steps: int = _DYNAQ.planning_steps
+    epsilon: float = _DYNAQ.epsilon
+    alpha: float = _DYNAQ.alpha
+    gamma: float = _DYNAQ.gamma
+    episodes: int = DEFAULT_EPISODES
+    experiments: int = DEFAULT_EXPERIMENTS
+    bins: int = ArmGrid.bins
     goal_deg: list[float] = Field(default_factory=lambda: list(DEFAULT_GOAL_DEG))
     demonstrations: list[str] = Field(default_factory=list)
-    seed: int = 0
+    seed: int = DEFAULT_SEED
 
 
 class RunPublic(BaseModel):
@@ -256,14 +272,20 @@ class RunPublic(BaseModel):
     cpu_seconds: float
     error: str | None
     has_policy: bool
+    origin: Literal["cli", "page", "reproduce", "sweep"] = "page"
+    group: str | None = None
 
 
 class CurvePublic(BaseModel):
-    """Steps per episode over the experiments that finished each episode."""
+    """Steps per episode over the ``count`` experiments that finished each episode (the
+    learning package's ``curve_statistics``)."""
 
     episodes: list[int]
     mean: list[float]
     std: list[float]
+    median: list[float]
+    p10: list[float]
+    p90: list[float]
     min: list[float]
     max: list[float]
     count: list[int]

@@ -26,14 +26,22 @@ def test_corridor_q_after_one_episode_matches_hand_computation(one_way_corridor)
     # Eq. 1 gives Q(0) = Q(1) = alpha * -1 and Q(2) = alpha * 10 (terminal state worth 0).
     alpha, gamma = 0.5, 0.9
     result = run_experiments(
-        one_way_corridor, DynaQConfig(alpha=alpha, gamma=gamma, epsilon=0.0), 1, 1, seed=3
+        one_way_corridor,
+        DynaQConfig(alpha=alpha, gamma=gamma, epsilon=0.0, planning="zero"),
+        1,
+        1,
+        seed=3,
     )
     np.testing.assert_array_equal(result.steps, [[3]])
     np.testing.assert_array_equal(result.updates, [[3]])
     np.testing.assert_allclose(result.q[0, :, 0], [-0.5, -0.5, 5.0, 0.0], rtol=0, atol=1e-15)
     # Second episode by hand: Q(0) = -0.5 + 0.5 (-1 + 0.9 * -0.5 + 0.5) = -0.975, and so on.
     result = run_experiments(
-        one_way_corridor, DynaQConfig(alpha=alpha, gamma=gamma, epsilon=0.0), 1, 2, seed=3
+        one_way_corridor,
+        DynaQConfig(alpha=alpha, gamma=gamma, epsilon=0.0, planning="zero"),
+        1,
+        2,
+        seed=3,
     )
     q1 = -0.5 + 0.5 * (-1 + 0.9 * -0.5 + 0.5)
     q2 = -0.5 + 0.5 * (-1 + 0.9 * 5.0 + 0.5)
@@ -185,7 +193,7 @@ def test_prioritized_sweeps_the_goal_back_to_the_start_in_one_episode() -> None:
     config = DynaQConfig(alpha=1.0, gamma=gamma, planning="prioritized", planning_steps=length)
     swept = run_experiments(mdp, config, 1, 1, seed=0)
     np.testing.assert_allclose(swept.q[0, :-1, 0], values, rtol=0, atol=1e-12)
-    alone = run_experiments(mdp, DynaQConfig(alpha=1.0, gamma=gamma), 1, 1, seed=0)
+    alone = run_experiments(mdp, DynaQConfig(alpha=1.0, gamma=gamma, planning="zero"), 1, 1, seed=0)
     np.testing.assert_array_equal(alone.q[0, :-1, 0], [-1.0] * (length - 2) + [GOAL_REWARD])
     # Cut one step short of the goal, the sweeps carry falling values back just as well: the k
     # states walked are worth -(1 + gamma + ... ) up to the cut, where nothing is known yet.

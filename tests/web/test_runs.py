@@ -4,11 +4,13 @@ from __future__ import annotations
 
 import io
 import json
+import os
+import threading
 
 import numpy as np
 import pytest
 
-from studio.learning import load_policy
+from studio.learning import CURVE_COLUMNS, load_policy
 from tests.web.conftest import TINY_RUN, wait_run
 
 BAD_RUNS = [
@@ -77,7 +79,7 @@ def test_a_tiny_run_trains_and_yields_a_loadable_policy(client, tmp_path):
     csv = client.get(f"/api/runs/{run['id']}/curve.csv")
     assert csv.headers["content-type"].startswith("text/csv")
     rows = csv.text.strip().splitlines()
-    assert rows[0] == "episode,mean,std,min,max,experiments" and len(rows) == 5
+    assert rows[0] == ",".join(CURVE_COLUMNS) and len(rows) == 5
     assert float(rows[1].split(",")[1]) == pytest.approx(curve["mean"][0])
 
     png = client.get(f"/api/runs/{run['id']}/plot.png?log=true")
@@ -90,7 +92,9 @@ def test_a_tiny_run_trains_and_yields_a_loadable_policy(client, tmp_path):
     assert {"config.json", "status.json", "steps.csv", "curves.csv", "policy.policy.npz"} <= {
         p.name for p in on_disk.iterdir()
     }
-    assert json.loads((on_disk / "config.json").read_text())["request"]["name"] == "my first run"
+    record = json.loads((on_disk / "config.json").read_text())
+    assert record["request"]["name"] == "my first run" and record["origin"] == "page"
+    assert done["origin"] == "page" and done["config"]["name"] == "my first run"
 
 
 def test_the_goal_is_the_bin_containing_goal_deg(client, tmp_path):
@@ -101,12 +105,30 @@ def test_the_goal_is_the_bin_containing_goal_deg(client, tmp_path):
     assert policy.grid.goal == tuple(policy.grid.bins_of_angles(np.radians([10, -20, 30])))
 
 
+def hold_before_training(client) -> tuple[threading.Event, threading.Event]:
+    """Make the run worker wait, each time it has marked a run running, until ``go`` is set;
+    ``held`` is set once it waits. Deterministic windows instead of sleeps."""
+    held, go = threading.Event(), threading.Event()
+
+    def hook(run) -> None:
+        held.set()
+        assert go.wait(30), "the test never released the run worker"
+
+    client.app.state.studio.runs.before_train = hook
+    return held, go
+
+
 def test_runs_queue_and_stop_queued_and_running(client):
+    held, go = hold_before_training(client)
     long = {"planning": "full", "experiments": 1, "episodes": 100_000, "seed": 0}
     first = client.post("/api/runs", json=long).json()
     second = client.post("/api/runs", json={**TINY_RUN}).json()
+    assert held.wait(30)
+    assert client.get(f"/api/runs/{first['id']}").json()["status"] == "running"
     assert client.get(f"/api/runs/{second['id']}").json()["status"] == "queued"
-    assert client.delete(f"/api/runs/{first['id']}").status_code in (204, 409)
+    r = client.delete(f"/api/runs/{first['id']}")
+    assert r.status_code == 409 and "stop it first" in r.json()["detail"]
+    go.set()
 
     stopped = client.post(f"/api/runs/{second['id']}/stop").json()
     assert stopped["status"] == "stopped" and stopped["episodes_done"] == 0
@@ -129,6 +151,35 @@ def test_runs_queue_and_stop_queued_and_running(client):
     assert len(curve["episodes"]) == done["episodes_done"]
     # the queued run stopped before it started never trained
     assert client.get(f"/api/runs/{second['id']}").json()["episodes_done"] == 0
+
+
+def test_a_stop_right_after_a_run_is_marked_running_is_never_lost(client):
+    """Issue 13 item 14: the Stop arrives after the worker marked the run running and before
+    training started; the run must end stopped, having trained nothing."""
+    stopped: list[dict] = []
+
+    def stop_now(run) -> None:
+        stopped.append(client.app.state.studio.runs.stop(run.id).public())
+
+    client.app.state.studio.runs.before_train = stop_now
+    run = client.post("/api/runs", json={**TINY_RUN, "episodes": 2000}).json()
+    done = wait_run(client, run["id"])
+    assert stopped and stopped[0]["status"] == "running"
+    assert done["status"] == "stopped" and done["episodes_done"] == 0
+    assert done["error"] == "Stopped before it started." and not done["has_policy"]
+
+
+def test_a_run_in_another_process_cannot_be_stopped_or_deleted_here(client, tmp_path):
+    from studio.learning import ArmGrid, DynaQConfig, RunFolder, RunRecord
+
+    record = RunRecord.for_arm_grid(ArmGrid(), DynaQConfig(), 1, 5, origin="cli")
+    folder = RunFolder.create(tmp_path / "runs", record, name="elsewhere", status="running")
+    folder.pid = os.getppid()  # a live process that is not this one
+    folder.save_status()
+    assert client.get("/api/runs/elsewhere").json()["status"] == "running"
+    for r in (client.post("/api/runs/elsewhere/stop"), client.delete("/api/runs/elsewhere")):
+        assert r.status_code == 409 and "another process" in r.json()["detail"]
+    assert folder.path.is_dir()
 
 
 def test_delete_run_removes_it_and_its_policy(client, tmp_path):
@@ -260,14 +311,14 @@ def test_csv_of_curve_is_parseable(client):
     data = np.loadtxt(
         io.StringIO(client.get(f"/api/runs/{run['id']}/curve.csv").text), delimiter=",", skiprows=1
     )
-    assert data.shape == (4, 6) and list(data[:, 0]) == [1, 2, 3, 4]
+    assert data.shape == (4, len(CURVE_COLUMNS)) and list(data[:, 0]) == [1, 2, 3, 4]
 
 
 def test_a_failing_run_shows_why_and_the_queue_goes_on(client, monkeypatch):
-    import studio.learning
+    import studio.learning._runs
     from studio.learning import LearningError
 
-    real = studio.learning.run_experiments
+    real = studio.learning._runs.run_experiments
     calls = []
 
     def flaky(*args, **kwargs):
@@ -278,7 +329,7 @@ def test_a_failing_run_shows_why_and_the_queue_goes_on(client, monkeypatch):
             raise RuntimeError("boom")
         return real(*args, **kwargs)
 
-    monkeypatch.setattr(studio.learning, "run_experiments", flaky)
+    monkeypatch.setattr(studio.learning._runs, "run_experiments", flaky)
     first = client.post("/api/runs", json=TINY_RUN).json()
     second = client.post("/api/runs", json=TINY_RUN).json()
     third = client.post("/api/runs", json=TINY_RUN).json()
