@@ -1,11 +1,13 @@
-"""Write the sample recordings and demonstrations shipped in ``recordings/`` (fixed seeds).
+"""Write the sample recordings and demonstrations shipped in ``studio/samples/`` (fixed seeds).
 
 Each sample is a few seconds of the simulated operator (:func:`studio.capture.simulate`) reaching
 the default goal of :class:`studio.learning.ArmGrid` (mirrored onto the Puma560, joint mode),
-with one demonstration cut from the reach, so a new user can train supervised agents at once::
+with one demonstration cut from the reach, so a new user can train supervised agents at once.
+Every data folder offers them read-only (:data:`studio.samples.SAMPLES_DIR`)::
 
-    python recordings/make_samples.py            # rewrites recordings/sample-*
-    studio train --demos recordings/sample-reach-1.demo.json
+    python recordings/make_samples.py            # rewrites studio/samples/sample-*
+    python recordings/make_samples.py --out recordings   # the copies some tests read from here
+    studio train --demos studio/samples/sample-reach-1.demo.json
 
 Angles are rounded to :data:`ANGLE_DECIMALS` decimals (0.1 mrad, a twentieth of the simulated
 sensor noise) to keep the files small; the header and demonstrations carry a fixed creation time
@@ -28,6 +30,7 @@ from studio.capture import (
     write_recording,
 )
 from studio.learning import ArmGrid
+from studio.samples import SAMPLES_DIR
 
 SEEDS = (1, 2, 3)
 """One sample per seed."""
@@ -39,7 +42,6 @@ ANGLE_DECIMALS = 4
 """Angles are stored to 0.1 mrad."""
 CREATED = "2026-11-22T00:00:00+00:00"
 """Fixed creation time, so regenerating gives identical files."""
-HERE = Path(__file__).resolve().parent
 
 
 def make_sample(seed: int, out_dir: Path, grid: ArmGrid) -> tuple[Path, Path]:
@@ -77,7 +79,12 @@ def make_sample(seed: int, out_dir: Path, grid: ArmGrid) -> tuple[Path, Path]:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--out", type=Path, default=HERE, help="folder (default: recordings/)")
+    parser.add_argument(
+        "--out",
+        type=Path,
+        default=SAMPLES_DIR,
+        help="folder (default: the package's studio/samples/)",
+    )
     args = parser.parse_args()
     grid = ArmGrid()
     for seed in SEEDS:

@@ -37,7 +37,7 @@ from studio.capture import (
     RECORDING_SUFFIX,
     Demonstration,
     load_demonstration,
-    read_recording,
+    summarize_recording,
 )
 from studio.learning import POLICY_SUFFIX, PolicyFile, load_policy
 from studio.samples import SAMPLES_DIR
@@ -435,19 +435,18 @@ class FolderStore(Generic[T]):
         return name
 
 
-def _recording_summary(path: Path) -> dict[str, Any]:
-    """The capture package's listing facts of a recording (read whole, so damage shows)."""
-    return read_recording(path).summary()
-
-
 def recording_store(folder: Path) -> FolderStore[dict[str, Any]]:
-    """Recordings ``<folder>/<name>.tape.csv`` (each cached as its :meth:`Recording.summary`)."""
+    """Recordings ``<folder>/<name>.tape.csv``, each cached as the capture package's summary.
+
+    :func:`studio.capture.summarize_recording` streams the whole file (so damage shows) in one
+    block of memory, however long the recording.
+    """
     return FolderStore(
         folder,
         suffix=RECORDING_SUFFIX,
         what="recording",
         plural="recordings",
-        load=_recording_summary,
+        load=summarize_recording,
         samples=SAMPLES_DIR,
     )
 

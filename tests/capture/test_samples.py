@@ -2,23 +2,28 @@
 
 from __future__ import annotations
 
+import json
+import runpy
+import sys
 from pathlib import Path
 
 import numpy as np
 
 from studio.capture import load_demonstration, read_recording
 from studio.learning import ArmGrid
+from studio.samples import SAMPLES_DIR
 
 RECORDINGS = Path(__file__).resolve().parents[2] / "recordings"
 
 
 def test_every_sample_demo_reaches_the_default_goal_of_arm_grid():
-    demos = sorted(RECORDINGS.glob("sample-*.demo.json"))
+    demos = sorted(SAMPLES_DIR.glob("sample-*.demo.json"))
     assert len(demos) >= 2
     grid = ArmGrid()
     total = 0
     for path in demos:
         demo = load_demonstration(path)
+        assert demo.recording.parent == SAMPLES_DIR  # found next to it, wherever it is installed
         rec = read_recording(demo.recording)
         total += path.stat().st_size + demo.recording.stat().st_size
         assert not rec.recovered and rec.problems == []
@@ -30,10 +35,6 @@ def test_every_sample_demo_reaches_the_default_goal_of_arm_grid():
 
 
 def test_the_committed_script_regenerates_the_samples(tmp_path):
-    import json
-    import runpy
-    import sys
-
     script = runpy.run_path(str(RECORDINGS / "make_samples.py"))
     argv = sys.argv
     sys.argv = ["make_samples.py", "--out", str(tmp_path)]
@@ -41,10 +42,10 @@ def test_the_committed_script_regenerates_the_samples(tmp_path):
         script["main"]()
     finally:
         sys.argv = argv
-    shipped = sorted(p.name for p in RECORDINGS.glob("sample-*"))
+    shipped = sorted(p.name for p in SAMPLES_DIR.glob("sample-*"))
     assert shipped == sorted(p.name for p in tmp_path.glob("sample-*"))
     for name in shipped:
-        new, old = tmp_path / name, RECORDINGS / name
+        new, old = tmp_path / name, SAMPLES_DIR / name
         if name.endswith(".tape.csv"):
             assert new.read_bytes() == old.read_bytes(), name
         else:  # demonstrations: the same path; the fit's trajectory to its stored micro-radian
@@ -52,3 +53,9 @@ def test_the_committed_script_regenerates_the_samples(tmp_path):
             ta, tb = a.pop("trajectory"), b.pop("trajectory")
             assert a == b, name
             assert np.allclose(ta["q_robot"], tb["q_robot"], atol=2e-6) and ta["t"] == tb["t"]
+
+
+def test_the_copies_in_the_repository_folder_are_the_shipped_samples():
+    """``recordings/sample-*`` stay only as byte-identical copies (some tests read them there)."""
+    for old in RECORDINGS.glob("sample-*"):
+        assert old.read_bytes() == (SAMPLES_DIR / old.name).read_bytes(), old.name
