@@ -307,35 +307,58 @@ async function loadRecordings() {
   });
 }
 
+function recordingRow(r) {
+  const flags = [];
+  if (r.sample) flags.push(el("span", { class: "badge", text: "sample", title: "shipped with the studio: read-only" }));
+  if (r.recovered) flags.push(el("span", { class: "badge warn", text: "recovered", title: "the capture did not close cleanly; every frame written is kept" }));
+  if (r.error) flags.push(el("span", { class: "badge failed", text: "unreadable", title: r.error, testid: "recording-damaged" }));
+  const title = [r.error, r.notes, r.operator && `operator: ${r.operator}`, r.created].filter(Boolean).join("\n");
+  const actions = [];
+  if (!r.error) actions.push(el("button", { class: "icon", title: "play as the live source", testid: "recording-play", onclick: () => useRecording(r.name) }, "▶"));
+  if (r.sample) {
+    actions.push(el("button", { class: "icon", title: "copy to my recordings", testid: "recording-copy", onclick: () => copyRecording(r.name) }, "copy"));
+  } else {
+    actions.push(el("button", { class: "icon", title: "rename / notes", testid: "recording-edit", onclick: () => editRecording(r) }, "✎"));
+  }
+  actions.push(el("button", { class: "icon", title: "download", testid: "recording-download", onclick: () => download(`/api/recordings/${enc(r.name)}/file`, `${r.name}.tape.csv`, "recordings-error") }, "⤓"));
+  if (!r.sample) actions.push(el("button", { class: "icon", title: "delete", testid: "recording-delete", onclick: () => deleteRecording(r.name) }, "✕"));
+  return el("tr", { "data-name": r.name, testid: "recording-row", title },
+    el("td", { class: "name" }, el("span", { text: r.name, testid: "recording-name" }), " ", ...flags),
+    el("td", { class: "num", testid: "recording-duration", text: fmtDuration(r.duration) }),
+    el("td", { class: "num", text: String(r.frames) }),
+    el("td", { class: "actions" }, ...actions),
+  );
+}
+
+/** A list's group heading row (the shipped samples under the user's own files). */
+function groupRow(cols, text, testid) {
+  return el("tr", { class: "group", testid }, el("td", { colspan: cols, text }));
+}
+
 function renderRecordings() {
   const body = $("recordings-body");
-  $("rec-count").textContent = S.recordings.length ? `(${S.recordings.length})` : "";
-  if (!S.recordings.length) {
-    body.replaceChildren(emptyRow(4, "No recordings yet: press Record, or upload a .tape.csv."));
-  } else {
-    body.replaceChildren(...S.recordings.map((r) => {
-      const flags = [];
-      if (r.sample) flags.push(el("span", { class: "badge", text: "sample", title: "shipped with the studio" }));
-      if (r.recovered) flags.push(el("span", { class: "badge warn", text: "recovered", title: "the capture did not close cleanly; every frame written is kept" }));
-      if (r.error) flags.push(el("span", { class: "badge failed", text: "unreadable", title: r.error }));
-      const title = [r.notes, r.operator && `operator: ${r.operator}`, r.created].filter(Boolean).join("\n");
-      return el("tr", { "data-name": r.name, testid: "recording-row", title },
-        el("td", { class: "name" }, el("span", { text: r.name, testid: "recording-name" }), " ", ...flags),
-        el("td", { class: "num", testid: "recording-duration", text: fmtDuration(r.duration) }),
-        el("td", { class: "num", text: String(r.frames) }),
-        el("td", { class: "actions" },
-          el("button", { class: "icon", title: "play as the live source", testid: "recording-play", onclick: () => useRecording(r.name) }, "▶"),
-          el("button", { class: "icon", title: "rename / notes", testid: "recording-edit", onclick: () => editRecording(r) }, "✎"),
-          el("button", { class: "icon", title: "download", testid: "recording-download", onclick: () => download(`/api/recordings/${enc(r.name)}/file`, `${r.name}.tape.csv`, "recordings-error") }, "⤓"),
-          el("button", { class: "icon", title: "delete", testid: "recording-delete", onclick: () => deleteRecording(r.name) }, "✕"),
-        ),
-      );
-    }));
+  const mine = S.recordings.filter((r) => !r.sample);
+  const samples = S.recordings.filter((r) => r.sample);
+  $("rec-count").textContent = mine.length ? `(${mine.length})` : "";
+  const rows = mine.length ? mine.map(recordingRow)
+    : [emptyRow(4, samples.length ? "No recordings of your own yet: press Record, upload a .tape.csv, or copy a sample." : "No recordings yet: press Record, or upload a .tape.csv.")];
+  if (samples.length) {
+    rows.push(groupRow(4, "Samples (read-only): play, cut, or copy one to make it yours", "recordings-samples"));
+    rows.push(...samples.map(recordingRow));
   }
+  body.replaceChildren(...rows);
   const items = S.recordings.filter((r) => !r.error).map((r) => [r.name, `${r.name} (${fmtDuration(r.duration)})`]);
   fillSelect($("source-recording"), items);
   fillSelect($("demo-recording"), items);
   syncDemoRange();
+}
+
+async function copyRecording(name) {
+  await guarded("recordings-error", async () => {
+    const rec = await api("POST", `/api/recordings/${enc(name)}/copy`);
+    await loadRecordings();
+    flashRow("recordings-body", rec && rec.name);
+  });
 }
 
 async function useRecording(name) {
@@ -496,29 +519,41 @@ async function loadDemos() {
   });
 }
 
+function demoRow(d) {
+  const goal = d.error
+    ? el("span", { class: "badge failed", text: "unreadable", title: d.error, testid: "demo-damaged" })
+    : el("span", { class: d.reaches_goal ? "badge done" : "badge warn", text: d.reaches_goal ? "reached" : "not reached", title: `goal ${(d.goal || []).map((g) => fmt(g, 0)).join(", ")}°` });
+  const actions = [];
+  if (!d.error) actions.push(el("button", { class: "icon", title: "preview on the robot", testid: "demo-preview", onclick: () => previewDemo(d.name) }, "▶"));
+  if (!d.sample) actions.push(el("button", { class: "icon", title: "delete", testid: "demo-delete", onclick: () => deleteDemo(d.name) }, "✕"));
+  return el("tr", { "data-name": d.name, testid: "demo-row", title: d.error || "" },
+    el("td", { class: "name", title: d.name }, d.name, d.sample ? " " : null, d.sample ? el("span", { class: "badge", text: "sample", title: "shipped with the studio: read-only" }) : null),
+    el("td", { class: "mono small", title: d.error ? "" : `from ${d.recording}`, text: d.error ? "" : `${fmt(d.t0, 1)}–${fmt(d.t1, 1)} s` }),
+    el("td", { class: "num", text: d.error ? "" : String(d.steps) }),
+    el("td", {}, goal),
+    el("td", { class: "actions" }, ...actions),
+  );
+}
+
 function renderDemos() {
   const body = $("demos-body");
-  if (!S.demos.length) {
-    body.replaceChildren(emptyRow(5, "No demonstrations: mark one while recording, or cut one from a recording."));
-  } else {
-    body.replaceChildren(...S.demos.map((d) => el("tr", { "data-name": d.name, testid: "demo-row" },
-      el("td", { class: "name", title: d.name, text: d.name }),
-      el("td", { class: "mono small", title: `from ${d.recording}`, text: `${fmt(d.t0, 1)}–${fmt(d.t1, 1)} s` }),
-      el("td", { class: "num", text: String(d.steps) }),
-      el("td", {}, el("span", { class: d.reaches_goal ? "badge done" : "badge warn", text: d.reaches_goal ? "reached" : "not reached", title: `goal ${(d.goal || []).map((g) => fmt(g, 0)).join(", ")}°` })),
-      el("td", { class: "actions" },
-        el("button", { class: "icon", title: "preview on the robot", testid: "demo-preview", onclick: () => previewDemo(d.name) }, "▶"),
-        el("button", { class: "icon", title: "delete", testid: "demo-delete", onclick: () => deleteDemo(d.name) }, "✕"),
-      ),
-    )));
+  const mine = S.demos.filter((d) => !d.sample);
+  const samples = S.demos.filter((d) => d.sample);
+  const rows = mine.length ? mine.map(demoRow)
+    : [emptyRow(5, "No demonstrations of your own: mark one while recording, or cut one from a recording.")];
+  if (samples.length) {
+    rows.push(groupRow(5, "Samples (read-only): preview, or tick them to train", "demos-samples"));
+    rows.push(...samples.map(demoRow));
   }
+  body.replaceChildren(...rows);
   // The training form's demonstration checkboxes keep their ticks across refreshes.
   const box = $("train-demos");
   const ticked = new Set([...box.querySelectorAll("input:checked")].map((i) => i.value));
-  if (!S.demos.length) {
+  const usable = [...mine, ...samples].filter((d) => !d.error);
+  if (!usable.length) {
     box.replaceChildren(el("span", { class: "muted", text: "none yet" }));
   } else {
-    box.replaceChildren(...S.demos.map((d) => el("label", { title: `${d.steps} steps from ${d.recording}` },
+    box.replaceChildren(...usable.map((d) => el("label", { title: `${d.steps} steps from ${d.recording}${d.sample ? " (sample)" : ""}` },
       el("input", { type: "checkbox", value: d.name, testid: "train-demo", checked: ticked.has(d.name) }), d.name)));
   }
 }
