@@ -18,7 +18,9 @@ from ._files import read_bytes_bounded as read_bytes_bounded
 from ._json import MAX_JSON_BYTES as MAX_JSON_BYTES
 from ._json import MAX_JSON_DEPTH as MAX_JSON_DEPTH
 from ._json import JSONFileError as JSONFileError
+from ._json import TOMLFileError as TOMLFileError
 from ._json import loads_json as loads_json
 from ._json import read_json as read_json
+from ._json import read_toml as read_toml
 
 __version__ = "0.1.0"

@@ -1,4 +1,5 @@
-"""The one bounded JSON reader: every JSON text the studio reads goes through :func:`loads_json`.
+"""The one bounded JSON reader: every JSON text the studio reads goes through :func:`loads_json`
+(and every TOML file through :func:`read_toml`).
 
 Python's ``json`` parser recurses once per nesting level, so ``[[[...]]]`` 50,000 deep raises a
 ``RecursionError`` (a 500 in the API, a traceback in the CLI), and a file of any size is parsed
@@ -15,6 +16,7 @@ from __future__ import annotations
 import json
 import os
 import re
+import tomllib
 from pathlib import Path
 from typing import Any
 
@@ -27,6 +29,8 @@ MAX_JSON_BYTES = 64 * 1024 * 1024
 """Largest JSON file read (a demonstration of a long recording is a few MB)."""
 MAX_JSON_DEPTH = 64
 """Deepest nesting of arrays and objects accepted (studio files use at most four or five)."""
+MAX_TOML_BYTES = 1024 * 1024
+"""Largest TOML file read (sweep specs are a few hundred bytes)."""
 
 _STRING = re.compile(rb'"[^"\\]*(?:\\.[^"\\]*)*"', re.DOTALL)
 """A JSON string literal (escapes included), blanked before brackets are counted."""
@@ -41,6 +45,10 @@ class JSONFileError(StudioError, ValueError):
     It is also a :class:`ValueError` (as ``json.JSONDecodeError`` is), so existing handlers of
     bad JSON keep working.
     """
+
+
+class TOMLFileError(StudioError, ValueError):
+    """A TOML file that is nested too deeply or not valid; the message names the file."""
 
 
 def nesting_depth(text: str | bytes) -> int:
@@ -124,3 +132,62 @@ def read_json(
         max_bytes=max_bytes,
         max_depth=max_depth,
     )
+
+
+def read_toml(
+    path: str | os.PathLike[str],
+    what: str | None = None,
+    *,
+    max_bytes: int = MAX_TOML_BYTES,
+    max_depth: int = MAX_JSON_DEPTH,
+) -> dict[str, Any]:
+    """Read a TOML file: a regular file of at most ``max_bytes``, tables nested at most ``max_depth``.
+
+    ``tomllib`` recurses on nested inline arrays and tables (a ``RecursionError`` on hostile
+    input), and dotted keys can build arbitrarily deep tables without recursing; both are refused.
+
+    Raises:
+        FileLimitError: missing, not a regular file, or too large (nothing is read then).
+        TOMLFileError: not UTF-8, not valid TOML, or nested too deeply.
+    """
+    label = what or str(Path(path))
+    data = read_bytes_bounded(path, max_bytes, label)
+    try:
+        value = tomllib.loads(data.decode("utf-8"))
+    except UnicodeDecodeError:
+        raise TOMLFileError(f"{label} is not UTF-8 text; it is damaged or not TOML.") from None
+    except tomllib.TOMLDecodeError as err:
+        raise TOMLFileError(f"{label} is not valid TOML ({err}); fix it.") from None
+    except RecursionError:
+        value = None
+    depth = None if value is None else value_depth(value, max_depth + 1)
+    if depth is None or depth > max_depth:
+        raise TOMLFileError(
+            f"{label} nests tables or arrays more than {max_depth} levels deep; it is damaged or "
+            "not a Teach Studio file."
+        )
+    return value
+
+
+def value_depth(value: Any, stop: int | None = None) -> int:
+    """Nesting depth of parsed lists and dicts (a scalar is 0), without recursion.
+
+    Args:
+        value: a parsed JSON or TOML value.
+        stop: give up (returning ``stop``) once this depth is reached.
+    """
+    deepest = 0
+    stack = [(value, 0)]
+    while stack:
+        item, depth = stack.pop()
+        if isinstance(item, dict):
+            children = list(item.values())
+        elif isinstance(item, list | tuple):
+            children = list(item)
+        else:
+            continue
+        deepest = max(deepest, depth + 1)
+        if stop is not None and deepest >= stop:
+            return stop
+        stack.extend((child, depth + 1) for child in children)
+    return deepest

@@ -18,8 +18,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from studio import JSONFileError, StudioError, loads_json, read_json
-from studio._json import MAX_JSON_DEPTH, nesting_depth
+from studio import JSONFileError, StudioError, TOMLFileError, loads_json, read_json, read_toml
+from studio._json import MAX_JSON_DEPTH, nesting_depth, value_depth
 from studio.capture import (
     CaptureError,
     DemonstrationError,
@@ -222,8 +222,23 @@ def _depth(value) -> int:
 @given(json_values)
 def test_nesting_depth_counts_brackets_outside_strings(value):
     text = json.dumps(value)
-    assert nesting_depth(text) == _depth(value)
+    assert nesting_depth(text) == _depth(value) == value_depth(value)
     assert loads_json(text) == value
+
+
+def test_toml_files_are_bounded_too(tmp_path):
+    path = tmp_path / "spec.toml"
+    path.write_text('name = "x"\n[grid]\nbins = [5, 7]\n')
+    assert read_toml(path) == {"name": "x", "grid": {"bins": [5, 7]}}
+    for deep in ("x = " + "[" * 5000 + "]" * 5000, "a" + ".a" * 3000 + " = 1"):
+        path.write_text(deep)
+        with pytest.raises(TOMLFileError, match="more than 64 levels deep"):
+            read_toml(path)
+    path.write_text("x = [1,")
+    with pytest.raises(TOMLFileError, match="not valid TOML"):
+        read_toml(path)
+    with pytest.raises(StudioError, match="not a regular file"):
+        read_toml("/dev/zero")
 
 
 @pytest.mark.parametrize("wrap", ["[{}]", '{{"a": {}}}'])

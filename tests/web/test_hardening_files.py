@@ -1,5 +1,6 @@
-"""Hostile files through the API (issue 13, items 2, 3, 13, 15): each is refused with a 4xx at a
-cost of a few MB, and never hides the good files in a listing.
+"""Hostile files and datagrams through the API (issue 13, items 2, 3, 8, 13, 15): each file is
+refused with a 4xx at a cost of a few MB and never hides the good files in a listing; a stray
+datagram never ends a capture.
 
 Memory is measured with ``tracemalloc`` around the request: the TestClient runs the app in this
 process, and numpy and zlib allocations are traced, so decompressing or sizing anything from a
@@ -10,6 +11,7 @@ from __future__ import annotations
 
 import io
 import json
+import socket
 import tracemalloc
 import zipfile
 from pathlib import Path
@@ -17,9 +19,10 @@ from pathlib import Path
 import numpy as np
 from numpy.lib import format as npy_format
 
-from studio.capture import RecordingWriter, read_recording
+from studio.capture import FrameSender, RecordingWriter, read_recording
 from studio.learning import ArmGrid, DynaQConfig, save_policy
 from tests.capture.conftest import synthetic_frames
+from tests.web.conftest import wait_for
 
 PEAK_BYTES = 16 * 1024 * 1024
 """Most a refused upload may make the server allocate at once (the upload itself is < 1 MB)."""
@@ -152,3 +155,28 @@ def test_a_recording_being_written_downloads_up_to_its_last_complete_row(client,
     copy.write_bytes(body)
     assert len(read_recording(copy)) == 40
     assert 'filename="live.tape.csv"' in response.headers["content-disposition"]
+
+
+def test_one_datagram_of_another_tape_does_not_end_a_capture(client):
+    """Issue 13 item 8: a well-formed 3-region datagram during a 16-region capture."""
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as probe:
+        probe.bind(("127.0.0.1", 0))
+        port = probe.getsockname()[1]
+    assert client.put("/api/source", json={"kind": "network", "port": port}).status_code == 200
+    frames = synthetic_frames(60)
+    with FrameSender("127.0.0.1", port) as sender:
+        sender.send(frames[0])  # the stream's width is fixed by its first frame
+        assert wait_for(lambda: client.get("/api/source").json()["frames"] >= 1)
+        assert client.post("/api/capture/start", json={"name": "mixed"}).status_code == 200
+        for frame in frames[1:30]:
+            sender.send(frame)
+        sender.send(synthetic_frames(1, regions=3)[0])
+        for frame in frames[30:]:
+            sender.send(frame)
+    assert wait_for(lambda: client.get("/api/capture").json()["frames"] >= 59)
+    capture = client.get("/api/capture").json()
+    source = client.get("/api/source").json()
+    assert capture["active"] and capture["name"] == "mixed"
+    assert source["rejected"] == 1 and "3 regions" in source["warning"]
+    stopped = client.post("/api/capture/stop")
+    assert stopped.status_code == 200 and stopped.json()["frames"] == 59
