@@ -66,18 +66,15 @@ def being_recorded(path: str | os.PathLike[str]) -> bool:
     capture.
 
     Raises:
-        RecordingError: the file does not exist.
+        RecordingError: the file does not exist or is not a regular file (a FIFO would block).
     """
-    try:
-        with open(path, "rb") as f:
-            try:
-                fcntl.flock(f.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
-            except BlockingIOError:
-                return True
-            fcntl.flock(f.fileno(), fcntl.LOCK_UN)
-            return False
-    except FileNotFoundError:
-        raise RecordingError(f"{path} does not exist; check the path.") from None
+    with _open(Path(path)) as f:
+        try:
+            fcntl.flock(f.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            return True
+        fcntl.flock(f.fileno(), fcntl.LOCK_UN)
+        return False
 
 
 def _check_not_recording(path: Path) -> None:

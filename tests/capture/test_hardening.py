@@ -313,6 +313,8 @@ def test_devices_and_pipes_are_refused_unread(tmp_path, fifo):
             read_raw_text(path, 32)
         with pytest.raises(DemonstrationError, match="not a regular file"):
             load_demonstration(path)
+        with pytest.raises(RecordingError, match="not a regular file"):
+            update_recording_meta(path, notes="x")  # never blocks on a pipe
 
 
 def test_a_serial_source_refuses_dev_zero_as_its_calibration():
