@@ -12,10 +12,11 @@ A run folder ``<parent>/<id>/`` holds:
   ``created``/``started``/``finished`` (ISO 8601 UTC), ``cpu_seconds``, ``error``, and ``pid``,
   the process training it (a ``running`` run whose process is gone is read as ``stopped``);
 - ``steps.csv``: real steps per episode, one row per experiment, ``-1`` where not done; rewritten
-  atomically at most every :data:`CHECKPOINT_SECONDS` while training, so a killed process loses
-  at most that much of its curve;
+  atomically every :data:`CHECKPOINT_SECONDS` while training (less often only when one write
+  takes over a tenth of that), so a killed process loses about that much of its curve;
 - ``curves.csv``: the :func:`curve_statistics` of ``steps.csv`` in the layout
-  :data:`CURVE_COLUMNS`, written with it;
+  :data:`CURVE_COLUMNS`, written when the run ends (or by :meth:`RunFolder.recover` after a
+  crash);
 - ``policy.policy.npz``: the best experiment's Q table (see ``_policy.py``), written when the run
   ends, also when it was stopped (Stop, Ctrl-C) after finishing episodes. A process killed with
   ``kill -9`` writes none: the Q tables live in the kernels until they return.
@@ -71,7 +72,10 @@ STEPS_FILE = "steps.csv"
 CURVES_FILE = "curves.csv"
 POLICY_FILE = "policy.policy.npz"
 CHECKPOINT_SECONDS = 1.0
-"""How often a training run's partial curve is written to disk (at most this much is lost)."""
+"""How often a training run's ``steps.csv`` is written to disk (at most this much is lost)."""
+CHECKPOINT_COST_FACTOR = 10.0
+"""A checkpoint waits at least this many times as long as the last one took to write, so a huge
+run (20 x 50,000 episodes) spends under a tenth of a core on checkpoints."""
 FIGURE_POINTS = 600
 """A curve figure draws at most about this many points per line (longer runs are averaged)."""
 ORIGINS = ("cli", "page", "reproduce", "sweep")
@@ -227,15 +231,14 @@ def write_curves_csv(
             writer.writerow(([name] if named else []) + values)
 
 
-def curve_figure(
+def curve_plot(
     curves: Sequence[tuple[str, dict[str, list]]],
-    fmt: str = "png",
     *,
     log_steps: bool = False,
     title: str = "",
     points: int = FIGURE_POINTS,
-) -> bytes:
-    """Learning curves as a PNG or SVG figure: per run its mean line and a 10-90 % band.
+) -> Any:
+    """Learning curves as a matplotlib ``Figure``: per run its mean line and a 10-90 % band.
 
     Long runs are averaged to about ``points`` points per line (:func:`downsample_curve`), so a
     25,000-episode run draws as a line, not a solid block. Where fewer experiments than the run's
@@ -244,8 +247,6 @@ def curve_figure(
     """
     from matplotlib.figure import Figure
 
-    if fmt not in ("png", "svg"):
-        raise LearningError(f"The figure format {fmt!r} is not supported; use png or svg.")
     fig = Figure(figsize=(7, 4), dpi=120, layout="constrained")
     ax = fig.add_subplot()
     drawn = False
@@ -260,9 +261,11 @@ def curve_figure(
         complete = count >= count.max()
         (line,) = ax.plot(x, np.where(complete, mean, np.nan), lw=1.6, label=label)
         if not complete.all():
+            fewer = ~complete
+            fewer[:-1] |= fewer[1:]  # start at the last complete point, so the two lines join
             ax.plot(
                 x,
-                np.where(complete, np.nan, mean),
+                np.where(fewer, mean, np.nan),
                 lw=1.2,
                 ls=":",
                 color=line.get_color(),
@@ -281,6 +284,21 @@ def curve_figure(
     ax.set_ylabel("steps to the goal (line: mean, band: 10-90 %)")
     ax.set_title(title)
     ax.grid(alpha=0.3)
+    return fig
+
+
+def curve_figure(
+    curves: Sequence[tuple[str, dict[str, list]]],
+    fmt: str = "png",
+    *,
+    log_steps: bool = False,
+    title: str = "",
+    points: int = FIGURE_POINTS,
+) -> bytes:
+    """:func:`curve_plot` as PNG or SVG bytes (the page's "Plot PNG/SVG" downloads)."""
+    if fmt not in ("png", "svg"):
+        raise LearningError(f"The figure format {fmt!r} is not supported; use png or svg.")
+    fig = curve_plot(curves, log_steps=log_steps, title=title, points=points)
     buffer = io.BytesIO()
     fig.savefig(buffer, format=fmt)
     return buffer.getvalue()
@@ -737,15 +755,25 @@ class RunFolder:
         except OSError as err:
             raise _disk_error(err, "the run's status", self.path) from None
 
-    def save_steps(self, steps: np.ndarray) -> None:
-        """Write ``steps.csv`` and ``curves.csv`` atomically (a checkpoint, or the final curve)."""
+    def save_steps(self, steps: np.ndarray, curves: bool = True) -> None:
+        """Write ``steps.csv`` and, unless ``curves`` is false (a checkpoint), ``curves.csv``,
+        each atomically. ``steps.csv`` is the truth; ``curves.csv`` is derived from it."""
         steps = np.asarray(steps, dtype=np.int64).copy()
         try:
             _atomic_write(self.path / STEPS_FILE, steps_text(steps))
-            _atomic_write(self.path / CURVES_FILE, curves_csv(curve_statistics(steps)))
+            if curves:
+                _atomic_write(self.path / CURVES_FILE, curves_csv(curve_statistics(steps)))
         except OSError as err:
             raise _disk_error(err, "the run's curve", self.path) from None
         self._steps = steps
+
+    def recover(self) -> None:
+        """Write down what :meth:`load` found for a run whose process died: its ``stopped``
+        status and a ``curves.csv`` of its last checkpoint (no-op for other runs)."""
+        if self.interrupted:
+            self.save_steps(self.steps())
+            self.save_status()
+            self.interrupted = False
 
     def save_policy(self, result: ExperimentResult) -> None:
         """Write the best experiment's Q table as the run's policy (arm-grid runs)."""
@@ -799,6 +827,7 @@ class RunFolder:
         if live.stopped:  # stopped before training started: nothing to run
             return self._finish(live, None, None)
         box: dict[str, Any] = {}
+        ended = threading.Event()  # not Thread.join: a Ctrl-C inside join can end it too early
 
         def target() -> None:
             try:
@@ -814,21 +843,25 @@ class RunFolder:
                 )
             except BaseException as err:  # handed to the caller's thread
                 box["error"] = err
+            finally:
+                ended.set()
 
         thread = threading.Thread(target=target, name=f"studio-train-{self.id}", daemon=True)
         thread.start()
         interrupted = False
-        saved, last = 0, time.monotonic()
-        while thread.is_alive():
+        saved, last, every = 0, time.monotonic(), CHECKPOINT_SECONDS
+        while not ended.is_set():
             try:
-                thread.join(poll_seconds)
+                ended.wait(poll_seconds)
                 if on_checkpoint is not None:
                     on_checkpoint(live)
                 now = time.monotonic()
                 done = live.completed
-                if now - last >= CHECKPOINT_SECONDS and done != saved and thread.is_alive():
-                    self.save_steps(live.steps)
-                    saved, last = done, now
+                if now - last >= every and done != saved and not ended.is_set():
+                    self.save_steps(live.steps, curves=False)
+                    saved, last = done, time.monotonic()
+                    # a huge run's checkpoint costs: keep writing it under a tenth of the time
+                    every = max(CHECKPOINT_SECONDS, CHECKPOINT_COST_FACTOR * (last - now))
             except KeyboardInterrupt:
                 interrupted = True
                 live.stop()

@@ -35,6 +35,7 @@ from studio.learning import (
     RunFolder,
     RunRecord,
     find_runs,
+    goal_degrees,
     goal_problems,
     grid_for_goal,
     raise_problems,
@@ -170,8 +171,7 @@ def run_create_of(record: RunRecord) -> RunCreate:
     grid_spec = record.task
     goal_deg: list[float] = []
     with contextlib.suppress(LearningError, TypeError, ValueError):
-        grid = record.arm_grid()
-        goal_deg = [round(float(a), 6) for a in np.degrees(grid.angles_of(grid.goal_state))]
+        goal_deg = goal_degrees(record.arm_grid())
     defaults = DynaQConfig()
     return RunCreate(
         name=record.name or None,
@@ -310,7 +310,7 @@ class RunQueue:
                     continue
                 if run.folder.interrupted:  # say so on disk too, once
                     with contextlib.suppress(LearningError):
-                        run.folder.save_status()
+                        run.folder.recover()
                 with self._cond:
                     self._runs.setdefault(run_id, run)
                 changed = True

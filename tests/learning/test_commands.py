@@ -2,14 +2,31 @@
 
 from __future__ import annotations
 
+import argparse
 import csv
 import json
 
 import numpy as np
+import pytest
+from fastapi.testclient import TestClient
 
 from studio.cli import main
-from studio.learning import load_policy
-from studio.learning._reproduce import CONFIGURATIONS, PAPER_MATLAB_SECONDS
+from studio.commands import train
+from studio.learning import (
+    CURVE_COLUMNS,
+    DEFAULT_EPISODES,
+    DEFAULT_EXPERIMENTS,
+    DEFAULT_GOAL_JOINTS_DEG,
+    DEFAULT_SEED,
+    ArmGrid,
+    DynaQConfig,
+    RunFolder,
+    goal_problems,
+    load_policy,
+)
+from studio.learning._reproduce import CONFIGURATIONS, EXTENSIONS, PAPER_MATLAB_SECONDS
+from studio.web import create_app
+from tests.web.conftest import TINY_RUN, make_settings, wait_run
 
 
 def test_reproduce_tiny_budget(tmp_path, capsys) -> None:
@@ -18,6 +35,16 @@ def test_reproduce_tiny_budget(tmp_path, capsys) -> None:
         ["reproduce", "--out", str(out), "--experiments", "2", "--episodes", "36", "--no-progress"]
     )
     assert code == 0
+    with (out / "curves.csv").open() as stream:
+        assert next(csv.reader(stream)) == ["configuration", *CURVE_COLUMNS]
+    for name in {**CONFIGURATIONS, **EXTENSIONS}:  # each configuration is an ordinary run
+        run = RunFolder.load(out / name)
+        assert run.status == "done" and run.has_policy
+        assert (run.record.origin, run.record.group, run.record.name) == (
+            "reproduce",
+            "repro",
+            name,
+        )
     for name in (
         "curves.csv",
         "timing.csv",
@@ -108,3 +135,112 @@ def test_user_errors_are_one_line_not_tracebacks(tmp_path, capsys) -> None:
     bad.write_text("nope")
     assert main(["export", str(bad)]) == 2
     assert "bad.policy.npz is corrupt" in capsys.readouterr().err
+
+
+def _parse_train(argv: list[str]) -> argparse.Namespace:
+    parser = argparse.ArgumentParser()
+    train.add_arguments(parser)
+    return parser.parse_args(argv)
+
+
+def test_the_train_commands_defaults_are_the_learning_packages() -> None:
+    settings = train.resolve(_parse_train([]))
+    assert settings.config == DynaQConfig() and settings.grid == ArmGrid()
+    assert (settings.experiments, settings.episodes, settings.seed) == (
+        DEFAULT_EXPERIMENTS,
+        DEFAULT_EPISODES,
+        DEFAULT_SEED,
+    )
+    assert settings.demonstrations == []
+    flags = train.resolve(_parse_train(["--planning", "soft", "--bins", "7", "--seed", "4"]))
+    assert flags.config == DynaQConfig(planning="soft") and flags.grid == ArmGrid(bins=7)
+    assert flags.seed == 4
+
+
+def test_the_page_and_the_command_share_every_default(tmp_path) -> None:
+    with TestClient(create_app(make_settings(tmp_path))) as client:
+        served = client.get("/api/config").json()
+    form = served["training"]
+    config, grid = DynaQConfig(), ArmGrid()
+    for key in ("planning", "planning_steps", "alpha", "gamma", "epsilon"):
+        assert form[key] == getattr(config, key), key
+    assert form["bins"] == grid.bins and form["goal_deg"] == list(DEFAULT_GOAL_JOINTS_DEG)
+    assert (form["experiments"], form["episodes"], form["seed"]) == (
+        DEFAULT_EXPERIMENTS,
+        DEFAULT_EPISODES,
+        DEFAULT_SEED,
+    )
+    assert served["planners"] == ["zero", "full", "soft", "prioritized"]
+    assert config.planning == "full"  # the paper's Dyna-Q: 100 planning updates per real step
+    # the default goal's bins are the grid's default goal
+    assert (
+        train.resolve(_parse_train(["--goal-deg", ",".join(map(str, form["goal_deg"]))])).grid
+        == grid
+    )
+
+
+def test_one_goal_check_for_the_page_and_the_command(tmp_path, capsys) -> None:
+    bad = [170.0, 0.0, -150.0]
+    sentences = goal_problems(bad)
+    assert len(sentences) == 2
+    assert main(["train", f"--goal-deg={','.join(map(str, bad))}", "--no-progress"]) == 2
+    printed = capsys.readouterr().err
+    assert all(sentence in printed for sentence in sentences)
+    with TestClient(create_app(make_settings(tmp_path))) as client:
+        r = client.post("/api/runs", json={**TINY_RUN, "goal_deg": bad})
+    assert r.status_code == 422 and r.json()["problems"] == sentences
+
+
+def test_every_bad_field_is_reported_at_once_by_the_page_and_the_command(tmp_path, capsys) -> None:
+    with TestClient(create_app(make_settings(tmp_path))) as client:
+        r = client.post("/api/runs", json={**TINY_RUN, "alpha": 5, "episodes": 0, "seed": -1})
+        assert client.get("/api/runs").json() == []
+    assert r.status_code == 422
+    body = r.json()
+    assert set(body["by_field"]) == {"alpha", "episodes", "seed"}
+    assert len(body["problems"]) == 3 and body["detail"] == " ".join(body["problems"])
+    assert main(["train", "--alpha", "5", "--episodes", "0", "--seed", "-1", "--no-progress"]) == 2
+    printed = capsys.readouterr().err
+    assert all(problem in printed for problem in body["problems"])
+
+
+def test_a_run_trained_on_the_command_line_is_listed_plotted_watched_and_exported(
+    tmp_path, monkeypatch
+) -> None:
+    monkeypatch.chdir(tmp_path)  # a data folder: studio train writes runs/<name>
+    args = ["--experiments", "2", "--episodes", "6", "--planning", "zero", "--no-progress"]
+    assert main(["train", "--out", "runs/cli-run", "--name", "from the terminal", *args]) == 0
+    assert main(["reproduce", "--out", "runs/paper", "--experiments", "1", "--episodes", "3",
+                 "--no-progress"]) == 0  # fmt: skip
+    with TestClient(create_app(make_settings(tmp_path))) as client:
+        listed = {r["id"]: r for r in client.get("/api/runs").json()}
+        cli = listed["cli-run"]
+        assert cli["origin"] == "cli" and cli["status"] == "done" and cli["has_policy"]
+        assert cli["name"] == "from the terminal" and cli["episodes_done"] == 12
+        assert cli["config"]["planning"] == "zero" and cli["config"]["episodes"] == 6
+        assert {f"paper~{name}" for name in CONFIGURATIONS} <= set(listed)
+        assert listed["paper~SV-FPL"]["origin"] == "reproduce"
+        assert listed["paper~SV-FPL"]["group"] == "paper"
+
+        curve = client.get("/api/runs/cli-run/curve").json()
+        steps = np.loadtxt(tmp_path / "runs/cli-run/steps.csv", delimiter=",")
+        assert curve["episodes"] == list(range(1, 7))
+        assert curve["mean"] == pytest.approx(steps.mean(axis=0), abs=1e-3)
+        watched = client.post("/api/watch", json={"run": "cli-run", "seed": 1})
+        assert watched.status_code == 200 and len(watched.json()["states"]) >= 1
+        policy = client.get("/api/runs/cli-run/policy")
+        assert policy.content == (tmp_path / "runs/cli-run/policy.policy.npz").read_bytes()
+        png = client.get("/api/runs/paper~SV-FPL/plot.png")
+        assert png.status_code == 200 and png.content[:4] == b"\x89PNG"
+
+        # one curves.csv layout: the command's file, the page's download, the page's own runs
+        page_csv = client.get("/api/runs/cli-run/curve.csv").text
+        assert page_csv == (tmp_path / "runs/cli-run/curves.csv").read_text()
+        page_run = client.post("/api/runs", json=TINY_RUN).json()
+        wait_run(client, page_run["id"])
+        page_file = (tmp_path / "runs" / page_run["id"] / "curves.csv").read_text()
+    header = ",".join(CURVE_COLUMNS)
+    assert page_csv.splitlines()[0] == page_file.splitlines()[0] == header
+    assert (tmp_path / "runs/paper/curves.csv").read_text().splitlines()[
+        0
+    ] == f"configuration,{header}"

@@ -340,3 +340,22 @@ def test_a_failing_run_shows_why_and_the_queue_goes_on(client, monkeypatch):
     assert two["status"] == "failed" and "RuntimeError: boom" in two["error"]
     assert client.get(f"/api/runs/{third['id']}").json()["status"] == "done"
     assert client.get(f"/api/runs/{first['id']}/policy").status_code == 409
+
+
+def test_a_new_run_on_a_full_disk_answers_one_sentence_and_leaves_nothing(
+    client, tmp_path, monkeypatch
+):
+    import errno
+    from pathlib import Path
+
+    def full(self, *args, **kwargs):
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(Path, "write_text", full)
+    r = client.post("/api/runs", json=TINY_RUN)
+    monkeypatch.undo()
+    assert r.status_code == 422
+    detail = r.json()["detail"]
+    assert "disk holding" in detail and "is full" in detail and "\n" not in detail
+    assert list((tmp_path / "runs").iterdir()) == []
+    assert client.get("/api/runs").json() == []
