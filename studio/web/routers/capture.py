@@ -19,7 +19,8 @@ def read_capture(studio: StudioDep) -> CapturePublic:
 
 @router.post("/start")
 def start_capture(body: CaptureStart, studio: StudioDep) -> CapturePublic:
-    """Start recording (409 if a recording is already running or there is no running source)."""
+    """Start recording (409 if a recording is already running, there is no running source, or
+    the name is taken; 422 for a bad name or one starting with ``sample-``)."""
     studio.start_capture(body.name, body.operator, body.notes)
     return CapturePublic.model_validate(studio.pipeline.capture_status())
 

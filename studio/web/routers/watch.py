@@ -24,7 +24,8 @@ ROUND_DECIMALS = 6
 
 @router.post("")
 def watch(body: WatchCreate, studio: StudioDep) -> WatchPublic:
-    """Roll the greedy policy out from a random or the current pose and play it in the scene."""
+    """Roll the greedy policy of a run or an uploaded policy (exactly one; 422 otherwise) out from
+    a random or the current pose and play it in the scene (409 if the run has no policy yet)."""
     policy, key = studio.load_policy(body.run, body.policy)
     grid = policy.grid
     if body.start == "current":
