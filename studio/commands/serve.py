@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import argparse
+import os
+import secrets
 import sys
 from pathlib import Path
 
@@ -11,6 +13,10 @@ from studio._errors import StudioError
 NAME = "serve"
 HELP = "Start the studio in the browser (the default verb)."
 MAX_PORT = 65535
+TOKEN_BYTES = 24
+"""Random bytes of a generated token (32 URL-safe characters)."""
+TOKEN_ENV = "STUDIO_TOKEN"
+"""Environment variable holding the token, so that it stays out of the process list."""
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -39,6 +45,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="MB",
         help="largest recording or policy upload, in MB (default: 50)",
     )
+    parser.add_argument(
+        "--token",
+        default=None,
+        help=f"the secret the page, API and scene require (default: ${TOKEN_ENV}; generated and "
+        "printed when --host is not loopback, where one is required)",
+    )
     parser.add_argument("--no-browser", action="store_true", help="do not open a browser")
 
 
@@ -54,12 +66,16 @@ def run(args: argparse.Namespace) -> int:
             raise StudioError(
                 f"--source {source} is neither 'simulator', a recording file nor a recording in {by_name.parent}; check the name."
             )
+    token = args.token if args.token is not None else os.environ.get(TOKEN_ENV) or None
     if not is_loopback(args.host):
         print(
-            f"studio serve: WARNING: binding {args.host} makes the studio (and its files) reachable "
-            "from other machines; there is no login. Use only on a trusted network.",
+            f"studio serve: WARNING: binding {args.host} makes the studio reachable from other "
+            "machines: it answers only requests carrying its token (an SSH tunnel to a loopback "
+            "studio is safer still; see the README).",
             file=sys.stderr,
         )
+        if token is None:
+            token = secrets.token_urlsafe(TOKEN_BYTES)
     allowed = list(args.allow_host)
     if not is_loopback(args.host):
         import socket
@@ -83,6 +99,7 @@ def run(args: argparse.Namespace) -> int:
         viser_port=args.viser_port,
         source=source,
         allowed_hosts=tuple(allowed),
+        token=token,
     )
     serve(settings, open_browser=not args.no_browser)
     return 0

@@ -24,6 +24,7 @@ from starlette.types import ASGIApp, Receive, Scope, Send
 from .. import __version__
 from .._errors import StudioError
 from ._errors import NotFoundError, WebError
+from ._guard import GuardMiddleware, SiteRule
 from ._settings import Settings, get_settings
 from ._state import Studio
 from ._store import human_bytes
@@ -76,6 +77,11 @@ def create_app(settings: Settings | None = None, scene: Any = None) -> FastAPI:
     )
     app.dependency_overrides[get_settings] = lambda: settings
     app.add_middleware(UploadLimitMiddleware, limit=settings.upload_limit_bytes)
+    # Inside the Host check: the token (beyond loopback) and no change from another site's page.
+    app.add_middleware(
+        GuardMiddleware,
+        rule=SiteRule(settings.trusted_hosts(), {settings.port}, settings.token, settings.port),
+    )
     app.add_middleware(TrustedHostMiddleware, allowed_hosts=settings.trusted_hosts())
 
     @app.exception_handler(StudioError)

@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import asyncio
 import errno
-import hmac
 import json
 import logging
 import secrets
@@ -19,12 +18,12 @@ import socket
 import threading
 import webbrowser
 from collections.abc import Callable, Iterable
-from http.cookies import SimpleCookie
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
-from urllib.parse import parse_qs, urlsplit
+from urllib.parse import urlsplit
 
 from .._errors import StudioError
+from ._guard import SiteRule
 from ._settings import Settings
 
 if TYPE_CHECKING:
@@ -47,11 +46,11 @@ class ServeError(StudioError):
     """The studio cannot start: a port taken, a data folder that cannot be written."""
 
 
-class SceneGuard:
+class SceneGuard(SiteRule):
     """Who the scene server answers: the studio's own Host and Origin, and the token if any.
 
-    The same rule as the API's host guard (:meth:`Settings.trusted_hosts`): a request whose
-    ``Host`` names another site (DNS rebinding) is refused, and so is a request, websocket
+    The same rule as the API's guard (one :class:`~studio.web._guard.SiteRule`): a request
+    whose ``Host`` names another site (DNS rebinding) is refused, and so is a request, websocket
     included, sent by a page of another origin. Clients that send no ``Origin`` (command-line
     tools, tests) are local programs and pass, as on the API.
 
@@ -68,6 +67,8 @@ class SceneGuard:
         share_requests_refused: share-tunnel requests refused so far.
     """
 
+    cookie_name = TOKEN_COOKIE
+
     def __init__(
         self,
         hosts: Iterable[str],
@@ -75,56 +76,10 @@ class SceneGuard:
         instance: str,
         token: str | None = None,
     ) -> None:
-        self.hosts = {h.strip("[]").lower() for h in hosts}
-        self.ports = set(ports)
+        super().__init__(hosts, ports, token)
         self.instance = instance
-        self.token = token
-        self.cookie_port = min(self.ports) if self.ports else 0
         self.refused = 0
         self.share_requests_refused = 0
-
-    # ------------------------------------------------------------------ the rule
-
-    def host_ok(self, host: str | None) -> bool:
-        """Whether a ``Host`` header names this studio."""
-        if not host:
-            return False
-        name = urlsplit(f"//{host}").hostname
-        return name is not None and name.lower() in self.hosts
-
-    def origin_ok(self, origin: str | None) -> bool:
-        """Whether an ``Origin`` header is absent or one of the studio's own pages."""
-        if origin is None:
-            return True
-        parts = urlsplit(origin)
-        try:
-            port = parts.port or {"http": 80, "https": 443}.get(parts.scheme)
-        except ValueError:
-            return False
-        return (
-            parts.scheme in ("http", "https")
-            and parts.hostname is not None
-            and parts.hostname.lower() in self.hosts
-            and port in self.ports
-        )
-
-    def token_ok(self, path: str, cookie: str | None) -> tuple[bool, bool]:
-        """``(allowed, from_query)``: the token matches (query or cookie), or none is needed."""
-        if self.token is None:
-            return True, False
-        given = parse_qs(urlsplit(path).query).get("token", [""])[0]
-        if given and hmac.compare_digest(given, self.token):
-            return True, True
-        if cookie:
-            jar = SimpleCookie()
-            try:
-                jar.load(cookie)
-            except Exception:  # a malformed cookie header is just no cookie
-                return False, False
-            morsel = jar.get(TOKEN_COOKIE.format(port=self.cookie_port))
-            if morsel is not None and hmac.compare_digest(morsel.value, self.token):
-                return True, False
-        return False, False
 
     # ------------------------------------------------------------------ websockets hook
 
@@ -160,10 +115,7 @@ class SceneGuard:
                 return reply(200, "OK", body, {"Content-Type": "application/json", **cors})
             response = process_request(connection, request) if process_request else None
             if response is not None and from_query and self.token is not None:
-                name = TOKEN_COOKIE.format(port=self.cookie_port)
-                response.headers["Set-Cookie"] = (
-                    f"{name}={self.token}; Path=/; HttpOnly; SameSite=Strict"
-                )
+                response.headers["Set-Cookie"] = self.set_cookie_header()
             return response
 
         return guarded
@@ -327,12 +279,17 @@ def serve(settings: Settings, open_browser: bool = True) -> None:
         open_browser: open the page in the default browser once the server is up.
 
     Raises:
-        ServeError: the API port is taken or the data folder cannot be written.
+        ServeError: the API port is taken, the data folder cannot be written, or the host is
+            not loopback and there is no token.
     """
     import uvicorn
 
     from ._app import create_app
 
+    if not settings.is_loopback and not settings.token:
+        raise ServeError(
+            f"--host {settings.host} opens the studio to other machines, which needs a token; give --token (or set STUDIO_TOKEN), or keep --host 127.0.0.1 and use an SSH tunnel."
+        )
     prepare_data_dir(settings.data_dir)
     sock = bind_port(settings.host, settings.port)
     try:
@@ -347,6 +304,8 @@ def serve(settings: Settings, open_browser: bool = True) -> None:
         app = create_app(settings, scene)
         host = "127.0.0.1" if settings.host in ("0.0.0.0", "::") else settings.host
         url = f"http://{host}:{settings.port}/"
+        if settings.token:
+            url += f"?token={settings.token}"
         config = uvicorn.Config(
             app,
             log_level="warning",

@@ -1101,13 +1101,16 @@ async function sceneIsOurs(src, instance) {
  * Pages on one site share a renderer process and its main thread in Chromium, so a busy 3D scene
  * (software WebGL, a fast live stream) would delay the page's own work: curves, buttons, lists.
  * 127.0.0.1 and localhost are different sites, so swapping one for the other gives the scene its
- * own process. Any other host is left alone.
+ * own process. A loopback scene seen from a page on another machine (a studio serving 0.0.0.0)
+ * is reached at the page's host. Any other host is left alone.
  */
 function sceneUrl(url) {
   const u = new URL(url, location.href);
   const loopback = ["127.0.0.1", "localhost"];
   if (loopback.includes(u.hostname) && u.hostname === location.hostname) {
     u.hostname = u.hostname === "localhost" ? "127.0.0.1" : "localhost";
+  } else if (loopback.includes(u.hostname) && !loopback.includes(location.hostname)) {
+    u.hostname = location.hostname; // a studio on 0.0.0.0 opened from another machine
   }
   return u.toString();
 }

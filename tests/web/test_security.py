@@ -1,0 +1,157 @@
+"""The API refuses changes from another site's page (Origin, else Referer), lets command-line
+clients (no Origin) through, and requires the token when one is set; beyond loopback the studio
+does not start without one."""
+
+from __future__ import annotations
+
+import argparse
+from collections.abc import Callable
+from pathlib import Path
+
+import pytest
+from fastapi.testclient import TestClient
+
+from studio.web import Settings
+from studio.web._guard import API_TOKEN_COOKIE, SiteRule
+from studio.web._serve import ServeError, serve
+
+EVIL = "http://evil.example"
+SAMPLE = Path(__file__).resolve().parents[2] / "studio" / "samples"
+
+
+def _recording_bytes() -> bytes:
+    return next(SAMPLE.glob("*.tape.csv")).read_bytes()
+
+
+@pytest.mark.parametrize(
+    ("method", "path", "kwargs", "own_status"),
+    [
+        ("POST", "/api/capture/stop", {}, 409),
+        ("POST", "/api/watch/stop", {}, 204),
+        ("PUT", "/api/source/retarget", {"json": {"mode": "joint"}}, 200),
+        ("DELETE", "/api/recordings/nothing-here", {}, 404),
+        ("PATCH", "/api/recordings/nothing-here", {"json": {"notes": "x"}}, 404),
+    ],
+)
+def test_a_change_from_another_site_is_refused(
+    client: TestClient, method: str, path: str, kwargs: dict, own_status: int
+) -> None:
+    refused = client.request(method, path, headers={"Origin": EVIL}, **kwargs)
+    assert refused.status_code == 403
+    assert "another site" in refused.json()["detail"]
+    by_referer = client.request(method, path, headers={"Referer": f"{EVIL}/page"}, **kwargs)
+    assert by_referer.status_code == 403
+    # the studio's own page, and a command-line client that sends neither header
+    own = client.request(method, path, headers={"Origin": "http://testserver"}, **kwargs)
+    assert own.status_code == own_status
+    assert client.request(method, path, **kwargs).status_code == own_status
+
+
+def test_a_cross_site_upload_stores_nothing(client: TestClient, tmp_path: Path) -> None:
+    files = {"file": ("mine.tape.csv", _recording_bytes(), "text/csv")}
+    refused = client.post("/api/recordings", files=files, headers={"Origin": EVIL})
+    assert refused.status_code == 403
+    assert list((tmp_path / "recordings").iterdir()) == []
+    ok = client.post("/api/recordings", files=files, headers={"Origin": "http://testserver"})
+    assert ok.status_code == 201
+    assert [p.name for p in (tmp_path / "recordings").iterdir()] == ["mine.tape.csv"]
+
+
+def test_reading_from_another_site_is_not_a_change(client: TestClient) -> None:
+    # no CORS header is sent, so the other site's script cannot read the answer anyway
+    r = client.get("/api/capture", headers={"Origin": EVIL})
+    assert r.status_code == 200
+    assert "access-control-allow-origin" not in r.headers
+
+
+@pytest.mark.parametrize(
+    ("origin", "ok"),
+    [
+        (None, True),
+        ("http://127.0.0.1:8000", True),
+        ("http://localhost:8000", True),
+        ("http://[::1]:8000", True),
+        ("http://testserver", True),  # the same host and port as the request (Jupyter's rule)
+        ("https://127.0.0.1:8000", True),
+        ("http://127.0.0.1:8080", False),  # another local program's page
+        ("http://127.0.0.1", False),
+        ("http://evil.example:8000", False),
+        ("http://127.0.0.1.evil.example:8000", False),
+        ("null", False),
+        ("file://", False),
+        ("http://127.0.0.1:notaport", False),
+    ],
+)
+def test_origin_rule(origin: str | None, ok: bool) -> None:
+    rule = SiteRule([*Settings().trusted_hosts(), "testserver"], {8000})
+    assert rule.origin_ok(origin, host="testserver") is ok
+
+
+def test_the_token_is_required_when_set(open_client: Callable[..., TestClient]) -> None:
+    client = open_client(token="t0k-en")
+    assert client.get("/api/config").status_code == 403
+    assert client.get("/").status_code == 403
+    assert client.get("/api/config?token=wrong").status_code == 403
+    assert client.get("/api/config", headers={"Authorization": "token wrong"}).status_code == 403
+    assert client.get("/api/config", headers={"Authorization": "token t0k-en"}).status_code == 200
+    assert client.get("/api/config", headers={"Authorization": "Bearer t0k-en"}).status_code == 200
+    page = client.get("/?token=t0k-en")
+    assert page.status_code == 200
+    cookie = API_TOKEN_COOKIE.format(port=8000)
+    assert page.cookies.get(cookie) == "t0k-en"
+    assert "HttpOnly" in page.headers["set-cookie"]
+    # the client keeps the cookie: the page's later requests carry the token
+    assert client.get("/api/config").status_code == 200
+    assert client.post("/api/watch/stop").status_code == 204
+    client.cookies.clear()
+    assert client.post("/api/watch/stop").status_code == 403
+    # the page embeds the scene with the token
+    client.cookies.set(cookie, "t0k-en")
+    assert client.get("/api/config").json()["viser_url"].endswith("?token=t0k-en")
+
+
+def test_the_origin_rule_holds_with_the_token(open_client: Callable[..., TestClient]) -> None:
+    client = open_client(token="t0k-en")
+    r = client.post("/api/watch/stop?token=t0k-en", headers={"Origin": EVIL})
+    assert r.status_code == 403
+
+
+def test_serving_beyond_loopback_needs_a_token(tmp_path: Path) -> None:
+    for host in ("0.0.0.0", "192.0.2.7"):
+        with pytest.raises(ServeError, match="needs a token"):
+            serve(Settings(host=host, data_dir=tmp_path, source=None), open_browser=False)
+        with pytest.raises(ServeError, match="needs a token"):
+            serve(Settings(host=host, data_dir=tmp_path, token=""), open_browser=False)
+
+
+def _serve_args(**given: object) -> argparse.Namespace:
+    from studio.commands import serve as command
+
+    parser = argparse.ArgumentParser()
+    command.add_arguments(parser)
+    argv = [f"--{k.replace('_', '-')}={v}" for k, v in given.items()]
+    return parser.parse_args([*argv, "--no-browser"])
+
+
+def test_the_command_generates_a_token_beyond_loopback(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path
+) -> None:
+    import studio.web
+    from studio.commands import serve as command
+
+    started: list[Settings] = []
+    monkeypatch.setattr(
+        studio.web, "serve", lambda settings, open_browser: started.append(settings)
+    )
+    monkeypatch.delenv(command.TOKEN_ENV, raising=False)
+    command.run(_serve_args(host="0.0.0.0", data_dir=tmp_path))
+    command.run(_serve_args(host="0.0.0.0", data_dir=tmp_path))
+    first, second = started[0].token, started[1].token
+    assert first and second and first != second and len(first) >= 32
+    command.run(_serve_args(data_dir=tmp_path))
+    assert started[-1].token is None  # loopback: no token unless asked
+    monkeypatch.setenv(command.TOKEN_ENV, "from-env")
+    command.run(_serve_args(host="0.0.0.0", data_dir=tmp_path))
+    assert started[-1].token == "from-env"
+    command.run(_serve_args(host="0.0.0.0", data_dir=tmp_path, token="given"))
+    assert started[-1].token == "given"
