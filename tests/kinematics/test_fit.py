@@ -35,13 +35,19 @@ CONFIGS = {side: TapeConfig(side=side) for side in ("right", "left")}
 OBSERVED = slice(0, 4)
 
 
-def observable_q():
+def observable_box() -> tuple[np.ndarray, np.ndarray]:
+    """(lower, upper) joint angles where the tape shows the arm's first four joints."""
     arm = ARMS["right"]
     lo, hi = np.array(arm.lower), np.array(arm.upper)
     lo[0], hi[0] = -2.5, 2.5  # shoulder flexion
     lo[1], hi[1] = -1.0, 1.3  # abduction, away from the gimbal at pi/2
     lo[2], hi[2] = -1.5, 2.5  # humeral rotation
     lo[3], hi[3] = 0.3, 2.4  # a bent elbow shows the humeral rotation
+    return lo, hi
+
+
+def observable_q():
+    lo, hi = observable_box()
     return st.tuples(*[st.floats(a, b) for a, b in zip(lo, hi, strict=True)]).map(np.array)
 
 
