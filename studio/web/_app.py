@@ -18,8 +18,9 @@ from fastapi.exceptions import RequestValidationError
 from fastapi.responses import FileResponse, JSONResponse
 from fastapi.staticfiles import StaticFiles
 from fastapi_offline import FastAPIOffline
+from starlette.exceptions import HTTPException
 from starlette.middleware.trustedhost import TrustedHostMiddleware
-from starlette.types import ASGIApp, Receive, Scope, Send
+from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from .. import __version__
 from .._errors import StudioError
@@ -148,31 +149,65 @@ def validation_sentence(errors: list[dict[str, Any]]) -> str:
 
 
 class UploadLimitMiddleware:
-    """Refuse request bodies announced larger than the upload limit before reading them (413).
+    """Refuse request bodies larger than the upload limit (413), without storing them.
 
-    The upload routes also count the bytes they receive, which covers bodies sent without a
-    ``Content-Length``.
+    A body announced larger (``Content-Length``) is refused before it is read; a body sent
+    without one (chunked) is counted while it streams in and refused at the limit, so at most
+    the limit (plus the multipart framing) is ever received.
     """
 
     def __init__(self, app: ASGIApp, limit: int) -> None:
         self.app = app
         self.limit = limit
 
+    def _sentence(self, size: str) -> str:
+        return f"The upload is {size}, over the limit of {human_bytes(self.limit)}; upload a smaller file or start the studio with a larger limit."
+
     async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
-        if scope["type"] == "http":
-            for key, value in scope.get("headers", ()):
-                if key == b"content-length":
-                    try:
-                        size = int(value)
-                    except ValueError:
-                        size = 0
-                    if size > self.limit + MULTIPART_OVERHEAD_BYTES:
-                        response = JSONResponse(
-                            {
-                                "detail": f"The upload is {human_bytes(size)}, over the limit of {human_bytes(self.limit)}; upload a smaller file or start the studio with a larger limit."
-                            },
-                            status_code=413,
-                        )
-                        await response(scope, receive, send)
-                        return
-        await self.app(scope, receive, send)
+        if scope["type"] != "http":
+            await self.app(scope, receive, send)
+            return
+        allowed = self.limit + MULTIPART_OVERHEAD_BYTES
+        for key, value in scope.get("headers", ()):
+            if key == b"content-length":
+                try:
+                    size = int(value)
+                except ValueError:
+                    size = 0
+                if size > allowed:
+                    response = JSONResponse(
+                        {"detail": self._sentence(human_bytes(size))}, status_code=413
+                    )
+                    await response(scope, receive, send)
+                    return
+        received = 0
+        started = False
+
+        async def counted_receive() -> Message:
+            nonlocal received
+            message = await receive()
+            if message["type"] == "http.request":
+                received += len(message.get("body", b""))
+                if received > allowed:
+                    # An HTTPException passes FastAPI's body parsing unchanged, and whatever
+                    # was read so far (Starlette's spooled parts, an upload's temporary file)
+                    # is dropped on the way out.
+                    raise BodyTooLarge(413, self._sentence(f"more than {human_bytes(allowed)}"))
+            return message
+
+        async def tracked_send(message: Message) -> None:
+            nonlocal started
+            if message["type"] == "http.response.start":
+                started = True
+            await send(message)
+
+        try:
+            await self.app(scope, counted_receive, tracked_send)
+        except BodyTooLarge as err:  # raised where no exception handler answered it
+            if started:
+                raise
+            await JSONResponse({"detail": err.detail}, status_code=413)(scope, receive, send)
+
+
+class BodyTooLarge(HTTPException):
+    """A request body that grew past the upload limit while it streamed in."""

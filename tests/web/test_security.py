@@ -155,3 +155,63 @@ def test_the_command_generates_a_token_beyond_loopback(
     assert started[-1].token == "from-env"
     command.run(_serve_args(host="0.0.0.0", data_dir=tmp_path, token="given"))
     assert started[-1].token == "given"
+
+
+def test_a_chunked_upload_is_stopped_at_the_limit(
+    open_client: Callable[..., TestClient], tmp_path: Path
+) -> None:
+    """A body without Content-Length is counted as it streams in: 413 at the limit, and the
+    server never reads (so never stores) more than the limit plus the multipart framing."""
+    from studio.web._app import MULTIPART_OVERHEAD_BYTES
+
+    limit = 200_000
+    client = open_client(upload_limit_bytes=limit)
+    chunk = b"0" * 65_536
+    total = 20_000_000
+    boundary = "studio-test-boundary"
+    head = (
+        f'--{boundary}\r\nContent-Disposition: form-data; name="file"; '
+        'filename="big.tape.csv"\r\nContent-Type: text/csv\r\n\r\n'
+    ).encode()
+    read = 0
+    messages: list[dict] = []
+
+    async def receive() -> dict:
+        nonlocal read
+        if read == 0:
+            read += len(head)
+            return {"type": "http.request", "body": head, "more_body": True}
+        if read >= total:
+            return {"type": "http.request", "body": f"\r\n--{boundary}--\r\n".encode()}
+        read += len(chunk)
+        return {"type": "http.request", "body": chunk, "more_body": True}
+
+    async def send(message: dict) -> None:
+        messages.append(message)
+
+    scope = {
+        "type": "http",
+        "asgi": {"version": "3.0"},
+        "http_version": "1.1",
+        "method": "POST",
+        "scheme": "http",
+        "path": "/api/recordings",
+        "raw_path": b"/api/recordings",
+        "root_path": "",
+        "query_string": b"",
+        "headers": [
+            (b"host", b"testserver"),
+            (b"content-type", f"multipart/form-data; boundary={boundary}".encode()),
+            (b"transfer-encoding", b"chunked"),
+        ],
+        "client": ("127.0.0.1", 5000),
+        "server": ("testserver", 80),
+        "state": {},
+    }
+    client.portal.call(client.app, scope, receive, send)
+    start = next(m for m in messages if m["type"] == "http.response.start")
+    body = b"".join(m.get("body", b"") for m in messages if m["type"] == "http.response.body")
+    assert start["status"] == 413, body
+    assert "over the limit" in body.decode()
+    assert read <= limit + MULTIPART_OVERHEAD_BYTES + len(chunk)
+    assert list((tmp_path / "recordings").iterdir()) == []
