@@ -129,6 +129,29 @@ def test_openapi_docs_list_every_resource(client):
         assert path in paths, path
 
 
+TYPED_TAGS = {"recordings", "demonstrations", "policies", "source", "capture", "watch"}
+"""Routers whose every JSON answer must be a declared ``*Public`` model."""
+
+
+def test_json_answers_are_declared_models(client):
+    """A route that answers JSON documents its model, so /docs shows every field (issue 9)."""
+    checked = 0
+    for path, methods in client.get("/openapi.json").json()["paths"].items():
+        for method, op in methods.items():
+            if not TYPED_TAGS & set(op.get("tags", [])):
+                continue
+            for status, answer in op["responses"].items():
+                schema = answer.get("content", {}).get("application/json", {}).get("schema")
+                if schema is None or not status.startswith("2"):
+                    continue
+                if path.endswith(("/file", ".csv")):  # downloads are files, not JSON
+                    continue
+                ref = schema.get("$ref") or schema.get("items", {}).get("$ref", "")
+                assert ref.endswith("Public") or ref.endswith("Detail"), (method, path, schema)
+                checked += 1
+    assert checked >= 15
+
+
 def test_malformed_bodies_get_one_sentence(client):
     r = client.post("/api/runs", content=b"{not json", headers={"content-type": "application/json"})
     assert r.status_code == 422 and isinstance(r.json()["detail"], str)

@@ -115,7 +115,7 @@ def read_demonstration(name: str, studio: StudioDep) -> DemonstrationDetail:
     )
 
 
-@router.post("/{name}/preview", status_code=202)
+@router.post("/{name}/preview", status_code=202, response_class=Response)
 def preview_demonstration(name: str, studio: StudioDep) -> Response:
     """Draw the demonstration's tool path and play it on the robot in the scene."""
     studio.preview_demonstration(name)
