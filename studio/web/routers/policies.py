@@ -6,6 +6,7 @@ from typing import Annotated, Literal
 
 from fastapi import APIRouter, File, Response, UploadFile
 from fastapi.responses import FileResponse
+from starlette.concurrency import run_in_threadpool
 
 from studio.learning import POLICY_SUFFIX, PolicyFile, policy_summary
 
@@ -73,10 +74,14 @@ async def upload_policy(
     ... appended.
     """
     tmp = await receive_upload(file, studio.policies.folder, settings.upload_limit_bytes)
-    taken = studio.policy_names()
-    name = studio.policies.adopt(tmp, file.filename, lambda n: n in taken)
-    studio.changes.bump("policies")
-    return policy_public(studio.policies.entry(name))
+
+    def adopt() -> PolicyPublic:  # reading the file and the run folders: not on the loop
+        taken = studio.policy_names()
+        name = studio.policies.adopt(tmp, file.filename, lambda n: n in taken)
+        studio.changes.bump("policies")
+        return policy_public(studio.policies.entry(name))
+
+    return await run_in_threadpool(adopt)
 
 
 @router.get("/{name}/file")

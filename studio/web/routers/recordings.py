@@ -10,6 +10,7 @@ from typing import Annotated, Any
 
 from fastapi import APIRouter, File, Response, UploadFile
 from fastapi.responses import StreamingResponse
+from starlette.concurrency import run_in_threadpool
 
 from studio.capture import (
     RECORDING_SUFFIX,
@@ -19,7 +20,7 @@ from studio.capture import (
 )
 
 from .._deps import SettingsDep, StudioDep
-from .._errors import ConflictError
+from .._errors import ConflictError, NotFoundError
 from .._schemas import RecordingCopy, RecordingPublic, RecordingUpdate
 from .._state import Studio
 from .._store import StoredFile, receive_upload
@@ -58,9 +59,15 @@ def list_recordings(studio: StudioDep) -> list[RecordingPublic]:
     The file a capture is writing appears once the capture stops.
     """
     capturing = studio.pipeline.capture_name
-    return [
-        recording_public(entry) for entry in studio.recordings.entries() if entry.name != capturing
-    ]
+    listed = []
+    for name in studio.recordings.names():
+        if name == capturing:  # never read the growing file: O(1) whatever its length
+            continue
+        try:
+            listed.append(recording_public(studio.recordings.entry(name)))
+        except (NotFoundError, FileNotFoundError):  # deleted meanwhile
+            continue
+    return listed
 
 
 @router.post("", status_code=201)
@@ -72,9 +79,13 @@ async def upload_recording(
     The name comes from the file name; a taken name gets ``-2``, ``-3``, ... appended.
     """
     tmp = await receive_upload(file, studio.recordings.folder, settings.upload_limit_bytes)
-    name = studio.recordings.adopt(tmp, file.filename)
-    studio.changes.bump("recordings")
-    return read_public(studio, name)
+
+    def adopt() -> RecordingPublic:  # parsing a long recording takes seconds: not on the loop
+        name = studio.recordings.adopt(tmp, file.filename)
+        studio.changes.bump("recordings")
+        return read_public(studio, name)
+
+    return await run_in_threadpool(adopt)
 
 
 @router.get("/{name}")
