@@ -35,8 +35,8 @@ from typing import Any
 
 import numpy as np
 
-from studio.kinematics import ArmTracker, TrackerConfig
 from studio import StudioError, read_json
+from studio.kinematics import ArmTracker, TrackerConfig
 from studio.learning import ArmGrid, LearningError
 
 from ._errors import DemonstrationError
