@@ -1,6 +1,6 @@
 """Capture: tape frames, sources (simulator, playback, network, serial), recordings, demonstrations.
 
-See ``docs/interfaces.md`` for the contract and :mod:`._recording_format` for the file format::
+See ``docs/architecture.md`` for the public names and :mod:`._recording_format` for the file format::
 
     from studio.capture import SimulatorSource, RecordingWriter, read_recording
 

@@ -1,4 +1,7 @@
-"""studio.kinematics (see docs/interfaces.md)."""
+"""Kinematics: Puma560 and human-arm models, tape reconstruction, arm fitting, retargeting.
+
+The public names are listed in ``docs/architecture.md``.
+"""
 
 from ._errors import KinematicsError as KinematicsError
 from ._fit import ArmFit as ArmFit

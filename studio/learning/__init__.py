@@ -1,6 +1,6 @@
 """Learning engine: tabular MDPs, Dyna-Q with four planners, the arm grid task, policy files.
 
-The public names (see ``docs/interfaces.md`` and this package's ``README.md``)::
+The public names (see ``docs/architecture.md`` and this package's ``README.md``)::
 
     from studio.learning import ArmGrid, DynaQConfig, run_experiments
 

@@ -1,0 +1,43 @@
+"""docs/architecture.md names only what the packages really export, so it cannot drift silently."""
+
+from __future__ import annotations
+
+import importlib
+import re
+from pathlib import Path
+
+DOC = Path(__file__).resolve().parents[1] / "docs" / "architecture.md"
+IMPORT_BLOCK = re.compile(r"from (studio\.\w+) import \(([^)]*)\)")
+OWNER = re.compile(r"`(studio\.[a-z]+)(?:\.([\w.]+))?`(?: \(([^)|]*)\))?")
+
+
+def _names(text: str) -> list[str]:
+    return [n.strip().strip("`").split("(")[0] for n in text.split(",") if n.strip()]
+
+
+def test_every_name_in_the_import_blocks_is_exported():
+    blocks = IMPORT_BLOCK.findall(DOC.read_text())
+    assert {module for module, _ in blocks} >= {
+        "studio.kinematics",
+        "studio.capture",
+        "studio.learning",
+    }
+    for module, names in blocks:
+        package = importlib.import_module(module)
+        missing = [n for n in _names(names) if not hasattr(package, n)]
+        assert not missing, f"{module} does not export {missing}"
+
+
+def test_every_owner_named_in_the_concept_table_exists():
+    text = DOC.read_text()
+    table = text[text.index("## Where each concept lives") : text.index("## Runtime")]
+    checked = 0
+    for module, attribute, listed in OWNER.findall(table):
+        package = importlib.import_module(module)
+        for name in ([attribute] if attribute else []) + _names(listed):
+            target = package
+            for part in name.split("."):
+                assert hasattr(target, part), f"{module} has no {name}"
+                target = getattr(target, part)
+            checked += 1
+    assert checked >= 10
