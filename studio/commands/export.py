@@ -7,7 +7,17 @@ from pathlib import Path
 
 import numpy as np
 
-from studio.learning import LearningError, greedy_path, load_policy, rollout, save_trajectory_csv
+from studio.learning import (
+    LearningError,
+    TilePolicyFile,
+    greedy_path,
+    load_any_policy,
+    rollout,
+    rollout_tile_policy,
+    save_trajectory_csv,
+)
+from studio.learning._linear_policy import DEFAULT_MAX_STEPS as TILE_MAX_STEPS
+from studio.learning._linear_policy import DEFAULT_SECONDS_PER_STEP as TILE_SECONDS_PER_STEP
 from studio.learning._policy import DEFAULT_MAX_STEPS, DEFAULT_RATE_HZ, DEFAULT_SECONDS_PER_STEP
 
 NAME = "export"
@@ -33,35 +43,84 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--seconds-per-step",
         type=float,
-        default=DEFAULT_SECONDS_PER_STEP,
-        help=f"seconds per grid step (default: {DEFAULT_SECONDS_PER_STEP:g})",
+        default=None,
+        help=f"seconds per step (default: {DEFAULT_SECONDS_PER_STEP:g} per grid step, {TILE_SECONDS_PER_STEP:g} per joint step of a tile-coded policy)",
     )
     parser.add_argument(
-        "--max-steps", type=int, default=DEFAULT_MAX_STEPS, help="cap on greedy steps"
+        "--max-steps",
+        type=int,
+        default=None,
+        help=f"cap on greedy steps (default: {DEFAULT_MAX_STEPS} grid steps, {TILE_MAX_STEPS} joint steps)",
     )
     parser.add_argument(
         "--out", type=Path, help="CSV path (default: the policy's name with .rollout.csv)"
     )
 
 
+def _start_degrees(text: str | None, joints: int) -> list[float]:
+    """The --start-deg angles (default all 0), checked to be one per joint."""
+    text = text or ",".join(["0"] * joints)
+    try:
+        degrees = [float(v) for v in text.split(",")]
+    except ValueError:
+        raise LearningError(
+            f"--start-deg is {text!r}; give {joints} angles in degrees separated by commas."
+        ) from None
+    if len(degrees) != joints:
+        raise LearningError(
+            f"--start-deg has {len(degrees)} angles; give {joints}, one per learned joint."
+        )
+    return degrees
+
+
+def _out_path(args: argparse.Namespace) -> Path:
+    return args.out or args.policy.with_name(
+        args.policy.name.removesuffix(".npz").removesuffix(".policy") + ".rollout.csv"
+    )
+
+
+def _run_tile(args: argparse.Namespace, policy: TilePolicyFile) -> int:
+    """Roll out a tile-coded arm policy from --start-deg (joint steps, constant speed)."""
+    if args.start_state is not None:
+        raise LearningError(
+            "--start-state numbers grid states; a tile-coded policy starts from --start-deg angles."
+        )
+    joints = policy.task.joints if policy.task is not None else 0
+    start = np.radians(_start_degrees(args.start_deg, joints)) if joints else np.zeros(0)
+    times, q, reached = rollout_tile_policy(
+        policy,
+        start,
+        rate_hz=args.rate,
+        max_steps=TILE_MAX_STEPS if args.max_steps is None else args.max_steps,
+        seconds_per_step=TILE_SECONDS_PER_STEP
+        if args.seconds_per_step is None
+        else args.seconds_per_step,
+    )
+    out = _out_path(args)
+    try:
+        save_trajectory_csv(out, times, q)
+    except OSError as err:
+        raise LearningError(f"Cannot write {out} ({err.strerror}); choose another --out.") from None
+    print(
+        f"the greedy policy {'reaches the goal' if reached else 'does NOT reach the goal'} in {times[-1]:.2f} s; "
+        f"wrote {len(times)} samples at {args.rate:g} Hz to {out}"
+    )
+    return 0
+
+
 def run(args: argparse.Namespace) -> int:
-    policy = load_policy(args.policy)
+    policy = load_any_policy(args.policy)
+    if isinstance(policy, TilePolicyFile):
+        return _run_tile(args, policy)
+    if args.max_steps is None:
+        args.max_steps = DEFAULT_MAX_STEPS
+    if args.seconds_per_step is None:
+        args.seconds_per_step = DEFAULT_SECONDS_PER_STEP
     grid = policy.grid
     if args.start_state is not None:
         start = args.start_state
     else:
-        text = args.start_deg or ",".join(["0"] * grid.joints)
-        try:
-            degrees = [float(v) for v in text.split(",")]
-        except ValueError:
-            raise LearningError(
-                f"--start-deg is {text!r}; give {grid.joints} angles in degrees separated by commas."
-            ) from None
-        if len(degrees) != grid.joints:
-            raise LearningError(
-                f"--start-deg has {len(degrees)} angles; give {grid.joints}, one per grid joint."
-            )
-        start = grid.state_of_angles(np.radians(degrees))
+        start = grid.state_of_angles(np.radians(_start_degrees(args.start_deg, grid.joints)))
     times, q = rollout(
         policy,
         start,
@@ -70,9 +129,7 @@ def run(args: argparse.Namespace) -> int:
         seconds_per_step=args.seconds_per_step,
     )
     path = greedy_path(policy, start, args.max_steps)
-    out = args.out or args.policy.with_name(
-        args.policy.name.removesuffix(".npz").removesuffix(".policy") + ".rollout.csv"
-    )
+    out = _out_path(args)
     try:
         save_trajectory_csv(out, times, q)
     except OSError as err:

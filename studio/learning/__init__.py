@@ -37,6 +37,19 @@ from ._goal import GOAL_JOINTS as GOAL_JOINTS
 from ._goal import check_goal_deg as check_goal_deg
 from ._goal import goal_problems as goal_problems
 from ._goal import grid_for_goal as grid_for_goal
+from ._gym import ARM_GRID_ID as ARM_GRID_ID
+from ._gym import ARM_REACH_ID as ARM_REACH_ID
+from ._gym import ArmGridEnv as ArmGridEnv
+from ._gym import ArmReachEnv as ArmReachEnv
+from ._gym import register as register_environments
+from ._linear import LinearResult as LinearResult
+from ._linear import greedy_rollout as greedy_rollout
+from ._linear import greedy_success as greedy_success
+from ._linear_policy import TilePolicyFile as TilePolicyFile
+from ._linear_policy import load_any_policy as load_any_policy
+from ._linear_policy import load_tile_policy as load_tile_policy
+from ._linear_policy import rollout_tile_policy as rollout_tile_policy
+from ._linear_policy import save_tile_policy as save_tile_policy
 from ._mdp import TabularMDP as TabularMDP
 from ._policy import PolicyFile as PolicyFile
 from ._policy import greedy_path as greedy_path
@@ -44,6 +57,7 @@ from ._policy import load_policy as load_policy
 from ._policy import rollout as rollout
 from ._policy import save_policy as save_policy
 from ._policy import save_trajectory_csv as save_trajectory_csv
+from ._reach import ArmReach as ArmReach
 from ._reproduce import ReproduceResult as ReproduceResult
 from ._reproduce import generate_demonstrations as generate_demonstrations
 from ._reproduce import reproduce as reproduce
@@ -64,3 +78,7 @@ from ._summary import POLICY_SUFFIX as POLICY_SUFFIX
 from ._summary import goal_degrees as goal_degrees
 from ._summary import has_default_goal as has_default_goal
 from ._summary import policy_summary as policy_summary
+from ._tiles import TileCoder as TileCoder
+from ._tiles import TileCoding as TileCoding
+
+register_environments()  # "TeachStudio/ArmGrid-v0" and "TeachStudio/ArmReach-v0"

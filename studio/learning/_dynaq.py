@@ -48,6 +48,7 @@ from numba import njit
 from ._config import PLANNERS, DynaQConfig, check_budget
 from ._errors import LearningError
 from ._mdp import TabularMDP
+from ._tiles import TileCoding
 
 _PLANNER_CODE = {name: code for code, name in enumerate(PLANNERS)}
 _ZERO, _FULL, _SOFT, _PRIORITIZED = (_PLANNER_CODE[name] for name in PLANNERS)
@@ -550,6 +551,7 @@ def run_experiments(
     episodes: int,
     seed: int,
     demonstrations: Sequence[Sequence[int]] | None = None,
+    features: TileCoding | None = None,
     *,
     workers: int | None = None,
     live: LiveProgress | None = None,
@@ -570,6 +572,10 @@ def run_experiments(
             (the agent takes the demonstrated actions, learning and planning as usual).
         workers: threads to use (default: one per CPU core).
         live: progress arrays to fill while running, and the stop flag to obey.
+        features: for a Gymnasium environment (a registered id or a zero-argument callable
+            returning one, Box observations, Discrete actions) in place of ``mdp``: the tile
+            coding of linear Dyna-Q (see :mod:`._linear`, which then runs the experiments and
+            returns a :class:`LinearResult` with the learned weights).
 
     Returns:
         The step and update counts per episode, CPU seconds per experiment and the final Q tables.
@@ -577,9 +583,16 @@ def run_experiments(
     Raises:
         LearningError: for a bad argument, a bad demonstration or a run over the limits.
     """
+    if not isinstance(mdp, TabularMDP) and (isinstance(mdp, str) or callable(mdp)):
+        from ._linear import run_linear_experiments  # imports this module: import it late
+
+        return run_linear_experiments(
+            mdp, config, experiments, episodes, seed, demonstrations, features,
+            workers=workers, live=live,
+        )  # fmt: skip
     if not isinstance(mdp, TabularMDP):
         raise LearningError(
-            f"mdp is a {type(mdp).__name__}; give a TabularMDP (for example ArmGrid().mdp())."
+            f"mdp is a {type(mdp).__name__}; give a TabularMDP (for example ArmGrid().mdp()), a Gymnasium environment id or a zero-argument callable returning an environment."
         )
     if not isinstance(config, DynaQConfig):
         raise LearningError(f"config is a {type(config).__name__}; give a DynaQConfig.")

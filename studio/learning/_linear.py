@@ -1,0 +1,859 @@
+"""Dyna-Q with linear function approximation over tile-coded features.
+
+Q(s, a) is the sum of the weights of s's active features in a's column of a ``(size, actions)``
+table (:mod:`._tiles`). A real step applies the semi-gradient Q-learning update
+
+    w[f, a] += (alpha / active) * (r + gamma * max_b Q(s', b) - Q(s, a))   for each active f of s
+
+(the target is ``r`` alone when s' is terminal), dividing ``alpha`` among the active tilings as
+Sutton & Barto do (their Mountain Car uses alpha = 0.5 / 8 with 8 tilings). The planners keep the
+meaning they have in the tabular learner (:mod:`._dynaq`): ``zero`` none, ``full`` exactly
+``planning_steps`` model updates per real step, ``soft`` ``max(planning_steps - k, 0)`` in
+episode ``k``, ``prioritized`` at most ``planning_steps`` updates per real step, largest error first.
+
+The model. Planning uses a **sample model over the visited transitions**: every real transition
+``(s, a, r, s', terminal)`` is stored as it happened (the observations, not their features), and
+a planning update replays one stored transition exactly as a real update would. We chose it over
+the linear expectation model of Sutton, Szepesvari, Geramifard & Bowling (2008) because (1) it is
+exact for the deterministic tasks here (the arm and Mountain Car) where the linear model (an F x F
+matrix per action, F the feature count) is an approximation whose error compounds, (2) it is the
+tabular learner's model, unchanged in meaning (its "previously visited (s, a)" are now the
+visited transitions), and (3) it costs O(active x actions) per update rather than O(F) or O(F^2).
+The model holds the last ``model_capacity`` transitions (a ring; older ones are forgotten). It is
+built from the agent's own steps only; planning never calls the environment.
+
+Prioritized sweeping over the sample model: each stored transition has a priority, its absolute
+TD error when last looked at. After a real step the transition and its predecessor are queued
+(as in :mod:`._dynaq`, the real update is applied directly, so prioritized with 0 steps is plain
+Q-learning); each planning update pops the largest, applies it, and requeues it and its
+predecessor with their remaining errors when above ``priority_threshold``. A transition's
+predecessor is the stored step before it in the same episode (whose s' is its s): exact for a
+sample model, and cheap; transitions that merely share features are reached when their own
+priority comes up.
+
+Where the dynamics run. For our arm task (``TeachStudio/ArmReach-v0``) and Gymnasium's
+``MountainCar-v0`` the whole experiment runs in one compiled kernel (:func:`_run_compiled`) that
+steps a numba twin of the environment's dynamics (the arm's are defined once in :mod:`._reach`;
+Mountain Car's twin is tested equal to Gymnasium's ``step``). Any other environment with a Box
+observation and Discrete actions runs a Python loop calling ``env.step`` and the same compiled
+learning step (:func:`_learn`), so both paths give the same result bit for bit on the same task.
+Start states come from ``env.reset`` in both paths (seeded per experiment), so they agree too.
+
+Random numbers: splitmix64 inside the kernels, as in the tabular learner, seeded per experiment
+by ``(seed, experiment)``; the environment's resets by ``seed`` and the experiment index.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import time
+from collections import namedtuple
+from collections.abc import Callable, Sequence
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numba import njit
+
+from ._config import MAX_Q_ENTRIES, PLANNERS, DynaQConfig, check_budget
+from ._dynaq import (
+    _GOLDEN,
+    ExperimentResult,
+    LiveProgress,
+    _below,
+    _heap_pop,
+    _heap_push,
+    _mix,
+    _unit,
+    experiment_seed,
+)
+from ._errors import LearningError
+from ._reach import ArmReach, reach_step
+from ._tiles import TileCoder, TileCoding, active_features
+
+DEFAULT_MODEL_CAPACITY = 1 << 18
+"""Transitions the sample model keeps (a ring; about 100 bytes each for a 6-D observation)."""
+
+_PLANNER_CODE = {name: code for code, name in enumerate(PLANNERS)}
+_ZERO, _FULL, _SOFT, _PRIORITIZED = (_PLANNER_CODE[name] for name in PLANNERS)
+
+_TASK_REACH = 0
+_TASK_MOUNTAIN_CAR = 1
+# Mountain Car's parameter layout (gymnasium's attribute names)
+_MOUNTAIN_CAR_PARAMS = (
+    "force",
+    "gravity",
+    "max_speed",
+    "min_position",
+    "max_position",
+    "goal_position",
+    "goal_velocity",
+)
+
+Agent = namedtuple(
+    "Agent",
+    "w spec gamma step planner threshold "
+    "model_obs model_next model_action model_reward model_terminal model_stamp model_follows "
+    "heap_idx heap_pri heap_pos counters feats feats_next plan_s plan_next qvals",
+)
+"""The learner's arrays and settings as one numba-friendly value (see :func:`_new_agent`).
+
+``counters`` int64: ``[stored, next slot, heap size, transitions ever stored]``.
+"""
+_STORED, _SLOT, _HEAP, _STAMP = 0, 1, 2, 3
+
+Episodes = namedtuple(
+    "Episodes", "starts demo_starts demo_actions demo_offsets max_steps planning_steps epsilon"
+)
+"""What the compiled kernel plays: start states ``(episodes, state_dim)``, demonstrations
+(starts ``(n, state_dim)``, actions back to back, offsets ``(n + 1,)``), the step cap, the
+planning budget and epsilon."""
+
+
+# --------------------------------------------------------------------------- Mountain Car twin
+
+
+@njit(nogil=True, cache=True)
+def mountain_car_step(params, state, action):
+    """Gymnasium's ``MountainCarEnv.step`` on ``state = [position, velocity]`` (in place).
+
+    Returns ``(reward, terminated)``. The same float64 operations in the same order as Gymnasium
+    1.x, so the result is equal bit for bit (a test steps both side by side).
+    """
+    force, gravity, max_speed = params[0], params[1], params[2]
+    min_position, max_position = params[3], params[4]
+    position = state[0]
+    velocity = state[1]
+    velocity += (action - 1) * force + math.cos(3 * position) * (-gravity)
+    velocity = min(max(velocity, -max_speed), max_speed)
+    position += velocity
+    position = min(max(position, min_position), max_position)
+    if position == min_position and velocity < 0:
+        velocity = 0.0
+    state[0] = position
+    state[1] = velocity
+    return -1.0, position >= params[5] and velocity >= params[6]
+
+
+# --------------------------------------------------------------------------- learning steps
+
+
+@njit(nogil=True, cache=True, inline="always")
+def _q_values(w, feats, out):
+    """``out[a] = Q(s, a)``: the active features' weights summed in feature order."""
+    n_actions = out.shape[0]
+    for a in range(n_actions):
+        out[a] = 0.0
+    for i in range(feats.shape[0]):
+        f = feats[i]
+        for a in range(n_actions):
+            out[a] += w[f, a]
+
+
+@njit(nogil=True, cache=True, inline="always")
+def _max(q):
+    best = q[0]
+    for a in range(1, q.shape[0]):
+        if q[a] > best:
+            best = q[a]
+    return best
+
+
+@njit(nogil=True, cache=True)
+def _choose(q, epsilon, rng):
+    """Epsilon-greedy on the action values ``q``, ties broken uniformly; returns ``(a, rng)``.
+
+    Draws exactly as the tabular kernel does: one draw for exploration, then one for the random
+    action or, when several actions tie for the best, one to pick among them.
+    """
+    n_actions = q.shape[0]
+    rng += _GOLDEN
+    if _unit(_mix(rng)) < epsilon:
+        rng += _GOLDEN
+        return _below(_mix(rng), n_actions), rng
+    best = _max(q)
+    ties = 0
+    for a in range(n_actions):
+        if q[a] == best:
+            ties += 1
+    k = 0
+    if ties > 1:
+        rng += _GOLDEN
+        k = _below(_mix(rng), ties)
+    count = 0
+    for a in range(n_actions):
+        if q[a] == best:
+            if count == k:
+                return a, rng
+            count += 1
+    return 0, rng
+
+
+@njit(nogil=True, cache=True)
+def _td_update(agent, feats_s, action, reward, terminal, feats_next):
+    """Semi-gradient Q-learning on one transition; returns the TD error before the update."""
+    q = agent.qvals
+    target = reward
+    if not terminal:
+        _q_values(agent.w, feats_next, q)
+        target += agent.gamma * _max(q)
+    w = agent.w
+    value = 0.0
+    for i in range(feats_s.shape[0]):
+        value += w[feats_s[i], action]
+    delta = target - value
+    change = agent.step * delta
+    for i in range(feats_s.shape[0]):
+        w[feats_s[i], action] += change
+    return delta
+
+
+@njit(nogil=True, cache=True)
+def _error(agent, slot):
+    """Absolute TD error of stored transition ``slot`` under the current weights."""
+    active_features(agent.spec, agent.model_obs[slot], agent.plan_s)
+    active_features(agent.spec, agent.model_next[slot], agent.plan_next)
+    q = agent.qvals
+    target = agent.model_reward[slot]
+    if not agent.model_terminal[slot]:
+        _q_values(agent.w, agent.plan_next, q)
+        target += agent.gamma * _max(q)
+    value = 0.0
+    a = agent.model_action[slot]
+    for i in range(agent.plan_s.shape[0]):
+        value += agent.w[agent.plan_s[i], a]
+    return abs(target - value)
+
+
+@njit(nogil=True, cache=True)
+def _replay(agent, slot):
+    """One planning update: the stored transition ``slot`` replayed as a real update."""
+    active_features(agent.spec, agent.model_obs[slot], agent.plan_s)
+    active_features(agent.spec, agent.model_next[slot], agent.plan_next)
+    _td_update(
+        agent, agent.plan_s, agent.model_action[slot], agent.model_reward[slot],
+        agent.model_terminal[slot], agent.plan_next,
+    )  # fmt: skip
+
+
+@njit(nogil=True, cache=True)
+def _queue(agent, slot):
+    """Queue ``slot`` with its current error when that exceeds the threshold."""
+    priority = _error(agent, slot)
+    if priority > agent.threshold:
+        agent.counters[_HEAP] = _heap_push(
+            agent.heap_idx, agent.heap_pri, agent.heap_pos, agent.counters[_HEAP], slot, priority
+        )
+
+
+@njit(nogil=True, cache=True)
+def _queue_predecessor(agent, slot):
+    """Queue the stored step before ``slot`` in the same episode, if the ring still holds it."""
+    if not agent.model_follows[slot]:
+        return
+    capacity = agent.model_stamp.shape[0]
+    prev = slot - 1 if slot > 0 else capacity - 1
+    if agent.model_stamp[prev] == agent.model_stamp[slot] - 1:
+        _queue(agent, prev)
+
+
+@njit(nogil=True, cache=True)
+def _store(agent, obs, action, reward, terminal, obs_next, follows):
+    """Remember a real transition in the sample model; returns its slot."""
+    slot = agent.counters[_SLOT]
+    capacity = agent.model_stamp.shape[0]
+    agent.model_obs[slot] = obs
+    agent.model_next[slot] = obs_next
+    agent.model_action[slot] = action
+    agent.model_reward[slot] = reward
+    agent.model_terminal[slot] = terminal
+    agent.model_stamp[slot] = agent.counters[_STAMP]
+    agent.model_follows[slot] = follows
+    agent.counters[_STAMP] += 1
+    agent.counters[_SLOT] = slot + 1 if slot + 1 < capacity else 0
+    if agent.counters[_STORED] < capacity:
+        agent.counters[_STORED] += 1
+    return slot
+
+
+@njit(nogil=True, cache=True)
+def _learn(agent, obs, feats_s, action, reward, terminal, obs_next, follows, n_plan, rng):
+    """A real step's learning: update, remember, plan. Returns ``(rng, updates)``.
+
+    Leaves the active features of ``obs_next`` in ``agent.feats_next``.
+    """
+    active_features(agent.spec, obs_next, agent.feats_next)
+    _td_update(agent, feats_s, action, reward, terminal, agent.feats_next)
+    updates = 1
+    if agent.model_stamp.shape[0] == 0:
+        return rng, updates
+    slot = _store(agent, obs, action, reward, terminal, obs_next, follows)
+    if agent.planner == _PRIORITIZED:
+        _queue(agent, slot)
+        _queue_predecessor(agent, slot)
+        for _ in range(n_plan):
+            if agent.counters[_HEAP] == 0:
+                break
+            p, agent.counters[_HEAP] = _heap_pop(
+                agent.heap_idx, agent.heap_pri, agent.heap_pos, agent.counters[_HEAP]
+            )
+            _replay(agent, p)
+            updates += 1
+            _queue(agent, p)
+            _queue_predecessor(agent, p)
+    else:
+        stored = agent.counters[_STORED]
+        for _ in range(n_plan):
+            rng += _GOLDEN
+            _replay(agent, _below(_mix(rng), stored))
+        updates += n_plan
+    return rng, updates
+
+
+@njit(nogil=True, cache=True)
+def _act(agent, feats, epsilon, rng):
+    """Epsilon-greedy action at the state with active ``feats``; returns ``(a, rng)``."""
+    _q_values(agent.w, feats, agent.qvals)
+    return _choose(agent.qvals, epsilon, rng)
+
+
+@njit(nogil=True, cache=True, inline="always")
+def _plan_budget(planner, planning_steps, episode):
+    if planner == _ZERO:
+        return 0
+    if planner == _SOFT:
+        return max(planning_steps - episode, 0)
+    return planning_steps
+
+
+# --------------------------------------------------------------------------- compiled tasks
+
+
+@njit(nogil=True, cache=True, inline="always")
+def _task_step(task, params, state, action):
+    if task == _TASK_REACH:
+        return reach_step(params, state, action)
+    return mountain_car_step(params, state, action)
+
+
+@njit(nogil=True, cache=True, inline="always")
+def _observe(task, state, obs):
+    """The observation the learner sees: the state (Mountain Car rounds it to float32)."""
+    if task == _TASK_MOUNTAIN_CAR:
+        for d in range(state.shape[0]):
+            obs[d] = np.float64(np.float32(state[d]))
+    else:
+        for d in range(state.shape[0]):
+            obs[d] = state[d]
+
+
+@njit(nogil=True, cache=True)
+def _run_compiled(task, params, agent, plays, seed, stop, steps_out, updates_out):
+    """One experiment on a compiled task; fills ``steps_out``/``updates_out``, returns episodes."""
+    episodes = steps_out.shape[0]
+    n_demos = plays.demo_starts.shape[0]
+    dims = plays.starts.shape[1]
+    state = np.empty(dims)
+    obs = np.empty(dims)
+    obs_next = np.empty(dims)
+    feats = np.empty(agent.feats.shape[0], np.int64)
+    rng = seed
+    done = 0
+    for episode in range(episodes):
+        if stop[0] != 0:
+            break
+        n_plan = _plan_budget(agent.planner, plays.planning_steps, episode)
+        demo = episode < n_demos
+        if demo:
+            state[:] = plays.demo_starts[episode]
+            first = plays.demo_offsets[episode]
+            limit = plays.demo_offsets[episode + 1] - first
+        else:
+            state[:] = plays.starts[episode]
+            first = 0
+            limit = plays.max_steps
+        _observe(task, state, obs)
+        active_features(agent.spec, obs, feats)
+        steps = 0
+        updates = 0
+        while steps < limit:
+            if demo:
+                action = plays.demo_actions[first + steps]
+            else:
+                action, rng = _act(agent, feats, plays.epsilon, rng)
+            reward, terminal = _task_step(task, params, state, action)
+            _observe(task, state, obs_next)
+            rng, n = _learn(
+                agent, obs, feats, action, reward, terminal, obs_next, steps > 0, n_plan, rng
+            )
+            updates += n
+            steps += 1
+            if terminal:
+                break
+            obs[:] = obs_next
+            feats[:] = agent.feats_next
+        steps_out[episode] = steps
+        updates_out[episode] = updates
+        done += 1
+    return done
+
+
+@njit(nogil=True, cache=True)
+def _greedy_episode(task, params, spec, w, state, max_steps, path):
+    """Follow the greedy policy (ties: lowest action) from ``state`` (in place).
+
+    Writes each visited state into ``path`` rows (the start first) and returns the number of
+    steps taken, negative (``-steps - 1``) when ``max_steps`` ran out before the goal.
+    """
+    dims = state.shape[0]
+    n_actions = w.shape[1]
+    obs = np.empty(dims)
+    feats = np.empty(spec.bases.size, np.int64)
+    q = np.empty(n_actions)
+    path[0] = state
+    for steps in range(max_steps):
+        _observe(task, state, obs)
+        active_features(spec, obs, feats)
+        _q_values(w, feats, q)
+        best = 0
+        for a in range(1, n_actions):
+            if q[a] > q[best]:
+                best = a
+        _, terminal = _task_step(task, params, state, best)
+        if steps + 1 < path.shape[0]:
+            path[steps + 1] = state
+        if terminal:
+            return steps + 1
+    return -max_steps - 1
+
+
+# --------------------------------------------------------------------------- set-up
+
+
+def _new_agent(
+    coder: TileCoder, n_actions: int, dims: int, config: DynaQConfig, capacity: int
+) -> Agent:
+    """Zero weights, an empty model (none at all for zero planning) and scratch arrays."""
+    planner = _PLANNER_CODE[config.planning]
+    cap = 0 if planner == _ZERO or config.planning_steps == 0 else capacity
+    queue = cap if planner == _PRIORITIZED else 0
+    return Agent(
+        np.zeros((coder.size, n_actions), np.float64),
+        coder.spec,
+        float(config.gamma),
+        float(config.alpha) / coder.n_active,
+        planner,
+        float(config.priority_threshold),
+        np.zeros((cap, dims), np.float64),
+        np.zeros((cap, dims), np.float64),
+        np.zeros(cap, np.int64),
+        np.zeros(cap, np.float64),
+        np.zeros(cap, np.bool_),
+        np.full(cap, -1, np.int64),
+        np.zeros(cap, np.bool_),
+        np.zeros(queue, np.int64),
+        np.zeros(queue, np.float64),
+        np.full(queue, -1, np.int64),
+        np.zeros(4, np.int64),
+        np.zeros(coder.n_active, np.int64),
+        np.zeros(coder.n_active, np.int64),
+        np.zeros(coder.n_active, np.int64),
+        np.zeros(coder.n_active, np.int64),
+        np.zeros(n_actions, np.float64),
+    )
+
+
+@dataclass(frozen=True)
+class _Task:
+    """What a run knows about its environment after inspecting it."""
+
+    code: int | None  # compiled task code, or None for the Python loop
+    params: np.ndarray
+    low: np.ndarray
+    high: np.ndarray
+    n_actions: int
+    max_steps: int
+    reach: ArmReach | None
+    env_id: str | None
+
+
+_PASS_THROUGH_WRAPPERS = ("TimeLimit", "OrderEnforcing", "PassiveEnvChecker")
+"""Gymnasium wrappers that change neither observations, actions nor rewards."""
+
+
+def _make_env(env: object, index: int) -> Any:
+    """A fresh environment from an id or a zero-argument callable."""
+    import gymnasium
+
+    try:
+        made = gymnasium.make(env) if isinstance(env, str) else env()  # type: ignore[operator]
+    except gymnasium.error.Error as err:
+        raise LearningError(
+            f"Gymnasium cannot make {env!r} ({err}); give a registered environment id."
+        ) from None
+    if not isinstance(made, gymnasium.Env):
+        raise LearningError(
+            f"The environment factory returned a {type(made).__name__}; return a gymnasium.Env."
+        )
+    return made
+
+
+def _inspect(env: Any, config: DynaQConfig) -> _Task:
+    """Check the spaces and find a compiled twin of the dynamics, if there is one."""
+    from gymnasium import spaces
+    from gymnasium.envs.classic_control.mountain_car import MountainCarEnv
+
+    from ._gym import ArmReachEnv
+
+    name = getattr(getattr(env, "spec", None), "id", None) or type(env.unwrapped).__name__
+    if not isinstance(env.action_space, spaces.Discrete):
+        raise LearningError(
+            f"{name} has a {type(env.action_space).__name__} action space; this learner needs Discrete actions (discretise the actions, for example with a wrapper)."
+        )
+    if not isinstance(env.observation_space, spaces.Box) or len(env.observation_space.shape) != 1:
+        raise LearningError(
+            f"{name} has a {env.observation_space} observation space; tile coding needs a one-dimensional Box."
+        )
+    if int(env.action_space.start) != 0:
+        raise LearningError(
+            f"{name}'s actions start at {int(env.action_space.start)}; give a Discrete space starting at 0."
+        )
+    max_steps = int(config.max_steps_per_episode)
+    plain = True
+    layer = env
+    while hasattr(layer, "env"):
+        if type(layer).__name__ not in _PASS_THROUGH_WRAPPERS:
+            plain = False
+        if type(layer).__name__ == "TimeLimit":
+            max_steps = min(max_steps, int(layer._max_episode_steps))
+        layer = layer.env
+    raw = env.unwrapped
+    space = env.observation_space
+    code: int | None = None
+    params = np.zeros(0)
+    reach = None
+    if plain and type(raw) is ArmReachEnv:
+        code, reach = _TASK_REACH, raw.task
+        params = reach.params
+    elif plain and type(raw) is MountainCarEnv:
+        code = _TASK_MOUNTAIN_CAR
+        params = np.array([float(getattr(raw, p)) for p in _MOUNTAIN_CAR_PARAMS])
+    spec_id = getattr(getattr(env, "spec", None), "id", None)
+    return _Task(
+        code,
+        params,
+        np.asarray(space.low, np.float64),
+        np.asarray(space.high, np.float64),
+        int(env.action_space.n),
+        max_steps,
+        reach,
+        spec_id,
+    )
+
+
+def _internal_state(env: Any, task: _Task, obs: np.ndarray) -> np.ndarray:
+    """The state a compiled twin steps from, right after ``env.reset``."""
+    raw = env.unwrapped
+    if task.code == _TASK_MOUNTAIN_CAR:
+        return np.asarray(raw.state, dtype=np.float64).copy()
+    if task.code == _TASK_REACH:
+        return np.asarray(raw.q, dtype=np.float64).copy()
+    return np.asarray(obs, dtype=np.float64)
+
+
+def reset_seed(seed: int, experiment: int) -> int:
+    """The seed of an experiment's first ``env.reset`` (later resets continue its generator)."""
+    return int(np.random.SeedSequence([seed, experiment, 1]).generate_state(1, np.uint32)[0])
+
+
+@dataclass(frozen=True, eq=False)
+class LinearResult(ExperimentResult):
+    """What :func:`run_experiments` returns for a Gymnasium environment.
+
+    The :class:`ExperimentResult` fields, with ``q`` holding the learned weights, plus:
+
+    Attributes:
+        weights: float ``(experiments, size, actions)``: each experiment's weight table
+            (the same array as ``q``).
+        coder: the bound tile coder (``coder.active(obs)`` gives an observation's features).
+        task: the arm task when the environment is ``TeachStudio/ArmReach-v0``, else None.
+        env_id: the environment's registered id, when it has one.
+        compiled: whether the experiments ran in the compiled kernel (else a Python loop).
+    """
+
+    weights: np.ndarray = None  # type: ignore[assignment]
+    coder: TileCoder = None  # type: ignore[assignment]
+    task: ArmReach | None = None
+    env_id: str | None = None
+    compiled: bool = False
+
+    def q_values(self, obs: np.ndarray, experiment: int = 0) -> np.ndarray:
+        """Q(obs, .) of one experiment's weights, ``(..., actions)``."""
+        feats = self.coder.active(obs)
+        return self.weights[experiment][feats].sum(axis=-2)
+
+
+def _demonstrations(
+    demonstrations: Sequence[Any], task: _Task, dims: int
+) -> tuple[list[np.ndarray | None], list[np.ndarray]]:
+    """Per demonstration: its start state (None: from ``env.reset``) and its actions."""
+    starts: list[np.ndarray | None] = []
+    actions: list[np.ndarray] = []
+    for i, demo in enumerate(demonstrations):
+        arr = np.asarray(demo)
+        if arr.ndim == 2 and task.reach is not None:
+            start, acts = task.reach.demonstration_actions(arr, i)
+            starts.append(start)
+            actions.append(acts)
+            continue
+        if arr.ndim != 1 or arr.size == 0 or not np.issubdtype(arr.dtype, np.integer):
+            what = "a joint path (N, joints) in radians or " if task.reach is not None else ""
+            raise LearningError(
+                f"Demonstration {i} has shape {arr.shape} and type {arr.dtype}; give {what}a non-empty sequence of action numbers."
+            )
+        if arr.min() < 0 or arr.max() >= task.n_actions:
+            raise LearningError(
+                f"Demonstration {i} holds action {int(arr.max() if arr.max() >= task.n_actions else arr.min())}, outside [0, {task.n_actions - 1}]; give actions of this environment."
+            )
+        starts.append(None)
+        actions.append(arr.astype(np.int64))
+    return starts, actions
+
+
+def run_linear_experiments(
+    env: str | Callable[[], Any],
+    config: DynaQConfig,
+    experiments: int,
+    episodes: int,
+    seed: int,
+    demonstrations: Sequence[Any] | None,
+    features: TileCoding | None,
+    *,
+    workers: int | None = None,
+    live: LiveProgress | None = None,
+    model_capacity: int = DEFAULT_MODEL_CAPACITY,
+) -> LinearResult:
+    """Linear Dyna-Q on a Gymnasium environment (``run_experiments``'s non-tabular branch).
+
+    Args:
+        env: a registered environment id, or a zero-argument callable returning a new
+            environment (a lambda is fine: it is called in this process, never pickled), with a
+            Box observation space and a Discrete action space.
+        config: learning settings (``alpha`` is divided among the active features).
+        experiments: independent repetitions.
+        episodes: episodes per experiment.
+        seed: a non-negative integer.
+        demonstrations: replayed as the first episodes: for ``TeachStudio/ArmReach-v0`` joint
+            paths ``(N, joints)`` in radians; for any environment, action sequences replayed from
+            ``env.reset``.
+        features: the tile coding (required).
+        workers: threads for the compiled kernel (default: one per core).
+        live: progress arrays to fill and the stop flag to obey.
+        model_capacity: transitions the sample model keeps.
+
+    Raises:
+        LearningError: bad input, each with one sentence naming it and the fix.
+    """
+    if not isinstance(features, TileCoding):
+        raise LearningError(
+            f"features is {type(features).__name__}; give a TileCoding (for example TileCoding(tilings=8, tiles=8)) to learn on a Gymnasium environment."
+        )
+    if not (isinstance(env, str) or callable(env)):
+        raise LearningError(
+            f"env is a {type(env).__name__}; give a TabularMDP, a Gymnasium id or a zero-argument callable returning an environment."
+        )
+    if not isinstance(config, DynaQConfig):
+        raise LearningError(f"config is a {type(config).__name__}; give a DynaQConfig.")
+    check_budget(experiments, episodes)
+    if not isinstance(seed, int | np.integer) or isinstance(seed, bool) or not 0 <= seed < 2**63:
+        raise LearningError(f"seed is {seed!r}; give a whole number from 0 to 2**63 - 1.")
+    seed = int(seed)
+    if workers is None:
+        workers = os.cpu_count() or 1
+    if not isinstance(workers, int) or isinstance(workers, bool) or workers < 1:
+        raise LearningError(f"workers is {workers!r}; give a whole number of threads, at least 1.")
+    if live is None:
+        live = LiveProgress(experiments, episodes)
+    elif not isinstance(live, LiveProgress) or live.steps.shape != (experiments, episodes):
+        raise LearningError(
+            f"live follows a run of shape {getattr(getattr(live, 'steps', None), 'shape', None)}; create LiveProgress({experiments}, {episodes}) for this run."
+        )
+    envs = [_make_env(env, e) for e in range(experiments)]
+    try:
+        task = _inspect(envs[0], config)
+        coder = features.bind(task.low, task.high)
+        entries = experiments * coder.size * task.n_actions
+        if entries > MAX_Q_ENTRIES:
+            raise LearningError(
+                f"{experiments} weight tables of {coder.size:,} rows x {task.n_actions} actions need {entries * 8 / 1e9:.1f} GB; give TileCoding a smaller size or run fewer experiments (at most {MAX_Q_ENTRIES:,} weights in all)."
+            )
+        dims = int(task.low.shape[0])
+        demo_starts, demo_actions = _demonstrations(demonstrations or [], task, dims)
+        agents = [
+            _new_agent(coder, task.n_actions, dims, config, model_capacity)
+            for _ in range(experiments)
+        ]
+        cpu_seconds = np.zeros(experiments)
+        runner = _compiled_experiment if task.code is not None else _python_experiment
+
+        def one(e: int) -> None:
+            start = time.thread_time()
+            runner(envs[e], task, agents[e], config, seed, e, demo_starts, demo_actions, live)
+            cpu_seconds[e] = time.thread_time() - start
+
+        threads = min(workers, experiments) if task.code is not None else 1
+        if threads == 1:
+            for e in range(experiments):
+                one(e)
+        else:
+            with ThreadPoolExecutor(max_workers=threads, thread_name_prefix="lineardyna") as pool:
+                for future in [pool.submit(one, e) for e in range(experiments)]:
+                    future.result()
+    finally:
+        for made in envs:
+            made.close()
+    weights = np.stack([agent.w for agent in agents])
+    return LinearResult(
+        steps=live.steps.copy(),
+        updates=live.updates.copy(),
+        cpu_seconds=cpu_seconds,
+        q=weights,
+        config=config,
+        seed=seed,
+        stopped=live.stopped and bool(np.any(live.steps < 0)),
+        weights=weights,
+        coder=coder,
+        task=task.reach,
+        env_id=task.env_id,
+        compiled=task.code is not None,
+    )
+
+
+def _reset_states(env: Any, task: _Task, seed: int, e: int, episodes: int) -> np.ndarray:
+    """Every episode's start state, from the environment's own ``reset`` (seeded once)."""
+    states = []
+    for k in range(episodes):
+        obs, _ = env.reset(seed=reset_seed(seed, e) if k == 0 else None)
+        states.append(_internal_state(env, task, obs))
+    return np.ascontiguousarray(np.array(states, dtype=np.float64))
+
+
+def _compiled_experiment(env, task, agent, config, seed, e, demo_starts, demo_actions, live):
+    episodes = live.steps.shape[1]
+    starts = _reset_states(env, task, seed, e, episodes)
+    dims = starts.shape[1]
+    if any(s is None for s in demo_starts):
+        raise LearningError(
+            "Action-sequence demonstrations start from env.reset; give the arm task joint paths instead."
+        )
+    offsets = np.concatenate([[0], np.cumsum([len(a) for a in demo_actions])]).astype(np.int64)
+    plays = Episodes(
+        starts,
+        np.ascontiguousarray(np.array(demo_starts, np.float64).reshape(len(demo_starts), dims)),
+        np.ascontiguousarray(
+            np.concatenate(demo_actions) if demo_actions else np.zeros(0), np.int64
+        ),
+        offsets,
+        np.int64(task.max_steps),
+        np.int64(config.planning_steps),
+        float(config.epsilon),
+    )
+    _run_compiled(
+        np.int64(task.code), task.params, agent, plays, experiment_seed(seed, e),
+        live._stop, live.steps[e], live.updates[e],
+    )  # fmt: skip
+
+
+def _python_experiment(env, task, agent, config, seed, e, demo_starts, demo_actions, live):
+    """The same experiment as :func:`_run_compiled`, stepping ``env`` from Python."""
+    episodes = live.steps.shape[1]
+    rng = experiment_seed(seed, e)
+    n_active = agent.feats.shape[0]
+    feats = np.empty(n_active, np.int64)
+    planner = agent.planner
+    epsilon = float(config.epsilon)
+    for episode in range(episodes):
+        if live.stopped:
+            break
+        n_plan = _plan_budget_py(planner, int(config.planning_steps), episode)
+        obs, _ = env.reset(seed=reset_seed(seed, e) if episode == 0 else None)
+        demo = episode < len(demo_actions)
+        if demo and demo_starts[episode] is not None:
+            obs, _ = env.reset(options={"q": demo_starts[episode]})
+        obs = np.asarray(obs, dtype=np.float64).copy()
+        limit = len(demo_actions[episode]) if demo else task.max_steps
+        active_features(agent.spec, obs, feats)
+        steps = updates = 0
+        while steps < limit:
+            if demo:
+                action = int(demo_actions[episode][steps])
+            else:
+                action, rng = _act(agent, feats, epsilon, rng)
+                rng = np.uint64(rng)  # numba hands uint64 back as a Python int
+            obs_next, reward, terminated, truncated, _ = env.step(int(action))
+            obs_next = np.asarray(obs_next, dtype=np.float64).copy()
+            rng, n = _learn(
+                agent, obs, feats, int(action), float(reward), bool(terminated), obs_next,
+                steps > 0, n_plan, rng,
+            )  # fmt: skip
+            rng = np.uint64(rng)
+            updates += n
+            steps += 1
+            if terminated or truncated:
+                break
+            obs = obs_next
+            feats[:] = agent.feats_next
+        live.steps[e, episode] = steps
+        live.updates[e, episode] = updates
+
+
+def _plan_budget_py(planner: int, planning_steps: int, episode: int) -> int:
+    if planner == _ZERO:
+        return 0
+    if planner == _SOFT:
+        return max(planning_steps - episode, 0)
+    return planning_steps
+
+
+def greedy_rollout(
+    task: ArmReach, coder: TileCoder, weights: np.ndarray, start: np.ndarray, max_steps: int
+) -> tuple[np.ndarray, bool]:
+    """The greedy policy's path on the arm task from ``start``: ``(states (K + 1, joints), reached)``.
+
+    Ties go to the lowest action, so a rollout is deterministic.
+    """
+    state = np.array(start, dtype=np.float64)
+    path = np.empty((max_steps + 1, task.joints))
+    steps = _greedy_episode(
+        np.int64(_TASK_REACH), task.params, coder.spec,
+        np.ascontiguousarray(weights, np.float64), state, np.int64(max_steps), path,
+    )  # fmt: skip
+    reached = steps >= 0
+    taken = steps if reached else -steps - 1
+    return path[: taken + 1].copy(), reached
+
+
+def greedy_success(
+    task: ArmReach,
+    coder: TileCoder,
+    weights: np.ndarray,
+    starts: np.ndarray,
+    max_steps: int,
+) -> np.ndarray:
+    """Per start ``(N, joints)``: whether the greedy policy reaches the goal within ``max_steps``."""
+    out = np.zeros(starts.shape[0], np.bool_)
+    _success_many(
+        task.params, coder.spec, np.ascontiguousarray(weights, np.float64),
+        np.ascontiguousarray(starts, np.float64), np.int64(max_steps), out,
+    )  # fmt: skip
+    return out
+
+
+@njit(nogil=True, cache=True)
+def _success_many(params, spec, w, starts, max_steps, out):
+    path = np.empty((1, starts.shape[1]))
+    for i in range(starts.shape[0]):
+        state = starts[i].copy()
+        out[i] = _greedy_episode(_TASK_REACH, params, spec, w, state, max_steps, path) >= 0

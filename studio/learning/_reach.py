@@ -1,0 +1,455 @@
+"""The continuous arm task: joints 1..J of the Puma560 reach a demonstrated pose, step by step.
+
+The state is the first ``joints`` joint angles (radians, inside the robot's limits); the other
+joints stay at the goal's values. Actions move ONE joint by ``step_deg`` at a time (2J actions:
+joint 1 up, joint 1 down, joint 2 up, ...). A move that would leave the joint's limits leaves the
+arm where it is, as on the paper's grid. Reaching the goal pays :data:`GOAL_REWARD` and ends the
+episode, every other step pays :data:`STEP_REWARD` (the paper's rewards), plus a potential-based
+shaping term (:data:`DEFAULT_SHAPING`). Episodes start uniformly across the limits (a start already
+at the goal is redrawn).
+
+Why one joint at a time rather than every joint -1/0/+1 at once (3**J actions, 729 for six
+joints): a linear learner evaluates every action at every step and learns each action's weights
+from its own visits, so 12 actions cost 60x less per step and each gets 60x more data; and with one
+joint per action the steps to the goal are a sum of per-joint distances, which per-joint tilings
+represent (:meth:`ArmReach.features`). The price is longer paths (the sum of the joints' distances
+instead of the largest). There is no "stay" action: it never helps a reach, and with function
+approximation its estimate can stick above the moves' and freeze the arm.
+
+The goal is judged where a user sees it: the tool (Puma560 DH frame 6) within
+``position_tolerance`` metres and ``angle_tolerance_deg`` degrees of the goal's tool pose, by
+forward kinematics. :func:`tool_pose` is a numba twin of :meth:`studio.kinematics.Puma560.forward`
+built from the same DH table (a test holds them equal), so the kernels can call it.
+
+Dynamics are defined once, here, in numba functions (:func:`reach_step`, :func:`reach_success`): the learner's compiled kernel and the Gymnasium environment
+``TeachStudio/ArmReach-v0`` both call them.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+from numba import njit
+
+from studio.kinematics import Puma560
+
+from ._arm import DEFAULT_GOAL_DEG, GOAL_REWARD, STEP_REWARD
+from ._errors import LearningError
+from ._tiles import TileCoding
+
+ROBOT_JOINTS = 6
+"""The Puma560's joints."""
+MIN_JOINTS = 3
+"""Fewest joints the continuous task offers (the paper's three)."""
+DEFAULT_JOINTS = 6
+"""All six joints, so the tool's orientation is learned too."""
+DEFAULT_STEP_DEG = 2.0
+"""Joint increment per action, degrees (no coarser than 2 degrees)."""
+MAX_STEP_DEG = 2.0
+"""Coarsest step allowed: beyond it the tool jumps by several centimetres per step."""
+MIN_STEP_DEG = 0.05
+"""Finest step allowed: below it an episode across the limits takes tens of thousands of steps."""
+DEFAULT_POSITION_TOLERANCE = 0.02
+"""Tool within this many metres of the goal's tool position counts as reached."""
+DEFAULT_ANGLE_TOLERANCE_DEG = 10.0
+"""...and within this many degrees of the goal's tool orientation."""
+DEFAULT_MAX_EPISODE_STEPS = 3_000
+"""Episode cap of the registered environment (about three times the longest greedy path)."""
+DEFAULT_TILINGS = 8
+"""Offset tilings of the arm's default features."""
+DEFAULT_TILES = 32
+"""Tiles per joint of the arm's default features (pairs of joints, see :meth:`ArmReach.features`):
+about 17 degrees of the widest joint each, about 2 degrees resolution over 8 tilings."""
+DEFAULT_SHAPING = 1.0
+"""Weight of the potential-based shaping reward (Ng, Harada & Russell 1999): the change of minus
+the tool's pose error, counted in tolerances. It leaves the optimal policies unchanged (with
+gamma = 1 the shaping terms of an episode telescope to a constant per start) and gives every
+step a direction toward the goal, without which a 6-joint random start almost never finds the
+goal's few-degree region at all; 0 gives the paper's bare +100 / -1."""
+MAX_SHAPING = 100.0
+"""Upper bound on ``shaping``."""
+LIMIT_SLACK_RAD = 1e-9
+"""A demonstration may touch its joint limits within this rounding."""
+
+# layout of the flat float64 parameter array the compiled functions take
+_J, _STEP, _POS_TOL2, _MIN_TRACE = 0, 1, 2, 3
+_GOAL_P = 4  # 3 values
+_GOAL_R = 7  # 9 values, row-major
+_LOWER = 16  # 6 values
+_UPPER = 22
+_HOLD = 28
+_D = 34
+_A = 40
+_ALPHA = 46
+_SHAPING = 52
+_POS_TOL = 53
+_ANG_TOL = 54
+_N_PARAMS = 55
+
+
+@dataclass(frozen=True)
+class ArmReach:
+    """The continuous reaching task over joints 1..``joints`` of the Puma560.
+
+    Attributes:
+        joints: joints learned, from joint 1 (3 to 6).
+        step_deg: joint increment per action, degrees.
+        goal: goal joint angles in radians: ``joints`` values, or six (the joints beyond
+            ``joints`` are held there); default: :data:`studio.learning.DEFAULT_GOAL_DEG`.
+        position_tolerance: metres.
+        angle_tolerance_deg: degrees.
+
+    Raises:
+        LearningError: a bad value, or a goal outside the joint limits.
+    """
+
+    joints: int = DEFAULT_JOINTS
+    step_deg: float = DEFAULT_STEP_DEG
+    goal: tuple[float, ...] | None = None
+    position_tolerance: float = DEFAULT_POSITION_TOLERANCE
+    angle_tolerance_deg: float = DEFAULT_ANGLE_TOLERANCE_DEG
+    shaping: float = DEFAULT_SHAPING
+
+    def __post_init__(self) -> None:
+        if (
+            not isinstance(self.joints, int | np.integer)
+            or isinstance(self.joints, bool)
+            or not MIN_JOINTS <= self.joints <= ROBOT_JOINTS
+        ):
+            raise LearningError(
+                f"joints is {self.joints!r}; give {MIN_JOINTS} to {ROBOT_JOINTS} (joints 1..J of the arm)."
+            )
+        object.__setattr__(self, "joints", int(self.joints))
+        for name, low, high in (
+            ("step_deg", MIN_STEP_DEG, MAX_STEP_DEG),
+            ("position_tolerance", 1e-4, 1.0),
+            ("angle_tolerance_deg", 0.1, 180.0),
+            ("shaping", 0.0, MAX_SHAPING),
+        ):
+            value = getattr(self, name)
+            if (
+                not isinstance(value, int | float | np.integer | np.floating)
+                or isinstance(value, bool)
+                or not math.isfinite(value)
+                or not low <= value <= high
+            ):
+                raise LearningError(f"{name} is {value!r}; give a number from {low} to {high}.")
+            object.__setattr__(self, name, float(value))
+        lower, upper = _limits()
+        if self.goal is None:
+            goal = np.radians(DEFAULT_GOAL_DEG)
+        else:
+            g = np.asarray(self.goal, dtype=np.float64).reshape(-1)
+            if g.shape not in ((self.joints,), (ROBOT_JOINTS,)) or not np.all(np.isfinite(g)):
+                raise LearningError(
+                    f"goal is {self.goal!r}; give {self.joints} or {ROBOT_JOINTS} finite joint angles in radians."
+                )
+            goal = np.radians(DEFAULT_GOAL_DEG).copy()
+            goal[: g.shape[0]] = g
+        outside = np.flatnonzero(
+            (goal < lower - LIMIT_SLACK_RAD) | (goal > upper + LIMIT_SLACK_RAD)
+        )
+        if outside.size:
+            j = int(outside[0])
+            raise LearningError(
+                f"The goal's joint {j + 1} is {np.degrees(goal[j]):.1f} deg, outside its limits [{np.degrees(lower[j]):.0f}, {np.degrees(upper[j]):.0f}]; give a goal inside the limits."
+            )
+        object.__setattr__(self, "goal", tuple(float(x) for x in np.clip(goal, lower, upper)))
+
+    # ------------------------------------------------------------------ sizes
+
+    @property
+    def n_actions(self) -> int:
+        """2J: one joint up or down by one step."""
+        return 2 * self.joints
+
+    @property
+    def step(self) -> float:
+        """The joint increment, radians."""
+        return math.radians(self.step_deg)
+
+    @property
+    def lower(self) -> np.ndarray:
+        """Lower limits of the learned joints, radians ``(joints,)``."""
+        return _limits()[0][: self.joints].copy()
+
+    @property
+    def upper(self) -> np.ndarray:
+        """Upper limits of the learned joints, radians ``(joints,)``."""
+        return _limits()[1][: self.joints].copy()
+
+    def to_dict(self) -> dict:
+        """JSON-ready settings (the inverse of ``ArmReach(**d)``)."""
+        return {
+            "joints": self.joints,
+            "step_deg": self.step_deg,
+            "goal": list(self.goal),
+            "position_tolerance": self.position_tolerance,
+            "angle_tolerance_deg": self.angle_tolerance_deg,
+            "shaping": self.shaping,
+        }
+
+    @classmethod
+    def from_dict(cls, data: dict) -> ArmReach:
+        """Settings from :meth:`to_dict`'s form."""
+        return cls(**{**data, "goal": None if data.get("goal") is None else tuple(data["goal"])})
+
+    def features(
+        self, tilings: int = DEFAULT_TILINGS, tiles: int = DEFAULT_TILES, size: int | None = None
+    ) -> TileCoding:
+        """The default tile coding of this task: every pair of joints tiled on its own.
+
+        One grid over all joints would need ``(tiles + 1) ** joints`` tiles per tiling (1.3e9
+        for six joints at 32 tiles) and generalise only within a few degrees in every joint at
+        once. With one joint moving per action, the steps to the goal are nearly a sum of
+        per-joint distances, so tilings of each joint alone would do in principle; measured, they
+        leave the greedy policy oscillating (each action's weights must carry the other joints'
+        share equally, and learning noise breaks the tie), while pairs of joints (``J (J - 1) / 2
+        x (tiles + 1) ** 2`` tiles per tiling) learn it: 88% greedy success on three joints
+        against 12% for single joints, same budget (see the package README).
+        """
+        pairs = tuple((i, j) for i in range(self.joints) for j in range(i + 1, self.joints))
+        return TileCoding(tilings=tilings, tiles=tiles, size=size, groups=pairs)
+
+    @cached_property
+    def params(self) -> np.ndarray:
+        """The flat parameter array of :func:`reach_step` and friends (read-only)."""
+        robot = Puma560()
+        p = np.zeros(_N_PARAMS, np.float64)
+        p[_J] = self.joints
+        p[_STEP] = self.step
+        p[_POS_TOL2] = self.position_tolerance**2
+        p[_MIN_TRACE] = 1.0 + 2.0 * math.cos(math.radians(self.angle_tolerance_deg))
+        lower, upper = _limits()
+        p[_LOWER : _LOWER + 6] = lower
+        p[_UPPER : _UPPER + 6] = upper
+        p[_HOLD : _HOLD + 6] = self.goal
+        p[_D : _D + 6] = [row.d for row in robot.dh]
+        p[_A : _A + 6] = [row.a for row in robot.dh]
+        p[_ALPHA : _ALPHA + 6] = [row.alpha for row in robot.dh]
+        p[_SHAPING] = self.shaping
+        p[_POS_TOL] = self.position_tolerance
+        p[_ANG_TOL] = math.radians(self.angle_tolerance_deg)
+        oMgoal = robot.forward(np.asarray(self.goal))
+        p[_GOAL_P : _GOAL_P + 3] = oMgoal[:3, 3]
+        p[_GOAL_R : _GOAL_R + 9] = oMgoal[:3, :3].reshape(-1)
+        p.flags.writeable = False
+        return p
+
+    # ------------------------------------------------------------------ Python-side helpers
+
+    def success(self, q: Sequence[float] | np.ndarray) -> bool:
+        """Whether joint angles ``q`` (the learned joints, radians) put the tool at the goal."""
+        state = self._state(q)
+        return bool(reach_success(self.params, state))
+
+    def tool_pose(self, q: Sequence[float] | np.ndarray) -> np.ndarray:
+        """The tool pose ``oMtool`` (4x4) at the learned joints ``q``, other joints held."""
+        out = np.empty((4, 4))
+        tool_pose(self.params, self._state(q), out)
+        return out
+
+    def full_q(self, q: Sequence[float] | np.ndarray) -> np.ndarray:
+        """All six joint angles: ``q`` for the learned joints, the goal's for the others."""
+        full = np.array(self.goal, dtype=np.float64)
+        full[: self.joints] = self._state(q)
+        return full
+
+    def random_start(self, rng: np.random.Generator) -> np.ndarray:
+        """A start drawn uniformly across the limits, not already at the goal."""
+        while True:
+            q = rng.uniform(self.lower, self.upper)
+            if not reach_success(self.params, q):
+                return q
+
+    def _state(self, q: Sequence[float] | np.ndarray) -> np.ndarray:
+        state = np.asarray(q, dtype=np.float64).reshape(-1)
+        if state.shape != (self.joints,) or not np.all(np.isfinite(state)):
+            raise LearningError(
+                f"q has shape {state.shape}; give {self.joints} finite joint angles in radians."
+            )
+        return np.ascontiguousarray(state)
+
+    def demonstration_actions(
+        self, q_path: np.ndarray | Sequence[Sequence[float]], index: int = 0
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """The start and the action sequence that follow a demonstrated joint path.
+
+        The walk starts at the path's first sample and steps toward each later sample in turn,
+        one joint per step (the joint farthest from the sample first), until every joint is within
+        half a step of it; it stops at its first arrival at the goal.
+
+        Args:
+            q_path: joint angles, radians, ``(N, joints)`` or wider (the first ``joints`` columns).
+            index: the demonstration's number, for messages.
+
+        Returns:
+            ``(start (joints,), actions (K,) int64)``.
+
+        Raises:
+            LearningError: a bad shape, a sample outside the joint limits, or a path that never
+                comes within tolerance of the goal.
+        """
+        q = np.asarray(q_path, dtype=np.float64)
+        if q.ndim != 2 or q.shape[0] < 1 or q.shape[1] < self.joints:
+            raise LearningError(
+                f"Demonstration {index} has shape {q.shape}; give an (N, {self.joints}) or wider array of joint angles in radians."
+            )
+        q = np.ascontiguousarray(q[:, : self.joints])
+        if not np.all(np.isfinite(q)):
+            raise LearningError(
+                f"Demonstration {index} holds NaN or infinite angles; re-record it."
+            )
+        lower, upper = self.lower, self.upper
+        bad = (q < lower - LIMIT_SLACK_RAD) | (q > upper + LIMIT_SLACK_RAD)
+        if bad.any():
+            k, j = (int(v) for v in np.argwhere(bad)[0])
+            raise LearningError(
+                f"Demonstration {index} leaves joint {j + 1}'s limits at sample {k} ({np.degrees(q[k, j]):.1f} deg, outside [{np.degrees(lower[j]):.0f}, {np.degrees(upper[j]):.0f}]); cut that part off or record it again inside the limits."
+            )
+        q = np.clip(q, lower, upper)
+        actions = np.empty(_walk_capacity(q, self.step), np.int64)
+        n = _walk(self.params, q, actions)
+        if n < 0:
+            raise LearningError(
+                f"Demonstration {index} never brings the tool within {self.position_tolerance * 100:g} cm and {self.angle_tolerance_deg:g} deg of the goal; end it at the goal or make the goal its final pose."
+            )
+        return q[0].copy(), actions[:n].copy()
+
+
+def _limits() -> tuple[np.ndarray, np.ndarray]:
+    robot = _robot()
+    return np.asarray(robot.lower, dtype=np.float64), np.asarray(robot.upper, dtype=np.float64)
+
+
+_ROBOT: list[Puma560] = []
+
+
+def _robot() -> Puma560:
+    """One shared Puma560 (building its Pinocchio model costs a few milliseconds)."""
+    if not _ROBOT:
+        _ROBOT.append(Puma560())
+    return _ROBOT[0]
+
+
+def _walk_capacity(q: np.ndarray, step: float) -> int:
+    """An upper bound on the walk's actions: the path's joint travel in steps, plus slack."""
+    travel = np.abs(np.diff(q, axis=0)).sum() if q.shape[0] > 1 else 0.0
+    return int(travel / step) + q.shape[0] * q.shape[1] + 8
+
+
+# --------------------------------------------------------------------------- compiled dynamics
+
+
+@njit(nogil=True, cache=True)
+def tool_pose(params, state, out):
+    """Standard-DH forward kinematics ``prod_i Rz(q_i) Tz(d_i) Tx(a_i) Rx(alpha_i)`` into ``out``.
+
+    The numba twin of :meth:`studio.kinematics.Puma560.forward`: ``state`` holds the learned
+    joints, the others come from the held goal angles in ``params``.
+    """
+    joints = int(params[_J])
+    for i in range(4):
+        for k in range(4):
+            out[i, k] = 1.0 if i == k else 0.0
+    for i in range(ROBOT_JOINTS):
+        theta = state[i] if i < joints else params[_HOLD + i]
+        ct, st = math.cos(theta), math.sin(theta)
+        ca, sa = math.cos(params[_ALPHA + i]), math.sin(params[_ALPHA + i])
+        a, d = params[_A + i], params[_D + i]
+        # A = [[ct, -st ca, st sa, a ct], [st, ct ca, -ct sa, a st], [0, sa, ca, d]]
+        for r in range(3):
+            x, y, z, p = out[r, 0], out[r, 1], out[r, 2], out[r, 3]
+            out[r, 0] = x * ct + y * st
+            out[r, 1] = -x * st * ca + y * ct * ca + z * sa
+            out[r, 2] = x * st * sa - y * ct * sa + z * ca
+            out[r, 3] = x * a * ct + y * a * st + z * d + p
+
+
+@njit(nogil=True, cache=True)
+def _errors(params, state):
+    """``(squared position error m^2, trace(R_goal^T R))`` of the tool at ``state``."""
+    pose = np.empty((4, 4))
+    tool_pose(params, state, pose)
+    dx = pose[0, 3] - params[_GOAL_P]
+    dy = pose[1, 3] - params[_GOAL_P + 1]
+    dz = pose[2, 3] - params[_GOAL_P + 2]
+    trace = 0.0  # trace(R_goal^T R) = 1 + 2 cos(angle between them)
+    for r in range(3):
+        for c in range(3):
+            trace += params[_GOAL_R + 3 * r + c] * pose[r, c]
+    return dx * dx + dy * dy + dz * dz, trace
+
+
+@njit(nogil=True, cache=True)
+def reach_success(params, state):
+    """Whether the tool is within the position and angle tolerances of the goal's tool pose."""
+    distance2, trace = _errors(params, state)
+    return distance2 <= params[_POS_TOL2] and trace >= params[_MIN_TRACE]
+
+
+@njit(nogil=True, cache=True)
+def reach_potential(params, state):
+    """Shaping potential: minus the joints' distance to the goal's joint angles, in steps."""
+    total = 0.0
+    for j in range(state.shape[0]):
+        total += abs(state[j] - params[_HOLD + j])
+    return -total / params[_STEP]
+
+
+@njit(nogil=True, cache=True)
+def reach_step(params, state, action):
+    """Apply ``action`` to ``state`` (in place); returns ``(reward, terminated)``.
+
+    Action ``2 j`` moves joint ``j`` up one step, ``2 j + 1`` down. A move
+    that would leave the joint's limits leaves it where it is. The reward is the paper's (+100 at
+    the goal, -1 otherwise) plus ``shaping`` times the change of :func:`reach_potential`.
+    """
+    shaping = params[_SHAPING]
+    before = reach_potential(params, state) if shaping != 0.0 else 0.0
+    j = action // 2
+    moved = state[j] + (params[_STEP] if action % 2 == 0 else -params[_STEP])
+    if params[_LOWER + j] <= moved <= params[_UPPER + j]:
+        state[j] = moved
+    done = reach_success(params, state)
+    reward = GOAL_REWARD if done else STEP_REWARD
+    if shaping != 0.0:
+        reward += shaping * (reach_potential(params, state) - before)
+    return reward, done
+
+
+@njit(nogil=True, cache=True)
+def _walk(params, path, actions):
+    """Fill ``actions`` with a one-joint-per-step walk along ``path``; returns their number.
+
+    Returns -1 when the walk never reaches the goal. See :meth:`ArmReach.demonstration_actions`.
+    """
+    joints = path.shape[1]
+    step = params[_STEP]
+    state = path[0].copy()
+    if reach_success(params, state):
+        return 0
+    n = 0
+    for i in range(1, path.shape[0]):
+        while n < actions.shape[0]:
+            best = -1
+            gap = 0.5 * step
+            for j in range(joints):
+                if abs(path[i, j] - state[j]) > gap:
+                    moved = state[j] + (step if path[i, j] > state[j] else -step)
+                    if params[_LOWER + j] <= moved <= params[_UPPER + j]:
+                        gap = abs(path[i, j] - state[j])
+                        best = j
+            if best < 0:
+                break
+            action = 2 * best + (0 if path[i, best] > state[best] else 1)
+            actions[n] = action
+            n += 1
+            _, done = reach_step(params, state, action)
+            if done:
+                return n
+    return -1

@@ -1,0 +1,82 @@
+"""The registered Gymnasium environments: check_env, seeding, nothing rendered, shared dynamics."""
+
+from __future__ import annotations
+
+import gymnasium
+import numpy as np
+import pytest
+from gymnasium.utils.env_checker import check_env
+
+import studio.learning  # noqa: F401  (registers the environments)
+from studio.learning import ARM_GRID_ID, ARM_REACH_ID, ArmGrid, ArmReach, LearningError
+from studio.learning._reach import reach_step
+
+
+@pytest.mark.filterwarnings("ignore:.*render_mode")
+@pytest.mark.parametrize(
+    "env_id, kwargs",
+    [(ARM_GRID_ID, {}), (ARM_REACH_ID, {}), (ARM_REACH_ID, {"joints": 3, "step_deg": 1.0})],
+)
+def test_check_env_passes_and_nothing_renders(env_id, kwargs):
+    env = gymnasium.make(env_id, **kwargs)
+    check_env(env.unwrapped)
+    assert env.render_mode is None and env.unwrapped.metadata["render_modes"] == []
+    with pytest.raises(LearningError, match="renders nothing"):
+        gymnasium.make(env_id, render_mode="human", **kwargs).unwrapped  # noqa: B018
+
+
+@pytest.mark.parametrize("env_id", [ARM_GRID_ID, ARM_REACH_ID])
+def test_reset_seed_repeats_the_episode(env_id):
+    def episode(seed):
+        env = gymnasium.make(env_id)
+        obs, _ = env.reset(seed=seed)
+        out = [np.asarray(obs, dtype=float).copy()]
+        rng = np.random.default_rng(0)
+        for _ in range(20):
+            obs, *_ = env.step(int(rng.integers(env.action_space.n)))
+            out.append(np.asarray(obs, dtype=float).copy())
+        return np.array(out)
+
+    assert np.array_equal(episode(3), episode(3))
+    assert not np.array_equal(episode(3)[0], episode(4)[0])
+
+
+def test_arm_grid_env_steps_the_learners_table():
+    grid = ArmGrid()
+    mdp = grid.mdp()
+    env = gymnasium.make(ARM_GRID_ID).unwrapped
+    state, _ = env.reset(seed=0)
+    rng = np.random.default_rng(1)
+    for _ in range(200):
+        a = int(rng.integers(grid.n_actions))
+        nxt, reward, terminated, truncated, _ = env.step(a)
+        assert (nxt, reward, terminated) == (
+            int(mdp.next_state[state, a]),
+            float(mdp.reward[state, a]),
+            bool(mdp.terminal[mdp.next_state[state, a]]),
+        )
+        state = nxt if not terminated else env.reset()[0]
+
+
+def test_arm_reach_env_steps_the_learners_function():
+    task = ArmReach(joints=4, step_deg=1.5)
+    env = gymnasium.make(ARM_REACH_ID, joints=4, step_deg=1.5).unwrapped
+    q, _ = env.reset(seed=2)
+    assert env.observation_space.contains(q)
+    mirror = q.copy()
+    rng = np.random.default_rng(3)
+    for _ in range(300):
+        a = int(rng.integers(task.n_actions))
+        q, reward, terminated, _, _ = env.step(a)
+        expected_reward, expected_done = reach_step(task.params, mirror, a)
+        assert np.array_equal(q, mirror) and reward == expected_reward
+        assert terminated == expected_done
+        assert np.all(q >= task.lower) and np.all(q <= task.upper)
+
+
+def test_arm_reach_env_options_start_and_bad_start():
+    env = gymnasium.make(ARM_REACH_ID, joints=3).unwrapped
+    q, _ = env.reset(options={"q": [0.1, 0.2, 0.3]})
+    assert np.array_equal(q, [0.1, 0.2, 0.3])
+    with pytest.raises(LearningError, match="inside the limits"):
+        env.reset(options={"q": [10.0, 0.0, 0.0]})
