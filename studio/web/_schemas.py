@@ -145,12 +145,17 @@ class CaptureStart(_Body):
 
 
 class CapturePublic(BaseModel):
-    """The capture in progress, if any."""
+    """The capture in progress, if any, and why the last one stopped by itself (until dismissed)."""
 
     active: bool
     name: str | None
     seconds: float
     frames: int
+    error: str | None = Field(
+        None,
+        description="why the last capture stopped by itself (a full disk: what is kept); "
+        "shown until DELETE /api/capture/error",
+    )
 
 
 class RecordingPublic(BaseModel):

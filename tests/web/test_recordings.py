@@ -7,9 +7,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from studio.capture import RecordingWriter, TapeFrame, read_recording
 from studio.samples import SAMPLES_DIR
+from studio.web._store import NAME_PATTERN, SAMPLE_PREFIX, check_name, clean_upload_name
 
 REGIONS = 16
 RATE_HZ = 110.0
@@ -262,3 +265,13 @@ def test_uploaded_copies_of_samples_become_the_users_own(recordings, client):
     assert r.status_code == 422 and "sample-" in r.json()["detail"]
     r = client.post("/api/capture/start", json={"name": "sample-take"})
     assert r.status_code in (409, 422)  # no source here; a sample name is never accepted
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.text(max_size=120).filter(lambda s: not any(c in s for c in "/\\") and ".." not in s))
+def test_an_upload_name_is_always_a_valid_name_of_the_users_own(filename):
+    """Law: whatever plain file name a browser sends, the store name is valid and not a sample's."""
+    name = clean_upload_name(filename, ".tape.csv", "recording")
+    assert NAME_PATTERN.match(name), name
+    assert not name.startswith(SAMPLE_PREFIX)
+    assert check_name(name) == name

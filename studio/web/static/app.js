@@ -271,6 +271,17 @@ function renderCaptureButton() {
   $("capture-elapsed").textContent = `${fmt(secs, 1)} s`;
   $("top-rec").hidden = !active;
   $("top-rec-time").textContent = fmt(secs, 1);
+  const failure = (S.capture && S.capture.error) || ""; // e.g. a full disk: shown until dismissed
+  $("capture-failure").hidden = !failure;
+  $("capture-failure-text").textContent = failure;
+}
+
+async function dismissCaptureFailure() {
+  await guarded("capture-error", async () => {
+    await api("DELETE", "/api/capture/error");
+    if (S.capture) S.capture.error = null;
+    renderCaptureButton();
+  }, $("capture-failure-dismiss"));
 }
 
 async function toggleCapture() {
@@ -278,7 +289,7 @@ async function toggleCapture() {
   if (b.dataset.active === "1") {
     await guarded("capture-error", async () => {
       const rec = await api("POST", "/api/capture/stop");
-      S.capture = { active: false, name: null, seconds: 0, frames: 0 };
+      S.capture = await api("GET", "/api/capture"); // inactive, with the reason if the disk failed
       renderCaptureButton();
       await loadRecordings();
       flashRow("recordings-body", rec && rec.name);
@@ -1139,6 +1150,7 @@ function wire() {
   $("retarget-mirror").addEventListener("change", setRetarget);
 
   $("capture-toggle").addEventListener("click", toggleCapture);
+  $("capture-failure-dismiss").addEventListener("click", dismissCaptureFailure);
   $("recording-upload").addEventListener("change", (e) => uploadRecording(e.target));
   $("edit-form").addEventListener("submit", saveRecordingEdit);
 
