@@ -24,7 +24,7 @@ from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from .. import __version__
 from .._errors import StudioError
-from ._errors import NotFoundError, WebError
+from ._errors import NotFoundError, StorageError, WebError, os_error_answer
 from ._guard import GuardMiddleware, SiteRule
 from ._settings import Settings, get_settings
 from ._state import Studio
@@ -97,6 +97,13 @@ def create_app(settings: Settings | None = None, scene: Any = None) -> FastAPI:
             body["problems"] = problems
             body["by_field"] = getattr(err, "by_field", {})
         return JSONResponse(body, status_code=status)
+
+    @app.exception_handler(OSError)
+    async def os_error(request: Request, err: OSError) -> JSONResponse:
+        status, sentence = os_error_answer(err, settings.data_dir.resolve())
+        if status >= 500 and status != StorageError.status_code:
+            log.error("%s %s failed", request.method, request.url.path, exc_info=err)
+        return JSONResponse({"detail": sentence}, status_code=status)
 
     @app.exception_handler(RequestValidationError)
     async def validation_error(request: Request, err: RequestValidationError) -> JSONResponse:

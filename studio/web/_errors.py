@@ -2,10 +2,16 @@
 
 Each is a :class:`studio.StudioError`, so its message names the problem and the fix; the class
 only chooses the HTTP status. Errors from the algorithm packages (bad training settings, a
-malformed recording, a refused demonstration) are also ``StudioError`` and answer 422.
+malformed recording, a refused demonstration) are also ``StudioError`` and answer 422. A write
+the disk refuses (full, read-only, not permitted) is one sentence too, made here for every write
+path (:func:`storage_sentence`), answered as 507.
 """
 
 from __future__ import annotations
+
+import errno
+import os
+from pathlib import Path
 
 from .._errors import StudioError
 
@@ -38,3 +44,77 @@ class TooLargeError(WebError):
     """An upload over the size limit."""
 
     status_code = 413
+
+
+class StorageError(WebError):
+    """The disk refused a write: full, over quota, read-only, or not the studio's to write."""
+
+    status_code = 507
+
+
+STORAGE_PROBLEMS = {
+    errno.ENOSPC: ("is full", "free some space"),
+    errno.EDQUOT: ("is over your disk quota", "free some space"),
+    errno.EROFS: ("is read-only", "start the studio with --data-dir on a writable disk"),
+    errno.EACCES: (
+        "may not be written by the studio",
+        "fix the folder's permissions or start the studio with another --data-dir",
+    ),
+    errno.EPERM: (
+        "may not be written by the studio",
+        "fix the folder's permissions or start the studio with another --data-dir",
+    ),
+}
+"""The write failures a user can fix, by errno: what the disk is, and the fix."""
+
+
+def storage_errno(err: BaseException) -> int | None:
+    """The errno of a write failure a user can fix, or None for any other error.
+
+    ``err`` is an ``OSError``, or an error whose message quotes one (the capture writer reports
+    its disk failures as a :class:`studio.capture.RecordingError` naming the ``strerror``).
+    """
+    if isinstance(err, OSError):
+        return err.errno if err.errno in STORAGE_PROBLEMS else None
+    text = str(err)
+    for code in STORAGE_PROBLEMS:
+        if os.strerror(code) in text:
+            return code
+    return None
+
+
+def storage_sentence(
+    err: BaseException, folder: Path, kept: str = "nothing was changed", then: str = "try again"
+) -> str | None:
+    """One sentence for a write the disk refused, or None when ``err`` is no such failure.
+
+    Args:
+        err: the failure (see :func:`storage_errno`).
+        folder: where the studio was writing (the data folder or one of its subfolders).
+        kept: what is left, e.g. ``"1234 frames kept"`` for a capture.
+        then: what to do after the fix, e.g. ``"record again"``.
+    """
+    code = storage_errno(err)
+    if code is None:
+        return None
+    what, fix = STORAGE_PROBLEMS[code]
+    return f"The disk holding {folder} {what}: {kept}; {fix} and {then}."
+
+
+def os_error_answer(err: OSError, data_dir: Path) -> tuple[int, str]:
+    """The HTTP status and the one sentence for an ``OSError`` a request ran into.
+
+    A write the disk refused is a 507 naming the disk and the fix; a file deleted by another
+    request meanwhile (a rename racing a delete) is a 404; anything else is a 500 that still
+    says what happened.
+    """
+    sentence = storage_sentence(err, data_dir)
+    if sentence is not None:
+        return StorageError.status_code, sentence
+    if isinstance(err, FileNotFoundError):
+        return (
+            NotFoundError.status_code,
+            "A file this request needs was deleted meanwhile; refresh the list and try again.",
+        )
+    reason = err.strerror or type(err).__name__
+    return 500, f"The studio could not read or write a file ({reason}); see the server log."

@@ -26,7 +26,7 @@ import numpy as np
 from studio.kinematics import ArmTracker, TapeConfig, TrackerConfig
 
 from .._errors import StudioError
-from ._errors import ConflictError
+from ._errors import ConflictError, storage_sentence
 
 log = logging.getLogger(__name__)
 
@@ -76,6 +76,7 @@ class Pipeline:
         self._capture_last_t: float | None = None
         self._kin_error: str | None = None
         self._fit_warning: str | None = None
+        self._capture_error: str | None = None  # kept until dismissed: fits never clear it
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
 
@@ -246,6 +247,7 @@ class Pipeline:
                 )
             self._writer, self._capture_name, self._capture_path = writer, name, path
             self._capture_frames = 0
+            self._capture_error = None
             self._capture_t0 = None
             self._capture_last_t = None
 
@@ -272,10 +274,27 @@ class Pipeline:
     def _close_writer(self) -> None:
         try:
             self._writer.close()
-        except Exception:  # the file's flushed frames are still there, marked recovered
-            log.exception("closing the capture %s failed", self._capture_name)
+        except Exception as err:  # the file's flushed frames are still there, marked recovered
+            log.warning("closing the capture %s failed: %s", self._capture_name, err)
+            self._capture_error = self._capture_failure(err)
         self._writer = None
         self._capture_name = None
+
+    def _capture_failure(self, err: Exception) -> str:
+        """One sentence for a capture the disk (or the writer) stopped, with the frames kept."""
+        kept = getattr(self._writer, "frames_on_disk", self._capture_frames)
+        folder = self._capture_path.parent if self._capture_path is not None else Path(".")
+        sentence = storage_sentence(
+            err, folder.resolve(), f"the recording stopped, {kept} frames kept", "record again"
+        )
+        if sentence is not None:
+            return sentence
+        return f"Writing the recording {self._capture_name!r} failed ({err}); it was stopped, its first {kept} frames are kept."
+
+    def dismiss_capture_error(self) -> None:
+        """Forget the last capture failure (the user has read it)."""
+        with self._lock:
+            self._capture_error = None
 
     def capture_status(self) -> dict[str, Any]:
         """The ``CapturePublic`` fields."""
@@ -289,6 +308,7 @@ class Pipeline:
                 "name": self._capture_name,
                 "seconds": round(float(seconds), 3),
                 "frames": self._capture_frames if active else 0,
+                "error": self._capture_error,
             }
 
     def capture_time(self) -> float | None:
@@ -340,9 +360,11 @@ class Pipeline:
             try:
                 writer.write_many(frames)
             except Exception as err:
-                log.exception("writing the capture failed")
-                self._kin_error = f"Writing the recording failed ({err}); it was stopped, its frames so far are kept."
-                self._close_writer()
+                log.warning("writing the capture %s failed: %s", self._capture_name, err)
+                self._capture_error = self._capture_failure(err)
+                error = self._capture_error
+                self._close_writer()  # says nothing more: the writer reported its failure once
+                self._capture_error = error
                 return
             if self._capture_t0 is None:
                 self._capture_t0 = float(frames[0].t)

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from fastapi import APIRouter
+from fastapi import APIRouter, Response
 
 from .._deps import StudioDep
 from .._schemas import CapturePublic, CaptureStart, RecordingPublic
@@ -23,6 +23,13 @@ def start_capture(body: CaptureStart, studio: StudioDep) -> CapturePublic:
     the name is taken; 422 for a bad name or one starting with ``sample-``)."""
     studio.start_capture(body.name, body.operator, body.notes)
     return CapturePublic.model_validate(studio.pipeline.capture_status())
+
+
+@router.delete("/error", status_code=204)
+def dismiss_capture_error(studio: StudioDep) -> Response:
+    """Dismiss the reason the last capture stopped by itself (the page's close button)."""
+    studio.pipeline.dismiss_capture_error()
+    return Response(status_code=204)
 
 
 @router.post("/stop")
