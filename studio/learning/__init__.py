@@ -78,6 +78,18 @@ from ._summary import POLICY_SUFFIX as POLICY_SUFFIX
 from ._summary import goal_degrees as goal_degrees
 from ._summary import has_default_goal as has_default_goal
 from ._summary import policy_summary as policy_summary
+from ._sweep import SweepError as SweepError
+from ._sweep import SweepInfo as SweepInfo
+from ._sweep import SweepProgress as SweepProgress
+from ._sweep import SweepResult as SweepResult
+from ._sweep import SweepSpec as SweepSpec
+from ._sweep import list_sweeps as list_sweeps
+from ._sweep import load_sweep as load_sweep
+from ._sweep import load_sweep_spec as load_sweep_spec
+from ._sweep import parse_sweep_spec as parse_sweep_spec
+from ._sweep import resume_target as resume_target
+from ._sweep import run_sweep as run_sweep
+from ._sweep import sweep_figure as sweep_figure
 from ._tiles import TileCoder as TileCoder
 from ._tiles import TileCoding as TileCoding
 

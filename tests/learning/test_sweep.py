@@ -1,0 +1,455 @@
+"""Sweeps on Ray Tune: spec checks, trials equal serial runs, retries, resumption, two nodes.
+
+One local Ray (2 CPUs) is shared by the in-process tests of this module; the interrupted sweep
+and the two-node cluster run ``studio sweep`` in subprocesses, as a user would.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import socket
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from studio.learning import ArmGrid, DynaQConfig, generate_demonstrations, run_experiments
+from studio.learning._runs import RunFolder
+from studio.learning._sweep import (
+    SUMMARY_FILE,
+    SweepError,
+    load_sweep_spec,
+    parse_sweep_spec,
+    run_sweep,
+    sweep_folder,
+    trial_records,
+    trial_run_path,
+)
+from tests.conftest import require
+
+try:
+    import ray
+except ImportError:  # pragma: no cover - the test extra installs it
+    ray = None
+
+REPO = Path(__file__).resolve().parents[2]
+RAY_ENV = {
+    "RAY_USAGE_STATS_ENABLED": "0",
+    "RAY_AUTH_MODE": "disabled",  # a loopback test cluster; `ray start` would enable tokens
+}
+WAIT_SECONDS = 120.0
+
+
+def wait_for(condition, what: str, timeout: float = WAIT_SECONDS, proc=None):
+    """Poll ``condition`` until it returns a truthy value (the event, never a fixed sleep)."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        value = condition()
+        if value:
+            return value
+        if proc is not None and proc.poll() is not None:
+            out = proc.stdout.read() if proc.stdout else ""
+            raise AssertionError(f"process ended (rc {proc.returncode}) before {what}: {out}")
+        time.sleep(0.02)
+    raise AssertionError(f"timed out waiting for {what}")
+
+
+def spec_dict(**overrides) -> dict:
+    data = {
+        "name": "s",
+        "task": "arm-grid",
+        "seeds": [0, 1],
+        "experiments": 2,
+        "episodes": 20,
+        "fixed": {"planning_steps": 10},
+        "space": {"planning": ["zero", "full"]},
+    }
+    data.update(overrides)
+    return {k: v for k, v in data.items() if v is not None}
+
+
+def write_spec(path: Path, text: str) -> Path:
+    path.write_text(text)
+    return path
+
+
+# ----------------------------------------------------------------------------- the spec
+
+
+def test_example_spec_is_valid_and_is_the_papers_figure_5() -> None:
+    spec = load_sweep_spec(REPO / "sweeps" / "planning.toml")
+    trials = spec.trials()
+    settings = {(t.settings["planning"], t.settings["demonstrations"]) for t in trials}
+    assert settings == {(p, d) for p in ("zero", "full", "soft") for d in (0, 20)}
+    assert len(trials) == 6 * len(spec.seeds)
+    assert len({t.key for t in trials}) == len(trials)
+
+
+def test_grid_search_is_every_combination_times_every_seed() -> None:
+    spec = parse_sweep_spec(
+        spec_dict(seeds=3, space={"planning": ["zero", "full"], "alpha": [0.1, 0.2, 0.3]})
+    )
+    trials = spec.trials()
+    assert len(trials) == 2 * 3 * 3
+    assert {(t.settings["planning"], t.settings["alpha"], t.seed) for t in trials} == {
+        (p, a, s) for p in ("zero", "full") for a in (0.1, 0.2, 0.3) for s in range(3)
+    }
+
+
+def test_random_search_draws_within_the_bounds_and_repeats_with_its_seed() -> None:
+    space = {
+        "alpha": {"uniform": [0.05, 0.5]},
+        "epsilon": {"loguniform": [0.01, 0.3]},
+        "planning_steps": {"randint": [1, 5]},
+        "planning": ["zero", "soft"],
+    }
+    data = spec_dict(space=space, fixed={}, search={"kind": "random", "samples": 40, "seed": 7})
+    trials = parse_sweep_spec(data).trials()
+    assert len(trials) == 40 * 2
+    for t in trials:
+        assert 0.05 <= t.settings["alpha"] <= 0.5
+        assert 0.01 <= t.settings["epsilon"] <= 0.3
+        assert t.settings["planning_steps"] in range(1, 6)
+        assert t.settings["planning"] in ("zero", "soft")
+    assert {t.settings["planning_steps"] for t in trials} == set(range(1, 6))
+    assert parse_sweep_spec(data).trials() == trials
+    other = parse_sweep_spec({**data, "search": {"kind": "random", "samples": 40, "seed": 8}})
+    assert other.trials() != trials
+
+
+@pytest.mark.parametrize(
+    ("change", "field"),
+    [
+        ({"space": {"alhpa": [0.1]}}, "alhpa"),  # an unknown setting
+        ({"fixed": {"planing": "full"}}, "planing"),
+        ({"space": {"planning": []}}, "planning"),  # an empty space
+        ({"space": {}}, "[space]"),
+        ({"space": {"alpha": [0.1, 1.5]}}, "alpha"),  # out of range, as DynaQConfig says
+        ({"space": {"bins": [11, 1]}}, "bins"),  # as ArmGrid says
+        ({"space": {"planning": ["zero", "dreaming"]}}, "planning"),
+        ({"space": {"joints": [3, 6]}, "fixed": {"bins": 11}}, "joints"),  # too big a table
+        ({"experiments": 5000}, "experiments"),  # as check_budget says
+        ({"space": {"demonstrations": [0, 30]}}, "demonstrations"),  # more than episodes
+        ({"seeds": [-1]}, "seed"),
+        ({"task": None}, "task"),  # a missing task
+        ({"task": "juggling"}, "task"),
+        ({"space": {"alpha": {"uniform": [0.1, 0.5]}}}, "alpha"),  # a distribution in a grid
+        (
+            {
+                "space": {"alpha": {"uniform": [0.5, 2.0]}},
+                "search": {"kind": "random", "samples": 3},
+            },
+            "alpha",
+        ),
+        ({"metric": {"name": "happiness"}}, "metric"),
+        ({"scheduler": {"grace_episodes": 0}}, "grace_episodes"),
+        ({"episodes": None}, "episodes"),
+    ],
+)
+def test_a_bad_spec_is_one_sentence_naming_the_field(change: dict, field: str) -> None:
+    data = spec_dict()
+    for key, value in change.items():
+        if value is None:
+            data.pop(key, None)
+        else:
+            data[key] = value
+    with pytest.raises(SweepError) as err:
+        parse_sweep_spec(data, "bad.toml")
+    message = str(err.value)
+    assert field in message and message.startswith("bad.toml"), message
+    assert "\n" not in message and message.endswith("."), message
+
+
+def test_a_spec_file_that_is_not_toml_is_refused(tmp_path: Path) -> None:
+    path = write_spec(tmp_path / "broken.toml", "task = arm-grid\n")
+    with pytest.raises(SweepError, match="not valid TOML"):
+        load_sweep_spec(path)
+    with pytest.raises(SweepError, match="does not exist"):
+        load_sweep_spec(tmp_path / "missing.toml")
+
+
+def test_without_ray_the_error_says_how_to_install_it(monkeypatch, tmp_path: Path) -> None:
+    from studio.learning import _sweep
+
+    monkeypatch.setitem(sys.modules, "ray", None)
+    with pytest.raises(SweepError, match=r"pip install -e '\.\[cluster\]'"):
+        _sweep._import_ray()
+
+
+def test_an_unreachable_address_is_one_sentence(tmp_path: Path) -> None:
+    spec = write_spec(tmp_path / "s.toml", 'task = "arm-grid"\nexperiments = 1\nepisodes = 2\n'
+                      '[space]\nplanning = ["zero"]\n')  # fmt: skip
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]  # nothing listens once it is closed
+    proc = subprocess.run(
+        [sys.executable, "-m", "studio", "sweep", str(spec), "--data-dir", str(tmp_path),
+         "--address", f"127.0.0.1:{port}", "--no-progress"],
+        capture_output=True, text=True, timeout=120, env={**os.environ, **RAY_ENV},
+    )  # fmt: skip
+    assert proc.returncode == 2, proc.stderr
+    line = proc.stderr.strip()
+    assert "\n" not in line and f"127.0.0.1:{port}" in line and "Traceback" not in line, line
+
+
+# ----------------------------------------------------------------------------- on a local Ray
+
+
+@pytest.fixture(scope="module")
+def local_ray():
+    """One local Ray with 2 CPUs for this module's in-process sweeps."""
+    require(ray is not None, "ray[tune] is not installed (pip install -e '.[cluster]')")
+    for key, value in RAY_ENV.items():
+        os.environ.setdefault(key, value)
+    ray.init(address="local", num_cpus=2, include_dashboard=False, log_to_driver=False)
+    try:
+        yield ray
+    finally:
+        ray.shutdown()
+
+
+def test_trials_equal_serial_runs_seed_for_seed(local_ray, tmp_path: Path) -> None:
+    """A 2-worker sweep's curves are exactly those of run_experiments with the same settings."""
+    data = spec_dict(
+        name="same",
+        seeds=[0, 1],
+        experiments=3,
+        episodes=15,
+        space={"planning": ["zero", "full"], "demonstrations": [0, 2]},
+    )
+    spec = parse_sweep_spec(data)
+    seen = []
+    result = run_sweep(spec, tmp_path, on_progress=lambda p: seen.append(p.done))
+    assert not result.interrupted and not result.failed
+    assert seen[-1] == len(spec.trials()) and seen == sorted(seen)
+    grid = ArmGrid()
+    for trial in spec.trials():
+        run = RunFolder.load(trial_run_path(tmp_path, "same", trial.key))
+        assert run.status == "done" and run.has_policy
+        assert run.record.group == "same" and run.record.origin == "sweep"
+        demos = generate_demonstrations(
+            grid, trial.settings["demonstrations"], np.random.default_rng([trial.seed, 1])
+        )
+        config = DynaQConfig(planning=trial.settings["planning"], planning_steps=10)
+        serial = run_experiments(grid.mdp(), config, 3, 15, trial.seed, demos, workers=1)
+        np.testing.assert_array_equal(run.steps(), serial.steps)
+    folder = sweep_folder(tmp_path, "same")
+    lines = (folder / SUMMARY_FILE).read_text().splitlines()
+    assert len(lines) == 1 + len(spec.trials())
+    assert lines[0].startswith("trial,seed,planning,demonstrations,status,")
+    assert all(",done," in line for line in lines[1:])
+    assert (folder / "sweep.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert b"<svg" in (folder / "sweep.svg").read_bytes()[:500]
+
+
+def test_a_killed_worker_is_retried_and_the_sweep_completes(local_ray, tmp_path: Path) -> None:
+    spec = parse_sweep_spec(
+        spec_dict(
+            name="kill",
+            seeds=[0, 1],
+            experiments=2,
+            episodes=60,
+            fixed={"planning_steps": 200},
+            space={"planning": ["full", "soft"]},
+        )
+    )
+    killed: dict[str, int] = {}
+
+    def kill_one_running_trial() -> None:
+        def running():
+            for status in (tmp_path / "runs" / "kill").glob("*/status.json"):
+                try:
+                    data = json.loads(status.read_text())
+                except (OSError, ValueError):
+                    continue
+                if data.get("status") == "running" and data.get("pid"):
+                    return status.parent.name, data["pid"]
+            return None
+
+        name, pid = wait_for(running, "a running trial")
+        os.kill(pid, signal.SIGKILL)
+        killed[name] = pid
+
+    killer = threading.Thread(target=kill_one_running_trial, daemon=True)
+    killer.start()
+    result = run_sweep(spec, tmp_path)
+    killer.join(5)
+    assert killed, "no trial was killed"
+    assert not result.interrupted and not result.failed
+    records = trial_records(sweep_folder(tmp_path, "kill"))
+    (name, pid), *_ = killed.items()
+    key = name.rsplit("-", 1)[1]
+    assert records[key]["attempts"] == 2, records[key]
+    assert [row["status"] for row in result.rows] == ["done"] * 4
+    with pytest.raises(ProcessLookupError):
+        os.kill(pid, 0)
+    for trial in spec.trials():
+        assert RunFolder.load(trial_run_path(tmp_path, "kill", trial.key)).status == "done"
+
+
+def test_an_interrupted_sweep_resumes_with_only_the_unfinished_trials(
+    local_ray, tmp_path: Path
+) -> None:
+    spec_path = write_spec(
+        tmp_path / "resume.toml",
+        'task = "arm-grid"\nseeds = [0, 1, 2, 3]\nexperiments = 2\nepisodes = 60\n'
+        '[fixed]\nplanning_steps = 150\n[space]\nplanning = ["full", "soft"]\n',
+    )  # fmt: skip
+    data = tmp_path / "data"
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "studio", "sweep", str(spec_path), "--data-dir", str(data),
+         "--workers", "2", "--no-progress"],
+        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+        env={**os.environ, **RAY_ENV},
+    )  # fmt: skip
+    try:
+        spec = load_sweep_spec(spec_path)
+
+        def one_done():
+            for trial in spec.trials():
+                with_status = trial_run_path(data, "resume", trial.key) / "status.json"
+                if with_status.is_file() and '"done"' in with_status.read_text():
+                    return True
+            return False
+
+        wait_for(one_done, "a finished trial", proc=proc)
+        proc.send_signal(signal.SIGINT)
+        out, _ = proc.communicate(timeout=WAIT_SECONDS)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    assert proc.returncode == 130, out
+    assert "studio sweep --resume resume" in out, out
+
+    before = {}
+    for trial in spec.trials():
+        path = trial_run_path(data, "resume", trial.key)
+        if (path / "status.json").is_file() and '"done"' in (path / "status.json").read_text():
+            before[trial.key] = (path / "steps.csv").stat().st_mtime_ns
+    unfinished = {t.key for t in spec.trials()} - set(before)
+    assert before and unfinished, (before, out)
+
+    result = run_sweep(spec, data, resume=True)
+    assert set(result.ran) == unfinished
+    assert not result.interrupted
+    assert [row["status"] for row in result.rows] == ["done"] * len(spec.trials())
+    for key, mtime in before.items():  # not run again
+        assert (trial_run_path(data, "resume", key) / "steps.csv").stat().st_mtime_ns == mtime
+    with pytest.raises(SweepError, match="already exists"):
+        run_sweep(spec, data)
+
+
+def test_a_scheduler_sweep_ends_every_trial_done_or_early_stopped(
+    local_ray, tmp_path: Path
+) -> None:
+    spec = parse_sweep_spec(
+        spec_dict(
+            name="asha",
+            seeds=[0, 1],
+            episodes=40,
+            space={"planning": ["zero", "full"]},
+            scheduler={"kind": "asha", "grace_episodes": 5, "reduction_factor": 2},
+            metric={"name": "mean_steps"},
+        )
+    )
+    result = run_sweep(spec, tmp_path)
+    assert not result.interrupted and not result.failed
+    for row in result.rows:
+        run = RunFolder.load(trial_run_path(tmp_path, "asha", row["trial"]))
+        if row["status"] == "done":
+            assert row["episodes_done"] == 40 and run.status == "done"
+        else:
+            assert row["status"] == "early-stopped", row
+            assert 5 <= row["episodes_done"] < 40 and run.status == "stopped"
+
+
+# ----------------------------------------------------------------------------- two Ray nodes
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def test_a_sweep_on_a_two_node_cluster_uses_both_nodes(tmp_path: Path) -> None:
+    require(ray is not None, "ray[tune] is not installed (pip install -e '.[cluster]')")
+    ray_cli = str(Path(sys.executable).with_name("ray"))
+    env = {**os.environ, **RAY_ENV}
+    port = _free_port()
+    address = f"127.0.0.1:{port}"
+    common = ["--num-cpus=1", "--disable-usage-stats", "--block"]
+    nodes: list[subprocess.Popen] = []
+    try:
+        nodes.append(
+            subprocess.Popen(
+                [
+                    ray_cli,
+                    "start",
+                    "--head",
+                    f"--port={port}",
+                    "--include-dashboard=false",
+                    *common,
+                ],
+                stdout=subprocess.DEVNULL,
+                stderr=subprocess.DEVNULL,
+                env=env,
+            )  # fmt: skip
+        )
+
+        def head_up():
+            try:
+                with socket.create_connection(("127.0.0.1", port), timeout=1):
+                    return True
+            except OSError:
+                return False
+
+        wait_for(head_up, "the head node", proc=None)
+        nodes.append(
+            subprocess.Popen(
+                [ray_cli, "start", f"--address={address}", *common],
+                stdout=subprocess.DEVNULL,
+                stderr=subprocess.DEVNULL,
+                env=env,
+            )  # fmt: skip
+        )
+        status = [ray_cli, "status", f"--address={address}"]
+        wait_for(lambda: _run_quiet(status, env).count(" node_") >= 2, "two nodes")
+        spec = write_spec(
+            tmp_path / "two.toml",
+            'task = "arm-grid"\nseeds = [0, 1, 2, 3]\nexperiments = 2\nepisodes = 40\n'
+            '[fixed]\nplanning_steps = 100\n[space]\nplanning = ["full"]\n',
+        )  # fmt: skip
+        data = tmp_path / "data"
+        proc = subprocess.run(
+            [sys.executable, "-m", "studio", "sweep", str(spec), "--data-dir", str(data),
+             "--address", address, "--no-progress"],
+            capture_output=True, text=True, timeout=300, env=env,
+        )  # fmt: skip
+        assert proc.returncode == 0, proc.stdout + proc.stderr
+        records = trial_records(sweep_folder(data, "two"))
+        assert len(records) == 4 and all(r["status"] == "done" for r in records.values())
+        assert len({r["node"] for r in records.values()}) == 2, records
+    finally:
+        for node in reversed(nodes):  # a --block process stops the Ray processes it started
+            node.terminate()
+        for node in reversed(nodes):
+            try:
+                node.wait(timeout=60)
+            except subprocess.TimeoutExpired:
+                node.kill()
+                node.wait()
+
+
+def _run_quiet(cmd: list[str], env: dict) -> str:
+    try:
+        return subprocess.run(cmd, capture_output=True, text=True, timeout=30, env=env).stdout
+    except subprocess.TimeoutExpired:
+        return ""
