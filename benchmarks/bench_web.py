@@ -4,8 +4,13 @@
    same uvicorn/FastAPI stack, plus the time until the 3D scene's canvas exists (goal: < 2 s).
 2. Curve updates per second in the page while a run trains (goal: >= 5/s).
 3. Training slowdown with the page open vs no page at all (same run config; goal: <= 10 %).
+4. The 3D scene alone in the browser: cores it uses, idle and live, against an empty viser scene
+   (the baseline: viser's client with nothing drawn) served by this script.
+5. Motion-to-scene latency while a run trains: from a tape frame's arrival at the studio (a UDP
+   datagram on loopback, 110 Hz) to the robot pose it causes reaching the browser's websocket;
+   p50 and p99 (goal: p99 < 50 ms).
 
-Run: ``python benchmarks/bench_web.py`` (about a minute; needs /usr/bin/chromium).
+Run: ``python benchmarks/bench_web.py`` (a minute or two; needs /usr/bin/chromium).
 """
 
 from __future__ import annotations
@@ -176,6 +181,9 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--loads", type=int, default=3, help="cold page loads per page")
     parser.add_argument("--runs", type=int, default=3, help="training runs per condition")
+    parser.add_argument(
+        "--latency-seconds", type=float, default=12.0, help="length of the latency measurement"
+    )
     args = parser.parse_args()
     if not Path(CHROMIUM).exists():
         raise SystemExit(f"needs Chromium at {CHROMIUM}")
@@ -219,6 +227,17 @@ def main() -> int:
             http("POST", base + "/api/source/playback", {"action": "pause"})
             without_idle = [wall(train(base, f"no-page-idle-{i}")) for i in range(args.runs)]
             idle = measure_with_page(browser, base, "idle", args.runs)
+            scene_url = http("GET", base + "/api/config")["viser_url"]
+            empty_url = start_empty_scene()
+            scene_cpu = [
+                ("empty viser scene (baseline)", scene_cores(browser, empty_url, args.runs)),
+                ("studio scene, still", scene_cores(browser, scene_url, args.runs)),
+            ]
+            http("PUT", base + "/api/source", {"kind": "simulator"})
+            scene_cpu.append(
+                ("studio scene, live simulator", scene_cores(browser, scene_url, args.runs))
+            )
+            latencies = motion_to_scene(browser, base, args.latency_seconds)
             browser.close()
         print(f"== training ({TRAIN}, median of {args.runs} runs each, s of wall time)")
         for label, without, (walls, rates, cores) in (
@@ -232,6 +251,22 @@ def main() -> int:
                 f"   curve updates {rate:5.1f}/s (goal >= 5)"
                 f"   browser used {statistics.median(cores):4.2f} of {os.cpu_count()} cores"
             )
+        print(
+            f"== the 3D scene alone (browser cores over {SCENE_CPU_S:.0f} s, median of {args.runs})"
+        )
+        for label, cores in scene_cpu:
+            print(f"  {label:<32} {statistics.median(cores):5.2f} cores")
+        print(
+            f"== motion to scene while training ({len(latencies)} pose steps at {LATENCY_RATE_HZ:.0f} Hz, ms)"
+        )
+        if latencies:
+            q = statistics.quantiles(latencies, n=100, method="inclusive")
+            print(
+                f"  p50 {q[49]:6.1f}  p99 {q[98]:6.1f}  max {max(latencies):6.1f}"
+                f"   goal: p99 < 50 ms -> {'OK' if q[98] < 50 else 'MISSED'}"
+            )
+        else:
+            print("  no pose reached the browser: MISSED")
     finally:
         proc.terminate()
         try:
@@ -263,6 +298,182 @@ def measure_with_page(
         rates.append(renders / wall(run))
     ctx.close()
     return walls, rates, cores
+
+
+SCENE_CPU_S = 5.0
+"""Window over which the scene's browser CPU is measured (after it settles)."""
+SCENE_SETTLE_S = 3.0
+LATENCY_RATE_HZ = 110.0
+LATENCY_PHASE_S = 0.25
+"""The tape holds one pose this long, then steps to the other (each step is one sample)."""
+POSE_A = (0.2, 0.3, 0.0, 0.5, 0.0, 0.0, 0.0)
+POSE_B = (1.1, 0.3, 0.0, 0.2, 0.0, 0.0, 0.0)
+"""Two arm poses (q_human, rad) far apart, so that the robot's forearm moves visibly."""
+WATCHED_NODE = "/robot/link3"
+
+
+def start_empty_scene() -> str:
+    """viser's client with nothing drawn, lit like the studio's scene: the baseline."""
+    import viser
+
+    server = viser.ViserServer(host="127.0.0.1", port=free_port(), verbose=False)
+    server.scene.configure_default_lights(enabled=True, cast_shadow=False)
+    server.scene.configure_environment_map(hdri=None)
+    return f"http://127.0.0.1:{server.get_port()}"
+
+
+def scene_cores(browser: Any, url: str, runs: int) -> list[float]:
+    """Cores the browser spends on a scene page (scene pane size) over SCENE_CPU_S, per run."""
+    out = []
+    for _ in range(runs):
+        ctx = browser.new_context(viewport={"width": 1000, "height": 560})
+        page = ctx.new_page()
+        page.goto(url)
+        page.locator("canvas").first.wait_for(state="attached", timeout=60_000)
+        time.sleep(SCENE_SETTLE_S)
+        cpu, t0 = chromium_cpu_seconds(), time.perf_counter()
+        time.sleep(SCENE_CPU_S)
+        out.append((chromium_cpu_seconds() - cpu) / (time.perf_counter() - t0))
+        ctx.close()
+    return out
+
+
+def _watched_positions(log: list[tuple[float, bytes]]) -> list[tuple[float, tuple[float, ...]]]:
+    """(receive time s, position) of every update of WATCHED_NODE in a websocket log."""
+    import msgspec
+    import zstandard
+
+    out = []
+    unzip = zstandard.ZstdDecompressor()
+    for t, raw in log:
+        if len(raw) < 16:
+            continue
+        size = int.from_bytes(raw[:8], "little")
+        packed = int.from_bytes(raw[8:16], "little")
+        try:
+            inner = msgspec.msgpack.decode(
+                unzip.decompress(raw[16 : 16 + packed], max_output_size=size)
+            )
+        except Exception:  # not a viser window (another socket of the page)
+            continue
+        for m in inner.get("messages", ()):
+            if m.get("type") == "SetPositionMessage" and m.get("name") == WATCHED_NODE:
+                out.append((t, tuple(m["position"])))
+    return out
+
+
+def _listen(scene_url: str, log: list[tuple[float, bytes]], stop: threading.Event) -> None:
+    """Receive the scene's websocket windows until ``stop``, with their arrival times."""
+    import asyncio
+
+    import viser
+    import websockets
+
+    host = scene_url.split("//", 1)[1]
+
+    async def run() -> None:
+        async with websockets.connect(
+            f"ws://{host}/",
+            origin=f"http://{host}",
+            subprotocols=[f"viser-v{viser.__version__}"],
+            max_size=None,
+        ) as ws:
+            while not stop.is_set():
+                try:
+                    raw = await asyncio.wait_for(ws.recv(), timeout=0.2)
+                except TimeoutError:
+                    continue
+                if isinstance(raw, bytes):
+                    log.append((time.time(), raw))
+
+    asyncio.run(run())
+
+
+def motion_to_scene(browser: Any, base: str, seconds: float) -> list[float]:
+    """Latencies (ms) from a pose step's first frame reaching the studio to the browser.
+
+    The tape alternates between two still poses over UDP at 110 Hz while a run trains; each
+    step's latency is the time until the browser receives the watched robot link more than
+    halfway from the old pose's position to the new one's.
+    """
+    import socket as socket_module
+
+    import numpy as np
+
+    from studio.capture import TapeFrame, encode_frame
+    from studio.kinematics import HumanArm, TapeConfig, tape_from_arm
+
+    udp_port = free_port()
+    http("PUT", base + "/api/source", {"kind": "network", "port": udp_port})
+    arm, config = HumanArm("right"), TapeConfig()
+    poses = [tape_from_arm(arm, np.array(q), config) for q in (POSE_A, POSE_B)]
+    ctx = browser.new_context(viewport={"width": 1440, "height": 900})
+    page = ctx.new_page()
+    page.goto(base + "/")
+    page.wait_for_selector("body[data-ready='1']", timeout=30_000)
+    scene_port = http("GET", base + "/api/config")["viser_url"].rstrip("/").rsplit(":", 1)[1]
+    frame = next(f for f in page.frames if f":{scene_port}" in f.url)
+    frame.locator("canvas").first.wait_for(state="attached", timeout=60_000)
+    stop = threading.Event()
+
+    def keep_training() -> None:
+        k = 0
+        while not stop.is_set():
+            train(base, f"latency-{k}")
+            k += 1
+
+    trainer = threading.Thread(target=keep_training, daemon=True)
+    # A websocket client of our own beside the page's: viser sends every client the same
+    # windows, and the page's socket lives in a worker that the browser does not report on.
+    scene_url = http("GET", base + "/api/config")["viser_url"].rstrip("/")
+    log: list[tuple[float, bytes]] = []
+    listener = threading.Thread(
+        target=_listen, args=(scene_url, log, stop), name="scene-listener", daemon=True
+    )
+    listener.start()
+    steps: list[float] = []
+    sock = socket_module.socket(socket_module.AF_INET, socket_module.SOCK_DGRAM)
+    period = 1.0 / LATENCY_RATE_HZ
+    per_phase = round(LATENCY_PHASE_S * LATENCY_RATE_HZ)
+    try:
+        n, start = 0, time.perf_counter()
+        trainer.start()
+        while time.perf_counter() - start < seconds:
+            phase = (n // per_phase) % 2
+            bend, twist = poses[phase]
+            due = start + n * period
+            delay = due - time.perf_counter()
+            if delay > 0:
+                time.sleep(delay)
+            sock.sendto(
+                encode_frame(TapeFrame(n * period, n, bend, twist, 0)), ("127.0.0.1", udp_port)
+            )
+            if n % per_phase == 0 and n > 0:
+                steps.append(time.time())
+            n += 1
+        page.wait_for_timeout(500)  # deliver the last frames' events
+    finally:
+        stop.set()
+        sock.close()
+        ctx.close()
+        trainer.join()
+        listener.join()
+        http("PUT", base + "/api/source", {"kind": "simulator"})
+    received = _watched_positions(log)
+    latencies = []
+    for i, t_step in enumerate(steps[1:-1], start=1):
+        before = [p for t, p in received if t < t_step]
+        after = [(t, p) for t, p in received if t_step <= t < steps[i + 1]]
+        if not before or not after:
+            continue
+        old, new = np.array(before[-1]), np.array(after[-1][1])
+        span = np.linalg.norm(new - old)
+        if span < 1e-3:
+            continue
+        arrival = next((t for t, p in after if np.linalg.norm(np.array(p) - old) > span / 2), None)
+        if arrival is not None:
+            latencies.append((arrival - t_step) * 1000.0)
+    return latencies
 
 
 if __name__ == "__main__":

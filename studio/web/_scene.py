@@ -33,6 +33,9 @@ from studio.kinematics import HumanBody, MeshConfig, MeshPart, Puma560, puma560_
 
 log = logging.getLogger(__name__)
 
+TAPE_LIFT_ROUNDS = 3
+"""Rounds of pushing tape points off the arm's segments (see ``StudioScene.tape_on_sleeve``)."""
+
 
 @dataclass(frozen=True)
 class SceneLayout:
@@ -50,6 +53,9 @@ class SceneLayout:
         camera_look_at: default camera target (m): between the two bodies.
         camera_fov_deg: default vertical field of view (degrees).
         ghost_opacity: opacity of the goal's ghost robot.
+        fill_light: intensity of the sky/ground fill light.
+        tape_lift_m: how far the tape is drawn from the upper arm's and the forearm's axis
+            (m): on the sleeve, where it is strapped, rather than hidden inside the mesh.
         mesh: mesh simplification (see :class:`~studio.kinematics.MeshConfig`).
         colors: named colours (0-255 rgb).
     """
@@ -64,6 +70,8 @@ class SceneLayout:
     camera_look_at: tuple[float, float, float] = (0.85, 0.0, 0.95)
     camera_fov_deg: float = 50.0
     ghost_opacity: float = 0.22
+    fill_light: float = 1.6
+    tape_lift_m: tuple[float, float] = (0.055, 0.045)
     mesh: MeshConfig = field(default_factory=MeshConfig)
     colors: dict[str, tuple[int, int, int]] = field(
         default_factory=lambda: {
@@ -276,6 +284,14 @@ class StudioScene:
         # the scene stands still, taken from training.
         s.configure_default_lights(enabled=True, cast_shadow=False)
         s.configure_environment_map(hdri=None)
+        # A sky/ground fill, so that the sides of the bodies turned from the default lights
+        # still read (without it the castings and the shirt go black).
+        s.add_light_hemisphere(
+            "/lights/fill",
+            sky_color=(255, 255, 255),
+            ground_color=(120, 120, 130),
+            intensity=lay.fill_light,
+        )
         # A static floor: a plate and line segments (viser's shader grid keeps the browser
         # redrawing while nothing moves, which costs a core with software WebGL).
         half, step = lay.floor_half_size, lay.floor_cell
@@ -384,6 +400,40 @@ class StudioScene:
         m = self._worldMbase
         return np.asarray(p, dtype=float) @ m[:3, :3].T + m[:3, 3]
 
+    def tape_on_sleeve(self, tape: np.ndarray, q_human: np.ndarray) -> np.ndarray:
+        """Tape points (arm base frame) lifted off the arm's axis onto its surface.
+
+        The fit models the tape along the bones; drawn there it would hide inside the arm's
+        mesh. Each point closer to the upper arm's (forearm's) axis than ``tape_lift_m`` is
+        pushed out radially to that distance; points away from the arm (on the back) stay.
+        """
+        side = self.side
+        axis = np.stack(
+            [
+                self.body.link_pose(f"{side}_{link}", q_human)[:3, 3]
+                for link in ("upperarm", "lowerarm", "hand")
+            ]
+        )
+        out = np.array(tape, dtype=float)
+        segments = list(zip(axis[:-1], axis[1:], self.layout.tape_lift_m, strict=True))
+        for k in range(len(out)):
+            # Pushed off one segment, a point near the elbow may land inside the other: a few
+            # rounds settle it.
+            for _ in range(TAPE_LIFT_ROUNDS):
+                for a, b, lift in segments:
+                    ab = b - a
+                    t = float(np.clip((out[k] - a) @ ab / (ab @ ab), 0.0, 1.0))
+                    c = a + t * ab
+                    d = float(np.linalg.norm(out[k] - c))
+                    if d >= lift:
+                        continue
+                    if d > 1e-9:
+                        away = out[k] - c
+                    else:  # on the axis: any direction across it
+                        away = np.cross(ab, np.eye(3)[int(np.argmin(np.abs(ab)))])
+                    out[k] = c + away / np.linalg.norm(away) * lift
+        return out
+
     def tool_positions(self, q_robot: np.ndarray) -> np.ndarray:
         """World tool positions of joint configurations ``(N, 6)`` -> ``(N, 3)``."""
         q = np.atleast_2d(np.asarray(q_robot, dtype=float))
@@ -417,7 +467,7 @@ class StudioScene:
             self._operator_handles[i].position = poses[i, :3, 3]
             self._operator_handles[i].wxyz = wxyz
         if tape is not None and len(tape) >= 2:
-            self._tape.points = self.to_world(tape).astype(np.float32)
+            self._tape.points = self.to_world(self.tape_on_sleeve(tape, q_human)).astype(np.float32)
             if not self._tape.visible:
                 self._tape.visible = True
 
@@ -488,6 +538,9 @@ class StudioScene:
             if playback is not None and pose.trace_upto > shown.trace_upto:
                 self._push_trace(playback, pose.trace_upto)
                 shown.trace_upto = pose.trace_upto
+        # Send now rather than at viser's next message window (up to 1/60 s later): the pose
+        # is what the operator is waiting to see.
+        self.server.flush()
         shown.live_version = version
         shown.playback = playback
         shown.mode = pose.mode

@@ -230,9 +230,13 @@ def test_tape_is_drawn_along_the_taped_arm(scene):
     tape = reconstruct(bend, twist, config).positions
     scene.update_live(q, np.zeros(6), tape)
     assert _wait_until(lambda: scene._tape.visible and np.allclose(scene.current_q_human(), q))
-    np.testing.assert_allclose(scene._tape.points, scene.to_world(tape), atol=1e-5)
-    # the regions strapped to the arm run along the drawn upper arm and forearm
-    strapped = scene.to_world(tape[config.shoulder_region : config.wrist_region + 1])
+    drawn = scene.to_world(scene.tape_on_sleeve(tape, q))
+    np.testing.assert_allclose(scene._tape.points, drawn, atol=1e-5)
+    # drawn on the sleeve: each point moves at most the lift off the fit's tape
+    lift = max(scene.layout.tape_lift_m)
+    assert np.all(np.linalg.norm(drawn - scene.to_world(tape), axis=1) <= lift + 1e-9)
+    # the regions strapped to the arm run along the drawn upper arm and forearm, on its surface
+    strapped = drawn[config.shoulder_region + 1 : config.wrist_region + 1]
     joints = scene.to_world(arm.points(q)[:3])
 
     def distance_to_arm(p: np.ndarray) -> float:
@@ -242,7 +246,9 @@ def test_tape_is_drawn_along_the_taped_arm(scene):
             best = min(best, float(np.linalg.norm(a + t * (b - a) - p)))
         return best
 
-    assert max(distance_to_arm(p) for p in strapped) < 0.08
+    distances = [distance_to_arm(p) for p in strapped]
+    assert max(distances) < 0.08
+    assert min(distances) >= min(scene.layout.tape_lift_m) - 1e-6  # not inside the arm
 
 
 def test_default_camera_frames_both_bodies_at_every_reachable_pose(scene):
