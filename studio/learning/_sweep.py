@@ -934,12 +934,40 @@ class SweepInfo:
     runs: list[str]
     folder: Path
 
+    @property
+    def metric(self) -> str:
+        """The metric the summary reports."""
+        return str(self.spec.get("metric", {}).get("name", DEFAULT_METRIC))
+
+    @property
+    def swept(self) -> list[str]:
+        """The swept settings, in the spec's order (the figure's x axis is the first)."""
+        return list(self.spec.get("space", {}))
+
+    def summary_csv(self) -> str:
+        """``sweep.csv``'s text: as written when the sweep ended, or computed from the run folders
+        while it runs (the file is written at its end)."""
+        if self.status != "running":
+            with contextlib.suppress(OSError):
+                return (self.folder / SUMMARY_FILE).read_text()
+        return sweep_csv(sweep_rows(self.folder.parent.parent, self._spec()))
+
     def rows(self) -> list[dict[str, str]]:
-        """``sweep.csv``'s rows as written (strings), empty before the first summary."""
-        try:
-            return list(csv.DictReader(io.StringIO((self.folder / SUMMARY_FILE).read_text())))
-        except OSError:
-            return []
+        """``sweep.csv``'s rows (strings, as in the file)."""
+        return list(csv.DictReader(io.StringIO(self.summary_csv())))
+
+    def figure(self, fmt: str = "png") -> bytes:
+        """The summary figure (:func:`sweep_figure`): as written, or drawn from the run folders."""
+        if fmt not in ("png", "svg"):
+            raise LearningError(f"The figure format {fmt!r} is not supported; use png or svg.")
+        if self.status != "running":
+            with contextlib.suppress(OSError):
+                return (self.folder / f"{FIGURE_STEM}.{fmt}").read_bytes()
+        spec = self._spec()
+        return sweep_figure(sweep_rows(self.folder.parent.parent, spec), spec, fmt)
+
+    def _spec(self) -> SweepSpec:
+        return parse_sweep_spec(self.spec, f"sweep {self.id}")
 
 
 def load_sweep(data_dir: Path, sweep_id: str) -> SweepInfo:

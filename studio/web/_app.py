@@ -38,6 +38,7 @@ from .routers import (
     recordings,
     runs,
     sources,
+    sweeps,
     watch,
 )
 
@@ -116,6 +117,7 @@ def create_app(settings: Settings | None = None, scene: Any = None) -> FastAPI:
         recordings,
         demonstrations,
         runs,
+        sweeps,
         policies,
         watch,
         events,

@@ -296,6 +296,25 @@ class CurvePublic(BaseModel):
     count: list[int]
 
 
+class SweepPublic(BaseModel):
+    """A parameter sweep (``studio sweep``, ``docs/sweeps.md``): its trials are ordinary runs whose
+    ``group`` is the sweep's id, and its summary is one row per trial."""
+
+    id: str
+    status: Literal["running", "done", "interrupted"]
+    created: str
+    task: str
+    metric: str
+    swept: list[str]
+    trials: int
+    finished: int
+    runs: list[str]
+    """The trials' run ids in ``/api/runs``."""
+    columns: list[str]
+    rows: list[dict[str, str]]
+    """``sweep.csv``'s rows: settings, status, metrics, CPU and wall time per trial."""
+
+
 # ----------------------------------------------------------------------------- policies, watch
 
 
