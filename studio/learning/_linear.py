@@ -684,11 +684,9 @@ def run_linear_experiments(
     try:
         task = _inspect(envs[0], config)
         coder = features.bind(task.low, task.high)
-        entries = experiments * coder.size * task.n_actions
-        if entries > MAX_Q_ENTRIES:
-            raise LearningError(
-                f"{experiments} weight tables of {coder.size:,} rows x {task.n_actions} actions need {entries * 8 / 1e9:.1f} GB; give TileCoding a smaller size or run fewer experiments (at most {MAX_Q_ENTRIES:,} weights in all)."
-            )
+        problem = weight_problem(experiments, coder, task.n_actions)
+        if problem:
+            raise LearningError(problem)
         dims = int(task.low.shape[0])
         demo_starts, demo_actions = _demonstrations(demonstrations or [], task, dims)
         agents = [
@@ -729,6 +727,14 @@ def run_linear_experiments(
         env_id=task.env_id,
         compiled=task.code is not None,
     )
+
+
+def weight_problem(experiments: int, coder: TileCoder, n_actions: int) -> str | None:
+    """The sentence refusing a run whose weight tables would not fit in memory, else None."""
+    entries = int(experiments) * coder.size * int(n_actions)
+    if entries <= MAX_Q_ENTRIES:
+        return None
+    return f"{experiments} weight tables of {coder.size:,} rows x {n_actions} actions need {entries * 8 / 1e9:.1f} GB; give TileCoding a smaller size or run fewer experiments (at most {MAX_Q_ENTRIES:,} weights in all)."
 
 
 def _reset_states(env: Any, task: _Task, seed: int, e: int, episodes: int) -> np.ndarray:

@@ -59,6 +59,8 @@ from ._config import DEFAULT_SEED, DynaQConfig, check_budget
 from ._dynaq import ExperimentResult, LiveProgress, run_experiments
 from ._errors import ConfigError, LearningError
 from ._policy import save_policy
+from ._reach import ArmReach
+from ._tiles import TileCoding
 
 log = logging.getLogger(__name__)
 
@@ -83,6 +85,11 @@ ORIGINS = ("cli", "page", "reproduce", "sweep")
 STATUSES = ("queued", "running", "done", "stopped", "failed")
 TASK_ARM_GRID = "arm-grid"
 """``task.kind`` of the paper's arm grid (``task`` also holds the :meth:`ArmGrid.to_dict` spec)."""
+TASK_ARM_REACH = "arm-reach"
+"""``task.kind`` of the continuous-joint task (``task`` also holds the :meth:`ArmReach.to_dict`
+fields and ``tile_coding``, the :meth:`TileCoding.to_dict` settings); its demonstrations are
+joint paths ``(N, joints)`` in radians."""
+TASK_KINDS = (TASK_ARM_GRID, TASK_ARM_REACH)
 
 CURVE_COLUMNS = (
     "episode",
@@ -386,10 +393,87 @@ class RunRecord:
             request=request,
         )
 
+    @classmethod
+    def for_arm_reach(
+        cls,
+        task: ArmReach,
+        coding: TileCoding,
+        config: DynaQConfig,
+        experiments: int,
+        episodes: int,
+        seed: int = DEFAULT_SEED,
+        demonstrations: Sequence[np.ndarray] = (),
+        *,
+        name: str = "",
+        origin: str = "cli",
+        group: str | None = None,
+        request: dict[str, Any] | None = None,
+    ) -> RunRecord:
+        """A checked record for the continuous-joint task learnt with tile coding.
+
+        Raises:
+            ConfigError: one sentence per bad field (budget, seed, name, origin, weight table,
+                demonstrations, each naming the demonstration and the fix).
+        """
+        from ._linear import weight_problem  # imports the kernels: import when needed
+
+        problems = run_problems(experiments, episodes, seed, name)
+        if origin not in ORIGINS:
+            problems.append(("origin", f"origin is {origin!r}; give one of {', '.join(ORIGINS)}."))
+        try:
+            coder = coding.bind(task.lower, task.upper)
+            problem = _is_int(experiments) and weight_problem(experiments, coder, task.n_actions)
+            if problem:
+                problems.append(("tiles", problem))
+        except LearningError as err:
+            problems.append(("tiles", str(err)))
+        paths = []
+        for i, path in enumerate(demonstrations):
+            try:
+                task.demonstration_actions(path, i)
+                paths.append(np.asarray(path, dtype=np.float64)[:, : task.joints].tolist())
+            except LearningError as err:
+                problems.append(("demonstrations", str(err)))
+        if _is_int(episodes) and len(paths) > episodes:
+            problems.append(
+                (
+                    "demonstrations",
+                    f"The run replays {len(paths)} demonstrations but has only {episodes} episodes; give at least as many episodes as demonstrations.",
+                )
+            )
+        raise_problems(problems)
+        return cls(
+            task={"kind": TASK_ARM_REACH, **task.to_dict(), "tile_coding": coding.to_dict()},
+            config=config.to_dict(),
+            experiments=int(experiments),
+            episodes=int(episodes),
+            seed=int(seed),
+            demonstrations=paths,
+            name=name,
+            origin=origin,
+            group=group,
+            created=now_iso(),
+            request=request,
+        )
+
     @property
     def kind(self) -> str:
-        """The task's kind (``"arm-grid"`` for the paper's task)."""
+        """The task's kind: ``"arm-grid"`` (the paper's task) or ``"arm-reach"`` (continuous)."""
         return str(self.task.get("kind", TASK_ARM_GRID))
+
+    def arm_reach(self) -> ArmReach:
+        """The task as an :class:`ArmReach` (for kind ``"arm-reach"``)."""
+        if self.kind != TASK_ARM_REACH:
+            raise LearningError(
+                f"This run's task is {self.kind!r}, not the continuous arm task; open it with the tool that made it."
+            )
+        spec = {k: v for k, v in self.task.items() if k not in ("kind", "tile_coding")}
+        return ArmReach.from_dict(spec)
+
+    def tile_coding(self) -> TileCoding:
+        """The tile coding of an ``"arm-reach"`` run."""
+        self.arm_reach()
+        return TileCoding.from_dict(self.task["tile_coding"])
 
     def arm_grid(self) -> ArmGrid:
         """The task as an :class:`ArmGrid` (for kind ``"arm-grid"``)."""
@@ -477,7 +561,12 @@ class RunRecord:
             experiments=int(data.get("experiments", _from(request, "experiments"))),
             episodes=int(data.get("episodes", _from(request, "episodes"))),
             seed=int(data.get("seed", _from(request, "seed") or DEFAULT_SEED)),
-            demonstrations=[list(map(int, p)) for p in data.get("demonstrations") or []],
+            demonstrations=[
+                [[float(x) for x in row] for row in p]
+                if task.get("kind") == TASK_ARM_REACH
+                else list(map(int, p))
+                for p in data.get("demonstrations") or []
+            ],
             name=str(data.get("name") or _from(request, "name") or ""),
             origin=str(data.get("origin") or ("page" if request is not None else "cli")),
             group=data.get("group"),
@@ -776,10 +865,22 @@ class RunFolder:
             self.interrupted = False
 
     def save_policy(self, result: ExperimentResult) -> None:
-        """Write the best experiment's Q table as the run's policy (arm-grid runs)."""
-        grid = self.record.arm_grid()
+        """Write the best experiment's Q table (or tile-coded weights) as the run's policy."""
         best = result.best_experiment()
         tmp = self.path / f".{POLICY_FILE}.{secrets.token_hex(4)}.tmp.npz"
+        notes = f"run {self.id}: experiment {best} of {self.record.experiments}, seed {self.record.seed}, {len(self.record.demonstrations)} demonstrations"
+        if self.record.kind == TASK_ARM_REACH:
+            from ._linear_policy import save_tile_policy
+
+            try:
+                save_tile_policy(tmp, result, best, notes=notes)  # type: ignore[arg-type]
+                os.replace(tmp, self.policy_path)
+            except OSError as err:
+                with contextlib.suppress(OSError):
+                    tmp.unlink()
+                raise _disk_error(err, "the run's policy", self.path) from None
+            return
+        grid = self.record.arm_grid()
         try:
             save_policy(
                 tmp,
@@ -831,6 +932,9 @@ class RunFolder:
 
         def target() -> None:
             try:
+                if record.kind == TASK_ARM_REACH:
+                    box["result"] = _train_arm_reach(record, workers, live)
+                    return
                 box["result"] = run_experiments(
                     record.arm_grid().mdp(),
                     record.dynaq_config(),
@@ -908,6 +1012,29 @@ class RunFolder:
         with contextlib.suppress(LearningError):
             self.save_status()
         return result
+
+
+def _train_arm_reach(
+    record: RunRecord, workers: int | None, live: LiveProgress
+) -> ExperimentResult:
+    """Linear Dyna-Q on ``TeachStudio/ArmReach-v0`` as the record says."""
+    import gymnasium
+
+    from ._gym import ARM_REACH_ID
+
+    task = record.arm_reach()
+    spec = task.to_dict()
+    return run_experiments(
+        lambda: gymnasium.make(ARM_REACH_ID, **spec),
+        record.dynaq_config(),
+        record.experiments,
+        record.episodes,
+        record.seed,
+        [np.asarray(p, dtype=np.float64) for p in record.demonstrations],
+        record.tile_coding(),
+        workers=workers,
+        live=live,
+    )
 
 
 def find_runs(parent: Path) -> list[Path]:

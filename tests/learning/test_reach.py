@@ -17,6 +17,8 @@ from studio.learning import (
     ArmReach,
     DynaQConfig,
     LearningError,
+    RunFolder,
+    RunRecord,
     TilePolicyFile,
     greedy_success,
     load_any_policy,
@@ -139,3 +141,21 @@ def test_a_six_joint_run_reaches_the_goal_and_exports_a_policy_that_rolls_out(tm
     assert math.degrees(math.acos(min(1.0, cos))) <= task.angle_tolerance_deg
     # smooth: no sample moves any joint by more than one step
     assert np.abs(np.diff(rows[:, 1:], axis=0)).max() <= task.step + 1e-12
+
+
+def test_a_continuous_run_folder_trains_saves_and_reads_back(tmp_path):
+    task = ArmReach(joints=4)
+    demo = np.linspace(task.random_start(np.random.default_rng(0)), task.goal[:4], 30)
+    config = DynaQConfig(planning="full", planning_steps=2, max_steps_per_episode=300)
+    record = RunRecord.for_arm_reach(task, task.features(), config, 2, 6, 0, [demo], name="reach")
+    run = RunFolder.create(tmp_path, record)
+    result = run.train()
+    assert run.status == "done" and run.has_policy and result.steps[:, 0].max() < 300
+    again = RunFolder.load(run.path)
+    assert again.record.kind == "arm-reach" and again.record.arm_reach() == task
+    assert np.allclose(again.record.demonstrations[0], demo)  # the joint path, not grid states
+    assert np.array_equal(again.steps(), result.steps)
+    policy = load_any_policy(run.policy_path)
+    assert isinstance(policy, TilePolicyFile) and policy.task == task
+    with pytest.raises(LearningError, match="leaves joint 1's limits at sample 0"):
+        RunRecord.for_arm_reach(task, task.features(), config, 2, 6, 0, [demo + 3.0])
