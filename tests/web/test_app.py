@@ -180,6 +180,7 @@ def test_capture_needs_a_source(client):
         "name": None,
         "seconds": 0.0,
         "frames": 0,
+        "error": None,
     }
     r = client.post("/api/capture/start", json={})
     assert r.status_code == 409 and "no live source" in r.json()["detail"]
