@@ -28,6 +28,7 @@ import numpy as np
 from studio.learning import (
     DEFAULT_GOAL_JOINTS_DEG,
     ArmGrid,
+    ArmReach,
     ConfigError,
     DynaQConfig,
     LearningError,
@@ -173,7 +174,18 @@ def run_create_of(record: RunRecord) -> RunCreate:
     with contextlib.suppress(LearningError, TypeError, ValueError):
         goal_deg = goal_degrees(record.arm_grid())
     defaults = DynaQConfig()
+    reach: dict[str, object] = {}
+    with contextlib.suppress(LearningError, TypeError, ValueError, KeyError):
+        task, coding = record.arm_reach(), record.tile_coding()
+        reach = {
+            "task": "arm-reach",
+            "joints": task.joints,
+            "step_deg": task.step_deg,
+            "tilings": coding.tilings,
+            "tiles": coding.tiles,
+        }
     return RunCreate(
+        **reach,  # type: ignore[arg-type]
         name=record.name or None,
         planning=config.get("planning", defaults.planning),
         planning_steps=config.get("planning_steps", defaults.planning_steps),
@@ -202,6 +214,8 @@ def prepare_run(create: RunCreate, demonstration_path: Callable[[str], np.ndarra
     Raises:
         ConfigError: one sentence per bad field, keyed by field (answered as 422).
     """
+    if create.task == "arm-reach":
+        return _prepare_reach_run(create, demonstration_path)
     problems: list[tuple[str, str]] = []
     config = None
     try:
@@ -256,6 +270,72 @@ def prepare_run(create: RunCreate, demonstration_path: Callable[[str], np.ndarra
         origin="page",
         request=create.model_dump(),
     )
+
+
+def _prepare_reach_run(
+    create: RunCreate, demonstration_path: Callable[[str], np.ndarray]
+) -> RunRecord:
+    """:func:`prepare_run` for the continuous task: joints, step, tiles; the goal is the first
+    demonstration's final pose (else ``goal_deg`` for joints 1-3, the wrist at zero)."""
+    problems: list[tuple[str, str]] = []
+    config = None
+    try:
+        config = DynaQConfig(
+            alpha=create.alpha,
+            gamma=create.gamma,
+            epsilon=create.epsilon,
+            planning=create.planning,
+            planning_steps=create.planning_steps,
+        )
+    except ConfigError as err:
+        problems += list(err.by_field.items())
+    paths = [
+        np.asarray(demonstration_path(name), dtype=np.float64) for name in create.demonstrations
+    ]
+    goal: tuple[float, ...] | None = None
+    if paths:
+        goal = tuple(paths[0][-1, :6])
+    else:
+        wrong = goal_problems(create.goal_deg)
+        problems += [("goal_deg", text) for text in wrong]
+        if not wrong:
+            goal = tuple(np.radians([*create.goal_deg, *([0.0] * (6 - len(create.goal_deg)))]))
+    task = coding = None
+    try:
+        task = ArmReach(joints=create.joints, step_deg=create.step_deg, goal=goal)
+    except LearningError as err:
+        field = str(err).split(" ", 1)[0]
+        problems.append((field if field in ("joints", "step_deg") else "goal_deg", str(err)))
+    if task is not None:
+        try:
+            coding = task.features(tilings=create.tilings, tiles=create.tiles)
+        except LearningError as err:
+            problems.append(("tiles" if str(err).startswith("tiles") else "tilings", str(err)))
+    if task is None or coding is None or config is None:
+        problems += run_problems(
+            create.experiments, create.episodes, create.seed, create.name or ""
+        )
+        raise_problems(problems)
+    assert task is not None and coding is not None and config is not None
+    try:
+        record = RunRecord.for_arm_reach(
+            task,
+            coding,
+            config,
+            create.experiments,
+            create.episodes,
+            create.seed,
+            [p[:, : task.joints] for p in paths],
+            name=create.name or "",
+            origin="page",
+            request=create.model_dump(),
+        )
+    except ConfigError as err:
+        problems += list(err.by_field.items())
+        raise_problems(problems)
+        raise
+    raise_problems(problems)
+    return record
 
 
 class RunQueue:

@@ -18,6 +18,7 @@ from studio.learning import (
     DEFAULT_GOAL_JOINTS_DEG,
     DEFAULT_SEED,
     ArmGrid,
+    ArmReach,
     DynaQConfig,
 )
 
@@ -28,6 +29,10 @@ SourceKind = Literal["simulator", "recording", "network", "serial"]
 DEFAULT_GOAL_DEG = DEFAULT_GOAL_JOINTS_DEG
 """The learning package's default goal for joints 1-3 (an arm reaching forward and down)."""
 _DYNAQ = DynaQConfig()
+_REACH_FEATURES = ArmReach().features()
+"""The continuous task's default tile coding (the learning package's)."""
+TaskKind = Literal["arm-grid", "arm-reach"]
+"""What a run learns: the paper's grid (tabular) or continuous joints (tile coding)."""
 """The learning package's training defaults: ``RunCreate`` takes each of its defaults from here."""
 
 
@@ -257,6 +262,16 @@ class RunCreate(_Body):
     episodes: int = DEFAULT_EPISODES
     experiments: int = DEFAULT_EXPERIMENTS
     bins: int = ArmGrid.bins
+    task: TaskKind = "arm-grid"
+    """``arm-grid``: the paper's grid, tabular; ``arm-reach``: continuous joints, tile coding."""
+    joints: int = ArmReach.joints
+    """Continuous task: joints 1..J learnt (3 to 6)."""
+    step_deg: float = ArmReach.step_deg
+    """Continuous task: joint increment per action, degrees."""
+    tilings: int = _REACH_FEATURES.tilings
+    """Continuous task: offset tilings per pair of joints."""
+    tiles: int = _REACH_FEATURES.tiles
+    """Continuous task: tiles per joint in each tiling."""
     goal_deg: list[float] = Field(default_factory=lambda: list(DEFAULT_GOAL_DEG))
     demonstrations: list[str] = Field(default_factory=list)
     seed: int = DEFAULT_SEED

@@ -396,7 +396,9 @@ class Studio:
                 raise ConflictError(
                     f"Run {run} has no policy yet; wait until it has finished episodes, then try again."
                 )
-            return self.policies.load_file(r.policy_path), f"run:{run}"
+            from studio.learning import load_any_policy  # a run's policy: either format
+
+            return load_any_policy(r.policy_path), f"run:{run}"
         assert policy is not None
         if not self.policies.exists(policy):
             try:

@@ -8,7 +8,13 @@ from pathlib import Path
 import numpy as np
 from fastapi import APIRouter, Response
 
-from studio.learning import greedy_path, rollout, save_trajectory_csv
+from studio.learning import (
+    TilePolicyFile,
+    greedy_path,
+    rollout,
+    rollout_tile_policy,
+    save_trajectory_csv,
+)
 
 from .._deps import StudioDep
 from .._errors import ConflictError
@@ -20,6 +26,10 @@ ROLLOUT_RATE_HZ = 50.0
 """Samples per second of a watched rollout (the scene interpolates between them)."""
 ROUND_DECIMALS = 6
 """Seconds and radians are sent to a micro-unit: far below what the scene can show."""
+TILE_DEMONSTRATION_PATH = "demonstration"
+"""Name of the scene path showing a continuous run's demonstration beside the watched robot."""
+TILE_WATCH_MAX_STEPS = 1_500
+"""Most joint steps of a watched continuous rollout (a minute of motion at 0.04 s per step)."""
 
 
 @router.post("")
@@ -27,6 +37,8 @@ def watch(body: WatchCreate, studio: StudioDep) -> WatchPublic:
     """Roll the greedy policy of a run or an uploaded policy (exactly one; 422 otherwise) out from
     a random or the current pose and play it in the scene (409 if the run has no policy yet)."""
     policy, key = studio.load_policy(body.run, body.policy)
+    if isinstance(policy, TilePolicyFile):
+        return _watch_tile_policy(body, studio, policy, key)
     grid = policy.grid
     if body.start == "current":
         q_now = (
@@ -57,6 +69,49 @@ def watch(body: WatchCreate, studio: StudioDep) -> WatchPublic:
         times=np.round(times, ROUND_DECIMALS).tolist(),
         q_robot=np.round(q, ROUND_DECIMALS).tolist(),
         reached_goal=states[-1] == grid.goal_state,
+    )
+
+
+def _watch_tile_policy(
+    body: WatchCreate, studio: StudioDep, policy: TilePolicyFile, key: str
+) -> WatchPublic:
+    """Play a tile-coded arm policy: one joint step at a time, the run's demonstration beside it."""
+    task = policy.task
+    if task is None:
+        raise ConflictError(
+            f"This policy was trained on {policy.env_id or 'another environment'}, not the arm; only arm policies can be watched."
+        )
+    if body.start == "current":
+        q_now = np.asarray(
+            studio.scene.current_q_robot()
+            if studio.scene is not None
+            else studio.pipeline.q_robot()
+        )
+        start = np.clip(q_now[: task.joints], task.lower, task.upper)
+    else:
+        start = task.random_start(np.random.default_rng(body.seed))
+    times, q, reached = rollout_tile_policy(policy, start, ROLLOUT_RATE_HZ, TILE_WATCH_MAX_STEPS)
+    with studio.watch_lock:
+        studio.last_rollout = (times, q)
+        studio.watching = key
+    if studio.scene is not None:
+        studio.scene.set_goal(np.asarray(task.goal))
+        studio.scene.clear_path(TILE_DEMONSTRATION_PATH)
+        demos = (
+            studio.runs.get(key.removeprefix("run:")).folder.record.demonstrations
+            if key.startswith("run:")
+            else []
+        )
+        if demos:
+            path = np.tile(np.asarray(task.goal), (len(demos[0]), 1))
+            path[:, : task.joints] = np.asarray(demos[0])[:, : task.joints]
+            studio.scene.show_path(TILE_DEMONSTRATION_PATH, path)
+        studio.scene.play_trajectory(times, q)
+    return WatchPublic(
+        states=[],
+        times=np.round(times, ROUND_DECIMALS).tolist(),
+        q_robot=np.round(q, ROUND_DECIMALS).tolist(),
+        reached_goal=bool(reached),
     )
 
 
