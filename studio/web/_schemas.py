@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from typing import Literal
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, ConfigDict, Field, StrictBool
 
 from studio.learning import (
     DEFAULT_EPISODES,
@@ -112,7 +112,7 @@ class SourceUpdate(_Body):
         "(flat-pose offsets and gains; see studio/capture); none reads raw counts as radians",
     )
     speed: float | None = Field(None, gt=0, le=100)
-    loop: bool | None = None
+    loop: StrictBool | None = None
     seed: int | None = Field(None, ge=0)
 
 
@@ -135,7 +135,7 @@ class RetargetUpdate(_Body):
     """Change the human-to-robot mapping."""
 
     mode: Literal["joint", "cartesian"]
-    mirror: bool | None = None
+    mirror: StrictBool | None = None
 
 
 # ----------------------------------------------------------------------------- capture
@@ -203,7 +203,7 @@ class DemonstrationCreate(_Body):
     recording: str
     t0: float = Field(ge=0)
     t1: float = Field(ge=0)
-    goal_from_end: bool = False
+    goal_from_end: StrictBool = False
     name: str | None = None
 
 
@@ -212,7 +212,7 @@ class DemonstrationMark(_Body):
 
     action: Literal["start", "stop"]
     name: str | None = None
-    goal_from_end: bool = False
+    goal_from_end: StrictBool = False
 
 
 class DemonstrationPublic(BaseModel):

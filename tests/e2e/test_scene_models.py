@@ -29,6 +29,11 @@ VIEWPORT = {"width": 1000, "height": 560}
 SETTLE_TIMEOUT_S = 30.0
 MIN_BODY_PIXELS = 2000
 """A body drawn at the default camera covers far more pixels than this."""
+DIFF_LEVEL = 48
+"""A pixel belongs to a body when hiding it changes a channel by more than this (of 255). viser
+lowers its resolution when software rendering is slow, which shifts the floor's lines by less."""
+STRAY_PERCENTILES = (0.2, 99.8)
+"""A body's extent on screen, ignoring the odd stray pixel of a resolution change."""
 
 
 @pytest.fixture(scope="module")
@@ -83,11 +88,14 @@ def _settled(page: Any, previous: np.ndarray | None = None) -> np.ndarray:
 
 def _footprint(with_body: np.ndarray, without: np.ndarray) -> tuple[int, int, int, int, int]:
     """(pixels, x0, y0, x1, y1) of where two screenshots differ."""
-    diff = np.any(np.abs(with_body.astype(int) - without.astype(int)) > 12, axis=2)
+    diff = np.any(np.abs(with_body.astype(int) - without.astype(int)) > DIFF_LEVEL, axis=2)
     ys, xs = np.nonzero(diff)
     if len(xs) == 0:
         return 0, 0, 0, 0, 0
-    return len(xs), int(xs.min()), int(ys.min()), int(xs.max()), int(ys.max())
+    lo, hi = STRAY_PERCENTILES
+    x0, x1 = np.percentile(xs, [lo, hi])
+    y0, y1 = np.percentile(ys, [lo, hi])
+    return len(xs), int(x0), int(y0), int(x1), int(y1)
 
 
 def _shown(handles: list[Any], visible: bool) -> None:
@@ -127,3 +135,18 @@ def test_both_models_are_meshes_and_framed(scene: Any, scene_page: Any) -> None:
         assert x0 > 0 and x1 < width - 1 and y0 > 0 and y1 < height - 1, (name, x0, y0, x1, y1)
         full = again
     Image.fromarray(full).save(ARTIFACTS / "scene-models-raised.png")
+
+
+def test_reset_view_returns_to_the_default_camera(scene: Any, scene_page: Any) -> None:
+    (client,) = scene.server.get_clients().values()
+    client.camera.position = (4.0, 4.0, 4.0)  # the user wandered off
+    client.camera.look_at = (3.0, 3.0, 0.0)
+    deadline = time.monotonic() + SETTLE_TIMEOUT_S
+    while np.allclose(client.camera.position, scene.layout.camera_position, atol=1e-3):
+        assert time.monotonic() < deadline, "the camera did not move"
+        time.sleep(0.05)
+    scene_page.get_by_role("button", name="Reset view").click()
+    while not np.allclose(client.camera.position, scene.layout.camera_position, atol=1e-3):
+        assert time.monotonic() < deadline, "Reset view did not bring the camera back"
+        time.sleep(0.05)
+    np.testing.assert_allclose(client.camera.look_at, scene.layout.camera_look_at, atol=1e-3)
