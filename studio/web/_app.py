@@ -8,6 +8,7 @@ fresh studio per ``with TestClient(create_app(settings))`` block.
 from __future__ import annotations
 
 import logging
+import re
 from collections.abc import AsyncIterator
 from contextlib import asynccontextmanager
 from pathlib import Path
@@ -24,7 +25,13 @@ from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from .. import __version__
 from .._errors import StudioError
-from ._errors import NotFoundError, StorageError, WebError, os_error_answer
+from ._errors import (
+    NotFoundError,
+    StorageError,
+    WebError,
+    document_errors,
+    os_error_answer,
+)
 from ._guard import GuardMiddleware, SiteRule
 from ._settings import Settings, get_settings
 from ._state import Studio
@@ -45,6 +52,7 @@ from .routers import (
 log = logging.getLogger(__name__)
 
 STATIC_DIR = Path(__file__).parent / "static"
+HTTP_METHODS = frozenset({"GET", "HEAD", "POST", "PUT", "PATCH", "DELETE", "OPTIONS"})
 MULTIPART_OVERHEAD_BYTES = 64 * 1024
 """Room for the multipart framing around an upload at the size limit."""
 
@@ -99,6 +107,15 @@ def create_app(settings: Settings | None = None, scene: Any = None) -> FastAPI:
             body["by_field"] = getattr(err, "by_field", {})
         return JSONResponse(body, status_code=status)
 
+    @app.exception_handler(405)
+    async def method_not_allowed(request: Request, err: Exception) -> JSONResponse:
+        allow = ", ".join(allowed_methods(app, request.url.path))
+        return JSONResponse(
+            {"detail": f"{request.method} is not allowed here; use {allow}."},
+            status_code=405,
+            headers={"Allow": allow},
+        )
+
     @app.exception_handler(OSError)
     async def os_error(request: Request, err: OSError) -> JSONResponse:
         status, sentence = os_error_answer(err, settings.data_dir.resolve())
@@ -134,7 +151,31 @@ def create_app(settings: Settings | None = None, scene: Any = None) -> FastAPI:
         return FileResponse(page, headers={"Cache-Control": "no-cache"})
 
     app.mount("/static", StaticFiles(directory=STATIC_DIR, check_dir=False), name="static")
+
+    def openapi() -> dict[str, Any]:
+        if app.openapi_schema is None:  # built once, with the studio's real error shape
+            app.openapi_schema = document_errors(FastAPI.openapi(app))
+        return app.openapi_schema
+
+    app.openapi = openapi  # type: ignore[method-assign]
     return app
+
+
+def allowed_methods(app: FastAPI, path: str) -> list[str]:
+    """Every method the API documents at ``path`` (for a 405's ``Allow``).
+
+    Starlette names only the methods of the first route matching the path, but a resource is
+    often served by several routes (``GET``, ``PATCH`` and ``DELETE /api/recordings/{name}``).
+    """
+    paths = app.openapi().get("paths", {})
+    if path in paths:  # a fixed path (``/api/demonstrations/mark``) wins over a template
+        return sorted(m.upper() for m in paths[path] if m.upper() in HTTP_METHODS)
+    methods: set[str] = set()
+    for template, item in paths.items():
+        parts = re.split(r"\{[^}]+\}", template)
+        if re.fullmatch("[^/]+".join(re.escape(part) for part in parts), path):
+            methods |= {m.upper() for m in item if m.upper() in HTTP_METHODS}
+    return sorted(methods)
 
 
 def validation_sentence(errors: list[dict[str, Any]]) -> str:

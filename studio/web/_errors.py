@@ -12,6 +12,9 @@ from __future__ import annotations
 import errno
 import os
 from pathlib import Path
+from typing import Any
+
+from pydantic import BaseModel, Field
 
 from .._errors import StudioError
 
@@ -118,3 +121,46 @@ def os_error_answer(err: OSError, data_dir: Path) -> tuple[int, str]:
         )
     reason = err.strerror or type(err).__name__
     return 500, f"The studio could not read or write a file ({reason}); see the server log."
+
+
+class ErrorPublic(BaseModel):
+    """What every refused request answers: one sentence, and for a refused form every bad field."""
+
+    detail: str = Field(description="one sentence naming the problem and the fix")
+    reason: str | None = Field(
+        None, description="a machine-readable reason, e.g. a refused demonstration's"
+    )
+    problems: list[str] | None = Field(None, description="every bad field of a refused form")
+    by_field: dict[str, str] | None = Field(None, description="the problems keyed by field")
+
+
+ERROR_RESPONSE = "An error: one sentence saying what is wrong and how to fix it."
+
+
+def document_errors(schema: dict[str, Any]) -> dict[str, Any]:
+    """Make an OpenAPI schema say what the studio's errors really look like.
+
+    FastAPI declares its own validation-error shape (``detail`` a list) for 422, but the studio
+    answers every error, 422 included, as :class:`ErrorPublic`; and any operation may answer
+    404, 409, 413, 507 and the like. Each operation gets that one error shape for 422 and as
+    its ``default`` response.
+    """
+    components = schema.setdefault("components", {}).setdefault("schemas", {})
+    for name in ("HTTPValidationError", "ValidationError"):
+        components.pop(name, None)
+    components["ErrorPublic"] = ErrorPublic.model_json_schema(
+        ref_template="#/components/schemas/{model}"
+    )
+    error = {
+        "description": ERROR_RESPONSE,
+        "content": {"application/json": {"schema": {"$ref": "#/components/schemas/ErrorPublic"}}},
+    }
+    for item in schema.get("paths", {}).values():
+        for operation in item.values():
+            if not isinstance(operation, dict) or "responses" not in operation:
+                continue
+            responses = operation["responses"]
+            if "422" in responses:
+                responses["422"] = error
+            responses["default"] = error
+    return schema

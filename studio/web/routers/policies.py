@@ -14,6 +14,7 @@ from .._deps import SettingsDep, StudioDep
 from .._errors import ConflictError
 from .._schemas import PolicyPublic
 from .._store import StoredFile, receive_upload
+from . import file_responses
 
 router = APIRouter(prefix="/api/policies", tags=["policies"])
 
@@ -84,7 +85,11 @@ async def upload_policy(
     return await run_in_threadpool(adopt)
 
 
-@router.get("/{name}/file")
+@router.get(
+    "/{name}/file",
+    response_class=FileResponse,
+    responses=file_responses("application/octet-stream"),
+)
 def download_policy(name: str, studio: StudioDep) -> FileResponse:
     """The uploaded policy file."""
     return FileResponse(

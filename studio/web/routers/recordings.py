@@ -19,11 +19,13 @@ from studio.capture import (
     update_recording_meta,
 )
 
+from ..._errors import StudioError
 from .._deps import SettingsDep, StudioDep
 from .._errors import ConflictError, NotFoundError
 from .._schemas import RecordingCopy, RecordingPublic, RecordingUpdate
 from .._state import Studio
 from .._store import StoredFile, receive_upload
+from . import file_responses
 
 router = APIRouter(prefix="/api/recordings", tags=["recordings"])
 
@@ -94,7 +96,7 @@ def read_recording(name: str, studio: StudioDep) -> RecordingPublic:
     return read_public(studio, name)
 
 
-@router.get("/{name}/file")
+@router.get("/{name}/file", response_class=StreamingResponse, responses=file_responses("text/csv"))
 def download_recording(name: str, studio: StudioDep) -> StreamingResponse:
     """The ``.tape.csv`` file, up to its last complete line (a capture in progress may be
     downloaded: its length is fixed when the download starts, so it is a valid recovered file)."""
@@ -146,13 +148,20 @@ def update_recording(name: str, body: RecordingUpdate, studio: StudioDep) -> Rec
     changes = {
         k: v for k, v in (("notes", body.notes), ("operator", body.operator)) if v is not None
     }
-    if changes:
-        update_recording_meta(path, **changes)
-    studio.changes.bump("recordings")
-    if renaming:
-        rename_recording(path, body.name)
-        studio.changes.bump("demonstrations")  # their "recording" follows the rename
-        return read_public(studio, body.name)
+    try:
+        if changes:
+            update_recording_meta(path, **changes)
+        studio.changes.bump("recordings")
+        if renaming:
+            rename_recording(path, body.name)
+            studio.changes.bump("demonstrations")  # their "recording" follows the rename
+            return read_public(studio, body.name)
+    except (StudioError, FileNotFoundError):
+        if not path.exists():  # a DELETE won the race: say so, not "cannot open <path>"
+            raise NotFoundError(
+                f"Recording {name!r} was deleted meanwhile; refresh the recordings list."
+            ) from None
+        raise
     return read_public(studio, name)
 
 

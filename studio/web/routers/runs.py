@@ -17,6 +17,7 @@ from studio.learning import curve_figure, curves_csv
 from .._deps import StudioDep
 from .._errors import ConflictError, NotFoundError
 from .._schemas import CurvePublic, RunCreate, RunPublic
+from . import file_responses
 
 router = APIRouter(prefix="/api/runs", tags=["runs"])
 
@@ -68,7 +69,7 @@ def delete_run(run_id: str, studio: StudioDep) -> Response:
     return Response(status_code=204)
 
 
-@router.get("/{run_id}/curve.csv")
+@router.get("/{run_id}/curve.csv", response_class=Response, responses=file_responses("text/csv"))
 def download_curve(run_id: str, studio: StudioDep) -> Response:
     """The curve as CSV, in the one layout of ``curves.csv`` (see ``studio/learning/README.md``)."""
     run = studio.runs.get(run_id)
@@ -79,7 +80,9 @@ def download_curve(run_id: str, studio: StudioDep) -> Response:
     )
 
 
-@router.get("/{run_id}/plot.{fmt}")
+@router.get(
+    "/{run_id}/plot.{fmt}", response_class=Response, responses=file_responses(*PLOT_MEDIA.values())
+)
 def download_plot(
     run_id: str,
     fmt: str,
@@ -99,7 +102,11 @@ def download_plot(
     )
 
 
-@router.get("/{run_id}/policy")
+@router.get(
+    "/{run_id}/policy",
+    response_class=FileResponse,
+    responses=file_responses("application/octet-stream"),
+)
 def download_policy(run_id: str, studio: StudioDep) -> FileResponse:
     """The run's policy file (409 before the run has finished an episode)."""
     run = studio.runs.get(run_id)

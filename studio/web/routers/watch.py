@@ -19,6 +19,7 @@ from studio.learning import (
 from .._deps import StudioDep
 from .._errors import ConflictError
 from .._schemas import WatchCreate, WatchPublic
+from . import file_responses
 
 router = APIRouter(prefix="/api/watch", tags=["watch"])
 
@@ -125,7 +126,7 @@ def stop_watch(studio: StudioDep) -> Response:
     return Response(status_code=204)
 
 
-@router.get("/trajectory.csv")
+@router.get("/trajectory.csv", response_class=Response, responses=file_responses("text/csv"))
 def download_trajectory(studio: StudioDep) -> Response:
     """The last rollout as CSV: ``time,q1..q6`` (seconds, radians); 409 before any watch."""
     with studio.watch_lock:
