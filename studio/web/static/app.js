@@ -593,6 +593,21 @@ function resetTrainForm() {
   f.elements.name.value = "";
 }
 
+/** Continuous-task fields of the train form (shown only for that task). */
+const REACH_FIELDS = ["joints", "step_deg", "tilings", "tiles"];
+
+/** Show the fields of the chosen task; empty continuous-task fields take /api/config's defaults. */
+function syncTaskFields() {
+  const f = $("train-form");
+  const reach = f.elements.task.value === "arm-reach";
+  for (const label of f.querySelectorAll(".reach-only")) label.hidden = !reach;
+  f.elements.bins.closest("label").hidden = reach;
+  const defaults = (S.config && S.config.training) || {};
+  for (const k of REACH_FIELDS) {
+    if (f.elements[k].value === "" && defaults[k] != null) f.elements[k].value = String(defaults[k]);
+  }
+}
+
 function readTrainForm() {
   const f = $("train-form").elements;
   const num = (k) => {
@@ -609,10 +624,12 @@ function readTrainForm() {
     episodes: num("episodes"),
     experiments: num("experiments"),
     bins: num("bins"),
+    task: f.task.value,
     seed: num("seed"),
     goal_deg: [num("goal0"), num("goal1"), num("goal2")],
     demonstrations: [...$("train-demos").querySelectorAll("input:checked")].map((i) => i.value),
   };
+  if (body.task === "arm-reach") for (const k of REACH_FIELDS) body[k] = num(k);
   if (f.name.value.trim()) body.name = f.name.value.trim();
   return body;
 }
@@ -1170,7 +1187,9 @@ function wire() {
   $("demo-mark").addEventListener("click", toggleMark);
 
   $("train-form").addEventListener("submit", startRun);
+  $("train-form").elements.task.addEventListener("change", syncTaskFields);
   $("train-defaults").addEventListener("click", resetTrainForm);
+  $("train-defaults").addEventListener("click", syncTaskFields); // after the reset above
   $("curve-log").addEventListener("change", markCurvesDirty);
   $("curve-band").addEventListener("change", markCurvesDirty);
 
