@@ -51,13 +51,22 @@ from ._arm import ArmGrid
 from ._config import DynaQConfig
 from ._dynaq import LiveProgress
 from ._errors import ConfigError, LearningError
+from ._reach import ArmReach
 from ._reproduce import (
     CONVERGENCE_FACTOR,
     _standard_error,
     episodes_to_converge,
     generate_demonstrations,
 )
-from ._runs import TASK_ARM_GRID, RunFolder, RunRecord, _pid_alive, curve_statistics, now_iso
+from ._runs import (
+    TASK_ARM_GRID,
+    TASK_ARM_REACH,
+    RunFolder,
+    RunRecord,
+    _pid_alive,
+    curve_statistics,
+    now_iso,
+)
 
 SWEEP_FORMAT = "teach-studio-sweep"
 """The ``format`` field of ``sweep.json``."""
@@ -74,15 +83,24 @@ RAY_DIR = "ray"
 SWEEP_ID = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]{0,63}$")
 """A sweep id: a folder name, unique per data folder."""
 
-TASKS = (TASK_ARM_GRID,)
-"""Tasks a sweep can train (the run record's ``task.kind``)."""
+TASKS = (TASK_ARM_GRID, TASK_ARM_REACH)
+"""Tasks a sweep can train (the run record's ``task.kind``): the paper's grid (tabular) and the
+continuous joints (tile-coded linear Dyna-Q)."""
 GRID_FIELDS = tuple(f.name for f in fields(ArmGrid))
 """Task settings of the arm grid: joints, bins, low_deg, high_deg, goal."""
+REACH_FIELDS = tuple(f.name for f in fields(ArmReach))
+"""Task settings of the continuous joints: joints, step_deg, goal, tolerances, shaping."""
+CODING_SETTINGS = ("tilings", "tiles", "size")
+"""The continuous task's tile coding (:meth:`ArmReach.features`, as the page and CLI build it)."""
 CONFIG_FIELDS = tuple(f.name for f in fields(DynaQConfig))
 """Learning settings: every :class:`DynaQConfig` field."""
 RUN_SETTINGS = ("demonstrations",)
-"""Run settings: ``demonstrations`` is the number of generated demonstrations replayed first
-(the same generator and seed as ``studio train --generated-demos N``)."""
+"""Run settings of the grid: ``demonstrations`` is the number of generated demonstrations replayed
+first (the same generator and seed as ``studio train --generated-demos N``)."""
+TASK_SETTINGS = {
+    TASK_ARM_GRID: GRID_FIELDS + RUN_SETTINGS,
+    TASK_ARM_REACH: REACH_FIELDS + CODING_SETTINGS,
+}
 SEARCH_KINDS = ("grid", "random")
 DISTRIBUTIONS = ("uniform", "loguniform", "randint")
 """Random-search distributions: ``{uniform = [lo, hi]}``, ``{loguniform = [lo, hi]}``,
@@ -185,6 +203,8 @@ class SweepSpec:
         episodes: episodes per experiment.
         metric: one of :data:`METRICS`.
         convergence_factor: ``episodes_to_converge``'s level, in mean shortest paths.
+        level_steps: ``episodes_to_converge``'s level in steps, instead (needed by the
+            continuous task, which has no shortest path to scale).
         scheduler: ASHA settings, or None to run every trial to the end.
         cpus_per_trial: cores a trial reserves.
     """
@@ -201,6 +221,7 @@ class SweepSpec:
     search_seed: int = 0
     metric: str = DEFAULT_METRIC
     convergence_factor: float = CONVERGENCE_FACTOR
+    level_steps: float | None = None
     scheduler: Scheduler | None = None
     cpus_per_trial: int = DEFAULT_CPUS_PER_TRIAL
 
@@ -241,6 +262,8 @@ class SweepSpec:
             "search": {"kind": self.search, "samples": self.samples, "seed": self.search_seed},
             "metric": {"name": self.metric, "convergence_factor": self.convergence_factor},
         }
+        if self.level_steps is not None:
+            data["metric"]["level_steps"] = self.level_steps
         if self.scheduler is not None:
             data["scheduler"] = {
                 "kind": "asha",
@@ -417,9 +440,9 @@ def parse_sweep_spec(data: Mapping[str, Any], source: str = "the sweep spec") ->
 
     metric_table = table("metric")
     for key in metric_table:
-        if key not in ("name", "convergence_factor"):
+        if key not in ("name", "convergence_factor", "level_steps"):
             raise SweepError(
-                f"{source} [metric] has an unknown setting {key!r}; use name and convergence_factor."
+                f"{source} [metric] has an unknown setting {key!r}; use name, convergence_factor and level_steps."
             )
     metric = metric_table.get("name", DEFAULT_METRIC)
     if metric not in METRICS:
@@ -428,6 +451,13 @@ def parse_sweep_spec(data: Mapping[str, Any], source: str = "the sweep spec") ->
     if not _is_number(factor) or factor <= 0:
         raise SweepError(
             f"{source} [metric] convergence_factor is {factor!r}; give a number above 0."
+        )
+    level = metric_table.get("level_steps")
+    if level is not None and (not _is_number(level) or level <= 0):
+        raise SweepError(f"{source} [metric] level_steps is {level!r}; give a number above 0.")
+    if metric == "episodes_to_converge" and level is None and task != TASK_ARM_GRID:
+        raise SweepError(
+            f"{source} [metric] episodes_to_converge on the {task} task needs level_steps (mean steps per episode that count as converged); add it, or choose another metric."
         )
 
     scheduler = None
@@ -467,6 +497,7 @@ def parse_sweep_spec(data: Mapping[str, Any], source: str = "the sweep spec") ->
         search_seed=int(search_seed),
         metric=metric,
         convergence_factor=float(factor),
+        level_steps=None if level is None else float(level),
         scheduler=scheduler,
         cpus_per_trial=int(cpus),
     )
@@ -490,7 +521,7 @@ def parse_sweep_spec(data: Mapping[str, Any], source: str = "the sweep spec") ->
 
 
 def _settings_of(task: str) -> tuple[str, ...]:
-    return CONFIG_FIELDS + GRID_FIELDS + RUN_SETTINGS
+    return CONFIG_FIELDS + TASK_SETTINGS[task]
 
 
 def _is_int(value: object) -> bool:
@@ -538,33 +569,50 @@ def _check(
     episodes: Any = 1,
     seed: Any = 0,
 ) -> None:
-    """Build what a run with these settings would build, turning a refusal into a SweepError."""
+    """Build the run record a trial with these settings would build (its task, settings, budget,
+    seed), turning a refusal into a SweepError naming ``where``."""
     try:
-        demos = settings.get("demonstrations", 0)
-        if not _is_int(demos) or demos < 0:
-            raise LearningError(
-                f"demonstrations is {demos!r}; give how many generated demonstrations to replay (0 or more)."
-            )
-        grid, config = _task_of(task, settings)
-        # The run record checks the budget, the seed and demonstrations against episodes; the
-        # demonstrations' content is drawn per trial, so the goal state stands in for each path.
-        RunRecord.for_arm_grid(
-            grid, config, experiments, episodes, seed, [[grid.goal_state]] * demos, origin="sweep"
-        )
+        _record(task, settings, experiments, episodes, seed, demonstrations=None)
     except ConfigError as err:
         raise SweepError(f"{where}: {err.problems[0]}") from None
     except LearningError as err:
         raise SweepError(f"{where}: {err}") from None
 
 
-def _task_of(task: str, settings: Mapping[str, Any]) -> tuple[ArmGrid, DynaQConfig]:
-    grid_spec = {k: v for k, v in settings.items() if k in GRID_FIELDS}
-    if grid_spec.get("goal") is not None:
-        goal = grid_spec["goal"]
-        grid_spec["goal"] = tuple(goal) if isinstance(goal, list) else goal
-    grid = ArmGrid(**grid_spec)
+def _record(
+    task: str,
+    settings: Mapping[str, Any],
+    experiments: Any,
+    episodes: Any,
+    seed: Any,
+    demonstrations: np.random.Generator | None,
+    **names: Any,
+) -> RunRecord:
+    """A trial's run record; ``demonstrations`` draws the generated demonstrations (None: check
+    only, the goal state standing in for each path, since only their count is checked)."""
     config = DynaQConfig.from_dict({k: v for k, v in settings.items() if k in CONFIG_FIELDS})
-    return grid, config
+    if task == TASK_ARM_REACH:
+        reach = ArmReach.from_dict({k: v for k, v in settings.items() if k in REACH_FIELDS})
+        coding = reach.features(**{k: v for k, v in settings.items() if k in CODING_SETTINGS})
+        return RunRecord.for_arm_reach(
+            reach, coding, config, experiments, episodes, seed, origin="sweep", **names
+        )
+    grid_spec = {k: v for k, v in settings.items() if k in GRID_FIELDS}
+    if isinstance(grid_spec.get("goal"), list):
+        grid_spec["goal"] = tuple(grid_spec["goal"])
+    grid = ArmGrid(**grid_spec)
+    count = settings.get("demonstrations", 0)
+    if not _is_int(count) or count < 0:
+        raise LearningError(
+            f"demonstrations is {count!r}; give how many generated demonstrations to replay (0 or more)."
+        )
+    if demonstrations is None:
+        paths = [[grid.goal_state]] * count
+    else:
+        paths = generate_demonstrations(grid, count, demonstrations) if count else []
+    return RunRecord.for_arm_grid(
+        grid, config, experiments, episodes, seed, paths, origin="sweep", **names
+    )
 
 
 # ----------------------------------------------------------------------------- one trial
@@ -572,30 +620,28 @@ def _task_of(task: str, settings: Mapping[str, Any]) -> tuple[ArmGrid, DynaQConf
 
 def trial_record(spec: SweepSpec, trial: Trial) -> RunRecord:
     """The run record of a trial: fixed and swept settings, its seed, generated demonstrations."""
-    settings = {**spec.fixed, **trial.settings}
-    grid, config = _task_of(spec.task, settings)
-    count = int(settings.get("demonstrations", 0))
-    demos = (
-        generate_demonstrations(grid, count, np.random.default_rng([trial.seed, DEMO_SEED_STREAM]))
-        if count
-        else []
-    )
-    return RunRecord.for_arm_grid(
-        grid,
-        config,
+    return _record(
+        spec.task,
+        {**spec.fixed, **trial.settings},
         spec.experiments,
         spec.episodes,
         trial.seed,
-        demos,
+        np.random.default_rng([trial.seed, DEMO_SEED_STREAM]),
         name=f"{spec.name}: {trial.label()}",
-        origin="sweep",
         group=spec.name,
     )
 
 
-def trial_metrics(steps: np.ndarray, record: RunRecord, convergence_factor: float) -> dict:
+def trial_metrics(
+    steps: np.ndarray,
+    record: RunRecord,
+    convergence_factor: float,
+    level_steps: float | None = None,
+) -> dict:
     """Every metric of :data:`METRICS` from a run's steps, over the episodes all experiments
-    finished (a stopped or early-stopped run counts what it did)."""
+    finished (a stopped or early-stopped run counts what it did). ``episodes_to_converge``'s level
+    is ``level_steps`` when given, else ``convergence_factor`` x the grid's mean shortest path
+    (NaN for the continuous task without ``level_steps``)."""
     steps = np.asarray(steps)
     done = int((steps >= 0).all(axis=0).cumprod().sum())
     start = min(len(record.demonstrations), done)
@@ -603,10 +649,18 @@ def trial_metrics(steps: np.ndarray, record: RunRecord, convergence_factor: floa
     if done == 0:
         return {**out, **{name: math.nan for name in METRICS}}
     mean = np.asarray(curve_statistics(steps[:, :done])["mean"], dtype=np.float64)
-    level = convergence_factor * record.arm_grid().mean_shortest_steps()
-    converged = episodes_to_converge(mean, level, start)
+    if level_steps is not None:
+        level = level_steps
+    elif record.kind == TASK_ARM_GRID:
+        level = convergence_factor * record.arm_grid().mean_shortest_steps()
+    else:
+        level = math.nan
+    converged = episodes_to_converge(mean, level, start) if not math.isnan(level) else None
     tail = max(1, int(np.ceil(done * FINAL_FRACTION)))
-    out["episodes_to_converge"] = float(converged if converged is not None else done + 1)
+    if math.isnan(level):
+        out["episodes_to_converge"] = math.nan
+    else:
+        out["episodes_to_converge"] = float(converged if converged is not None else done + 1)
     out["converged"] = converged is not None
     out["first_episode_steps"] = float(mean[start]) if start < done else math.nan
     out["final_steps"] = float(mean[-tail:].mean())
@@ -657,7 +711,9 @@ def _trainable(config: dict[str, Any], job: _Job) -> None:
         done = int((live.steps >= 0).all(axis=0).cumprod().sum())
         while pending and done >= pending[0]:
             k = pending.pop(0)
-            metrics = trial_metrics(live.steps[:, :k], record, spec.convergence_factor)
+            metrics = trial_metrics(
+                live.steps[:, :k], record, spec.convergence_factor, spec.level_steps
+            )
             try:
                 tune.report({**metrics, "episodes": k, "final": False, "node": node})
             except SystemExit:  # Tune stopped the trial (ASHA, or the sweep was interrupted)
@@ -670,7 +726,7 @@ def _trainable(config: dict[str, Any], job: _Job) -> None:
         return
     if run.status == "failed":
         raise SweepError(f"Trial {trial.key} failed: {run.error}")
-    metrics = trial_metrics(run.steps(), record, spec.convergence_factor)
+    metrics = trial_metrics(run.steps(), record, spec.convergence_factor, spec.level_steps)
     tune.report(
         {
             **metrics,
@@ -788,7 +844,9 @@ def sweep_rows(data_dir: Path, spec: SweepSpec) -> list[dict[str, Any]]:
         cpu, status = math.nan, "not run"
         with contextlib.suppress(LearningError):
             run = RunFolder.load(run_path)
-            metrics = trial_metrics(run.steps(), run.record, spec.convergence_factor)
+            metrics = trial_metrics(
+                run.steps(), run.record, spec.convergence_factor, spec.level_steps
+            )
             cpu, status = run.cpu_seconds, run.status
         if record.get("status") == "failed" or (
             record.get("status") == "early-stopped" and status != "done"

@@ -150,6 +150,10 @@ def test_random_search_draws_within_the_bounds_and_repeats_with_its_seed() -> No
         ({"metric": {"name": "happiness"}}, "metric"),
         ({"scheduler": {"grace_episodes": 0}}, "grace_episodes"),
         ({"episodes": None}, "episodes"),
+        ({"task": "arm-reach", "space": {"tiles": [8, 0]}}, "tiles"),  # as TileCoding says
+        ({"task": "arm-reach", "space": {"joints": [2]}}, "joints"),  # as ArmReach says
+        ({"task": "arm-reach", "space": {"demonstrations": [1]}}, "demonstrations"),
+        ({"task": "arm-reach"}, "level_steps"),  # no shortest path to scale a level by
     ],
 )
 def test_a_bad_spec_is_one_sentence_naming_the_field(change: dict, field: str) -> None:
@@ -246,6 +250,44 @@ def test_trials_equal_serial_runs_seed_for_seed(local_ray, tmp_path: Path) -> No
     assert all(",done," in line for line in lines[1:])
     assert (folder / "sweep.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert b"<svg" in (folder / "sweep.svg").read_bytes()[:500]
+
+
+def test_continuous_joint_trials_equal_serial_runs(local_ray, tmp_path: Path) -> None:
+    """The tile-coded continuous task sweeps too, each trial equal to run_experiments."""
+    import gymnasium
+
+    from studio.learning import ARM_REACH_ID, ArmReach
+
+    spec = parse_sweep_spec(
+        spec_dict(
+            name="reach",
+            task="arm-reach",
+            seeds=[0, 1],
+            experiments=1,
+            episodes=3,
+            fixed={"joints": 3, "tiles": 4, "max_steps_per_episode": 300},
+            space={"planning": ["zero", "full"]},
+            metric={"name": "final_steps"},
+        )
+    )
+    result = run_sweep(spec, tmp_path)
+    assert not result.interrupted and not result.failed
+    task = ArmReach(joints=3)
+    for trial in spec.trials():
+        run = RunFolder.load(trial_run_path(tmp_path, "reach", trial.key))
+        assert run.status == "done" and run.has_policy and run.record.kind == "arm-reach"
+        config = DynaQConfig(planning=trial.settings["planning"], max_steps_per_episode=300)
+        serial = run_experiments(
+            lambda: gymnasium.make(ARM_REACH_ID, **task.to_dict()),
+            config,
+            1,
+            3,
+            trial.seed,
+            None,
+            task.features(tiles=4),
+            workers=1,
+        )
+        np.testing.assert_array_equal(run.steps(), serial.steps)
 
 
 def test_a_killed_worker_is_retried_and_the_sweep_completes(local_ray, tmp_path: Path) -> None:
