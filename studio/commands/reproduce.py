@@ -36,6 +36,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument("--workers", type=int, default=None, help="threads (default: all cores)")
     parser.add_argument("--no-progress", action="store_true", help="hide the progress bar")
+    parser.add_argument(
+        "--beyond",
+        action="store_true",
+        help="also measure the continuous-joint task with tile coding for 3 to 6 joints (table memory, time to 95%% greedy success, final success; beyond.png and a REPORT.md section; several CPU minutes)",
+    )
 
 
 def run(args: argparse.Namespace) -> int:
@@ -47,6 +52,7 @@ def run(args: argparse.Namespace) -> int:
         seed=args.seed,
         progress=not args.no_progress,
         workers=args.workers,
+        beyond=args.beyond,
     )
     print(result.table)
     print()

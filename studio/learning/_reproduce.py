@@ -533,6 +533,7 @@ def reproduce(
     progress: bool = True,
     *,
     workers: int | None = None,
+    beyond: bool = False,
 ) -> ReproduceResult:
     """Run the paper's six configurations and write curves, figures, timing and a report.
 
@@ -543,6 +544,8 @@ def reproduce(
         seed: seeds the demonstrations and every experiment.
         progress: show a tqdm progress bar on the terminal.
         workers: threads (default: one per core).
+        beyond: also measure the continuous-joint task for 3 to 6 joints (``beyond.png``/``.svg``
+            and a REPORT.md section, see :mod:`._beyond`); a few minutes of CPU, so off by default.
 
     Returns:
         The results, the claims judged and the paths written.
@@ -618,4 +621,11 @@ def reproduce(
     _write_report(files[2], claims, table, grid, experiments, episodes, seed)
     with files[2].open("a") as stream:
         stream.write(_extension_section(results, extensions, grid))
+    if beyond:
+        from ._beyond import beyond_the_paper
+
+        section, figures, _ = beyond_the_paper(out, seed, workers=workers)
+        with files[2].open("a") as stream:
+            stream.write(section)
+        files += figures
     return ReproduceResult(out, results, wall, claims, table, files, extensions)

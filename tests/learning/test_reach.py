@@ -159,3 +159,16 @@ def test_a_continuous_run_folder_trains_saves_and_reads_back(tmp_path):
     assert isinstance(policy, TilePolicyFile) and policy.task == task
     with pytest.raises(LearningError, match="leaves joint 1's limits at sample 0"):
         RunRecord.for_arm_reach(task, task.features(), config, 2, 6, 0, [demo + 3.0])
+
+
+def test_beyond_the_paper_measures_memory_and_success(tmp_path):
+    from studio.learning._beyond import beyond_the_paper, memory_row
+
+    row = memory_row(ArmReach(joints=6))
+    assert row["paper_entries"] == 11**6 * 3**6  # the paper's grid at six joints
+    assert row["fine_entries"] > 1e14 > 1e8 > row["tile_entries"]  # tiles: a few MB, not petabytes
+    text, files, rows = beyond_the_paper(tmp_path, 0, joints=(3,), episodes=(20,), experiments=1)
+    assert [f.name for f in files] == ["beyond.png", "beyond.svg"]
+    assert "| 3 | 35,937 entries" in text and "greedy success" in text
+    (budget,) = rows[0]["budgets"]
+    assert budget["episodes"] == 20 and 0.0 <= budget["success"][0] <= 1.0
