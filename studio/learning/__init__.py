@@ -67,6 +67,7 @@ from ._runs import FIGURE_POINTS as FIGURE_POINTS
 from ._runs import RunFolder as RunFolder
 from ._runs import RunRecord as RunRecord
 from ._runs import curve_figure as curve_figure
+from ._runs import curve_plot as curve_plot
 from ._runs import curve_statistics as curve_statistics
 from ._runs import curves_csv as curves_csv
 from ._runs import downsample_curve as downsample_curve

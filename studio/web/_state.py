@@ -15,6 +15,8 @@ from typing import Any
 
 import numpy as np
 
+from studio.learning import GOAL_JOINTS, check_goal_deg
+
 from .._errors import StudioError
 from ._errors import ConflictError, InvalidError, NotFoundError
 from ._pipeline import Pipeline
@@ -192,7 +194,7 @@ class Studio:
 
         Raises:
             ConflictError: the live source is not the simulator.
-            InvalidError: the goal is not 3 angles within the Puma560's limits.
+            ConfigError: the goal is not 3 angles within the Puma560's limits.
         """
         source = self.pipeline.source
         if self.pipeline.kind != "simulator" or source is None:
@@ -424,22 +426,9 @@ def goal_q_robot(goal_deg: list[float]) -> np.ndarray:
     """A Puma560 pose (rad, (6,)) with joints 1-3 at ``goal_deg`` and the wrist at zero.
 
     Raises:
-        InvalidError: not three finite angles within the robot's limits.
+        ConfigError: not three finite angles within the robot's limits (the learning package's
+            one goal check, as for a run).
     """
-    from studio.kinematics import Puma560
-
-    goal = np.asarray(goal_deg, dtype=np.float64)
-    if goal.shape != (3,) or not np.all(np.isfinite(goal)):
-        raise InvalidError(
-            f"goal_deg is {goal_deg!r}; give 3 finite angles in degrees, one per joint 1-3."
-        )
-    robot = Puma560()
     q = np.zeros(6)
-    q[:3] = np.radians(goal)
-    lower, upper = np.degrees(robot.lower[:3]), np.degrees(robot.upper[:3])
-    for j in range(3):
-        if not lower[j] <= goal[j] <= upper[j]:
-            raise InvalidError(
-                f"goal_deg joint {j + 1} is {goal[j]:g} degrees, which the Puma560 cannot reach; give an angle from {lower[j]:g} to {upper[j]:g}."
-            )
+    q[:GOAL_JOINTS] = np.radians(check_goal_deg(goal_deg))
     return q

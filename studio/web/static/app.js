@@ -19,7 +19,7 @@ const S = {
   demos: [],
   runs: [],
   policies: [],
-  curves: new Map(), // run id -> {episodes, mean, std, min, max}
+  curves: new Map(), // run id -> {episodes, mean, std, min, max, count}
   shown: new Set(), // run ids plotted
   shownTouched: false, // the user changed which runs are plotted
   marking: false,
@@ -50,7 +50,9 @@ async function api(method, path, body) {
   let data = null;
   try { data = text ? JSON.parse(text) : null; } catch (e) { data = null; }
   if (!resp.ok) {
-    throw new ApiError(detailOf(data, resp, text));
+    const err = new ApiError(detailOf(data, resp, text));
+    err.data = data; // e.g. a refused form: {detail, problems, by_field}
+    throw err;
   }
   return data;
 }
@@ -582,15 +584,46 @@ async function deleteDemo(name) {
 }
 
 /* ------------------------------------------------------------------ training */
-const TRAIN_DEFAULTS = {
-  planning: "full", planning_steps: 100, epsilon: 0.1, alpha: 0.1, gamma: 0.95,
-  episodes: 100, experiments: 20, bins: 11, seed: 0, goal0: 0, goal1: 45, goal2: -90,
-};
+/** Form inputs of a field the API names (the goal is three inputs). */
+const TRAIN_INPUTS = { goal_deg: ["goal0", "goal1", "goal2"] };
 
+/** Fill the train form with the learning package's defaults (served by /api/config). */
 function resetTrainForm() {
+  showTrainErrors(null);
+  const defaults = S.config && S.config.training;
+  if (!defaults) return;
   const f = $("train-form");
-  for (const [k, v] of Object.entries(TRAIN_DEFAULTS)) f.elements[k].value = String(v);
-  f.elements.name.value = "";
+  const planners = S.config.planners || [defaults.planning];
+  f.elements.planning.replaceChildren(...planners.map((p) => el("option", { value: p, text: p })));
+  for (const [k, v] of Object.entries(defaults)) {
+    if (k === "goal_deg") v.forEach((g, i) => { f.elements[`goal${i}`].value = String(g); });
+    else if (f.elements[k] && !(f.elements[k] instanceof RadioNodeList)) f.elements[k].value = v == null ? "" : String(v);
+  }
+}
+
+/** Show every problem of a refused run beside the form, and mark each bad field (null clears). */
+function showTrainErrors(err) {
+  const f = $("train-form");
+  for (const input of f.querySelectorAll(".bad")) {
+    input.classList.remove("bad");
+    input.removeAttribute("aria-invalid");
+    input.removeAttribute("title");
+  }
+  const box = $("train-error");
+  if (!err) { showError("train-error", null); return; }
+  const data = err.data || {};
+  const problems = data.problems && data.problems.length ? data.problems : [err.message || String(err)];
+  box.replaceChildren(...problems.map((p) => el("div", { testid: "train-problem", text: p })));
+  box.hidden = false;
+  for (const [field, text] of Object.entries(data.by_field || {})) {
+    for (const name of TRAIN_INPUTS[field] || [field]) {
+      const input = f.elements[name];
+      if (!input || !input.classList) continue;
+      input.classList.add("bad");
+      input.setAttribute("aria-invalid", "true");
+      input.setAttribute("title", text);
+    }
+  }
 }
 
 /** Continuous-task fields of the train form (shown only for that task). */
@@ -610,9 +643,10 @@ function syncTaskFields() {
 
 function readTrainForm() {
   const f = $("train-form").elements;
+  const empty = [];
   const num = (k) => {
     const raw = f[k].value.trim();
-    if (raw === "") throw new ApiError(`${k.replace("_", " ")} is empty; enter a number.`);
+    if (raw === "") empty.push(k);
     return Number(raw);
   };
   const body = {
@@ -629,6 +663,12 @@ function readTrainForm() {
     goal_deg: [num("goal0"), num("goal1"), num("goal2")],
     demonstrations: [...$("train-demos").querySelectorAll("input:checked")].map((i) => i.value),
   };
+  if (empty.length) {
+    const problems = empty.map((k) => `${k.replace("_", " ")} is empty; enter a number.`);
+    const err = new ApiError(problems.join(" "));
+    err.data = { problems, by_field: Object.fromEntries(empty.map((k, i) => [k, problems[i]])) };
+    throw err;
+  }
   if (body.task === "arm-reach") for (const k of REACH_FIELDS) body[k] = num(k);
   if (f.name.value.trim()) body.name = f.name.value.trim();
   return body;
@@ -636,19 +676,28 @@ function readTrainForm() {
 
 async function startRun(ev) {
   ev.preventDefault();
-  await guarded("train-error", async () => {
-    const body = readTrainForm();
-    const run = await api("POST", "/api/runs", body);
+  showTrainErrors(null);
+  const button = $("train-start");
+  button.disabled = true;
+  try {
+    const run = await api("POST", "/api/runs", readTrainForm());
     upsertRun(run);
     if (!S.shown.has(run.id)) S.shown.add(run.id);
     S.curves.set(run.id, emptyCurve());
     renderRuns();
     markCurvesDirty();
-  }, $("train-start"));
+  } catch (e) {
+    showTrainErrors(e);
+    if (!(e instanceof ApiError)) console.error(e);
+  } finally {
+    button.disabled = false;
+  }
 }
 
+const CURVE_KEYS = ["episodes", "mean", "std", "min", "max", "count"];
+
 function emptyCurve() {
-  return { episodes: [], mean: [], std: [], min: [], max: [] };
+  return Object.fromEntries(CURVE_KEYS.map((k) => [k, []]));
 }
 
 function upsertRun(run) {
@@ -673,7 +722,7 @@ async function loadRuns() {
 async function loadCurve(id) {
   try {
     const c = await api("GET", `/api/runs/${enc(id)}/curve`);
-    S.curves.set(id, { episodes: c.episodes, mean: c.mean, std: c.std, min: c.min, max: c.max });
+    S.curves.set(id, Object.fromEntries(CURVE_KEYS.map((k) => [k, c[k] || []])));
     markCurvesDirty();
   } catch (e) {
     showError("runs-error", e);
@@ -772,8 +821,8 @@ function mergeCurve(id, piece, from) {
     cut = c.episodes.findIndex((e) => e >= first);
     if (cut < 0) cut = c.episodes.length;
   }
-  for (const k of ["episodes", "mean", "std", "min", "max"]) {
-    c[k] = c[k].slice(0, cut).concat(piece[k] || []);
+  for (const k of CURVE_KEYS) {
+    c[k] = (c[k] || []).slice(0, cut).concat(piece[k] || []);
   }
   markCurvesDirty();
 }
@@ -798,29 +847,75 @@ function plottedRuns() {
   });
 }
 
+/** Episodes per experiment of a run (its fraction-of-run axis divides by this). */
+function runLength(r) {
+  const c = S.curves.get(r.id);
+  const planned = r.config && r.config.episodes;
+  return Math.max(1, planned || (c.episodes.length ? c.episodes[c.episodes.length - 1] : 1));
+}
+
 /**
- * The chart's columns: the episode axis, then per run its mean and, with a band, its low and high
- * edges. Missing episodes are null (a gap); on a log axis nothing below one step is drawn.
+ * Bucket edges of the x axis: ``x[b]`` is bucket b's x value and ``bucketOf(run, episode)`` its
+ * bucket. "episode": equal buckets of episodes; "log": log-spaced buckets, so a 100-episode run
+ * keeps its shape beside a 50 000-episode one; "fraction": each run over [0, 1] of its own length.
  */
-function chartData(runs, band, log) {
+function chartAxis(runs, xMode) {
+  if (xMode === "fraction") {
+    const longest = Math.max(...runs.map(runLength));
+    const n = Math.min(MAX_PLOT_POINTS, longest);
+    const x = Array.from({ length: n }, (_, b) => (b + 1) / n);
+    return { x, bucketOf: (r, e) => Math.min(n - 1, Math.floor(((e - 1) / runLength(r)) * n)) };
+  }
   let last = 0;
   for (const r of runs) {
     const e = S.curves.get(r.id).episodes;
     last = Math.max(last, e[e.length - 1]);
   }
+  if (xMode === "log" && last > MAX_PLOT_POINTS) {
+    // upper edges geometric from 1 to last (duplicates merged), so early episodes stay single
+    const edges = [];
+    for (let b = 1; b <= MAX_PLOT_POINTS; b++) {
+      const edge = Math.ceil(Math.exp((Math.log(last) * b) / MAX_PLOT_POINTS));
+      if (!edges.length || edge > edges[edges.length - 1]) edges.push(edge);
+    }
+    edges[edges.length - 1] = last;
+    const bucketOf = (r, e) => {
+      let lo = 0; let hi = edges.length - 1;
+      while (lo < hi) { const mid = (lo + hi) >> 1; if (edges[mid] >= e) hi = mid; else lo = mid + 1; }
+      return lo;
+    };
+    return { x: edges, bucketOf };
+  }
   const k = Math.max(1, Math.ceil(last / MAX_PLOT_POINTS));
   const n = Math.ceil(last / k);
-  const x = Array.from({ length: n }, (_, b) => Math.min(last, (b + 1) * k));
+  return { x: Array.from({ length: n }, (_, b) => Math.min(last, (b + 1) * k)), bucketOf: (r, e) => Math.floor((e - 1) / k) };
+}
+
+/**
+ * The chart's columns: the x axis, then per run its mean and, with a band, its low and high
+ * edges. Missing episodes are null (a gap); on a log axis nothing below one step is drawn. Also
+ * per run the fewest experiments any point of a bucket averages (``counts``) and the run's most
+ * (``full``), so the legend and a marker say where the band stops averaging every experiment.
+ */
+function chartData(runs, band, log, xMode = "episode") {
+  const { x, bucketOf } = chartAxis(runs, xMode);
+  const n = x.length;
   const cols = [x];
+  const counts = [];
+  const full = [];
   const floor = (v) => (log && v < 1 ? null : v);
   for (const r of runs) {
     const c = S.curves.get(r.id);
     const sum = new Float64Array(n); const sd = new Float64Array(n); const cnt = new Uint32Array(n);
     const lo = new Float64Array(n).fill(Infinity); const hi = new Float64Array(n).fill(-Infinity);
+    const fewest = new Array(n).fill(null);
+    let most = 0;
     for (let i = 0; i < c.episodes.length; i++) {
-      const b = Math.floor((c.episodes[i] - 1) / k);
+      const b = bucketOf(r, c.episodes[i]);
       sum[b] += c.mean[i]; sd[b] += c.std[i] || 0; cnt[b] += 1;
       lo[b] = Math.min(lo[b], c.min[i]); hi[b] = Math.max(hi[b], c.max[i]);
+      const k = c.count && c.count[i] !== undefined ? c.count[i] : null;
+      if (k !== null) { fewest[b] = fewest[b] === null ? k : Math.min(fewest[b], k); most = Math.max(most, k); }
     }
     const mean = new Array(n).fill(null); const low = new Array(n).fill(null); const high = new Array(n).fill(null);
     for (let b = 0; b < n; b++) {
@@ -836,8 +931,21 @@ function chartData(runs, band, log) {
     }
     cols.push(mean);
     if (band !== "none") cols.push(low, high);
+    counts.push(fewest);
+    full.push(most || (r.config && r.config.experiments) || 0);
   }
+  cols.counts = counts;
+  cols.full = full;
   return cols;
+}
+
+/** Where each run's points stop averaging all its experiments: the first such x, or null. */
+function fewerFrom(data, i) {
+  const counts = data.counts[i];
+  for (let b = 0; b < counts.length; b++) {
+    if (counts[b] !== null && counts[b] < data.full[i]) return data[0][b];
+  }
+  return null;
 }
 
 function hexAlpha(hex, a) {
@@ -845,16 +953,23 @@ function hexAlpha(hex, a) {
   return `rgba(${(n >> 16) & 255},${(n >> 8) & 255},${n & 255},${a})`;
 }
 
-/** uPlot options for these runs: a mean line per run and, with a band, two unlabelled edges filled. */
-function chartOptions(runs, band, log, width, height) {
-  const series = [{ label: "episode", value: (u, v) => (v == null ? "–" : String(v)) }];
+/** uPlot options for these runs: a mean line per run and, with a band, two unlabelled edges filled;
+ * a dashed marker where a run's points start averaging fewer experiments than it has. */
+function chartOptions(runs, band, log, width, height, xMode = "episode") {
+  const xLabel = xMode === "fraction" ? "fraction of run" : "episode";
+  const series = [{ label: xLabel, value: (u, v) => (v == null ? "–" : xMode === "fraction" ? v.toFixed(3) : String(v)) }];
   const bands = [];
-  for (const r of runs) {
+  runs.forEach((r, i) => {
     const color = runColor(r.id);
     const meanIdx = series.length;
     series.push({
       label: runLabel(r), stroke: color, width: 1.8, spanGaps: false,
-      value: (u, v) => (v == null ? "–" : `${v.toFixed(1)} steps`),
+      value: (u, v, si, di) => {
+        if (v == null) return "–";
+        const n = di == null || !u.data.counts ? null : u.data.counts[i][di];
+        const of = u.data.full ? u.data.full[i] : null;
+        return `${v.toFixed(1)} steps${n != null && of ? ` · ${n} of ${of} exp.` : ""}`;
+      },
     });
     if (band !== "none") {
       for (const edge of ["low", "high"]) {
@@ -862,16 +977,16 @@ function chartOptions(runs, band, log, width, height) {
       }
       bands.push({ series: [meanIdx + 2, meanIdx + 1], fill: hexAlpha(color, 0.16) });
     }
-  }
+  });
   const axis = { stroke: "#555", grid: { stroke: "#eceef1", width: 1 }, ticks: { stroke: "#d6d9de", width: 1 }, font: "11px system-ui, sans-serif", labelFont: "11px system-ui, sans-serif" };
   return {
     width, height, series, bands,
     scales: {
-      x: { time: false },
+      x: xMode === "log" ? { time: false, distr: 3, log: 10 } : { time: false },
       y: log ? { distr: 3, log: 10 } : { range: (u, min, max) => [0, max > 0 ? max * 1.05 : 1] },
     },
     axes: [
-      { ...axis, label: "episode", labelSize: 16, size: 30 },
+      { ...axis, label: xLabel, labelSize: 16, size: 30 },
       { ...axis, label: "steps", labelSize: 16, size: 48 },
     ],
     legend: { live: true },
@@ -882,6 +997,25 @@ function chartOptions(runs, band, log, width, height) {
         u.over.addEventListener("dblclick", () => { S.chartZoomed = false; });
       }],
       setSelect: [(u) => { if (u.select.width > 0) S.chartZoomed = true; }],
+      draw: [(u) => {
+        // Mark where each run's band stops averaging all of its experiments (runs of different
+        // lengths, or a stopped run): the band goes on, over fewer experiments, as the legend says.
+        const ctx = u.ctx;
+        runs.forEach((r, i) => {
+          const at = u.data.counts ? fewerFrom(u.data, i) : null;
+          if (at === null) return;
+          const px = Math.round(u.valToPos(at, "x", true));
+          ctx.save();
+          ctx.strokeStyle = runColor(r.id);
+          ctx.setLineDash([4, 4]);
+          ctx.lineWidth = 1;
+          ctx.beginPath();
+          ctx.moveTo(px, u.bbox.top);
+          ctx.lineTo(px, u.bbox.top + u.bbox.height);
+          ctx.stroke();
+          ctx.restore();
+        });
+      }],
     },
   };
 }
@@ -905,20 +1039,21 @@ function renderCurves() {
   S.curveDirty = false;
   const band = $("curve-band").value;
   const log = $("curve-log").checked;
+  const xMode = $("curve-x").value;
   const runs = plottedRuns();
   $("curve-empty").hidden = runs.length > 0;
   if (!runs.length) {
     if (chart) { chart.destroy(); chart = null; chartKey = ""; chartRuns = []; }
     return;
   }
-  const key = JSON.stringify([runs.map((r) => [r.id, runLabel(r), runColor(r.id)]), band, log]);
-  const data = chartData(runs, band, log);
+  const key = JSON.stringify([runs.map((r) => [r.id, runLabel(r), runColor(r.id)]), band, log, xMode]);
+  const data = chartData(runs, band, log, xMode);
   if (chart && key === chartKey) {
     chart.setData(data, !S.chartZoomed);
   } else {
     if (chart) chart.destroy();
     const box = $("curve-plot");
-    chart = new uPlot(chartOptions(runs, band, log, box.clientWidth, box.clientHeight), data, box);
+    chart = new uPlot(chartOptions(runs, band, log, box.clientWidth, box.clientHeight, xMode), data, box);
     chartKey = key;
     chartRuns = runs.map((r) => r.id);
     chartStride = band === "none" ? 1 : 3;
@@ -930,6 +1065,9 @@ function renderCurves() {
 
 /** Ids of the runs in the chart, in legend order (used by the browser tests). */
 S.plottedRuns = () => (chart ? [...chartRuns] : []);
+
+/** The x where a plotted run starts averaging fewer experiments than it has, or null (tests). */
+S.chartFewerFrom = (id) => (chart && chartRuns.includes(id) ? fewerFrom(chart.data, chartRuns.indexOf(id)) : null);
 
 /** Number of plotted mean-curve points of a run, or of all runs (used by the browser tests). */
 S.curvePoints = (id) => {
@@ -1087,6 +1225,7 @@ function scheduleRunsRender() {
 async function loadConfig() {
   try {
     S.config = await api("GET", "/api/config");
+    resetTrainForm(); // the learning package's defaults, the one definition
   } catch (e) {
     $("scene-msg").textContent = `The 3D scene is unavailable: ${e.message}`;
     $("scene-msg").hidden = false;
@@ -1192,6 +1331,7 @@ function wire() {
   $("train-defaults").addEventListener("click", syncTaskFields); // after the reset above
   $("curve-log").addEventListener("change", markCurvesDirty);
   $("curve-band").addEventListener("change", markCurvesDirty);
+  $("curve-x").addEventListener("change", markCurvesDirty);
 
   $("watch-go").addEventListener("click", watch);
   $("watch-stop").addEventListener("click", () => guarded("watch-error", () => api("POST", "/api/watch/stop")));
