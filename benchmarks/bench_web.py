@@ -160,11 +160,33 @@ def wall(run: dict[str, Any]) -> float:
     return run["wall"]
 
 
+def _descendants(root: int) -> set[int]:
+    """Process ids below ``root`` (Linux /proc)."""
+    children: dict[int, list[int]] = {}
+    for pid in filter(str.isdigit, os.listdir("/proc")):
+        try:
+            with open(f"/proc/{pid}/stat") as f:
+                ppid = int(f.read().rsplit(")", 1)[1].split()[1])
+        except OSError:  # the process ended meanwhile
+            continue
+        children.setdefault(ppid, []).append(int(pid))
+    out, todo = set(), [root]
+    while todo:
+        for child in children.get(todo.pop(), []):
+            out.add(child)
+            todo.append(child)
+    return out
+
+
 def chromium_cpu_seconds() -> float:
-    """CPU seconds used so far by every Chromium process on this machine (Linux /proc)."""
+    """CPU seconds used so far by this benchmark's Chromium processes (Linux /proc).
+
+    Only the browser this script started counts (its processes descend from this one): other
+    programs' browsers on a shared machine must not enter the figure.
+    """
     tick = os.sysconf("SC_CLK_TCK")
     total = 0.0
-    for pid in filter(str.isdigit, os.listdir("/proc")):
+    for pid in _descendants(os.getpid()):
         try:
             with open(f"/proc/{pid}/cmdline", "rb") as f:
                 if b"chromium" not in f.read():

@@ -57,10 +57,11 @@ class MeshConfig:
 
     Attributes:
         cell_m: vertex-clustering cell (m); 0 keeps the meshes whole. The default keeps every
-            feature larger than a centimetre and cuts the triangles about 5x.
+            feature larger than 2 cm, which is all that shows at the scene's viewing distance,
+            and cuts the triangles about 10x (human 108,686 -> 10,858; Puma560 10,160 -> 1,378).
     """
 
-    cell_m: float = 0.01
+    cell_m: float = 0.02
 
 
 @dataclass(frozen=True)
