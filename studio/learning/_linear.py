@@ -41,6 +41,10 @@ Start states come from ``env.reset`` in both paths (seeded per experiment), so t
 
 Random numbers: splitmix64 inside the kernels, as in the tabular learner, seeded per experiment
 by ``(seed, experiment)``; the environment's resets by ``seed`` and the experiment index.
+
+Caching caveat: numba's disk cache of these kernels is keyed on this file alone, yet they compile
+in the dynamics of ``_reach.py`` and the features of ``_tiles.py``; after editing either, touch
+this file (or delete ``__pycache__/_linear*.nb*``) so the kernels recompile.
 """
 
 from __future__ import annotations
