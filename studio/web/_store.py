@@ -205,6 +205,15 @@ class _FileCache:
             raise hit[2]
         return hit[1]
 
+    def forget_missing(self) -> None:
+        """Drop the entries of files that no longer exist (deleted or renamed)."""
+        with self._lock:
+            paths = list(self._entries)
+        gone = [path for path in paths if not path.exists()]
+        with self._lock:
+            for path in gone:
+                self._entries.pop(path, None)
+
 
 class FolderStore(Generic[T]):
     """Files ``<folder>/<name><suffix>`` of one kind, plus the shipped samples of that kind.
@@ -218,6 +227,7 @@ class FolderStore(Generic[T]):
             with one sentence for a damaged file. Its result is cached per file until the file
             changes.
         samples: a read-only folder of shipped samples (names starting with ``sample-``), or None.
+        sample_fix: what to do instead of changing a sample, the second half of the refusal.
     """
 
     def __init__(
@@ -229,12 +239,14 @@ class FolderStore(Generic[T]):
         plural: str,
         load: Callable[[Path], T],
         samples: Path | None = None,
+        sample_fix: str = "copy it to make your own",
     ) -> None:
         self.folder = folder
         self.suffix = suffix
         self.what = what
         self.plural = plural
         self.samples = samples
+        self.sample_fix = sample_fix
         self._load = load
         self._cache = _FileCache()
         self._claim_lock = threading.Lock()  # choosing a free name and taking it are one step
@@ -282,7 +294,7 @@ class FolderStore(Generic[T]):
         path = self.path(name)
         if self.is_sample(name):
             raise ConflictError(
-                f"The {self.what} {name!r} is a shipped sample, which cannot be changed or deleted; copy it to make your own."
+                f"The {self.what} {name!r} is a shipped sample, which cannot be changed or deleted; {self.sample_fix}."
             )
         return path
 
@@ -355,6 +367,7 @@ class FolderStore(Generic[T]):
                 out.append(self.entry_at(name, path))
             except FileNotFoundError:  # deleted meanwhile
                 continue
+        self._cache.forget_missing()
         return out
 
     # ------------------------------------------------------------------ changing
@@ -448,6 +461,7 @@ def recording_store(folder: Path) -> FolderStore[dict[str, Any]]:
         plural="recordings",
         load=summarize_recording,
         samples=SAMPLES_DIR,
+        sample_fix="copy it to your recordings to change it",
     )
 
 
@@ -460,6 +474,7 @@ def demonstration_store(folder: Path) -> FolderStore[Demonstration]:
         plural="demonstrations",
         load=load_demonstration,
         samples=SAMPLES_DIR,
+        sample_fix="cut your own from its recording instead",
     )
 
 

@@ -275,3 +275,18 @@ def test_an_upload_name_is_always_a_valid_name_of_the_users_own(filename):
     assert NAME_PATTERN.match(name), name
     assert not name.startswith(SAMPLE_PREFIX)
     assert check_name(name) == name
+
+
+def test_the_listing_rereads_a_file_that_changed(recordings, client):
+    def frames_of_mine() -> int:
+        return next(r for r in client.get("/api/recordings").json() if r["name"] == "mine")[
+            "frames"
+        ]
+
+    assert frames_of_mine() == 111
+    (recordings / "mine.tape.csv").unlink()
+    write_recording(recordings / "mine.tape.csv", frames=57, seed=3)
+    assert frames_of_mine() == 57
+    (recordings / "mine.tape.csv").write_text("no longer a recording\n")
+    damaged = next(r for r in client.get("/api/recordings").json() if r["name"] == "mine")
+    assert damaged["error"] and damaged["frames"] == 0
