@@ -37,6 +37,8 @@ the step itself; inlined, a planning update is ~10 ns and a real step a few tens
 from __future__ import annotations
 
 import os
+import sys
+import threading
 import time
 from collections.abc import Sequence
 from concurrent.futures import ThreadPoolExecutor
@@ -51,6 +53,8 @@ from ._mdp import TabularMDP
 from ._tiles import TileCoding
 
 _PLANNER_CODE = {name: code for code, name in enumerate(PLANNERS)}
+MAX_NICENESS = 19
+"""The lowest CPU priority Linux gives a thread."""
 _ZERO, _FULL, _SOFT, _PRIORITIZED = (_PLANNER_CODE[name] for name in PLANNERS)
 
 _GOLDEN = np.uint64(0x9E3779B97F4A7C15)
@@ -381,11 +385,15 @@ class LiveProgress:
     Args:
         experiments: number of experiments of the run this object will follow.
         episodes: episodes per experiment.
+        niceness: how much lower the CPU priority of the threads running the kernels is
+            (Linux ``nice``; 0 leaves it). A studio serving a page trains at a lower priority,
+            so that a heavy run takes only the CPU its API, live pipeline and scene leave.
     """
 
-    def __init__(self, experiments: int, episodes: int) -> None:
+    def __init__(self, experiments: int, episodes: int, niceness: int = 0) -> None:
         self.steps = np.full((experiments, episodes), -1, np.int64)
         self.updates = np.full((experiments, episodes), -1, np.int64)
+        self.niceness = niceness
         self._stop = np.zeros(1, np.int64)
 
     def stop(self) -> None:
@@ -406,6 +414,24 @@ class LiveProgress:
     def total(self) -> int:
         """Episodes the run will do if not stopped."""
         return int(self.steps.size)
+
+
+def lower_thread_priority(niceness: int) -> None:
+    """Run the calling thread ``niceness`` below the process's CPU priority (Linux, per thread).
+
+    Only the threads that run the kernels call it: they hold no GIL while they compute, so
+    the process's Python threads (a web server's) never wait for a low-priority thread holding
+    it. Idempotent; a no-op for ``niceness <= 0`` and where threads have no priority of their own.
+    """
+    if niceness <= 0 or not hasattr(os, "setpriority") or sys.platform != "linux":
+        return
+    try:
+        target = min(os.getpriority(os.PRIO_PROCESS, os.getpid()) + niceness, MAX_NICENESS)
+        tid = threading.get_native_id()
+        if os.getpriority(os.PRIO_PROCESS, tid) < target:
+            os.setpriority(os.PRIO_PROCESS, tid, target)
+    except OSError:  # never a reason not to train
+        return
 
 
 @dataclass(frozen=True, eq=False)
@@ -621,6 +647,7 @@ def run_experiments(
     planner = _PLANNER_CODE[config.planning]
 
     def one(e: int) -> None:
+        lower_thread_priority(live.niceness)
         start = time.thread_time()
         _run_experiment(
             mdp.next_state, mdp.reward, mdp.terminal, mdp.start_states,

@@ -60,6 +60,10 @@ RUN_ID = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.-]{0,99}(~[A-Za-z0-9_][A-Za-z0-9_
 """A run id: a folder name, or a group folder's and a run folder's names joined by ``~``."""
 TRAINING_THREADS = ("studio-train-", "dynaq")
 """Name prefixes of the threads a training run uses (RunFolder.train's and the kernels' pool)."""
+TRAINING_NICENESS = 10
+"""How much lower the training threads' CPU priority is than the studio's (Linux ``nice``,
+0-19): on a busy machine the API, the live pipeline and the scene get the cores first and
+training takes what they leave, so a heavy run cannot starve the page."""
 
 
 def _training_cpu_seconds() -> float:
@@ -349,7 +353,10 @@ class RunQueue:
     Attributes:
         before_train: called in the worker with a run just marked running, before it trains
             (tests act in that window, e.g. to stop it; a Stop there is never lost).
+        niceness: how much lower the CPU priority of the threads running the kernels is.
     """
+
+    niceness: int = TRAINING_NICENESS
 
     def __init__(
         self,
@@ -468,7 +475,9 @@ class RunQueue:
         """Validate a run, write its folder (atomically) and queue it."""
         record = prepare_run(create, demonstration_path)
         folder = RunFolder.create(self.folder, record)
-        run = Run(folder.id, folder, LiveProgress(record.experiments, record.episodes))
+        # the kernels' threads run at a lower priority: training must never starve the studio
+        live = LiveProgress(record.experiments, record.episodes, niceness=self.niceness)
+        run = Run(folder.id, folder, live)
         with self._cond:
             self._runs[run.id] = run
             self._queue.append(run.id)

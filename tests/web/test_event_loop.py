@@ -1,6 +1,6 @@
-"""Blocking file work stays off the event loop: a request made while an upload is being parsed is
-answered before the parse ends, and listing recordings during a capture never reads the growing
-file."""
+"""The studio stays responsive: blocking file work stays off the event loop (a request made while
+an upload is being parsed is answered before the parse ends, and listing recordings during a
+capture never reads the growing file), and training runs below the studio's CPU priority."""
 
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ import pytest
 from fastapi.testclient import TestClient
 
 import studio.web._store as store_module
-from tests.web.conftest import wait_for
+from tests.web.conftest import TINY_RUN, wait_for
 
 SAMPLES = Path(__file__).resolve().parents[2] / "studio" / "samples"
 HOLD_S = 20.0
@@ -86,3 +86,35 @@ def test_listing_during_a_capture_never_reads_the_live_file(
     stopped = client.post("/api/capture/stop")
     assert stopped.status_code == 200 and stopped.json()["frames"] > 200
     assert "live" in [r["name"] for r in client.get("/api/recordings").json()]
+
+
+def test_training_runs_below_the_studios_priority(
+    client: TestClient, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The kernels' threads lower their own CPU priority (the studio's threads keep theirs), so
+    a heavy run takes only the CPU the API, the pipeline and the scene leave."""
+    import os
+
+    import studio.learning._dynaq as dynaq
+    from studio.learning import ArmGrid, DynaQConfig, run_experiments
+    from studio.web._runs import TRAINING_NICENESS
+
+    seen: list[int] = []
+    real = dynaq._run_experiment
+
+    def observed(*args):
+        seen.append(os.getpriority(os.PRIO_PROCESS, threading.get_native_id()))
+        return real(*args)
+
+    monkeypatch.setattr(dynaq, "_run_experiment", observed)
+    base = os.getpriority(os.PRIO_PROCESS, os.getpid())
+    mine = os.getpriority(os.PRIO_PROCESS, threading.get_native_id())
+    run = client.post("/api/runs", json=TINY_RUN).json()
+    assert client.app.state.studio.runs.wait_idle(60)
+    assert client.get(f"/api/runs/{run['id']}").json()["status"] == "done"
+    assert seen and all(n == min(base + TRAINING_NICENESS, 19) for n in seen)
+    assert os.getpriority(os.PRIO_PROCESS, threading.get_native_id()) == mine
+    # a plain call (the CLI's) leaves the priority alone
+    seen.clear()
+    run_experiments(ArmGrid().mdp(), DynaQConfig(planning="zero"), 2, 2, seed=1, workers=2)
+    assert seen == [base, base]
