@@ -368,9 +368,41 @@ class RunRecord:
             ConfigError: one sentence per bad field (budget, seed, name, origin, demonstrations).
         """
         problems = run_problems(experiments, episodes, seed, name, grid)
+        paths = [[int(s) for s in path] for path in demonstrations]
+        return cls._checked(
+            problems,
+            {"kind": TASK_ARM_GRID, **grid.to_dict()},
+            config,
+            experiments,
+            episodes,
+            seed,
+            paths,
+            name=name,
+            origin=origin,
+            group=group,
+            request=request,
+        )
+
+    @classmethod
+    def _checked(
+        cls,
+        problems: list[tuple[str, str]],
+        task: dict[str, Any],
+        config: DynaQConfig,
+        experiments: int,
+        episodes: int,
+        seed: int,
+        paths: list,
+        *,
+        name: str,
+        origin: str,
+        group: str | None,
+        request: dict[str, Any] | None,
+    ) -> RunRecord:
+        """The record, once the checks every task shares (origin, demonstrations against
+        episodes) join the task's own ``problems``; all of them raised at once."""
         if origin not in ORIGINS:
             problems.append(("origin", f"origin is {origin!r}; give one of {', '.join(ORIGINS)}."))
-        paths = [[int(s) for s in path] for path in demonstrations]
         if _is_int(episodes) and len(paths) > episodes:
             problems.append(
                 (
@@ -380,7 +412,7 @@ class RunRecord:
             )
         raise_problems(problems)
         return cls(
-            task={"kind": TASK_ARM_GRID, **grid.to_dict()},
+            task=task,
             config=config.to_dict(),
             experiments=int(experiments),
             episodes=int(episodes),
@@ -418,8 +450,6 @@ class RunRecord:
         from ._linear import weight_problem  # imports the kernels: import when needed
 
         problems = run_problems(experiments, episodes, seed, name)
-        if origin not in ORIGINS:
-            problems.append(("origin", f"origin is {origin!r}; give one of {', '.join(ORIGINS)}."))
         try:
             coder = coding.bind(task.lower, task.upper)
             problem = _is_int(experiments) and weight_problem(experiments, coder, task.n_actions)
@@ -434,25 +464,17 @@ class RunRecord:
                 paths.append(np.asarray(path, dtype=np.float64)[:, : task.joints].tolist())
             except LearningError as err:
                 problems.append(("demonstrations", str(err)))
-        if _is_int(episodes) and len(paths) > episodes:
-            problems.append(
-                (
-                    "demonstrations",
-                    f"The run replays {len(paths)} demonstrations but has only {episodes} episodes; give at least as many episodes as demonstrations.",
-                )
-            )
-        raise_problems(problems)
-        return cls(
-            task={"kind": TASK_ARM_REACH, **task.to_dict(), "tile_coding": coding.to_dict()},
-            config=config.to_dict(),
-            experiments=int(experiments),
-            episodes=int(episodes),
-            seed=int(seed),
-            demonstrations=paths,
+        return cls._checked(
+            problems,
+            {"kind": TASK_ARM_REACH, **task.to_dict(), "tile_coding": coding.to_dict()},
+            config,
+            experiments,
+            episodes,
+            seed,
+            paths,
             name=name,
             origin=origin,
             group=group,
-            created=now_iso(),
             request=request,
         )
 
