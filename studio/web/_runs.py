@@ -205,6 +205,21 @@ def run_create_of(record: RunRecord) -> RunCreate:
     )
 
 
+def _dynaq_config(create: RunCreate, problems: list[tuple[str, str]]) -> DynaQConfig | None:
+    """The form's Dyna-Q settings, or None with their problems added to ``problems``."""
+    try:
+        return DynaQConfig(
+            alpha=create.alpha,
+            gamma=create.gamma,
+            epsilon=create.epsilon,
+            planning=create.planning,
+            planning_steps=create.planning_steps,
+        )
+    except ConfigError as err:
+        problems += list(err.by_field.items())
+        return None
+
+
 def prepare_run(create: RunCreate, demonstration_path: Callable[[str], np.ndarray]) -> RunRecord:
     """Check a ``RunCreate`` with the learning package's rules, reporting every bad field at once.
 
@@ -221,17 +236,7 @@ def prepare_run(create: RunCreate, demonstration_path: Callable[[str], np.ndarra
     if create.task == "arm-reach":
         return _prepare_reach_run(create, demonstration_path)
     problems: list[tuple[str, str]] = []
-    config = None
-    try:
-        config = DynaQConfig(
-            alpha=create.alpha,
-            gamma=create.gamma,
-            epsilon=create.epsilon,
-            planning=create.planning,
-            planning_steps=create.planning_steps,
-        )
-    except ConfigError as err:
-        problems += list(err.by_field.items())
+    config = _dynaq_config(create, problems)
     grid = None
     goal = goal_problems(create.goal_deg)
     if goal:
@@ -282,17 +287,7 @@ def _prepare_reach_run(
     """:func:`prepare_run` for the continuous task: joints, step, tiles; the goal is the first
     demonstration's final pose (else ``goal_deg`` for joints 1-3, the wrist at zero)."""
     problems: list[tuple[str, str]] = []
-    config = None
-    try:
-        config = DynaQConfig(
-            alpha=create.alpha,
-            gamma=create.gamma,
-            epsilon=create.epsilon,
-            planning=create.planning,
-            planning_steps=create.planning_steps,
-        )
-    except ConfigError as err:
-        problems += list(err.by_field.items())
+    config = _dynaq_config(create, problems)
     paths = [
         np.asarray(demonstration_path(name), dtype=np.float64) for name in create.demonstrations
     ]
