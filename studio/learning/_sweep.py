@@ -125,12 +125,12 @@ MAX_TRIALS = 100_000
 """Upper bound on the trials of one sweep."""
 DEFAULT_CPUS_PER_TRIAL = 1
 """Cores a trial reserves (its experiments run on that many threads)."""
+MAX_CPUS_PER_TRIAL = 256
+"""Upper bound on ``cpus_per_trial`` (a trial's experiments run on that many threads)."""
 MAX_RETRIES = 3
 """A trial whose worker dies (a crash, a lost node, ``kill -9``) is run again up to this often."""
 DEFAULT_REDUCTION_FACTOR = 3
 """ASHA keeps the best 1/reduction_factor of the trials at each rung."""
-STOP_SECONDS = 60
-"""How long a trial stopped by the scheduler may take to save its run before Tune gives up."""
 ADDRESS_TIMEOUT_SECONDS = 5.0
 """How long to try to reach a cluster's ``HOST:PORT`` before calling it unreachable."""
 RAY_HINT = "install it with pip install -e '.[cluster]'"
@@ -411,9 +411,9 @@ def parse_sweep_spec(data: Mapping[str, Any], source: str = "the sweep spec") ->
                 f"{source} gives no {key}; add {key} = N at the top (per trial's run)."
             )
     cpus = data.get("cpus_per_trial", DEFAULT_CPUS_PER_TRIAL)
-    if not _is_int(cpus) or not 1 <= cpus <= (os.cpu_count() or 1) * 64:
+    if not _is_int(cpus) or not 1 <= cpus <= MAX_CPUS_PER_TRIAL:
         raise SweepError(
-            f"{source}: cpus_per_trial is {cpus!r}; give a whole number of cores, at least 1."
+            f"{source}: cpus_per_trial is {cpus!r}; give a whole number of cores from 1 to {MAX_CPUS_PER_TRIAL}."
         )
     for seed in seeds:  # the run-level checks (budget, seed) of the fixed settings
         _check(task, fixed, f"{source} seeds", experiments, episodes, seed)
@@ -687,11 +687,6 @@ def _trainable(config: dict[str, Any], job: _Job) -> None:
     """Tune's trial function: train one trial as an ordinary run and report its metrics."""
     from ray import get_runtime_context, tune
 
-    # When the scheduler stops this trial, Tune waits this long for the function to return before
-    # it gives up re-using the worker (and, in Ray 2.60, fails the next trial meant for it):
-    # stopping at the next episode boundary and saving the policy takes longer on a busy machine
-    # than Tune's default of 2 s. Read by this process's Tune at that moment.
-    os.environ.setdefault("TUNE_FUNCTION_THREAD_TIMEOUT_S", str(STOP_SECONDS))
     spec = parse_sweep_spec(job.spec, f"sweep {job.spec['name']}")
     trial = job.trials[config["key"]]
     record = trial_record(spec, trial)
@@ -1215,6 +1210,8 @@ def run_sweep(
     Raises:
         SweepError: Ray missing, a cluster out of reach, the sweep exists (or not, to resume).
     """
+    if workers is not None and (not _is_int(workers) or workers < 1):
+        raise SweepError(f"--workers is {workers!r}; give a whole number of cores, at least 1.")
     data_dir = Path(data_dir).resolve()
     folder = _prepare(data_dir, spec, resume)
     trials = spec.trials()

@@ -295,9 +295,9 @@ def test_a_killed_worker_is_retried_and_the_sweep_completes(local_ray, tmp_path:
         spec_dict(
             name="kill",
             seeds=[0, 1],
-            experiments=2,
+            experiments=4,
             episodes=60,
-            fixed={"planning_steps": 200},
+            fixed={"planning_steps": 1000},  # about a second a trial: killed mid-training
             space={"planning": ["full", "soft"]},
         )
     )
