@@ -1127,10 +1127,9 @@ def _connect(ray: Any, address: str | None, workers: int | None) -> bool:
         cpus = workers or os.cpu_count() or 1
         ray.init(address="local", num_cpus=cpus, include_dashboard=False, **quiet)
         return True
-    _check_address(address)
     try:
         ray.init(address=address, **quiet)
-    except (ConnectionError, RuntimeError, ValueError) as err:
+    except Exception as err:  # refused, no cluster at "auto", a token mismatch: one sentence
         raise SweepError(
             f"Cannot join the Ray cluster at {address} ({str(err).splitlines()[0]}); check that it runs (ray status) and --address."
         ) from None
@@ -1212,6 +1211,9 @@ def run_sweep(
     """
     if workers is not None and (not _is_int(workers) or workers < 1):
         raise SweepError(f"--workers is {workers!r}; give a whole number of cores, at least 1.")
+    ray = _import_ray()  # before anything is written: a missing Ray or cluster leaves no trace
+    if address is not None and not ray.is_initialized():
+        _check_address(address)
     data_dir = Path(data_dir).resolve()
     folder = _prepare(data_dir, spec, resume)
     trials = spec.trials()
@@ -1230,7 +1232,6 @@ def run_sweep(
         _set_status(folder, "done")
         return SweepResult(folder, spec, rows)
 
-    ray = _import_ray()
     from ray import tune
     from ray.tune.schedulers import ASHAScheduler
 

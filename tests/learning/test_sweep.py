@@ -200,6 +200,7 @@ def test_an_unreachable_address_is_one_sentence(tmp_path: Path) -> None:
     assert proc.returncode == 2, proc.stderr
     line = proc.stderr.strip()
     assert "\n" not in line and f"127.0.0.1:{port}" in line and "Traceback" not in line, line
+    assert not (tmp_path / "sweeps").exists()  # nothing written for a sweep that cannot run
 
 
 # ----------------------------------------------------------------------------- on a local Ray
