@@ -31,6 +31,8 @@ from pathlib import Path
 
 import numpy as np
 
+from studio.web._runs import TRAINING_NICENESS
+
 CLIENTS = 20
 PATHS = (
     "/api/source",
@@ -228,10 +230,97 @@ def measure(niceness: int, seconds: float, rounds: int) -> dict[str, dict[str, f
     }
 
 
+def long_recording(path: Path, megabytes: float) -> Path:
+    """A valid recording of about ``megabytes`` MB: a shipped sample's frames, over and over."""
+    from studio.capture import RecordingWriter, TapeFrame, read_recording
+    from studio.samples import SAMPLES_DIR
+
+    source = SAMPLES_DIR / "sample-reach-1.tape.csv"
+    sample = read_recording(source)
+    frames = int(megabytes * 1e6 / (source.stat().st_size / len(sample.t)))
+    period = 1.0 / sample.rate_hz
+    n = len(sample.t)
+    with RecordingWriter(path, config=sample.config, name=path.name.split(".")[0]) as writer:
+        for k in range(0, frames, n):
+            writer.write_many(
+                [
+                    TapeFrame((k + i) * period, k + i, sample.bend[i], sample.twist[i])
+                    for i in range(n)
+                ]
+            )
+    return path
+
+
+def upload_stall(megabytes: float) -> dict[str, float]:
+    """The longest wait of a client polling the API while a long recording is uploaded and
+    parsed, against the same client's longest wait with no upload."""
+    with tempfile.TemporaryDirectory(prefix="bench-api-upload-") as data:
+        recording = long_recording(Path(data) / "long.tape.csv", megabytes)
+        size_mb = recording.stat().st_size / 1e6
+        studio = Studio(TRAINING_NICENESS, Path(data) / "studio")
+        try:
+
+            def poll(until: threading.Event) -> float:
+                conn = http.client.HTTPConnection("127.0.0.1", studio.port, timeout=60)
+                worst = 0.0
+                while not until.is_set():
+                    t0 = time.perf_counter()
+                    conn.request("GET", "/api/capture")
+                    conn.getresponse().read()
+                    worst = max(worst, time.perf_counter() - t0)
+                    time.sleep(0.01)
+                conn.close()
+                return worst
+
+            quiet = threading.Event()
+            timer = threading.Timer(3.0, quiet.set)
+            timer.start()
+            idle_worst = poll(quiet)
+            done = threading.Event()
+            worst: list[float] = []
+            poller = threading.Thread(target=lambda: worst.append(poll(done)))
+            poller.start()
+            body, boundary = multipart(recording)
+            conn = http.client.HTTPConnection("127.0.0.1", studio.port, timeout=300)
+            t0 = time.perf_counter()
+            conn.request(
+                "POST",
+                "/api/recordings",
+                body=body,
+                headers={"Content-Type": f"multipart/form-data; boundary={boundary}"},
+            )
+            status = conn.getresponse().status
+            upload_s = time.perf_counter() - t0
+            done.set()
+            poller.join()
+            conn.close()
+        finally:
+            studio.stop()
+    print(
+        f"upload of a {size_mb:.0f} MB recording: {status} in {upload_s:.1f} s; "
+        f"longest wait of another request {worst[0] * 1000:.0f} ms during it, "
+        f"{idle_worst * 1000:.0f} ms without"
+    )
+    return {"upload_s": upload_s, "worst_ms": worst[0] * 1000, "idle_worst_ms": idle_worst * 1000}
+
+
+def multipart(path: Path) -> tuple[bytes, str]:
+    """A ``multipart/form-data`` body holding ``path`` as the field ``file``."""
+    boundary = "bench-api-load-boundary"
+    head = (
+        f'--{boundary}\r\nContent-Disposition: form-data; name="file"; filename="{path.name}"'
+        "\r\nContent-Type: text/csv\r\n\r\n"
+    ).encode()
+    return head + path.read_bytes() + f"\r\n--{boundary}--\r\n".encode(), boundary
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seconds", type=float, default=6.0, help="length of each window")
     parser.add_argument("--rounds", type=int, default=2, help="idle/training window pairs")
+    parser.add_argument(
+        "--upload-mb", type=float, default=45.0, help="size of the uploaded recording (0: skip)"
+    )
     parser.add_argument(
         "--niceness",
         type=int,
@@ -239,8 +328,6 @@ def main() -> None:
         help="training priority to measure (default: the studio's own, TRAINING_NICENESS)",
     )
     args = parser.parse_args()
-    from studio.web._runs import TRAINING_NICENESS
-
     niceness = TRAINING_NICENESS if args.niceness is None else args.niceness
     print(
         f"{CLIENTS} clients polling the API, the simulator at 110 Hz with a capture, "
@@ -260,6 +347,8 @@ def main() -> None:
         f"{busy['p99_ms']:.0f} ms {verdict} the {GOAL_P99_MS:.0f} ms goal "
         f"(nice {niceness}); frames dropped while training: {busy['dropped']}"
     )
+    if args.upload_mb > 0:
+        upload_stall(args.upload_mb)
 
 
 if __name__ == "__main__":
