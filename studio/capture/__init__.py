@@ -16,6 +16,7 @@ from ._calibration import Calibration as Calibration
 from ._calibration import load_calibration as load_calibration
 from ._capture_loop import capture as capture
 from ._capture_loop import describe as describe
+from ._demonstration import DEMO_FORMAT as DEMO_FORMAT
 from ._demonstration import MAX_FIT_RESIDUAL_M as MAX_FIT_RESIDUAL_M
 from ._demonstration import Demonstration as Demonstration
 from ._demonstration import demonstrations_for as demonstrations_for

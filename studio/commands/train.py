@@ -16,14 +16,15 @@ is a run's ``config.json`` (to repeat a run) or looks like::
      "demonstrations": [[12, 133, ...], ...]}
 
 Demonstrations may also come from ``--demos FILE.json``: a JSON list of state lists, an object with
-a ``"demonstrations"`` list, or a ``*.demo.json`` with a ``"grid_path"``; or be generated with
-``--generated-demos N`` (noisy shortest-ish paths, as ``studio reproduce`` uses).
+a ``"demonstrations"`` list, or a cut ``*.demo.json``, whose grid path is computed from its joint
+trajectory on the run's grid by the one demonstration-to-grid-path function
+(:meth:`ArmGrid.path_from_joints`), as the page does; or be generated with ``--generated-demos N``
+(noisy shortest-ish paths, as ``studio reproduce`` uses).
 """
 
 from __future__ import annotations
 
 import argparse
-import json
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -31,6 +32,8 @@ from typing import Any
 
 import numpy as np
 
+from studio import StudioError, read_json
+from studio.capture import DEMO_FORMAT, load_demonstration
 from studio.learning import (
     DEFAULT_EPISODES,
     DEFAULT_EXPERIMENTS,
@@ -103,27 +106,46 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _read_json(path: Path, what: str) -> Any:
+    """A JSON file the user names, read bounded (size, nesting depth, regular files only)."""
+    if not path.exists():
+        raise LearningError(f"The {what} file {path} does not exist; check the path.")
     try:
-        return json.loads(path.read_text())
-    except FileNotFoundError:
-        raise LearningError(f"The {what} file {path} does not exist; check the path.") from None
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError, RecursionError) as err:
-        raise LearningError(
-            f"The {what} file {path} is not valid JSON ({err}); fix or replace it."
-        ) from None
+        return read_json(path, f"The {what} file {path}")
+    except StudioError as err:
+        raise LearningError(str(err)) from None
 
 
-def _demos_from(data: Any, source: str) -> list[list[int]]:
-    if isinstance(data, dict):
-        if "grid_path" in data:
-            data = [data["grid_path"]]
-        elif "demonstrations" in data:
-            data = data["demonstrations"]
+def _demos_from(data: Any, source: Path, grid: ArmGrid) -> list[list[int]]:
+    """The grid paths of ``--demos`` (or a config's ``demonstrations``) on the run's grid.
+
+    A cut demonstration (``*.demo.json``) is replayed along the path the page replays: its joint
+    trajectory through :meth:`ArmGrid.path_from_joints` on this run's grid, never the file's
+    stored ``grid_path`` (written by older code, or edited by hand).
+    """
+    if isinstance(data, dict) and data.get("format") == DEMO_FORMAT:
+        return [_demonstration_path(source, grid)]
+    if isinstance(data, dict) and "demonstrations" in data:
+        data = data["demonstrations"]
     if not isinstance(data, list) or not all(isinstance(d, list) for d in data):
         raise LearningError(
-            f"{source} holds no demonstrations; give a list of grid state lists, or an object with 'demonstrations' or 'grid_path'."
+            f"{source} holds no demonstrations; give a list of grid state lists, an object with 'demonstrations', or a *.demo.json file."
         )
     return data
+
+
+def _demonstration_path(source: Path, grid: ArmGrid) -> list[int]:
+    """A ``*.demo.json``'s grid path on ``grid``, refused when it does not reach the goal."""
+    demo = load_demonstration(source)
+    try:
+        path = grid.path_from_joints(demo.q_robot, stop_at_goal=True)
+    except LearningError as err:
+        raise LearningError(f"The demonstration {source} has no usable trajectory: {err}") from None
+    if path[-1] != grid.goal_state:
+        end = np.degrees(demo.q_robot[-1, :3])
+        raise LearningError(
+            f"The demonstration {source} ends at joints ({end[0]:.0f}, {end[1]:.0f}, {end[2]:.0f}) degrees, not in this run's goal bins {tuple(grid.goal)}; give another demonstration or set --goal-deg where it ends."
+        )
+    return list(path)
 
 
 def _numbers(text: str, flag: str, kind: type, example: str) -> list[Any]:
@@ -226,10 +248,10 @@ def resolve(args: argparse.Namespace) -> TrainSettings:
     raise_problems(problems)
     assert grid is not None and config is not None
     demos = (
-        _demos_from(spec["demonstrations"], str(args.config)) if "demonstrations" in spec else []
+        _demos_from(spec["demonstrations"], args.config, grid) if "demonstrations" in spec else []
     )
     if args.demos is not None:
-        demos = _demos_from(_read_json(args.demos, "demonstrations"), str(args.demos))
+        demos = _demos_from(_read_json(args.demos, "demonstrations"), args.demos, grid)
     if args.generated_demos:
         demos = generate_demonstrations(
             grid, args.generated_demos, np.random.default_rng([seed, 1])

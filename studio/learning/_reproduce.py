@@ -26,7 +26,6 @@ The result is shortest-ish, slightly wandering paths, like a person's.
 from __future__ import annotations
 
 import csv
-import json
 import shutil
 import time
 from dataclasses import dataclass, field
@@ -34,6 +33,8 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+
+from studio import StudioError, read_json
 
 from ._arm import ArmGrid
 from ._config import DEFAULT_EPISODES, DEFAULT_EXPERIMENTS, DEFAULT_SEED, DynaQConfig, check_budget
@@ -518,8 +519,8 @@ def _extension_section(
 def _remove_earlier_run(path: Path) -> None:
     """Delete a configuration's run folder left by an earlier ``studio reproduce`` (only that)."""
     try:
-        record = json.loads((path / CONFIG_FILE).read_text())
-    except (OSError, ValueError):
+        record = read_json(path / CONFIG_FILE)  # bounded: size, nesting depth, regular file
+    except (StudioError, OSError):
         return
     if isinstance(record, dict) and record.get("origin") == "reproduce":
         shutil.rmtree(path, ignore_errors=True)

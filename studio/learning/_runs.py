@@ -54,8 +54,10 @@ from typing import Any
 
 import numpy as np
 
+from studio import StudioError, read_bytes_bounded, read_json
+
 from ._arm import ArmGrid
-from ._config import DEFAULT_SEED, DynaQConfig, check_budget
+from ._config import DEFAULT_SEED, MAX_STEPS_PER_EPISODE, DynaQConfig, check_budget
 from ._dynaq import ExperimentResult, LiveProgress, run_experiments
 from ._errors import ConfigError, LearningError
 from ._policy import save_policy
@@ -90,6 +92,10 @@ TASK_ARM_REACH = "arm-reach"
 fields and ``tile_coding``, the :meth:`TileCoding.to_dict` settings); its demonstrations are
 joint paths ``(N, joints)`` in radians."""
 TASK_KINDS = (TASK_ARM_GRID, TASK_ARM_REACH)
+MAX_STATUS_BYTES = 64 * 1024
+"""Largest ``status.json`` read (the studio writes a few hundred bytes)."""
+STEPS_HEADER_BYTES = 1024
+"""Room for ``steps.csv``'s comment line when bounding its size."""
 
 CURVE_COLUMNS = (
     "episode",
@@ -601,6 +607,11 @@ def _from(request: Any, key: str) -> Any:
     return request.get(key) if isinstance(request, dict) else None
 
 
+def _text(value: object) -> str | None:
+    """A string field of ``status.json``, or None when missing or of another type (damaged)."""
+    return value if isinstance(value, str) else None
+
+
 def _is_int(value: object) -> bool:
     return isinstance(value, int | np.integer) and not isinstance(value, bool)
 
@@ -779,37 +790,51 @@ class RunFolder:
             LearningError: no readable ``config.json``.
         """
         path = Path(path)
+        if not (path / CONFIG_FILE).exists():
+            raise LearningError(f"{path} has no {CONFIG_FILE}; it is not a run folder.")
         try:
-            data = json.loads((path / CONFIG_FILE).read_text())
-        except FileNotFoundError:
-            raise LearningError(f"{path} has no {CONFIG_FILE}; it is not a run folder.") from None
-        except (OSError, UnicodeDecodeError, ValueError, RecursionError) as err:
+            data = read_json(path / CONFIG_FILE)  # bounded: size, nesting depth, regular file
+        except StudioError as err:
+            raise LearningError(f"{err} Delete the run {path.name} if it stays so.") from None
+        try:
+            record = RunRecord.from_dict(data)
+        except LearningError:
+            raise
+        except (TypeError, ValueError, KeyError, AttributeError) as err:
             raise LearningError(
-                f"{path / CONFIG_FILE} is unreadable ({err}); delete the run."
+                f"{path / CONFIG_FILE} garbles a field ({type(err).__name__}: {err}); delete the run."
             ) from None
-        run = cls(path, RunRecord.from_dict(data))
+        try:  # the size of the steps array a listing allocates for it
+            check_budget(record.experiments, record.episodes)
+        except ConfigError as err:
+            raise LearningError(f"{path / CONFIG_FILE}: {err} Delete the run.") from None
+        run = cls(path, record)
         run.reload()
         return run
 
     def reload(self) -> None:
         """Read ``status.json`` and ``steps.csv`` again (another process may be training it)."""
-        try:
-            status = json.loads((self.path / STATUS_FILE).read_text())
-            if not isinstance(status, dict):
-                raise ValueError("not an object")
-        except (OSError, ValueError, RecursionError):
-            status = {}
+        status: dict[str, Any] = {}
+        if (self.path / STATUS_FILE).exists():
+            try:
+                read = read_json(self.path / STATUS_FILE, max_bytes=MAX_STATUS_BYTES)
+                if not isinstance(read, dict):
+                    raise LearningError(f"{self.path / STATUS_FILE} holds no JSON object.")
+                status = read
+            except (StudioError, OSError) as err:  # the status is derived from the steps then
+                log.warning("run %s: status ignored: %s", self.id, err)
         steps = self._read_steps()
         if steps is not None:
             self._steps = steps
         default = "done" if steps is not None and bool(np.all(steps >= 0)) else "stopped"
         state = status.get("status", default)
         self.status = state if state in STATUSES else "stopped"
-        self.created = status.get("created") or self.record.created or self.created
-        self.started = status.get("started")
-        self.finished = status.get("finished")
-        self.cpu_seconds = float(status.get("cpu_seconds") or 0.0)
-        self.error = status.get("error")
+        self.created = _text(status.get("created")) or self.record.created or self.created
+        self.started = _text(status.get("started"))
+        self.finished = _text(status.get("finished"))
+        cpu = status.get("cpu_seconds")
+        self.cpu_seconds = float(cpu) if isinstance(cpu, int | float) and np.isfinite(cpu) else 0.0
+        self.error = _text(status.get("error"))
         self.pid = status.get("pid")
         if self.status in ("queued", "running") and not _pid_alive(self.pid):
             self.interrupted = True
@@ -824,12 +849,18 @@ class RunFolder:
 
     def _read_steps(self) -> np.ndarray | None:
         path = self.path / STEPS_FILE
-        if not path.is_file():
+        if not path.exists():
             return None
+        # at most one number of MAX_STEPS_PER_EPISODE's width (or -1) and a separator per episode
+        cell = len(str(MAX_STEPS_PER_EPISODE)) + 1
+        limit = STEPS_HEADER_BYTES + self.record.experiments * self.record.episodes * cell
         try:
-            steps = np.loadtxt(path, delimiter=",", dtype=np.int64, ndmin=2, comments="#")
-        except ValueError:
-            log.warning("run %s: unreadable %s, curve dropped", self.id, path)
+            text = read_bytes_bounded(path, limit).decode("ascii")
+            steps = np.loadtxt(
+                io.StringIO(text), delimiter=",", dtype=np.int64, ndmin=2, comments="#"
+            )
+        except (StudioError, ValueError, OSError) as err:  # not a file, too large, not numbers
+            log.warning("run %s: unreadable %s, curve dropped: %s", self.id, path, err)
             return None
         if steps.shape != (self.record.experiments, self.record.episodes):
             log.warning("run %s: %s has shape %s, curve dropped", self.id, path, steps.shape)

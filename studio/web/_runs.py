@@ -35,6 +35,7 @@ from studio.learning import (
     LiveProgress,
     RunFolder,
     RunRecord,
+    curve_statistics,
     find_runs,
     goal_degrees,
     goal_problems,
@@ -42,13 +43,12 @@ from studio.learning import (
     raise_problems,
     run_problems,
 )
-from studio.learning import curve_statistics as curve_of  # the events stream's name for it
 
 from ._errors import ConflictError, InvalidError, NotFoundError
 from ._schemas import RunCreate, RunPublic
 from ._store import now_iso
 
-__all__ = ["Run", "RunQueue", "curve_of", "prepare_run"]
+__all__ = ["Run", "RunQueue", "prepare_run"]
 
 log = logging.getLogger(__name__)
 
@@ -127,11 +127,7 @@ class Run:
 
     def curve(self, start: int = 0) -> dict[str, list]:
         """The learning curve (:func:`studio.learning.curve_statistics`)."""
-        return curve_of(self.steps(), start)
-
-    def public(self, steps: np.ndarray | None = None) -> dict[str, object]:
-        """:meth:`model` as JSON-ready values (the event stream sends it inside its events)."""
-        return self.model(steps).model_dump()
+        return curve_statistics(self.steps(), start)
 
     def model(self, steps: np.ndarray | None = None) -> RunPublic:
         """The run as the API shows it (``episodes_done`` from ``steps`` when given)."""
@@ -387,7 +383,8 @@ class RunQueue:
             if run is None:
                 try:
                     run = Run(run_id, RunFolder.load(path))
-                except (OSError, LearningError) as err:
+                    run.model()  # a damaged field must not break the whole list
+                except (OSError, ValueError, TypeError, LearningError) as err:
                     log.warning("skipping unreadable run folder %s: %s", path, err)
                     continue
                 if run.folder.interrupted:  # say so on disk too, once

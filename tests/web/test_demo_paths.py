@@ -1,6 +1,6 @@
 """One demonstration, one replayed path: the cutter, the page's run queue and ``studio train``.
 
-Issue 9: for ``recordings/sample-reach-2`` the page replayed 20 steps (a path flickering between
+Issue 9: for the shipped ``sample-reach-2`` the page replayed 20 steps (a path flickering between
 two bins) and the CLI 8, while the demonstration list said 8. All three now go through
 ``ArmGrid.path_from_joints``.
 """
@@ -15,9 +15,8 @@ import numpy as np
 
 from studio.cli import main
 from studio.learning import ArmGrid
+from studio.samples import SAMPLES_DIR as SAMPLES
 from tests.web.conftest import TINY_RUN, wait_run
-
-SAMPLES = Path(__file__).resolve().parents[2] / "recordings"
 
 
 def _listed(client, name: str) -> dict:
@@ -123,3 +122,37 @@ def test_the_shipped_sample_replays_its_listed_steps(client, tmp_path, capsys):
     cli = _cli_paths(recordings / "sample-reach-2.demo.json", tmp_path / "cli-run")
     assert page == cli
     assert len(page[0]) - 1 == listed["steps"] == 8  # the page replayed 20 before
+
+
+def test_the_cli_replays_the_trajectory_not_a_stored_grid_path(client, tmp_path, capsys):
+    """A demo file whose stored ``grid_path`` was edited (or written by older code) replays the
+    path its joint trajectory gives on the run's grid, as the page does."""
+    recordings = tmp_path / "recordings"
+    shutil.copy(SAMPLES / "sample-reach-2.tape.csv", recordings / "tampered.tape.csv")
+    data = json.loads((SAMPLES / "sample-reach-2.demo.json").read_text())
+    true_path = data["grid_path"]
+    data["recording"] = "tampered.tape.csv"
+    data["name"] = "tampered"
+    data["grid_path"] = [true_path[0], *true_path[-1:]]  # a 1-step "path" no grid allows
+    (recordings / "tampered.demo.json").write_text(json.dumps(data))
+    page = _page_paths(client, tmp_path / "runs", ["tampered"])
+    cli = _cli_paths(recordings / "tampered.demo.json", tmp_path / "cli-run")
+    grid = ArmGrid()
+    assert page == cli == [grid.path_from_joints(np.asarray(data["trajectory"]["q_robot"]))]
+    assert cli == [true_path]
+
+
+def test_the_cli_refuses_a_demonstration_that_misses_the_goal(tmp_path, capsys):
+    data = json.loads((SAMPLES / "sample-reach-2.demo.json").read_text())
+    q = np.asarray(data["trajectory"]["q_robot"])
+    data["trajectory"]["q_robot"] = q[: len(q) // 4].tolist()  # stops well before the goal
+    data["trajectory"]["t"] = data["trajectory"]["t"][: len(q) // 4]
+    short = tmp_path / "short.demo.json"
+    short.write_text(json.dumps(data))
+    code = main(
+        ["train", "--demos", str(short), "--out", str(tmp_path / "cli-run"), "--no-progress"]
+    )
+    assert code != 0
+    err = capsys.readouterr().err
+    assert "not in this run's goal bins (5, 6, 2)" in err and "Traceback" not in err
+    assert not (tmp_path / "cli-run").exists()  # nothing half-made

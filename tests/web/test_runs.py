@@ -160,7 +160,7 @@ def test_a_stop_right_after_a_run_is_marked_running_is_never_lost(client):
     stopped: list[dict] = []
 
     def stop_now(run) -> None:
-        stopped.append(client.app.state.studio.runs.stop(run.id).public())
+        stopped.append(client.app.state.studio.runs.stop(run.id).model().model_dump())
 
     client.app.state.studio.runs.before_train = stop_now
     run = client.post("/api/runs", json={**TINY_RUN, "episodes": 2000}).json()

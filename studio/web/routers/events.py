@@ -18,8 +18,10 @@ import numpy as np
 from fastapi import APIRouter, Request
 from fastapi.responses import StreamingResponse
 
+from studio.learning import curve_statistics
+
 from .._deps import StudioDep
-from .._runs import Run, curve_of
+from .._runs import Run
 from .._state import Studio
 
 router = APIRouter(prefix="/api/events", tags=["events"])
@@ -104,7 +106,11 @@ def run_event(run: Run, counts: dict[str, np.ndarray]) -> dict[str, Any]:
         changed = np.flatnonzero(previous != now)
         start = int(changed[0]) if changed.size else int(now.shape[0])
     counts[run.id] = now
-    return {"run": run.public(steps), "curve": curve_of(steps, start), "from": start}
+    return {
+        "run": run.model(steps).model_dump(mode="json"),
+        "curve": curve_statistics(steps, start),
+        "from": start,
+    }
 
 
 def _final_run(studio: Studio, run_id: str, counts: dict[str, np.ndarray]) -> dict[str, Any] | None:
