@@ -11,7 +11,8 @@ Measures, in one run (``python benchmarks/bench_sweep.py``, about a minute on 2 
    loop's time per trial (goal: < 10 % for trials of >= 1 s). With one worker nothing runs in
    parallel, so the difference is what Ray adds: scheduling, the worker, the reports and the
    bookkeeping. Also printed: per trial, Ray's time outside the trial function (2-worker sweep:
-   2 x wall / trials - the mean time the trial function took).
+   2 x wall / trials - the mean time the trial function took). ``--planning-steps`` scales the
+   trials' length (1000: about a second each; 5000: about five).
 3. ``--six-joint``: the cost of one six-joint trial (6 joints x 5 bins, the largest grid), and
    from it a paper estimate for a 1,000-trial six-joint sweep on a 16-node cluster.
 
@@ -100,6 +101,12 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--six-joint", action="store_true", help="also time a six-joint trial")
     parser.add_argument(
+        "--planning-steps",
+        type=int,
+        default=SPEC["fixed"]["planning_steps"],
+        help="planning updates per step: scales each trial's length (1000: about a second)",
+    )
+    parser.add_argument(
         "--repeats",
         type=int,
         default=1,
@@ -110,13 +117,14 @@ def main() -> None:
         os.environ.setdefault(key, value)
     warm_up()
     print(f"cores: {os.cpu_count()}, load average {os.getloadavg()[0]:.1f}; {TRIALS} trials")
+    spec = {**SPEC, "fixed": {"planning_steps": args.planning_steps}}
     serial_walls, ray2, ray1 = [], [], []
     with tempfile.TemporaryDirectory() as tmp:
         root = Path(tmp)
         for i in range(args.repeats):  # interleaved, so a busy spell hurts every side alike
-            serial_walls.append(serial(SPEC, root / f"serial{i}")[0])
-            ray2.append(on_ray(SPEC, root / f"ray2-{i}", WORKERS))
-            ray1.append(on_ray(SPEC, root / f"ray1-{i}", 1))
+            serial_walls.append(serial(spec, root / f"serial{i}")[0])
+            ray2.append(on_ray(spec, root / f"ray2-{i}", WORKERS))
+            ray1.append(on_ray(spec, root / f"ray1-{i}", 1))
             print(
                 f"  round {i + 1}: serial {serial_walls[-1]:.2f} s, Ray x{WORKERS} {ray2[-1][1]:.2f} s, "
                 f"Ray x1 {ray1[-1][1]:.2f} s (load {os.getloadavg()[0]:.1f})"
