@@ -8,6 +8,11 @@ from pathlib import Path
 import numpy as np
 
 from studio.learning import (
+    ROLLOUT_MAX_STEPS,
+    ROLLOUT_RATE_HZ,
+    ROLLOUT_SECONDS_PER_STEP,
+    TILE_ROLLOUT_MAX_STEPS,
+    TILE_ROLLOUT_SECONDS_PER_STEP,
     LearningError,
     TilePolicyFile,
     greedy_path,
@@ -16,9 +21,6 @@ from studio.learning import (
     rollout_tile_policy,
     save_trajectory_csv,
 )
-from studio.learning._linear_policy import DEFAULT_MAX_STEPS as TILE_MAX_STEPS
-from studio.learning._linear_policy import DEFAULT_SECONDS_PER_STEP as TILE_SECONDS_PER_STEP
-from studio.learning._policy import DEFAULT_MAX_STEPS, DEFAULT_RATE_HZ, DEFAULT_SECONDS_PER_STEP
 
 NAME = "export"
 HELP = "Roll a policy file out greedily from a start pose and write the joint trajectory as CSV."
@@ -37,20 +39,20 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--rate",
         type=float,
-        default=DEFAULT_RATE_HZ,
-        help=f"control rate in Hz (default: {DEFAULT_RATE_HZ:g})",
+        default=ROLLOUT_RATE_HZ,
+        help=f"control rate in Hz (default: {ROLLOUT_RATE_HZ:g})",
     )
     parser.add_argument(
         "--seconds-per-step",
         type=float,
         default=None,
-        help=f"seconds per step (default: {DEFAULT_SECONDS_PER_STEP:g} per grid step, {TILE_SECONDS_PER_STEP:g} per joint step of a tile-coded policy)",
+        help=f"seconds per step (default: {ROLLOUT_SECONDS_PER_STEP:g} per grid step, {TILE_ROLLOUT_SECONDS_PER_STEP:g} per joint step of a tile-coded policy)",
     )
     parser.add_argument(
         "--max-steps",
         type=int,
         default=None,
-        help=f"cap on greedy steps (default: {DEFAULT_MAX_STEPS} grid steps, {TILE_MAX_STEPS} joint steps)",
+        help=f"cap on greedy steps (default: {ROLLOUT_MAX_STEPS} grid steps, {TILE_ROLLOUT_MAX_STEPS} joint steps)",
     )
     parser.add_argument(
         "--out", type=Path, help="CSV path (default: the policy's name with .rollout.csv)"
@@ -91,8 +93,8 @@ def _run_tile(args: argparse.Namespace, policy: TilePolicyFile) -> int:
         policy,
         start,
         rate_hz=args.rate,
-        max_steps=TILE_MAX_STEPS if args.max_steps is None else args.max_steps,
-        seconds_per_step=TILE_SECONDS_PER_STEP
+        max_steps=TILE_ROLLOUT_MAX_STEPS if args.max_steps is None else args.max_steps,
+        seconds_per_step=TILE_ROLLOUT_SECONDS_PER_STEP
         if args.seconds_per_step is None
         else args.seconds_per_step,
     )
@@ -113,9 +115,9 @@ def run(args: argparse.Namespace) -> int:
     if isinstance(policy, TilePolicyFile):
         return _run_tile(args, policy)
     if args.max_steps is None:
-        args.max_steps = DEFAULT_MAX_STEPS
+        args.max_steps = ROLLOUT_MAX_STEPS
     if args.seconds_per_step is None:
-        args.seconds_per_step = DEFAULT_SECONDS_PER_STEP
+        args.seconds_per_step = ROLLOUT_SECONDS_PER_STEP
     grid = policy.grid
     if args.start_state is not None:
         start = args.start_state

@@ -6,7 +6,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from .._errors import StudioError
+from studio import StudioError
 
 NAME = "export-urdf"
 HELP = "Write a URDF of the Puma560 (joints, limits, visuals) to a file or to standard output."

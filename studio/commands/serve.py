@@ -8,7 +8,7 @@ import secrets
 import sys
 from pathlib import Path
 
-from studio._errors import StudioError
+from studio import StudioError
 
 NAME = "serve"
 HELP = "Start the studio in the browser (the default verb)."
@@ -55,8 +55,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from studio.web import Settings, serve
-    from studio.web._settings import DEFAULT_UPLOAD_LIMIT_BYTES, is_loopback
+    from studio.web import DEFAULT_UPLOAD_LIMIT_BYTES, Settings, is_loopback, serve
 
     source = args.source
     data_dir: Path = args.data_dir

@@ -45,12 +45,17 @@ from ._gym import register as register_environments
 from ._linear import LinearResult as LinearResult
 from ._linear import greedy_rollout as greedy_rollout
 from ._linear import greedy_success as greedy_success
+from ._linear_policy import DEFAULT_MAX_STEPS as TILE_ROLLOUT_MAX_STEPS  # noqa: F401 (re-export)
+from ._linear_policy import DEFAULT_SECONDS_PER_STEP as TILE_ROLLOUT_SECONDS_PER_STEP  # noqa: F401
 from ._linear_policy import TilePolicyFile as TilePolicyFile
 from ._linear_policy import load_any_policy as load_any_policy
 from ._linear_policy import load_tile_policy as load_tile_policy
 from ._linear_policy import rollout_tile_policy as rollout_tile_policy
 from ._linear_policy import save_tile_policy as save_tile_policy
 from ._mdp import TabularMDP as TabularMDP
+from ._policy import ROLLOUT_MAX_STEPS as ROLLOUT_MAX_STEPS
+from ._policy import ROLLOUT_RATE_HZ as ROLLOUT_RATE_HZ
+from ._policy import ROLLOUT_SECONDS_PER_STEP as ROLLOUT_SECONDS_PER_STEP
 from ._policy import PolicyFile as PolicyFile
 from ._policy import greedy_path as greedy_path
 from ._policy import load_policy as load_policy
@@ -72,6 +77,7 @@ from ._runs import curve_statistics as curve_statistics
 from ._runs import curves_csv as curves_csv
 from ._runs import downsample_curve as downsample_curve
 from ._runs import find_runs as find_runs
+from ._runs import pid_alive as pid_alive
 from ._runs import raise_problems as raise_problems
 from ._runs import run_problems as run_problems
 from ._runs import write_curves_csv as write_curves_csv

@@ -49,11 +49,11 @@ FORMAT_NAME = "teach-studio-policy"
 FORMAT_VERSION = 1
 ROBOT_JOINTS = 6
 """Columns of a rollout trajectory: the Puma560's six joints."""
-DEFAULT_RATE_HZ = 50.0
+ROLLOUT_RATE_HZ = 50.0
 """Default control rate of a rollout trajectory."""
-DEFAULT_SECONDS_PER_STEP = 0.5
+ROLLOUT_SECONDS_PER_STEP = 0.5
 """Default time the arm takes to move one grid step."""
-DEFAULT_MAX_STEPS = 1_000
+ROLLOUT_MAX_STEPS = 1_000
 """Default cap on greedy steps in a rollout."""
 MAX_NPY_HEADER_BYTES = 10_000
 """Longest ``.npy`` member header read (numpy's own safe limit)."""
@@ -409,7 +409,7 @@ def _check_header(name: str, header: Any) -> tuple[ArmGrid, DynaQConfig, np.ndar
 
 
 def greedy_path(
-    policy: PolicyFile, start_state: int, max_steps: int = DEFAULT_MAX_STEPS
+    policy: PolicyFile, start_state: int, max_steps: int = ROLLOUT_MAX_STEPS
 ) -> list[int]:
     """States visited by following the greedy actions from ``start_state``.
 
@@ -439,10 +439,10 @@ def _min_jerk(u: np.ndarray) -> np.ndarray:
 def rollout(
     policy: PolicyFile,
     start_state: int,
-    rate_hz: float = DEFAULT_RATE_HZ,
-    max_steps: int = DEFAULT_MAX_STEPS,
+    rate_hz: float = ROLLOUT_RATE_HZ,
+    max_steps: int = ROLLOUT_MAX_STEPS,
     *,
-    seconds_per_step: float = DEFAULT_SECONDS_PER_STEP,
+    seconds_per_step: float = ROLLOUT_SECONDS_PER_STEP,
     hold: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """The greedy policy from ``start_state`` as a Puma560 joint trajectory.

@@ -649,7 +649,9 @@ def raise_problems(problems: Iterable[tuple[str, str]]) -> None:
 # ----------------------------------------------------------------------------- the folder
 
 
-def _pid_alive(pid: object) -> bool:
+def pid_alive(pid: object) -> bool:
+    """Whether ``pid`` is a live process other than this one: a run or sweep whose status says
+    it is training but whose process is gone (a crash, ``kill -9``) reads as stopped."""
     if not _is_int(pid) or pid <= 0:  # type: ignore[operator]
         return False
     if pid == os.getpid():  # this process's only trainer, the page's queue, never reloads its own
@@ -836,7 +838,7 @@ class RunFolder:
         self.cpu_seconds = float(cpu) if isinstance(cpu, int | float) and np.isfinite(cpu) else 0.0
         self.error = _text(status.get("error"))
         self.pid = status.get("pid")
-        if self.status in ("queued", "running") and not _pid_alive(self.pid):
+        if self.status in ("queued", "running") and not pid_alive(self.pid):
             self.interrupted = True
             self.error = (
                 "The process training it stopped while this run was training; its curve so far is kept, start it again to finish."

@@ -45,7 +45,7 @@ from typing import Any
 
 import numpy as np
 
-from studio import StudioError, read_json, read_toml
+from studio import MAX_JSON_BYTES, StudioError, read_bytes_bounded, read_json, read_toml
 
 from ._arm import ArmGrid
 from ._config import DynaQConfig
@@ -63,9 +63,9 @@ from ._runs import (
     TASK_ARM_REACH,
     RunFolder,
     RunRecord,
-    _pid_alive,
     curve_statistics,
     now_iso,
+    pid_alive,
 )
 
 SWEEP_FORMAT = "teach-studio-sweep"
@@ -1001,8 +1001,8 @@ class SweepInfo:
         """``sweep.csv``'s text: as written when the sweep ended, or computed from the run folders
         while it runs (the file is written at its end)."""
         if self.status != "running":
-            with contextlib.suppress(OSError):
-                return (self.folder / SUMMARY_FILE).read_text()
+            with contextlib.suppress(StudioError, OSError, UnicodeDecodeError):  # bounded read
+                return read_bytes_bounded(self.folder / SUMMARY_FILE, MAX_JSON_BYTES).decode()
         return sweep_csv(sweep_rows(self.folder.parent.parent, self._spec()))
 
     def rows(self) -> list[dict[str, str]]:
@@ -1046,7 +1046,7 @@ def load_sweep(data_dir: Path, sweep_id: str) -> SweepInfo:
         sorted(p.name for p in runs_parent.iterdir() if p.is_dir()) if runs_parent.is_dir() else []
     )
     status = str(data.get("status", "interrupted"))
-    if status == "running" and not _pid_alive(data.get("pid")):  # its driver died
+    if status == "running" and not pid_alive(data.get("pid")):  # its driver died
         status = "interrupted"
     return SweepInfo(
         id=sweep_id,

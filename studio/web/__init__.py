@@ -8,5 +8,7 @@ from __future__ import annotations
 
 from ._app import create_app as create_app
 from ._serve import serve as serve
+from ._settings import DEFAULT_UPLOAD_LIMIT_BYTES as DEFAULT_UPLOAD_LIMIT_BYTES
 from ._settings import Settings as Settings
 from ._settings import get_settings as get_settings
+from ._settings import is_loopback as is_loopback

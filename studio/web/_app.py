@@ -23,8 +23,8 @@ from starlette.exceptions import HTTPException
 from starlette.middleware.trustedhost import TrustedHostMiddleware
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
-from .. import __version__
-from .._errors import StudioError
+from studio import StudioError, __version__, human_size
+
 from ._errors import (
     NotFoundError,
     StorageError,
@@ -35,7 +35,6 @@ from ._errors import (
 from ._guard import GuardMiddleware, SiteRule
 from ._settings import Settings, get_settings
 from ._state import Studio
-from ._store import human_bytes
 from .routers import (
     capture,
     config,
@@ -211,7 +210,7 @@ class UploadLimitMiddleware:
         self.limit = limit
 
     def _sentence(self, size: str) -> str:
-        return f"The upload is {size}, over the limit of {human_bytes(self.limit)}; upload a smaller file or start the studio with a larger limit."
+        return f"The upload is {size}, over the limit of {human_size(self.limit)}; upload a smaller file or start the studio with a larger limit."
 
     async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
         if scope["type"] != "http":
@@ -226,7 +225,7 @@ class UploadLimitMiddleware:
                     size = 0
                 if size > allowed:
                     response = JSONResponse(
-                        {"detail": self._sentence(human_bytes(size))}, status_code=413
+                        {"detail": self._sentence(human_size(size))}, status_code=413
                     )
                     await response(scope, receive, send)
                     return
@@ -242,7 +241,7 @@ class UploadLimitMiddleware:
                     # An HTTPException passes FastAPI's body parsing unchanged, and whatever
                     # was read so far (Starlette's spooled parts, an upload's temporary file)
                     # is dropped on the way out.
-                    raise BodyTooLarge(413, self._sentence(f"more than {human_bytes(allowed)}"))
+                    raise BodyTooLarge(413, self._sentence(f"more than {human_size(allowed)}"))
             return message
 
         async def tracked_send(message: Message) -> None:

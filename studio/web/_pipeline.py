@@ -23,9 +23,9 @@ from typing import Any
 
 import numpy as np
 
+from studio import StudioError
 from studio.kinematics import ArmTracker, TapeConfig, TrackerConfig
 
-from .._errors import StudioError
 from ._errors import ConflictError, storage_sentence
 
 log = logging.getLogger(__name__)

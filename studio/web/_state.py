@@ -15,9 +15,9 @@ from typing import Any
 
 import numpy as np
 
+from studio import StudioError
 from studio.learning import GOAL_JOINTS, check_goal_deg
 
-from .._errors import StudioError
 from ._errors import ConflictError, InvalidError, NotFoundError
 from ._pipeline import Pipeline
 from ._runs import RunQueue

@@ -32,6 +32,7 @@ from typing import Any, Generic, TypeVar
 
 from fastapi import UploadFile
 
+from studio import StudioError, human_size
 from studio.capture import (
     DEMO_SUFFIX,
     RECORDING_SUFFIX,
@@ -42,7 +43,6 @@ from studio.capture import (
 from studio.learning import POLICY_SUFFIX, PolicyFile, load_policy
 from studio.samples import SAMPLES_DIR
 
-from .._errors import StudioError
 from ._errors import ConflictError, InvalidError, NotFoundError, TooLargeError
 
 log = logging.getLogger(__name__)
@@ -56,15 +56,6 @@ DEMONSTRATION_SUFFIX = DEMO_SUFFIX
 """Demonstrations lie next to their recordings: ``<name>.demo.json`` (the capture package's)."""
 
 T = TypeVar("T")
-
-
-def human_bytes(n: float) -> str:
-    """A size as people read it: ``50 MB``, ``1.5 MB``, ``900 kB``, ``120 bytes``."""
-    if n >= 1e6:
-        return f"{n / 1e6:.3g} MB"
-    if n >= 1e3:
-        return f"{n / 1e3:.3g} kB"
-    return f"{int(n)} bytes"
 
 
 def check_name(name: str, what: str = "name") -> str:
@@ -146,7 +137,7 @@ async def receive_upload(upload: UploadFile, folder: Path, limit: int) -> Path:
                 size += len(chunk)
                 if size > limit:
                     raise TooLargeError(
-                        f"The upload is larger than the limit of {human_bytes(limit)}; upload a smaller file or start the studio with a larger limit."
+                        f"The upload is larger than the limit of {human_size(limit)}; upload a smaller file or start the studio with a larger limit."
                     )
                 out.write(chunk)
     except BaseException:
