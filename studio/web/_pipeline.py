@@ -72,6 +72,7 @@ class Pipeline:
         self._capture_name: str | None = None
         self._capture_path: Path | None = None
         self._capture_frames = 0
+        self._capture_rejected = 0  # frames of another tape width, left out of the recording
         self._capture_t0: float | None = None
         self._capture_last_t: float | None = None
         self._kin_error: str | None = None
@@ -196,8 +197,10 @@ class Pipeline:
                 "frames": int(st.frames) if st is not None else 0,
                 "dropped": int(st.dropped) if st is not None else 0,
                 "error": error,
-                "warning": getattr(st, "warning", None) or self._fit_warning,
-                "rejected": int(getattr(st, "rejected", 0) or 0),
+                "warning": getattr(st, "warning", None)
+                or self._fit_warning
+                or self._rejected_warning(),
+                "rejected": int(getattr(st, "rejected", 0) or 0) + self._capture_rejected,
                 "recording": self._recording,
                 "retarget": {"mode": self._mode, "mirror": self._mirror},
                 "fit_residual_mm": None if self._residual is None else self._residual * 1000.0,
@@ -247,6 +250,7 @@ class Pipeline:
                 )
             self._writer, self._capture_name, self._capture_path = writer, name, path
             self._capture_frames = 0
+            self._capture_rejected = 0
             self._capture_error = None
             self._capture_t0 = None
             self._capture_last_t = None
@@ -308,6 +312,7 @@ class Pipeline:
                 "name": self._capture_name,
                 "seconds": round(float(seconds), 3),
                 "frames": self._capture_frames if active else 0,
+                "rejected": self._capture_rejected,
                 "error": self._capture_error,
             }
 
@@ -352,11 +357,26 @@ class Pipeline:
             if source is self._source:
                 self._fit(source, frames[-MAX_FITS_PER_BATCH:])
 
+    def _rejected_warning(self) -> str | None:
+        if not self._capture_rejected:
+            return None
+        return f"{self._capture_rejected} frames of another tape width were left out of the recording; check that one tape sends."
+
     def _record(self, frames: list[Any]) -> None:
+        """Append frames to the capture; a frame of another width than the recording's is left
+        out and counted (one odd frame never ends a capture); a failed write ends it, with the
+        reason kept in ``capture_status()["error"]`` until dismissed."""
         with self._lock:
             writer = self._writer
             if writer is None:
                 return
+            regions = getattr(writer, "regions", None)
+            if regions is not None:
+                fits = [f for f in frames if np.shape(f.bend) == (regions,) == np.shape(f.twist)]
+                self._capture_rejected += len(frames) - len(fits)
+                frames = fits
+                if not frames:
+                    return
             try:
                 writer.write_many(frames)
             except Exception as err:
