@@ -30,6 +30,8 @@ import urllib.request
 from pathlib import Path
 from typing import Any
 
+from studio.samples import SAMPLES_DIR
+
 REPO = Path(__file__).resolve().parents[1]
 CHROMIUM = "/usr/bin/chromium"
 FLAGS = [
@@ -213,7 +215,7 @@ def main() -> int:
 
     data = Path(tempfile.mkdtemp(prefix="bench-web-"))
     (data / "recordings").mkdir()
-    for sample in (REPO / "recordings").glob("sample-*"):
+    for sample in SAMPLES_DIR.glob("sample-*"):
         shutil.copy(sample, data / "recordings" / sample.name)
     proc, base = start_studio(data)
     try:

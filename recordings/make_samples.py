@@ -6,8 +6,8 @@ with one demonstration cut from the reach, so a new user can train supervised ag
 Every data folder offers them read-only (:data:`studio.samples.SAMPLES_DIR`)::
 
     python recordings/make_samples.py            # rewrites studio/samples/sample-*
-    python recordings/make_samples.py --out recordings   # the copies some tests read from here
-    studio train --demos studio/samples/sample-reach-1.demo.json
+    python recordings/make_samples.py --out /tmp/samples   # elsewhere, to compare
+    studio train --demos sample-reach-1          # a sample by name, from any data folder
 
 Angles are rounded to :data:`ANGLE_DECIMALS` decimals (0.1 mrad, a twentieth of the simulated
 sensor noise) to keep the files small; the header and demonstrations carry a fixed creation time

@@ -25,11 +25,38 @@ def test_output_into_a_closed_pipe_ends_quietly():
     """`studio info FILES | head` is not an error: no traceback when the reader goes away."""
     import subprocess
     import sys
-    from pathlib import Path
 
-    sample = Path(__file__).resolve().parents[1] / "recordings" / "sample-reach-1.tape.csv"
+    from studio.samples import SAMPLES_DIR
+
+    sample = SAMPLES_DIR / "sample-reach-1.tape.csv"
     cmd = [sys.executable, "-m", "studio", "info", *[str(sample)] * 400]  # more than a pipe holds
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     proc.stdout.close()  # the reader is gone before the first line
     _, err = proc.communicate(timeout=120)
     assert proc.returncode == 0 and b"Traceback" not in err, err.decode()
+
+
+def test_train_finds_a_demonstration_by_name_from_a_fresh_data_folder(tmp_path, monkeypatch):
+    """README's ``studio train --demos sample-reach-2``: a shipped sample by name, from any folder;
+    a demonstration of the data folder's own ``recordings/`` by name comes first."""
+    import json
+
+    from studio.capture import load_demonstration
+    from studio.cli import main
+    from studio.samples import SAMPLES_DIR
+
+    monkeypatch.chdir(tmp_path)
+    args = ["--episodes", "2", "--experiments", "1", "--planning", "zero", "--no-progress"]
+    assert main(["train", "--demos", "sample-reach-2", "--out", "runs/a", *args]) == 0
+    stored = json.loads((tmp_path / "runs/a/config.json").read_text())["demonstrations"]
+    assert stored == [load_demonstration(SAMPLES_DIR / "sample-reach-2.demo.json").grid_path]
+    (tmp_path / "recordings").mkdir()
+    mine = load_demonstration(SAMPLES_DIR / "sample-reach-3.demo.json")
+    mine.save(tmp_path / "recordings" / "sample-reach-2.demo.json")
+    assert main(["train", "--demos", "sample-reach-2.demo.json", "--out", "runs/b", *args]) == 0
+    stored = json.loads((tmp_path / "runs/b/config.json").read_text())["demonstrations"]
+    assert (
+        stored
+        == [mine.grid_path]
+        != [load_demonstration(SAMPLES_DIR / "sample-reach-2.demo.json").grid_path]
+    )

@@ -33,7 +33,7 @@ from typing import Any
 import numpy as np
 
 from studio import StudioError, read_json
-from studio.capture import DEMO_FORMAT, load_demonstration
+from studio.capture import DEMO_FORMAT, DEMO_SUFFIX, load_demonstration
 from studio.learning import (
     DEFAULT_EPISODES,
     DEFAULT_EXPERIMENTS,
@@ -51,9 +51,12 @@ from studio.learning import (
     raise_problems,
     run_problems,
 )
+from studio.samples import SAMPLES_DIR
 
 NAME = "train"
 HELP = "Train Dyna-Q on the arm grid: a config in, a run folder with curves and a policy out."
+RECORDINGS_DIR = "recordings"
+"""Where a data folder keeps its recordings and the demonstrations cut from them."""
 _DYNAQ = DynaQConfig()
 _GRID = ArmGrid()
 
@@ -99,7 +102,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="goal as joint 1-3 angles in degrees, comma-separated, checked against the Puma560's "
         "limits as the page does; write --goal-deg=-30,45,-90 when the first is negative",
     )
-    parser.add_argument("--demos", type=Path, help="JSON file of demonstrations (grid state lists)")
+    parser.add_argument(
+        "--demos",
+        type=Path,
+        help="a cut demonstration (a *.demo.json file, or the name of one in recordings/ or of a "
+        "shipped sample such as sample-reach-2), or a JSON file of grid state lists",
+    )
     parser.add_argument("--generated-demos", type=int, help="replay N generated demonstrations")
     parser.add_argument("--workers", type=int, default=None, help="threads (default: all cores)")
     parser.add_argument("--no-progress", action="store_true", help="hide the progress bar")
@@ -113,6 +121,28 @@ def _read_json(path: Path, what: str) -> Any:
         return read_json(path, f"The {what} file {path}")
     except StudioError as err:
         raise LearningError(str(err)) from None
+
+
+def demonstration_file(given: Path) -> Path:
+    """The file ``--demos`` names: a path, else a demonstration's name (``sample-reach-2``, with
+    or without ``.demo.json``) in the data folder's ``recordings/``, else a shipped sample's.
+
+    Raises:
+        LearningError: no such file or demonstration.
+    """
+    if given.exists() or len(given.parts) != 1:
+        return given
+    name = given.name.removesuffix(DEMO_SUFFIX)
+    candidates = [
+        Path(RECORDINGS_DIR) / f"{name}{DEMO_SUFFIX}",
+        SAMPLES_DIR / f"{name}{DEMO_SUFFIX}",
+    ]
+    for candidate in candidates:
+        if candidate.is_file():
+            return candidate
+    raise LearningError(
+        f"There is no demonstration file {given}, nor a demonstration {name!r} in {candidates[0].parent}/ or among the samples (sample-reach-1 to 3); check the name or give a path."
+    )
 
 
 def _demos_from(data: Any, source: Path, grid: ArmGrid) -> list[list[int]]:
@@ -251,7 +281,8 @@ def resolve(args: argparse.Namespace) -> TrainSettings:
         _demos_from(spec["demonstrations"], args.config, grid) if "demonstrations" in spec else []
     )
     if args.demos is not None:
-        demos = _demos_from(_read_json(args.demos, "demonstrations"), args.demos, grid)
+        demo_file = demonstration_file(args.demos)
+        demos = _demos_from(_read_json(demo_file, "demonstrations"), demo_file, grid)
     if args.generated_demos:
         demos = generate_demonstrations(
             grid, args.generated_demos, np.random.default_rng([seed, 1])

@@ -21,6 +21,7 @@ from studio.capture import (
     simulate,
 )
 from studio.learning import ArmGrid
+from studio.samples import SAMPLES_DIR
 
 SECONDS = 5.0
 
@@ -250,8 +251,7 @@ def test_a_file_written_by_older_code_still_loads(tmp_path):
 
 def test_the_shipped_samples_replay_what_their_files_say():
     """The sample demonstrations' stored paths are what the one path function gives."""
-    folder = Path(__file__).resolve().parents[2] / "recordings"
-    for demo_path in sorted(folder.glob("sample-reach-*.demo.json")):
+    for demo_path in sorted(SAMPLES_DIR.glob("sample-reach-*.demo.json")):
         stored = json.loads(demo_path.read_text())["grid_path"]
         demo = load_demonstration(demo_path)
         assert demo.grid_path == stored == demo.arm_grid().path_from_joints(demo.q_robot)

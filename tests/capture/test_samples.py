@@ -14,6 +14,7 @@ from studio.learning import ArmGrid
 from studio.samples import SAMPLES_DIR
 
 RECORDINGS = Path(__file__).resolve().parents[2] / "recordings"
+"""The repository folder of the recording format's README and the script that makes the samples."""
 
 
 def test_every_sample_demo_reaches_the_default_goal_of_arm_grid():
@@ -53,9 +54,3 @@ def test_the_committed_script_regenerates_the_samples(tmp_path):
             ta, tb = a.pop("trajectory"), b.pop("trajectory")
             assert a == b, name
             assert np.allclose(ta["q_robot"], tb["q_robot"], atol=2e-6) and ta["t"] == tb["t"]
-
-
-def test_the_copies_in_the_repository_folder_are_the_shipped_samples():
-    """``recordings/sample-*`` stay only as byte-identical copies (some tests read them there)."""
-    for old in RECORDINGS.glob("sample-*"):
-        assert old.read_bytes() == (SAMPLES_DIR / old.name).read_bytes(), old.name

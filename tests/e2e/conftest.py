@@ -22,6 +22,7 @@ from typing import Any
 
 import pytest
 
+from studio.samples import SAMPLES_DIR
 from tests.conftest import require
 
 REPO = Path(__file__).resolve().parents[2]
@@ -82,7 +83,7 @@ def studio_server(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Studio]:
     """``studio serve`` on random free ports with a fresh data directory."""
     data_dir = tmp_path_factory.mktemp("studio-data")
     (data_dir / "recordings").mkdir()
-    for sample in sorted((REPO / "recordings").glob("sample-*")):
+    for sample in sorted(SAMPLES_DIR.glob("sample-*")):
         shutil.copy(sample, data_dir / "recordings" / sample.name)
     port, viser_port = free_port(), free_port()
     while viser_port == port:

@@ -14,7 +14,9 @@ from typing import Any
 import numpy as np
 import pytest
 
-from .conftest import ARTIFACTS, REPO, Studio, shot
+from studio.samples import SAMPLES_DIR
+
+from .conftest import ARTIFACTS, Studio, shot
 
 pytestmark = pytest.mark.e2e
 
@@ -140,7 +142,7 @@ def test_story2_switch_sources(page: Any, studio_server: Studio, tmp_path: Path)
 
     # A recording uploaded from disk, played as the source: pause, seek, speed.
     upload = tmp_path / "uploaded-reach.tape.csv"
-    upload.write_bytes((REPO / "recordings" / "sample-reach-2.tape.csv").read_bytes())
+    upload.write_bytes((SAMPLES_DIR / "sample-reach-2.tape.csv").read_bytes())
     page.set_input_files("[data-testid='recording-upload']", str(upload))
     row = page.locator("[data-testid='recording-row'][data-name='uploaded-reach']")
     row.wait_for(timeout=T)

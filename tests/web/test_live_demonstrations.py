@@ -80,11 +80,11 @@ def test_a_segment_that_misses_the_goal_is_refused_with_its_reason(open_client):
 
 def test_the_shipped_samples_are_listed_and_train(open_client, tmp_path):
     import shutil
-    from pathlib import Path
 
-    repo = Path(__file__).resolve().parents[2] / "recordings"
-    samples = sorted(repo.glob("sample-*"))
-    assert samples, "the repository ships sample recordings"
+    from studio.samples import SAMPLES_DIR
+
+    samples = sorted(SAMPLES_DIR.glob("sample-*"))
+    assert samples, "the package ships sample recordings"
     (tmp_path / "recordings").mkdir()
     for path in samples:
         shutil.copy(path, tmp_path / "recordings" / path.name)

@@ -4,14 +4,14 @@ from __future__ import annotations
 
 import shutil
 import time
-from pathlib import Path
 
 import numpy as np
 
 from studio.capture import Calibration, ShapeTapeEmulator, read_recording
+from studio.samples import SAMPLES_DIR
 from tests.web.conftest import wait_for
 
-SAMPLE = Path(__file__).resolve().parents[2] / "recordings" / "sample-reach-1.tape.csv"
+SAMPLE = SAMPLES_DIR / "sample-reach-1.tape.csv"
 GAIN = 2e-4
 """rad per count: the calibration's resolution, so angles come back within one count."""
 
