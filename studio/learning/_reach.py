@@ -12,7 +12,8 @@ Why one joint at a time rather than every joint -1/0/+1 at once (3**J actions, 7
 joints): a linear learner evaluates every action at every step and learns each action's weights
 from its own visits, so 12 actions cost 60x less per step and each gets 60x more data; and with one
 joint per action the steps to the goal are a sum of per-joint distances, which per-joint tilings
-represent (:meth:`ArmReach.features`). The price is longer paths (the sum of the joints' distances
+represent (:meth:`ArmReach.features`; :data:`DEFAULT_SHAPING` says why the shaping weight matters).
+The price is longer paths (the sum of the joints' distances
 instead of the largest). There is no "stay" action: it never helps a reach, and with function
 approximation its estimate can stick above the moves' and freeze the arm.
 
@@ -62,14 +63,29 @@ DEFAULT_MAX_EPISODE_STEPS = 3_000
 DEFAULT_TILINGS = 8
 """Offset tilings of the arm's default features."""
 DEFAULT_TILES = 32
-"""Tiles per joint of the arm's default features (pairs of joints, see :meth:`ArmReach.features`):
-about 17 degrees of the widest joint each, about 2 degrees resolution over 8 tilings."""
-DEFAULT_SHAPING = 1.0
-"""Weight of the potential-based shaping reward (Ng, Harada & Russell 1999): the change of minus
-the tool's pose error, counted in tolerances. It leaves the optimal policies unchanged (with
-gamma = 1 the shaping terms of an episode telescope to a constant per start) and gives every
-step a direction toward the goal, without which a 6-joint random start almost never finds the
-goal's few-degree region at all; 0 gives the paper's bare +100 / -1."""
+"""Tiles per joint of the arm's default features (each joint tiled alone, see
+:meth:`ArmReach.features`): about 17 degrees of the widest joint each, about 2 degrees resolution
+over 8 tilings."""
+DEFAULT_SHAPING = 5.0
+"""Weight of the potential-based shaping reward (Ng, Harada & Russell 1999): ``shaping`` times the
+change of :func:`reach_potential` (minus the joints' distance to the goal's angles, in steps). It
+gives every step a direction toward the goal, without which a 6-joint random start almost never
+finds the goal's few-degree region; 0 gives the paper's bare +100 / -1. With gamma = 1 the terms of
+an episode telescope to a constant per start, so the optimal policies are unchanged; with the
+paper's gamma = 0.95 the term also charges ``(1 - gamma) x shaping x distance``, which only pulls
+harder toward the goal.
+
+Why 5 and not 1. A joint step toward the goal pays ``shaping - 1``, one away ``-shaping - 1``.
+With 1 the step cost cancels exactly: every move toward the goal pays 0, so which joint to move is
+told apart only by the discounted +100, ``100 x 0.95 ** (sum of the joints' distances)``, a
+*product* of per-joint factors that no sum of per-joint (or pair) tile weights represents; the
+fitted error exceeds the true gaps and the greedy policy steps a near-goal joint back and forth
+(measured at six joints: 16% greedy success after 4,000 episodes, 32% after 16,000). With 5, the
+value is dominated by a sum over joints of per-joint terms (+4 per step toward the goal, -6 per
+step away), which per-joint tilings represent exactly, and the +100 only settles the last steps:
+100% after 4,000 episodes (package README). A cycle still costs (toward then away:
+``4 - 0.95 x 6 < 0``), so no loop pays; that holds while ``shaping < (1 + gamma) / (1 - gamma)``
+(39 at gamma = 0.95)."""
 MAX_SHAPING = 100.0
 """Upper bound on ``shaping``."""
 LIMIT_SLACK_RAD = 1e-9
@@ -201,19 +217,20 @@ class ArmReach:
     def features(
         self, tilings: int = DEFAULT_TILINGS, tiles: int = DEFAULT_TILES, size: int | None = None
     ) -> TileCoding:
-        """The default tile coding of this task: every pair of joints tiled on its own.
+        """The default tile coding of this task: every joint tiled on its own.
 
         One grid over all joints would need ``(tiles + 1) ** joints`` tiles per tiling (1.3e9
         for six joints at 32 tiles) and generalise only within a few degrees in every joint at
-        once. With one joint moving per action, the steps to the goal are nearly a sum of
-        per-joint distances, so tilings of each joint alone would do in principle; measured, they
-        leave the greedy policy oscillating (each action's weights must carry the other joints'
-        share equally, and learning noise breaks the tie), while pairs of joints (``J (J - 1) / 2
-        x (tiles + 1) ** 2`` tiles per tiling) learn it: 88% greedy success on three joints
-        against 12% for single joints, same budget (see the package README).
+        once. With one joint moving per action and the shaping of :data:`DEFAULT_SHAPING`, an
+        action's value is nearly a sum of per-joint terms (is the moved joint above or below its
+        goal angle, how far are the others), which tilings of each joint alone represent:
+        ``J x (tiles + 1)`` tiles per tiling, six joints learn in seconds. Measured against pairs
+        of joints (``J (J - 1) / 2 x (tiles + 1) ** 2`` tiles per tiling) at six joints, 4,000
+        episodes: 100% greedy success for single joints against 77% for pairs and 94% for both
+        (see the package README); pass ``TileCoding(groups=...)`` for other choices.
         """
-        pairs = tuple((i, j) for i in range(self.joints) for j in range(i + 1, self.joints))
-        return TileCoding(tilings=tilings, tiles=tiles, size=size, groups=pairs)
+        singles = tuple((j,) for j in range(self.joints))
+        return TileCoding(tilings=tilings, tiles=tiles, size=size, groups=singles)
 
     @cached_property
     def params(self) -> np.ndarray:
