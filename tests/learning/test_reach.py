@@ -176,3 +176,25 @@ def test_beyond_the_paper_measures_memory_and_success(tmp_path):
     assert "| 3 | 35,937 entries" in text and "greedy success" in text
     (budget,) = rows[0]["budgets"]
     assert budget["episodes"] == 20 and 0.0 <= budget["success"][0] <= 1.0
+
+
+def test_six_joint_greedy_policy_reaches_the_goal_from_random_starts_without_oscillating():
+    # the defaults (shaping 5, per-joint tilings) make each action's value a per-joint sum the
+    # features fit; with shaping 1 (toward-goal steps paying 0) the greedy policy stepped a
+    # near-goal joint back and forth: 16% success after 4,000 episodes instead of 97-100%
+    task = ArmReach(joints=6)
+    config = DynaQConfig(planning="zero", max_steps_per_episode=3000)
+    result = run_experiments(
+        lambda: gymnasium.make(ARM_REACH_ID, joints=6), config, 1, 3000, 0, features=task.features()
+    )
+    rng = np.random.default_rng(5)
+    starts = np.array([task.random_start(rng) for _ in range(100)])
+    assert greedy_success(task, result.coder, result.weights[0], starts, 3000).mean() >= 0.9
+
+
+def test_first_own_success_counts_episodes_after_the_demonstrations():
+    from studio.learning._beyond import _first_own_success
+
+    steps = np.array([[40, 50, 3000, 700, 9], [40, 50, 3000, 3000, 3000]])
+    assert _first_own_success(steps, 2, 3000) == [[2, 700], None]
+    assert _first_own_success(steps, 0, 3000) == [[1, 40], [1, 40]]
