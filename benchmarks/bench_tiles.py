@@ -10,7 +10,7 @@ Measures, in one run (``python benchmarks/bench_tiles.py``, about 20-40 s on one
    random draws). Both runs take exactly the same steps (checked), so the ratio compares equal work.
    Goal: well under one second of kernel time.
 2. The same with full planning (5 model updates per real step), 100 episodes.
-3. The arm task: real steps per CPU second for six joints with the default pair tilings.
+3. The arm task: real steps per CPU second for six joints with the default per-joint tilings.
 """
 
 from __future__ import annotations
@@ -101,7 +101,7 @@ def arm_speed() -> None:
     )
     real = int(result.steps.sum())
     print(
-        f"ArmReach six joints, pair tilings ({result.coder.n_active} active of {result.coder.size:,} rows "
+        f"ArmReach six joints, per-joint tilings ({result.coder.n_active} active of {result.coder.size:,} rows "
         f"x {task.n_actions} actions): {real:,} real steps in {result.cpu_seconds[0]:.2f} s CPU = "
         f"{real / result.cpu_seconds[0] / 1e6:.2f} M steps/s"
     )
