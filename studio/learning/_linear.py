@@ -72,6 +72,7 @@ from ._dynaq import (
     _mix,
     _unit,
     experiment_seed,
+    lower_thread_priority,
 )
 from ._errors import LearningError
 from ._reach import ArmReach, reach_step
@@ -701,6 +702,8 @@ def run_linear_experiments(
         runner = _compiled_experiment if task.code is not None else _python_experiment
 
         def one(e: int) -> None:
+            if task.code is not None:  # the compiled kernel holds no GIL: it may yield the CPU
+                lower_thread_priority(live.niceness)
             start = time.thread_time()
             runner(envs[e], task, agents[e], config, seed, e, demo_starts, demo_actions, live)
             cpu_seconds[e] = time.thread_time() - start

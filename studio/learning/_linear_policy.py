@@ -8,11 +8,11 @@ Format ``teach-studio-tile-policy``, version 1: a ``.policy.npz`` archive
       {"format": "teach-studio-tile-policy", "version": 1,
        "env_id": "TeachStudio/ArmReach-v0",
        "task": {"joints": 6, "step_deg": 2.0, "goal": [...rad, 6...], "position_tolerance": 0.02,
-                "angle_tolerance_deg": 10.0, "shaping": 1.0},      (null for other environments)
+                "angle_tolerance_deg": 10.0, "shaping": 5.0},      (null for other environments)
        "tile_coding": {"tilings": 8, "tiles": 32, "size": null, "low": null, "high": null,
-                       "groups": [[0, 1], [0, 2], ...]},          (the settings as given)
-       "features": {"low": [...], "high": [...], "groups": [[0, 1], ...], "size": 126720,
-                    "hashed": false, "n_active": 120},            (as bound to the observations)
+                       "groups": [[0], [1], ...]},                (the settings as given)
+       "features": {"low": [...], "high": [...], "groups": [[0], [1], ...], "size": 1584,
+                    "hashed": false, "n_active": 48},             (as bound to the observations)
        "n_actions": 12, "config": {... DynaQConfig fields ...},
        "curve": {"mean_steps": [...], "experiments": 2}, "created": "...", "notes": ""}
 
@@ -287,6 +287,18 @@ def load_any_policy(path: str | Path) -> PolicyFile | TilePolicyFile:
     )
 
 
+def sample_times(duration: float, rate_hz: float) -> np.ndarray:
+    """Sample times ``0, 1/rate_hz, ...`` up to ``duration``, ending exactly once at ``duration``.
+
+    The end is appended only when it lies past the last tick by more than a rounding error
+    (188 steps of 0.04 s end 1e-15 s after 376 ticks at 50 Hz: that is the same instant).
+    """
+    times = np.arange(int(np.floor(duration * rate_hz + 1e-9)) + 1) / rate_hz
+    if duration - times[-1] > 1e-9:
+        times = np.append(times, duration)
+    return times
+
+
 def rollout_tile_policy(
     policy: TilePolicyFile,
     start_q: np.ndarray,
@@ -331,10 +343,7 @@ def rollout_tile_policy(
     if np.any(start < task.lower) or np.any(start > task.upper):
         raise LearningError("The start lies outside the joint limits; give angles inside them.")
     path, reached = greedy_rollout(task, policy.coder, policy.weights, start, max_steps)
-    duration = (path.shape[0] - 1) * seconds_per_step
-    times = np.arange(int(np.floor(duration * rate_hz + 1e-9)) + 1) / rate_hz
-    if times[-1] < duration:
-        times = np.append(times, duration)
+    times = sample_times((path.shape[0] - 1) * seconds_per_step, rate_hz)
     knots = np.arange(path.shape[0]) * seconds_per_step
     q = np.tile(np.asarray(task.goal, dtype=np.float64), (times.shape[0], 1))
     for j in range(task.joints):

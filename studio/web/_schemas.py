@@ -52,12 +52,12 @@ class ConfigPublic(BaseModel):
     version: str
     upload_limit_bytes: int
     data_dir: str
+    scene_instance: str | None = None
+    """The id the scene at ``viser_url`` answers at ``/studio-instance`` (None: not checked)."""
     training: RunCreate | None = Field(
         None, description="the train form's defaults: the learning package's, served once"
     )
     planners: list[str] = Field(default_factory=list, description="the planning modes")
-    scene_instance: str | None = None
-    """The id the scene at ``viser_url`` answers at ``/studio-instance`` (None: not checked)."""
 
 
 # ----------------------------------------------------------------------------- source
@@ -269,7 +269,7 @@ class RunCreate(_Body):
     step_deg: float = ArmReach.step_deg
     """Continuous task: joint increment per action, degrees."""
     tilings: int = _REACH_FEATURES.tilings
-    """Continuous task: offset tilings per pair of joints."""
+    """Continuous task: offset tilings of each joint."""
     tiles: int = _REACH_FEATURES.tiles
     """Continuous task: tiles per joint in each tiling."""
     goal_deg: list[float] = Field(default_factory=lambda: list(DEFAULT_GOAL_DEG))

@@ -184,3 +184,20 @@ def test_bad_input_one_sentence_each():
         features=TileCoding(4, 4, low=(-2.4, -3, -0.21, -3), high=(2.4, 3, 0.21, 3)),
     )  # fmt: skip
     assert result.steps.min() >= 1 and not result.compiled
+
+
+def test_rollout_sample_times_end_once_at_the_duration():
+    # 188 steps of 0.04 s end 1e-15 s past the 376th tick at 50 Hz: one sample there, not two
+    from studio.learning._linear_policy import sample_times
+
+    for steps, per_step, rate in (
+        (188, 0.04, 50.0),
+        (10, 0.1, 7.0),
+        (1, 0.04, 110.0),
+        (0, 0.04, 50.0),
+    ):
+        duration = steps * per_step
+        times = sample_times(duration, rate)
+        assert times[0] == 0.0 and np.all(np.diff(times) > 1e-9)
+        assert abs(times[-1] - duration) <= 1e-9  # ends at the duration
+        assert np.all(np.diff(times[:-1]) == pytest.approx(1 / rate))
