@@ -156,6 +156,9 @@ class CapturePublic(BaseModel):
     name: str | None
     seconds: float
     frames: int
+    rejected: int = Field(
+        0, description="frames of another tape width left out of the current or last capture"
+    )
     error: str | None = Field(
         None,
         description="why the last capture stopped by itself (a full disk: what is kept); "

@@ -180,6 +180,7 @@ def test_capture_needs_a_source(client):
         "name": None,
         "seconds": 0.0,
         "frames": 0,
+        "rejected": 0,
         "error": None,
     }
     r = client.post("/api/capture/start", json={})

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from studio.capture import RecordingWriter, read_recording
 from studio.web._pipeline import Pipeline
+from studio.web._schemas import CapturePublic
 from tests.capture.conftest import synthetic_frames
 
 
@@ -24,6 +25,7 @@ def test_frames_of_another_width_are_left_out_and_counted(tmp_path):
     capture = pipeline.capture_status()
     assert capture["active"] and capture["error"] is None
     assert capture["frames"] == 40 and capture["rejected"] == 3
+    assert CapturePublic.model_validate(capture).rejected == 3  # what GET /api/capture answers
     source = pipeline.status()
     assert source["rejected"] == 3 and "3 frames of another tape width" in source["warning"]
     name, written = pipeline.stop_capture()
