@@ -140,8 +140,9 @@ def demonstration_file(given: Path) -> Path:
     for candidate in candidates:
         if candidate.is_file():
             return candidate
+    samples = sorted(p.name.removesuffix(DEMO_SUFFIX) for p in SAMPLES_DIR.glob(f"*{DEMO_SUFFIX}"))
     raise LearningError(
-        f"There is no demonstration file {given}, nor a demonstration {name!r} in {candidates[0].parent}/ or among the samples (sample-reach-1 to 3); check the name or give a path."
+        f"There is no demonstration file {given}, nor a demonstration {name!r} in {candidates[0].parent}/ or among the samples ({', '.join(samples)}); check the name or give a path."
     )
 
 
