@@ -78,7 +78,8 @@ class Studio:
             return ""
 
 
-@pytest.fixture(scope="session")
+# package scope: closed with tests/e2e, so the sync Playwright loop does not outlive it
+@pytest.fixture(scope="package")
 def studio_server(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Studio]:
     """``studio serve`` on random free ports with a fresh data directory."""
     data_dir = tmp_path_factory.mktemp("studio-data")
@@ -131,7 +132,8 @@ def studio_server(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Studio]:
             proc.wait()
 
 
-@pytest.fixture(scope="session")
+# package scope: closed with tests/e2e, so the sync Playwright loop does not outlive it
+@pytest.fixture(scope="package")
 def browser() -> Iterator[Any]:
     """Debian's Chromium, headless, driven by Playwright (never ``playwright install``)."""
     require(
@@ -150,7 +152,8 @@ def browser() -> Iterator[Any]:
             b.close()
 
 
-@pytest.fixture(scope="session")
+# package scope: closed with tests/e2e, so the sync Playwright loop does not outlive it
+@pytest.fixture(scope="package")
 def page(browser: Any, studio_server: Studio) -> Iterator[Any]:
     """The studio page, loaded once for the whole session (stories follow one another)."""
     ARTIFACTS.mkdir(parents=True, exist_ok=True)

@@ -91,5 +91,7 @@ def test_a_continuous_run_trains_from_the_page_is_watched_and_downloaded(
     # leave the form as the stories expect it
     page.select_option("[data-testid='train-task']", "arm-grid")
     page.click("[data-testid='train-defaults']")
+    if demos.count():
+        demos.first.uncheck()
     assert not page.is_visible("[data-testid='train-joints']")
     assert not page.errors  # type: ignore[attr-defined]

@@ -328,7 +328,8 @@ def test_story5_training_curve_updates_live(page: Any, studio_server: Studio) ->
     page.click("[data-testid='train-defaults']")
     _set_train(page, name="e2e-full", planning="full", episodes=500, experiments=8, bins=41)
     page.click("[data-testid='train-start']")
-    row = page.locator("[data-testid='run-row']").first
+    # by name: earlier tests of this package left their own runs in the shared studio
+    row = page.locator("[data-testid='run-row']", has_text="e2e-full").first
     row.wait_for(timeout=T)
     run_id = row.get_attribute("data-id")
     counts: list[int] = []
@@ -354,7 +355,7 @@ def test_story5_training_curve_updates_live(page: Any, studio_server: Studio) ->
     # A second, long run is overlaid on the first; stopping it ends it early.
     _set_train(page, name="e2e-zero", planning="zero", episodes=100000, experiments=20, bins=31)
     page.click("[data-testid='train-start']")
-    second = page.locator("[data-testid='run-row']").first
+    second = page.locator("[data-testid='run-row']", has_text="e2e-zero").first
     assert _wait(lambda: second.get_attribute("data-id") != run_id, 10)
     second_id = second.get_attribute("data-id")
     assert _wait(lambda: page.evaluate("id => window.studio.curvePoints(id)", second_id) > 0, 30)

@@ -275,7 +275,12 @@ def _wait_for_checkpoints(path: Path, proc: subprocess.Popen, count: int) -> lis
     return seen
 
 
-LONG_RUN = ["--planning", "full", "--experiments", "1", "--episodes", "100000", "--no-progress"]
+# Long enough (about a minute even on a quiet machine) that the signal always lands mid-training:
+# with 100 planning updates the 100,000 episodes could end in the ~2 s before the kill.
+LONG_RUN = [
+    "--planning", "full", "--planning-steps", "2000",
+    "--experiments", "1", "--episodes", "100000", "--no-progress",
+]  # fmt: skip
 
 
 def test_kill_9_mid_training_keeps_the_curve_to_the_last_checkpoint(tmp_path):
