@@ -18,6 +18,8 @@ const S = {
   recordings: [],
   demos: [],
   runs: [],
+  sweeps: [], // `studio sweep` summaries (GET /api/sweeps); their trials are runs of a group
+  openSweeps: new Set(), // sweep ids unfolded in the run list (table, figure, runs)
   policies: [],
   curves: new Map(), // run id -> {episodes, mean, std, min, max, count}
   shown: new Set(), // run ids plotted
@@ -709,6 +711,7 @@ function upsertRun(run) {
 async function loadRuns() {
   await guarded("runs-error", async () => {
     S.runs = await api("GET", "/api/runs");
+    S.sweeps = S.runs.some(sweepOf) ? await api("GET", "/api/sweeps") : [];
     if (!S.shownTouched) {
       // By default plot the newest few runs, so a fresh page shows the latest comparison.
       S.shown = new Set(S.runs.slice(0, 4).map((r) => r.id));
@@ -748,34 +751,114 @@ function renderRuns() {
     body.replaceChildren(emptyRow(6, "No runs yet: fill in the form and press Start."));
     return;
   }
-  body.replaceChildren(...S.runs.map((r) => {
-    const total = r.episodes_total || (r.config && r.config.episodes) || 1;
-    const pct = Math.min(100, (100 * (r.episodes_done || 0)) / total);
-    const live = r.status === "running" || r.status === "queued";
-    const c = r.config || {};
-    const title = `planning ${c.planning} n=${c.planning_steps} ε=${c.epsilon} α=${c.alpha} γ=${c.gamma}\n` +
-      `${c.episodes} episodes × ${c.experiments} experiments, ${c.bins} bins, goal ${(c.goal_deg || []).join(", ")}°, seed ${c.seed}` +
-      `${(c.demonstrations || []).length ? `\ndemonstrations: ${c.demonstrations.join(", ")}` : ""}` +
-      `${r.error ? `\n${r.error}` : ""}`;
-    return el("tr", { "data-id": r.id, testid: "run-row", "data-status": r.status, title },
-      el("td", {}, el("input", {
-        type: "checkbox", testid: "run-show", checked: S.shown.has(r.id),
-        onchange: (e) => toggleShown(r.id, e.target.checked),
-      })),
-      el("td", { class: "name" }, el("span", { class: "swatch", style: `background:${runColor(r.id)}` }), runLabel(r)),
-      el("td", {}, el("span", { class: `badge ${r.status}`, testid: "run-status", text: r.status })),
-      el("td", { title: `${r.episodes_done} / ${total} episodes` },
-        el("span", { class: "progress", testid: "run-progress", "data-done": r.episodes_done },
-          el("span", { style: `width:${pct.toFixed(1)}%` }))),
-      el("td", { class: "num", testid: "run-cpu", text: fmtCpu(r.cpu_seconds) }),
-      el("td", { class: "actions" },
-        live ? el("button", { class: "icon", title: "stop", testid: "run-stop", onclick: () => stopRun(r.id) }, "■") : null,
-        !live ? el("button", { class: "icon", title: "delete", testid: "run-delete", onclick: () => deleteRun(r.id) }, "✕") : null,
-      ),
-    );
-  }));
+  const rows = [];
+  const grouped = new Set();
+  for (const r of S.runs) { // a sweep's trials show as one group row, at its newest trial's place
+    const sweep = sweepOf(r);
+    if (!sweep) rows.push(runRow(r));
+    else if (!grouped.has(sweep)) { grouped.add(sweep); rows.push(...sweepRows(sweep)); }
+  }
+  body.replaceChildren(...rows);
   const failed = S.runs.find((r) => r.status === "failed" && r.error && !r._errorShown);
   if (failed) { failed._errorShown = true; showError("runs-error", `${failed.name || failed.id}: ${failed.error}`); }
+}
+
+function runRow(r) {
+  const total = r.episodes_total || (r.config && r.config.episodes) || 1;
+  const pct = Math.min(100, (100 * (r.episodes_done || 0)) / total);
+  const live = r.status === "running" || r.status === "queued";
+  const c = r.config || {};
+  const title = `planning ${c.planning} n=${c.planning_steps} ε=${c.epsilon} α=${c.alpha} γ=${c.gamma}\n` +
+    `${c.episodes} episodes × ${c.experiments} experiments, ${c.bins} bins, goal ${(c.goal_deg || []).join(", ")}°, seed ${c.seed}` +
+    `${(c.demonstrations || []).length ? `\ndemonstrations: ${c.demonstrations.join(", ")}` : ""}` +
+    `${r.error ? `\n${r.error}` : ""}`;
+  return el("tr", { "data-id": r.id, testid: "run-row", "data-status": r.status, title },
+    el("td", {}, el("input", {
+      type: "checkbox", testid: "run-show", checked: S.shown.has(r.id),
+      onchange: (e) => toggleShown(r.id, e.target.checked),
+    })),
+    el("td", { class: "name" }, el("span", { class: "swatch", style: `background:${runColor(r.id)}` }), runLabel(r)),
+    el("td", {}, el("span", { class: `badge ${r.status}`, testid: "run-status", text: r.status })),
+    el("td", { title: `${r.episodes_done} / ${total} episodes` },
+      el("span", { class: "progress", testid: "run-progress", "data-done": r.episodes_done },
+        el("span", { style: `width:${pct.toFixed(1)}%` }))),
+    el("td", { class: "num", testid: "run-cpu", text: fmtCpu(r.cpu_seconds) }),
+    el("td", { class: "actions" },
+      live ? el("button", { class: "icon", title: "stop", testid: "run-stop", onclick: () => stopRun(r.id) }, "■") : null,
+      !live ? el("button", { class: "icon", title: "delete", testid: "run-delete", onclick: () => deleteRun(r.id) }, "✕") : null,
+    ),
+  );
+}
+
+/* ------------------------------------------------------------------ sweeps (`studio sweep`) */
+// A sweep's trials are ordinary runs (origin "sweep", group = the sweep's id): the list shows them
+// as one group row. Ticking it plots all of them; ▸ unfolds the summary figure, its table (the
+// columns that matter; sweep.csv has them all), downloads, and the trials' own rows.
+const SWEEP_TABLE_COLUMNS = ["trial", "seed", "status", "episodes_done", "cpu_seconds", "wall_seconds"];
+
+function sweepOf(r) {
+  return r.origin === "sweep" && r.group ? r.group : null;
+}
+
+function toggleSweep(id, on) {
+  for (const r of S.runs) if (sweepOf(r) === id) toggleShown(r.id, on);
+  renderRuns();
+}
+
+function foldSweep(id) {
+  if (S.openSweeps.has(id)) S.openSweeps.delete(id);
+  else S.openSweeps.add(id);
+  renderRuns();
+}
+
+function sweepRows(id) {
+  const runs = S.runs.filter((r) => sweepOf(r) === id);
+  const info = S.sweeps.find((s) => s.id === id);
+  const open = S.openSweeps.has(id);
+  const trials = info ? info.trials : runs.length;
+  const finished = info ? info.finished : runs.filter((r) => r.status === "done").length;
+  const status = info ? info.status : runs.some((r) => r.status === "running") ? "running" : "done";
+  const cpu = runs.reduce((sum, r) => sum + (r.cpu_seconds || 0), 0);
+  const about = info ? ` · ${info.swept.join(" × ")} · ${info.metric}` : "";
+  const head = el("tr", { class: "sweep", "data-id": id, testid: "sweep-row", "data-status": status,
+    title: `sweep ${id}: ${finished} of ${trials} trials finished; tick to plot every trial` },
+    el("td", {}, el("input", {
+      type: "checkbox", testid: "sweep-show", checked: runs.length > 0 && runs.every((r) => S.shown.has(r.id)),
+      onchange: (e) => toggleSweep(id, e.target.checked),
+    })),
+    el("td", { class: "name" },
+      el("button", { class: "icon", testid: "sweep-open", title: open ? "fold" : "unfold: summary, figure and trials",
+        onclick: () => foldSweep(id) }, open ? "▾" : "▸"),
+      `sweep ${id}${about} (${runs.length} runs)`),
+    el("td", {}, el("span", { class: `badge ${status === "interrupted" ? "stopped" : status}`, testid: "sweep-status", text: status })),
+    el("td", { title: `${finished} / ${trials} trials` },
+      el("span", { class: "progress", testid: "sweep-progress", "data-done": finished },
+        el("span", { style: `width:${(100 * finished / Math.max(trials, 1)).toFixed(1)}%` }))),
+    el("td", { class: "num", text: fmtCpu(cpu) }),
+    el("td", {}),
+  );
+  return open ? [head, sweepDetail(id, info), ...runs.map(runRow)] : [head];
+}
+
+function sweepDetail(id, info) {
+  const base = `/api/sweeps/${enc(id)}`;
+  const get = (path, name) => download(`${base}/${path}`, `${id}-${name}`, "runs-error");
+  let table = el("div", { class: "muted", text: "No summary yet." });
+  if (info && info.rows.length) {
+    const cols = info.columns.filter((c) => SWEEP_TABLE_COLUMNS.includes(c) || info.swept.includes(c) || c === info.metric);
+    table = el("table", { class: "list", testid: "sweep-table" },
+      el("thead", {}, el("tr", {}, ...cols.map((c) => el("th", { text: c })))),
+      el("tbody", {}, ...info.rows.map((row) => el("tr", {}, ...cols.map((c) => el("td", { text: row[c] }))))));
+  }
+  const version = info ? `${info.status}-${info.finished}` : "0";
+  return el("tr", { class: "sweep-detail", "data-id": id, testid: "sweep-detail" }, el("td", { colspan: 6 },
+    el("img", { src: `${base}/figure.png?v=${enc(version)}`, testid: "sweep-figure", style: "max-width:100%",
+      alt: info ? `${info.metric} against ${info.swept[0]}, mean and standard error over seeds` : "sweep figure" }),
+    el("div", { class: "row" },
+      el("button", { type: "button", testid: "sweep-csv", onclick: () => get("sweep.csv", "sweep.csv") }, "sweep.csv"),
+      el("button", { type: "button", testid: "sweep-png", onclick: () => get("figure.png", "sweep.png") }, "Figure PNG"),
+      el("button", { type: "button", testid: "sweep-svg", onclick: () => get("figure.svg", "sweep.svg") }, "Figure SVG")),
+    el("div", { style: "overflow-x:auto" }, table)));
 }
 
 function toggleShown(id, on) {
