@@ -53,6 +53,7 @@ from ._policy import (
     MAX_NPZ_BYTES,
     BoundedNpz,
     PolicyFile,
+    curve_header,
     load_policy,
 )
 from ._reach import ArmReach
@@ -116,10 +117,7 @@ class TilePolicyFile:
             },
             "n_actions": self.n_actions,
             "config": self.config.to_dict(),
-            "curve": {
-                "mean_steps": [None if not np.isfinite(x) else float(x) for x in self.mean_steps],
-                "experiments": int(self.experiments),
-            },
+            "curve": curve_header(self.mean_steps, self.experiments),
             "created": self.created,
             "notes": self.notes,
         }

@@ -262,13 +262,21 @@ class PolicyFile:
             "n_states": self.grid.n_states,
             "n_actions": self.grid.n_actions,
             "config": self.config.to_dict(),
-            "curve": {
-                "mean_steps": [None if not np.isfinite(x) else float(x) for x in self.mean_steps],
-                "experiments": int(self.experiments),
-            },
+            "curve": curve_header(self.mean_steps, self.experiments),
             "created": self.created,
             "notes": self.notes,
         }
+
+
+def curve_header(mean_steps: np.ndarray, experiments: int) -> dict[str, Any]:
+    """A policy header's ``curve``: the learning curve it came from, JSON-ready (NaN as null).
+
+    Shared by the tabular and the tile-coded policy formats.
+    """
+    return {
+        "mean_steps": [None if not np.isfinite(x) else float(x) for x in mean_steps],
+        "experiments": int(experiments),
+    }
 
 
 def greedy_actions(q: np.ndarray) -> np.ndarray:

@@ -16,7 +16,7 @@ from typing import Any
 
 from pydantic import BaseModel, Field
 
-from .._errors import StudioError
+from studio import StudioError
 
 
 class WebError(StudioError):

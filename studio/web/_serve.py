@@ -22,7 +22,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 from urllib.parse import urlsplit
 
-from .._errors import StudioError
+from studio import StudioError
+
 from ._guard import SiteRule
 from ._settings import Settings
 
