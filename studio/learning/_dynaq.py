@@ -570,6 +570,47 @@ def warm_up() -> float:
     return time.perf_counter() - start
 
 
+def check_run_arguments(
+    config: object,
+    experiments: object,
+    episodes: object,
+    seed: object,
+    workers: object,
+    live: object,
+    n_states: int = 1,
+    n_actions: int = 1,
+) -> tuple[int, int, LiveProgress]:
+    """Check the arguments every learner's ``run_experiments`` shares, before any work starts.
+
+    Returns:
+        ``(seed, workers, live)``: the seed as a plain int, the thread count (``None``: one per
+        core), and the progress to fill (a new one when ``live`` is None).
+
+    Raises:
+        ConfigError, LearningError: one sentence naming the bad argument and the fix.
+    """
+    if not isinstance(config, DynaQConfig):
+        raise LearningError(f"config is a {type(config).__name__}; give a DynaQConfig.")
+    check_budget(experiments, episodes, n_states, n_actions)
+    if not isinstance(seed, int | np.integer) or isinstance(seed, bool) or not 0 <= seed < 2**63:
+        raise LearningError(f"seed is {seed!r}; give a whole number from 0 to 2**63 - 1.")
+    if workers is None:
+        workers = os.cpu_count() or 1
+    if not isinstance(workers, int) or isinstance(workers, bool) or workers < 1:
+        raise LearningError(f"workers is {workers!r}; give a whole number of threads, at least 1.")
+    if live is None:
+        live = LiveProgress(experiments, episodes)  # type: ignore[arg-type]
+    elif not isinstance(live, LiveProgress) or live.steps.shape != (experiments, episodes):
+        raise LearningError(
+            f"live follows a run of shape {getattr(getattr(live, 'steps', None), 'shape', None)}; create LiveProgress({experiments}, {episodes}) for this run."
+        )
+    if live.completed:
+        raise LearningError(
+            "live already holds a finished run; create a new LiveProgress for each run."
+        )
+    return int(seed), workers, live
+
+
 def run_experiments(
     mdp: TabularMDP,
     config: DynaQConfig,
@@ -620,26 +661,9 @@ def run_experiments(
         raise LearningError(
             f"mdp is a {type(mdp).__name__}; give a TabularMDP (for example ArmGrid().mdp()), a Gymnasium environment id or a zero-argument callable returning an environment."
         )
-    if not isinstance(config, DynaQConfig):
-        raise LearningError(f"config is a {type(config).__name__}; give a DynaQConfig.")
-    check_budget(experiments, episodes, mdp.n_states, mdp.n_actions)
-    if not isinstance(seed, int | np.integer) or isinstance(seed, bool) or not 0 <= seed < 2**63:
-        raise LearningError(f"seed is {seed!r}; give a whole number from 0 to 2**63 - 1.")
-    seed = int(seed)
-    if workers is None:
-        workers = os.cpu_count() or 1
-    if not isinstance(workers, int) or isinstance(workers, bool) or workers < 1:
-        raise LearningError(f"workers is {workers!r}; give a whole number of threads, at least 1.")
-    if live is None:
-        live = LiveProgress(experiments, episodes)
-    elif not isinstance(live, LiveProgress) or live.steps.shape != (experiments, episodes):
-        raise LearningError(
-            f"live follows a run of shape {getattr(getattr(live, 'steps', None), 'shape', None)}; create LiveProgress({experiments}, {episodes}) for this run."
-        )
-    if live.completed:
-        raise LearningError(
-            "live already holds a finished run; create a new LiveProgress for each run."
-        )
+    seed, workers, live = check_run_arguments(
+        config, experiments, episodes, seed, workers, live, mdp.n_states, mdp.n_actions
+    )
     demo_actions, demo_offsets, demo_starts = demonstration_actions(mdp, demonstrations or [])
 
     q = np.zeros((experiments, mdp.n_states, mdp.n_actions), np.float64)

@@ -50,7 +50,6 @@ this file (or delete ``__pycache__/_linear*.nb*``) so the kernels recompile.
 from __future__ import annotations
 
 import math
-import os
 import time
 from collections import namedtuple
 from collections.abc import Callable, Sequence
@@ -61,7 +60,7 @@ from typing import Any
 import numpy as np
 from numba import njit
 
-from ._config import MAX_Q_ENTRIES, PLANNERS, DynaQConfig, check_budget
+from ._config import MAX_Q_ENTRIES, PLANNERS, DynaQConfig
 from ._dynaq import (
     _GOLDEN,
     ExperimentResult,
@@ -71,6 +70,7 @@ from ._dynaq import (
     _heap_push,
     _mix,
     _unit,
+    check_run_arguments,
     experiment_seed,
     lower_thread_priority,
 )
@@ -669,22 +669,7 @@ def run_linear_experiments(
         raise LearningError(
             f"env is a {type(env).__name__}; give a TabularMDP, a Gymnasium id or a zero-argument callable returning an environment."
         )
-    if not isinstance(config, DynaQConfig):
-        raise LearningError(f"config is a {type(config).__name__}; give a DynaQConfig.")
-    check_budget(experiments, episodes)
-    if not isinstance(seed, int | np.integer) or isinstance(seed, bool) or not 0 <= seed < 2**63:
-        raise LearningError(f"seed is {seed!r}; give a whole number from 0 to 2**63 - 1.")
-    seed = int(seed)
-    if workers is None:
-        workers = os.cpu_count() or 1
-    if not isinstance(workers, int) or isinstance(workers, bool) or workers < 1:
-        raise LearningError(f"workers is {workers!r}; give a whole number of threads, at least 1.")
-    if live is None:
-        live = LiveProgress(experiments, episodes)
-    elif not isinstance(live, LiveProgress) or live.steps.shape != (experiments, episodes):
-        raise LearningError(
-            f"live follows a run of shape {getattr(getattr(live, 'steps', None), 'shape', None)}; create LiveProgress({experiments}, {episodes}) for this run."
-        )
+    seed, workers, live = check_run_arguments(config, experiments, episodes, seed, workers, live)
     envs = [_make_env(env, e) for e in range(experiments)]
     try:
         task = _inspect(envs[0], config)
