@@ -7,6 +7,7 @@ turns such a skip into a failure there.
 from __future__ import annotations
 
 import os
+import socket
 
 import pytest
 
@@ -20,3 +21,10 @@ def require(condition: bool, reason: str) -> None:
     if IN_CI:
         pytest.fail(f"{reason} (required in CI)")
     pytest.skip(reason)
+
+
+def free_port() -> int:
+    """A TCP port on loopback that nobody listens on now (the OS picks it)."""
+    with socket.socket() as sock:
+        sock.bind(("127.0.0.1", 0))
+        return sock.getsockname()[1]

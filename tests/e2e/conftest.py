@@ -10,7 +10,6 @@ from __future__ import annotations
 import json
 import os
 import shutil
-import socket
 import subprocess
 import sys
 import time
@@ -23,7 +22,7 @@ from typing import Any
 import pytest
 
 from studio.samples import SAMPLES_DIR
-from tests.conftest import require
+from tests.conftest import free_port, require
 
 REPO = Path(__file__).resolve().parents[2]
 ARTIFACTS = REPO / "test-artifacts" / "e2e"
@@ -40,13 +39,6 @@ CHROMIUM_FLAGS = [
     "--enable-unsafe-swiftshader",
 ]
 SERVER_START_TIMEOUT_S = 90.0
-
-
-def free_port() -> int:
-    """A TCP port nobody listens on now (the OS picks it)."""
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
 
 
 class Studio:

@@ -31,6 +31,7 @@ from studio.learning._sweep import (
     trial_records,
     trial_run_path,
 )
+from tests.conftest import free_port as _free_port
 from tests.conftest import require
 
 try:
@@ -414,12 +415,6 @@ def test_a_scheduler_sweep_ends_every_trial_done_or_early_stopped(
 
 
 # ----------------------------------------------------------------------------- two Ray nodes
-
-
-def _free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
 
 
 def test_a_sweep_on_a_two_node_cluster_uses_both_nodes(tmp_path: Path) -> None:

@@ -4,7 +4,6 @@ updates never block; playback animates, holds and hands back to live; errors are
 from __future__ import annotations
 
 import logging
-import socket
 import threading
 import time
 
@@ -34,18 +33,13 @@ from studio.web._scene import (
     pose_at,
     wxyz_of,
 )
+from tests.conftest import free_port as _free_port
 
 PLACEMENT_TOLERANCE_M = 0.16
 """How far a Puma560 link mesh's bounding box may lie from its DH frame's origin. The largest
 gap is the upper arm's: its casting sits beside the shoulder axis by the d3 = 0.150 m offset."""
 SCENE_ASPECTS = (1.2, 1.6, 2.0, 2.4)
 """Width/height of the page's scene pane, from a narrow window to a wide one."""
-
-
-def _free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
 
 
 def _wait_until(cond, timeout: float = 5.0) -> bool:

@@ -5,8 +5,6 @@ clients against a real guarded viser server."""
 from __future__ import annotations
 
 import asyncio
-import socket
-import time
 import urllib.error
 import urllib.request
 
@@ -18,23 +16,10 @@ from websockets.exceptions import InvalidStatus
 
 from studio.web import Settings
 from studio.web._serve import INSTANCE_PATH, TOKEN_COOKIE, SceneGuard, start_scene
+from tests.conftest import free_port as _free_port
+from tests.web.conftest import wait_for
 
 SUBPROTOCOL = [f"viser-v{viser.__version__}"]
-
-
-def _free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
-def _wait_until(cond, timeout: float = 5.0) -> bool:
-    end = time.monotonic() + timeout
-    while time.monotonic() < end:
-        if cond():
-            return True
-        time.sleep(0.01)
-    return cond()
 
 
 @pytest.fixture(scope="module", params=[None, "s3cret-token"], ids=["loopback", "token"])
@@ -88,7 +73,7 @@ def test_a_share_request_opens_no_tunnel(studio_scene):
         async with _connect(port, f"http://localhost:{port}", settings.token) as ws:
             await ws.send(msgspec.msgpack.encode({"type": "ShareUrlRequest"}))
             assert await asyncio.to_thread(
-                _wait_until, lambda: guard.share_requests_refused >= 1, 5.0
+                wait_for, lambda: guard.share_requests_refused >= 1, 5.0, 0.01
             )
 
     asyncio.run(ask())

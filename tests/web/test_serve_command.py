@@ -14,6 +14,7 @@ import pytest
 
 import studio.web
 from studio.cli import main
+from tests.conftest import free_port
 
 
 @pytest.fixture
@@ -74,12 +75,6 @@ def test_a_recording_source_by_name_or_path(served, tmp_path):
     other.write_text("x")
     assert main(["serve", "--data-dir", str(tmp_path), "--source", str(other)]) == 0
     assert served[-1][0].source == str(other)
-
-
-def free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
 
 
 def test_the_real_server_starts_answers_and_stops(tmp_path):
