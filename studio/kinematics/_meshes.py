@@ -19,7 +19,9 @@ several times, so the scene stays smooth under software WebGL.
 
 from __future__ import annotations
 
+import copy
 import importlib.util
+import threading
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -173,38 +175,31 @@ def _human_color(link: str) -> tuple[float, float, float]:
 class HumanBody:
     """Gepetto's whole human, posed with one arm following ``q_human`` and the rest at neutral.
 
+    The studio has one tape, so one arm follows the fit and the other rests (hangs at neutral).
+    :meth:`with_side` gives the same body taped on the other arm without loading the meshes
+    again: the meshes are shared, only the taped arm's joints and the arm base frame differ.
+
     Args:
         side: the taped arm (``"right"`` or ``"left"``); poses are in its arm base frame.
         config: simplification (default :class:`MeshConfig`).
 
     Attributes:
-        parts: the meshes, each attached to a ``human.urdf`` link.
+        side: the taped arm.
+        parts: the meshes, each attached to a ``human.urdf`` link (shared by both sides).
         moving: indices into ``parts`` of the meshes that move with the taped arm.
         floor_z: height of the lowest vertex in the neutral pose (arm base frame, m): the body
             stands on a floor at this height.
-        model, data: the full Pinocchio model (immutable) and its scratch data (not thread-safe).
+        model, data: the full Pinocchio model (immutable) and its scratch data (used under the
+            body's own lock, so one body may be posed from several threads).
     """
 
     def __init__(self, side: str = "right", config: MeshConfig | None = None) -> None:
-        if side not in ("right", "left"):
-            raise KinematicsError(f'side must be "right" or "left"; got {side!r}.')
+        _check_side(side)
         import yourdfpy
 
         config = config if config is not None else MeshConfig()
         urdf = find_human_urdf()
-        self.side = side
         self.model = pin.buildModelFromUrdf(str(urdf))
-        self.data = self.model.createData()
-        self._q0 = pin.neutral(self.model)
-        joints = [self.model.getJointId(f"{side}_{name}") for name in ARM_JOINTS]
-        self._arm_idx_q = np.array([self.model.joints[j].idx_q for j in joints])
-        # The arm base frame: Z up, origin at the taped side's shoulder at neutral (as HumanArm).
-        pin.forwardKinematics(self.model, self.data, self._q0)
-        shoulder = self.data.oMi[joints[0]].translation.copy()
-        self._baseMurdf = np.eye(4)
-        self._baseMurdf[:3, :3] = YUP_TO_ZUP
-        self._baseMurdf[:3, 3] = -YUP_TO_ZUP @ shoulder
-
         root = urdf.parents[1]  # .../robots/human_description
         description = yourdfpy.URDF.load(str(urdf), load_meshes=False, build_scene_graph=False)
         parts: list[MeshPart] = []
@@ -226,10 +221,42 @@ class HumanBody:
                 frame_ids.append(self.model.getFrameId(link.name, pin.FrameType.BODY))
         self.parts = parts
         self._frame_ids = frame_ids
+        self._tape_on(side)
+
+    def with_side(self, side: str) -> HumanBody:
+        """The same body with the tape on ``side``'s arm (this body itself when already so).
+
+        Shares the meshes and the model; only the taped arm, its base frame and the scratch data
+        are new, so switching arms costs milliseconds rather than reloading the meshes.
+
+        Raises:
+            KinematicsError: ``side`` is neither ``"right"`` nor ``"left"``.
+        """
+        _check_side(side)
+        if side == self.side:
+            return self
+        other = copy.copy(self)
+        other._tape_on(side)
+        return other
+
+    def _tape_on(self, side: str) -> None:
+        """Make ``side``'s arm the taped one: its joints, base frame, moving meshes and floor."""
+        self.side = side
+        self.data = self.model.createData()
+        self._lock = threading.Lock()
+        self._q0 = pin.neutral(self.model)
+        joints = [self.model.getJointId(f"{side}_{name}") for name in ARM_JOINTS]
+        self._arm_idx_q = np.array([self.model.joints[j].idx_q for j in joints])
+        # The arm base frame: Z up, origin at the taped side's shoulder at neutral (as HumanArm).
+        pin.forwardKinematics(self.model, self.data, self._q0)
+        shoulder = self.data.oMi[joints[0]].translation.copy()
+        self._baseMurdf = np.eye(4)
+        self._baseMurdf[:3, :3] = YUP_TO_ZUP
+        self._baseMurdf[:3, 3] = -YUP_TO_ZUP @ shoulder
         first_arm_joint = joints[0]
         self.moving = [
             i
-            for i, fid in enumerate(frame_ids)
+            for i, fid in enumerate(self._frame_ids)
             if self._below(self.model.frames[fid].parentJoint, first_arm_joint)
         ]
         rest = self.poses(None)
@@ -261,16 +288,26 @@ class HumanBody:
             q_human: the taped arm's seven joints (rad), or None for the neutral pose.
         """
         q = self.full_q(q_human)
-        pin.framesForwardKinematics(self.model, self.data, q)
         out = np.empty((len(self.parts), 4, 4))
-        for k, fid in enumerate(self._frame_ids):
-            out[k] = self._baseMurdf @ self.data.oMf[fid].homogeneous
+        with self._lock:
+            pin.framesForwardKinematics(self.model, self.data, q)
+            for k, fid in enumerate(self._frame_ids):
+                out[k] = self._baseMurdf @ self.data.oMf[fid].homogeneous
         return out
 
     def link_pose(self, link: str, q_human: np.ndarray | None) -> np.ndarray:
         """The pose (4x4, arm base frame) of a ``human.urdf`` link."""
-        pin.framesForwardKinematics(self.model, self.data, self.full_q(q_human))
         fid = self.model.getFrameId(link, pin.FrameType.BODY)
         if fid >= len(self.model.frames):
             raise KinematicsError(f"human.urdf has no link {link!r}; give a link of the model.")
-        return self._baseMurdf @ self.data.oMf[fid].homogeneous
+        q = self.full_q(q_human)
+        with self._lock:
+            pin.framesForwardKinematics(self.model, self.data, q)
+            return self._baseMurdf @ self.data.oMf[fid].homogeneous
+
+
+def _check_side(side: object) -> None:
+    if side not in ("right", "left"):
+        raise KinematicsError(
+            f'The taped arm must be "right" or "left"; got {side!r}, so give one of those.'
+        )

@@ -397,6 +397,8 @@ class Pipeline:
         if tracker is None:
             config = TrackerConfig(tape=self.tape_config(), mode=self._mode, mirror=self._mirror)
             tracker = ArmTracker(config)  # the arm the tape is strapped to
+            if self.scene is not None:  # and the scene draws that arm following, the tape on it
+                self.scene.set_side(config.tape.side)
             self._tracker = tracker
         return tracker
 

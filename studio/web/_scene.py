@@ -5,6 +5,11 @@ from ``human.urdf``, whose taped arm follows the fit, and the Toolbox's Puma560 
 DH frames. They face each other as in front of a mirror: with mirrored retargeting the robot
 moves as the operator's reflection.
 
+The studio reads one tape, so the other arm rests: it hangs at its neutral pose (a second tape is
+not a source here, so no second arm follows anything). The taped arm is the current source's
+(``TapeConfig.side``); :meth:`StudioScene.set_side` moves the tape to the other arm when a source
+taped there starts, and the tape is drawn along that arm's sleeve.
+
 The live pipeline runs at the tape's 110 Hz; a browser's websocket may be far slower. So
 :meth:`StudioScene.update_live` only stores the latest values (latest wins) and a scene thread
 pushes them to viser at a bounded rate, one batched message per update. What the robot shows at
@@ -201,14 +206,37 @@ def camera_projection(
     return np.stack([x, y], axis=1), depth
 
 
+@dataclass(frozen=True, eq=False)
+class _Operator:
+    """The operator as taped now: the body (taped arm) and where its arm base frame stands.
+
+    Replaced whole by :meth:`StudioScene.set_side` (under the scene's lock), so a reader that
+    took one snapshot poses, places and draws the tape with one consistent arm.
+
+    Attributes:
+        body: the meshes, posed with the taped arm following the fit.
+        worldMbase: world pose of the taped arm's base frame (4x4).
+        version: increases with each switch; the scene thread redraws the operator when it
+            differs from the version it drew.
+    """
+
+    body: HumanBody
+    worldMbase: np.ndarray
+    version: int
+
+
 class StudioScene:
     """The studio's viser scene, fed by the live pipeline and by playbacks.
+
+    The operator wears one tape: the taped arm follows the fit, the other arm rests (there is no
+    second tape to follow). :meth:`set_side` moves the tape to the other arm at run time.
 
     Args:
         server: the viser server to draw into.
         robot: the Puma560 model (a fresh one by default).
-        side: which arm the operator wears the tape on.
-        body: the operator's meshes (``HumanBody(side)`` by default).
+        side: which arm the operator wears the tape on (ignored when ``body`` is given).
+        body: the operator's meshes (``HumanBody(side)`` by default); its ``side`` is the taped
+            arm.
         layout: placement, camera, colours and the push rate.
     """
 
@@ -224,10 +252,11 @@ class StudioScene:
         self.server = server
         self.layout = layout if layout is not None else SceneLayout()
         self.robot = robot if robot is not None else Puma560()
-        self.body = body if body is not None else HumanBody(side, self.layout.mesh)
-        self.side = self.body.side
+        body = body if body is not None else HumanBody(side, self.layout.mesh)
+        self._bodies = {body.side: body}  # one per taped arm, sharing the meshes
+        self._operator = _Operator(body, self._operator_placement(body), 0)
+        self._switch_lock = threading.Lock()  # one set_side at a time
         self._robot_parts = puma560_meshes(self.layout.mesh)
-        self._worldMbase = self._operator_placement()
 
         # Inputs, written by any thread under _lock; the loop reads a snapshot.
         self._lock = threading.Lock()
@@ -237,6 +266,7 @@ class StudioScene:
         # Published by the loop (under _lock) for readers.
         self._q_robot_shown = np.array(self.robot.qz, dtype=float)
         self._q_human_shown = np.zeros(7)
+        self._side_shown = body.side
         self._shown_playback: Playback | None = None
         self._shown_mode = Mode.LIVE
         self.pushes = 0  # scene updates sent, for tests and benchmarks
@@ -252,22 +282,23 @@ class StudioScene:
 
     # ------------------------------------------------------------------ building
 
-    def _operator_placement(self) -> np.ndarray:
-        """World pose of the taped arm's base frame: the body upright on the floor, facing -X."""
+    def _operator_placement(self, body: HumanBody) -> np.ndarray:
+        """World pose of the taped arm's base frame: the body upright on the floor, facing -X.
+
+        The body's middle and feet are placed, not its shoulder, so the resting body stands on
+        the same spot whichever arm is taped.
+        """
         lay = self.layout
-        rest = self.body.poses(None)
+        rest = body.poses(None)
         pts = np.concatenate(
-            [
-                p.vertices @ m[:3, :3].T + m[:3, 3]
-                for p, m in zip(self.body.parts, rest, strict=True)
-            ]
+            [p.vertices @ m[:3, :3].T + m[:3, 3] for p, m in zip(body.parts, rest, strict=True)]
         )
         centre = (pts.min(axis=0) + pts.max(axis=0)) / 2
         rotation = vtf.SO3.from_z_radians(lay.operator_yaw).as_matrix()
         out = np.eye(4)
         out[:3, :3] = rotation
         target = np.array([lay.operator_position[0], lay.operator_position[1], 0.0])
-        out[:3, 3] = target - rotation @ np.array([centre[0], centre[1], self.body.floor_z])
+        out[:3, 3] = target - rotation @ np.array([centre[0], centre[1], body.floor_z])
         return out
 
     def _build(self) -> None:
@@ -373,9 +404,10 @@ class StudioScene:
 
     def _add_operator(self) -> list[viser.MeshHandle]:
         s = self.server.scene
-        poses = self._operator_poses(None)
+        operator = self._operator
+        poses = _operator_poses(operator, None)
         handles = []
-        for part, pose in zip(self.body.parts, poses, strict=True):
+        for part, pose in zip(operator.body.parts, poses, strict=True):
             handles.append(
                 s.add_mesh_simple(
                     f"/operator/{part.name}",
@@ -392,25 +424,36 @@ class StudioScene:
 
     # ------------------------------------------------------------------ geometry
 
-    def _operator_poses(self, q_human: np.ndarray | None) -> np.ndarray:
-        return self._worldMbase @ self.body.poses(q_human)
+    @property
+    def body(self) -> HumanBody:
+        """The operator's meshes, with the tape on the current taped arm."""
+        with self._lock:
+            return self._operator.body
+
+    @property
+    def side(self) -> str:
+        """The taped arm (``"right"`` or ``"left"``): the one following the fit."""
+        return self.body.side
 
     def to_world(self, p: np.ndarray) -> np.ndarray:
         """Points ``(..., 3)`` in the taped arm's base frame (the tape's frame) to world points."""
-        m = self._worldMbase
-        return np.asarray(p, dtype=float) @ m[:3, :3].T + m[:3, 3]
+        with self._lock:
+            operator = self._operator
+        return _to_world(operator, p)
 
     def tape_on_sleeve(self, tape: np.ndarray, q_human: np.ndarray) -> np.ndarray:
-        """Tape points (arm base frame) lifted off the arm's axis onto its surface.
+        """Tape points (arm base frame) lifted off the taped arm's axis onto its surface.
 
         The fit models the tape along the bones; drawn there it would hide inside the arm's
         mesh. Each point closer to the upper arm's (forearm's) axis than ``tape_lift_m`` is
         pushed out radially to that distance; points away from the arm (on the back) stay.
         """
-        side = self.side
+        return self._on_sleeve(self.body, tape, q_human)
+
+    def _on_sleeve(self, body: HumanBody, tape: np.ndarray, q_human: np.ndarray) -> np.ndarray:
         axis = np.stack(
             [
-                self.body.link_pose(f"{side}_{link}", q_human)[:3, 3]
+                body.link_pose(f"{body.side}_{link}", q_human)[:3, 3]
                 for link in ("upperarm", "lowerarm", "hand")
             ]
         )
@@ -446,8 +489,10 @@ class StudioScene:
 
     def operator_mesh_points(self, q_human: np.ndarray | None) -> list[np.ndarray]:
         """World vertices of each operator mesh with the taped arm at ``q_human``."""
-        poses = self._operator_poses(q_human)
-        return [_placed(p, m) for p, m in zip(self.body.parts, poses, strict=True)]
+        with self._lock:
+            operator = self._operator
+        poses = _operator_poses(operator, q_human)
+        return [_placed(p, m) for p, m in zip(operator.body.parts, poses, strict=True)]
 
     # ------------------------------------------------------------------ pushing
 
@@ -459,17 +504,28 @@ class StudioScene:
             h.position = pose[:3, 3]
             h.wxyz = wxyz
 
-    def _push_operator(self, q_human: np.ndarray, tape: np.ndarray | None) -> None:
-        poses = self._operator_poses(q_human)
-        moving = self.body.moving
+    def _push_operator(
+        self,
+        operator: _Operator,
+        q_human: np.ndarray | None,
+        tape: np.ndarray | None,
+        whole: bool = False,
+    ) -> None:
+        """Pose the taped arm's meshes (every mesh when ``whole``: the taped arm changed, and
+        the tape goes until the new arm's first tape) and draw the tape on its sleeve."""
+        poses = _operator_poses(operator, q_human)
+        moving = list(range(len(poses))) if whole else operator.body.moving
         quats = wxyz_of(poses[moving, :3, :3])
         for i, wxyz in zip(moving, quats, strict=True):
             self._operator_handles[i].position = poses[i, :3, 3]
             self._operator_handles[i].wxyz = wxyz
-        if tape is not None and len(tape) >= 2:
-            self._tape.points = self.to_world(self.tape_on_sleeve(tape, q_human)).astype(np.float32)
+        if q_human is not None and tape is not None and len(tape) >= 2:
+            sleeve = self._on_sleeve(operator.body, tape, q_human)
+            self._tape.points = _to_world(operator, sleeve).astype(np.float32)
             if not self._tape.visible:
                 self._tape.visible = True
+        elif whole and self._tape.visible:
+            self._tape.visible = False
 
     def _push_trace(self, playback: Playback, upto: int) -> None:
         tool = playback.tool[: upto + 1]
@@ -514,17 +570,24 @@ class StudioScene:
     def _tick(self, now: float, shown: _Shown) -> None:
         with self._lock:
             live, version, playback = self._live, self._live_version, self._playback
+            operator = self._operator
         pose = pose_at(
             now, None if live is None else live[1], playback, self.layout.playback_hold_s
         )
         new_live = live is not None and version != shown.live_version
+        operator_changed = operator.version != shown.operator_version
         robot_changed = pose.q_robot is not None and (
             shown.q_robot is None or not np.array_equal(pose.q_robot, shown.q_robot)
         )
         playback_changed = playback is not shown.playback
         trace_grows = pose.trace_upto > shown.trace_upto and playback is not None
         if not (
-            new_live or robot_changed or playback_changed or trace_grows or pose.mode != shown.mode
+            new_live
+            or operator_changed
+            or robot_changed
+            or playback_changed
+            or trace_grows
+            or pose.mode != shown.mode
         ):
             return
         with self.server.atomic():
@@ -532,7 +595,9 @@ class StudioScene:
                 self._hide_trace()
                 shown.trace_upto = -1
             if new_live and live is not None:
-                self._push_operator(live[0], live[2])
+                self._push_operator(operator, live[0], live[2], whole=operator_changed)
+            elif operator_changed:
+                self._push_operator(operator, None, None, whole=True)
             if robot_changed and pose.q_robot is not None:
                 self._push_robot(self._robot_handles, pose.q_robot)
             if playback is not None and pose.trace_upto > shown.trace_upto:
@@ -542,6 +607,7 @@ class StudioScene:
         # is what the operator is waiting to see.
         self.server.flush()
         shown.live_version = version
+        shown.operator_version = operator.version
         shown.playback = playback
         shown.mode = pose.mode
         if pose.q_robot is not None:
@@ -549,6 +615,9 @@ class StudioScene:
         with self._lock:
             if pose.q_robot is not None:
                 self._q_robot_shown = shown.q_robot.copy()
+            if operator_changed:
+                self._side_shown = operator.body.side
+                self._q_human_shown = np.zeros(len(self._q_human_shown))  # the new arm rests
             if new_live and live is not None:
                 self._q_human_shown = live[0].copy()
             self._shown_playback = playback
@@ -580,6 +649,39 @@ class StudioScene:
             self._live = value
             self._live_version += 1
         self._wake.set()
+
+    def set_side(self, side: str) -> None:
+        """Put the tape on the operator's ``side`` arm: it follows the fit, the other rests.
+
+        Called when a source taped on that arm starts (``TapeConfig.side``). Only the operator
+        changes: the same meshes, posed from the new arm's base frame. A live pose given before
+        the switch belongs to the other arm and is dropped; the next :meth:`update_live` poses
+        the new arm. Returns at once; the scene thread redraws the operator (at rest, the tape
+        hidden until the new arm's first tape). Nothing happens when ``side`` is already taped.
+
+        Raises:
+            KinematicsError: ``side`` is neither ``"right"`` nor ``"left"``.
+        """
+        with self._switch_lock:
+            with self._lock:
+                current = self._operator
+            body = self._bodies.get(side) if isinstance(side, str) else None
+            if body is None:
+                body = current.body.with_side(side)  # checks the side; shares the meshes
+                self._bodies[body.side] = body
+            if body is current.body:
+                return
+            operator = _Operator(body, self._operator_placement(body), current.version + 1)
+            with self._lock:
+                self._operator = operator
+                self._live = None
+        self._wake.set()
+
+    @property
+    def shown_side(self) -> str:
+        """The taped arm the scene has drawn (lags :attr:`side` until the next push)."""
+        with self._lock:
+            return self._side_shown
 
     def set_goal(self, q_robot_goal: np.ndarray | None) -> None:
         """Show a translucent ghost robot and a marker at the goal (None hides them)."""
@@ -736,10 +838,21 @@ class _Shown:
     """What the scene thread pushed last (its own bookkeeping; no other thread touches it)."""
 
     live_version: int = 0
+    operator_version: int = 0
     q_robot: np.ndarray | None = None
     playback: Playback | None = None
     mode: Mode = Mode.LIVE
     trace_upto: int = -1
+
+
+def _operator_poses(operator: _Operator, q_human: np.ndarray | None) -> np.ndarray:
+    """World poses of every operator mesh with the taped arm at ``q_human`` (None: at rest)."""
+    return operator.worldMbase @ operator.body.poses(q_human)
+
+
+def _to_world(operator: _Operator, p: np.ndarray) -> np.ndarray:
+    m = operator.worldMbase
+    return np.asarray(p, dtype=float) @ m[:3, :3].T + m[:3, 3]
 
 
 def _placed(part: MeshPart, pose: np.ndarray) -> np.ndarray:

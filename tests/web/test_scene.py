@@ -16,6 +16,7 @@ from hypothesis import strategies as st
 from studio.kinematics import (
     HumanArm,
     HumanBody,
+    KinematicsError,
     MeshConfig,
     Puma560,
     TapeConfig,
@@ -34,6 +35,7 @@ from studio.web._scene import (
     wxyz_of,
 )
 from tests.conftest import free_port as _free_port
+from tests.web.conftest import wait_for
 
 PLACEMENT_TOLERANCE_M = 0.16
 """How far a Puma560 link mesh's bounding box may lie from its DH frame's origin. The largest
@@ -167,14 +169,19 @@ def test_simplify_keeps_the_shape_and_cuts_triangles():
 @given(st.lists(st.floats(-1.5, 1.5), min_size=7, max_size=7))
 @settings(max_examples=25, deadline=None)
 def test_the_body_arm_is_the_fitted_arm(body, q):
-    """The drawn body's elbow and wrist are where HumanArm puts them (one model, one frame)."""
-    arm = HumanArm("right")
+    """The drawn body's elbow and wrist are where HumanArm puts them (one model, one frame),
+    on either taped arm."""
     q = np.asarray(q)
-    pose = arm.forward(q)
-    np.testing.assert_allclose(
-        body.link_pose("right_lowerarm", q)[:3, 3], pose.elbow[:3, 3], atol=1e-9
-    )
-    np.testing.assert_allclose(body.link_pose("right_hand", q)[:3, 3], pose.wrist[:3, 3], atol=1e-9)
+    for side in ("right", "left"):
+        taped = body.with_side(side)
+        pose = HumanArm(side).forward(q)
+        np.testing.assert_allclose(
+            taped.link_pose(f"{side}_lowerarm", q)[:3, 3], pose.elbow[:3, 3], atol=1e-9
+        )
+        np.testing.assert_allclose(
+            taped.link_pose(f"{side}_hand", q)[:3, 3], pose.wrist[:3, 3], atol=1e-9
+        )
+    assert body.side == "right"  # with_side leaves the body as it was
 
 
 # ---------------------------------------------------------------------- live drawing
@@ -245,9 +252,11 @@ def test_tape_is_drawn_along_the_taped_arm(scene):
     assert min(distances) >= min(scene.layout.tape_lift_m) - 1e-6  # not inside the arm
 
 
-def test_default_camera_frames_both_bodies_at_every_reachable_pose(scene):
+@pytest.mark.parametrize("side", ["right", "left"])
+def test_default_camera_frames_both_bodies_at_every_reachable_pose(scene, side):
+    scene.set_side(side)
     rng = np.random.default_rng(0)
-    arm, robot = HumanArm("right"), Puma560()
+    arm, robot = HumanArm(side), Puma560()
     pts = [
         np.concatenate(scene.robot_mesh_points(rng.uniform(robot.lower, robot.upper)))
         for _ in range(60)
@@ -261,6 +270,185 @@ def test_default_camera_frames_both_bodies_at_every_reachable_pose(scene):
         ndc, depth = camera_projection(pts, scene.layout, aspect)
         assert np.all(depth > 0)
         assert np.all(np.abs(ndc) <= 1.0), aspect
+
+
+# ---------------------------------------------------------------------- the taped arm
+
+ARM_LINKS = ("upperarm", "lowerarm", "hand")
+"""The links of an arm whose origins are its shoulder, elbow and wrist."""
+
+
+def _arm_handles(scene, side: str) -> dict[str, object]:
+    """The operator's mesh handles of one arm (shoulder to hand), by part name."""
+    names = [p.name for p in scene.body.parts]
+    return {
+        name: scene._operator_handles[i]
+        for i, name in enumerate(names)
+        if name.split("/")[0] in {f"{side}_{link}" for link in ARM_LINKS}
+    }
+
+
+def _expected_positions(scene, q_human) -> dict[str, np.ndarray]:
+    """World position of every operator mesh with the taped arm at ``q_human``."""
+    poses = scene._operator.worldMbase @ scene.body.poses(q_human)
+    return {p.name: poses[i, :3, 3] for i, p in enumerate(scene.body.parts)}
+
+
+def _assert_drawn(scene, q_human) -> None:
+    """Every operator handle is where the current taped arm at ``q_human`` puts it."""
+    expected = _expected_positions(scene, q_human)
+    for part, handle in zip(scene.body.parts, scene._operator_handles, strict=True):
+        np.testing.assert_allclose(handle.position, expected[part.name], atol=1e-5)
+
+
+def _switch(scene, side: str) -> None:
+    scene.set_side(side)
+    assert scene.side == side
+    assert wait_for(lambda: scene.shown_side == side)
+
+
+def _distance_to_polyline(p: np.ndarray, joints: np.ndarray) -> float:
+    best = np.inf
+    for a, b in zip(joints[:-1], joints[1:], strict=True):
+        t = np.clip((p - a) @ (b - a) / ((b - a) @ (b - a)), 0.0, 1.0)
+        best = min(best, float(np.linalg.norm(a + t * (b - a) - p)))
+    return best
+
+
+def _world_arm(scene, side: str, q_human) -> np.ndarray:
+    """World shoulder, elbow and wrist of ``side``'s arm (the taped arm at ``q_human``)."""
+    body = scene.body
+    return scene.to_world(
+        np.stack([body.link_pose(f"{side}_{link}", q_human)[:3, 3] for link in ARM_LINKS])
+    )
+
+
+def test_a_left_tape_moves_the_left_arm_and_rests_the_right(scene):
+    """After set_side("left") the left arm's meshes follow q_human (where HumanArm("left") puts
+    them) and the right arm keeps its rest pose; back on the right, the left arm rests again."""
+    rest = _expected_positions(scene, None)
+    rest_rotation = {
+        p.name: m[:3, :3]
+        for p, m in zip(
+            scene.body.parts, scene._operator.worldMbase @ scene.body.poses(None), strict=True
+        )
+    }
+    q = np.array([0.9, 0.3, 0.2, 1.1, 0.0, 0.2, 0.0])
+    _switch(scene, "left")
+    scene.update_live(q, np.zeros(6), None)
+    assert wait_for(lambda: np.allclose(scene.current_q_human(), q))
+    _assert_drawn(scene, q)
+    left, right = _arm_handles(scene, "left"), _arm_handles(scene, "right")
+    assert len(left) == len(right) == len(scene.body.moving) >= 3
+    np.testing.assert_allclose(
+        left["left_hand/hand_mesh"].position,
+        scene.to_world(HumanArm("left").forward(q).wrist[:3, 3]),
+        atol=1e-5,
+    )
+    for name, handle in left.items():  # moved off the rest pose (the shoulder only turns)
+        turned = not np.allclose(_rotation_of(handle.wxyz), rest_rotation[name], atol=0.1)
+        assert turned or np.linalg.norm(np.asarray(handle.position) - rest[name]) > 0.05, name
+    for name, handle in right.items():  # resting
+        np.testing.assert_allclose(handle.position, rest[name], atol=1e-5)
+
+    _switch(scene, "right")
+    assert np.allclose(scene.current_q_human(), 0.0)  # the new taped arm rests until a fit
+    _assert_drawn(scene, None)  # the left arm went back to rest
+    scene.update_live(q, np.zeros(6), None)
+    assert wait_for(lambda: np.allclose(scene.current_q_human(), q))
+    _assert_drawn(scene, q)
+    for name, handle in _arm_handles(scene, "left").items():
+        np.testing.assert_allclose(handle.position, rest[name], atol=1e-5)
+    np.testing.assert_allclose(
+        _arm_handles(scene, "right")["right_hand/hand_mesh"].position,
+        scene.to_world(HumanArm("right").forward(q).wrist[:3, 3]),
+        atol=1e-5,
+    )
+
+
+def test_the_resting_body_stands_on_the_same_spot_whichever_arm_is_taped(scene):
+    rest_right = np.concatenate(scene.operator_mesh_points(None))
+    scene.set_side("left")
+    np.testing.assert_allclose(
+        np.concatenate(scene.operator_mesh_points(None)), rest_right, atol=1e-9
+    )
+
+
+def test_a_left_tape_is_drawn_along_the_left_sleeve(scene):
+    config = TapeConfig(side="left")
+    q = np.array([0.5, 0.4, 0.1, 0.8, 0.0, 0.0, 0.0])
+    bend, twist = tape_from_arm(HumanArm("left"), q, config)
+    tape = reconstruct(bend, twist, config).positions
+    scene.set_side("left")
+    scene.update_live(q, np.zeros(6), tape)
+    assert wait_for(lambda: scene._tape.visible and np.allclose(scene.current_q_human(), q))
+    drawn = np.asarray(scene._tape.points, dtype=float)
+    np.testing.assert_allclose(drawn, scene.to_world(scene.tape_on_sleeve(tape, q)), atol=1e-5)
+    strapped = drawn[config.shoulder_region + 1 : config.wrist_region + 1]
+    left, right = _world_arm(scene, "left", q), _world_arm(scene, "right", q)
+    np.testing.assert_allclose(left, scene.to_world(HumanArm("left").points(q)[:3]), atol=1e-9)
+    near = [_distance_to_polyline(p, left) for p in strapped]
+    far = [_distance_to_polyline(p, right) for p in strapped]
+    assert max(near) < 0.08  # on the left sleeve
+    assert min(near) >= min(scene.layout.tape_lift_m) - 1e-6  # not inside the arm
+    assert min(far) > 0.25  # nowhere near the resting right arm
+
+
+def test_switching_the_arm_hides_the_old_arms_tape(scene):
+    config = TapeConfig()
+    q = np.array([0.5, 0.4, 0.1, 0.8, 0.0, 0.0, 0.0])
+    bend, twist = tape_from_arm(HumanArm("right"), q, config)
+    scene.update_live(q, np.zeros(6), reconstruct(bend, twist, config).positions)
+    assert wait_for(lambda: scene._tape.visible and np.allclose(scene.current_q_human(), q))
+    _switch(scene, "left")
+    assert not scene._tape.visible  # it was strapped to the right arm, now resting
+
+
+def test_set_side_is_a_no_op_on_the_taped_arm_and_refuses_a_bad_one(scene):
+    operator = scene._operator
+    scene.set_side("right")
+    assert scene._operator is operator
+    for bad in ("up", "RIGHT", None, ["left"]):
+        with pytest.raises(KinematicsError, match="right.*left") as err:
+            scene.set_side(bad)
+        assert str(err.value).count(". ") == 0  # one sentence
+    assert scene._operator is operator
+    assert scene.side == "right"
+
+
+def test_set_side_is_safe_against_the_scene_thread(scene):
+    """Switching arms while live poses stream in: no failed push, and the scene settles on the
+    last arm at the last pose, the other arm at rest."""
+    rest = _expected_positions(scene, None)
+    stop = threading.Event()
+    rng = np.random.default_rng(3)
+    poses = rng.uniform(-0.5, 0.5, (64, 7))
+
+    def stream() -> None:
+        k = 0
+        while not stop.is_set():
+            scene.update_live(poses[k % len(poses)], np.zeros(6), None)
+            k += 1
+            time.sleep(0.001)
+
+    streamer = threading.Thread(target=stream)
+    streamer.start()
+    try:
+        for k in range(20):
+            scene.set_side("left" if k % 2 == 0 else "right")
+            pushed = scene.pushes
+            assert wait_for(lambda p=pushed: scene.pushes > p + 1)
+    finally:
+        stop.set()
+        streamer.join()
+    assert scene.errors == 0
+    q = np.array([0.3, 0.2, 0.1, 0.6, 0.0, 0.0, 0.0])
+    scene.update_live(q, np.zeros(6), None)
+    assert wait_for(lambda: np.allclose(scene.current_q_human(), q))
+    assert scene.shown_side == scene.side == "right"
+    _assert_drawn(scene, q)
+    for name, handle in _arm_handles(scene, "left").items():
+        np.testing.assert_allclose(handle.position, rest[name], atol=1e-5)
 
 
 def test_reset_view_puts_the_camera_back(server, scene):

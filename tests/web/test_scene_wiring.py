@@ -24,6 +24,9 @@ class FakeScene:
     def update_live(self, q_human, q_robot, tape_positions=None) -> None:
         self.calls.append(("update_live", (q_human, q_robot)))
 
+    def set_side(self, side) -> None:
+        self.calls.append(("set_side", (side,)))
+
     def set_goal(self, q_robot_goal) -> None:
         self.calls.append(("set_goal", (q_robot_goal,)))
 
@@ -120,3 +123,62 @@ def test_ticking_loop_changes_the_playing_recording_in_place(tmp_path):
         answer = client.put("/api/source", json={**body, "loop": True, "speed": 2.0}).json()
         assert studio.pipeline.source is source and source.loop and source.speed == 2.0
         assert answer["playback"]["loop"] is True
+
+
+def _write_taped_recording(path, side: str, frames: int = 330) -> None:
+    """A recording of a tape on ``side``'s arm (its header says so), the arm raised forward."""
+    from studio.capture import RecordingWriter, TapeFrame
+    from studio.kinematics import HumanArm, TapeConfig, tape_from_arm
+
+    config = TapeConfig(side=side)
+    arm = HumanArm(side)
+    with RecordingWriter(path, config=config) as writer:
+        for k in range(frames):
+            q = np.array([0.8 + 0.2 * np.sin(k / 30.0), 0.3, 0.1, 0.9, 0.0, 0.0, 0.0])
+            bend, twist = tape_from_arm(arm, q, config)
+            writer.write(TapeFrame(k / 110.0, k, bend, twist))
+
+
+def test_a_recording_taped_on_the_left_arm_is_drawn_on_the_left_arm(tmp_path):
+    """The pipeline puts the scene's tape on the recording's arm: left for a left-arm recording
+    (the left arm follows the fit, the right rests), and back to the right for a right-arm one."""
+    import viser
+
+    from studio.web._scene import SceneLayout, StudioScene
+    from tests.conftest import free_port
+    from tests.web.conftest import wait_for
+
+    folder = tmp_path / "recordings"
+    folder.mkdir()
+    _write_taped_recording(folder / "lefty.tape.csv", "left")
+    _write_taped_recording(folder / "righty.tape.csv", "right")
+    server = viser.ViserServer(host="127.0.0.1", port=free_port(), verbose=False)
+    scene = StudioScene(server, layout=SceneLayout(rate_hz=100.0))
+    parts = [p.name for p in scene.body.parts]
+    rest = [np.array(h.position) for h in scene._operator_handles]
+
+    def hand_moved(side: str) -> bool:
+        i = parts.index(f"{side}_hand/hand_mesh")
+        return np.linalg.norm(np.asarray(scene._operator_handles[i].position) - rest[i]) > 0.1
+
+    def arm_rests(side: str) -> bool:
+        return all(
+            np.allclose(scene._operator_handles[i].position, rest[i], atol=1e-6)
+            for i, name in enumerate(parts)
+            if name.startswith((f"{side}_upperarm", f"{side}_lowerarm", f"{side}_hand"))
+        )
+
+    try:
+        with TestClient(create_app(make_settings(tmp_path), scene)) as client:
+            body = {"kind": "recording", "recording": "lefty", "loop": True}
+            assert client.put("/api/source", json=body).status_code == 200
+            assert wait_for(lambda: scene.shown_side == "left" and hand_moved("left"))
+            assert client.get("/api/source").json()["error"] is None
+            assert arm_rests("right")
+            body = {**body, "recording": "righty"}
+            assert client.put("/api/source", json=body).status_code == 200
+            assert wait_for(lambda: scene.shown_side == "right" and hand_moved("right"))
+            assert arm_rests("left")
+    finally:
+        scene.close()
+        server.stop()
