@@ -74,9 +74,22 @@ function detailOf(data, resp, text) {
 function showError(id, err) {
   const el = $(id);
   if (!el) return;
-  if (!err) { el.hidden = true; el.textContent = ""; return; }
-  el.textContent = err instanceof Error ? err.message : String(err);
-  el.hidden = false;
+  if (!err) { setProp(el, "hidden", true); setText(el, ""); return; }
+  setText(el, err instanceof Error ? err.message : String(err));
+  setProp(el, "hidden", false);
+}
+
+/** Write a text or a property only when it changes: an unchanged value then costs no style,
+ * layout or paint. The live stream re-sends the same status several times a second, and with
+ * software rendering every repaint of the page costs the training run CPU. */
+function setText(idOrEl, text) {
+  const e = typeof idOrEl === "string" ? $(idOrEl) : idOrEl;
+  text = String(text);
+  if (e && e.textContent !== text) e.textContent = text;
+}
+function setProp(idOrEl, prop, value) { // also a dataset: setProp(e.dataset, "x", "1")
+  const e = typeof idOrEl === "string" ? $(idOrEl) : idOrEl;
+  if (e && e[prop] !== value) e[prop] = value;
 }
 
 /** Run an action, showing its error (or clearing the old one) next to the control. */
@@ -125,7 +138,7 @@ async function download(url, fallbackName, errId) {
 
 function confirmDialog(text, okLabel = "Delete") {
   const dlg = $("confirm-dialog");
-  $("confirm-text").textContent = text;
+  setText("confirm-text", text);
   dlg.querySelector('[data-testid="confirm-ok"]').textContent = okLabel;
   dlg.returnValue = "";
   dlg.showModal();
@@ -172,37 +185,37 @@ function fillSelect(sel, items, keep = true) {
 function renderSource() {
   const s = S.source;
   if (!s) return;
-  $("top-source-kind").textContent = s.kind ? (s.kind === "recording" ? `recording ${s.recording || ""}` : s.kind) : "none";
-  $("top-rate").textContent = fmt(s.rate_hz, 0);
-  $("top-dropped").textContent = s.dropped ?? "–";
-  $("src-running").textContent = s.running ? "yes" : "no";
-  $("src-rate").textContent = fmt(s.rate_hz, 1);
-  $("src-frames").textContent = s.frames ?? "–";
-  $("src-dropped").textContent = s.dropped ?? "–";
-  $("src-residual").textContent = fmt(s.fit_residual_mm, 1);
-  $("src-q").textContent = (s.q_robot || []).map((v) => ((v * 180) / Math.PI).toFixed(0).padStart(4)).join(" ") + " °";
+  setText("top-source-kind", s.kind ? (s.kind === "recording" ? `recording ${s.recording || ""}` : s.kind) : "none");
+  setText("top-rate", fmt(s.rate_hz, 0));
+  setText("top-dropped", s.dropped ?? "–");
+  setText("src-running", s.running ? "yes" : "no");
+  setText("src-rate", fmt(s.rate_hz, 1));
+  setText("src-frames", s.frames ?? "–");
+  setText("src-dropped", s.dropped ?? "–");
+  setText("src-residual", fmt(s.fit_residual_mm, 1));
+  setText("src-q", (s.q_robot || []).map((v) => ((v * 180) / Math.PI).toFixed(0).padStart(4)).join(" ") + " °");
   // The source's own trouble (no device, a dropped bridge) stays apart from a refused action.
   showError("source-status-error", s.error ? `Source: ${s.error}` : null);
   const rejected = s.rejected ? `${s.rejected} datagram${s.rejected === 1 ? "" : "s"} rejected` : "";
   const warning = [s.warning, rejected].filter(Boolean).join(" · ");
-  $("source-warning").hidden = !warning;
-  $("source-warning").textContent = warning;
-  if (document.activeElement !== $("retarget-mode") && s.retarget) $("retarget-mode").value = s.retarget.mode;
-  if (s.retarget) $("retarget-mirror").checked = !!s.retarget.mirror;
+  setProp("source-warning", "hidden", !warning);
+  setText("source-warning", warning);
+  if (document.activeElement !== $("retarget-mode") && s.retarget) setProp("retarget-mode", "value", s.retarget.mode);
+  if (s.retarget) setProp("retarget-mirror", "checked", !!s.retarget.mirror);
   const pb = s.playback;
-  $("playback").hidden = !(s.kind === "recording" && pb);
+  setProp("playback", "hidden", !(s.kind === "recording" && pb));
   if (pb) {
-    $("playback-toggle").textContent = pb.playing ? "❚❚" : "▶";
-    $("playback-toggle").dataset.playing = pb.playing ? "1" : "0";
+    setText("playback-toggle", pb.playing ? "❚❚" : "▶");
+    setProp($("playback-toggle").dataset, "playing", pb.playing ? "1" : "0");
     const seek = $("playback-seek");
-    seek.max = String(Math.max(pb.duration, 0.01));
-    if (!seek.dataset.dragging) seek.value = String(pb.t);
-    $("playback-time").textContent = `${pb.t.toFixed(1)} / ${pb.duration.toFixed(1)} s`;
+    setProp(seek, "max", String(Math.max(pb.duration, 0.01)));
+    if (!seek.dataset.dragging) setProp(seek, "value", String(pb.t));
+    setText("playback-time", `${pb.t.toFixed(1)} / ${pb.duration.toFixed(1)} s`);
     if (document.activeElement !== $("playback-speed")) {
       const sp = String(pb.speed);
-      if ([...$("playback-speed").options].some((o) => o.value === sp)) $("playback-speed").value = sp;
+      if ([...$("playback-speed").options].some((o) => o.value === sp)) setProp("playback-speed", "value", sp);
     }
-    if (!$("playback-loop").dataset.pending) $("playback-loop").checked = !!pb.loop;
+    if (!$("playback-loop").dataset.pending) setProp("playback-loop", "checked", !!pb.loop);
   }
   renderCaptureButton();
   updateMarkButton();
@@ -269,15 +282,15 @@ function renderCaptureButton() {
   const active = !!(S.capture && S.capture.active) || !!(S.source && S.source.recording_active);
   const b = $("capture-toggle");
   b.classList.toggle("active", active);
-  b.textContent = active ? "■ Stop" : "● Record";
-  b.dataset.active = active ? "1" : "0";
+  setText(b, active ? "■ Stop" : "● Record");
+  setProp(b.dataset, "active", active ? "1" : "0");
   const secs = S.capture && S.capture.active ? S.capture.seconds : 0;
-  $("capture-elapsed").textContent = `${fmt(secs, 1)} s`;
-  $("top-rec").hidden = !active;
-  $("top-rec-time").textContent = fmt(secs, 1);
+  setText("capture-elapsed", `${fmt(secs, 1)} s`);
+  setProp("top-rec", "hidden", !active);
+  setText("top-rec-time", fmt(secs, 1));
   const failure = (S.capture && S.capture.error) || ""; // e.g. a full disk: shown until dismissed
-  $("capture-failure").hidden = !failure;
-  $("capture-failure-text").textContent = failure;
+  setProp("capture-failure", "hidden", !failure);
+  setText("capture-failure-text", failure);
 }
 
 async function dismissCaptureFailure() {
@@ -354,7 +367,7 @@ function renderRecordings() {
   const body = $("recordings-body");
   const mine = S.recordings.filter((r) => !r.sample);
   const samples = S.recordings.filter((r) => r.sample);
-  $("rec-count").textContent = mine.length ? `(${mine.length})` : "";
+  setText("rec-count", mine.length ? `(${mine.length})` : "");
   const rows = mine.length ? mine.map(recordingRow)
     : [emptyRow(4, samples.length ? "No recordings of your own yet: press Record, upload a .tape.csv, or copy a sample." : "No recordings yet: press Record, or upload a .tape.csv.")];
   if (samples.length) {
@@ -386,7 +399,7 @@ async function useRecording(name) {
 
 function editRecording(r) {
   const dlg = $("edit-dialog");
-  $("edit-title").textContent = r.name;
+  setText("edit-title", r.name);
   $("edit-name").value = r.name;
   $("edit-operator").value = r.operator || "";
   $("edit-notes").value = r.notes || "";
@@ -520,11 +533,11 @@ async function toggleMark() {
 function updateMarkButton() {
   const b = $("demo-mark");
   const capturing = !!(S.capture && S.capture.active) || !!(S.source && S.source.recording_active);
-  b.textContent = S.marking ? "Mark stop" : "Mark start";
+  setText(b, S.marking ? "Mark stop" : "Mark start");
   b.classList.toggle("active", S.marking);
-  b.disabled = !capturing && !S.marking;
-  b.title = capturing ? "mark a demonstration in the recording being captured" : "start a recording first (Record)";
-  $("demo-mark-state").textContent = S.marking ? `marking from ${fmt(S.markT0, 1)} s` : "";
+  setProp(b, "disabled", !capturing && !S.marking);
+  setProp(b, "title", capturing ? "mark a demonstration in the recording being captured" : "start a recording first (Record)");
+  setText("demo-mark-state", S.marking ? `marking from ${fmt(S.markT0, 1)} s` : "");
 }
 
 async function loadDemos() {
@@ -758,9 +771,21 @@ function renderRuns() {
     if (!sweep) rows.push(runRow(r));
     else if (!grouped.has(sweep)) { grouped.add(sweep); rows.push(...sweepRows(sweep)); }
   }
-  body.replaceChildren(...rows);
+  reconcileRows(body, rows);
   const failed = S.runs.find((r) => r.status === "failed" && r.error && !r._errorShown);
   if (failed) { failed._errorShown = true; showError("runs-error", `${failed.name || failed.id}: ${failed.error}`); }
+}
+
+/** Put ``rows`` into ``body``, keeping every row that is drawn the same already: a running run
+ * refreshes its row a few times a second, and rebuilding the whole list each time would lay out
+ * and repaint all of it. Rows are equal when their HTML is (their handlers depend on the id alone). */
+function reconcileRows(body, rows) {
+  const old = [...body.children];
+  rows.forEach((row, i) => {
+    if (i >= old.length) body.append(row);
+    else if (old[i].outerHTML !== row.outerHTML) old[i].replaceWith(row);
+  });
+  for (const extra of old.slice(rows.length)) extra.remove();
 }
 
 function runRow(r) {
@@ -1219,12 +1244,12 @@ async function watch() {
   const body = { start: $("watch-start").value };
   if (t.type === "run") body.run = t.id; else body.policy = t.id;
   if ($("watch-seed").value !== "") body.seed = Number($("watch-seed").value);
-  $("watch-result").textContent = "";
+  setText("watch-result", "");
   await guarded("watch-error", async () => {
     const w = await api("POST", "/api/watch", body);
     const steps = Math.max(0, (w.states || []).length - 1);
     const secs = w.times && w.times.length ? w.times[w.times.length - 1] : 0;
-    $("watch-result").textContent = `${steps} steps, ${secs.toFixed(1)} s — ${w.reached_goal ? "reaches the goal" : "does not reach the goal"}`;
+    setText("watch-result", `${steps} steps, ${secs.toFixed(1)} s — ${w.reached_goal ? "reaches the goal" : "does not reach the goal"}`);
     S.watchedRun = t;
   }, $("watch-go"));
 }
@@ -1271,7 +1296,7 @@ function connectEvents() {
   if (events) events.close();
   events = new EventSource("/api/events");
   const conn = $("conn");
-  events.onopen = () => { conn.textContent = "live"; conn.className = "chip ok"; };
+  events.onopen = () => { setText(conn, "live"); setProp(conn, "className", "chip ok"); };
   events.onerror = () => {
     conn.textContent = "reconnecting…"; conn.className = "chip bad";
   };
@@ -1310,20 +1335,20 @@ async function loadConfig() {
     S.config = await api("GET", "/api/config");
     resetTrainForm(); // the learning package's defaults, the one definition
   } catch (e) {
-    $("scene-msg").textContent = `The 3D scene is unavailable: ${e.message}`;
+    setText("scene-msg", `The 3D scene is unavailable: ${e.message}`);
     $("scene-msg").hidden = false;
     return;
   }
-  $("version").textContent = `v${S.config.version}`;
+  setText("version", `v${S.config.version}`);
   const url = S.config.viser_url;
   if (!url) {
-    $("scene-msg").textContent = "This studio runs without a 3D scene (no viser URL configured).";
+    setText("scene-msg", "This studio runs without a 3D scene (no viser URL configured).");
     $("scene-msg").hidden = false;
     return;
   }
   const src = sceneUrl(url);
   if (S.config.scene_instance && !(await sceneIsOurs(src, S.config.scene_instance))) {
-    $("scene-msg").textContent = `The 3D scene at ${new URL(src).host} does not belong to this studio (another studio or program answers there); restart this studio so that it starts its own scene.`;
+    setText("scene-msg", `The 3D scene at ${new URL(src).host} does not belong to this studio (another studio or program answers there); restart this studio so that it starts its own scene.`);
     $("scene-msg").hidden = false;
     return;
   }

@@ -1,0 +1,94 @@
+"""In a real browser, the page writes the DOM only when what it shows changes.
+
+The live stream re-sends the source's status several times a second. With software rendering (a
+machine without a GPU) every write that changes nothing still costs a style pass, a layout and a
+repaint, and that CPU is taken from a training run. So: a still source causes no DOM writes at
+all, and re-drawing the run list keeps the rows that are drawn the same already.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from typing import Any
+
+import pytest
+
+from tests.e2e.conftest import Studio
+
+SOURCE_EVENTS = 8
+"""Source events to wait for while watching the DOM (the stream sends about four a second)."""
+READY_TIMEOUT_MS = 30_000
+EVENTS_TIMEOUT_MS = 20_000
+SAMPLE = "sample-reach-1"
+
+
+@pytest.fixture
+def quiet_page(browser: Any, studio_server: Studio) -> Iterator[Any]:
+    """A fresh page on the studio with a paused recording as the source (nothing moves)."""
+    studio_server.send("PUT", "/api/source", {"kind": "recording", "recording": SAMPLE})
+    studio_server.send("POST", "/api/source/playback", {"action": "pause"})
+    context = browser.new_context(viewport={"width": 1440, "height": 900})
+    page = context.new_page()
+    try:
+        page.goto(studio_server.base + "/")
+        page.wait_for_selector("body[data-ready='1']", timeout=READY_TIMEOUT_MS)
+        yield page
+    finally:
+        context.close()
+        studio_server.send("PUT", "/api/source", {"kind": "simulator"})  # as the stories expect
+
+
+def test_a_still_source_writes_nothing_to_the_page(quiet_page: Any) -> None:
+    page = quiet_page
+    # Let the status settle after the pause (the frame rate falls to 0 over its window), then
+    # watch every change to the document.
+    page.wait_for_function(
+        "() => { const s = window.studio.source; return s && !s.playback.playing && !s.rate_hz; }",
+        timeout=EVENTS_TIMEOUT_MS,
+    )
+    page.evaluate(
+        """() => {
+            window.__mutations = [];
+            window.__sourceEvents = 0;
+            events.addEventListener("source", () => { window.__sourceEvents++; });
+            new MutationObserver((records) => {
+                for (const m of records) {
+                    const where = m.target.id || (m.target.parentElement && m.target.parentElement.id) || m.target.nodeName;
+                    window.__mutations.push(`${m.type} ${where} ${m.attributeName || ""}`);
+                }
+            }).observe(document.body, { subtree: true, childList: true, attributes: true, characterData: true });
+        }"""
+    )
+    page.wait_for_function(
+        f"() => window.__sourceEvents >= {SOURCE_EVENTS}", timeout=EVENTS_TIMEOUT_MS
+    )
+    assert page.evaluate("() => window.__mutations") == []
+
+
+def test_redrawing_the_run_list_keeps_unchanged_rows(
+    quiet_page: Any, studio_server: Studio
+) -> None:
+    page = quiet_page
+    run = studio_server.send(
+        "POST", "/api/runs", {"name": "quiet-rows", "episodes": 5, "experiments": 2}
+    )
+    row = f"tr[data-id='{run['id']}']"
+    page.wait_for_selector(f"{row}[data-status='done']", timeout=EVENTS_TIMEOUT_MS)
+    same, updated = page.evaluate(
+        """(id) => {
+            const find = () => document.querySelector(`tr[data-id='${id}']`);
+            const before = find();
+            renderRuns();
+            const same = find() === before;
+            const r = window.studio.runs.find((x) => x.id === id);
+            r.status = "stopped"; // a change the row shows: it must be redrawn
+            renderRuns();
+            const updated = find() !== before && find().dataset.status === "stopped";
+            r.status = "done";
+            renderRuns();
+            return [same, updated];
+        }""",
+        run["id"],
+    )
+    assert same, "an unchanged run row was rebuilt"
+    assert updated, "a changed run row was not redrawn"
