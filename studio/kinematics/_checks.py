@@ -14,6 +14,9 @@ import numpy as np
 
 from ._errors import KinematicsError
 
+SIDES = ("right", "left")
+"""The arms a tape can be strapped to (``human.urdf``'s link prefixes)."""
+
 #: NumPy dtype kinds that hold real numbers (bool, signed and unsigned integers, floats).
 _REAL_KINDS = "biuf"
 
@@ -92,3 +95,15 @@ def instance_of(value: object, kind: type, what: str, *, optional: bool = False)
             f"{what} must be a {kind.__name__}, got {type(value).__name__}; "
             f"pass {kind.__name__}(...){fix}."
         )
+
+
+def check_side(side: object, what: str) -> str:
+    """``side`` when it names an arm (see :data:`SIDES`), else a KinematicsError naming ``what``.
+
+    The one check of a taped arm's side, for the arm model, the tape and the operator's meshes.
+    """
+    if not isinstance(side, str) or side not in SIDES:
+        raise KinematicsError(
+            f'{what} must be "right" or "left"; got {side!r}, so give one of those.'
+        )
+    return side

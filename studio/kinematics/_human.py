@@ -27,7 +27,7 @@ from typing import Literal
 import numpy as np
 import pinocchio as pin
 
-from ._checks import positive_number, real_array
+from ._checks import check_side, positive_number, real_array
 from ._errors import KinematicsError
 
 URDF_RELATIVE = Path(
@@ -150,9 +150,7 @@ class HumanArm:
         forearm: float | None = None,
         hand: float | None = None,
     ) -> None:
-        if side not in ("right", "left"):
-            raise KinematicsError(f'side must be "right" or "left"; got {side!r}.')
-        self.side = side
+        self.side = check_side(side, "The arm's side")
         self.joint_names = tuple(f"{side}_{name}" for name in ARM_JOINTS)
         full = pin.buildModelFromUrdf(str(find_human_urdf()))
         keep = {full.getJointId(name) for name in self.joint_names}

@@ -28,6 +28,7 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
+from ._checks import check_side
 from ._errors import KinematicsError
 from ._human import ARM_JOINTS, YUP_TO_ZUP, find_human_urdf
 
@@ -194,7 +195,7 @@ class HumanBody:
     """
 
     def __init__(self, side: str = "right", config: MeshConfig | None = None) -> None:
-        _check_side(side)
+        check_side(side, "The taped arm")
         import yourdfpy
 
         config = config if config is not None else MeshConfig()
@@ -232,7 +233,7 @@ class HumanBody:
         Raises:
             KinematicsError: ``side`` is neither ``"right"`` nor ``"left"``.
         """
-        _check_side(side)
+        check_side(side, "The taped arm")
         if side == self.side:
             return self
         other = copy.copy(self)
@@ -304,10 +305,3 @@ class HumanBody:
         with self._lock:
             pin.framesForwardKinematics(self.model, self.data, q)
             return self._baseMurdf @ self.data.oMf[fid].homogeneous
-
-
-def _check_side(side: object) -> None:
-    if side not in ("right", "left"):
-        raise KinematicsError(
-            f'The taped arm must be "right" or "left"; got {side!r}, so give one of those.'
-        )

@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING, Literal
 import numpy as np
 from numba import njit
 
-from ._checks import positive_number, real_array, whole_number
+from ._checks import check_side, positive_number, real_array, whole_number
 from ._errors import KinematicsError
 
 if TYPE_CHECKING:
@@ -113,8 +113,7 @@ class TapeConfig:
             or self.regions < 1
         ):
             raise KinematicsError(f"Tape regions must be a positive integer; got {self.regions!r}.")
-        if self.side not in ("right", "left"):
-            raise KinematicsError(f'Tape side must be "right" or "left"; got {self.side!r}.')
+        check_side(self.side, "The tape's side")
         s = whole_number(self.shoulder_region, "The tape's shoulder_region", 0)
         w = whole_number(self.wrist_region, "The tape's wrist_region", 1)
         object.__setattr__(self, "regions", int(self.regions))
