@@ -9,8 +9,9 @@ A run folder ``<parent>/<id>/`` holds:
 - ``config.json``: the :class:`RunRecord`, everything needed to repeat the run without the page or
   the demonstration files (format ``teach-studio-run``, version 1; see ``README.md``);
 - ``status.json``: ``status`` (``queued``, ``running``, ``done``, ``stopped``, ``failed``),
-  ``created``/``started``/``finished`` (ISO 8601 UTC), ``cpu_seconds``, ``error``, and ``pid``,
-  the process training it (a ``running`` run whose process is gone is read as ``stopped``);
+  ``created``/``started``/``finished`` (ISO 8601 UTC), ``cpu_seconds``, ``error``, and ``pid``
+  and ``host`` (:func:`this_host`), the process training it and where it runs (a ``running`` run
+  whose process is gone from its host is read as ``stopped``);
 - ``steps.csv``: real steps per episode, one row per experiment, ``-1`` where not done; rewritten
   atomically every :data:`CHECKPOINT_SECONDS` while training (less often only when one write
   takes over a tenth of that), so a killed process loses about that much of its curve;
@@ -43,6 +44,8 @@ import logging
 import os
 import secrets
 import shutil
+import socket
+import sys
 import threading
 import time
 import warnings
@@ -649,11 +652,36 @@ def raise_problems(problems: Iterable[tuple[str, str]]) -> None:
 # ----------------------------------------------------------------------------- the folder
 
 
-def pid_alive(pid: object) -> bool:
+def this_host() -> dict[str, str | None]:
+    """Where this process runs, recorded beside every ``pid`` a run or a sweep writes (a pid names
+    a process only on its own host): ``hostname``, and ``node``, the Ray node id when this process
+    is part of a Ray cluster (a sweep's driver or worker), else None. Ray is never imported here."""
+    ray = sys.modules.get("ray")
+    node = None
+    if ray is not None and ray.is_initialized():
+        node = ray.get_runtime_context().get_node_id()
+    return {"hostname": socket.gethostname(), "node": node}
+
+
+def on_this_host(host: object) -> bool:
+    """Whether a record's ``host`` (:func:`this_host`) is this machine; a record without one (older
+    runs, written before hosts were recorded) counts as this machine's."""
+    hostname = host.get("hostname") if isinstance(host, dict) else None
+    return not isinstance(hostname, str) or hostname == socket.gethostname()
+
+
+def pid_alive(pid: object, host: object = None) -> bool:
     """Whether ``pid`` is a live process other than this one: a run or sweep whose status says
-    it is training but whose process is gone (a crash, ``kill -9``) reads as stopped."""
+    it is training but whose process is gone (a crash, ``kill -9``) reads as stopped.
+
+    ``host`` is the record's :func:`this_host`. A pid recorded on another host (a sweep's trial
+    on another node of a cluster, seen through shared storage) names no process here, so this
+    host cannot judge it: it counts as alive (its driver records a trial whose worker died).
+    """
     if not _is_int(pid) or pid <= 0:  # type: ignore[operator]
         return False
+    if not on_this_host(host):
+        return True
     if pid == os.getpid():  # this process's only trainer, the page's queue, never reloads its own
         return False
     try:
@@ -710,6 +738,7 @@ class RunFolder:
         self.cpu_seconds = 0.0
         self.error: str | None = None
         self.pid: int | None = None
+        self.host: dict[str, str | None] | None = None  # this_host() of the process training it
         self.interrupted = False  # read as stopped because its training process is gone
         self._steps: np.ndarray | None = None
 
@@ -767,7 +796,7 @@ class RunFolder:
         run.status = status
         if status == "running":
             run.started = now_iso()
-            run.pid = os.getpid()
+            run.pid, run.host = os.getpid(), this_host()
         try:
             tmp.mkdir()
             (tmp / CONFIG_FILE).write_text(json.dumps(record.to_dict(), indent=1))
@@ -838,7 +867,9 @@ class RunFolder:
         self.cpu_seconds = float(cpu) if isinstance(cpu, int | float) and np.isfinite(cpu) else 0.0
         self.error = _text(status.get("error"))
         self.pid = status.get("pid")
-        if self.status in ("queued", "running") and not pid_alive(self.pid):
+        host = status.get("host")
+        self.host = host if isinstance(host, dict) else None
+        if self.status in ("queued", "running") and not pid_alive(self.pid, self.host):
             self.interrupted = True
             self.error = (
                 "The process training it stopped while this run was training; its curve so far is kept, start it again to finish."
@@ -847,7 +878,7 @@ class RunFolder:
             )
             self.status = "stopped"
             self.finished = self.finished or now_iso()
-            self.pid = None
+            self.pid = self.host = None
 
     def _read_steps(self) -> np.ndarray | None:
         path = self.path / STEPS_FILE
@@ -893,6 +924,7 @@ class RunFolder:
             "cpu_seconds": self.cpu_seconds,
             "error": self.error,
             "pid": self.pid if self.status in ("queued", "running") else None,
+            "host": self.host if self.status in ("queued", "running") else None,
         }
         try:
             _atomic_write(self.path / STATUS_FILE, json.dumps(status, indent=1))
@@ -979,6 +1011,7 @@ class RunFolder:
         record = self.record
         live = live or LiveProgress(record.experiments, record.episodes)
         self.status, self.started, self.pid = "running", self.started or now_iso(), os.getpid()
+        self.host = this_host()
         self.save_status()
         if live.stopped:  # stopped before training started: nothing to run
             return self._finish(live, None, None)

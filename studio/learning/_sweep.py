@@ -66,6 +66,7 @@ from ._runs import (
     curve_statistics,
     now_iso,
     pid_alive,
+    this_host,
 )
 
 SWEEP_FORMAT = "teach-studio-sweep"
@@ -134,12 +135,23 @@ DEFAULT_REDUCTION_FACTOR = 3
 ADDRESS_TIMEOUT_SECONDS = 5.0
 """How long to try to reach a cluster's ``HOST:PORT`` before calling it unreachable."""
 RAY_HINT = "install it with pip install -e '.[cluster]'"
+STOP_WAIT_SECONDS = 300
+"""How long a worker whose trial the scheduler stopped waits for the trial to save its run (the
+learners end at their next episode boundary) before Tune gives up re-using the worker for the next
+trial, which would then fail. Tune's own default, 2 s, is shorter than one episode of a big trial."""
+TUNE_SNAPSHOT_SECONDS = 600
+"""At most how often Tune snapshots its experiment state while a sweep runs (its default is every
+10 s, longer for big sweeps). A sweep resumes from its own records (:func:`finished_trials`), not
+from Tune's snapshot, so these writes only cost the driver time."""
 RAY_ENVIRONMENT = {
     "RAY_USAGE_STATS_ENABLED": "0",  # never phone home
     "RAY_AIR_NEW_OUTPUT": "0",  # the classic reporter honours verbose=0: our bar is the output
     "TUNE_DISABLE_AUTO_CALLBACK_LOGGERS": "1",  # no CSV/JSON/TensorBoard copies of the metrics
+    "TUNE_FUNCTION_THREAD_TIMEOUT_S": str(STOP_WAIT_SECONDS),  # read by each worker
+    "TUNE_GLOBAL_CHECKPOINT_S": str(TUNE_SNAPSHOT_SECONDS),  # read by the driver
 }
-"""Set (unless already set) before Ray is imported."""
+"""Set (unless already set) before Ray is imported, in the driver and in every worker (a cluster's
+workers do not inherit the driver's environment)."""
 
 
 class SweepError(LearningError):
@@ -684,24 +696,33 @@ class _Job:
 
 
 def _trainable(config: dict[str, Any], job: _Job) -> None:
-    """Tune's trial function: train one trial as an ordinary run and report its metrics."""
-    from ray import get_runtime_context, tune
+    """Tune's trial function: train one trial as an ordinary run and report its metrics.
 
+    Every report says where the trial runs (Ray node, hostname, worker pid). When Tune stops the
+    trial (ASHA, Ctrl-C), its ``tune.report`` raises ``SystemExit``: the run stops at the next
+    episode boundary and saves what it learnt, then the ``SystemExit`` goes on up, which is how
+    Tune knows the trial ended and can re-use this worker for the next trial.
+    """
+    from ray import tune
+
+    for key, value in RAY_ENVIRONMENT.items():  # e.g. how long a re-used worker waits for a stop
+        os.environ.setdefault(key, value)
     spec = parse_sweep_spec(job.spec, f"sweep {job.spec['name']}")
     trial = job.trials[config["key"]]
     record = trial_record(spec, trial)
     path = trial_run_path(Path(job.data_dir), spec.name, trial.key)
     if path.exists():  # an earlier attempt died (a killed worker, a lost node): start over
         shutil.rmtree(path)
-    node = get_runtime_context().get_node_id()
+    host = this_host()
+    where = {"node": host["node"], "hostname": host["hostname"], "pid": os.getpid()}
     start = time.perf_counter()
     run = RunFolder.create(path.parent, record, name=path.name, status="running")
     live = LiveProgress(spec.experiments, spec.episodes)
     pending = list(job.milestones)
-    state = {"stopped": False}
+    stopped: list[SystemExit] = []
 
     def on_checkpoint(live: LiveProgress) -> None:
-        if not pending or state["stopped"]:
+        if not pending or stopped:
             return
         done = int((live.steps >= 0).all(axis=0).cumprod().sum())
         while pending and done >= pending[0]:
@@ -710,15 +731,17 @@ def _trainable(config: dict[str, Any], job: _Job) -> None:
                 live.steps[:, :k], record, spec.convergence_factor, spec.level_steps
             )
             try:
-                tune.report({**metrics, "episodes": k, "final": False, "node": node})
-            except SystemExit:  # Tune stopped the trial (ASHA, or the sweep was interrupted)
+                tune.report({**metrics, "episodes": k, "final": False, **where})
+            except SystemExit as stop:  # Tune stopped the trial (ASHA, or Ctrl-C)
                 live.stop()
-                state["stopped"] = True
+                stopped.append(stop)
                 return
 
     run.train(live, workers=spec.cpus_per_trial, on_checkpoint=on_checkpoint)
-    if state["stopped"]:
-        return
+    if stopped:
+        # Saved. A normal return would report once more and wait forever for Tune's answer, so
+        # the worker could not be re-used: the SystemExit tells Tune the trial ended.
+        raise stopped[0]
     if run.status == "failed":
         raise SweepError(f"Trial {trial.key} failed: {run.error}")
     metrics = trial_metrics(run.steps(), record, spec.convergence_factor, spec.level_steps)
@@ -727,8 +750,7 @@ def _trainable(config: dict[str, Any], job: _Job) -> None:
             **metrics,
             "episodes": spec.episodes,
             "final": True,
-            "node": node,
-            "pid": os.getpid(),
+            **where,
             "cpu_seconds": run.cpu_seconds,
             "wall_seconds": time.perf_counter() - start,
         }
@@ -899,13 +921,25 @@ def metric_by_setting(
     return out
 
 
+FIGURE_FORMATS = ("png", "svg")
+"""The summary figure is written in these formats."""
+
+
 def sweep_figure(rows: Sequence[Mapping[str, Any]], spec: SweepSpec, fmt: str = "png") -> bytes:
     """The metric against the first swept setting (mean and standard error over seeds), one line
     per combination of the other swept settings, as PNG or SVG bytes."""
+    return sweep_figures(rows, spec, (fmt,))[fmt]
+
+
+def sweep_figures(
+    rows: Sequence[Mapping[str, Any]], spec: SweepSpec, formats: Sequence[str] = FIGURE_FORMATS
+) -> dict[str, bytes]:
+    """:func:`sweep_figure` in several formats, drawn once: ``{format: bytes}``."""
     from matplotlib.figure import Figure
 
-    if fmt not in ("png", "svg"):
-        raise LearningError(f"The figure format {fmt!r} is not supported; use png or svg.")
+    for fmt in formats:
+        if fmt not in FIGURE_FORMATS:
+            raise LearningError(f"The figure format {fmt!r} is not supported; use png or svg.")
     fig = Figure(figsize=(7, 4), dpi=120, layout="constrained")
     ax = fig.add_subplot()
     x_name = spec.swept[0]
@@ -943,9 +977,12 @@ def sweep_figure(rows: Sequence[Mapping[str, Any]], spec: SweepSpec, fmt: str = 
     ax.set_ylabel(f"{spec.metric} (mean ± s.e. over {len(spec.seeds)} seeds)")
     ax.set_title(f"sweep {spec.name}")
     ax.grid(alpha=0.3)
-    buffer = io.BytesIO()
-    fig.savefig(buffer, format=fmt)
-    return buffer.getvalue()
+    out = {}
+    for fmt in formats:
+        buffer = io.BytesIO()
+        fig.savefig(buffer, format=fmt)
+        out[fmt] = buffer.getvalue()
+    return out
 
 
 def write_summary(data_dir: Path, spec: SweepSpec) -> list[dict[str, Any]]:
@@ -954,8 +991,8 @@ def write_summary(data_dir: Path, spec: SweepSpec) -> list[dict[str, Any]]:
     rows = sweep_rows(data_dir, spec)
     try:
         (folder / SUMMARY_FILE).write_text(sweep_csv(rows))
-        for fmt in ("png", "svg"):
-            (folder / f"{FIGURE_STEM}.{fmt}").write_bytes(sweep_figure(rows, spec, fmt))
+        for fmt, image in sweep_figures(rows, spec).items():
+            (folder / f"{FIGURE_STEM}.{fmt}").write_bytes(image)
     except OSError as err:
         raise SweepError(
             f"Cannot write the sweep summary in {folder} ({err.strerror or err}); check the disk."
@@ -1011,7 +1048,7 @@ class SweepInfo:
 
     def figure(self, fmt: str = "png") -> bytes:
         """The summary figure (:func:`sweep_figure`): as written, or drawn from the run folders."""
-        if fmt not in ("png", "svg"):
+        if fmt not in FIGURE_FORMATS:
             raise LearningError(f"The figure format {fmt!r} is not supported; use png or svg.")
         if self.status != "running":
             with contextlib.suppress(OSError):
@@ -1046,7 +1083,7 @@ def load_sweep(data_dir: Path, sweep_id: str) -> SweepInfo:
         sorted(p.name for p in runs_parent.iterdir() if p.is_dir()) if runs_parent.is_dir() else []
     )
     status = str(data.get("status", "interrupted"))
-    if status == "running" and not pid_alive(data.get("pid")):  # its driver died
+    if status == "running" and not pid_alive(data.get("pid"), data.get("host")):  # driver died
         status = "interrupted"
     return SweepInfo(
         id=sweep_id,
@@ -1170,15 +1207,16 @@ def _prepare(data_dir: Path, spec: SweepSpec, resume: bool) -> Path:
             ],
         }
     stored["status"] = "running"
-    stored["pid"] = os.getpid()
+    stored["pid"], stored["host"] = os.getpid(), this_host()
     _write_json(folder / SWEEP_FILE, stored)
     return folder
 
 
-def _set_status(folder: Path, status: str) -> None:
+def _set_status(folder: Path, status: str, **fields: Any) -> None:
+    """Write the sweep's ``status`` (and other top-level ``fields``) into ``sweep.json``."""
     data = _read_json(folder / SWEEP_FILE)
     if isinstance(data, dict):
-        data["status"] = status
+        data.update(status=status, **fields)
         _write_json(folder / SWEEP_FILE, data)
 
 
@@ -1221,7 +1259,7 @@ def run_sweep(
     todo = [t for t in trials if t.key not in finished]
     progress = SweepProgress(total=len(trials), done=len(finished))
     notify = on_progress or (lambda _p: None)
-    rows = sweep_rows(data_dir, spec)
+    rows = sweep_rows(data_dir, spec) if finished else []  # the best so far, on resume
     labels = {t.key: t.label() for t in trials}
     for row in rows:
         if row["trial"] in finished:
@@ -1236,6 +1274,8 @@ def run_sweep(
     from ray.tune.schedulers import ASHAScheduler
 
     started = _connect(ray, address, workers)
+    if started:  # the driver's host now has its Ray node id
+        _set_status(folder, "running", host=this_host())
     ran: list[str] = []
     failed: list[str] = []
     try:
@@ -1266,9 +1306,10 @@ def run_sweep(
                 metric=spec.metric,
                 mode="min",
                 scheduler=scheduler,
-                # Re-using a worker saves its start-up per trial, but Ray 2.60 fails the next
-                # trial when it re-uses the worker of a trial the scheduler stopped.
-                reuse_actors=scheduler is None,
+                # A new worker process costs seconds (Python, Ray, Tune, this package, the
+                # kernels): every trial runs in a worker an earlier trial of the sweep started,
+                # also after the scheduler stopped that trial (_trainable re-raises the stop).
+                reuse_actors=True,
             ),
             run_config=tune.RunConfig(
                 name=f"session-{session}",
@@ -1359,6 +1400,8 @@ def _progress_callback(
                 "status": status,
                 "attempts": int(getattr(trial, "num_failures", 0)) + 1,
                 "node": result.get("node"),
+                "hostname": result.get("hostname"),
+                "pid": result.get("pid"),
                 "episodes": result.get("episodes"),
                 "wall_seconds": result.get("wall_seconds"),
                 "cpu_seconds": result.get("cpu_seconds"),

@@ -252,6 +252,13 @@ def test_trials_equal_serial_runs_seed_for_seed(local_ray, tmp_path: Path) -> No
     assert all(",done," in line for line in lines[1:])
     assert (folder / "sweep.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert b"<svg" in (folder / "sweep.svg").read_bytes()[:500]
+    nodes = {node["NodeID"] for node in local_ray.nodes()}
+    for record in trial_records(folder).values():  # where each trial ran: node, host, worker
+        assert record["node"] in nodes and record["hostname"] == socket.gethostname()
+        assert isinstance(record["pid"], int) and record["pid"] != os.getpid()
+    stored = json.loads((folder / "sweep.json").read_text())
+    assert stored["pid"] == os.getpid() and stored["host"]["hostname"] == socket.gethostname()
+    assert stored["host"]["node"] in nodes  # the driver's node
 
 
 def test_continuous_joint_trials_equal_serial_runs(local_ray, tmp_path: Path) -> None:
@@ -313,6 +320,8 @@ def test_a_killed_worker_is_retried_and_the_sweep_completes(local_ray, tmp_path:
                 except (OSError, ValueError):
                     continue
                 if data.get("status") == "running" and data.get("pid"):
+                    host = data["host"]  # the trial's worker: this machine, a Ray node
+                    assert host["hostname"] == socket.gethostname() and host["node"], host
                     return status.parent.name, data["pid"]
             return None
 
@@ -393,18 +402,29 @@ def test_an_interrupted_sweep_resumes_with_only_the_unfinished_trials(
 def test_a_scheduler_sweep_ends_every_trial_done_or_early_stopped(
     local_ray, tmp_path: Path
 ) -> None:
+    """ASHA stops the weak trials, and the worker of a stopped trial runs the next trial.
+
+    Each trial takes both CPUs, so the trials run one after another in one worker: both seeds of
+    full planning first, then zero planning, whose steps at the first rung are far worse, so
+    ASHA stops t0002 while t0003 waits for that worker.
+    """
     spec = parse_sweep_spec(
         spec_dict(
             name="asha",
             seeds=[0, 1],
             episodes=40,
-            space={"planning": ["zero", "full"]},
+            cpus_per_trial=2,
+            space={"planning": ["full", "zero"]},
             scheduler={"kind": "asha", "grace_episodes": 5, "reduction_factor": 2},
             metric={"name": "mean_steps"},
         )
     )
     result = run_sweep(spec, tmp_path)
     assert not result.interrupted and not result.failed
+    records = trial_records(sweep_folder(tmp_path, "asha"))
+    assert records["t0002"]["status"] == "early-stopped", records
+    assert records["t0003"]["status"] in ("done", "early-stopped"), records
+    assert len({record["pid"] for record in records.values()}) == 1, records  # one worker
     for row in result.rows:
         run = RunFolder.load(trial_run_path(tmp_path, "asha", row["trial"]))
         if row["status"] == "done":
