@@ -67,7 +67,7 @@ class SceneLayout:
 
     operator_position: tuple[float, float] = (1.75, 0.0)
     operator_yaw: float = float(np.pi)
-    rate_hz: float = 30.0
+    rate_hz: float = 60.0
     floor_half_size: float = 1.6
     floor_cell: float = 0.25
     playback_hold_s: float = 5.0
@@ -458,23 +458,24 @@ class StudioScene:
             ]
         )
         out = np.array(tape, dtype=float)
-        segments = list(zip(axis[:-1], axis[1:], self.layout.tape_lift_m, strict=True))
-        for k in range(len(out)):
-            # Pushed off one segment, a point near the elbow may land inside the other: a few
-            # rounds settle it.
-            for _ in range(TAPE_LIFT_ROUNDS):
-                for a, b, lift in segments:
-                    ab = b - a
-                    t = float(np.clip((out[k] - a) @ ab / (ab @ ab), 0.0, 1.0))
-                    c = a + t * ab
-                    d = float(np.linalg.norm(out[k] - c))
-                    if d >= lift:
-                        continue
-                    if d > 1e-9:
-                        away = out[k] - c
-                    else:  # on the axis: any direction across it
-                        away = np.cross(ab, np.eye(3)[int(np.argmin(np.abs(ab)))])
-                    out[k] = c + away / np.linalg.norm(away) * lift
+        # Pushed off one segment, a point near the elbow may land inside the other: a few rounds
+        # settle it. All points at once: this runs for every live pose the scene shows.
+        for _ in range(TAPE_LIFT_ROUNDS):
+            for a, b, lift in zip(axis[:-1], axis[1:], self.layout.tape_lift_m, strict=True):
+                ab = b - a
+                t = np.clip((out - a) @ ab / (ab @ ab), 0.0, 1.0)
+                c = a + t[:, None] * ab
+                away = out - c
+                d = np.linalg.norm(away, axis=1)
+                inside = d < lift
+                if not inside.any():
+                    continue
+                on_axis = inside & (d <= 1e-9)
+                if on_axis.any():  # any direction across the axis
+                    across = np.cross(ab, np.eye(3)[int(np.argmin(np.abs(ab)))])
+                    away[on_axis] = across
+                    d[on_axis] = np.linalg.norm(across)
+                out[inside] = c[inside] + away[inside] / d[inside, None] * lift
         return out
 
     def tool_positions(self, q_robot: np.ndarray) -> np.ndarray:
