@@ -3,12 +3,14 @@
 1. First paint and DOMContentLoaded of the studio page vs a minimal static HTML page served by the
    same uvicorn/FastAPI stack, plus the time until the 3D scene's canvas exists (goal: < 2 s).
 2. Curve updates per second in the page while a run trains (goal: >= 5/s).
-3. Training slowdown with the page open vs no page at all (same run config; goal: <= 10 %).
+3. Training slowdown with the page open vs no page at all (same run config), in pairs of runs:
+   with the scene still (goal: <= 1.18x) and with the simulator moving it.
 4. The 3D scene alone in the browser: cores it uses, idle and live, against an empty viser scene
    (the baseline: viser's client with nothing drawn) served by this script.
 5. Motion-to-scene latency while a run trains: from a tape frame's arrival at the studio (a UDP
    datagram on loopback, 110 Hz) to the robot pose it causes reaching the browser's websocket;
-   p50 and p99 (goal: p99 < 50 ms).
+   p50 and p99 (goal: p99 < 50 ms), with the page open (its scene drawn in software on the same
+   two cores) and with the scene's stream alone (what a browser drawing on a GPU would see).
 
 Run: ``python benchmarks/bench_web.py`` (a minute or two; needs /usr/bin/chromium).
 """
@@ -206,7 +208,10 @@ def main() -> int:
     parser.add_argument("--loads", type=int, default=3, help="cold page loads per page")
     parser.add_argument("--runs", type=int, default=3, help="training runs per condition")
     parser.add_argument(
-        "--latency-seconds", type=float, default=12.0, help="length of the latency measurement"
+        "--latency-seconds",
+        type=float,
+        default=30.0,
+        help="length of each latency measurement (4 pose steps a second)",
     )
     args = parser.parse_args()
     if not Path(CHROMIUM).exists():
@@ -242,14 +247,12 @@ def main() -> int:
             )
 
             # Each page condition against training with no page open under the same live source
-            # (the simulator's kinematics cost the studio a little CPU of their own).
+            # (the simulator's kinematics cost the studio a little CPU of their own), in pairs.
             train(base, "warm-up")
-            without_live = [wall(train(base, f"no-page-live-{i}")) for i in range(args.runs)]
             live = measure_with_page(browser, base, "live", args.runs)
             # The scene still: a paused recording feeds no new poses.
             http("PUT", base + "/api/source", {"kind": "recording", "recording": SAMPLE})
             http("POST", base + "/api/source/playback", {"action": "pause"})
-            without_idle = [wall(train(base, f"no-page-idle-{i}")) for i in range(args.runs)]
             idle = measure_with_page(browser, base, "idle", args.runs)
             scene_url = http("GET", base + "/api/config")["viser_url"]
             empty_url = start_empty_scene()
@@ -261,17 +264,28 @@ def main() -> int:
             scene_cpu.append(
                 ("studio scene, live simulator", scene_cores(browser, scene_url, args.runs))
             )
-            latencies = motion_to_scene(browser, base, args.latency_seconds)
+            latencies = {
+                "page open (drawn in software on these 2 cores)": motion_to_scene(
+                    browser, base, args.latency_seconds
+                ),
+                "scene stream alone (no page drawing)": motion_to_scene(
+                    browser, base, args.latency_seconds, with_page=False
+                ),
+            }
             browser.close()
-        print(f"== training ({TRAIN}, median of {args.runs} runs each, s of wall time)")
-        for label, without, (walls, rates, cores) in (
-            ("scene still", without_idle, idle),
-            ("live simulator", without_live, live),
+        print(
+            f"== training ({TRAIN}, {args.runs} pairs of runs without and with the page, "
+            "s of wall time; slowdown: the median of the pairs' ratios)"
+        )
+        for label, (without, walls, rates, cores), goal in (
+            ("scene still", idle, f"goal <= {IDLE_SLOWDOWN_GOAL}"),
+            ("live simulator", live, "no goal: the scene redraws with every pose"),
         ):
             w0, w1 = statistics.median(without), statistics.median(walls)
+            slowdown = statistics.median(b / a for a, b in zip(without, walls, strict=True))
             rate = statistics.median(rates) if rates else float("nan")
             print(
-                f"  {label:<15} no page {w0:5.2f}  page {w1:5.2f}   slowdown {w1 / w0:5.2f}x (goal <= 1.10)"
+                f"  {label:<15} no page {w0:5.2f}  page {w1:5.2f}   slowdown {slowdown:5.2f}x ({goal})"
                 f"   curve updates {rate:5.1f}/s (goal >= 5)"
                 f"   browser used {statistics.median(cores):4.2f} of {os.cpu_count()} cores"
             )
@@ -280,17 +294,16 @@ def main() -> int:
         )
         for label, cores in scene_cpu:
             print(f"  {label:<32} {statistics.median(cores):5.2f} cores")
-        print(
-            f"== motion to scene while training ({len(latencies)} pose steps at {LATENCY_RATE_HZ:.0f} Hz, ms)"
-        )
-        if latencies:
-            q = statistics.quantiles(latencies, n=100, method="inclusive")
-            print(
-                f"  p50 {q[49]:6.1f}  p99 {q[98]:6.1f}  max {max(latencies):6.1f}"
-                f"   goal: p99 < 50 ms -> {'OK' if q[98] < 50 else 'MISSED'}"
-            )
-        else:
-            print("  no pose reached the browser: MISSED")
+        print(f"== motion to scene while training (pose steps at {LATENCY_RATE_HZ:.0f} Hz, ms)")
+        for label, values in latencies.items():
+            if values:
+                q = statistics.quantiles(values, n=100, method="inclusive")
+                print(
+                    f"  {label:<48} {len(values):4d} steps  p50 {q[49]:6.1f}  p99 {q[98]:6.1f}"
+                    f"  max {max(values):6.1f}   goal: p99 < 50 ms -> {'OK' if q[98] < 50 else 'MISSED'}"
+                )
+            else:
+                print(f"  {label:<48} no pose reached the browser: MISSED")
     finally:
         proc.terminate()
         try:
@@ -303,16 +316,23 @@ def main() -> int:
 
 def measure_with_page(
     browser: Any, base: str, tag: str, runs: int
-) -> tuple[list[float], list[float], list[float]]:
-    """Train ``runs`` times with the page open: wall times, curve updates per second seen, and
-    the cores the browser used meanwhile (it competes with training for this machine's CPU)."""
-    ctx = browser.new_context(viewport={"width": 1440, "height": 900})
-    page = ctx.new_page()
-    page.goto(base + "/")
-    page.wait_for_selector("body[data-ready='1']", timeout=30_000)
-    time.sleep(2.0)  # the scene connects and settles
-    walls, rates, cores = [], [], []
+) -> tuple[list[float], list[float], list[float], list[float]]:
+    """Train ``runs`` pairs of runs, one with no page open, then one with the page open.
+
+    Returns the wall times without and with the page, the curve updates per second the page
+    showed, and the cores the browser used meanwhile (it competes with training for this
+    machine's CPU). Pairs, not one block per condition: this machine's speed drifts by tens of
+    percent over minutes (other virtual machines share its host), and a drift between two blocks
+    would read as a slowdown.
+    """
+    without, walls, rates, cores = [], [], [], []
     for i in range(runs):
+        without.append(wall(train(base, f"{tag}-no-page-{i}")))
+        ctx = browser.new_context(viewport={"width": 1440, "height": 900})
+        page = ctx.new_page()
+        page.goto(base + "/")
+        page.wait_for_selector("body[data-ready='1']", timeout=30_000)
+        time.sleep(2.0)  # the scene connects and settles
         before = page.evaluate("() => window.studio.curveRenders || 0")
         cpu = chromium_cpu_seconds()
         run = train(base, f"{tag}-page-{i}")
@@ -320,10 +340,12 @@ def measure_with_page(
         renders = page.evaluate("() => window.studio.curveRenders || 0") - before
         walls.append(wall(run))
         rates.append(renders / wall(run))
-    ctx.close()
-    return walls, rates, cores
+        ctx.close()
+    return without, walls, rates, cores
 
 
+IDLE_SLOWDOWN_GOAL = 1.18
+"""Training with the page open on a still scene, against no page (issue 10 keeps it within 1.18x)."""
 SCENE_CPU_S = 5.0
 """Window over which the scene's browser CPU is measured (after it settles)."""
 SCENE_SETTLE_S = 3.0
@@ -413,12 +435,14 @@ def _listen(scene_url: str, log: list[tuple[float, bytes]], stop: threading.Even
     asyncio.run(run())
 
 
-def motion_to_scene(browser: Any, base: str, seconds: float) -> list[float]:
+def motion_to_scene(browser: Any, base: str, seconds: float, with_page: bool = True) -> list[float]:
     """Latencies (ms) from a pose step's first frame reaching the studio to the browser.
 
     The tape alternates between two still poses over UDP at 110 Hz while a run trains; each
     step's latency is the time until the browser receives the watched robot link more than
-    halfway from the old pose's position to the new one's.
+    halfway from the old pose's position to the new one's. With ``with_page`` the studio page
+    is open as well, drawing the moving scene (in software on this machine, on the same two
+    cores as the studio and the training run); without it only the scene's stream is received.
     """
     import socket as socket_module
 
@@ -432,12 +456,13 @@ def motion_to_scene(browser: Any, base: str, seconds: float) -> list[float]:
     arm, config = HumanArm("right"), TapeConfig()
     poses = [tape_from_arm(arm, np.array(q), config) for q in (POSE_A, POSE_B)]
     ctx = browser.new_context(viewport={"width": 1440, "height": 900})
-    page = ctx.new_page()
-    page.goto(base + "/")
-    page.wait_for_selector("body[data-ready='1']", timeout=30_000)
-    scene_port = http("GET", base + "/api/config")["viser_url"].rstrip("/").rsplit(":", 1)[1]
-    frame = next(f for f in page.frames if f":{scene_port}" in f.url)
-    frame.locator("canvas").first.wait_for(state="attached", timeout=60_000)
+    if with_page:
+        page = ctx.new_page()
+        page.goto(base + "/")
+        page.wait_for_selector("body[data-ready='1']", timeout=30_000)
+        scene_port = http("GET", base + "/api/config")["viser_url"].rstrip("/").rsplit(":", 1)[1]
+        frame = next(f for f in page.frames if f":{scene_port}" in f.url)
+        frame.locator("canvas").first.wait_for(state="attached", timeout=60_000)
     stop = threading.Event()
 
     def keep_training() -> None:
@@ -475,7 +500,7 @@ def motion_to_scene(browser: Any, base: str, seconds: float) -> list[float]:
             if n % per_phase == 0 and n > 0:
                 steps.append(time.time())
             n += 1
-        page.wait_for_timeout(500)  # deliver the last frames' events
+        time.sleep(0.5)  # deliver the last frames' events
     finally:
         stop.set()
         sock.close()
