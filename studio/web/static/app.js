@@ -5,7 +5,7 @@
  */
 "use strict";
 
-const CURVE_FPS = 10; // chart redraws per second at most
+const CURVE_FPS = 6; // chart redraws per second at most (each one repaints and composites the page)
 // Without a GPU the scene is drawn at this device-pixel ratio (a quarter of the pixels at 0.5):
 // a still scene then costs about 0.09 instead of 0.15 cores, a moving one far less, and that
 // CPU goes to training instead. A browser with a GPU draws at its own ratio.
@@ -1155,7 +1155,7 @@ function renderCurves() {
   const log = $("curve-log").checked;
   const xMode = $("curve-x").value;
   const runs = plottedRuns();
-  $("curve-empty").hidden = runs.length > 0;
+  setProp("curve-empty", "hidden", runs.length > 0);
   if (!runs.length) {
     if (chart) { chart.destroy(); chart = null; chartKey = ""; chartRuns = []; }
     return;
