@@ -5,13 +5,15 @@
  */
 "use strict";
 
-const CURVE_FPS = 6; // chart redraws per second at most (each one repaints and composites the page)
+// Live updates (the chart and the run list's progress) are drawn together, at most this often:
+// without a GPU every repaint of the page is composited by the CPU that trains, so two timers
+// drawing apart would cost two frames where one does.
+const CURVE_FPS = 6;
 // Without a GPU the scene is drawn at this device-pixel ratio (a quarter of the pixels at 0.5):
 // a still scene then costs about 0.09 instead of 0.15 cores, a moving one far less, and that
 // CPU goes to training instead. A browser with a GPU draws at its own ratio.
 const SOFTWARE_SCENE_DPR = 0.5;
 const SOFTWARE_RENDERERS = /swiftshader|llvmpipe|softpipe|software/i;
-const RUNS_TABLE_MS = 250; // the run list (progress, CPU time) refreshes at most this often
 const PALETTE = ["#2a62b8", "#d9822b", "#23874b", "#b83280", "#6b4fbb", "#0f8b8d", "#a0522d", "#7a7a7a"];
 const $ = (id) => document.getElementById(id);
 
@@ -1329,10 +1331,15 @@ function connectEvents() {
 }
 
 let runsRenderPending = false;
-function scheduleRunsRender() {
-  if (runsRenderPending) return;
+function scheduleRunsRender() { // drawn by the next renderLive, in the same frame as the chart
   runsRenderPending = true;
-  setTimeout(() => { runsRenderPending = false; renderRuns(); }, RUNS_TABLE_MS);
+}
+function renderLive() {
+  if (runsRenderPending) {
+    runsRenderPending = false;
+    renderRuns();
+  }
+  renderCurves();
 }
 
 /* ------------------------------------------------------------------ start-up */
@@ -1484,7 +1491,7 @@ async function main() {
   syncKindOptions();
   updateMarkButton();
   renderCaptureButton();
-  setInterval(renderCurves, 1000 / CURVE_FPS);
+  setInterval(renderLive, 1000 / CURVE_FPS);
   new ResizeObserver(fitChart).observe($("curve-plot"));
   connectEvents();
   S.softwareScene = softwareWebGL();
