@@ -182,6 +182,30 @@ def _descendants(root: int) -> set[int]:
     return out
 
 
+SETTLED_CORES = 0.5
+"""A browser using less than this over a second has finished loading the page and its scene."""
+SETTLE_TIMEOUT_S = 30.0
+
+
+def wait_until_browser_settles() -> None:
+    """Wait until the browser has loaded the page and the scene (fetching the meshes, compiling
+    the shaders, which in software take seconds of CPU): a training run timed meanwhile would
+    count the page's start-up as its steady cost."""
+    end = time.monotonic() + SETTLE_TIMEOUT_S
+    while time.monotonic() < end:
+        cpu = chromium_cpu_seconds()
+        time.sleep(1.0)
+        if chromium_cpu_seconds() - cpu < SETTLED_CORES:
+            return
+
+
+def process_cpu_seconds(pid: int) -> float:
+    """CPU seconds (user + system) used so far by process ``pid`` and its threads (Linux /proc)."""
+    with open(f"/proc/{pid}/stat") as f:
+        fields = f.read().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
 def chromium_cpu_seconds() -> float:
     """CPU seconds used so far by this benchmark's Chromium processes (Linux /proc).
 
@@ -249,11 +273,11 @@ def main() -> int:
             # Each page condition against training with no page open under the same live source
             # (the simulator's kinematics cost the studio a little CPU of their own), in pairs.
             train(base, "warm-up")
-            live = measure_with_page(browser, base, "live", args.runs)
+            live = measure_with_page(browser, base, "live", args.runs, proc.pid)
             # The scene still: a paused recording feeds no new poses.
             http("PUT", base + "/api/source", {"kind": "recording", "recording": SAMPLE})
             http("POST", base + "/api/source/playback", {"action": "pause"})
-            idle = measure_with_page(browser, base, "idle", args.runs)
+            idle = measure_with_page(browser, base, "idle", args.runs, proc.pid)
             scene_url = http("GET", base + "/api/config")["viser_url"]
             empty_url = start_empty_scene()
             scene_cpu = [
@@ -275,9 +299,10 @@ def main() -> int:
             browser.close()
         print(
             f"== training ({TRAIN}, {args.runs} pairs of runs without and with the page, "
-            "s of wall time; slowdown: the median of the pairs' ratios)"
+            "s of wall time; slowdown: the median of the pairs' ratios of wall time, and of the "
+            "studio's cores without the page to its cores with it)"
         )
-        for label, (without, walls, rates, cores), goal in (
+        for label, (without, walls, rates, cores, shares), goal in (
             ("scene still", idle, f"goal <= {IDLE_SLOWDOWN_GOAL}"),
             ("live simulator", live, "no goal: the scene redraws with every pose"),
         ):
@@ -285,7 +310,8 @@ def main() -> int:
             slowdown = statistics.median(b / a for a, b in zip(without, walls, strict=True))
             rate = statistics.median(rates) if rates else float("nan")
             print(
-                f"  {label:<15} no page {w0:5.2f}  page {w1:5.2f}   slowdown {slowdown:5.2f}x ({goal})"
+                f"  {label:<15} no page {w0:5.2f}  page {w1:5.2f}   slowdown {slowdown:5.2f}x, "
+                f"by cores {statistics.median(shares):5.2f}x ({goal})"
                 f"   curve updates {rate:5.1f}/s (goal >= 5)"
                 f"   browser used {statistics.median(cores):4.2f} of {os.cpu_count()} cores"
             )
@@ -315,33 +341,55 @@ def main() -> int:
 
 
 def measure_with_page(
-    browser: Any, base: str, tag: str, runs: int
-) -> tuple[list[float], list[float], list[float], list[float]]:
-    """Train ``runs`` pairs of runs, one with no page open, then one with the page open.
+    browser: Any, base: str, tag: str, runs: int, studio_pid: int
+) -> tuple[list[float], list[float], list[float], list[float], list[float]]:
+    """Train ``runs`` pairs of runs, one with no page open and one with the page open.
 
     Returns the wall times without and with the page, the curve updates per second the page
-    showed, and the cores the browser used meanwhile (it competes with training for this
-    machine's CPU). Pairs, not one block per condition: this machine's speed drifts by tens of
-    percent over minutes (other virtual machines share its host), and a drift between two blocks
-    would read as a slowdown.
+    showed, the cores the browser used meanwhile (it competes with training for this machine's
+    CPU), and per pair the studio's cores without the page over its cores with it. Pairs, not one
+    block per condition: this machine's speed drifts by tens of percent over minutes (the same
+    run took 14 to 25 CPU seconds a minute apart: other virtual machines share its host), and a
+    drift between two blocks would read as a slowdown. The cores ratio does not depend on that
+    speed: it says how much of the machine the page took from training.
     """
-    without, walls, rates, cores = [], [], [], []
-    for i in range(runs):
-        without.append(wall(train(base, f"{tag}-no-page-{i}")))
+    without, walls, rates, cores, shares = [], [], [], [], []
+
+    def alone(i: int) -> float:
+        """Train with no page open; the studio's cores meanwhile."""
+        cpu0 = process_cpu_seconds(studio_pid)
+        run = train(base, f"{tag}-no-page-{i}")
+        without.append(wall(run))
+        return (process_cpu_seconds(studio_pid) - cpu0) / wall(run)
+
+    def with_page(i: int) -> float:
+        """Train with the page open (loaded and settled first); the studio's cores meanwhile."""
         ctx = browser.new_context(viewport={"width": 1440, "height": 900})
         page = ctx.new_page()
         page.goto(base + "/")
         page.wait_for_selector("body[data-ready='1']", timeout=30_000)
-        time.sleep(2.0)  # the scene connects and settles
+        wait_until_browser_settles()
         before = page.evaluate("() => window.studio.curveRenders || 0")
         cpu = chromium_cpu_seconds()
+        cpu0 = process_cpu_seconds(studio_pid)
         run = train(base, f"{tag}-page-{i}")
+        studio_cores = (process_cpu_seconds(studio_pid) - cpu0) / wall(run)
         cores.append((chromium_cpu_seconds() - cpu) / wall(run))
         renders = page.evaluate("() => window.studio.curveRenders || 0") - before
         walls.append(wall(run))
         rates.append(renders / wall(run))
         ctx.close()
-    return without, walls, rates, cores
+        return studio_cores
+
+    for i in range(runs):  # the order alternates, so a steady drift in speed cancels out
+        if i % 2 == 0:
+            studio_alone = alone(i)
+            studio_with_page = with_page(i)
+        else:
+            studio_with_page = with_page(i)
+            studio_alone = alone(i)
+        shares.append(studio_alone / studio_with_page)
+    return without, walls, rates, cores, shares
 
 
 IDLE_SLOWDOWN_GOAL = 1.18
