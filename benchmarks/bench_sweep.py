@@ -5,7 +5,8 @@ trials of about a second each (the paper's grid, 20 experiments x 100 episodes o
 planning with 1000 updates per step) three ways: a plain loop training the trials one after
 another in this process, ``run_sweep`` on a local Ray with ONE worker, and with 2 workers. Both
 sides do identical work per trial: the same trials (``trial_record``), written as the same
-ordinary runs (``RunFolder.train`` with one thread per trial); the kernels are warmed up first.
+ordinary runs (``RunFolder.train`` with one thread per trial); the kernels are warmed up first,
+and a throwaway sweep of tiny trials takes the driver's one-time costs (first imports).
 
 A sweep's wall time is a fixed cost per sweep plus a cost per trial. Each side runs two sweep sizes
 (``--sizes``, default 4 and 16 trials); the line through the two walls gives
@@ -191,6 +192,9 @@ def main() -> None:
     runs: list[dict[str, dict[int, Sweep]]] = []  # per repeat, per side, per size
     with tempfile.TemporaryDirectory() as tmp:
         root = Path(tmp)
+        # A throwaway sweep of tiny trials first: what the driver process does once (imports of
+        # Tune's and matplotlib's modules on first use) must fall on no measured sweep.
+        on_ray(sweep_spec(2, 1), root / "warm-up", WORKERS)
         for r in range(args.repeats):
             runs.append({})
             order = SIDES if r % 2 == 0 else SIDES[::-1]
