@@ -10,7 +10,8 @@ of a trial whose worker died, and the optional ASHA early stopping; this module 
   folders) into ``<data>/runs/<sweep>/<sweep>-<trial>/``, with ``origin="sweep"`` and
   ``group=<sweep>``, so the page lists, plots, watches and exports it like any run.
 - **The sweep folder** ``<data>/sweeps/<sweep>/``: ``sweep.json`` (the spec, its trials, status),
-  ``trials/<trial>.json`` (written by the driver when a trial ends: node, attempts, times),
+  ``trials/<trial>.json`` (written by the driver when a trial ends: where it ran, i.e. Ray node,
+  hostname and worker pid, attempts, times),
   ``sweep.csv`` (one row per trial: settings, metrics, CPU and wall time), ``sweep.png``/``.svg``
   (the metric against the first swept setting, mean and standard error over seeds) and ``ray/``
   (Tune's own bookkeeping).
