@@ -278,15 +278,25 @@ def main() -> int:
             http("PUT", base + "/api/source", {"kind": "recording", "recording": SAMPLE})
             http("POST", base + "/api/source/playback", {"action": "pause"})
             idle = measure_with_page(browser, base, "idle", args.runs, proc.pid)
-            scene_url = http("GET", base + "/api/config")["viser_url"]
+            scene_url = http("GET", base + "/api/config")["viser_url"].rstrip("/")
             empty_url = start_empty_scene()
             scene_cpu = [
                 ("empty viser scene (baseline)", scene_cores(browser, empty_url, args.runs)),
                 ("studio scene, still", scene_cores(browser, scene_url, args.runs)),
+                (
+                    f"  as the page loads it here ({SOFTWARE_DPR_QUERY})",
+                    scene_cores(browser, f"{scene_url}/?{SOFTWARE_DPR_QUERY}", args.runs),
+                ),
             ]
             http("PUT", base + "/api/source", {"kind": "simulator"})
             scene_cpu.append(
                 ("studio scene, live simulator", scene_cores(browser, scene_url, args.runs))
+            )
+            scene_cpu.append(
+                (
+                    f"  as the page loads it here ({SOFTWARE_DPR_QUERY})",
+                    scene_cores(browser, f"{scene_url}/?{SOFTWARE_DPR_QUERY}", args.runs),
+                )
             )
             latencies = {
                 "page open (drawn in software on these 2 cores)": motion_to_scene(
@@ -319,7 +329,7 @@ def main() -> int:
             f"== the 3D scene alone (browser cores over {SCENE_CPU_S:.0f} s, median of {args.runs})"
         )
         for label, cores in scene_cpu:
-            print(f"  {label:<32} {statistics.median(cores):5.2f} cores")
+            print(f"  {label:<40} {statistics.median(cores):5.2f} cores")
         print(f"== motion to scene while training (pose steps at {LATENCY_RATE_HZ:.0f} Hz, ms)")
         for label, values in latencies.items():
             if values:
@@ -392,6 +402,8 @@ def measure_with_page(
     return without, walls, rates, cores, shares
 
 
+SOFTWARE_DPR_QUERY = "fixedDpr=0.5"
+"""How the page loads the scene in a browser without a GPU (app.js, SOFTWARE_SCENE_DPR)."""
 IDLE_SLOWDOWN_GOAL = 1.18
 """Training with the page open on a still scene, against no page (issue 10 keeps it within 1.18x)."""
 SCENE_CPU_S = 5.0
