@@ -22,6 +22,7 @@ from __future__ import annotations
 import copy
 import importlib.util
 import threading
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -298,10 +299,18 @@ class HumanBody:
 
     def link_pose(self, link: str, q_human: np.ndarray | None) -> np.ndarray:
         """The pose (4x4, arm base frame) of a ``human.urdf`` link."""
-        fid = self.model.getFrameId(link, pin.FrameType.BODY)
-        if fid >= len(self.model.frames):
-            raise KinematicsError(f"human.urdf has no link {link!r}; give a link of the model.")
+        return self.link_poses((link,), q_human)[0]
+
+    def link_poses(self, links: Sequence[str], q_human: np.ndarray | None) -> np.ndarray:
+        """The poses ``(len(links), 4, 4)`` (arm base frame) of ``human.urdf`` links, from one
+        forward-kinematics pass (the scene asks for three links at every live pose)."""
+        fids = []
+        for link in links:
+            fid = self.model.getFrameId(link, pin.FrameType.BODY)
+            if fid >= len(self.model.frames):
+                raise KinematicsError(f"human.urdf has no link {link!r}; give a link of the model.")
+            fids.append(fid)
         q = self.full_q(q_human)
         with self._lock:
             pin.framesForwardKinematics(self.model, self.data, q)
-            return self._baseMurdf @ self.data.oMf[fid].homogeneous
+            return np.stack([self._baseMurdf @ self.data.oMf[fid].homogeneous for fid in fids])

@@ -451,12 +451,8 @@ class StudioScene:
         return self._on_sleeve(self.body, tape, q_human)
 
     def _on_sleeve(self, body: HumanBody, tape: np.ndarray, q_human: np.ndarray) -> np.ndarray:
-        axis = np.stack(
-            [
-                body.link_pose(f"{body.side}_{link}", q_human)[:3, 3]
-                for link in ("upperarm", "lowerarm", "hand")
-            ]
-        )
+        links = [f"{body.side}_{link}" for link in ("upperarm", "lowerarm", "hand")]
+        axis = body.link_poses(links, q_human)[:, :3, 3]
         out = np.array(tape, dtype=float)
         # Pushed off one segment, a point near the elbow may land inside the other: a few rounds
         # settle it. All points at once: this runs for every live pose the scene shows.
