@@ -1348,21 +1348,18 @@ async function loadConfig() {
     S.config = await api("GET", "/api/config");
     resetTrainForm(); // the learning package's defaults, the one definition
   } catch (e) {
-    setText("scene-msg", `The 3D scene is unavailable: ${e.message}`);
-    $("scene-msg").hidden = false;
+    showError("scene-msg", `The 3D scene is unavailable: ${e.message}`);
     return;
   }
   setText("version", `v${S.config.version}`);
   const url = S.config.viser_url;
   if (!url) {
-    setText("scene-msg", "This studio runs without a 3D scene (no viser URL configured).");
-    $("scene-msg").hidden = false;
+    showError("scene-msg", "This studio runs without a 3D scene (no viser URL configured).");
     return;
   }
   const src = sceneUrl(url);
   if (S.config.scene_instance && !(await sceneIsOurs(src, S.config.scene_instance))) {
-    setText("scene-msg", `The 3D scene at ${new URL(src).host} does not belong to this studio (another studio or program answers there); restart this studio so that it starts its own scene.`);
-    $("scene-msg").hidden = false;
+    showError("scene-msg", `The 3D scene at ${new URL(src).host} does not belong to this studio (another studio or program answers there); restart this studio so that it starts its own scene.`);
     return;
   }
   $("scene").src = S.softwareScene ? withSceneDpr(src, SOFTWARE_SCENE_DPR) : src;
@@ -1375,7 +1372,8 @@ async function loadConfig() {
  */
 function softwareWebGL() {
   try {
-    const gl = document.createElement("canvas").getContext("webgl2") || document.createElement("canvas").getContext("webgl");
+    const canvas = document.createElement("canvas");
+    const gl = canvas.getContext("webgl2") || canvas.getContext("webgl");
     if (!gl) return false;
     const info = gl.getExtension("WEBGL_debug_renderer_info");
     const renderer = String(gl.getParameter(info ? info.UNMASKED_RENDERER_WEBGL : gl.RENDERER));
