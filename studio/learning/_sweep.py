@@ -708,8 +708,7 @@ def _trainable(config: dict[str, Any], job: _Job) -> None:
     """
     from ray import tune
 
-    for key, value in RAY_ENVIRONMENT.items():  # e.g. how long a re-used worker waits for a stop
-        os.environ.setdefault(key, value)
+    _set_ray_environment()  # in this worker too: e.g. how long a re-used worker waits for a stop
     spec = job.spec
     trial = job.trials[config["key"]]
     record = trial_record(spec, trial)
@@ -928,6 +927,11 @@ FIGURE_FORMATS = ("png", "svg")
 """The summary figure is written in these formats."""
 
 
+def _check_figure_format(fmt: object) -> None:
+    if fmt not in FIGURE_FORMATS:
+        raise LearningError(f"The figure format {fmt!r} is not supported; use png or svg.")
+
+
 def sweep_figure(rows: Sequence[Mapping[str, Any]], spec: SweepSpec, fmt: str = "png") -> bytes:
     """The metric against the first swept setting (mean and standard error over seeds), one line
     per combination of the other swept settings, as PNG or SVG bytes."""
@@ -941,8 +945,7 @@ def sweep_figures(
     from matplotlib.figure import Figure
 
     for fmt in formats:
-        if fmt not in FIGURE_FORMATS:
-            raise LearningError(f"The figure format {fmt!r} is not supported; use png or svg.")
+        _check_figure_format(fmt)
     fig = Figure(figsize=(7, 4), dpi=120, layout="constrained")
     ax = fig.add_subplot()
     x_name = spec.swept[0]
@@ -1051,8 +1054,7 @@ class SweepInfo:
 
     def figure(self, fmt: str = "png") -> bytes:
         """The summary figure (:func:`sweep_figure`): as written, or drawn from the run folders."""
-        if fmt not in FIGURE_FORMATS:
-            raise LearningError(f"The figure format {fmt!r} is not supported; use png or svg.")
+        _check_figure_format(fmt)
         if self.status != "running":
             with contextlib.suppress(OSError):
                 return (self.folder / f"{FIGURE_STEM}.{fmt}").read_bytes()
@@ -1130,9 +1132,14 @@ def resume_target(data_dir: Path, what: str | None) -> SweepSpec:
 # ----------------------------------------------------------------------------- running it
 
 
-def _import_ray() -> Any:
+def _set_ray_environment() -> None:
+    """Set :data:`RAY_ENVIRONMENT` (each variable unless already set) in this process."""
     for key, value in RAY_ENVIRONMENT.items():
         os.environ.setdefault(key, value)
+
+
+def _import_ray() -> Any:
+    _set_ray_environment()
     try:
         import ray
         from ray import tune  # noqa: F401
