@@ -212,18 +212,15 @@ def chromium_cpu_seconds() -> float:
     Only the browser this script started counts (its processes descend from this one): other
     programs' browsers on a shared machine must not enter the figure.
     """
-    tick = os.sysconf("SC_CLK_TCK")
     total = 0.0
     for pid in _descendants(os.getpid()):
         try:
             with open(f"/proc/{pid}/cmdline", "rb") as f:
                 if b"chromium" not in f.read():
                     continue
-            with open(f"/proc/{pid}/stat") as f:
-                fields = f.read().rsplit(")", 1)[1].split()
+            total += process_cpu_seconds(pid)
         except OSError:  # the process ended meanwhile
             continue
-        total += (int(fields[11]) + int(fields[12])) / tick
     return total
 
 
