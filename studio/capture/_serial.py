@@ -42,7 +42,8 @@ def _import_serial() -> Any:
         import serial
     except ImportError:
         raise CaptureError(
-            "reading a ShapeTape needs pyserial; install it with `pip install teach-studio[serial]`."
+            'reading a ShapeTape needs pyserial; install it with `pip install -e ".[serial]"` '
+            "in the studio's folder, then restart the studio."
         ) from None
     return serial
 

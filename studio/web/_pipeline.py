@@ -131,10 +131,18 @@ class Pipeline:
                 self._start_error = f"The {kind} source could not start ({err.strerror or err}); check the device or port and try again."
 
     def report_error(self, kind: str, message: str) -> None:
-        """Show a source that could not even be built as selected, with its error."""
+        """Switch to ``kind`` without a source, showing why it could not even be built.
+
+        A failed switch ends the way a source that cannot start does: the old source is
+        stopped and ``kind`` is selected with ``message`` as its error, so the server's state,
+        the page's selector and the one message shown all name the same source.
+
+        Raises:
+            ConflictError: a capture is running (stop it before switching).
+        """
         with self._lock:
-            self._stop_source()
-            self._kind, self._recording, self._start_error = kind, None, message
+            self.set_source(None, kind)  # type: ignore[arg-type]
+            self._start_error = message
 
     def clear_source(self) -> None:
         """Stop the source and run without one."""

@@ -182,9 +182,14 @@ class Studio:
                 )
             from studio.capture import SerialSource
 
-            # A missing or malformed calibration file is refused here, before the old source stops.
             path = calibration.strip() if calibration else ""
-            source = SerialSource(device, calibration=path or None)
+            try:
+                source = SerialSource(device, calibration=path or None)
+            except StudioError as err:
+                # pyserial missing, a missing or malformed calibration file: the switch happens
+                # as for a device that cannot open, with the serial source showing why.
+                self.pipeline.report_error(kind, str(err))
+                return
             self.pipeline.set_source(source, kind)
         else:  # the schema allows only the kinds above
             raise InvalidError(f"kind is {kind!r}; give simulator, recording, network or serial.")

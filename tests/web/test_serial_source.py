@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import re
 import shutil
 import time
+from pathlib import Path
 
 import numpy as np
 
@@ -51,15 +53,55 @@ def test_a_serial_tape_with_its_calibration_is_captured_in_radians(client, tmp_p
     assert "disconnected" in client.get("/api/source").json()["error"]
 
 
-def test_a_missing_calibration_file_is_refused_and_the_source_keeps_running(client, tmp_path):
+def _playing(client, tmp_path) -> None:
     (tmp_path / "recordings").mkdir(exist_ok=True)
     shutil.copy(SAMPLE, tmp_path / "recordings" / "take.tape.csv")
     assert client.put("/api/source", json={"kind": "recording", "recording": "take"}).is_success
+    assert wait_for(lambda: client.get("/api/source").json()["frames"] > 0, 10)
+
+
+def _switched_to_serial_with_one_error(client, answer, words: str) -> None:
+    """A failed switch leaves one state: the old source stopped, serial selected, one error."""
+    assert answer.status_code == 200, answer.text
+    for source in (answer.json(), client.get("/api/source").json()):
+        assert source["kind"] == "serial" and source["running"] is False
+        assert source["recording"] is None and source["frames"] == 0
+        assert words in source["error"]
+    assert client.app.state.studio.pipeline.source is None  # the recording no longer plays
+
+
+def test_a_missing_calibration_file_switches_to_serial_showing_why(client, tmp_path):
+    _playing(client, tmp_path)
     r = client.put(
         "/api/source",
         json={"kind": "serial", "device": "/dev/ttyUSB0", "calibration": "/nowhere/cal.json"},
     )
-    assert r.status_code == 422
-    assert "/nowhere/cal.json" in r.json()["detail"]
+    _switched_to_serial_with_one_error(client, r, "/nowhere/cal.json")
+
+
+def test_without_pyserial_the_switch_names_the_readme_install(client, tmp_path, monkeypatch):
+    import builtins
+
+    real_import = builtins.__import__
+
+    def no_serial(name, *args, **kwargs):
+        if name == "serial" or name.startswith("serial."):
+            raise ImportError("No module named 'serial'")
+        return real_import(name, *args, **kwargs)
+
+    _playing(client, tmp_path)
+    monkeypatch.setattr(builtins, "__import__", no_serial)
+    r = client.put("/api/source", json={"kind": "serial", "device": "/dev/ttyUSB0"})
+    monkeypatch.undo()
+    _switched_to_serial_with_one_error(client, r, "pyserial")
+    readme = (Path(__file__).resolve().parents[2] / "README.md").read_text()
+    (install,) = re.findall(r"`(pip install [^`]*\[serial\][^`]*)`", r.json()["error"])
+    assert f"`{install}`" in readme  # the page's hint is the README's command, word for word
+
+
+def test_a_switch_without_a_device_is_refused_and_changes_nothing(client, tmp_path):
+    _playing(client, tmp_path)
+    r = client.put("/api/source", json={"kind": "serial", "device": ""})
+    assert r.status_code == 422 and "device is missing" in r.json()["detail"]
     source = client.get("/api/source").json()
-    assert source["kind"] == "recording" and source["error"] is None
+    assert source["kind"] == "recording" and source["error"] is None and source["running"]

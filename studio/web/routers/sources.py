@@ -27,8 +27,10 @@ def read_source(studio: StudioDep) -> SourcePublic:
 def set_source(body: SourceUpdate, studio: StudioDep) -> SourcePublic:
     """Switch the live source; the old one is stopped first (409 while recording).
 
-    A source that cannot start (no such serial device, port in use) is still selected and shows
-    its error in ``error``, so the page can show it next to the source.
+    A source that cannot be built or cannot start (pyserial missing, an unreadable calibration
+    file, no such serial device, a port in use) is still selected, the old one stopped, and
+    shows its error in ``error``, so the page shows one message next to the source it names.
+    A request that names no device or recording is refused (4xx) and changes nothing.
     """
     studio.set_source(**body.model_dump())
     return SourcePublic.model_validate(studio.source_public())
