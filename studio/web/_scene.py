@@ -39,6 +39,10 @@ from studio.kinematics import HumanBody, MeshConfig, MeshPart, Puma560, puma560_
 log = logging.getLogger(__name__)
 
 TAPE_LIFT_ROUNDS = 3
+SOFTWARE_WEBGL_NOTICE = "webgl-software-rendering"
+"""The id of the notice viser's client raises by itself when WebGL is drawn in software
+(``client/src/BrowserWarning.tsx``). The studio's page says the same in its own words, beside the
+scene rather than over it, so every browser that connects gets this notice closed."""
 """Rounds of pushing tape points off the arm's segments (see ``StudioScene.tape_on_sleeve``)."""
 
 
@@ -170,6 +174,21 @@ def pose_at(
 def wxyz_of(rotations: np.ndarray) -> np.ndarray:
     """Unit quaternions (w, x, y, z) of rotation matrices ``(..., 3, 3)`` (viser's convention)."""
     return np.asarray(vtf.SO3.from_matrix(np.asarray(rotations, dtype=float)).wxyz)
+
+
+def _close_software_webgl_notice(client: viser.ClientHandle) -> None:
+    """Close viser's own software-WebGL notice in a browser that just connected.
+
+    The client raises it before it connects, under a fixed id, and viser's message handler
+    closes a notification by id (``RemoveNotificationMessage``); viser has no public call for a
+    notice the client raised itself, hence the connection's message queue. A browser whose WebGL
+    is missing altogether still gets viser's "WebGL unavailable" notice.
+    """
+    from viser import _messages
+
+    client._websock_connection.queue_message(
+        _messages.RemoveNotificationMessage(SOFTWARE_WEBGL_NOTICE)
+    )
 
 
 def _rgb255(rgb: Sequence[float]) -> tuple[int, int, int]:
@@ -377,6 +396,12 @@ class StudioScene:
         self._push_robot(self._robot_handles, self._q_robot_shown)
         reset = self.server.gui.add_button("Reset view", hint="Frame both bodies again")
         reset.on_click(lambda event: self.reset_view(event.client))
+        # viser's control panel floats over the scene by default (its connection status and
+        # the button above): dock it to the right edge, folded into a narrow rail, so that it
+        # takes a strip beside the scene instead of covering a corner of it.
+        self.server.gui.main_panel.dock_right()
+        self.server.gui.main_panel.minimize()
+        self.server.on_client_connect(_close_software_webgl_notice)
 
     def _add_robot(
         self, root: str, opacity: float | None, visible: bool = True

@@ -56,9 +56,10 @@ def scene_page(browser: Any, scene: Any) -> Iterator[Any]:
     deadline = time.monotonic() + SETTLE_TIMEOUT_S
     while not scene.server.get_clients() and time.monotonic() < deadline:
         time.sleep(0.05)
-    # viser's own notices (software WebGL, connection) cover parts of the view: close them.
-    for button in page.locator("button.mantine-Notification-closeButton").all():
-        button.click()
+    # viser's software-WebGL notice is closed by the studio once the browser connects.
+    page.wait_for_function(
+        "() => !document.getElementById('webgl-software-rendering')", timeout=60_000
+    )
     try:
         yield page
     finally:
@@ -145,7 +146,11 @@ def test_reset_view_returns_to_the_default_camera(scene: Any, scene_page: Any) -
     while np.allclose(client.camera.position, scene.layout.camera_position, atol=1e-3):
         assert time.monotonic() < deadline, "the camera did not move"
         time.sleep(0.05)
-    scene_page.get_by_role("button", name="Reset view").click()
+    # viser's panel is folded into a rail beside the scene: unfold it to reach the button.
+    reset = scene_page.get_by_role("button", name="Reset view")
+    if not reset.is_visible():
+        scene_page.get_by_role("button", name="Expand column").click()
+    reset.click()
     while not np.allclose(client.camera.position, scene.layout.camera_position, atol=1e-3):
         assert time.monotonic() < deadline, "Reset view did not bring the camera back"
         time.sleep(0.05)
