@@ -58,6 +58,10 @@ class ConfigPublic(BaseModel):
         None, description="the train form's defaults: the learning package's, served once"
     )
     planners: list[str] = Field(default_factory=list, description="the planning modes")
+    scene_colors: dict[str, tuple[int, int, int]] = Field(
+        default_factory=dict,
+        description="the scene's named colours (0-255 rgb): the page's scene legend uses them",
+    )
 
 
 # ----------------------------------------------------------------------------- source

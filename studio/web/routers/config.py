@@ -9,6 +9,7 @@ from studio.learning import PLANNERS
 
 from ... import __version__
 from .._deps import SettingsDep
+from .._scene import SceneLayout
 from .._schemas import ConfigPublic, RunCreate
 
 router = APIRouter(prefix="/api/config", tags=["config"])
@@ -16,7 +17,8 @@ router = APIRouter(prefix="/api/config", tags=["config"])
 
 @router.get("", response_model=ConfigPublic)
 def read_config(settings: SettingsDep) -> ConfigPublic:
-    """The viser scene's URL, the studio version, the upload limit and the training defaults."""
+    """The viser scene's URL and colours, the studio version, the upload limit and the training
+    defaults."""
     return ConfigPublic(
         viser_url=settings.scene_url(),
         version=__version__,
@@ -25,4 +27,5 @@ def read_config(settings: SettingsDep) -> ConfigPublic:
         scene_instance=settings.scene_instance,
         training=RunCreate(),
         planners=list(PLANNERS),
+        scene_colors=SceneLayout().colors,
     )

@@ -250,10 +250,17 @@ async function applySource() {
   } else if ($("source-seed").value !== "") {
     body.seed = Number($("source-seed").value);
   }
-  await guarded("source-error", async () => {
+  const switched = await guarded("source-error", async () => {
     S.source = await api("PUT", "/api/source", body);
     renderSource();
+    return true;
   }, $("source-apply"));
+  // A refused switch changed nothing on the server: the selector goes back to the source that
+  // still runs, so the page never names one source while another one feeds it.
+  if (!switched && S.source && S.source.kind) {
+    setProp("source-kind", "value", S.source.kind);
+    syncKindOptions();
+  }
 }
 
 async function simulatorReach(action) {
@@ -359,7 +366,7 @@ function recordingRow(r) {
   actions.push(el("button", { class: "icon", title: "download", testid: "recording-download", onclick: () => download(`/api/recordings/${enc(r.name)}/file`, `${r.name}.tape.csv`, "recordings-error") }, "⤓"));
   if (!r.sample) actions.push(el("button", { class: "icon", title: "delete", testid: "recording-delete", onclick: () => deleteRecording(r.name) }, "✕"));
   return el("tr", { "data-name": r.name, testid: "recording-row", title },
-    el("td", { class: "name" }, el("span", { text: r.name, testid: "recording-name" }), " ", ...flags),
+    el("td", { class: "name", title: [r.name, title].filter(Boolean).join("\n") }, el("span", { text: r.name, testid: "recording-name" }), " ", ...flags),
     el("td", { class: "num", testid: "recording-duration", text: fmtDuration(r.duration) }),
     el("td", { class: "num", text: String(r.frames) }),
     el("td", { class: "actions" }, ...actions),
@@ -758,12 +765,19 @@ function runColor(id) {
   return PALETTE[((i % PALETTE.length) + PALETTE.length) % PALETTE.length];
 }
 
+/** What a run learns, in words: the paper's grid (tabular) or continuous joints (tile coding).
+ * A run made before the continuous task existed has no task in its config: it is a grid run. */
+function runTask(r) {
+  const c = r.config || {};
+  return c.task === "arm-reach" ? `continuous, ${c.joints} joints` : "grid";
+}
+
 function runLabel(r) {
   const c = r.config || {};
   const name = r.name || r.id;
   const demos = (c.demonstrations || []).length;
   const planning = c.planning && !name.includes(c.planning) ? ` · ${c.planning}` : "";
-  return `${name}${planning}${demos && !/demo/.test(name) ? ` +${demos} demo` : ""}`;
+  return `${name} · ${runTask(r)}${planning}${demos && !/demo/.test(name) ? ` +${demos} demo` : ""}`;
 }
 
 function renderRuns() {
@@ -810,7 +824,7 @@ function runRow(r) {
       type: "checkbox", testid: "run-show", checked: S.shown.has(r.id),
       onchange: (e) => toggleShown(r.id, e.target.checked),
     })),
-    el("td", { class: "name" }, el("span", { class: "swatch", style: `background:${runColor(r.id)}` }), runLabel(r)),
+    el("td", { class: "name", title: runLabel(r) }, el("span", { class: "swatch", style: `background:${runColor(r.id)}` }), runLabel(r)),
     el("td", {}, el("span", { class: `badge ${r.status}`, testid: "run-status", text: r.status })),
     el("td", { title: `${r.episodes_done} / ${total} episodes` },
       el("span", { class: "progress", testid: "run-progress", "data-done": r.episodes_done },
@@ -859,7 +873,7 @@ function sweepRows(id) {
       type: "checkbox", testid: "sweep-show", checked: runs.length > 0 && runs.every((r) => S.shown.has(r.id)),
       onchange: (e) => toggleSweep(id, e.target.checked),
     })),
-    el("td", { class: "name" },
+    el("td", { class: "name", title: `sweep ${id}${about} (${runs.length} runs)` },
       el("button", { class: "icon", testid: "sweep-open", title: open ? "fold" : "unfold: summary, figure and trials",
         onclick: () => foldSweep(id) }, open ? "▾" : "▸"),
       `sweep ${id}${about} (${runs.length} runs)`),
@@ -1136,6 +1150,15 @@ function chartOptions(runs, band, log, width, height, xMode = "episode") {
   };
 }
 
+/** The chart's key: what the line, the band and the dashed marker mean (each run's name and
+ * colour are in uPlot's own legend under the chart). Written only when it changes. */
+function renderCurveKey(runs, data, band) {
+  setProp("curve-key", "hidden", runs.length === 0);
+  setProp("curve-key-band", "hidden", band === "none");
+  setText("curve-key-band-text", band === "minmax" ? "min–max" : "± 1 std");
+  setProp("curve-key-fewer", "hidden", !runs.some((r, i) => fewerFrom(data, i) !== null));
+}
+
 let chart = null;
 let chartKey = "";
 let chartRuns = []; // run ids of the chart's mean columns, in order
@@ -1160,10 +1183,12 @@ function renderCurves() {
   setProp("curve-empty", "hidden", runs.length > 0);
   if (!runs.length) {
     if (chart) { chart.destroy(); chart = null; chartKey = ""; chartRuns = []; }
+    setProp("curve-key", "hidden", true);
     return;
   }
   const key = JSON.stringify([runs.map((r) => [r.id, runLabel(r), runColor(r.id)]), band, log, xMode]);
   const data = chartData(runs, band, log, xMode);
+  renderCurveKey(runs, data, band);
   if (chart && key === chartKey) {
     chart.setData(data, !S.chartZoomed);
   } else {
@@ -1364,6 +1389,16 @@ async function loadConfig() {
   }
   $("scene").src = S.softwareScene ? withSceneDpr(src, SOFTWARE_SCENE_DPR) : src;
   setProp("scene-note", "hidden", !S.softwareScene);
+  showSceneLegend(S.config.scene_colors || {});
+}
+
+/** The scene's legend, in the scene's own colours (served by /api/config, defined once). */
+function showSceneLegend(colors) {
+  for (const sw of $("scene-legend").querySelectorAll("[data-color]")) {
+    const rgb = colors[sw.dataset.color];
+    if (rgb) sw.style.color = `rgb(${rgb.join(",")})`;
+  }
+  setProp("scene-legend", "hidden", false);
 }
 
 /**
