@@ -181,6 +181,9 @@ class RecordingPublic(BaseModel):
     size_bytes: int
     sample: bool
     error: str | None = None
+    capturing: bool = False
+    """Another studio (or ``studio record``) on the same data folder is writing it now: its
+    frames so far are not counted, and it is neither recovered nor deletable."""
 
 
 class RecordingCopy(_Body):

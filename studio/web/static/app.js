@@ -348,16 +348,17 @@ function recordingRow(r) {
   if (r.sample) flags.push(el("span", { class: "badge", text: "sample", title: "shipped with the studio: read-only" }));
   if (r.recovered) flags.push(el("span", { class: "badge warn", text: "recovered", title: "the capture did not close cleanly; every frame written is kept" }));
   if (r.error) flags.push(el("span", { class: "badge failed", text: "unreadable", title: r.error, testid: "recording-damaged" }));
+  if (r.capturing) flags.push(el("span", { class: "badge warn", text: "being captured", title: "another studio on this data folder is recording it; it can be changed once that capture stops", testid: "recording-capturing" }));
   const title = [r.error, r.notes, r.operator && `operator: ${r.operator}`, r.created].filter(Boolean).join("\n");
   const actions = [];
   if (!r.error) actions.push(el("button", { class: "icon", title: "play as the live source", testid: "recording-play", onclick: () => useRecording(r.name) }, "▶"));
   if (r.sample) {
     actions.push(el("button", { class: "icon", title: "copy to my recordings", testid: "recording-copy", onclick: () => copyRecording(r.name) }, "copy"));
-  } else {
+  } else if (!r.capturing) {
     actions.push(el("button", { class: "icon", title: "rename / notes", testid: "recording-edit", onclick: () => editRecording(r) }, "✎"));
   }
   actions.push(el("button", { class: "icon", title: "download", testid: "recording-download", onclick: () => download(`/api/recordings/${enc(r.name)}/file`, `${r.name}.tape.csv`, "recordings-error") }, "⤓"));
-  if (!r.sample) actions.push(el("button", { class: "icon", title: "delete", testid: "recording-delete", onclick: () => deleteRecording(r.name) }, "✕"));
+  if (!r.sample && !r.capturing) actions.push(el("button", { class: "icon", title: "delete", testid: "recording-delete", onclick: () => deleteRecording(r.name) }, "✕"));
   return el("tr", { "data-name": r.name, testid: "recording-row", title },
     el("td", { class: "name" }, el("span", { text: r.name, testid: "recording-name" }), " ", ...flags),
     el("td", { class: "num", testid: "recording-duration", text: fmtDuration(r.duration) }),
