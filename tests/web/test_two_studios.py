@@ -13,7 +13,7 @@ import pytest
 from studio.capture import RecordingError, RecordingWriter, TapeFrame
 from studio.samples import SAMPLES_DIR
 from studio.web._store import recording_store
-from tests.web.conftest import wait_for
+from tests.web.conftest import TINY_RUN, wait_for, wait_run
 
 
 def _names(client) -> dict[str, dict]:
@@ -64,3 +64,45 @@ def test_a_file_being_captured_is_never_deleted_by_the_store(tmp_path):
         assert (folder / "live.tape.csv").exists()
     store.delete("live")
     assert not (folder / "live.tape.csv").exists()
+
+
+LONG_RUN = {"planning": "full", "experiments": 1, "episodes": 100_000, "seed": 1}
+
+
+def test_a_second_studio_reads_the_first_ones_runs_and_never_rewrites_them(open_client, tmp_path):
+    a, b = open_client(), open_client()
+    long = a.post("/api/runs", json=LONG_RUN).json()["id"]
+    queued = a.post("/api/runs", json=TINY_RUN).json()["id"]
+    status_file = tmp_path / "runs" / queued / "status.json"
+    before = status_file.read_bytes()
+
+    listed = {r["id"]: r for r in b.get("/api/runs").json()}
+    assert listed[queued]["status"] == "queued" and listed[queued]["elsewhere"] is True
+    assert listed[long]["status"] in ("queued", "running") and listed[long]["elsewhere"]
+    assert status_file.read_bytes() == before  # listing wrote nothing
+    for response in (
+        b.delete(f"/api/runs/{queued}"),
+        b.post(f"/api/runs/{queued}/mark-stopped"),
+        b.post(f"/api/runs/{queued}/stop"),
+    ):
+        assert response.status_code == 409, response.text
+    assert (tmp_path / "runs" / queued / "config.json").exists()
+
+    a.post(f"/api/runs/{long}/stop")
+    assert wait_run(a, queued)["status"] == "done"  # A trained it: nothing went missing
+    assert wait_for(lambda: b.get(f"/api/runs/{queued}").json()["status"] == "done")
+    assert b.get(f"/api/runs/{long}").json()["status"] == "stopped"
+    assert b.delete(f"/api/runs/{queued}").status_code == 204  # finished: anyone may delete it
+
+
+def test_queued_runs_of_a_studio_that_closed_read_as_stopped(open_client, tmp_path):
+    a = open_client()
+    long = a.post("/api/runs", json=LONG_RUN).json()["id"]
+    queued = a.post("/api/runs", json=TINY_RUN).json()["id"]
+    a.__exit__(None, None, None)  # its queue lets its runs go
+    b = open_client()
+    listed = {r["id"]: r for r in b.get("/api/runs").json()}
+    assert listed[queued]["status"] == "stopped" and not listed[queued]["elsewhere"]
+    assert "before this run started" in listed[queued]["error"]
+    assert listed[long]["status"] == "stopped"
+    assert b.delete(f"/api/runs/{queued}").status_code == 204
