@@ -21,8 +21,10 @@ A run folder ``<parent>/<id>/`` holds:
 - ``curves.csv``: the :func:`curve_statistics` of ``steps.csv`` in the layout
   :data:`CURVE_COLUMNS`, written when the run ends (or by :meth:`RunFolder.recover` after a
   crash);
-- ``policy.policy.npz``: the best experiment's Q table (see ``_policy.py``), written when the run
-  ends, also when it was stopped (Stop, Ctrl-C) after finishing episodes.
+- ``policy.policy.npz``: the best experiment's Q table (see ``_policy.py``), saved with every
+  ``steps.csv`` checkpoint from the tables the kernels are filling (:attr:`LiveProgress.snapshot`)
+  and again when the run ends, also when it was stopped (Stop, Ctrl-C). A process killed with
+  ``kill -9`` leaves the policy of its last checkpoint.
 
 No file of a run folder, nor the folder itself, is read through a symbolic link.
 
@@ -1224,6 +1226,7 @@ class RunFolder:
                 done = live.completed
                 if now - last >= every and done != saved and not ended.is_set():
                     self.save_steps(live.steps, curves=False)
+                    self._checkpoint_policy(live)
                     saved, last = done, time.monotonic()
                     # a huge run's checkpoint costs: keep writing it under a tenth of the time
                     every = max(CHECKPOINT_SECONDS, CHECKPOINT_COST_FACTOR * (last - now))
@@ -1239,6 +1242,20 @@ class RunFolder:
         if interrupted:
             raise KeyboardInterrupt
         return result
+
+    def _checkpoint_policy(self, live: LiveProgress) -> None:
+        """Save the policy learnt so far (the kernels' tables as they are now), so a process
+        killed mid-run leaves one up to its last checkpoint; the run's end replaces it."""
+        snapshot = live.snapshot
+        if snapshot is None:  # the learner has not built its tables yet
+            return
+        result = snapshot()
+        if not result.completed.any():
+            return
+        try:
+            self.save_policy(result)
+        except (LearningError, ValueError) as err:  # diverged weights: keep the last good one
+            log.warning("run %s: policy checkpoint skipped: %s", self.id, err)
 
     def _finish(
         self,
