@@ -1124,8 +1124,9 @@ class RunFolder:
             self._owner.release()
             self._owner = None
 
-    def save_policy(self, result: ExperimentResult) -> None:
-        """Write the best experiment's Q table (or tile-coded weights) as the run's policy."""
+    def save_policy(self, result: ExperimentResult, compress: bool = True) -> None:
+        """Write the best experiment's Q table (or tile-coded weights) as the run's policy
+        (``compress`` false for a checkpoint: far quicker to write, read the same)."""
         best = result.best_experiment()
         tmp = self.path / f".{POLICY_FILE}.{secrets.token_hex(4)}.tmp.npz"
         notes = f"run {self.id}: experiment {best} of {self.record.experiments}, seed {self.record.seed}, {len(self.record.demonstrations)} demonstrations"
@@ -1133,7 +1134,7 @@ class RunFolder:
             from ._linear_policy import save_tile_policy
 
             try:
-                save_tile_policy(tmp, result, best, notes=notes)  # type: ignore[arg-type]
+                save_tile_policy(tmp, result, best, notes=notes, compress=compress)  # type: ignore[arg-type]
                 os.replace(tmp, self.policy_path)
             except OSError as err:
                 with contextlib.suppress(OSError):
@@ -1149,7 +1150,8 @@ class RunFolder:
                 result.config,
                 result.mean_steps(),
                 experiments=self.record.experiments,
-                notes=f"run {self.id}: experiment {best} of {self.record.experiments}, seed {self.record.seed}, {len(self.record.demonstrations)} demonstrations",
+                notes=notes,
+                compress=compress,
             )
             os.replace(tmp, self.policy_path)
         except OSError as err:
@@ -1253,7 +1255,7 @@ class RunFolder:
         if not result.completed.any():
             return
         try:
-            self.save_policy(result)
+            self.save_policy(result, compress=False)
         except (LearningError, ValueError) as err:  # diverged weights: keep the last good one
             log.warning("run %s: policy checkpoint skipped: %s", self.id, err)
 
