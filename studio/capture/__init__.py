@@ -40,6 +40,7 @@ from ._raw_import import read_raw_text as read_raw_text
 from ._recording_edit import DEMO_SUFFIX as DEMO_SUFFIX
 from ._recording_edit import being_recorded as being_recorded
 from ._recording_edit import copy_recording as copy_recording
+from ._recording_edit import delete_recording as delete_recording
 from ._recording_edit import rename_recording as rename_recording
 from ._recording_edit import update_recording_meta as update_recording_meta
 from ._recording_edit import write_recording as write_recording

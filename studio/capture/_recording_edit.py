@@ -7,12 +7,13 @@ a half-written one. A file under a running capture (its writer holds an ``flock`
 
 from __future__ import annotations
 
+import contextlib
 import fcntl
 import json
 import os
 import shutil
 import tempfile
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any, BinaryIO
@@ -63,7 +64,8 @@ def being_recorded(path: str | os.PathLike[str]) -> bool:
     """Whether a :class:`RecordingWriter` is appending to ``path`` right now (it holds the lock).
 
     Such a file has no ``# end`` line yet, which a reader alone would take for an interrupted
-    capture.
+    capture. The lock is seen from any process, so a second studio on the same data folder sees
+    the first one's capture too.
 
     Raises:
         RecordingError: the file does not exist or is not a regular file (a FIFO would block).
@@ -77,11 +79,43 @@ def being_recorded(path: str | os.PathLike[str]) -> bool:
         return False
 
 
-def _check_not_recording(path: Path) -> None:
-    if being_recorded(path):
-        raise RecordingError(
-            f"{path} is being recorded right now; stop the capture before editing it."
-        )
+def _busy_text(path: Path) -> str:
+    return (
+        f"{path.name} is being recorded right now (by this or another studio on the same data "
+        "folder); stop that capture first."
+    )
+
+
+@contextlib.contextmanager
+def _not_recording(path: Path) -> Iterator[BinaryIO]:
+    """Hold the writers' lock on ``path`` (open for reading) for a change, so no capture can be
+    holding the file meanwhile; a capture holding it now is refused."""
+    with _open(path) as f:
+        try:
+            fcntl.flock(f.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            raise RecordingError(_busy_text(path)) from None
+        yield f
+
+
+def delete_recording(path: str | os.PathLike[str]) -> None:
+    """Delete a recording's file, refusing one a capture is writing (in any process).
+
+    The check and the unlink happen under the writers' lock, so a capture of another studio on
+    the same data folder is never deleted under it. A symbolic link is removed itself, never
+    followed.
+
+    Raises:
+        RecordingError: a capture is writing the file, or it is not a regular file.
+    """
+    path = Path(path)
+    if path.is_symlink():
+        path.unlink()
+        return
+    with _not_recording(path) as f:
+        if os.fstat(f.fileno()).st_ino != os.lstat(path).st_ino:  # replaced meanwhile
+            raise RecordingError(f"{path.name} changed while it was being deleted; try again.")
+        path.unlink()
 
 
 def update_recording_meta(path: str | os.PathLike[str], **changes: Any) -> dict[str, Any]:
@@ -108,8 +142,7 @@ def update_recording_meta(path: str | os.PathLike[str], **changes: Any) -> dict[
             )
         if not isinstance(value, str):
             raise RecordingError(f"{key} must be text, got {type(value).__name__}; give a string.")
-    _check_not_recording(path)
-    with _open(path) as source:
+    with _not_recording(path) as source:
         meta = _parse_header(path, _first_line(path, source))
         meta.update(changes)
         meta["edited"] = datetime.now(UTC).isoformat(timespec="seconds")

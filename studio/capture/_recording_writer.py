@@ -15,6 +15,7 @@ from __future__ import annotations
 import contextlib
 import fcntl
 import os
+import secrets
 import threading
 import time
 from datetime import UTC, datetime
@@ -80,6 +81,39 @@ def recording_meta(
     }
 
 
+def _create_locked(path: Path) -> int:
+    """Create ``path`` for appending, already holding the writers' ``flock``.
+
+    The file is made under a hidden name, locked, then given its name by a hard link (which
+    never replaces a file), so no other process (a second studio on the same folder) ever sees it
+    unlocked and takes it for an interrupted capture it may delete.
+    """
+    tmp = path.with_name(f".{path.name}.{secrets.token_hex(4)}.tmp")
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_APPEND, 0o644)
+    except OSError as err:
+        raise RecordingError(
+            f"cannot create {path} ({err.strerror}); choose a writable folder."
+        ) from None
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX)
+        os.link(tmp, path)
+    except FileExistsError:
+        os.close(fd)
+        raise RecordingError(
+            f"{path} already exists; choose another file name (recordings are never overwritten)."
+        ) from None
+    except OSError as err:
+        os.close(fd)
+        raise RecordingError(
+            f"cannot create {path} ({err.strerror}); choose a writable folder."
+        ) from None
+    finally:
+        tmp.unlink(missing_ok=True)
+    return fd
+
+
 class RecordingWriter:
     """Append frames to a new ``*.tape.csv`` file, crash-safely.
 
@@ -135,18 +169,7 @@ class RecordingWriter:
             source=source,
             **(extra or {}),
         )
-        try:
-            self.path.parent.mkdir(parents=True, exist_ok=True)
-            self._fd = os.open(self.path, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_APPEND, 0o644)
-        except FileExistsError:
-            raise RecordingError(
-                f"{self.path} already exists; choose another file name (recordings are never overwritten)."
-            ) from None
-        except OSError as err:
-            raise RecordingError(
-                f"cannot create {self.path} ({err.strerror}); choose a writable folder."
-            ) from None
-        fcntl.flock(self._fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        self._fd = _create_locked(self.path)
         self._lock = threading.Lock()
         self._buffer: list[str] = [header_line(self.meta), ",".join(columns(self.regions)) + "\n"]
         self._frames = 0

@@ -75,6 +75,7 @@ from ._runs import curve_figure as curve_figure
 from ._runs import curve_plot as curve_plot
 from ._runs import curve_statistics as curve_statistics
 from ._runs import curves_csv as curves_csv
+from ._runs import delete_run_folder as delete_run_folder
 from ._runs import downsample_curve as downsample_curve
 from ._runs import find_runs as find_runs
 from ._runs import pid_alive as pid_alive

@@ -40,9 +40,10 @@ import os
 import sys
 import threading
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
+from typing import Any, TypeVar
 
 import numpy as np
 from numba import njit
@@ -51,6 +52,8 @@ from ._config import PLANNERS, DynaQConfig, check_budget
 from ._errors import LearningError
 from ._mdp import TabularMDP
 from ._tiles import TileCoding
+
+R = TypeVar("R", bound="ExperimentResult")
 
 _PLANNER_CODE = {name: code for code, name in enumerate(PLANNERS)}
 MAX_NICENESS = 19
@@ -382,6 +385,10 @@ class LiveProgress:
     another thread to draw live curves, and calls :meth:`stop` to end the run at the next episode
     boundary.
 
+    The learner also sets :attr:`snapshot` once its tables exist: the result so far, whose Q
+    tables (or weights) are the very arrays the kernels update in place, so a checkpoint can save
+    the policy learnt so far without stopping them (or copying every table).
+
     Args:
         experiments: number of experiments of the run this object will follow.
         episodes: episodes per experiment.
@@ -395,6 +402,7 @@ class LiveProgress:
         self.updates = np.full((experiments, episodes), -1, np.int64)
         self.niceness = niceness
         self._stop = np.zeros(1, np.int64)
+        self.snapshot: Callable[[], ExperimentResult] | None = None
 
     def stop(self) -> None:
         """Ask every experiment to stop at its next episode boundary."""
@@ -414,6 +422,30 @@ class LiveProgress:
     def total(self) -> int:
         """Episodes the run will do if not stopped."""
         return int(self.steps.size)
+
+
+def result_so_far(
+    kind: type[R],
+    live: LiveProgress,
+    cpu_seconds: np.ndarray,
+    q: np.ndarray,
+    config: DynaQConfig,
+    seed: int,
+    **extra: Any,
+) -> R:
+    """A learner's result as it stands: the progress so far, and ``q``, the tables the kernels
+    are updating in place (not copied); ``stopped`` while episodes remain. Every learner builds
+    its result, final or partial (:attr:`LiveProgress.snapshot`), through this."""
+    return kind(
+        steps=live.steps.copy(),
+        updates=live.updates.copy(),
+        cpu_seconds=cpu_seconds.copy(),
+        q=q,
+        config=config,
+        seed=seed,
+        stopped=bool(np.any(live.steps < 0)),
+        **extra,
+    )
 
 
 def lower_thread_priority(niceness: int) -> None:
@@ -683,6 +715,10 @@ def run_experiments(
         )  # fmt: skip
         cpu_seconds[e] = time.thread_time() - start
 
+    def so_far() -> ExperimentResult:
+        return result_so_far(ExperimentResult, live, cpu_seconds, q, config, seed)
+
+    live.snapshot = so_far
     workers = min(workers, experiments)
     if workers == 1:
         for e in range(experiments):
@@ -691,12 +727,4 @@ def run_experiments(
         with ThreadPoolExecutor(max_workers=workers, thread_name_prefix="dynaq") as pool:
             for future in [pool.submit(one, e) for e in range(experiments)]:
                 future.result()
-    return ExperimentResult(
-        steps=live.steps.copy(),
-        updates=live.updates.copy(),
-        cpu_seconds=cpu_seconds,
-        q=q,
-        config=config,
-        seed=seed,
-        stopped=live.stopped and bool(np.any(live.steps < 0)),
-    )
+    return replace(so_far(), stopped=live.stopped and bool(np.any(live.steps < 0)))

@@ -54,7 +54,7 @@ import time
 from collections import namedtuple
 from collections.abc import Callable, Sequence
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -73,6 +73,7 @@ from ._dynaq import (
     check_run_arguments,
     experiment_seed,
     lower_thread_priority,
+    result_so_far,
 )
 from ._errors import LearningError
 from ._reach import ArmReach, reach_step
@@ -438,14 +439,20 @@ def _greedy_episode(task, params, spec, w, state, max_steps, path):
 
 
 def _new_agent(
-    coder: TileCoder, n_actions: int, dims: int, config: DynaQConfig, capacity: int
+    coder: TileCoder,
+    n_actions: int,
+    dims: int,
+    config: DynaQConfig,
+    capacity: int,
+    weights: np.ndarray | None = None,
 ) -> Agent:
-    """Zero weights, an empty model (none at all for zero planning) and scratch arrays."""
+    """Zero weights (``weights``, a zeroed ``(size, actions)`` table to learn into, when given),
+    an empty model (none at all for zero planning) and scratch arrays."""
     planner = _PLANNER_CODE[config.planning]
     cap = 0 if planner == _ZERO or config.planning_steps == 0 else capacity
     queue = cap if planner == _PRIORITIZED else 0
     return Agent(
-        np.zeros((coder.size, n_actions), np.float64),
+        np.zeros((coder.size, n_actions), np.float64) if weights is None else weights,
         coder.spec,
         float(config.gamma),
         float(config.alpha) / coder.n_active,
@@ -679,9 +686,10 @@ def run_linear_experiments(
             raise LearningError(problem)
         dims = int(task.low.shape[0])
         demo_starts, demo_actions = _demonstrations(demonstrations or [], task, dims)
-        agents = [
-            _new_agent(coder, task.n_actions, dims, config, model_capacity)
-            for _ in range(experiments)
+        weights = np.zeros((experiments, coder.size, task.n_actions), np.float64)
+        agents = [  # each learns into its row of ``weights``, which checkpoints read as it learns
+            _new_agent(coder, task.n_actions, dims, config, model_capacity, weights[e])
+            for e in range(experiments)
         ]
         cpu_seconds = np.zeros(experiments)
         runner = _compiled_experiment if task.code is not None else _python_experiment
@@ -693,6 +701,14 @@ def run_linear_experiments(
             runner(envs[e], task, agents[e], config, seed, e, demo_starts, demo_actions, live)
             cpu_seconds[e] = time.thread_time() - start
 
+        def so_far() -> LinearResult:
+            return result_so_far(
+                LinearResult, live, cpu_seconds, weights, config, seed,
+                weights=weights, coder=coder, task=task.reach, env_id=task.env_id,
+                compiled=task.code is not None,
+            )  # fmt: skip
+
+        live.snapshot = so_far
         threads = min(workers, experiments) if task.code is not None else 1
         if threads == 1:
             for e in range(experiments):
@@ -704,21 +720,7 @@ def run_linear_experiments(
     finally:
         for made in envs:
             made.close()
-    weights = np.stack([agent.w for agent in agents])
-    return LinearResult(
-        steps=live.steps.copy(),
-        updates=live.updates.copy(),
-        cpu_seconds=cpu_seconds,
-        q=weights,
-        config=config,
-        seed=seed,
-        stopped=live.stopped and bool(np.any(live.steps < 0)),
-        weights=weights,
-        coder=coder,
-        task=task.reach,
-        env_id=task.env_id,
-        compiled=task.code is not None,
-    )
+    return replace(so_far(), stopped=live.stopped and bool(np.any(live.steps < 0)))
 
 
 def weight_problem(experiments: int, coder: TileCoder, n_actions: int) -> str | None:

@@ -133,6 +133,7 @@ def save_tile_policy(
     experiment: int | None = None,
     *,
     notes: str = "",
+    compress: bool = True,
 ) -> TilePolicyFile:
     """Write one experiment's weights of a linear run as a policy file (format above).
 
@@ -141,6 +142,8 @@ def save_tile_policy(
         result: what :func:`run_experiments` returned for a Gymnasium environment.
         experiment: which experiment's weights (default: ``result.best_experiment()``).
         notes: free text kept in the header.
+        compress: deflate the members (a training checkpoint does not: a large table is written
+            in a fraction of the time, and the file reads the same).
     """
     if not isinstance(result, LinearResult):
         raise LearningError(
@@ -166,7 +169,7 @@ def save_tile_policy(
         notes=notes,
     )
     with Path(path).open("wb") as stream:
-        np.savez_compressed(
+        (np.savez_compressed if compress else np.savez)(
             stream, header=np.array(json.dumps(policy.header())), weights=policy.weights
         )
     return policy

@@ -293,6 +293,7 @@ def save_policy(
     *,
     experiments: int = 1,
     notes: str = "",
+    compress: bool = True,
 ) -> PolicyFile:
     """Write a policy file (format above) and return what was written.
 
@@ -304,6 +305,8 @@ def save_policy(
         mean_steps: the learning curve, for example ``result.mean_steps()``.
         experiments: how many experiments the curve averages.
         notes: free text kept in the header.
+        compress: deflate the members (a training checkpoint does not: a large table is written
+            in a fraction of the time, and the file reads the same).
     """
     q = np.ascontiguousarray(q, dtype=np.float64)
     if q.shape != (grid.n_states, grid.n_actions):
@@ -326,7 +329,7 @@ def save_policy(
     )
     path = Path(path)
     with path.open("wb") as stream:
-        np.savez_compressed(
+        (np.savez_compressed if compress else np.savez)(
             stream,
             header=np.array(json.dumps(policy.header())),
             q=policy.q,

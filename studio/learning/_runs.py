@@ -10,17 +10,23 @@ A run folder ``<parent>/<id>/`` holds:
   the demonstration files (format ``teach-studio-run``, version 1; see ``README.md``);
 - ``status.json``: ``status`` (``queued``, ``running``, ``done``, ``stopped``, ``failed``),
   ``created``/``started``/``finished`` (ISO 8601 UTC), ``cpu_seconds``, ``error``, and ``pid``
-  and ``host`` (:func:`this_host`), the process training it and where it runs (a ``running`` run
-  whose process is gone from its host is read as ``stopped``);
+  and ``host`` (:func:`this_host`), the process training it and where it runs;
+- ``owner.lock``: held (``flock``) by the process that will train or is training the run, while
+  it is ``queued`` or ``running`` (see ``_owner.py``). A ``queued`` or ``running`` run whose lock
+  nobody holds is read as ``stopped``, by every process, without rewriting its status; a folder
+  from before owners locked is judged by its pid and that process's start time instead;
 - ``steps.csv``: real steps per episode, one row per experiment, ``-1`` where not done; rewritten
   atomically every :data:`CHECKPOINT_SECONDS` while training (less often only when one write
   takes over a tenth of that), so a killed process loses about that much of its curve;
 - ``curves.csv``: the :func:`curve_statistics` of ``steps.csv`` in the layout
   :data:`CURVE_COLUMNS`, written when the run ends (or by :meth:`RunFolder.recover` after a
   crash);
-- ``policy.policy.npz``: the best experiment's Q table (see ``_policy.py``), written when the run
-  ends, also when it was stopped (Stop, Ctrl-C) after finishing episodes. A process killed with
-  ``kill -9`` writes none: the Q tables live in the kernels until they return.
+- ``policy.policy.npz``: the best experiment's Q table (see ``_policy.py``), saved with every
+  ``steps.csv`` checkpoint from the tables the kernels are filling (:attr:`LiveProgress.snapshot`)
+  and again when the run ends, also when it was stopped (Stop, Ctrl-C). A process killed with
+  ``kill -9`` leaves the policy of its last checkpoint.
+
+No file of a run folder, nor the folder itself, is read through a symbolic link.
 
 A folder is created atomically: it is built as a hidden temporary folder next to its final place
 and renamed there, so a full disk leaves no half-made run behind (:class:`LearningError` says so).
@@ -63,6 +69,7 @@ from ._arm import ArmGrid
 from ._config import DEFAULT_SEED, MAX_STEPS_PER_EPISODE, DynaQConfig, check_budget
 from ._dynaq import ExperimentResult, LiveProgress, run_experiments
 from ._errors import ConfigError, LearningError
+from ._owner import OWNER_FILE, OwnerLock, owner_alive, process_started
 from ._policy import save_policy
 from ._reach import ArmReach
 from ._tiles import TileCoding
@@ -670,13 +677,15 @@ def on_this_host(host: object) -> bool:
     return not isinstance(hostname, str) or hostname == socket.gethostname()
 
 
-def pid_alive(pid: object, host: object = None) -> bool:
+def pid_alive(pid: object, host: object = None, started: object = None) -> bool:
     """Whether ``pid`` is a live process other than this one: a run or sweep whose status says
     it is training but whose process is gone (a crash, ``kill -9``) reads as stopped.
 
     ``host`` is the record's :func:`this_host`. A pid recorded on another host (a sweep's trial
     on another node of a cluster, seen through shared storage) names no process here, so this
     host cannot judge it: it counts as alive (its driver records a trial whose worker died).
+    ``started`` is when the record says its process started the work (ISO 8601): a live process
+    with that pid that started later reused the pid after the recorded one ended.
     """
     if not _is_int(pid) or pid <= 0:  # type: ignore[operator]
         return False
@@ -689,8 +698,25 @@ def pid_alive(pid: object, host: object = None) -> bool:
     except ProcessLookupError:
         return False
     except PermissionError:
-        return True
-    return True
+        pass
+    return not _started_after(int(pid), started)  # type: ignore[arg-type]
+
+
+PID_CLOCK_SLACK_SECONDS = 2.0
+"""How much later than a record's ``started`` (kept to the second) its process may seem to have
+started before the pid counts as reused."""
+
+
+def _started_after(pid: int, started: object) -> bool:
+    """Whether process ``pid`` started after the ISO time ``started`` (unknown: False)."""
+    if not isinstance(started, str):
+        return False
+    try:
+        when = datetime.fromisoformat(started).timestamp()
+    except ValueError:
+        return False
+    began = process_started(pid)
+    return began is not None and began > when + PID_CLOCK_SLACK_SECONDS
 
 
 def _atomic_write(path: Path, text: str) -> None:
@@ -702,6 +728,68 @@ def _atomic_write(path: Path, text: str) -> None:
         with contextlib.suppress(OSError):
             tmp.unlink()
         raise
+
+
+def delete_run_folder(path: Path, owner: OwnerLock | None = None) -> None:
+    """Delete a run folder, readable or damaged, or only the link when it is a symbolic link.
+
+    Args:
+        path: the run folder.
+        owner: this process's lock on it, when it owns the run (let go once deleted).
+
+    Raises:
+        LearningError: a live process owns the run, or some files could not be deleted (the
+            sentence counts them and names the first; what was deleted stays deleted).
+    """
+    path = Path(path)
+    if path.is_symlink() or not path.is_dir():
+        try:
+            path.unlink(missing_ok=True)
+        except OSError as err:
+            raise _disk_error(err, "the run folder", path.parent) from None
+        return
+    owner = owner or OwnerLock(path)  # refuses a run another live process owns
+    try:
+        failed = _remove_tree(path)
+    finally:
+        owner.release()
+    if failed:
+        where, err = failed[0]
+        raise LearningError(
+            f"{len(failed)} file(s) of run {path.name} could not be deleted (first: {where}: {getattr(err, 'strerror', None) or err}); fix the folder's permissions and delete it again."
+        )
+
+
+def _remove_tree(path: Path) -> list[tuple[str, BaseException]]:
+    """Delete a run folder (links inside are removed, never followed); every path that could
+    not be deleted, with its error (none: all gone). ``config.json`` goes last, and only when
+    everything else went, so a folder left half-deleted is still a run folder the page lists."""
+    failed: list[tuple[str, BaseException]] = []
+
+    def note(_f: object, where: str, err: object) -> None:
+        failed.append((where, err[1] if isinstance(err, tuple) else err))  # type: ignore[arg-type]
+
+    handler = {"onexc": note} if sys.version_info >= (3, 12) else {"onerror": note}
+    for child in sorted(path.iterdir()):
+        if child.name == CONFIG_FILE:
+            continue
+        try:
+            if child.is_dir() and not child.is_symlink():
+                shutil.rmtree(child, **handler)  # type: ignore[arg-type]
+            else:
+                os.unlink(child)
+        except OSError as err:
+            failed.append((str(child), err))
+    if failed:
+        return failed
+    for last, remove in ((path / CONFIG_FILE, os.unlink), (path, os.rmdir)):
+        try:
+            remove(last)
+        except FileNotFoundError:
+            continue
+        except OSError as err:
+            return [(str(last), err)]
+    return []
 
 
 def _disk_error(err: OSError, what: str, where: Path) -> LearningError:
@@ -741,6 +829,7 @@ class RunFolder:
         self.host: dict[str, str | None] | None = None  # this_host() of the process training it
         self.interrupted = False  # read as stopped because its training process is gone
         self._steps: np.ndarray | None = None
+        self._owner: OwnerLock | None = None  # held while this process owns a live run
 
     @property
     def id(self) -> str:
@@ -754,8 +843,18 @@ class RunFolder:
 
     @property
     def has_policy(self) -> bool:
-        """Whether the run has saved a policy."""
-        return self.policy_path.is_file()
+        """Whether the run has saved a policy (a link is never one)."""
+        return self.policy_path.is_file() and not self.policy_path.is_symlink()
+
+    def owner_alive(self) -> bool | None:
+        """Whether a live process owns the run now (its ``owner.lock``); None for a folder from
+        before owner locks."""
+        return owner_alive(self.path)
+
+    @property
+    def owned_here(self) -> bool:
+        """Whether this process owns the run (it will train it, or trains it now)."""
+        return self._owner is not None and self._owner.held
 
     # ------------------------------------------------------------------ create and load
 
@@ -799,12 +898,16 @@ class RunFolder:
             run.pid, run.host = os.getpid(), this_host()
         try:
             tmp.mkdir()
+            if status in ("queued", "running"):  # owned before anyone can see the folder
+                run._owner = OwnerLock(tmp)
             (tmp / CONFIG_FILE).write_text(json.dumps(record.to_dict(), indent=1))
             run.save_status()
             if final.is_dir():  # an empty folder the user made for it
                 final.rmdir()
             os.rename(tmp, final)
         except OSError as err:
+            if run._owner is not None:
+                run._owner.release()
             shutil.rmtree(tmp, ignore_errors=True)
             raise _disk_error(err, "the run folder", parent) from None
         run.path = final
@@ -821,6 +924,11 @@ class RunFolder:
             LearningError: no readable ``config.json``.
         """
         path = Path(path)
+        for link in (path, path / CONFIG_FILE):
+            if link.is_symlink():
+                raise LearningError(
+                    f"{link} is a symbolic link, which the studio never follows in a data folder; delete the run (only the link goes)."
+                )
         if not (path / CONFIG_FILE).exists():
             raise LearningError(f"{path} has no {CONFIG_FILE}; it is not a run folder.")
         try:
@@ -843,10 +951,23 @@ class RunFolder:
         run.reload()
         return run
 
-    def reload(self) -> None:
-        """Read ``status.json`` and ``steps.csv`` again (another process may be training it)."""
+    def reload(self, owner: bool | None | str = "probe") -> None:
+        """Read ``status.json`` and ``steps.csv`` again (another process may be training it).
+
+        A ``queued`` or ``running`` run is read as ``stopped`` (``interrupted``) when its owner is
+        gone; nothing is written.
+
+        Args:
+            owner: whether another live process owns the run, when the caller knows (it holds
+                the lock itself: False); None to judge by the pid (a folder from before owner
+                locks); by default, asked of the run's ``owner.lock``.
+        """
+        if owner == "probe":  # before the status: a lock let go means its final status is written
+            owner = owner_alive(self.path)
         status: dict[str, Any] = {}
-        if (self.path / STATUS_FILE).exists():
+        if (self.path / STATUS_FILE).is_symlink():
+            log.warning("run %s: %s is a link, ignored", self.id, STATUS_FILE)
+        elif (self.path / STATUS_FILE).exists():
             try:
                 read = read_json(self.path / STATUS_FILE, max_bytes=MAX_STATUS_BYTES)
                 if not isinstance(read, dict):
@@ -869,7 +990,9 @@ class RunFolder:
         self.pid = status.get("pid")
         host = status.get("host")
         self.host = host if isinstance(host, dict) else None
-        if self.status in ("queued", "running") and not pid_alive(self.pid, self.host):
+        alive = owner if owner is not None else pid_alive(self.pid, self.host, self.started)
+        self.interrupted = False
+        if self.status in ("queued", "running") and not (self.owned_here or alive):
             self.interrupted = True
             self.error = (
                 "The process training it stopped while this run was training; its curve so far is kept, start it again to finish."
@@ -882,7 +1005,7 @@ class RunFolder:
 
     def _read_steps(self) -> np.ndarray | None:
         path = self.path / STEPS_FILE
-        if not path.exists():
+        if not path.exists() or path.is_symlink():
             return None
         # at most one number of MAX_STEPS_PER_EPISODE's width (or -1) and a separator per episode
         cell = len(str(MAX_STEPS_PER_EPISODE)) + 1
@@ -930,6 +1053,9 @@ class RunFolder:
             _atomic_write(self.path / STATUS_FILE, json.dumps(status, indent=1))
         except OSError as err:
             raise _disk_error(err, "the run's status", self.path) from None
+        if self.status not in ("queued", "running") and self._owner is not None:
+            self._owner.release()  # the final status is written: nobody owns a finished run
+            self._owner = None
 
     def save_steps(self, steps: np.ndarray, curves: bool = True) -> None:
         """Write ``steps.csv`` and, unless ``curves`` is false (a checkpoint), ``curves.csv``,
@@ -945,14 +1071,62 @@ class RunFolder:
 
     def recover(self) -> None:
         """Write down what :meth:`load` found for a run whose process died: its ``stopped``
-        status and a ``curves.csv`` of its last checkpoint (no-op for other runs)."""
-        if self.interrupted:
-            self.save_steps(self.steps())
-            self.save_status()
-            self.interrupted = False
+        status and a ``curves.csv`` of its last checkpoint (no-op for other runs, and for a run
+        whose owner turns out to be alive). The run's lock is held while it is written."""
+        if not self.interrupted:
+            return
+        locked = (self.path / OWNER_FILE).exists()  # else a folder from before owner locks
+        try:
+            owner = OwnerLock(self.path)
+        except LearningError:  # its owner is alive after all
+            self.reload()
+            return
+        try:
+            self.reload(owner=False if locked else None)  # under the lock: the last status
+            if self.interrupted:
+                self.save_steps(self.steps())
+                self.save_status()
+                self.interrupted = False
+        finally:
+            owner.release()
 
-    def save_policy(self, result: ExperimentResult) -> None:
-        """Write the best experiment's Q table (or tile-coded weights) as the run's policy."""
+    def mark_stopped(self) -> None:
+        """Mark a ``queued`` or ``running`` run ``stopped`` by hand, when no live process owns
+        it: a run written before owners locked whose pid now names another process, or whose
+        host cannot be asked. Its curve so far is kept.
+
+        Raises:
+            LearningError: a live process owns it (stop it there), or the disk refused.
+        """
+        owner = OwnerLock(self.path)  # refuses a run whose owner is alive
+        try:
+            self.reload(owner=False)  # the user's word, for a folder from before owner locks too
+            if self.interrupted or self.status in ("queued", "running"):
+                self.status = "stopped"
+                self.interrupted = False
+                self.finished = self.finished or now_iso()
+                self.error = "Marked stopped by hand: no live process was training it; its curve so far is kept."
+                self.save_steps(self.steps())
+                self.save_status()
+        finally:
+            owner.release()
+
+    def delete(self) -> None:
+        """Delete the run folder (see :func:`delete_run_folder`); this process's own lock on it,
+        if any, is let go as it goes."""
+        owner, self._owner = self._owner, None
+        delete_run_folder(self.path, owner if owner is not None and owner.held else None)
+
+    def disown(self) -> None:
+        """Let the run go without training it (a queue shutting down): other processes then
+        read it as stopped before it started."""
+        if self._owner is not None:
+            self._owner.release()
+            self._owner = None
+
+    def save_policy(self, result: ExperimentResult, compress: bool = True) -> None:
+        """Write the best experiment's Q table (or tile-coded weights) as the run's policy
+        (``compress`` false for a checkpoint: far quicker to write, read the same)."""
         best = result.best_experiment()
         tmp = self.path / f".{POLICY_FILE}.{secrets.token_hex(4)}.tmp.npz"
         notes = f"run {self.id}: experiment {best} of {self.record.experiments}, seed {self.record.seed}, {len(self.record.demonstrations)} demonstrations"
@@ -960,7 +1134,7 @@ class RunFolder:
             from ._linear_policy import save_tile_policy
 
             try:
-                save_tile_policy(tmp, result, best, notes=notes)  # type: ignore[arg-type]
+                save_tile_policy(tmp, result, best, notes=notes, compress=compress)  # type: ignore[arg-type]
                 os.replace(tmp, self.policy_path)
             except OSError as err:
                 with contextlib.suppress(OSError):
@@ -976,7 +1150,8 @@ class RunFolder:
                 result.config,
                 result.mean_steps(),
                 experiments=self.record.experiments,
-                notes=f"run {self.id}: experiment {best} of {self.record.experiments}, seed {self.record.seed}, {len(self.record.demonstrations)} demonstrations",
+                notes=notes,
+                compress=compress,
             )
             os.replace(tmp, self.policy_path)
         except OSError as err:
@@ -1010,6 +1185,8 @@ class RunFolder:
         """
         record = self.record
         live = live or LiveProgress(record.experiments, record.episodes)
+        if not self.owned_here:  # a loaded folder trained here: own it first
+            self._owner = OwnerLock(self.path)
         self.status, self.started, self.pid = "running", self.started or now_iso(), os.getpid()
         self.host = this_host()
         self.save_status()
@@ -1051,6 +1228,7 @@ class RunFolder:
                 done = live.completed
                 if now - last >= every and done != saved and not ended.is_set():
                     self.save_steps(live.steps, curves=False)
+                    self._checkpoint_policy(live)
                     saved, last = done, time.monotonic()
                     # a huge run's checkpoint costs: keep writing it under a tenth of the time
                     every = max(CHECKPOINT_SECONDS, CHECKPOINT_COST_FACTOR * (last - now))
@@ -1066,6 +1244,20 @@ class RunFolder:
         if interrupted:
             raise KeyboardInterrupt
         return result
+
+    def _checkpoint_policy(self, live: LiveProgress) -> None:
+        """Save the policy learnt so far (the kernels' tables as they are now), so a process
+        killed mid-run leaves one up to its last checkpoint; the run's end replaces it."""
+        snapshot = live.snapshot
+        if snapshot is None:  # the learner has not built its tables yet
+            return
+        result = snapshot()
+        if not result.completed.any():
+            return
+        try:
+            self.save_policy(result, compress=False)
+        except (LearningError, ValueError) as err:  # diverged weights: keep the last good one
+            log.warning("run %s: policy checkpoint skipped: %s", self.id, err)
 
     def _finish(
         self,
@@ -1133,7 +1325,12 @@ def find_runs(parent: Path) -> list[Path]:
         return []
     found: list[Path] = []
     for child in sorted(parent.iterdir()):
-        if not child.is_dir() or child.name.startswith("."):
+        if child.name.startswith("."):
+            continue
+        if child.is_symlink():  # never followed: listed, so that it shows as damaged
+            found.append(child)
+            continue
+        if not child.is_dir():
             continue
         if (child / CONFIG_FILE).is_file():
             found.append(child)
@@ -1142,6 +1339,7 @@ def find_runs(parent: Path) -> list[Path]:
             found += [
                 sub
                 for sub in sorted(child.iterdir())
-                if sub.is_dir() and not sub.name.startswith(".") and (sub / CONFIG_FILE).is_file()
+                if not sub.name.startswith(".")
+                and (sub.is_symlink() or (sub.is_dir() and (sub / CONFIG_FILE).is_file()))
             ]
     return found

@@ -16,11 +16,11 @@ from __future__ import annotations
 import contextlib
 import logging
 import re
-import shutil
 import threading
 import time
 from collections import deque
 from collections.abc import Callable
+from datetime import UTC, datetime
 from pathlib import Path
 
 import numpy as np
@@ -36,6 +36,7 @@ from studio.learning import (
     RunFolder,
     RunRecord,
     curve_statistics,
+    delete_run_folder,
     find_runs,
     goal_degrees,
     goal_problems,
@@ -91,6 +92,23 @@ class Run:
     def status(self) -> str:
         """``queued``, ``running``, ``done``, ``stopped`` or ``failed``."""
         return self.folder.status
+
+    def refresh(self) -> bool:
+        """Read a run another process owns again when it wrote progress or its owner went away
+        (a lock let go changes no file); whether anything was read."""
+        folder = self.folder
+        if self.live is not None or not (
+            self.status in ("running", "queued") or folder.interrupted
+        ):
+            return False
+        mtime = _status_mtime(folder.path)
+        gone = self.status in ("running", "queued") and folder.owner_alive() is False
+        if mtime == self._mtime and not gone:
+            return False
+        self._mtime = mtime
+        with contextlib.suppress(OSError, LearningError):
+            folder.reload()
+        return True
 
     @property
     def name(self) -> str:
@@ -151,7 +169,47 @@ class Run:
             has_policy=folder.has_policy,
             origin=record.origin,
             group=record.group,
+            elsewhere=self.status in ("queued", "running") and self.live is None,
         )
+
+
+class DamagedRun:
+    """A run folder that cannot be read: listed with the reason, so it can be deleted."""
+
+    def __init__(self, run_id: str, path: Path, reason: str) -> None:
+        self.id = run_id
+        self.path = path
+        self.reason = reason
+
+    def model(self) -> RunPublic:
+        """The folder as the API lists it: status ``damaged``, the reason as its error."""
+        try:
+            stamp = datetime.fromtimestamp(self.path.lstat().st_mtime, UTC)
+            created = stamp.isoformat(timespec="seconds")
+        except OSError:
+            created = ""
+        return RunPublic(
+            id=self.id,
+            name=self.id,
+            status="damaged",
+            config=RunCreate(),
+            created=created,
+            started=None,
+            finished=None,
+            episodes_done=0,
+            episodes_total=0,
+            cpu_seconds=0.0,
+            error=self.reason,
+            has_policy=False,
+            damaged=True,
+        )
+
+
+def _damage_text(err: BaseException) -> str:
+    """Why a run folder cannot be read, as one sentence the page shows beside its delete button."""
+    if isinstance(err, LearningError):
+        return str(err)
+    return f"The run folder's config.json or status.json holds a field the studio cannot read ({type(err).__name__}); delete the run."
 
 
 def _status_mtime(path: Path) -> float:
@@ -360,6 +418,7 @@ class RunQueue:
         self.workers = workers
         self.before_train: Callable[[Run], None] | None = None
         self._runs: dict[str, Run] = {}
+        self._damaged: dict[str, DamagedRun] = {}
         self._queue: deque[str] = deque()
         self._cond = threading.Condition()
         self._closing = False
@@ -378,6 +437,7 @@ class RunQueue:
         found = {k: p for k, p in found.items() if RUN_ID.match(k)}
         with self._cond:
             known = dict(self._runs)
+        damaged: dict[str, DamagedRun] = {}
         for run_id, path in found.items():
             run = known.get(run_id)
             if run is None:
@@ -385,26 +445,22 @@ class RunQueue:
                     run = Run(run_id, RunFolder.load(path))
                     run.model()  # a damaged field must not break the whole list
                 except (OSError, ValueError, TypeError, LearningError) as err:
-                    log.warning("skipping unreadable run folder %s: %s", path, err)
+                    log.warning("unreadable run folder %s: %s", path, err)
+                    damaged[run_id] = DamagedRun(run_id, path, _damage_text(err))
                     continue
-                if run.folder.interrupted:  # say so on disk too, once
-                    with contextlib.suppress(LearningError):
-                        run.folder.recover()
+                # a run whose owner is gone reads as stopped; its status is its owner's to write
                 with self._cond:
                     self._runs.setdefault(run_id, run)
                 changed = True
-            elif run.live is None and run.status in ("running", "queued"):
-                mtime = _status_mtime(path)
-                if mtime != run._mtime:  # another process wrote its progress
-                    run._mtime = mtime
-                    with contextlib.suppress(OSError, LearningError):
-                        run.folder.reload()
-                    changed = True
+            elif run.refresh():
+                changed = True
         with self._cond:
             for run_id, run in list(self._runs.items()):
                 if run_id not in found and run.live is None and not run.folder.path.exists():
                     del self._runs[run_id]
                     changed = True
+            changed = changed or set(damaged) != set(self._damaged)
+            self._damaged = damaged
         return changed
 
     # ------------------------------------------------------------------ lifecycle
@@ -422,6 +478,8 @@ class RunQueue:
             for run in self._runs.values():
                 if run.status == "running" and run.live is not None:
                     run.live.stop()
+                elif run.status == "queued" and run.live is not None:
+                    run.folder.disown()  # never trained here now: others read it as stopped
             self._cond.notify_all()
         if self._thread is not None:
             self._thread.join(timeout)
@@ -437,6 +495,11 @@ class RunQueue:
             runs = list(self._runs.values())
         return sorted(runs, key=lambda r: (r.folder.created, r.id), reverse=True)
 
+    def damaged(self) -> list[DamagedRun]:
+        """The run folders that cannot be read (as of the last listing), by id."""
+        with self._cond:
+            return sorted(self._damaged.values(), key=lambda d: d.id)
+
     def get(self, run_id: str) -> Run:
         """The run with that id (404 otherwise)."""
         if not isinstance(run_id, str) or not RUN_ID.match(run_id) or ".." in run_id:
@@ -448,6 +511,8 @@ class RunQueue:
                 run = self._runs.get(run_id)
         if run is None:
             raise NotFoundError(f"There is no run {run_id!r}; pick one from the runs list.")
+        if run.refresh():
+            self.on_change("runs")
         return run
 
     def running(self) -> list[Run]:
@@ -505,8 +570,32 @@ class RunQueue:
             self.on_change("runs")
         return run
 
+    def mark_stopped(self, run_id: str) -> Run:
+        """Mark a run that no live process trains ``stopped`` (its curve is kept).
+
+        Raises:
+            ConflictError: this studio trains it (stop it instead), or another live process
+                owns it (stop it there).
+        """
+        run = self.get(run_id)
+        if run.live is not None:
+            raise ConflictError(f"Run {run_id} is this studio's; stop it instead.")
+        try:
+            run.folder.mark_stopped()
+        except LearningError as err:
+            raise ConflictError(str(err)) from None
+        run._mtime = _status_mtime(run.folder.path)
+        self.on_change("runs")
+        return run
+
     def delete(self, run_id: str) -> None:
-        """Delete a run and its folder (409 while it is training)."""
+        """Delete a run and its folder (409 while it is training; 507-like 409 naming what could
+        not be deleted). A damaged folder from the list may be deleted too."""
+        with self._cond:
+            broken = self._damaged.get(run_id)
+        if broken is not None and run_id not in self._runs:
+            self._delete_damaged(broken)
+            return
         run = self.get(run_id)
         with self._cond:
             if run.status in ("running", "queued") and run.live is None:
@@ -519,10 +608,24 @@ class RunQueue:
                 self._queue.remove(run_id)
             del self._runs[run_id]
         had_policy = run.has_policy
-        shutil.rmtree(run.folder.path, ignore_errors=True)
-        self.on_change("runs")
-        if had_policy:
-            self.on_change("policies")
+        try:
+            run.folder.delete()  # under its owner lock: refused if another process owns it
+        except LearningError as err:
+            self._scan()  # what is left of it is listed again
+            raise ConflictError(str(err)) from None
+        finally:
+            self.on_change("runs")
+            if had_policy:
+                self.on_change("policies")
+
+    def _delete_damaged(self, broken: DamagedRun) -> None:
+        try:
+            delete_run_folder(broken.path)  # a link goes, never what it points to
+        except LearningError as err:
+            raise ConflictError(str(err)) from None
+        finally:
+            self._scan()
+            self.on_change("runs")
 
     def wait_idle(self, timeout: float) -> bool:
         """Block until nothing is queued or running here (for scripts and tests)."""

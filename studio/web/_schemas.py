@@ -23,7 +23,7 @@ from studio.learning import (
 )
 
 PlanningName = Literal["zero", "full", "soft", "prioritized"]
-RunStatus = Literal["queued", "running", "done", "stopped", "failed"]
+RunStatus = Literal["queued", "running", "done", "stopped", "failed", "damaged"]
 SourceKind = Literal["simulator", "recording", "network", "serial"]
 
 DEFAULT_GOAL_DEG = DEFAULT_GOAL_JOINTS_DEG
@@ -185,6 +185,9 @@ class RecordingPublic(BaseModel):
     size_bytes: int
     sample: bool
     error: str | None = None
+    capturing: bool = False
+    """Another studio (or ``studio record``) on the same data folder is writing it now: its
+    frames so far are not counted, and it is neither recovered nor deletable."""
 
 
 class RecordingCopy(_Body):
@@ -301,6 +304,16 @@ class RunPublic(BaseModel):
     has_policy: bool
     origin: Literal["cli", "page", "reproduce", "sweep"] = "page"
     group: str | None = None
+    elsewhere: bool = Field(
+        False,
+        description="queued or running in another process (another studio, studio train): "
+        "stop it there; POST .../mark-stopped only if no live process owns it",
+    )
+    damaged: bool = Field(
+        False,
+        description="the folder cannot be read (status 'damaged', the reason in error): it can "
+        "only be deleted",
+    )
 
 
 class CurvePublic(BaseModel):

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import logging
 import threading
+import uuid
 from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
@@ -16,6 +17,7 @@ from typing import Any
 import numpy as np
 
 from studio import StudioError
+from studio.capture import being_recorded
 from studio.learning import GOAL_JOINTS, check_goal_deg
 
 from ._errors import ConflictError, InvalidError, NotFoundError
@@ -23,7 +25,6 @@ from ._pipeline import Pipeline
 from ._runs import RunQueue
 from ._settings import Settings
 from ._store import (
-    DEMONSTRATION_SUFFIX,
     RECORDING_SUFFIX,
     demonstration_store,
     policy_store,
@@ -333,7 +334,9 @@ class Studio:
             goal_from_end=goal_from_end,
             name=final,
         )
-        demo.save(self.settings.recordings_dir / f"{final}{DEMONSTRATION_SUFFIX}")
+        tmp = self.settings.recordings_dir / f".cut-{uuid.uuid4().hex}.tmp"
+        demo.save(tmp)  # then named without replacing a file that took the name meanwhile
+        final = self.demonstrations.claim(tmp, final, exact=name is not None)
         self.changes.bump("demonstrations")
         if self.scene is not None:
             self.scene.show_path(f"demo-{final}", np.asarray(demo.q_robot))
@@ -374,12 +377,24 @@ class Studio:
     # ------------------------------------------------------------------ in-use checks
 
     def recording_in_use(self, name: str) -> str | None:
-        """Why recording ``name`` cannot be deleted or renamed now, or None."""
+        """Why recording ``name`` cannot be deleted or renamed now, or None (a capture by
+        another studio on the same data folder counts: its writer's lock says so)."""
         if self.pipeline.kind == "recording" and self.pipeline.recording == name:
             return f"Recording {name!r} is the live source; switch the source to another one first."
         if self.pipeline.capture_name == name:
             return f"Recording {name!r} is being captured; stop the recording first."
+        if self.captured_elsewhere(name):
+            return f"Recording {name!r} is being captured by another studio or `studio record` on this data folder; stop that capture first."
         return None
+
+    def captured_elsewhere(self, name: str) -> bool:
+        """Whether another process (a second studio, ``studio record``) is capturing ``name``."""
+        if self.pipeline.capture_name == name:
+            return False
+        try:
+            return being_recorded(self.recordings.path(name))
+        except StudioError:  # missing, a link, not a regular file: nobody writes it
+            return False
 
     def policy_in_use(self, key: str) -> bool:
         """Whether the scene is playing this policy (``policy:<name>`` or ``run:<id>``)."""

@@ -9,7 +9,12 @@ Training runs have their own store in :mod:`studio.web._runs`.
 
 Names are plain file stems (letters, digits, ``-``, ``_``, ``.``; no separators, no ``..``), so a
 name from a request can never point outside its folder. New files never replace old ones: an
-upload or a new capture whose name is taken gets ``-2``, ``-3``, ... appended.
+upload or a new capture whose name is taken gets ``-2``, ``-3``, ... appended, and a file appears
+under its name by a hard link that fails if the name was taken meanwhile (by another studio on
+the same folder, say).
+
+A symbolic link in a store's folder is never followed: it is listed as damaged (the studio reads
+only regular files there), never read, served or changed, and deleting it removes the link only.
 
 The shipped samples (:data:`studio.samples.SAMPLES_DIR`) are offered by every data folder as a
 read-only group: names starting with ``sample-`` belong to it, can be played, trained on and
@@ -37,6 +42,7 @@ from studio.capture import (
     DEMO_SUFFIX,
     RECORDING_SUFFIX,
     Demonstration,
+    delete_recording,
     load_demonstration,
     summarize_recording,
 )
@@ -56,6 +62,24 @@ DEMONSTRATION_SUFFIX = DEMO_SUFFIX
 """Demonstrations lie next to their recordings: ``<name>.demo.json`` (the capture package's)."""
 
 T = TypeVar("T")
+
+
+def symlink_text(path: Path) -> str:
+    """The refusal of a symbolic link found in a data folder."""
+    return (
+        f"{path.name} is a symbolic link, which the studio never follows in its data folder; "
+        "put the file itself there, or delete the link."
+    )
+
+
+def link_new(tmp: Path, final: Path) -> bool:
+    """Give the file ``tmp`` the name ``final`` unless that name is taken (never replacing a
+    file, even one that appeared a moment ago); whether it did. ``tmp`` is left in place."""
+    try:
+        os.link(tmp, final)
+    except FileExistsError:
+        return False
+    return True
 
 
 def check_name(name: str, what: str = "name") -> str:
@@ -219,6 +243,8 @@ class FolderStore(Generic[T]):
             changes.
         samples: a read-only folder of shipped samples (names starting with ``sample-``), or None.
         sample_fix: what to do instead of changing a sample, the second half of the refusal.
+        remove: deletes one of the user's files (default: unlink it); raises a
+            :class:`studio.StudioError` to refuse.
     """
 
     def __init__(
@@ -231,6 +257,7 @@ class FolderStore(Generic[T]):
         load: Callable[[Path], T],
         samples: Path | None = None,
         sample_fix: str = "copy it to make your own",
+        remove: Callable[[Path], None] = Path.unlink,
     ) -> None:
         self.folder = folder
         self.suffix = suffix
@@ -239,6 +266,7 @@ class FolderStore(Generic[T]):
         self.samples = samples
         self.sample_fix = sample_fix
         self._load = load
+        self._remove = remove
         self._cache = _FileCache()
         self._claim_lock = threading.Lock()  # choosing a free name and taking it are one step
 
@@ -251,9 +279,13 @@ class FolderStore(Generic[T]):
         return [s for s in stems if NAME_PATTERN.match(s)]
 
     def _find(self, name: str) -> Path | None:
+        """The file of ``name`` (a symbolic link too, which callers refuse to follow)."""
         for folder in (self.folder, self.samples):
-            if folder is not None and (folder / f"{name}{self.suffix}").is_file():
-                return folder / f"{name}{self.suffix}"
+            if folder is None:
+                continue
+            path = folder / f"{name}{self.suffix}"
+            if path.is_symlink() or path.is_file():
+                return path
         return None
 
     def names(self) -> list[str]:
@@ -271,8 +303,8 @@ class FolderStore(Generic[T]):
         """Whether ``name`` is a read-only shipped sample."""
         return name.startswith(SAMPLE_PREFIX)
 
-    def path(self, name: str) -> Path:
-        """The file of ``name``, a user's file or a sample (422 for a bad name, 404 if none)."""
+    def _located(self, name: str) -> Path:
+        """The file of ``name``, a symbolic link included (422 for a bad name, 404 if none)."""
         path = self._find(check_name(name, f"{self.what} name"))
         if path is None:
             raise NotFoundError(
@@ -280,14 +312,31 @@ class FolderStore(Generic[T]):
             )
         return path
 
+    def path(self, name: str) -> Path:
+        """The file of ``name``, a user's file or a sample, to read or serve (422 for a bad
+        name, 404 if none, 409 for a symbolic link, which is never followed)."""
+        path = self._located(name)
+        if path.is_symlink():
+            raise ConflictError(symlink_text(path))
+        return path
+
     def writable_path(self, name: str) -> Path:
-        """The file of ``name`` for a change or a delete (404 if none, 409 for a sample)."""
+        """The file of ``name`` for a change (404 if none, 409 for a sample or a symbolic link)."""
         path = self.path(name)
+        self._check_writable(name)
+        return path
+
+    def check_deletable(self, name: str) -> None:
+        """Refuse what :meth:`delete` would refuse before trying (404 if none, 409 for a
+        sample); a symbolic link may be deleted (the link only)."""
+        self._located(name)
+        self._check_writable(name)
+
+    def _check_writable(self, name: str) -> None:
         if self.is_sample(name):
             raise ConflictError(
                 f"The {self.what} {name!r} is a shipped sample, which cannot be changed or deleted; {self.sample_fix}."
             )
-        return path
 
     def check_new_name(self, name: str) -> str:
         """Return ``name`` if a new user file may take it (422 for a bad or sample name, 409 if taken)."""
@@ -320,6 +369,8 @@ class FolderStore(Generic[T]):
             StudioError: the reader's one sentence about a damaged file; a failure the reader
                 did not foresee becomes an :class:`InvalidError` naming the file.
         """
+        if path.is_symlink():  # never read through a link (a run's policy too)
+            raise ConflictError(symlink_text(path))
         return self._cache.get(path, self._read)
 
     def _read(self, path: Path) -> T:
@@ -334,12 +385,12 @@ class FolderStore(Generic[T]):
             ) from None
 
     def entry(self, name: str) -> StoredFile[T]:
-        """``name`` as a listing shows it (404 if it does not exist)."""
-        return self.entry_at(name, self.path(name))
+        """``name`` as a listing shows it (404 if it does not exist; a link: damaged)."""
+        return self.entry_at(name, self._located(name))
 
     def entry_at(self, name: str, path: Path) -> StoredFile[T]:
         """The file at ``path`` as a listing shows it under ``name`` (e.g. a run's policy)."""
-        size = path.stat().st_size
+        size = path.lstat().st_size
         sample = self.is_sample(name)
         try:
             value = self.load_file(path)
@@ -364,8 +415,15 @@ class FolderStore(Generic[T]):
     # ------------------------------------------------------------------ changing
 
     def delete(self, name: str) -> None:
-        """Delete a user's file (404 if none, 409 for a sample)."""
-        self.writable_path(name).unlink()
+        """Delete a user's file (404 if none, 409 for a sample); a symbolic link is removed
+        itself, never what it points to. The store's ``remove`` does the deleting (for
+        recordings it refuses a file a capture holds)."""
+        self.check_deletable(name)
+        path = self._located(name)
+        if path.is_symlink():
+            path.unlink()
+            return
+        self._remove(path)
 
     def adopt(
         self, tmp: Path, filename: str | None, taken: Callable[[str], bool] | None = None
@@ -394,7 +452,7 @@ class FolderStore(Generic[T]):
                 raise InvalidError(
                     f"{label} is not a valid Teach Studio {self.what}: {message}"
                 ) from None
-            return self._claim(tmp, base, taken or self.exists)
+            return self.claim(tmp, base, taken)
         finally:
             tmp.unlink(missing_ok=True)
 
@@ -421,22 +479,42 @@ class FolderStore(Generic[T]):
             shutil.copyfile(source, tmp)
             with self._claim_lock:
                 final = new_name or self.new_name(name)
-                if self.exists(final):
+                if prepare is not None:
+                    prepare(tmp, final)
+                if self.exists(final) or not link_new(tmp, self.folder / f"{final}{self.suffix}"):
                     raise ConflictError(
                         f"A {self.what} named {final!r} already exists; choose another name."
                     )
-                if prepare is not None:
-                    prepare(tmp, final)
-                os.replace(tmp, self.folder / f"{final}{self.suffix}")
             return final
         finally:
             tmp.unlink(missing_ok=True)
 
-    def _claim(self, tmp: Path, base: str, taken: Callable[[str], bool]) -> str:
-        with self._claim_lock:
-            name = unique_name(base, lambda n: taken(n) or self.exists(n))
-            os.replace(tmp, self.folder / f"{name}{self.suffix}")
-        return name
+    def claim(
+        self, tmp: Path, base: str, taken: Callable[[str], bool] | None = None, exact: bool = False
+    ) -> str:
+        """Give the finished file ``tmp`` (in this store's folder) a free name; returns it.
+
+        The name is ``base``, else ``base-2``, ``base-3``, ... ; with ``exact`` only ``base``
+        (409 when taken). A name taken meanwhile, by another studio too, is never replaced.
+        ``tmp`` is removed either way.
+        """
+        taken = taken or self.exists
+        try:
+            with self._claim_lock:
+                while True:
+                    name = (
+                        base if exact else unique_name(base, lambda n: taken(n) or self.exists(n))
+                    )
+                    if not (exact and taken(name)) and link_new(
+                        tmp, self.folder / f"{name}{self.suffix}"
+                    ):
+                        return name
+                    if exact:
+                        raise ConflictError(
+                            f"A {self.what} named {name!r} already exists; choose another name."
+                        )
+        finally:
+            tmp.unlink(missing_ok=True)
 
 
 def recording_store(folder: Path) -> FolderStore[dict[str, Any]]:
@@ -453,6 +531,7 @@ def recording_store(folder: Path) -> FolderStore[dict[str, Any]]:
         load=summarize_recording,
         samples=SAMPLES_DIR,
         sample_fix="copy it to your recordings to change it",
+        remove=delete_recording,
     )
 
 

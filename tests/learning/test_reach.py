@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import time
 
 import gymnasium
 import numpy as np
@@ -17,6 +18,7 @@ from studio.learning import (
     ArmReach,
     DynaQConfig,
     LearningError,
+    LiveProgress,
     RunFolder,
     RunRecord,
     TilePolicyFile,
@@ -194,3 +196,28 @@ def test_first_own_success_counts_episodes_after_the_demonstrations():
     steps = np.array([[40, 50, 3000, 700, 9], [40, 50, 3000, 3000, 3000]])
     assert _first_own_success(steps, 2, 3000) == [[2, 700], None]
     assert _first_own_success(steps, 0, 3000) == [[1, 40], [1, 40]]
+
+
+def test_a_continuous_run_checkpoints_its_policy_while_it_learns(tmp_path):
+    """The weights the kernel is filling are saved with each checkpoint, so a crash (the run
+    never reaching its end) still leaves a loadable policy."""
+    task = ArmReach(joints=3)
+    config = DynaQConfig(planning="full", planning_steps=2, max_steps_per_episode=200)
+    record = RunRecord.for_arm_reach(task, task.features(), config, 1, 100_000, 0, [])
+    run = RunFolder.create(tmp_path, record)
+    seen: list = []
+    give_up = time.monotonic() + 120  # a bound, not a wait: the event is the policy appearing
+
+    def on_checkpoint(live: LiveProgress) -> None:
+        if not seen and run.has_policy:  # the first checkpoint's policy, mid-run
+            seen.append((live.completed, load_any_policy(run.policy_path)))
+            live.stop()
+        elif time.monotonic() > give_up:
+            live.stop()
+
+    run.train(on_checkpoint=on_checkpoint)
+    assert seen, "no policy was checkpointed while the run learnt"
+    done, policy = seen[0]
+    assert 0 < done < 100_000
+    assert isinstance(policy, TilePolicyFile) and policy.task == task
+    assert np.abs(policy.weights).max() > 0  # what the kernel had learnt, not a blank table

@@ -283,7 +283,7 @@ LONG_RUN = [
 ]  # fmt: skip
 
 
-def test_kill_9_mid_training_keeps_the_curve_to_the_last_checkpoint(tmp_path):
+def test_kill_9_mid_training_keeps_the_curve_and_the_policy_to_the_last_checkpoint(tmp_path):
     proc = _studio("train", "--out", "runs/killed", *LONG_RUN, cwd=tmp_path)
     folder = tmp_path / "runs" / "killed"
     try:
@@ -296,6 +296,11 @@ def test_kill_9_mid_training_keeps_the_curve_to_the_last_checkpoint(tmp_path):
     assert "stopped while this run was training" in run.error
     done = int((run.steps() >= 0).sum())
     assert seen[-1] <= done < 100_000
+    assert run.has_policy  # checkpointed with the steps: a crash loses seconds, not the learning
+    policy = load_policy(run.policy_path)
+    assert len(policy.mean_steps) == 100_000
+    assert np.isfinite(policy.mean_steps[: seen[0]]).all()  # learnt up to a checkpoint at least
+    assert np.abs(policy.q).max() > 0  # the table the kernel had filled, not a blank one
     assert not (folder / "curves.csv").exists()  # derived at the end, or on recovery:
     run.recover()
     assert RunFolder.load(folder).status == "stopped"

@@ -34,8 +34,12 @@ def dead_pid() -> int:
 
 
 def running_run(tmp_path: Path) -> RunFolder:
+    """A running run's folder as written before owner locks: judged by its pid and host."""
     record = RunRecord.for_arm_grid(ArmGrid(), DynaQConfig(), 2, 5, seed=0, origin="cli")
-    return RunFolder.create(tmp_path, record, name="r", status="running")
+    run = RunFolder.create(tmp_path, record, name="r", status="running")
+    run.disown()
+    (run.path / "owner.lock").unlink()
+    return run
 
 
 def write_status(run: RunFolder, **fields) -> bytes:

@@ -244,6 +244,10 @@ def test_runs_survive_a_restart_and_interrupted_runs_show_stopped(open_client, t
     partial = second.get(f"/api/runs/{crashed.name}/curve").json()
     assert partial["episodes"] == [1, 2] and partial["count"] == [2, 1]
     assert partial["mean"] == [8.0, 5.0]
+    # only its owner writes a run's status: a studio that lists it never does
+    assert json.loads((crashed / "status.json").read_text())["status"] == "running"
+    marked = second.post(f"/api/runs/{crashed.name}/mark-stopped")  # the user may, by hand
+    assert marked.status_code == 200 and marked.json()["status"] == "stopped"
     assert json.loads((crashed / "status.json").read_text())["status"] == "stopped"
 
 

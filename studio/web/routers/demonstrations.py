@@ -125,7 +125,7 @@ def preview_demonstration(name: str, studio: StudioDep) -> Response:
 @router.delete("/{name}", status_code=204)
 def delete_demonstration(name: str, studio: StudioDep) -> Response:
     """Delete a demonstration (409 for a sample, or while a queued or running run replays it)."""
-    studio.demonstrations.writable_path(name)
+    studio.demonstrations.check_deletable(name)
     run = studio.runs.uses_demonstration(name)
     if run is not None:
         raise ConflictError(

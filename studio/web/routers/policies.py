@@ -106,7 +106,7 @@ def delete_policy(name: str, studio: StudioDep) -> Response:
         raise ConflictError(
             f"Policy {name!r} belongs to a run; delete the run to delete its policy."
         )
-    studio.policies.path(name)
+    studio.policies.check_deletable(name)
     if studio.policy_in_use(f"policy:{name}"):
         raise ConflictError(f"Policy {name!r} is playing in the scene; stop watching it first.")
     studio.policies.delete(name)

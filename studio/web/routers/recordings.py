@@ -14,6 +14,7 @@ from starlette.concurrency import run_in_threadpool
 
 from studio.capture import (
     RECORDING_SUFFIX,
+    RecordingError,
     recording_bytes,
     rename_recording,
     update_recording_meta,
@@ -50,7 +51,27 @@ def recording_public(entry: StoredFile[dict[str, Any]]) -> RecordingPublic:
 
 
 def read_public(studio: Studio, name: str) -> RecordingPublic:
-    """One recording's list entry by name (404 if none)."""
+    """One recording's list entry by name (404 if none).
+
+    A file another process is capturing is shown as such, not read (it grows, and without its
+    ``# end`` line a reader would call it recovered).
+    """
+    if studio.captured_elsewhere(name):
+        path = studio.recordings.path(name)
+        return RecordingPublic(
+            name=name,
+            frames=0,
+            duration=0.0,
+            rate_hz=None,
+            created="",
+            operator="",
+            notes="",
+            source="",
+            recovered=False,
+            size_bytes=path.stat().st_size,
+            sample=False,
+            capturing=True,
+        )
     return recording_public(studio.recordings.entry(name))
 
 
@@ -58,7 +79,8 @@ def read_public(studio: Studio, name: str) -> RecordingPublic:
 def list_recordings(studio: StudioDep) -> list[RecordingPublic]:
     """Every recording, the shipped samples first; a damaged file is listed with the reason.
 
-    The file a capture is writing appears once the capture stops.
+    The file this studio's capture is writing appears once the capture stops; one another
+    studio on the same data folder is capturing is listed as ``capturing``.
     """
     capturing = studio.pipeline.capture_name
     listed = []
@@ -66,7 +88,7 @@ def list_recordings(studio: StudioDep) -> list[RecordingPublic]:
         if name == capturing:  # never read the growing file: O(1) whatever its length
             continue
         try:
-            listed.append(recording_public(studio.recordings.entry(name)))
+            listed.append(read_public(studio, name))
         except (NotFoundError, FileNotFoundError):  # deleted meanwhile
             continue
     return listed
@@ -137,8 +159,11 @@ def update_recording(name: str, body: RecordingUpdate, studio: StudioDep) -> Rec
     updates the demonstrations cut from the recording. Samples are refused (409).
     """
     path = studio.recordings.writable_path(name)
-    if studio.pipeline.capture_name == name:
-        raise ConflictError(f"Recording {name!r} is being captured; stop the recording first.")
+    if studio.pipeline.capture_name == name or studio.captured_elsewhere(name):
+        raise ConflictError(
+            studio.recording_in_use(name)
+            or f"Recording {name!r} is being captured; stop the recording first."
+        )
     renaming = body.name is not None and body.name != name
     if renaming:
         studio.recordings.check_new_name(body.name)
@@ -167,11 +192,15 @@ def update_recording(name: str, body: RecordingUpdate, studio: StudioDep) -> Rec
 
 @router.delete("/{name}", status_code=204)
 def delete_recording(name: str, studio: StudioDep) -> Response:
-    """Delete a recording (409 while it is the live source or being captured, or a sample)."""
-    studio.recordings.writable_path(name)
+    """Delete a recording (409 while it is the live source or being captured, here or by
+    another studio on the same data folder, or a sample)."""
+    studio.recordings.check_deletable(name)
     reason = studio.recording_in_use(name)
     if reason:
         raise ConflictError(reason)
-    studio.recordings.delete(name)
+    try:  # under the capture's lock: a capture that started meanwhile is refused too
+        studio.recordings.delete(name)
+    except RecordingError as err:
+        raise ConflictError(str(err)) from None
     studio.changes.bump("recordings")
     return Response(status_code=204)

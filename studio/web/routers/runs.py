@@ -26,8 +26,10 @@ PLOT_MEDIA = {"png": "image/png", "svg": "image/svg+xml"}
 
 @router.get("", response_model=list[RunPublic])
 def list_runs(studio: StudioDep) -> list[RunPublic]:
-    """Every run, newest first, with its status and progress (page, CLI, reproduce, sweeps)."""
-    return [run.model() for run in studio.runs.list()]
+    """Every run, newest first, with its status and progress (page, CLI, reproduce, sweeps);
+    then the folders that cannot be read, as ``damaged`` with the reason (delete them)."""
+    runs = studio.runs.list()
+    return [run.model() for run in runs] + [d.model() for d in studio.runs.damaged()]
 
 
 @router.post("", response_model=RunPublic, status_code=201)
@@ -57,13 +59,21 @@ def stop_run(run_id: str, studio: StudioDep) -> RunPublic:
     return studio.runs.stop(run_id).model()
 
 
+@router.post("/{run_id}/mark-stopped", response_model=RunPublic)
+def mark_run_stopped(run_id: str, studio: StudioDep) -> RunPublic:
+    """Mark a run ``stopped`` that says queued or running but that no live process trains (a
+    folder from before owner locks whose pid was reused, or whose host cannot be asked); 409
+    while a live process owns it or this studio trains it."""
+    return studio.runs.mark_stopped(run_id).model()
+
+
 @router.delete("/{run_id}", status_code=204)
 def delete_run(run_id: str, studio: StudioDep) -> Response:
-    """Delete a run and its files (409 while it is training)."""
-    run = studio.runs.get(run_id)
-    if studio.policy_in_use(f"run:{run.id}"):
+    """Delete a run and its files, or a damaged run folder (409 while it is training, or naming
+    the files that could not be deleted)."""
+    if studio.policy_in_use(f"run:{run_id}"):
         raise ConflictError(
-            f"Run {run.id}'s policy is playing in the scene; stop watching it first."
+            f"Run {run_id}'s policy is playing in the scene; stop watching it first."
         )
     studio.runs.delete(run_id)
     return Response(status_code=204)

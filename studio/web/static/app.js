@@ -355,16 +355,17 @@ function recordingRow(r) {
   if (r.sample) flags.push(el("span", { class: "badge", text: "sample", title: "shipped with the studio: read-only" }));
   if (r.recovered) flags.push(el("span", { class: "badge warn", text: "recovered", title: "the capture did not close cleanly; every frame written is kept" }));
   if (r.error) flags.push(el("span", { class: "badge failed", text: "unreadable", title: r.error, testid: "recording-damaged" }));
+  if (r.capturing) flags.push(el("span", { class: "badge warn", text: "being captured", title: "another studio on this data folder is recording it; it can be changed once that capture stops", testid: "recording-capturing" }));
   const title = [r.error, r.notes, r.operator && `operator: ${r.operator}`, r.created].filter(Boolean).join("\n");
   const actions = [];
   if (!r.error) actions.push(el("button", { class: "icon", title: "play as the live source", testid: "recording-play", onclick: () => useRecording(r.name) }, "▶"));
   if (r.sample) {
     actions.push(el("button", { class: "icon", title: "copy to my recordings", testid: "recording-copy", onclick: () => copyRecording(r.name) }, "copy"));
-  } else {
+  } else if (!r.capturing) {
     actions.push(el("button", { class: "icon", title: "rename / notes", testid: "recording-edit", onclick: () => editRecording(r) }, "✎"));
   }
   actions.push(el("button", { class: "icon", title: "download", testid: "recording-download", onclick: () => download(`/api/recordings/${enc(r.name)}/file`, `${r.name}.tape.csv`, "recordings-error") }, "⤓"));
-  if (!r.sample) actions.push(el("button", { class: "icon", title: "delete", testid: "recording-delete", onclick: () => deleteRecording(r.name) }, "✕"));
+  if (!r.sample && !r.capturing) actions.push(el("button", { class: "icon", title: "delete", testid: "recording-delete", onclick: () => deleteRecording(r.name) }, "✕"));
   return el("tr", { "data-name": r.name, testid: "recording-row", title },
     el("td", { class: "name", title: [r.name, title].filter(Boolean).join("\n") }, el("span", { text: r.name, testid: "recording-name" }), " ", ...flags),
     el("td", { class: "num", testid: "recording-duration", text: fmtDuration(r.duration) }),
@@ -742,7 +743,7 @@ async function loadRuns() {
     S.sweeps = S.runs.some(sweepOf) ? await api("GET", "/api/sweeps") : [];
     if (!S.shownTouched) {
       // By default plot the newest few runs, so a fresh page shows the latest comparison.
-      S.shown = new Set(S.runs.slice(0, 4).map((r) => r.id));
+      S.shown = new Set(S.runs.filter((r) => !r.damaged).slice(0, 4).map((r) => r.id));
     }
     renderRuns();
     await Promise.all([...S.shown].filter((id) => !S.curves.has(id)).map(loadCurve));
@@ -810,7 +811,21 @@ function reconcileRows(body, rows) {
   for (const extra of old.slice(rows.length)) extra.remove();
 }
 
+/** A run folder the studio cannot read: the reason, and a way to delete it. */
+function damagedRunRow(r) {
+  return el("tr", { "data-id": r.id, testid: "run-row", "data-status": "damaged", title: r.error || "" },
+    el("td", {}),
+    el("td", { class: "name" }, r.id, " ", el("span", { class: "muted", testid: "run-damage", text: r.error || "" })),
+    el("td", {}, el("span", { class: "badge failed", testid: "run-status", text: "damaged" })),
+    el("td", {}),
+    el("td", {}),
+    el("td", { class: "actions" },
+      el("button", { class: "icon", title: "delete this damaged run folder", testid: "run-delete", onclick: () => deleteRun(r.id) }, "✕")),
+  );
+}
+
 function runRow(r) {
+  if (r.damaged) return damagedRunRow(r);
   const total = r.episodes_total || (r.config && r.config.episodes) || 1;
   const pct = Math.min(100, (100 * (r.episodes_done || 0)) / total);
   const live = r.status === "running" || r.status === "queued";
@@ -831,7 +846,8 @@ function runRow(r) {
         el("span", { style: `width:${pct.toFixed(1)}%` }))),
     el("td", { class: "num", testid: "run-cpu", text: fmtCpu(r.cpu_seconds) }),
     el("td", { class: "actions" },
-      live ? el("button", { class: "icon", title: "stop", testid: "run-stop", onclick: () => stopRun(r.id) }, "■") : null,
+      live && !r.elsewhere ? el("button", { class: "icon", title: "stop", testid: "run-stop", onclick: () => stopRun(r.id) }, "■") : null,
+      live && r.elsewhere ? el("button", { class: "icon", title: "another process trains it: stop it there; mark it stopped only if that process is gone", testid: "run-mark-stopped", onclick: () => markRunStopped(r.id) }, "⊘") : null,
       !live ? el("button", { class: "icon", title: "delete", testid: "run-delete", onclick: () => deleteRun(r.id) }, "✕") : null,
     ),
   );
@@ -926,9 +942,19 @@ async function stopRun(id) {
   });
 }
 
+async function markRunStopped(id) {
+  const r = S.runs.find((x) => x.id === id);
+  if (!(await confirmDialog(`Mark the run ${(r && r.name) || id} stopped? Do so only if no process trains it any more (a crash, a reboot, another machine); its curve so far is kept.`, "Mark stopped"))) return;
+  await guarded("runs-error", async () => {
+    upsertRun(await api("POST", `/api/runs/${enc(id)}/mark-stopped`));
+    renderRuns();
+  });
+}
+
 async function deleteRun(id) {
   const r = S.runs.find((x) => x.id === id);
-  if (!(await confirmDialog(`Delete the run ${(r && r.name) || id} with its curves and policy?`))) return;
+  const what = r && r.damaged ? `the damaged run folder ${id}` : `the run ${(r && r.name) || id} with its curves and policy`;
+  if (!(await confirmDialog(`Delete ${what}?`))) return;
   await guarded("runs-error", async () => {
     await api("DELETE", `/api/runs/${enc(id)}`);
     S.shown.delete(id);
