@@ -1020,6 +1020,9 @@ class RunFolder:
 
         def target() -> None:
             try:
+                from ._prepare import prepare_learner  # imports this module
+
+                prepare_learner(record.kind, live)  # the first run here compiles the kernels
                 if record.kind == TASK_ARM_REACH:
                     box["result"] = _train_arm_reach(record, workers, live)
                     return

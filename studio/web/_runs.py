@@ -28,13 +28,13 @@ import numpy as np
 from studio.learning import (
     DEFAULT_GOAL_JOINTS_DEG,
     ArmGrid,
-    ArmReach,
     ConfigError,
     DynaQConfig,
     LearningError,
     LiveProgress,
     RunFolder,
     RunRecord,
+    arm_reach_record,
     curve_statistics,
     find_runs,
     goal_degrees,
@@ -58,23 +58,10 @@ GROUP_SEPARATOR = "~"
 """Joins a group folder's name and a run folder's name into a run id (``paper~SV-ZPL``)."""
 RUN_ID = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.-]{0,99}(~[A-Za-z0-9_][A-Za-z0-9_.-]{0,99})?$")
 """A run id: a folder name, or a group folder's and a run folder's names joined by ``~``."""
-TRAINING_THREADS = ("studio-train-", "dynaq")
-"""Name prefixes of the threads a training run uses (RunFolder.train's and the kernels' pool)."""
 TRAINING_NICENESS = 10
 """How much lower the training threads' CPU priority is than the studio's (Linux ``nice``,
 0-19): on a busy machine the API, the live pipeline and the scene get the cores first and
 training takes what they leave, so a heavy run cannot starve the page."""
-
-
-def _training_cpu_seconds() -> float:
-    """CPU seconds of the threads training right now (the queue trains one run at a time)."""
-    total = 0.0
-    for thread in threading.enumerate():
-        if thread.ident is None or not thread.name.startswith(TRAINING_THREADS):
-            continue
-        with contextlib.suppress(OSError, AttributeError, OverflowError):
-            total += time.clock_gettime(time.pthread_getcpuclockid(thread.ident))
-    return total
 
 
 class Run:
@@ -133,9 +120,9 @@ class Run:
         """The run as the API shows it (``episodes_done`` from ``steps`` when given)."""
         steps = self.steps() if steps is None else steps
         folder, record = self.folder, self.folder.record
-        cpu = folder.cpu_seconds
-        if self.status == "running" and self.live is not None:
-            cpu = _training_cpu_seconds()
+        cpu, note, live = folder.cpu_seconds, None, self.live
+        if self.status == "running" and live is not None:
+            cpu, note = live.cpu_seconds, live.note
         return RunPublic(
             id=self.id,
             name=self.name,
@@ -148,6 +135,7 @@ class Run:
             episodes_total=record.experiments * record.episodes,
             cpu_seconds=round(float(cpu), 3),
             error=folder.error,
+            note=note,
             has_policy=folder.has_policy,
             origin=record.origin,
             group=record.group,
@@ -280,57 +268,26 @@ def prepare_run(create: RunCreate, demonstration_path: Callable[[str], np.ndarra
 def _prepare_reach_run(
     create: RunCreate, demonstration_path: Callable[[str], np.ndarray]
 ) -> RunRecord:
-    """:func:`prepare_run` for the continuous task: joints, step, tiles; the goal is the first
-    demonstration's final pose (else ``goal_deg`` for joints 1-3, the wrist at zero)."""
+    """:func:`prepare_run` for the continuous task (the learning package's
+    :func:`~studio.learning.arm_reach_record`, as ``studio train --task arm-reach`` does)."""
     problems: list[tuple[str, str]] = []
     config = _dynaq_config(create, problems)
-    paths = [
-        np.asarray(demonstration_path(name), dtype=np.float64) for name in create.demonstrations
-    ]
-    goal: tuple[float, ...] | None = None
-    if paths:
-        goal = tuple(paths[0][-1, :6])
-    else:
-        wrong = goal_problems(create.goal_deg)
-        problems += [("goal_deg", text) for text in wrong]
-        if not wrong:
-            goal = tuple(np.radians([*create.goal_deg, *([0.0] * (6 - len(create.goal_deg)))]))
-    task = coding = None
-    try:
-        task = ArmReach(joints=create.joints, step_deg=create.step_deg, goal=goal)
-    except LearningError as err:
-        field = str(err).split(" ", 1)[0]
-        problems.append((field if field in ("joints", "step_deg") else "goal_deg", str(err)))
-    if task is not None:
-        try:
-            coding = task.features(tilings=create.tilings, tiles=create.tiles)
-        except LearningError as err:
-            problems.append(("tiles" if str(err).startswith("tiles") else "tilings", str(err)))
-    if task is None or coding is None or config is None:
-        problems += run_problems(
-            create.experiments, create.episodes, create.seed, create.name or ""
-        )
-        raise_problems(problems)
-    assert task is not None and coding is not None and config is not None
-    try:
-        record = RunRecord.for_arm_reach(
-            task,
-            coding,
-            config,
-            create.experiments,
-            create.episodes,
-            create.seed,
-            [p[:, : task.joints] for p in paths],
-            name=create.name or "",
-            origin="page",
-            request=create.model_dump(),
-        )
-    except ConfigError as err:
-        problems += list(err.by_field.items())
-        raise_problems(problems)
-        raise
-    raise_problems(problems)
-    return record
+    return arm_reach_record(
+        config,
+        joints=create.joints,
+        step_deg=create.step_deg,
+        tilings=create.tilings,
+        tiles=create.tiles,
+        goal_deg=create.goal_deg,
+        experiments=create.experiments,
+        episodes=create.episodes,
+        seed=create.seed,
+        demonstrations=[demonstration_path(name) for name in create.demonstrations],
+        name=create.name or "",
+        origin="page",
+        request=create.model_dump(),
+        problems=problems,
+    )
 
 
 class RunQueue:

@@ -24,6 +24,7 @@ from typing import TYPE_CHECKING, Any
 from urllib.parse import urlsplit
 
 from studio import StudioError
+from studio.learning import prepare_in_background
 
 from ._guard import SiteRule
 from ._settings import Settings
@@ -295,6 +296,7 @@ def serve(settings: Settings, open_browser: bool = True) -> None:
             f"--host {settings.host} opens the studio to other machines, which needs a token; give --token (or set STUDIO_TOKEN), or keep --host 127.0.0.1 and use an SSH tunnel."
         )
     prepare_data_dir(settings.data_dir)
+    prepare_in_background()  # a first run then loads the kernels instead of compiling them
     # A live pose hops across four Python threads (source, pipeline, scene, viser's loop) before
     # it reaches the browser; at each hop the next thread may wait for the GIL for a whole
     # switch interval (5 ms by default) while a request or the run list holds it. 1 ms keeps

@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from studio.learning import CURVE_COLUMNS, load_policy
+from tests.conftest import hold_preparation
 from tests.web.conftest import TINY_RUN, wait_for, wait_run
 
 BAD_RUNS = [
@@ -517,3 +518,63 @@ def test_the_simulators_reach_and_a_run_check_a_goal_with_one_function(client, g
         assert r.json()["problems"] == goal_problems(goal)
     else:  # a malformed list is refused by the schema first
         assert r.status_code == 422 and "goal_deg" in r.json()["detail"]
+
+
+def test_a_first_run_reports_preparing_the_learner_before_its_first_episode(client, monkeypatch):
+    compiling, compiled = hold_preparation(monkeypatch)
+    run = client.post("/api/runs", json=TINY_RUN).json()
+    assert compiling.wait(30)
+    preparing = client.get(f"/api/runs/{run['id']}").json()
+    assert preparing["status"] == "running" and preparing["episodes_done"] == 0
+    assert preparing["note"].startswith("preparing the learner (first run on this machine, about ")
+    assert client.get("/api/runs").json()[0]["note"] == preparing["note"]
+    compiled.set()
+    done = wait_run(client, run["id"])
+    assert done["status"] == "done" and done["note"] is None
+
+
+def test_a_continuous_run_counts_its_cpu_while_it_trains(open_client):
+    client = open_client(run_workers=2)  # the page's studio: one kernel thread per core
+    body = {**TINY_RUN, "task": "arm-reach", "joints": 3, "episodes": 100_000,
+            "planning": "full", "planning_steps": 50}  # fmt: skip
+    run = client.post("/api/runs", json=body).json()
+
+    def mid_way() -> dict | None:
+        now = client.get(f"/api/runs/{run['id']}").json()
+        # a second of CPU: far beyond what the thread polling the run spends meanwhile
+        return now if now["episodes_done"] > 0 and now["cpu_seconds"] >= 1.0 else None
+
+    try:
+        assert wait_for(mid_way, 300, step=0.2), client.get(f"/api/runs/{run['id']}").json()
+        now = client.get(f"/api/runs/{run['id']}").json()
+        assert now["status"] == "running" and now["episodes_done"] < 2 * 100_000
+    finally:
+        client.post(f"/api/runs/{run['id']}/stop")
+        wait_run(client, run["id"])
+
+
+def test_the_run_list_says_a_first_run_prepares_the_learner(page_server, browser_page, monkeypatch):
+    from fastapi.testclient import TestClient
+
+    compiling, compiled = hold_preparation(monkeypatch)
+    base, app = page_server
+    page = browser_page
+    api = TestClient(app, base_url=base)
+    page.goto(base + "/")
+    page.wait_for_selector("body[data-ready='1']", timeout=60_000)
+    try:
+        run = api.post("/api/runs", json=TINY_RUN).json()
+        assert compiling.wait(30)
+        row = f"[data-testid='run-row'][data-id='{run['id']}']"
+        page.wait_for_selector(f"{row} [data-testid='run-note']", timeout=30_000)
+        assert page.inner_text(f"{row} [data-testid='run-status']") == "preparing"
+        note = page.inner_text(f"{row} [data-testid='run-note']")
+        assert note.startswith("preparing the learner (first run on this machine, about ")
+    finally:
+        compiled.set()
+    assert app.state.studio.runs.wait_idle(120)
+    page.wait_for_selector(
+        f"{row}[data-status='done'] [data-testid='run-progress']", timeout=30_000
+    )
+    assert page.locator(f"{row} [data-testid='run-note']").count() == 0
+    assert not page.errors

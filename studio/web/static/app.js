@@ -811,10 +811,12 @@ function runRow(r) {
       onchange: (e) => toggleShown(r.id, e.target.checked),
     })),
     el("td", { class: "name" }, el("span", { class: "swatch", style: `background:${runColor(r.id)}` }), runLabel(r)),
-    el("td", {}, el("span", { class: `badge ${r.status}`, testid: "run-status", text: r.status })),
-    el("td", { title: `${r.episodes_done} / ${total} episodes` },
-      el("span", { class: "progress", testid: "run-progress", "data-done": r.episodes_done },
-        el("span", { style: `width:${pct.toFixed(1)}%` }))),
+    el("td", {}, el("span", { class: `badge ${r.status}`, testid: "run-status", text: r.note ? "preparing" : r.status })),
+    r.note // before its first episode: what the run does (compiling the learner, the first time)
+      ? el("td", { class: "run-note", testid: "run-note", text: r.note })
+      : el("td", { title: `${r.episodes_done} / ${total} episodes` },
+        el("span", { class: "progress", testid: "run-progress", "data-done": r.episodes_done },
+          el("span", { style: `width:${pct.toFixed(1)}%` }))),
     el("td", { class: "num", testid: "run-cpu", text: fmtCpu(r.cpu_seconds) }),
     el("td", { class: "actions" },
       live ? el("button", { class: "icon", title: "stop", testid: "run-stop", onclick: () => stopRun(r.id) }, "■") : null,

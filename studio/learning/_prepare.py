@@ -1,0 +1,165 @@
+"""Preparing the learner: its compiled kernels, loaded from numba's disk cache or compiled.
+
+The learners' kernels are numba functions cached on disk (``cache=True``). The first run of a
+task on a machine (or after an update of the studio) compiles them, which takes tens of seconds
+(:data:`PREPARE_SECONDS`); every later run, in any process, loads them in about a second. So that
+such a run does not look stuck, :func:`prepare_learner` compiles them before the first episode
+and sets the run's :attr:`LiveProgress.note` meanwhile (:func:`preparing_note`), and
+:func:`prepare_in_background` lets a studio compile them at start in a low-priority child process
+(a child, so the compiler, which holds the GIL, never slows the studio's own threads).
+
+:func:`learner_ready` tells whether a task's kernels are compiled in this process or cached on
+disk for this machine, without loading them: from the dispatchers' signatures and numba's cache
+index (the entries whose code and CPU match this process's).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import logging
+import os
+import subprocess
+import sys
+import threading
+import time
+
+import numpy as np
+
+from ._config import DynaQConfig
+from ._dynaq import LiveProgress, _run_experiment, run_experiments
+from ._mdp import TabularMDP
+from ._runs import TASK_ARM_GRID, TASK_ARM_REACH, TASK_KINDS
+
+log = logging.getLogger(__name__)
+
+PREPARE_SECONDS = {TASK_ARM_GRID: 25.0, TASK_ARM_REACH: 60.0}
+"""Seconds a task's kernels take to compile, measured on a 2-core machine shared with other work
+(``python benchmarks/bench_prepare.py``; 26 s and 60-75 s there): the estimate a first run shows."""
+BACKGROUND_NICENESS = 19
+"""The CPU priority the background compilation runs at (Linux ``nice``): the lowest."""
+
+BACKGROUND_WAIT_SECONDS = 600.0
+"""A run waits at most this long for the background compilation before compiling itself."""
+
+_lock = threading.Lock()
+_background: subprocess.Popen | None = None
+
+
+def _kernels(kind: str) -> list:
+    """The task's compiled entry points (their callees are compiled into them)."""
+    if kind == TASK_ARM_REACH:
+        from ._linear import _greedy_episode, _run_compiled
+
+        return [_run_compiled, _greedy_episode]
+    return [_run_experiment]
+
+
+def _cached_on_disk(dispatcher: object) -> bool:
+    """Whether numba's cache index holds a build of this function's current code for this CPU."""
+    try:
+        cache = dispatcher._cache  # type: ignore[attr-defined]
+        probe = cache._index_key(None, dispatcher.targetctx.codegen())  # type: ignore[attr-defined]
+        index = cache._cache_file._load_index()  # empty when the source changed since
+    except Exception:  # numba's internals moved, an unreadable cache: assume it must compile
+        return False
+    return any(key[1:] == probe[1:] for key in index)
+
+
+def learner_ready(kind: str) -> bool:
+    """Whether a run of task ``kind`` starts learning at once: its kernels are compiled in this
+    process or cached on disk for this machine (else its first run compiles them)."""
+    return all(k.signatures or _cached_on_disk(k) for k in _kernels(kind))
+
+
+def preparing_note(kind: str) -> str:
+    """What a run says while its kernels compile (the page's run list, the CLI)."""
+    seconds = PREPARE_SECONDS.get(kind, max(PREPARE_SECONDS.values()))
+    return f"preparing the learner (first run on this machine, about {seconds:.0f} s)"
+
+
+def _warm(kind: str) -> None:
+    """Compile (or load) every kernel a run of ``kind`` uses, with a one-episode run."""
+    if kind == TASK_ARM_REACH:
+        import gymnasium
+
+        from ._gym import ARM_REACH_ID
+        from ._linear import greedy_rollout
+        from ._reach import ArmReach
+
+        task = ArmReach(joints=3)
+        coding = task.features()
+        result = run_experiments(
+            lambda: gymnasium.make(ARM_REACH_ID, **task.to_dict()),
+            DynaQConfig(planning_steps=1),
+            1,
+            1,
+            0,
+            None,
+            coding,
+            workers=1,
+        )
+        greedy_rollout(task, result.coder, result.weights[0], np.zeros(3), 1)
+        return
+    corridor = TabularMDP(
+        np.array([[1], [1]]), np.array([[1.0], [0.0]]), np.array([False, True]), np.array([0])
+    )
+    for planning in ("full", "prioritized"):
+        run_experiments(corridor, DynaQConfig(planning=planning, planning_steps=1), 1, 1, 0)
+
+
+def prepare_learner(kind: str, live: LiveProgress | None = None) -> float:
+    """Make a run of task ``kind`` ready to learn; returns the seconds it took.
+
+    When the kernels must be compiled, ``live.note`` says so (:func:`preparing_note`) until they
+    are; a compilation already under way in the background is waited for, then its result loaded.
+    """
+    start = time.perf_counter()
+    ready = learner_ready(kind)
+    if live is not None and not ready:
+        live.note = preparing_note(kind)
+    try:
+        with _lock:
+            background = _background
+        if background is not None and not ready:
+            with contextlib.suppress(subprocess.TimeoutExpired):  # else compile it here
+                background.wait(BACKGROUND_WAIT_SECONDS)
+        _warm(kind)
+    finally:
+        if live is not None:
+            live.note = None
+    seconds = time.perf_counter() - start
+    if not ready:
+        log.info("prepared the %s learner in %.1f s", kind, seconds)
+    return seconds
+
+
+def prepare_in_background() -> subprocess.Popen | None:
+    """Compile every task's kernels into the disk cache in a low-priority child process, unless
+    they are there already; returns the child (None when there was nothing to do).
+
+    A run that starts meanwhile waits for the child (:func:`prepare_learner`), then loads.
+    """
+    global _background
+    if all(learner_ready(kind) for kind in TASK_KINDS):
+        return None
+    code = "from studio.learning._prepare import _warm_all; _warm_all()"
+    try:
+        child = subprocess.Popen(
+            [sys.executable, "-c", code],
+            stdin=subprocess.DEVNULL,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+        )
+    except OSError as err:  # no harm: the first run compiles them itself
+        log.info("could not prepare the learner in the background: %s", err)
+        return None
+    with contextlib.suppress(OSError, AttributeError):
+        os.setpriority(os.PRIO_PROCESS, child.pid, BACKGROUND_NICENESS)
+    with _lock:
+        _background = child
+    return child
+
+
+def _warm_all() -> None:
+    for kind in TASK_KINDS:
+        _warm(kind)
