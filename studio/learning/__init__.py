@@ -52,6 +52,7 @@ from ._linear_policy import load_any_policy as load_any_policy
 from ._linear_policy import load_tile_policy as load_tile_policy
 from ._linear_policy import rollout_tile_policy as rollout_tile_policy
 from ._linear_policy import save_tile_policy as save_tile_policy
+from ._live_curve import LiveCurve as LiveCurve
 from ._mdp import TabularMDP as TabularMDP
 from ._policy import ROLLOUT_MAX_STEPS as ROLLOUT_MAX_STEPS
 from ._policy import ROLLOUT_RATE_HZ as ROLLOUT_RATE_HZ

@@ -14,13 +14,14 @@ polls the live arrays.
 from __future__ import annotations
 
 import contextlib
+import json
 import logging
 import re
 import shutil
 import threading
 import time
 from collections import deque
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import numpy as np
@@ -31,11 +32,11 @@ from studio.learning import (
     ConfigError,
     DynaQConfig,
     LearningError,
+    LiveCurve,
     LiveProgress,
     RunFolder,
     RunRecord,
     arm_reach_record,
-    curve_statistics,
     find_runs,
     goal_degrees,
     goal_problems,
@@ -53,7 +54,12 @@ __all__ = ["Run", "RunQueue", "prepare_run"]
 log = logging.getLogger(__name__)
 
 CURVE_CACHE_SECONDS = 0.05
-"""A live curve is recomputed at most this often, however many clients ask."""
+"""A live curve takes in the episodes finished meanwhile at most this often, however many clients
+ask (only those episodes are recomputed: :class:`studio.learning.LiveCurve`)."""
+CURVE_JSON_SECONDS = 1.0
+"""A running run's ``/curve`` answer is encoded again at most this often (its 2,000,000-cell
+curve is 180,000 numbers of JSON, encoded holding the GIL); the page follows a running run
+through the event stream, which sends only what changed."""
 GROUP_SEPARATOR = "~"
 """Joins a group folder's name and a run folder's name into a run id (``paper~SV-ZPL``)."""
 RUN_ID = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.-]{0,99}(~[A-Za-z0-9_][A-Za-z0-9_.-]{0,99})?$")
@@ -71,7 +77,11 @@ class Run:
         self.id = run_id
         self.folder = folder
         self.live = live  # set from submission on, so a Stop is never lost
-        self._curve_cache: tuple[float, np.ndarray] | None = None
+        self._curve = LiveCurve(folder.record.episodes)
+        self._curve_lock = threading.RLock()
+        self._json_lock = threading.Lock()
+        self._curve_taken: tuple[float, object] = (-1e9, None)  # when, and which steps array
+        self._curve_json: tuple[float, int, bytes] | None = None  # when, version, JSON
         self._mtime = _status_mtime(folder.path)
 
     @property
@@ -100,25 +110,55 @@ class Run:
         request = self.folder.record.request or {}
         return list(request.get("demonstrations") or [])
 
-    def steps(self) -> np.ndarray:
-        """Steps per episode ``(experiments, episodes)``, -1 where not done (live while training)."""
+    def live_curve(self) -> LiveCurve:
+        """The run's curve, brought up to date: while it trains at most every
+        :data:`CURVE_CACHE_SECONDS`, recomputing only the episodes finished meanwhile."""
         live = self.live
-        if live is not None and self.status == "running":
+        with self._curve_lock:  # one thread updates; the others wait without holding the GIL
+            when, source = self._curve_taken
             now = time.monotonic()
-            cache = self._curve_cache
-            if cache is None or now - cache[0] > CURVE_CACHE_SECONDS:
-                cache = (now, live.steps.copy())
-                self._curve_cache = cache
-            return cache[1]
-        return self.folder.steps()
+            if live is not None and self.status == "running":
+                if now - when > CURVE_CACHE_SECONDS or source is not live.steps:
+                    self._curve.update(live.steps)
+                    self._curve_taken = (now, live.steps)
+            elif self.status != "queued":  # (a queued run has no steps yet)
+                steps = self.folder.steps()
+                if source is not steps:
+                    self._curve.update(steps)
+                    self._curve_taken = (now, steps)
+        return self._curve
+
+    @contextlib.contextmanager
+    def curve_held(self) -> Iterator[LiveCurve]:
+        """:meth:`live_curve`, which no other thread updates until the block ends (an event
+        built from it is consistent: the run's ``episodes_done`` and the curve's pieces)."""
+        with self._curve_lock:
+            yield self.live_curve()
 
     def curve(self, start: int = 0) -> dict[str, list]:
         """The learning curve (:func:`studio.learning.curve_statistics`)."""
-        return curve_statistics(self.steps(), start)
+        return self.live_curve().curve(start)
 
-    def model(self, steps: np.ndarray | None = None) -> RunPublic:
-        """The run as the API shows it (``episodes_done`` from ``steps`` when given)."""
-        steps = self.steps() if steps is None else steps
+    def curve_json(self) -> bytes:
+        """:meth:`curve` as JSON (``CurvePublic``), encoded once per change for every client, and
+        at most every :data:`CURVE_JSON_SECONDS` while the run trains."""
+        running = self.status == "running"
+        with self._json_lock:  # one thread encodes; the others wait for its answer
+            curve, cached, now = self.live_curve(), self._curve_json, time.monotonic()
+            if (
+                cached is None
+                or (cached[1] != curve.version and not running)
+                or (cached[1] != curve.version and now - cached[0] > CURVE_JSON_SECONDS)
+            ):
+                with self._curve_lock:
+                    version, data = curve.version, curve.curve()
+                text = json.dumps(data, separators=(",", ":"))  # the event stream goes on meanwhile
+                cached = self._curve_json = (now, version, text.encode())
+        return cached[2]
+
+    def model(self, curve: LiveCurve | None = None) -> RunPublic:
+        """The run as the API shows it (``episodes_done`` from ``curve`` when given)."""
+        done = (curve or self.live_curve()).episodes_done
         folder, record = self.folder, self.folder.record
         cpu, note, live = folder.cpu_seconds, None, self.live
         if self.status == "running" and live is not None:
@@ -131,7 +171,7 @@ class Run:
             created=folder.created,
             started=folder.started,
             finished=folder.finished,
-            episodes_done=int(np.count_nonzero(steps >= 0)),
+            episodes_done=done,
             episodes_total=record.experiments * record.episodes,
             cpu_seconds=round(float(cpu), 3),
             error=folder.error,

@@ -273,27 +273,65 @@ def test_run_events_stream_the_curve_while_training(client):
         if client.get(f"/api/runs/{run['id']}").json()["episodes_done"] > 0:
             break
         client.app.state.studio.runs.wait_idle(0.05)
-    events = []
-    with client.stream("GET", "/api/events?max_seconds=1.5") as r:
-        assert r.headers["content-type"].startswith("text/event-stream")
-        event = None
-        for line in r.iter_lines():
-            if line.startswith("event: "):
-                event = line[7:]
-            elif line.startswith("data: ") and event == "run":
-                events.append(json.loads(line[6:]))
+    events = stream_run_events(client, 1.5)
     client.post(f"/api/runs/{run['id']}/stop")
     wait_run(client, run["id"])
     assert len(events) >= 7  # at least 5 per second over the 1.5 s stream
     assert all(e["run"]["id"] == run["id"] for e in events)
     assert events[0]["from"] == 0
     # replaying the partial updates rebuilds the curve the API serves at that moment
+    counts = replay_counts(events)
+    assert events[-1]["run"]["episodes_done"] > events[0]["run"]["episodes_done"]
+    assert len(counts) <= 100_000
+
+
+def replay_counts(events: list[dict]) -> list[int]:
+    """A page's copy of a run's ``count`` column, rebuilt from its events (the first holds the
+    whole curve, later ones the pieces that changed); each step's total is the run's progress."""
     counts: list[int] = []
     for e in events:
-        counts = counts[: e["from"]] + e["curve"]["count"]
-        assert e["curve"]["episodes"][:1] in ([], [e["from"] + 1])
+        if "curve" in e:
+            counts = counts[: e["from"]] + e["curve"]["count"]
+            assert e["curve"]["episodes"][:1] in ([], [e["from"] + 1])
+        for piece in e.get("pieces", []):
+            assert piece["curve"]["episodes"] == list(range(piece["from"] + 1, piece["to"] + 1))
+            counts += [0] * (piece["from"] - len(counts))
+            counts[piece["from"] : piece["to"]] = piece["curve"]["count"]
         assert sum(counts) == e["run"]["episodes_done"]
-    assert events[-1]["run"]["episodes_done"] > events[0]["run"]["episodes_done"]
+    return counts
+
+
+def stream_run_events(client, seconds: float) -> list[dict]:
+    events, event = [], None
+    with client.stream("GET", f"/api/events?max_seconds={seconds}") as r:
+        assert r.headers["content-type"].startswith("text/event-stream")
+        for line in r.iter_lines():
+            if line.startswith("event: "):
+                event = line[7:]
+            elif line.startswith("data: ") and event == "run":
+                events.append(json.loads(line[6:]))
+    return events
+
+
+def test_run_events_send_only_what_changed_when_experiments_train_far_apart(open_client):
+    # one kernel thread: experiment 1 starts at episode 1 while experiment 0 finished them all,
+    # so the episodes that change lie at both ends of a 20,000-episode curve
+    client = open_client(run_workers=1)
+    body = {"planning": "full", "planning_steps": 500, "experiments": 3, "episodes": 20_000}
+    run = client.post("/api/runs", json=body).json()
+    assert wait_for(
+        lambda: client.get(f"/api/runs/{run['id']}").json()["episodes_done"] > 20_000, 300
+    )
+    try:
+        events = stream_run_events(client, 1.5)
+    finally:
+        client.post(f"/api/runs/{run['id']}/stop")
+        wait_run(client, run["id"])
+    assert len(events) >= 5 and len(events[0]["curve"]["count"]) == 20_000
+    later = [e for e in events[1:] if e["run"]["status"] == "running"]
+    sent = [sum(p["to"] - p["from"] for p in e["pieces"]) for e in later]
+    assert later and max(sent) < 2_000, sent  # not the 20,000-episode tail again and again
+    assert len(replay_counts(events)) == 20_000
 
 
 def test_a_client_that_disconnects_mid_run_changes_nothing(client):

@@ -927,10 +927,18 @@ async function deleteRun(id) {
 }
 
 /** Merge an SSE curve piece into the run's curve: replace everything from its first episode on. */
-function mergeCurve(id, piece, from) {
+function mergeCurve(id, piece, from, to) {
   if (!piece || !piece.episodes) return;
   let c = S.curves.get(id);
   if (!c) { c = emptyCurve(); S.curves.set(id, c); }
+  if (to !== undefined && to !== null) { // episodes [from, to) changed: replace just those
+    for (let e = c.episodes.length; e < from; e++) { // episodes nobody finished yet: empty
+      for (const k of CURVE_KEYS) c[k].push(k === "episodes" ? e + 1 : 0);
+    }
+    for (const k of CURVE_KEYS) c[k].splice(from, to - from, ...(piece[k] || []));
+    markCurvesDirty();
+    return;
+  }
   // `from` is the 0-based index of the piece's first episode (episode numbers are 1-based).
   const first = from !== undefined && from !== null ? from + 1 : piece.episodes[0];
   // Episodes are numbered; drop what we already hold from `first` on, then append.
@@ -1319,6 +1327,7 @@ function connectEvents() {
     upsertRun(d.run);
     if (!before && !S.shownTouched) S.shown.add(d.run.id);
     if (d.curve) mergeCurve(d.run.id, d.curve, d.from);
+    for (const p of d.pieces || []) mergeCurve(d.run.id, p.curve, p.from, p.to);
     scheduleRunsRender();
     if (before && before.status !== d.run.status && !["running", "queued"].includes(d.run.status)) {
       loadCurve(d.run.id);
