@@ -717,7 +717,8 @@ def _disk_error(err: OSError, what: str, where: Path) -> LearningError:
 def steps_text(steps: np.ndarray) -> str:
     """``steps.csv``'s text: a comment line, then one comma-separated row per experiment."""
     lines = ["# steps per episode; one row per experiment; -1 = not done"]
-    lines += [",".join(map(str, row)) for row in np.asarray(steps, dtype=np.int64).tolist()]
+    # row by row: a 100 x 20,000 checkpoint holds the GIL for one row at a time, not for all
+    lines += [",".join(map(str, row.tolist())) for row in np.asarray(steps, dtype=np.int64)]
     return "\n".join(lines) + "\n"
 
 
