@@ -6,7 +6,8 @@ task on a machine (or after an update of the studio) compiles them, which takes 
 such a run does not look stuck, :func:`prepare_learner` compiles them before the first episode
 and sets the run's :attr:`LiveProgress.note` meanwhile (:func:`preparing_note`), and
 :func:`prepare_in_background` lets a studio compile them at start in a low-priority child process
-(a child, so the compiler, which holds the GIL, never slows the studio's own threads).
+(a child, so the compiler, which holds the GIL, never slows the studio's own threads; one
+child per task, so a run waits only for its own task's).
 
 :func:`learner_ready` tells whether a task's kernels are compiled in this process or cached on
 disk for this machine, without loading them: from the dispatchers' signatures and numba's cache
@@ -37,14 +38,16 @@ PREPARE_SECONDS = {TASK_ARM_GRID: 8.0, TASK_ARM_REACH: 25.0}
 ``python benchmarks/bench_prepare.py`` measured (5.5 s and 19.7 s on a 2-core x86-64 machine),
 rounded up, which is the wall time where nothing else competes for the core; a busy machine
 takes longer (38 s and 256 s of wall time at a load average of 26 there)."""
-BACKGROUND_NICENESS = 19
-"""The CPU priority the background compilation runs at (Linux ``nice``): the lowest."""
+BACKGROUND_NICENESS = 10
+"""How much lower the background compilation's CPU priority is (Linux ``nice``): the training
+runs' (``TRAINING_NICENESS``), so the studio's own threads come first, yet a run waiting for it
+is not left behind every other process of a busy machine."""
 
 BACKGROUND_WAIT_SECONDS = 600.0
 """A run waits at most this long for the background compilation before compiling itself."""
 
 _lock = threading.Lock()
-_background: subprocess.Popen | None = None
+_background: tuple[subprocess.Popen | None, str | None] = (None, None)  # child, its task
 
 
 def _kernels(kind: str) -> list:
@@ -113,7 +116,8 @@ def prepare_learner(kind: str, live: LiveProgress | None = None) -> float:
     """Make a run of task ``kind`` ready to learn; returns the seconds it took.
 
     When the kernels must be compiled, ``live.note`` says so (:func:`preparing_note`) until they
-    are; a compilation already under way in the background is waited for, then its result loaded.
+    are. When the background child (:func:`prepare_in_background`) is compiling this very task,
+    the run waits for it, then loads its result; otherwise it compiles here, at once.
     """
     start = time.perf_counter()
     ready = learner_ready(kind)
@@ -121,10 +125,10 @@ def prepare_learner(kind: str, live: LiveProgress | None = None) -> float:
         live.note = preparing_note(kind)
     try:
         with _lock:
-            background = _background
-        if background is not None and not ready:
+            child, child_kind = _background
+        if not ready and child is not None and child_kind == kind:
             with contextlib.suppress(subprocess.TimeoutExpired):  # else compile it here
-                background.wait(BACKGROUND_WAIT_SECONDS)
+                child.wait(BACKGROUND_WAIT_SECONDS)
         _warm(kind)
     finally:
         if live is not None:
@@ -135,33 +139,44 @@ def prepare_learner(kind: str, live: LiveProgress | None = None) -> float:
     return seconds
 
 
-def prepare_in_background() -> subprocess.Popen | None:
-    """Compile every task's kernels into the disk cache in a low-priority child process, unless
-    they are there already; returns the child (None when there was nothing to do).
+def prepare_in_background() -> threading.Thread | None:
+    """Compile the tasks' kernels into the disk cache, one task at a time in a child process at
+    a lower CPU priority, unless they are there already; returns the thread that starts the
+    children (None when there was nothing to do).
 
-    A run that starts meanwhile waits for the child (:func:`prepare_learner`), then loads.
+    The arm grid comes first: most first runs are the paper's task. A run of the task being
+    compiled waits for its child; a run of another task compiles its own at once.
     """
+    kinds = [kind for kind in TASK_KINDS if not learner_ready(kind)]
+    if not kinds:
+        return None
+    thread = threading.Thread(
+        target=_compile_children, args=(kinds,), name="studio-prepare", daemon=True
+    )
+    thread.start()
+    return thread
+
+
+def _compile_children(kinds: list[str]) -> None:
     global _background
-    if all(learner_ready(kind) for kind in TASK_KINDS):
-        return None
-    code = "from studio.learning._prepare import _warm_all; _warm_all()"
-    try:
-        child = subprocess.Popen(
-            [sys.executable, "-c", code],
-            stdin=subprocess.DEVNULL,
-            stdout=subprocess.DEVNULL,
-            stderr=subprocess.DEVNULL,
-        )
-    except OSError as err:  # no harm: the first run compiles them itself
-        log.info("could not prepare the learner in the background: %s", err)
-        return None
-    with contextlib.suppress(OSError, AttributeError):
-        os.setpriority(os.PRIO_PROCESS, child.pid, BACKGROUND_NICENESS)
-    with _lock:
-        _background = child
-    return child
-
-
-def _warm_all() -> None:
-    for kind in TASK_KINDS:
-        _warm(kind)
+    for kind in kinds:
+        if learner_ready(kind):  # a run compiled it meanwhile
+            continue
+        code = f"from studio.learning._prepare import _warm; _warm({kind!r})"
+        try:
+            child = subprocess.Popen(
+                [sys.executable, "-c", code],
+                stdin=subprocess.DEVNULL,
+                stdout=subprocess.DEVNULL,
+                stderr=subprocess.DEVNULL,
+            )
+        except OSError as err:  # no harm: the first run compiles them itself
+            log.info("could not prepare the learner in the background: %s", err)
+            return
+        with contextlib.suppress(OSError, AttributeError):
+            os.setpriority(os.PRIO_PROCESS, child.pid, BACKGROUND_NICENESS)
+        with _lock:
+            _background = (child, kind)
+        child.wait()
+        with _lock:
+            _background = (None, None)

@@ -109,3 +109,39 @@ def test_an_experiments_cpu_time_is_counted_while_it_runs():
     thread.join(30)
     done = live.cpu_seconds
     assert done >= 0.1 and live.cpu_seconds == done  # kept once the thread is gone
+
+
+class _Compiling:
+    """Stands for the background child compiling a task: ``wait`` returns once ``done`` is set."""
+
+    def __init__(self) -> None:
+        self.done, self.waited = threading.Event(), threading.Event()
+
+    def wait(self, timeout: float | None = None) -> int:
+        self.waited.set()
+        assert self.done.wait(timeout)
+        return 0
+
+
+def test_a_run_waits_for_the_background_child_only_when_it_compiles_its_own_task(monkeypatch):
+    warmed: list[str] = []
+    child = _Compiling()
+    monkeypatch.setattr(_prepare, "learner_ready", lambda kind: False)
+    monkeypatch.setattr(_prepare, "_warm", warmed.append)
+    monkeypatch.setattr(_prepare, "_background", (child, "arm-reach"))
+    _prepare.prepare_learner("arm-grid")  # another task: compiled here, no wait
+    assert warmed == ["arm-grid"] and not child.waited.is_set()
+    live = LiveProgress(1, 1)
+    waiting = threading.Thread(target=_prepare.prepare_learner, args=("arm-reach", live))
+    waiting.start()
+    assert child.waited.wait(30)
+    assert live.note == preparing_note("arm-reach") and warmed == ["arm-grid"]
+    child.done.set()
+    waiting.join(30)
+    assert warmed == ["arm-grid", "arm-reach"] and live.note is None
+
+
+def test_nothing_is_compiled_in_the_background_when_every_task_is_ready(monkeypatch):
+    monkeypatch.setattr(_prepare, "learner_ready", lambda kind: True)
+    monkeypatch.setattr(subprocess, "Popen", None)  # a child would fail the test
+    assert _prepare.prepare_in_background() is None
