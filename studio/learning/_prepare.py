@@ -5,7 +5,7 @@ task on a machine (or after an update of the studio) compiles them, which takes 
 (:data:`PREPARE_SECONDS`); every later run, in any process, loads them in about a second. So that
 such a run does not look stuck, :func:`prepare_learner` compiles them before the first episode
 and sets the run's :attr:`LiveProgress.note` meanwhile (:func:`preparing_note`), and
-:func:`prepare_in_background` lets a studio compile them at start in a low-priority child process
+:func:`prepare_in_background` lets a studio compile them at start in a child process
 (a child, so the compiler, which holds the GIL, never slows the studio's own threads; one
 child per task, so a run waits only for its own task's).
 
@@ -38,11 +38,11 @@ PREPARE_SECONDS = {TASK_ARM_GRID: 8.0, TASK_ARM_REACH: 25.0}
 ``python benchmarks/bench_prepare.py`` measured (5.5 s and 19.7 s on a 2-core x86-64 machine),
 rounded up, which is the wall time where nothing else competes for the core; a busy machine
 takes longer (38 s and 256 s of wall time at a load average of 26 there)."""
-BACKGROUND_NICENESS = 10
-"""How much lower the background compilation's CPU priority is (Linux ``nice``): the training
-runs' (``TRAINING_NICENESS``), so the studio's own threads come first, yet a run waiting for it
-is not left behind every other process of a busy machine."""
-
+BACKGROUND_NICENESS = 0
+"""How much lower the background compilation's CPU priority is (Linux ``nice``): none. It runs in
+its own process, so it never holds the studio's GIL; and a first run may wait for it, which must
+not put the user behind the machine's other work (measured with ``bench_prepare.py`` at a load
+average of 26: a first run waited 157 s for a child at nice 10, against 28 s compiling itself)."""
 BACKGROUND_WAIT_SECONDS = 600.0
 """A run waits at most this long for the background compilation before compiling itself."""
 
@@ -140,8 +140,8 @@ def prepare_learner(kind: str, live: LiveProgress | None = None) -> float:
 
 
 def prepare_in_background() -> threading.Thread | None:
-    """Compile the tasks' kernels into the disk cache, one task at a time in a child process at
-    a lower CPU priority, unless they are there already; returns the thread that starts the
+    """Compile the tasks' kernels into the disk cache, one task at a time in a child process,
+    unless they are there already; returns the thread that starts the
     children (None when there was nothing to do).
 
     The arm grid comes first: most first runs are the paper's task. A run of the task being
@@ -173,8 +173,9 @@ def _compile_children(kinds: list[str]) -> None:
         except OSError as err:  # no harm: the first run compiles them itself
             log.info("could not prepare the learner in the background: %s", err)
             return
-        with contextlib.suppress(OSError, AttributeError):
-            os.setpriority(os.PRIO_PROCESS, child.pid, BACKGROUND_NICENESS)
+        if BACKGROUND_NICENESS:
+            with contextlib.suppress(OSError, AttributeError):
+                os.setpriority(os.PRIO_PROCESS, child.pid, BACKGROUND_NICENESS)
         with _lock:
             _background = (child, kind)
         child.wait()
