@@ -39,7 +39,7 @@ print(json.dumps({"wall": time.perf_counter() - wall, "cpu": time.process_time()
 """
 FIRST_RUN = {"planning": "full", "experiments": 2, "episodes": 50, "seed": 0}
 SETTLE_S = 10.0
-"""The user opens the page and presses Start this long after the studio is up."""
+"""The user opens the page and presses Start this long after the studio is up (``--settle``)."""
 
 
 def child(kind: str, cache: str) -> dict[str, float]:
@@ -63,7 +63,7 @@ def compile_times() -> None:
         )
 
 
-def first_run(background: bool) -> tuple[float, float]:
+def first_run(background: bool, settle: float = SETTLE_S) -> tuple[float, float]:
     """Seconds until the API answers, and from submitting a first run to its first episode."""
     with (
         tempfile.TemporaryDirectory(prefix="bench-prepare-") as cache,
@@ -75,7 +75,7 @@ def first_run(background: bool) -> tuple[float, float]:
             studio = Studio(10, Path(data), background_prepare=background)
             up = time.perf_counter() - t0
             try:
-                time.sleep(SETTLE_S)
+                time.sleep(settle)
                 t1 = time.perf_counter()
                 run = studio.call("POST", "/api/runs", FIRST_RUN)
                 while studio.call("GET", f"/api/runs/{run['id']}")["episodes_done"] == 0:
@@ -91,6 +91,9 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--skip-serve", action="store_true", help="only the compile times")
     parser.add_argument("--serve-only", action="store_true", help="only studio serve's part")
+    parser.add_argument(
+        "--settle", type=float, default=SETTLE_S, help="seconds from start to the first run"
+    )
     args = parser.parse_args()
     print(f"{os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f}")
     if not args.serve_only:
@@ -98,11 +101,11 @@ def main() -> None:
     if args.skip_serve:
         return
     for background in (True, False):  # the machine's other load changes: report each pair
-        up, first = first_run(background)
+        up, first = first_run(background, args.settle)
         label = "compiled at start" if background else "compiled by the run"
         print(
             f"studio serve, {label:<19}: API up in {up:5.1f} s; a first run submitted "
-            f"{SETTLE_S:g} s later starts its first episode after {first:6.1f} s "
+            f"{args.settle:g} s later starts its first episode after {first:6.1f} s "
             f"(load average {os.getloadavg()[0]:.1f})",
             flush=True,
         )

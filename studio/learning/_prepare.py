@@ -113,20 +113,22 @@ def _warm(kind: str) -> None:
 
 
 def prepare_learner(kind: str, live: LiveProgress | None = None) -> float:
-    """Make a run of task ``kind`` ready to learn; returns the seconds it took.
+    """Make a run of task ``kind`` ready to learn; returns the seconds it took (0 when its
+    kernels are compiled in this process or cached on disk already).
 
     When the kernels must be compiled, ``live.note`` says so (:func:`preparing_note`) until they
     are. When the background child (:func:`prepare_in_background`) is compiling this very task,
     the run waits for it, then loads its result; otherwise it compiles here, at once.
     """
+    if learner_ready(kind):  # compiled here, or cached: the run loads them in about a second
+        return 0.0
     start = time.perf_counter()
-    ready = learner_ready(kind)
-    if live is not None and not ready:
+    if live is not None:
         live.note = preparing_note(kind)
     try:
         with _lock:
             child, child_kind = _background
-        if not ready and child is not None and child_kind == kind:
+        if child is not None and child_kind == kind:
             with contextlib.suppress(subprocess.TimeoutExpired):  # else compile it here
                 child.wait(BACKGROUND_WAIT_SECONDS)
         _warm(kind)
@@ -134,8 +136,7 @@ def prepare_learner(kind: str, live: LiveProgress | None = None) -> float:
         if live is not None:
             live.note = None
     seconds = time.perf_counter() - start
-    if not ready:
-        log.info("prepared the %s learner in %.1f s", kind, seconds)
+    log.info("prepared the %s learner in %.1f s", kind, seconds)
     return seconds
 
 
