@@ -56,6 +56,8 @@ log = logging.getLogger(__name__)
 CURVE_CACHE_SECONDS = 0.05
 """A live curve takes in the episodes finished meanwhile at most this often, however many clients
 ask (only those episodes are recomputed: :class:`studio.learning.LiveCurve`)."""
+JSON_SLICE = 2_000
+"""Values per ``json.dumps`` call when a curve is encoded (between calls other threads run)."""
 CURVE_JSON_SECONDS = 1.0
 """A running run's ``/curve`` answer is encoded again at most this often (its 2,000,000-cell
 curve is 180,000 numbers of JSON, encoded holding the GIL); the page follows a running run
@@ -152,8 +154,7 @@ class Run:
             ):
                 with self._curve_lock:
                     version, data = curve.version, curve.curve()
-                text = json.dumps(data, separators=(",", ":"))  # the event stream goes on meanwhile
-                cached = self._curve_json = (now, version, text.encode())
+                cached = self._curve_json = (now, version, _json_in_slices(data).encode())
         return cached[2]
 
     def model(self, curve: LiveCurve | None = None) -> RunPublic:
@@ -180,6 +181,20 @@ class Run:
             origin=record.origin,
             group=record.group,
         )
+
+
+def _json_in_slices(data: dict[str, list]) -> str:
+    """``json.dumps(data)`` (compact) for a dict of long lists, encoded :data:`JSON_SLICE` values
+    at a time: one ``json.dumps`` call holds the GIL until it returns, and a whole 20,000-episode
+    curve (180,000 numbers) took the event loop's GIL for a tenth of a second and more."""
+    fields = []
+    for key, values in data.items():
+        pieces = [
+            json.dumps(values[i : i + JSON_SLICE], separators=(",", ":"))[1:-1]
+            for i in range(0, len(values), JSON_SLICE)
+        ]
+        fields.append(f"{json.dumps(key)}:[{','.join(pieces)}]")
+    return "{" + ",".join(fields) + "}"
 
 
 def _status_mtime(path: Path) -> float:

@@ -616,3 +616,13 @@ def test_the_run_list_says_a_first_run_prepares_the_learner(page_server, browser
     )
     assert page.locator(f"{row} [data-testid='run-note']").count() == 0
     assert not page.errors
+
+
+def test_a_curve_encoded_in_slices_is_the_same_json():
+    from studio.web._runs import JSON_SLICE, _json_in_slices
+
+    rng = np.random.default_rng(0)
+    n = 2 * JSON_SLICE + 7
+    curve = {"episodes": list(range(1, n + 1)), "mean": rng.random(n).round(3).tolist(),
+             "count": rng.integers(0, 9, n).tolist(), "empty": []}  # fmt: skip
+    assert _json_in_slices(curve) == json.dumps(curve, separators=(",", ":"))
