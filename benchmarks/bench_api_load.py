@@ -12,6 +12,9 @@ run at a lower CPU priority (``TRAINING_NICENESS``), so the API, the pipeline an
 the cores first. ``--niceness 0`` starts the studio without it, to see the difference.
 
 Run: ``python benchmarks/bench_api_load.py`` (about 50 s; ``--seconds`` per window, ``--rounds``).
+``--heavy`` measures issue 18's load instead: 15 s windows while a 100 x 20,000-episode run with
+full planning trains, a page's live stream open and the clients polling the run's curve too,
+each round's baseline measured right after the run is stopped (its finished curve polled).
 """
 
 from __future__ import annotations
@@ -45,6 +48,18 @@ PATHS = (
 )
 HEAVY_RUN = {"planning": "full", "experiments": 20, "episodes": 3000, "seed": 1}
 """Far more work than a window lasts: it trains on every core until it is stopped."""
+ISSUE_RUN = {
+    "planning": "full",
+    "planning_steps": 3000,
+    "experiments": 100,
+    "episodes": 20_000,
+    "seed": 1,
+}
+"""``--heavy``: the largest run the studio accepts (100 x 20,000 episodes, full planning with
+3,000 planning updates per step), the run issue 18 measured the API under. Its 2,000,000-cell
+curve is what the page's live stream, the run list and the curve endpoint read while it trains."""
+CURVE_PATH = "/api/runs/{run}/curve"
+"""``--heavy`` adds the run's curve to what the clients poll (the page loads it for each shown run)."""
 START_TIMEOUT_S = 120.0
 GOAL_P99_MS = 250.0
 
@@ -53,8 +68,11 @@ import json, sys
 from pathlib import Path
 import studio.web._runs as runs
 from studio.web import Settings, serve
+import studio.web._serve as served
 a = json.loads(sys.argv[1])
 runs.RunQueue.niceness = a["niceness"]
+if not a["background_prepare"]:
+    served.prepare_in_background = lambda: None
 serve(Settings(data_dir=Path(a["data"]), port=a["port"], viser_port=a["viser_port"],
                source="simulator"), open_browser=False)
 """
@@ -69,9 +87,10 @@ def free_port() -> int:
 class Studio:
     """A studio in a child process on loopback, and a small JSON client for it."""
 
-    def __init__(self, niceness: int, data: Path) -> None:
+    def __init__(self, niceness: int, data: Path, background_prepare: bool = True) -> None:
         self.port = free_port()
         args = {"niceness": niceness, "data": str(data), "port": self.port}
+        args["background_prepare"] = background_prepare
         args["viser_port"] = free_port()
         self.process = subprocess.Popen(
             [sys.executable, "-c", SERVER, json.dumps(args)],
@@ -115,9 +134,11 @@ class Studio:
                 self.process.wait()
 
 
-def load(port: int, seconds: float) -> tuple[np.ndarray, np.ndarray]:
+def load(
+    port: int, seconds: float, paths_polled: tuple[str, ...] = PATHS
+) -> tuple[np.ndarray, np.ndarray]:
     """``CLIENTS`` threads polling the API for ``seconds``; every request's latency (s) and
-    the index of its path in :data:`PATHS`."""
+    the index of its path in ``paths_polled``."""
     latencies: list[list[float]] = [[] for _ in range(CLIENTS)]
     paths: list[list[int]] = [[] for _ in range(CLIENTS)]
     failures = [0]
@@ -129,7 +150,7 @@ def load(port: int, seconds: float) -> tuple[np.ndarray, np.ndarray]:
         start.wait()
         i = k
         while time.monotonic() < deadline:
-            path = PATHS[i % len(PATHS)]
+            path = paths_polled[i % len(paths_polled)]
             i += 1
             t0 = time.perf_counter()
             try:
@@ -142,7 +163,7 @@ def load(port: int, seconds: float) -> tuple[np.ndarray, np.ndarray]:
                 conn.close()
                 conn = http.client.HTTPConnection("127.0.0.1", port, timeout=30)
             latencies[k].append(time.perf_counter() - t0)
-            paths[k].append((i - 1) % len(PATHS))
+            paths[k].append((i - 1) % len(paths_polled))
             failures[0] += not ok
         conn.close()
 
@@ -169,16 +190,18 @@ def summary(latencies: np.ndarray, seconds: float) -> dict[str, float]:
     }
 
 
-def window(studio: Studio, label: str, seconds: float) -> tuple[np.ndarray, int]:
+def window(
+    studio: Studio, label: str, seconds: float, paths_polled: tuple[str, ...] = PATHS
+) -> tuple[np.ndarray, int]:
     """Load the API for ``seconds``; the latencies and the frames the pipeline dropped."""
     source0 = studio.call("GET", "/api/source")
-    latencies, paths = load(studio.port, seconds)
+    latencies, paths = load(studio.port, seconds, paths_polled)
     source1 = studio.call("GET", "/api/source")
     dropped = source1["dropped"] - source0["dropped"]
     row = summary(latencies, seconds)
     p99 = {
-        PATHS[j]: float(np.percentile(latencies[paths == j], 99) * 1000)
-        for j in range(len(PATHS))
+        paths_polled[j]: float(np.percentile(latencies[paths == j], 99) * 1000)
+        for j in range(len(paths_polled))
         if np.any(paths == j)
     }
     slowest = max(p99, key=p99.__getitem__)
@@ -191,38 +214,71 @@ def window(studio: Studio, label: str, seconds: float) -> tuple[np.ndarray, int]
     return latencies, dropped
 
 
-def measure(niceness: int, seconds: float, rounds: int) -> dict[str, dict[str, float]]:
+def page_stream(port: int, until: threading.Event) -> threading.Thread:
+    """A page's live stream (``/api/events``), read until ``until`` is set, in a thread."""
+
+    def read() -> None:
+        conn = http.client.HTTPConnection("127.0.0.1", port, timeout=30)
+        conn.request("GET", "/api/events")
+        response = conn.getresponse()
+        while not until.is_set() and response.read1(65536):
+            pass
+        conn.close()
+
+    thread = threading.Thread(target=read, daemon=True)
+    thread.start()
+    return thread
+
+
+def measure(
+    niceness: int, seconds: float, rounds: int, heavy: bool = False
+) -> dict[str, dict[str, float]]:
     """Alternate windows without and with training on one studio (the machine's other load
-    changes over time: alternating spreads it over both conditions)."""
+    changes over time: alternating spreads it over both conditions).
+
+    ``heavy``: the run is :data:`ISSUE_RUN`, a page's live stream is open throughout, the
+    clients also poll the run's curve, and each round measures while training first, then with
+    the run stopped (its finished curve polled as the baseline's)."""
     pooled: dict[str, list[np.ndarray]] = {"idle": [], "training": []}
     dropped = {"idle": 0, "training": 0}
+    body = ISSUE_RUN if heavy else HEAVY_RUN
     with tempfile.TemporaryDirectory(prefix="bench-api-load-") as data:
         studio = Studio(niceness, Path(data))
+        closing = threading.Event()
         try:
             studio.call("POST", "/api/capture/start", {"name": "bench"})
+            if heavy:
+                page_stream(studio.port, closing)
             time.sleep(1.0)  # the capture and the scene settle
             for _ in range(rounds):
-                latencies, lost = window(studio, "no training", seconds)
-                pooled["idle"].append(latencies)
-                dropped["idle"] += lost
-                run = studio.call("POST", "/api/runs", HEAVY_RUN)
+                if not heavy:
+                    latencies, lost = window(studio, "no training", seconds)
+                    pooled["idle"].append(latencies)
+                    dropped["idle"] += lost
+                run = studio.call("POST", "/api/runs", body)
+                polled = PATHS + (CURVE_PATH.format(run=run["id"]),) if heavy else PATHS
                 deadline = time.monotonic() + START_TIMEOUT_S
                 while studio.call("GET", f"/api/runs/{run['id']}")["episodes_done"] == 0:
                     if time.monotonic() > deadline:
                         raise RuntimeError("the heavy run did not start training")
                     time.sleep(0.2)
-                latencies, lost = window(studio, f"training (nice {niceness})", seconds)
+                latencies, lost = window(studio, f"training (nice {niceness})", seconds, polled)
                 pooled["training"].append(latencies)
                 dropped["training"] += lost
                 studio.call("POST", f"/api/runs/{run['id']}/stop")
                 while studio.call("GET", f"/api/runs/{run['id']}")["status"] == "running":
                     time.sleep(0.2)
+                if heavy:
+                    latencies, lost = window(studio, "no training", seconds, polled)
+                    pooled["idle"].append(latencies)
+                    dropped["idle"] += lost
             recording = studio.call("POST", "/api/capture/stop")
             print(
                 f"  the capture kept {recording['frames']} frames of "
                 f"{recording['duration']:.1f} s ({recording['frames'] / recording['duration']:.1f} Hz)"
             )
         finally:
+            closing.set()
             studio.stop()
     return {
         name: {**summary(np.concatenate(parts), seconds * rounds), "dropped": dropped[name]}
@@ -327,14 +383,23 @@ def main() -> None:
         default=None,
         help="training priority to measure (default: the studio's own, TRAINING_NICENESS)",
     )
+    parser.add_argument(
+        "--heavy",
+        action="store_true",
+        help="issue 18's load: a 100 x 20,000-episode run, 15 s windows, a page's live stream "
+        "and the run's curve polled too (a few minutes)",
+    )
     args = parser.parse_args()
+    if args.heavy and args.seconds == parser.get_default("seconds"):
+        args.seconds = 15.0
     niceness = TRAINING_NICENESS if args.niceness is None else args.niceness
     print(
         f"{CLIENTS} clients polling the API, the simulator at 110 Hz with a capture, "
         f"{os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f}; "
         f"{args.rounds} x {args.seconds:g} s per condition"
+        + (f"; heavy: {ISSUE_RUN}, a page's live stream, the run's curve" if args.heavy else "")
     )
-    result = measure(niceness, args.seconds, args.rounds)
+    result = measure(niceness, args.seconds, args.rounds, args.heavy)
     idle, busy = result["idle"], result["training"]
     for name, row in result.items():
         print(

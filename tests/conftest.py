@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import os
 import socket
+import threading
 
 import pytest
 
@@ -28,3 +29,21 @@ def free_port() -> int:
     with socket.socket() as sock:
         sock.bind(("127.0.0.1", 0))
         return sock.getsockname()[1]
+
+
+def hold_preparation(monkeypatch: pytest.MonkeyPatch) -> tuple[threading.Event, threading.Event]:
+    """Make every run's learner look uncompiled and its preparation wait until ``compiled`` is set
+    (standing for numba compiling the kernels); ``compiling`` is set once one waits."""
+    from studio.learning import _prepare
+
+    compiling, compiled = threading.Event(), threading.Event()
+    real_warm = _prepare._warm
+
+    def slow_warm(kind: str) -> None:
+        compiling.set()
+        assert compiled.wait(60), "the test never let the preparation finish"
+        real_warm(kind)
+
+    monkeypatch.setattr(_prepare, "learner_ready", lambda kind: False)
+    monkeypatch.setattr(_prepare, "_warm", slow_warm)
+    return compiling, compiled

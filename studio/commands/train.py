@@ -1,4 +1,5 @@
-"""``studio train``: train Dyna-Q on the arm grid from the terminal into a run folder.
+"""``studio train``: train Dyna-Q on the arm grid (or, with ``--task arm-reach``, on the arm's
+continuous joints with tile coding, as the page does) from the terminal into a run folder.
 
 The run folder is the same one the page makes (:class:`studio.learning.RunFolder`): started in a
 data folder, ``studio train --out runs/my-run`` shows up in the page's run list, where it can be
@@ -37,8 +38,11 @@ from studio.capture import DEMO_FORMAT, DEMO_SUFFIX, load_demonstration
 from studio.learning import (
     DEFAULT_EPISODES,
     DEFAULT_EXPERIMENTS,
+    DEFAULT_GOAL_JOINTS_DEG,
     DEFAULT_SEED,
     PLANNERS,
+    REACH_DEFAULTS,
+    TASK_KINDS,
     ArmGrid,
     ConfigError,
     DynaQConfig,
@@ -46,6 +50,7 @@ from studio.learning import (
     LiveProgress,
     RunFolder,
     RunRecord,
+    arm_reach_record,
     generate_demonstrations,
     grid_for_goal,
     raise_problems,
@@ -54,7 +59,7 @@ from studio.learning import (
 from studio.samples import SAMPLES_DIR
 
 NAME = "train"
-HELP = "Train Dyna-Q on the arm grid: a config in, a run folder with curves and a policy out."
+HELP = "Train Dyna-Q on the arm grid or the arm's continuous joints: a run folder with curves and a policy out."
 RECORDINGS_DIR = "recordings"
 """Where a data folder keeps its recordings and the demonstrations cut from them."""
 _DYNAQ = DynaQConfig()
@@ -90,8 +95,35 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--episodes", type=int, help=f"episodes per experiment (default: {DEFAULT_EPISODES})"
     )
     parser.add_argument("--seed", type=int, help=f"random seed (default: {DEFAULT_SEED})")
-    parser.add_argument("--joints", type=int, help=f"grid joints (default: {_GRID.joints})")
+    parser.add_argument(
+        "--task",
+        choices=TASK_KINDS,
+        default=TASK_KINDS[0],
+        help="what is learnt: the paper's grid, tabular, or the arm's continuous joints with "
+        "tile coding, as the page's Task choice (default: %(default)s)",
+    )
+    parser.add_argument(
+        "--joints",
+        type=int,
+        help=f"grid joints (default: {_GRID.joints}); with --task arm-reach, joints 1..J learnt "
+        f"(default: {REACH_DEFAULTS['joints']})",
+    )
     parser.add_argument("--bins", type=int, help=f"bins per joint (default: {_GRID.bins})")
+    parser.add_argument(
+        "--step-deg",
+        type=float,
+        help=f"arm-reach: joint increment per action, degrees (default: {REACH_DEFAULTS['step_deg']:g})",
+    )
+    parser.add_argument(
+        "--tilings",
+        type=int,
+        help=f"arm-reach: offset tilings of each joint (default: {REACH_DEFAULTS['tilings']})",
+    )
+    parser.add_argument(
+        "--tiles",
+        type=int,
+        help=f"arm-reach: tiles per joint in each tiling (default: {REACH_DEFAULTS['tiles']})",
+    )
     goal = parser.add_mutually_exclusive_group()
     goal.add_argument(
         "--goal",
@@ -190,14 +222,17 @@ def _numbers(text: str, flag: str, kind: type, example: str) -> list[Any]:
 
 @dataclass(frozen=True)
 class TrainSettings:
-    """What ``studio train`` will run: flags over the config file over the learning defaults."""
+    """What ``studio train`` will run: flags over the config file over the learning defaults.
 
-    grid: ArmGrid
+    ``reach`` is the checked record of a ``--task arm-reach`` run (``grid`` is None then)."""
+
+    grid: ArmGrid | None
     config: DynaQConfig
     experiments: int
     episodes: int
     seed: int
-    demonstrations: list[list[int]]
+    demonstrations: list
+    reach: RunRecord | None = None
 
 
 def _spec_of(args: argparse.Namespace) -> dict[str, Any]:
@@ -210,6 +245,10 @@ def _spec_of(args: argparse.Namespace) -> dict[str, Any]:
         )
     if "task" in spec or "format" in spec:  # a run's own config.json: repeat that run
         record = RunRecord.from_dict(spec)
+        if record.kind != TASK_KINDS[0]:
+            raise LearningError(
+                f"The config file {args.config} is a {record.kind} run; --config repeats {TASK_KINDS[0]} runs, so give --task {record.kind} with its flags instead."
+            )
         spec = {
             "grid": {k: v for k, v in record.task.items() if k != "kind"},
             "config": record.config,
@@ -227,8 +266,17 @@ def resolve(args: argparse.Namespace) -> TrainSettings:
     Raises:
         LearningError: a bad file or flag (a :class:`ConfigError` lists every bad field).
     """
+    if getattr(args, "task", TASK_KINDS[0]) != TASK_KINDS[0]:
+        return _resolve_reach(args)
+    problems = [
+        (
+            flag,
+            f"--{flag.replace('_', '-')} sets the continuous task; add --task {TASK_KINDS[1]} or leave it out.",
+        )
+        for flag in REACH_DEFAULTS
+        if flag != "joints" and getattr(args, flag, None) is not None
+    ]
     spec = _spec_of(args)
-    problems: list[tuple[str, str]] = []
     grid_spec = dict(spec.get("grid", {}))
     for key in ("joints", "bins"):
         if getattr(args, key) is not None:
@@ -291,11 +339,72 @@ def resolve(args: argparse.Namespace) -> TrainSettings:
     return TrainSettings(grid, config, experiments, episodes, seed, demos)
 
 
+def _resolve_reach(args: argparse.Namespace) -> TrainSettings:
+    """:func:`resolve` for ``--task arm-reach``: the page's continuous-task settings and checks
+    (:func:`studio.learning.arm_reach_record`), with the learning package's defaults."""
+    problems = [
+        (flag, f"--{flag.replace('_', '-')} {why}; leave it out with --task {args.task}.")
+        for flag, why in (
+            ("config", "repeats arm-grid runs"),
+            ("bins", "sets the arm grid"),
+            ("goal", "sets goal bins of the arm grid; give --goal-deg"),
+            ("generated_demos", "generates arm-grid paths; give --demos"),
+        )
+        if getattr(args, flag) is not None
+    ]
+    config: DynaQConfig | None = None
+    try:
+        config = DynaQConfig.from_dict(
+            {
+                key: getattr(args, key)
+                for key in ("planning", "planning_steps", "alpha", "gamma", "epsilon")
+                if getattr(args, key) is not None
+            }
+        )
+    except ConfigError as err:
+        problems += list(err.by_field.items())
+    goal_deg = DEFAULT_GOAL_JOINTS_DEG
+    if args.goal_deg is not None:
+        goal_deg = _numbers(args.goal_deg, "--goal-deg", float, "0,45,-90")
+    demos = []
+    if args.demos is not None:
+        demo_file = demonstration_file(args.demos)
+        data = _read_json(demo_file, "demonstrations")
+        if not isinstance(data, dict) or data.get("format") != DEMO_FORMAT:
+            raise LearningError(
+                f"{demo_file} is not a cut demonstration; the continuous task replays a *.demo.json (its joint path)."
+            )
+        demos = [load_demonstration(demo_file).q_robot]
+    settings = {
+        key: default if getattr(args, key) is None else getattr(args, key)
+        for key, default in REACH_DEFAULTS.items()
+    }
+    picked = {
+        "experiments": DEFAULT_EXPERIMENTS if args.experiments is None else args.experiments,
+        "episodes": DEFAULT_EPISODES if args.episodes is None else args.episodes,
+        "seed": DEFAULT_SEED if args.seed is None else args.seed,
+    }
+    record = arm_reach_record(
+        config,
+        **settings,
+        goal_deg=goal_deg,
+        **picked,
+        demonstrations=demos,
+        name=args.name or "",
+        origin="cli",
+        problems=problems,
+    )
+    assert config is not None
+    return TrainSettings(
+        None, config, record.experiments, record.episodes, record.seed, demos, reach=record
+    )
+
+
 def run(args: argparse.Namespace) -> int:
     """Train into a new run folder; Ctrl-C stops at the next episode and keeps what was learnt."""
     settings = resolve(args)
-    record = RunRecord.for_arm_grid(
-        settings.grid,
+    record = settings.reach or RunRecord.for_arm_grid(
+        settings.grid,  # type: ignore[arg-type]
         settings.config,
         settings.experiments,
         settings.episodes,
@@ -318,6 +427,9 @@ def run(args: argparse.Namespace) -> int:
 
     def progress(live: LiveProgress) -> None:
         if bar is not None:
+            note = live.note or "train"
+            if bar.desc != note:
+                bar.set_description_str(note)
             done = live.completed
             bar.update(done - shown[0])
             shown[0] = done

@@ -40,8 +40,9 @@ import os
 import sys
 import threading
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import ThreadPoolExecutor
+from contextlib import contextmanager, suppress
 from dataclasses import dataclass, replace
 from typing import Any, TypeVar
 
@@ -401,8 +402,44 @@ class LiveProgress:
         self.steps = np.full((experiments, episodes), -1, np.int64)
         self.updates = np.full((experiments, episodes), -1, np.int64)
         self.niceness = niceness
+        self.note: str | None = None
+        """A sentence on what the run does before its first episode (preparing the learner), or
+        None once it learns."""
         self._stop = np.zeros(1, np.int64)
         self.snapshot: Callable[[], ExperimentResult] | None = None
+        self._cpu_lock = threading.Lock()
+        self._cpu_done = 0.0
+        self._cpu_running: dict[int, float] = {}  # thread ident -> its CPU clock at start
+
+    @contextmanager
+    def counting_cpu(self) -> Iterator[list[float]]:
+        """Count the calling thread's CPU time as this run's while the block runs (the kernels'
+        threads wrap each experiment in it), so :attr:`cpu_seconds` grows live.
+
+        Yields a one-element list that holds the block's CPU seconds once it ends.
+        """
+        ident = threading.get_ident()
+        spent = [0.0]
+        start = time.thread_time()
+        with self._cpu_lock:
+            self._cpu_running[ident] = start
+        try:
+            yield spent
+        finally:
+            spent[0] = time.thread_time() - start
+            with self._cpu_lock:
+                del self._cpu_running[ident]
+                self._cpu_done += spent[0]
+
+    @property
+    def cpu_seconds(self) -> float:
+        """CPU seconds the run's experiments have used so far, the ones still running included."""
+        with self._cpu_lock:  # a thread leaves _cpu_running under this lock before it ends
+            total = self._cpu_done
+            for ident, start in self._cpu_running.items():
+                with suppress(OSError, AttributeError, OverflowError):  # no per-thread clocks
+                    total += time.clock_gettime(time.pthread_getcpuclockid(ident)) - start
+        return total
 
     def stop(self) -> None:
         """Ask every experiment to stop at its next episode boundary."""
@@ -704,16 +741,16 @@ def run_experiments(
 
     def one(e: int) -> None:
         lower_thread_priority(live.niceness)
-        start = time.thread_time()
-        _run_experiment(
-            mdp.next_state, mdp.reward, mdp.terminal, mdp.start_states,
-            float(config.alpha), float(config.gamma), float(config.epsilon), planner,
-            int(config.planning_steps), int(config.max_steps_per_episode),
-            float(config.priority_threshold),
-            demo_actions, demo_offsets, demo_starts,
-            experiment_seed(seed, e), live._stop, live.steps[e], live.updates[e], q[e],
-        )  # fmt: skip
-        cpu_seconds[e] = time.thread_time() - start
+        with live.counting_cpu() as spent:
+            _run_experiment(
+                mdp.next_state, mdp.reward, mdp.terminal, mdp.start_states,
+                float(config.alpha), float(config.gamma), float(config.epsilon), planner,
+                int(config.planning_steps), int(config.max_steps_per_episode),
+                float(config.priority_threshold),
+                demo_actions, demo_offsets, demo_starts,
+                experiment_seed(seed, e), live._stop, live.steps[e], live.updates[e], q[e],
+            )  # fmt: skip
+        cpu_seconds[e] = spent[0]
 
     def so_far() -> ExperimentResult:
         return result_so_far(ExperimentResult, live, cpu_seconds, q, config, seed)

@@ -50,7 +50,6 @@ this file (or delete ``__pycache__/_linear*.nb*``) so the kernels recompile.
 from __future__ import annotations
 
 import math
-import time
 from collections import namedtuple
 from collections.abc import Callable, Sequence
 from concurrent.futures import ThreadPoolExecutor
@@ -697,9 +696,9 @@ def run_linear_experiments(
         def one(e: int) -> None:
             if task.code is not None:  # the compiled kernel holds no GIL: it may yield the CPU
                 lower_thread_priority(live.niceness)
-            start = time.thread_time()
-            runner(envs[e], task, agents[e], config, seed, e, demo_starts, demo_actions, live)
-            cpu_seconds[e] = time.thread_time() - start
+            with live.counting_cpu() as spent:
+                runner(envs[e], task, agents[e], config, seed, e, demo_starts, demo_actions, live)
+            cpu_seconds[e] = spent[0]
 
         def so_far() -> LinearResult:
             return result_so_far(

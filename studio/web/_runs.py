@@ -14,12 +14,13 @@ polls the live arrays.
 from __future__ import annotations
 
 import contextlib
+import json
 import logging
 import re
 import threading
 import time
 from collections import deque
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from datetime import UTC, datetime
 from pathlib import Path
 
@@ -28,14 +29,14 @@ import numpy as np
 from studio.learning import (
     DEFAULT_GOAL_JOINTS_DEG,
     ArmGrid,
-    ArmReach,
     ConfigError,
     DynaQConfig,
     LearningError,
+    LiveCurve,
     LiveProgress,
     RunFolder,
     RunRecord,
-    curve_statistics,
+    arm_reach_record,
     delete_run_folder,
     find_runs,
     goal_degrees,
@@ -54,28 +55,22 @@ __all__ = ["Run", "RunQueue", "prepare_run"]
 log = logging.getLogger(__name__)
 
 CURVE_CACHE_SECONDS = 0.05
-"""A live curve is recomputed at most this often, however many clients ask."""
+"""A live curve takes in the episodes finished meanwhile at most this often, however many clients
+ask (only those episodes are recomputed: :class:`studio.learning.LiveCurve`)."""
+JSON_SLICE = 2_000
+"""Values per ``json.dumps`` call when a curve is encoded (between calls other threads run)."""
+CURVE_JSON_SECONDS = 1.0
+"""A running run's ``/curve`` answer is encoded again at most this often (its 2,000,000-cell
+curve is 180,000 numbers of JSON, encoded holding the GIL); the page follows a running run
+through the event stream, which sends only what changed."""
 GROUP_SEPARATOR = "~"
 """Joins a group folder's name and a run folder's name into a run id (``paper~SV-ZPL``)."""
 RUN_ID = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.-]{0,99}(~[A-Za-z0-9_][A-Za-z0-9_.-]{0,99})?$")
 """A run id: a folder name, or a group folder's and a run folder's names joined by ``~``."""
-TRAINING_THREADS = ("studio-train-", "dynaq")
-"""Name prefixes of the threads a training run uses (RunFolder.train's and the kernels' pool)."""
 TRAINING_NICENESS = 10
 """How much lower the training threads' CPU priority is than the studio's (Linux ``nice``,
 0-19): on a busy machine the API, the live pipeline and the scene get the cores first and
 training takes what they leave, so a heavy run cannot starve the page."""
-
-
-def _training_cpu_seconds() -> float:
-    """CPU seconds of the threads training right now (the queue trains one run at a time)."""
-    total = 0.0
-    for thread in threading.enumerate():
-        if thread.ident is None or not thread.name.startswith(TRAINING_THREADS):
-            continue
-        with contextlib.suppress(OSError, AttributeError, OverflowError):
-            total += time.clock_gettime(time.pthread_getcpuclockid(thread.ident))
-    return total
 
 
 class Run:
@@ -85,7 +80,11 @@ class Run:
         self.id = run_id
         self.folder = folder
         self.live = live  # set from submission on, so a Stop is never lost
-        self._curve_cache: tuple[float, np.ndarray] | None = None
+        self._curve = LiveCurve(folder.record.episodes)
+        self._curve_lock = threading.RLock()
+        self._json_lock = threading.Lock()
+        self._curve_taken: tuple[float, object] = (-1e9, None)  # when, and which steps array
+        self._curve_json: tuple[float, int, bytes] | None = None  # when, version, JSON
         self._mtime = _status_mtime(folder.path)
 
     @property
@@ -131,29 +130,58 @@ class Run:
         request = self.folder.record.request or {}
         return list(request.get("demonstrations") or [])
 
-    def steps(self) -> np.ndarray:
-        """Steps per episode ``(experiments, episodes)``, -1 where not done (live while training)."""
+    def live_curve(self) -> LiveCurve:
+        """The run's curve, brought up to date: while it trains at most every
+        :data:`CURVE_CACHE_SECONDS`, recomputing only the episodes finished meanwhile."""
         live = self.live
-        if live is not None and self.status == "running":
+        with self._curve_lock:  # one thread updates; the others wait without holding the GIL
+            when, source = self._curve_taken
             now = time.monotonic()
-            cache = self._curve_cache
-            if cache is None or now - cache[0] > CURVE_CACHE_SECONDS:
-                cache = (now, live.steps.copy())
-                self._curve_cache = cache
-            return cache[1]
-        return self.folder.steps()
+            if live is not None and self.status == "running":
+                if now - when > CURVE_CACHE_SECONDS or source is not live.steps:
+                    self._curve.update(live.steps)
+                    self._curve_taken = (now, live.steps)
+            elif self.status != "queued":  # (a queued run has no steps yet)
+                steps = self.folder.steps()
+                if source is not steps:
+                    self._curve.update(steps)
+                    self._curve_taken = (now, steps)
+        return self._curve
+
+    @contextlib.contextmanager
+    def curve_held(self) -> Iterator[LiveCurve]:
+        """:meth:`live_curve`, which no other thread updates until the block ends (an event
+        built from it is consistent: the run's ``episodes_done`` and the curve's pieces)."""
+        with self._curve_lock:
+            yield self.live_curve()
 
     def curve(self, start: int = 0) -> dict[str, list]:
         """The learning curve (:func:`studio.learning.curve_statistics`)."""
-        return curve_statistics(self.steps(), start)
+        return self.live_curve().curve(start)
 
-    def model(self, steps: np.ndarray | None = None) -> RunPublic:
-        """The run as the API shows it (``episodes_done`` from ``steps`` when given)."""
-        steps = self.steps() if steps is None else steps
+    def curve_json(self) -> bytes:
+        """:meth:`curve` as JSON (``CurvePublic``), encoded once per change for every client, and
+        at most every :data:`CURVE_JSON_SECONDS` while the run trains."""
+        running = self.status == "running"
+        with self._json_lock:  # one thread encodes; the others wait for its answer
+            curve, cached, now = self.live_curve(), self._curve_json, time.monotonic()
+            if (
+                cached is None
+                or (cached[1] != curve.version and not running)
+                or (cached[1] != curve.version and now - cached[0] > CURVE_JSON_SECONDS)
+            ):
+                with self._curve_lock:
+                    version, data = curve.version, curve.curve()
+                cached = self._curve_json = (now, version, _json_in_slices(data).encode())
+        return cached[2]
+
+    def model(self, curve: LiveCurve | None = None) -> RunPublic:
+        """The run as the API shows it (``episodes_done`` from ``curve`` when given)."""
+        done = (curve or self.live_curve()).episodes_done
         folder, record = self.folder, self.folder.record
-        cpu = folder.cpu_seconds
-        if self.status == "running" and self.live is not None:
-            cpu = _training_cpu_seconds()
+        cpu, note, live = folder.cpu_seconds, None, self.live
+        if self.status == "running" and live is not None:
+            cpu, note = live.cpu_seconds, live.note
         return RunPublic(
             id=self.id,
             name=self.name,
@@ -162,10 +190,11 @@ class Run:
             created=folder.created,
             started=folder.started,
             finished=folder.finished,
-            episodes_done=int(np.count_nonzero(steps >= 0)),
+            episodes_done=done,
             episodes_total=record.experiments * record.episodes,
             cpu_seconds=round(float(cpu), 3),
             error=folder.error,
+            note=note,
             has_policy=folder.has_policy,
             origin=record.origin,
             group=record.group,
@@ -210,6 +239,20 @@ def _damage_text(err: BaseException) -> str:
     if isinstance(err, LearningError):
         return str(err)
     return f"The run folder's config.json or status.json holds a field the studio cannot read ({type(err).__name__}); delete the run."
+
+
+def _json_in_slices(data: dict[str, list]) -> str:
+    """``json.dumps(data)`` (compact) for a dict of long lists, encoded :data:`JSON_SLICE` values
+    at a time: one ``json.dumps`` call holds the GIL until it returns, and a whole 20,000-episode
+    curve (180,000 numbers) took the event loop's GIL for a tenth of a second and more."""
+    fields = []
+    for key, values in data.items():
+        pieces = [
+            json.dumps(values[i : i + JSON_SLICE], separators=(",", ":"))[1:-1]
+            for i in range(0, len(values), JSON_SLICE)
+        ]
+        fields.append(f"{json.dumps(key)}:[{','.join(pieces)}]")
+    return "{" + ",".join(fields) + "}"
 
 
 def _status_mtime(path: Path) -> float:
@@ -338,57 +381,26 @@ def prepare_run(create: RunCreate, demonstration_path: Callable[[str], np.ndarra
 def _prepare_reach_run(
     create: RunCreate, demonstration_path: Callable[[str], np.ndarray]
 ) -> RunRecord:
-    """:func:`prepare_run` for the continuous task: joints, step, tiles; the goal is the first
-    demonstration's final pose (else ``goal_deg`` for joints 1-3, the wrist at zero)."""
+    """:func:`prepare_run` for the continuous task (the learning package's
+    :func:`~studio.learning.arm_reach_record`, as ``studio train --task arm-reach`` does)."""
     problems: list[tuple[str, str]] = []
     config = _dynaq_config(create, problems)
-    paths = [
-        np.asarray(demonstration_path(name), dtype=np.float64) for name in create.demonstrations
-    ]
-    goal: tuple[float, ...] | None = None
-    if paths:
-        goal = tuple(paths[0][-1, :6])
-    else:
-        wrong = goal_problems(create.goal_deg)
-        problems += [("goal_deg", text) for text in wrong]
-        if not wrong:
-            goal = tuple(np.radians([*create.goal_deg, *([0.0] * (6 - len(create.goal_deg)))]))
-    task = coding = None
-    try:
-        task = ArmReach(joints=create.joints, step_deg=create.step_deg, goal=goal)
-    except LearningError as err:
-        field = str(err).split(" ", 1)[0]
-        problems.append((field if field in ("joints", "step_deg") else "goal_deg", str(err)))
-    if task is not None:
-        try:
-            coding = task.features(tilings=create.tilings, tiles=create.tiles)
-        except LearningError as err:
-            problems.append(("tiles" if str(err).startswith("tiles") else "tilings", str(err)))
-    if task is None or coding is None or config is None:
-        problems += run_problems(
-            create.experiments, create.episodes, create.seed, create.name or ""
-        )
-        raise_problems(problems)
-    assert task is not None and coding is not None and config is not None
-    try:
-        record = RunRecord.for_arm_reach(
-            task,
-            coding,
-            config,
-            create.experiments,
-            create.episodes,
-            create.seed,
-            [p[:, : task.joints] for p in paths],
-            name=create.name or "",
-            origin="page",
-            request=create.model_dump(),
-        )
-    except ConfigError as err:
-        problems += list(err.by_field.items())
-        raise_problems(problems)
-        raise
-    raise_problems(problems)
-    return record
+    return arm_reach_record(
+        config,
+        joints=create.joints,
+        step_deg=create.step_deg,
+        tilings=create.tilings,
+        tiles=create.tiles,
+        goal_deg=create.goal_deg,
+        experiments=create.experiments,
+        episodes=create.episodes,
+        seed=create.seed,
+        demonstrations=[demonstration_path(name) for name in create.demonstrations],
+        name=create.name or "",
+        origin="page",
+        request=create.model_dump(),
+        problems=problems,
+    )
 
 
 class RunQueue:

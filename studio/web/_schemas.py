@@ -17,8 +17,9 @@ from studio.learning import (
     DEFAULT_EXPERIMENTS,
     DEFAULT_GOAL_JOINTS_DEG,
     DEFAULT_SEED,
+    REACH_DEFAULTS,
+    TASK_KINDS,
     ArmGrid,
-    ArmReach,
     DynaQConfig,
 )
 
@@ -29,9 +30,7 @@ SourceKind = Literal["simulator", "recording", "network", "serial"]
 DEFAULT_GOAL_DEG = DEFAULT_GOAL_JOINTS_DEG
 """The learning package's default goal for joints 1-3 (an arm reaching forward and down)."""
 _DYNAQ = DynaQConfig()
-_REACH_FEATURES = ArmReach().features()
-"""The continuous task's default tile coding (the learning package's)."""
-TaskKind = Literal["arm-grid", "arm-reach"]
+TaskKind = Literal[TASK_KINDS]  # type: ignore[valid-type]
 """What a run learns: the paper's grid (tabular) or continuous joints (tile coding)."""
 """The learning package's training defaults: ``RunCreate`` takes each of its defaults from here."""
 
@@ -274,13 +273,13 @@ class RunCreate(_Body):
     bins: int = ArmGrid.bins
     task: TaskKind = "arm-grid"
     """``arm-grid``: the paper's grid, tabular; ``arm-reach``: continuous joints, tile coding."""
-    joints: int = ArmReach.joints
+    joints: int = REACH_DEFAULTS["joints"]
     """Continuous task: joints 1..J learnt (3 to 6)."""
-    step_deg: float = ArmReach.step_deg
+    step_deg: float = REACH_DEFAULTS["step_deg"]
     """Continuous task: joint increment per action, degrees."""
-    tilings: int = _REACH_FEATURES.tilings
+    tilings: int = REACH_DEFAULTS["tilings"]
     """Continuous task: offset tilings of each joint."""
-    tiles: int = _REACH_FEATURES.tiles
+    tiles: int = REACH_DEFAULTS["tiles"]
     """Continuous task: tiles per joint in each tiling."""
     goal_deg: list[float] = Field(default_factory=lambda: list(DEFAULT_GOAL_DEG))
     demonstrations: list[str] = Field(default_factory=list)
@@ -300,7 +299,11 @@ class RunPublic(BaseModel):
     episodes_done: int
     episodes_total: int
     cpu_seconds: float
+    """CPU time of the run's learning so far, counted live while it trains."""
     error: str | None
+    note: str | None = None
+    """While a running run prepares its learner before its first episode: what it does, e.g.
+    "preparing the learner (first run on this machine, about 25 s)"; None otherwise."""
     has_policy: bool
     origin: Literal["cli", "page", "reproduce", "sweep"] = "page"
     group: str | None = None

@@ -17,6 +17,7 @@ import secrets
 import socket
 import sys
 import threading
+import time
 import webbrowser
 from collections.abc import Callable, Iterable
 from pathlib import Path
@@ -24,6 +25,7 @@ from typing import TYPE_CHECKING, Any
 from urllib.parse import urlsplit
 
 from studio import StudioError
+from studio.learning import prepare_in_background
 
 from ._guard import SiteRule
 from ._settings import Settings
@@ -37,6 +39,8 @@ log = logging.getLogger(__name__)
 
 SHUTDOWN_GRACE_S = 3
 """On Ctrl+C, open event streams (which never end by themselves) are closed after this long."""
+UP_POLL_S = 0.1
+"""How often the start checks whether the API is up, to compile the learner after it."""
 GIL_SWITCH_INTERVAL_S = 0.001
 """How long a Python thread may keep the GIL while another waits (CPython's default: 5 ms)."""
 INSTANCE_PATH = "/studio-instance"
@@ -275,6 +279,16 @@ def prepare_data_dir(data_dir: Path) -> None:
         ) from None
 
 
+def _prepare_when_up(http: Any) -> None:
+    """Once the API answers, compile the learner's kernels in the background if they are not
+    cached (a first run then loads them instead of compiling them); after, so that the compile
+    never slows the start."""
+    while not http.started and not http.should_exit:
+        time.sleep(UP_POLL_S)
+    if http.started:
+        prepare_in_background()
+
+
 def serve(settings: Settings, open_browser: bool = True) -> None:
     """Serve the studio until interrupted (Ctrl+C).
 
@@ -328,6 +342,7 @@ def serve(settings: Settings, open_browser: bool = True) -> None:
         )
         if open_browser:
             threading.Timer(1.0, lambda: webbrowser.open(url)).start()
+        threading.Thread(target=_prepare_when_up, args=(http,), daemon=True).start()
         http.run(sockets=[sock])
     finally:
         sock.close()

@@ -22,10 +22,12 @@ from studio.learning import (
     DynaQConfig,
     RunFolder,
     goal_problems,
+    load_any_policy,
     load_policy,
 )
 from studio.learning._reproduce import CONFIGURATIONS, EXTENSIONS, PAPER_MATLAB_SECONDS
 from studio.web import create_app
+from studio.web._schemas import RunCreate
 from tests.web.conftest import TINY_RUN, make_settings, wait_run
 
 
@@ -244,3 +246,55 @@ def test_a_run_trained_on_the_command_line_is_listed_plotted_watched_and_exporte
     assert (tmp_path / "runs/paper/curves.csv").read_text().splitlines()[
         0
     ] == f"configuration,{header}"
+
+
+def test_train_learns_the_continuous_task_the_page_trains_and_export_reads_it(
+    tmp_path, capsys
+) -> None:
+    run_dir = tmp_path / "reach"
+    argv = ["train", "--task", "arm-reach", "--joints", "4", "--step-deg", "2", "--tiles", "16",
+            "--tilings", "4", "--experiments", "1", "--episodes", "2", "--planning-steps", "5",
+            "--out", str(run_dir), "--no-progress"]  # fmt: skip
+    assert main(argv) == 0, capsys.readouterr().err
+    record = json.loads((run_dir / "config.json").read_text())
+    assert record["task"]["kind"] == "arm-reach" and record["task"]["joints"] == 4
+    assert record["task"]["tile_coding"]["tiles"] == 16
+    assert record["task"]["tile_coding"]["tilings"] == 4
+    policy = load_any_policy(run_dir / "policy.policy.npz")
+    assert policy.task.joints == 4
+    csv_path = tmp_path / "reach.csv"
+    assert main(["export", str(run_dir / "policy.policy.npz"), "--out", str(csv_path)]) == 0
+    data = np.loadtxt(csv_path, delimiter=",", skiprows=1)
+    assert data.ndim == 2 and data.shape[1] == 7
+
+
+def test_train_takes_the_continuous_defaults_and_checks_from_the_page(tmp_path) -> None:
+    settings = train.resolve(_parse_train(["--task", "arm-reach"]))
+    with TestClient(create_app(make_settings(tmp_path))) as client:
+        form = client.get("/api/config").json()["training"]
+    task = settings.reach.task
+    assert task["joints"] == form["joints"] and task["step_deg"] == form["step_deg"]
+    assert task["tile_coding"]["tiles"] == form["tiles"]
+    assert task["tile_coding"]["tilings"] == form["tilings"]
+    page = RunCreate(task="arm-reach")
+    keys = ("planning", "planning_steps", "alpha", "gamma", "epsilon")
+    assert settings.config == DynaQConfig(**{key: getattr(page, key) for key in keys})
+    assert (settings.experiments, settings.episodes) == (page.experiments, page.episodes)
+
+
+@pytest.mark.parametrize(
+    ("argv", "words"),
+    [
+        (["--task", "arm-reach", "--joints", "9"], "joints is 9"),
+        (["--task", "arm-reach", "--step-deg", "5"], "step_deg"),
+        (["--task", "arm-reach", "--tiles", "0"], "tiles"),
+        (["--task", "arm-reach", "--bins", "5"], "--bins sets the arm grid"),
+        (["--task", "arm-reach", "--generated-demos", "2"], "--generated-demos"),
+        (["--task", "arm-reach", "--goal-deg=170,0,0"], "goal_deg joint 1"),
+        (["--tiles", "8"], "--tiles sets the continuous task; add --task arm-reach"),
+    ],
+)
+def test_bad_continuous_settings_give_one_sentence(argv, words, capsys) -> None:
+    assert main(["train", *argv, "--episodes", "2", "--no-progress"]) == 2
+    err = capsys.readouterr().err
+    assert words in err and "Traceback" not in err and err.count("\n") == 1

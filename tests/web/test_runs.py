@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from studio.learning import CURVE_COLUMNS, load_policy
+from tests.conftest import hold_preparation
 from tests.web.conftest import TINY_RUN, wait_for, wait_run
 
 BAD_RUNS = [
@@ -276,27 +277,65 @@ def test_run_events_stream_the_curve_while_training(client):
         if client.get(f"/api/runs/{run['id']}").json()["episodes_done"] > 0:
             break
         client.app.state.studio.runs.wait_idle(0.05)
-    events = []
-    with client.stream("GET", "/api/events?max_seconds=1.5") as r:
-        assert r.headers["content-type"].startswith("text/event-stream")
-        event = None
-        for line in r.iter_lines():
-            if line.startswith("event: "):
-                event = line[7:]
-            elif line.startswith("data: ") and event == "run":
-                events.append(json.loads(line[6:]))
+    events = stream_run_events(client, 1.5)
     client.post(f"/api/runs/{run['id']}/stop")
     wait_run(client, run["id"])
     assert len(events) >= 7  # at least 5 per second over the 1.5 s stream
     assert all(e["run"]["id"] == run["id"] for e in events)
     assert events[0]["from"] == 0
     # replaying the partial updates rebuilds the curve the API serves at that moment
+    counts = replay_counts(events)
+    assert events[-1]["run"]["episodes_done"] > events[0]["run"]["episodes_done"]
+    assert len(counts) <= 100_000
+
+
+def replay_counts(events: list[dict]) -> list[int]:
+    """A page's copy of a run's ``count`` column, rebuilt from its events (the first holds the
+    whole curve, later ones the pieces that changed); each step's total is the run's progress."""
     counts: list[int] = []
     for e in events:
-        counts = counts[: e["from"]] + e["curve"]["count"]
-        assert e["curve"]["episodes"][:1] in ([], [e["from"] + 1])
+        if "curve" in e:
+            counts = counts[: e["from"]] + e["curve"]["count"]
+            assert e["curve"]["episodes"][:1] in ([], [e["from"] + 1])
+        for piece in e.get("pieces", []):
+            assert piece["curve"]["episodes"] == list(range(piece["from"] + 1, piece["to"] + 1))
+            counts += [0] * (piece["from"] - len(counts))
+            counts[piece["from"] : piece["to"]] = piece["curve"]["count"]
         assert sum(counts) == e["run"]["episodes_done"]
-    assert events[-1]["run"]["episodes_done"] > events[0]["run"]["episodes_done"]
+    return counts
+
+
+def stream_run_events(client, seconds: float) -> list[dict]:
+    events, event = [], None
+    with client.stream("GET", f"/api/events?max_seconds={seconds}") as r:
+        assert r.headers["content-type"].startswith("text/event-stream")
+        for line in r.iter_lines():
+            if line.startswith("event: "):
+                event = line[7:]
+            elif line.startswith("data: ") and event == "run":
+                events.append(json.loads(line[6:]))
+    return events
+
+
+def test_run_events_send_only_what_changed_when_experiments_train_far_apart(open_client):
+    # one kernel thread: experiment 1 starts at episode 1 while experiment 0 finished them all,
+    # so the episodes that change lie at both ends of a 20,000-episode curve
+    client = open_client(run_workers=1)
+    body = {"planning": "full", "planning_steps": 500, "experiments": 3, "episodes": 20_000}
+    run = client.post("/api/runs", json=body).json()
+    assert wait_for(
+        lambda: client.get(f"/api/runs/{run['id']}").json()["episodes_done"] > 20_000, 300
+    )
+    try:
+        events = stream_run_events(client, 1.5)
+    finally:
+        client.post(f"/api/runs/{run['id']}/stop")
+        wait_run(client, run["id"])
+    assert len(events) >= 5 and len(events[0]["curve"]["count"]) == 20_000
+    later = [e for e in events[1:] if e["run"]["status"] == "running"]
+    sent = [sum(p["to"] - p["from"] for p in e["pieces"]) for e in later]
+    assert later and max(sent) < 2_000, sent  # not the 20,000-episode tail again and again
+    assert len(replay_counts(events)) == 20_000
 
 
 def test_a_client_that_disconnects_mid_run_changes_nothing(client):
@@ -521,3 +560,73 @@ def test_the_simulators_reach_and_a_run_check_a_goal_with_one_function(client, g
         assert r.json()["problems"] == goal_problems(goal)
     else:  # a malformed list is refused by the schema first
         assert r.status_code == 422 and "goal_deg" in r.json()["detail"]
+
+
+def test_a_first_run_reports_preparing_the_learner_before_its_first_episode(client, monkeypatch):
+    compiling, compiled = hold_preparation(monkeypatch)
+    run = client.post("/api/runs", json=TINY_RUN).json()
+    assert compiling.wait(30)
+    preparing = client.get(f"/api/runs/{run['id']}").json()
+    assert preparing["status"] == "running" and preparing["episodes_done"] == 0
+    assert preparing["note"].startswith("preparing the learner (first run on this machine, about ")
+    assert client.get("/api/runs").json()[0]["note"] == preparing["note"]
+    compiled.set()
+    done = wait_run(client, run["id"])
+    assert done["status"] == "done" and done["note"] is None
+
+
+def test_a_continuous_run_counts_its_cpu_while_it_trains(open_client):
+    client = open_client(run_workers=2)  # the page's studio: one kernel thread per core
+    body = {**TINY_RUN, "task": "arm-reach", "joints": 3, "episodes": 100_000,
+            "planning": "full", "planning_steps": 50}  # fmt: skip
+    run = client.post("/api/runs", json=body).json()
+
+    def mid_way() -> dict | None:
+        now = client.get(f"/api/runs/{run['id']}").json()
+        # a second of CPU: far beyond what the thread polling the run spends meanwhile
+        return now if now["episodes_done"] > 0 and now["cpu_seconds"] >= 1.0 else None
+
+    try:
+        assert wait_for(mid_way, 300, step=0.2), client.get(f"/api/runs/{run['id']}").json()
+        now = client.get(f"/api/runs/{run['id']}").json()
+        assert now["status"] == "running" and now["episodes_done"] < 2 * 100_000
+    finally:
+        client.post(f"/api/runs/{run['id']}/stop")
+        wait_run(client, run["id"])
+
+
+def test_the_run_list_says_a_first_run_prepares_the_learner(page_server, browser_page, monkeypatch):
+    from fastapi.testclient import TestClient
+
+    compiling, compiled = hold_preparation(monkeypatch)
+    base, app = page_server
+    page = browser_page
+    api = TestClient(app, base_url=base)
+    page.goto(base + "/")
+    page.wait_for_selector("body[data-ready='1']", timeout=60_000)
+    try:
+        run = api.post("/api/runs", json=TINY_RUN).json()
+        assert compiling.wait(30)
+        row = f"[data-testid='run-row'][data-id='{run['id']}']"
+        page.wait_for_selector(f"{row} [data-testid='run-note']", timeout=30_000)
+        assert page.inner_text(f"{row} [data-testid='run-status']") == "preparing"
+        note = page.inner_text(f"{row} [data-testid='run-note']")
+        assert note.startswith("preparing the learner (first run on this machine, about ")
+    finally:
+        compiled.set()
+    assert app.state.studio.runs.wait_idle(120)
+    page.wait_for_selector(
+        f"{row}[data-status='done'] [data-testid='run-progress']", timeout=30_000
+    )
+    assert page.locator(f"{row} [data-testid='run-note']").count() == 0
+    assert not page.errors
+
+
+def test_a_curve_encoded_in_slices_is_the_same_json():
+    from studio.web._runs import JSON_SLICE, _json_in_slices
+
+    rng = np.random.default_rng(0)
+    n = 2 * JSON_SLICE + 7
+    curve = {"episodes": list(range(1, n + 1)), "mean": rng.random(n).round(3).tolist(),
+             "count": rng.integers(0, 9, n).tolist(), "empty": []}  # fmt: skip
+    assert _json_in_slices(curve) == json.dumps(curve, separators=(",", ":"))

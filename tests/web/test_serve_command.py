@@ -5,6 +5,7 @@ from __future__ import annotations
 import socket
 import subprocess
 import sys
+import threading
 import time
 import urllib.error
 import urllib.request
@@ -189,3 +190,22 @@ def test_two_studios_each_embed_their_own_scene(tmp_path):
             proc.terminate()
         for proc in procs:
             proc.wait(timeout=20)
+
+
+@pytest.mark.parametrize("comes_up", [True, False])
+def test_the_learner_is_compiled_in_the_background_once_the_api_is_up(monkeypatch, comes_up):
+    import types
+
+    from studio.web import _serve
+
+    calls: list[int] = []
+    monkeypatch.setattr(_serve, "prepare_in_background", lambda: calls.append(1))
+    http = types.SimpleNamespace(started=False, should_exit=False)
+    waiter = threading.Thread(target=_serve._prepare_when_up, args=(http,))
+    waiter.start()
+    if comes_up:
+        http.started = True
+    else:  # stopped before it ever answered: nothing to prepare for
+        http.should_exit = True
+    waiter.join(30)
+    assert calls == ([1] if comes_up else [])

@@ -14,11 +14,8 @@ import time
 from collections.abc import AsyncIterator
 from typing import Any
 
-import numpy as np
 from fastapi import APIRouter, Request
 from fastapi.responses import StreamingResponse
-
-from studio.learning import curve_statistics
 
 from .._deps import StudioDep
 from .._runs import Run
@@ -53,7 +50,7 @@ async def stream_events(
     """
     start = time.monotonic()
     versions = studio.changes.versions()
-    run_counts: dict[str, np.ndarray] = {}
+    run_seen: dict[str, int] = {}  # per run: the curve version this client has
     last = {"source": -1e9, "run": -1e9, "keepalive": start, "capture": -1e9}
     capture_was_active = False
     yield "retry: 2000\n\n"
@@ -73,13 +70,13 @@ async def stream_events(
         if now - last["run"] >= RUN_EVERY_S:
             last["run"] = now
             for run in studio.runs.running():
-                yield sse("run", run_event(run, run_counts))
+                yield sse("run", run_event(run, run_seen))
         current = studio.changes.versions()
         for name, version in current.items():
             if version != versions.get(name):
                 if name == "runs":
-                    for run_id in list(run_counts):
-                        final = _final_run(studio, run_id, run_counts)
+                    for run_id in list(run_seen):
+                        final = _final_run(studio, run_id, run_seen)
                         if final is not None:
                             yield sse("run", final)
                 yield sse("lists", {"changed": name})
@@ -91,39 +88,40 @@ async def stream_events(
         await asyncio.sleep(max(0.0, TICK_S - (time.monotonic() - now)))
 
 
-def run_event(run: Run, counts: dict[str, np.ndarray]) -> dict[str, Any]:
-    """A ``run`` event: the run and its curve from the first episode that changed for this client.
+def run_event(run: Run, seen: dict[str, int]) -> dict[str, Any]:
+    """A ``run`` event: the run, and its curve where it changed since this client's last event.
 
-    Only the changed tail is computed and sent, so a long run costs the same per event at
-    episode 10 and at episode 50 000.
+    A client's first event carries the whole curve (``curve``, ``from`` 0); later ones carry
+    ``pieces``, each ``{"from", "to", "curve"}``: episodes ``from`` to ``to`` (0-based, end
+    excluded) that finished meanwhile, which replace those episodes of the client's copy. So an
+    event costs the same at episode 10 and at episode 50,000, and the same when a run's many
+    experiments train at far-apart episodes (each running experiment makes one small piece).
     """
-    steps = run.steps()
-    now = (steps >= 0).sum(axis=0)
-    previous = counts.get(run.id)
-    if previous is None or previous.shape != now.shape:
-        start = 0
-    else:
-        changed = np.flatnonzero(previous != now)
-        start = int(changed[0]) if changed.size else int(now.shape[0])
-    counts[run.id] = now
-    return {
-        "run": run.model(steps).model_dump(mode="json"),
-        "curve": curve_statistics(steps, start),
-        "from": start,
-    }
+    with run.curve_held() as curve:
+        event: dict[str, Any] = {"run": run.model(curve).model_dump(mode="json")}
+        previous = seen.get(run.id)
+        if previous is None:
+            event.update({"curve": curve.curve(), "from": 0})
+        else:
+            event["pieces"] = [
+                {"from": start, "to": stop, "curve": curve.curve(start, stop)}
+                for start, stop in curve.changed_since(previous)
+            ]
+        seen[run.id] = curve.version
+    return event
 
 
-def _final_run(studio: Studio, run_id: str, counts: dict[str, np.ndarray]) -> dict[str, Any] | None:
+def _final_run(studio: Studio, run_id: str, seen: dict[str, int]) -> dict[str, Any] | None:
     """The last event of a run that stopped training since the previous tick."""
     try:
         run = studio.runs.get(run_id)
     except Exception:
-        counts.pop(run_id, None)
+        seen.pop(run_id, None)
         return None
     if run.status == "running":
         return None
-    event = run_event(run, counts)
-    counts.pop(run_id, None)
+    event = run_event(run, seen)
+    seen.pop(run_id, None)
     return event
 
 

@@ -47,10 +47,10 @@ def read_run(run_id: str, studio: StudioDep) -> RunPublic:
 
 
 @router.get("/{run_id}/curve", response_model=CurvePublic)
-def read_curve(run_id: str, studio: StudioDep) -> CurvePublic:
+def read_curve(run_id: str, studio: StudioDep) -> Response:
     """Steps per episode: mean, std, median, p10, p90, min, max over the ``count`` experiments
-    that finished each episode."""
-    return CurvePublic(**studio.runs.get(run_id).curve())
+    that finished each episode (a running run's at most a second old: its event stream is live)."""
+    return Response(studio.runs.get(run_id).curve_json(), media_type="application/json")
 
 
 @router.post("/{run_id}/stop", response_model=RunPublic)

@@ -840,10 +840,12 @@ function runRow(r) {
       onchange: (e) => toggleShown(r.id, e.target.checked),
     })),
     el("td", { class: "name", title: runLabel(r) }, el("span", { class: "swatch", style: `background:${runColor(r.id)}` }), runLabel(r)),
-    el("td", {}, el("span", { class: `badge ${r.status}`, testid: "run-status", text: r.status })),
-    el("td", { title: `${r.episodes_done} / ${total} episodes` },
-      el("span", { class: "progress", testid: "run-progress", "data-done": r.episodes_done },
-        el("span", { style: `width:${pct.toFixed(1)}%` }))),
+    el("td", {}, el("span", { class: `badge ${r.status}`, testid: "run-status", text: r.note ? "preparing" : r.status })),
+    r.note // before its first episode: what the run does (compiling the learner, the first time)
+      ? el("td", { class: "run-note", testid: "run-note", text: r.note })
+      : el("td", { title: `${r.episodes_done} / ${total} episodes` },
+        el("span", { class: "progress", testid: "run-progress", "data-done": r.episodes_done },
+          el("span", { style: `width:${pct.toFixed(1)}%` }))),
     el("td", { class: "num", testid: "run-cpu", text: fmtCpu(r.cpu_seconds) }),
     el("td", { class: "actions" },
       live && !r.elsewhere ? el("button", { class: "icon", title: "stop", testid: "run-stop", onclick: () => stopRun(r.id) }, "■") : null,
@@ -965,10 +967,18 @@ async function deleteRun(id) {
 }
 
 /** Merge an SSE curve piece into the run's curve: replace everything from its first episode on. */
-function mergeCurve(id, piece, from) {
+function mergeCurve(id, piece, from, to) {
   if (!piece || !piece.episodes) return;
   let c = S.curves.get(id);
   if (!c) { c = emptyCurve(); S.curves.set(id, c); }
+  if (to !== undefined && to !== null) { // episodes [from, to) changed: replace just those
+    for (let e = c.episodes.length; e < from; e++) { // episodes nobody finished yet: empty
+      for (const k of CURVE_KEYS) c[k].push(k === "episodes" ? e + 1 : 0);
+    }
+    for (const k of CURVE_KEYS) c[k].splice(from, to - from, ...(piece[k] || []));
+    markCurvesDirty();
+    return;
+  }
   // `from` is the 0-based index of the piece's first episode (episode numbers are 1-based).
   const first = from !== undefined && from !== null ? from + 1 : piece.episodes[0];
   // Episodes are numbered; drop what we already hold from `first` on, then append.
@@ -1368,6 +1378,7 @@ function connectEvents() {
     upsertRun(d.run);
     if (!before && !S.shownTouched) S.shown.add(d.run.id);
     if (d.curve) mergeCurve(d.run.id, d.curve, d.from);
+    for (const p of d.pieces || []) mergeCurve(d.run.id, p.curve, p.from, p.to);
     scheduleRunsRender();
     if (before && before.status !== d.run.status && !["running", "queued"].includes(d.run.status)) {
       loadCurve(d.run.id);
