@@ -1282,7 +1282,7 @@ async function watch() {
   await guarded("watch-error", async () => {
     const w = await api("POST", "/api/watch", body);
     const secs = w.times && w.times.length ? w.times[w.times.length - 1] : 0;
-    const from = w.seed == null ? "from the current pose" : `from random start ${w.seed}`;
+    const from = w.seed == null ? "from the current pose" : `from a random start (seed ${w.seed})`;
     setText("watch-result", `${w.steps} steps, ${secs.toFixed(1)} s ${from} — ${w.reached_goal ? "reaches the goal" : "does not reach the goal"}`);
     S.watchedRun = t;
   }, $("watch-go"));
