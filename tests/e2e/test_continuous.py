@@ -49,27 +49,27 @@ def continuous_run(page: Any, studio_server: Studio) -> dict:
     demos = page.locator("[data-testid='train-demo']")
     if demos.count():
         demos.first.check()
-    page.click("[data-testid='train-start']")
+    try:
+        page.click("[data-testid='train-start']")
 
-    def finished() -> dict | None:
-        if page.is_visible("[data-testid='train-error']"):
-            raise AssertionError(page.inner_text("[data-testid='train-error']"))
-        runs = [r for r in studio_server.get("/api/runs") if r["name"] == RUN_NAME]
-        return runs[0] if runs and runs[0]["status"] in ("done", "failed", "stopped") else None
+        def finished() -> dict | None:
+            if page.is_visible("[data-testid='train-error']"):
+                raise AssertionError(page.inner_text("[data-testid='train-error']"))
+            runs = [r for r in studio_server.get("/api/runs") if r["name"] == RUN_NAME]
+            return runs[0] if runs and runs[0]["status"] in ("done", "failed", "stopped") else None
 
-    run = _wait(finished, TRAIN_TIMEOUT_S)
-    assert run and run["status"] == "done", run
-    assert run["config"]["task"] == "arm-reach" and run["config"]["joints"] == 3
-    assert run["has_policy"] and run["episodes_done"] == 40
-    row = page.locator(f"[data-testid='run-row'][data-id='{run['id']}']")
-    row.wait_for(timeout=T)
-    shot(page, "continuous-01-trained", "sec-train")
-
-    # leave the form as the stories expect it
-    page.select_option("[data-testid='train-task']", "arm-grid")
-    page.click("[data-testid='train-defaults']")
-    if demos.count():
-        demos.first.uncheck()
+        run = _wait(finished, TRAIN_TIMEOUT_S)
+        assert run and run["status"] == "done", run
+        assert run["config"]["task"] == "arm-reach" and run["config"]["joints"] == 3
+        assert run["has_policy"] and run["episodes_done"] == 40
+        row = page.locator(f"[data-testid='run-row'][data-id='{run['id']}']")
+        row.wait_for(timeout=T)
+        shot(page, "continuous-01-trained", "sec-train")
+    finally:  # leave the form as the stories expect it, whatever happened
+        page.select_option("[data-testid='train-task']", "arm-grid")
+        page.click("[data-testid='train-defaults']")
+        if demos.count():
+            demos.first.uncheck()
     assert not page.is_visible("[data-testid='train-joints']")
     return run
 
