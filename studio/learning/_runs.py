@@ -330,6 +330,20 @@ def curve_figure(
 # ----------------------------------------------------------------------------- config.json
 
 
+def task_spec(task: ArmGrid | ArmReach, coding: TileCoding | None = None) -> dict[str, Any]:
+    """A task as run records and policy listings write it: its kind and its settings.
+
+    ``{"kind": "arm-grid", **grid.to_dict()}``, or ``{"kind": "arm-reach", **task.to_dict(),
+    "tile_coding": coding.to_dict()}`` for the continuous task.
+    """
+    if isinstance(task, ArmGrid):
+        return {"kind": TASK_ARM_GRID, **task.to_dict()}
+    spec: dict[str, Any] = {"kind": TASK_ARM_REACH, **task.to_dict()}
+    if coding is not None:
+        spec["tile_coding"] = coding.to_dict()
+    return spec
+
+
 @dataclass(frozen=True)
 class RunRecord:
     """A run's ``config.json``: what it trains and how, self-describing without the page.
@@ -387,7 +401,7 @@ class RunRecord:
         paths = [[int(s) for s in path] for path in demonstrations]
         return cls._checked(
             problems,
-            {"kind": TASK_ARM_GRID, **grid.to_dict()},
+            task_spec(grid),
             config,
             experiments,
             episodes,
@@ -482,7 +496,7 @@ class RunRecord:
                 problems.append(("demonstrations", str(err)))
         return cls._checked(
             problems,
-            {"kind": TASK_ARM_REACH, **task.to_dict(), "tile_coding": coding.to_dict()},
+            task_spec(task, coding),
             config,
             experiments,
             episodes,

@@ -12,7 +12,9 @@ from typing import Any
 import numpy as np
 
 from ._arm import ArmGrid
+from ._linear_policy import TilePolicyFile
 from ._policy import PolicyFile
+from ._runs import task_spec
 
 POLICY_SUFFIX = ".policy.npz"
 """The file suffix of policy files (the format is in :mod:`._policy`)."""
@@ -37,17 +39,35 @@ def has_default_goal(grid: ArmGrid) -> bool:
     return tuple(grid.goal) == tuple(default.goal)
 
 
-def policy_summary(policy: PolicyFile) -> dict[str, Any]:
-    """JSON-ready facts about a policy file for listings (the page, scripts).
+def policy_summary(policy: PolicyFile | TilePolicyFile) -> dict[str, Any]:
+    """JSON-ready facts about a policy file of either kind for listings (the page, scripts).
 
     Returns:
-        ``grid`` (the :meth:`ArmGrid.to_dict` spec), ``goal_deg`` (see :func:`goal_degrees`),
-        ``planning`` (the planner it was trained with), ``episodes`` (length of its learning
-        curve), ``experiments`` (how many the curve averages), ``created`` and ``notes``.
+        ``task`` (what it acts on, as a run record writes it: ``{"kind": "arm-grid", ...}`` or
+        ``{"kind": "arm-reach", ..., "tile_coding": {...}}``; for a tile-coded policy of another
+        Gymnasium environment ``{"kind": <its id>}``), ``grid`` (the :meth:`ArmGrid.to_dict` spec
+        of a tabular policy, ``{}`` otherwise), ``joints`` (joints it moves, 0 off the arm),
+        ``goal_deg`` (the goal of those joints in degrees: the goal bin's centre, see
+        :func:`goal_degrees`, or the continuous task's goal angles), ``planning`` (the planner
+        it was trained with), ``episodes`` (length of its learning curve), ``experiments`` (how
+        many the curve averages), ``created`` and ``notes``.
     """
+    if isinstance(policy, TilePolicyFile):
+        reach = policy.task
+        if reach is None:
+            task, joints, goal = {"kind": policy.env_id or "gymnasium"}, 0, []
+        else:
+            task, joints = task_spec(reach, policy.coder.coding), reach.joints
+            goal = [round(float(x), GOAL_DECIMALS) for x in np.degrees(reach.goal[:joints])]
+        grid: dict[str, Any] = {}
+    else:
+        task, grid, joints = task_spec(policy.grid), policy.grid.to_dict(), policy.grid.joints
+        goal = goal_degrees(policy.grid)
     return {
-        "grid": policy.grid.to_dict(),
-        "goal_deg": goal_degrees(policy.grid),
+        "task": task,
+        "grid": grid,
+        "joints": joints,
+        "goal_deg": goal,
         "planning": policy.config.planning,
         "episodes": int(len(policy.mean_steps)),
         "experiments": int(policy.experiments),

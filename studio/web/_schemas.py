@@ -357,20 +357,27 @@ class SweepPublic(BaseModel):
 
 
 class PolicyPublic(BaseModel):
-    """A policy that can be watched or downloaded."""
+    """A policy that can be watched or downloaded: the learning package's listing facts
+    (``policy_summary``), tabular or tile-coded. A damaged file has only its name, size and
+    ``error``; the other fields keep their empty defaults."""
 
     name: str
     source: Literal["upload", "run"]
     run: str | None
-    planning: str
-    grid: dict
-    goal_deg: list[float]
-    episodes: int
-    experiments: int
-    created: str
-    notes: str
     size_bytes: int
     error: str | None = None
+    task: dict = Field(default_factory=dict)
+    """What it acts on, as a run's ``config.json`` writes it; ``task["kind"]`` is ``arm-grid`` or
+    ``arm-reach`` (or a Gymnasium id)."""
+    grid: dict = Field(default_factory=dict)
+    """The arm grid of a tabular policy; empty for a tile-coded one."""
+    joints: int = 0
+    goal_deg: list[float] = Field(default_factory=list)
+    planning: str = ""
+    episodes: int = 0
+    experiments: int = 0
+    created: str = ""
+    notes: str = ""
 
 
 class WatchCreate(_Body):
@@ -385,7 +392,12 @@ class WatchCreate(_Body):
 class WatchPublic(BaseModel):
     """The greedy rollout being played."""
 
+    steps: int
+    """Steps the greedy policy took: grid steps, or joint steps of a continuous policy."""
+    seed: int | None
+    """The seed of a random start (give it again to watch the same start); None from the current pose."""
     states: list[int]
+    """Grid states visited (tabular policies; empty for continuous ones)."""
     times: list[float]
     q_robot: list[list[float]]
     reached_goal: bool

@@ -1,4 +1,4 @@
-"""The studio's state: the stores, the live pipeline, the run queue, the scene and the last rollout.
+"""The studio's state: the stores, the live pipeline, the run queue, the scene and the watched rollouts.
 
 One :class:`Studio` per app, built when the app starts and closed when it stops. Routes reach it
 through the ``StudioDep`` dependency. List changes bump a version per list; the SSE stream
@@ -34,6 +34,8 @@ from ._store import (
 log = logging.getLogger(__name__)
 
 LIST_NAMES = ("recordings", "demonstrations", "runs", "policies")
+ROLLOUTS_KEPT = 16
+"""Policies whose last watched rollout stays downloadable (each at most a megabyte or two)."""
 
 
 class ListChanges:
@@ -75,7 +77,8 @@ class Studio:
         self.pipeline = Pipeline(scene)
         self.watch_lock = threading.Lock()
         self.watching: str | None = None  # "policy:<name>" or "run:<id>" being played
-        self.last_rollout: tuple[np.ndarray, np.ndarray] | None = None
+        # the last rollout watched of each policy key: (times, q), the oldest watched first
+        self.rollouts: dict[str, tuple[np.ndarray, np.ndarray]] = {}
         self.mark_t0: float | None = None  # live demonstration start, recording time (s)
 
     def start(self) -> None:
@@ -408,8 +411,9 @@ class Studio:
         """Names taken by uploaded policies and runs (a policy upload must not shadow them)."""
         return set(self.policies.names()) | {run.id for run in self.runs.list()}
 
-    def load_policy(self, run: str | None, policy: str | None) -> tuple[Any, str]:
-        """Load the policy of a run or an uploaded policy; returns it and its key."""
+    def policy_file(self, run: str | None, policy: str | None) -> tuple[Path, str]:
+        """The file of a run's or an uploaded policy and its key (``run:<id>`` or
+        ``policy:<name>``); ``policy`` may also name a run, as the policy list does."""
         if (run is None) == (policy is None):
             raise InvalidError("Give either run or policy (exactly one) to choose what to watch.")
         if run is not None:
@@ -418,9 +422,7 @@ class Studio:
                 raise ConflictError(
                     f"Run {run} has no policy yet; wait until it has finished episodes, then try again."
                 )
-            from studio.learning import load_any_policy  # a run's policy: either format
-
-            return load_any_policy(r.policy_path), f"run:{run}"
+            return r.policy_path, f"run:{run}"
         assert policy is not None
         if not self.policies.exists(policy):
             try:
@@ -428,8 +430,39 @@ class Studio:
             except (NotFoundError, InvalidError):
                 r = None
             if r is not None and r.has_policy:
-                return self.policies.load_file(r.policy_path), f"run:{policy}"
-        return self.policies.load(policy), f"policy:{policy}"
+                return r.policy_path, f"run:{policy}"
+        return self.policies.path(policy), f"policy:{policy}"
+
+    def load_policy(self, run: str | None, policy: str | None) -> tuple[Any, str]:
+        """Load the policy of a run or an uploaded policy, of either kind, through the policy
+        store's one reader; returns it and its key (see :meth:`policy_file`)."""
+        path, key = self.policy_file(run, policy)
+        return self.policies.load_file(path), key
+
+    def keep_rollout(self, key: str, times: np.ndarray, q: np.ndarray) -> None:
+        """Remember the rollout just watched of policy ``key`` (the last :data:`ROLLOUTS_KEPT`
+        policies' are kept) and mark it as playing."""
+        with self.watch_lock:
+            self.rollouts.pop(key, None)
+            self.rollouts[key] = (times, q)
+            while len(self.rollouts) > ROLLOUTS_KEPT:
+                self.rollouts.pop(next(iter(self.rollouts)))
+            self.watching = key
+
+    def forget_rollout(self, key: str) -> None:
+        """Drop the rollout of policy ``key`` (its file is gone)."""
+        with self.watch_lock:
+            self.rollouts.pop(key, None)
+
+    def watched_rollout(self, key: str | None) -> tuple[str, np.ndarray, np.ndarray] | None:
+        """The last rollout watched of policy ``key`` (None: of any policy) as ``(key, times,
+        q)``, or None."""
+        with self.watch_lock:
+            if key is None:
+                key = next(reversed(self.rollouts), None)
+            if key is None or key not in self.rollouts:
+                return None
+            return (key, *self.rollouts[key])
 
 
 def _playback_state(source: Any) -> dict[str, Any] | None:

@@ -46,7 +46,7 @@ from studio.capture import (
     load_demonstration,
     summarize_recording,
 )
-from studio.learning import POLICY_SUFFIX, PolicyFile, load_policy
+from studio.learning import POLICY_SUFFIX, PolicyFile, TilePolicyFile, load_any_policy
 from studio.samples import SAMPLES_DIR
 
 from ._errors import ConflictError, InvalidError, NotFoundError, TooLargeError
@@ -548,8 +548,9 @@ def demonstration_store(folder: Path) -> FolderStore[Demonstration]:
     )
 
 
-def policy_store(folder: Path) -> FolderStore[PolicyFile]:
-    """Uploaded policies ``<folder>/<name>.policy.npz`` (runs keep theirs in their run folder)."""
+def policy_store(folder: Path) -> FolderStore[PolicyFile | TilePolicyFile]:
+    """Policies ``<folder>/<name>.policy.npz`` of every kind the studio writes, tabular or
+    tile-coded (runs keep theirs in their run folder; the store reads those too)."""
     return FolderStore(
-        folder, suffix=POLICY_SUFFIX, what="policy", plural="policies", load=load_policy
+        folder, suffix=POLICY_SUFFIX, what="policy", plural="policies", load=load_any_policy
     )

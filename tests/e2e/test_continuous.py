@@ -9,6 +9,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import pytest
 
 from tests.e2e.conftest import Studio, shot
 
@@ -28,11 +29,10 @@ def _wait(predicate: Any, timeout: float) -> Any:
     return predicate()
 
 
-def test_a_continuous_run_trains_from_the_page_is_watched_and_downloaded(
-    page: Any, studio_server: Studio, tmp_path: Path
-) -> None:
-    from studio.learning import TilePolicyFile, load_any_policy
-
+@pytest.fixture(scope="module")
+def continuous_run(page: Any, studio_server: Studio) -> dict:
+    """A tiny continuous-joint run trained from the page's form; the form is left as the stories
+    expect it (the paper's grid, its defaults, no demonstration ticked)."""
     defaults = studio_server.get("/api/config")["training"]
     page.click("[data-testid='train-defaults']")
     assert not page.is_visible("[data-testid='train-joints']")  # the paper's grid by default
@@ -49,22 +49,38 @@ def test_a_continuous_run_trains_from_the_page_is_watched_and_downloaded(
     demos = page.locator("[data-testid='train-demo']")
     if demos.count():
         demos.first.check()
-    page.click("[data-testid='train-start']")
+    try:
+        page.click("[data-testid='train-start']")
 
-    def finished() -> dict | None:
-        if page.is_visible("[data-testid='train-error']"):
-            raise AssertionError(page.inner_text("[data-testid='train-error']"))
-        runs = [r for r in studio_server.get("/api/runs") if r["name"] == RUN_NAME]
-        return runs[0] if runs and runs[0]["status"] in ("done", "failed", "stopped") else None
+        def finished() -> dict | None:
+            if page.is_visible("[data-testid='train-error']"):
+                raise AssertionError(page.inner_text("[data-testid='train-error']"))
+            runs = [r for r in studio_server.get("/api/runs") if r["name"] == RUN_NAME]
+            return runs[0] if runs and runs[0]["status"] in ("done", "failed", "stopped") else None
 
-    run = _wait(finished, TRAIN_TIMEOUT_S)
-    assert run and run["status"] == "done", run
-    assert run["config"]["task"] == "arm-reach" and run["config"]["joints"] == 3
-    assert run["has_policy"] and run["episodes_done"] == 40
-    row = page.locator(f"[data-testid='run-row'][data-id='{run['id']}']")
-    row.wait_for(timeout=T)
-    shot(page, "continuous-01-trained", "sec-train")
+        run = _wait(finished, TRAIN_TIMEOUT_S)
+        assert run and run["status"] == "done", run
+        assert run["config"]["task"] == "arm-reach" and run["config"]["joints"] == 3
+        assert run["has_policy"] and run["episodes_done"] == 40
+        row = page.locator(f"[data-testid='run-row'][data-id='{run['id']}']")
+        row.wait_for(timeout=T)
+        shot(page, "continuous-01-trained", "sec-train")
+    finally:  # leave the form as the stories expect it, whatever happened
+        page.select_option("[data-testid='train-task']", "arm-grid")
+        page.click("[data-testid='train-defaults']")
+        if demos.count():
+            demos.first.uncheck()
+    assert not page.is_visible("[data-testid='train-joints']")
+    return run
 
+
+def test_a_continuous_run_trains_from_the_page_is_watched_and_downloaded(
+    page: Any, studio_server: Studio, continuous_run: dict, tmp_path: Path
+) -> None:
+    from studio.learning import TilePolicyFile, load_any_policy
+
+    run = continuous_run
+    defaults = studio_server.get("/api/config")["training"]
     page.select_option("[data-testid='watch-policy']", f"run:{run['id']}")
     page.select_option("[data-testid='watch-start']", "random")
     page.fill("[data-testid='watch-seed']", "3")
@@ -87,11 +103,93 @@ def test_a_continuous_run_trains_from_the_page_is_watched_and_downloaded(
     policy = load_any_policy(target)
     assert isinstance(policy, TilePolicyFile) and policy.task is not None
     assert policy.task.joints == 3 and policy.weights.shape[1] == 6
+    assert not page.errors  # type: ignore[attr-defined]
 
-    # leave the form as the stories expect it
-    page.select_option("[data-testid='train-task']", "arm-grid")
-    page.click("[data-testid='train-defaults']")
-    if demos.count():
-        demos.first.uncheck()
-    assert not page.is_visible("[data-testid='train-joints']")
+
+def _watch_text(page: Any, click: Any) -> str:
+    """The Watch result after ``click()``, waiting for a fresh one."""
+    page.evaluate("document.querySelector(\"[data-testid='watch-result']\").textContent = ''")
+    click()
+    page.wait_for_selector("[data-testid='watch-result']:has-text(' s ')", timeout=T)
+    assert not page.is_visible("[data-testid='watch-error']"), page.inner_text(
+        "[data-testid='watch-error']"
+    )
+    return page.inner_text("[data-testid='watch-result']")
+
+
+def _download(page: Any, testid: str, folder: Path) -> Path:
+    with page.expect_download(timeout=T) as download:
+        page.click(f"[data-testid='{testid}']")
+    target = folder / download.value.suggested_filename
+    download.value.save_as(target)
+    assert not page.is_visible("[data-testid='export-error']"), page.inner_text(
+        "[data-testid='export-error']"
+    )
+    return target
+
+
+def test_a_continuous_policy_is_listed_watched_uploaded_and_downloaded_in_the_policy_list(
+    page: Any, studio_server: Studio, continuous_run: dict, tmp_path: Path
+) -> None:
+    from studio.learning import TilePolicyFile, load_any_policy
+
+    run = continuous_run
+    key = f"run:{run['id']}"
+    row = page.locator(f"[data-testid='policy-row'][data-key='{key}']")
+    row.wait_for(timeout=T)
+    # listed with its task, under the name Watch shows, and no hidden error
+    assert page.locator("[data-testid='policy-damaged']").count() == 0
+    assert not page.is_visible("[data-testid='policies-error']")
+    assert "continuous 3 joints" in row.locator("[data-testid='policy-task']").inner_text()
+    option = page.locator(f"[data-testid='watch-policy'] option[value='{key}']").inner_text()
+    label = row.locator("td.name").inner_text()
+    assert RUN_NAME in label and option == f"run {label}"
+
+    # Watch and the list's ▶ agree, with the rollout's own step count
+    page.select_option("[data-testid='watch-policy']", key)
+    page.select_option("[data-testid='watch-start']", "random")
+    page.fill("[data-testid='watch-seed']", "3")
+    by_watch = _watch_text(page, lambda: page.click("[data-testid='watch-go']"))
+    by_row = _watch_text(page, lambda: row.locator("[data-testid='policy-watch']").click())
+    assert by_watch == by_row, (by_watch, by_row)
+    api = studio_server.send("POST", "/api/watch", {"run": run["id"], "seed": 3})
+    assert by_watch.startswith(f"{api['steps']} steps, ") and api["steps"] > 0
+    assert ("does not reach" in by_watch) == (not api["reached_goal"])
+    shot(page, "continuous-03-policy-list", "sec-watch")
+
+    # its Policy .npz, uploaded back through the page: listed, watched, downloaded again
+    npz = _download(page, "download-policy", tmp_path)
+    page.set_input_files("[data-testid='policy-upload']", str(npz))
+    uploaded = page.locator("[data-testid='policy-row'][data-key^='policy:']")
+    uploaded.wait_for(timeout=T)
+    assert not page.is_visible("[data-testid='policies-error']"), page.inner_text(
+        "[data-testid='policies-error']"
+    )
+    assert page.locator("[data-testid='policy-damaged']").count() == 0
+    assert "continuous 3 joints" in uploaded.locator("[data-testid='policy-task']").inner_text()
+    upload_key = uploaded.get_attribute("data-key")
+    assert page.input_value("[data-testid='watch-policy']") == upload_key  # selected on upload
+    page.fill("[data-testid='watch-seed']", "4")
+    of_upload = _watch_text(page, lambda: page.click("[data-testid='watch-go']"))
+    assert int(of_upload.split(" steps, ")[0]) > 0
+    (tmp_path / "again").mkdir()
+    again = load_any_policy(_download(page, "download-policy", tmp_path / "again"))
+    assert isinstance(again, TilePolicyFile) and again.task is not None and again.task.joints == 3
+
+    # Rollout CSV is the selected policy's (the run's, watched from start 3), not the last watched
+    page.select_option("[data-testid='watch-policy']", key)
+    csv = _download(page, "download-rollout", tmp_path)
+    assert csv.name == f"{run['id']}.rollout.csv"
+    rows = np.loadtxt(csv, delimiter=",", skiprows=1)
+    assert np.allclose(rows[:, 1:], np.asarray(api["q_robot"]), atol=1e-5)
+    page.select_option("[data-testid='watch-policy']", upload_key)
+    csv = _download(page, "download-rollout", tmp_path)
+    assert csv.name == f"{upload_key.removeprefix('policy:')}.rollout.csv"
+    shot(page, "continuous-04-uploaded", "sec-watch")
+
+    # leave the lists as the stories expect them: no uploaded policy, nothing playing
+    studio_server.send("POST", "/api/watch/stop")
+    studio_server.send("DELETE", f"/api/policies/{upload_key.removeprefix('policy:')}")
+    uploaded.wait_for(state="detached", timeout=T)
+    page.fill("[data-testid='watch-seed']", "")
     assert not page.errors  # type: ignore[attr-defined]

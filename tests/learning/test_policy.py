@@ -115,3 +115,26 @@ def test_rollout_follows_the_greedy_path_smoothly(tmp_path, trained) -> None:
     np.testing.assert_allclose(
         np.loadtxt(csv_path, delimiter=",", skiprows=1), np.column_stack([times, q]), atol=1e-8
     )
+
+
+def test_policy_summary_lists_both_kinds_with_their_task(tmp_path, trained) -> None:
+    from studio.learning import ArmReach, TilePolicyFile, policy_summary
+
+    grid, config, result = trained
+    tabular = policy_summary(save_policy(tmp_path / "g.policy.npz", grid, result.q[0], config))
+    assert tabular["task"] == {"kind": "arm-grid", **grid.to_dict()}
+    assert tabular["grid"] == grid.to_dict() and tabular["joints"] == 2
+    reach = ArmReach(joints=4)
+    coding = reach.features()
+    coder = coding.bind(reach.lower, reach.upper)
+    tile = TilePolicyFile(coder, np.zeros((coder.size, reach.n_actions)), config, task=reach)
+    listed = policy_summary(tile)
+    assert listed["task"] == {
+        "kind": "arm-reach",
+        **reach.to_dict(),
+        "tile_coding": coding.to_dict(),
+    }
+    assert listed["grid"] == {} and listed["joints"] == 4 and listed["planning"] == config.planning
+    assert listed["goal_deg"] == pytest.approx(np.degrees(reach.goal[:4]))
+    other = TilePolicyFile(coder, tile.weights, config, env_id="MountainCar-v0")
+    assert policy_summary(other)["task"] == {"kind": "MountainCar-v0"}

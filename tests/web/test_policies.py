@@ -201,3 +201,94 @@ def test_damaged_policies_are_listed_with_the_reason_and_hide_nothing(client, tm
     r = client.post("/api/watch", json={"policy": "junk"})
     assert r.status_code == 422
     assert client.delete("/api/policies/junk").status_code == 204
+
+
+TINY_REACH_RUN = {
+    "task": "arm-reach",
+    "joints": 3,
+    "planning": "zero",
+    "experiments": 1,
+    "episodes": 4,
+    "seed": 1,
+}
+"""A continuous-joint (tile-coded) run that trains in a few seconds once its kernels are compiled."""
+
+
+def test_a_continuous_run_policy_is_listed_uploaded_watched_and_downloaded(client, tmp_path):
+    from studio.learning import TILE_ROLLOUT_SECONDS_PER_STEP, TilePolicyFile, load_any_policy
+
+    run = client.post("/api/runs", json={**TINY_REACH_RUN, "name": "reach"}).json()
+    assert wait_run(client, run["id"], timeout=180)["status"] == "done"
+    listed = client.get("/api/policies").json()
+    assert len(listed) == 1
+    entry = listed[0]
+    assert entry["error"] is None, entry["error"]
+    assert (entry["name"], entry["source"], entry["run"]) == (run["id"], "run", run["id"])
+    assert entry["task"]["kind"] == "arm-reach" and entry["task"]["joints"] == 3
+    assert entry["task"]["tile_coding"]["tiles"] == run["config"]["tiles"]
+    assert entry["joints"] == 3 and entry["grid"] == {}
+    assert entry["goal_deg"] == pytest.approx(run["config"]["goal_deg"])
+    assert (entry["planning"], entry["episodes"], entry["experiments"]) == ("zero", 4, 1)
+
+    # the page's "Policy .npz" of the run, uploaded back: accepted and listed the same way
+    content = client.get(f"/api/runs/{run['id']}/policy").content
+    r = upload(client, f"{run['id']}.policy.npz", content)
+    assert r.status_code == 201, r.text
+    uploaded = r.json()
+    assert uploaded["name"] == f"{run['id']}-2" and uploaded["error"] is None
+    assert uploaded["task"] == entry["task"] and uploaded["episodes"] == 4
+    back = tmp_path / "back.policy.npz"
+    back.write_bytes(client.get(f"/api/policies/{uploaded['name']}/file").content)
+    assert isinstance(load_any_policy(back), TilePolicyFile)
+
+    # watched by run, by the run's name in the policy list, and as the upload: one rollout
+    answers = [
+        client.post("/api/watch", json={**target, "seed": 5})
+        for target in ({"run": run["id"]}, {"policy": run["id"]}, {"policy": uploaded["name"]})
+    ]
+    assert [a.status_code for a in answers] == [200, 200, 200], [a.text for a in answers]
+    watches = [a.json() for a in answers]
+    first = watches[0]
+    assert first["states"] == [] and first["seed"] == 5
+    # the step count is the rollout's: one joint step per TILE_ROLLOUT_SECONDS_PER_STEP
+    assert first["steps"] == round(first["times"][-1] / TILE_ROLLOUT_SECONDS_PER_STEP) > 0
+    for other in watches[1:]:
+        assert (other["steps"], other["reached_goal"]) == (first["steps"], first["reached_goal"])
+        assert other["q_robot"] == first["q_robot"]
+
+
+def test_the_rollout_csv_is_the_chosen_policys_under_its_name(client, tmp_path):
+    content = policy_bytes(tmp_path)
+    for name in ("near", "far"):
+        assert upload(client, f"{name}.policy.npz", content).status_code == 201
+    r = client.get("/api/watch/trajectory.csv", params={"policy": "near"})
+    assert r.status_code == 409
+    assert r.json()["detail"] == (
+        "Policy near has not been watched yet; watch it first, then download its rollout."
+    )
+    near = client.post("/api/watch", json={"policy": "near", "seed": 1}).json()
+    far = client.post("/api/watch", json={"policy": "far", "seed": 2}).json()
+    assert near["q_robot"] != far["q_robot"]
+    for name, watched in (("near", near), ("far", far)):
+        r = client.get("/api/watch/trajectory.csv", params={"policy": name})
+        assert r.status_code == 200
+        assert f'filename="{name}.rollout.csv"' in r.headers["content-disposition"]
+        rows = np.loadtxt(io.StringIO(r.text), delimiter=",", skiprows=1)
+        assert np.allclose(rows[:, 1:], watched["q_robot"], atol=1e-5)
+    last = client.get("/api/watch/trajectory.csv")  # no policy named: the last one watched
+    assert 'filename="far.rollout.csv"' in last.headers["content-disposition"]
+    assert client.get("/api/watch/trajectory.csv", params={"policy": "gone"}).status_code == 404
+    # a deleted policy's rollout goes with it, even when the name is taken again
+    assert client.delete("/api/policies/near").status_code == 204
+    assert upload(client, "near.policy.npz", content).json()["name"] == "near"
+    assert client.get("/api/watch/trajectory.csv", params={"policy": "near"}).status_code == 409
+
+
+def test_a_random_start_reports_its_seed_so_it_can_be_watched_again(client, tmp_path):
+    assert upload(client, "reach.policy.npz", policy_bytes(tmp_path)).status_code == 201
+    first = client.post("/api/watch", json={"policy": "reach"}).json()
+    assert isinstance(first["seed"], int) and first["steps"] == len(first["states"]) - 1
+    again = client.post("/api/watch", json={"policy": "reach", "seed": first["seed"]}).json()
+    assert again["states"] == first["states"]
+    current = client.post("/api/watch", json={"policy": "reach", "start": "current"}).json()
+    assert current["seed"] is None

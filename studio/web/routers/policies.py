@@ -8,7 +8,7 @@ from fastapi import APIRouter, File, Response, UploadFile
 from fastapi.responses import FileResponse
 from starlette.concurrency import run_in_threadpool
 
-from studio.learning import POLICY_SUFFIX, PolicyFile, policy_summary
+from studio.learning import POLICY_SUFFIX, PolicyFile, TilePolicyFile, policy_summary
 
 from .._deps import SettingsDep, StudioDep
 from .._errors import ConflictError
@@ -20,25 +20,13 @@ router = APIRouter(prefix="/api/policies", tags=["policies"])
 
 
 def policy_public(
-    entry: StoredFile[PolicyFile], source: Literal["upload", "run"] = "upload"
+    entry: StoredFile[PolicyFile | TilePolicyFile], source: Literal["upload", "run"] = "upload"
 ) -> PolicyPublic:
-    """The list entry of one policy file, from the learning package's summary of it.
+    """The list entry of one policy file of either kind, from the learning package's summary.
 
     A damaged file keeps its name and size and says why it cannot be used.
     """
-    summary = (
-        policy_summary(entry.value)
-        if entry.value is not None
-        else {
-            "grid": {},
-            "goal_deg": [],
-            "planning": "",
-            "episodes": 0,
-            "experiments": 0,
-            "created": "",
-            "notes": "",
-        }
-    )
+    summary = policy_summary(entry.value) if entry.value is not None else {}
     return PolicyPublic(
         name=entry.name,
         source=source,
@@ -110,5 +98,6 @@ def delete_policy(name: str, studio: StudioDep) -> Response:
     if studio.policy_in_use(f"policy:{name}"):
         raise ConflictError(f"Policy {name!r} is playing in the scene; stop watching it first.")
     studio.policies.delete(name)
+    studio.forget_rollout(f"policy:{name}")
     studio.changes.bump("policies")
     return Response(status_code=204)

@@ -11,6 +11,7 @@ from fastapi import APIRouter, Response
 from studio.learning import (
     TilePolicyFile,
     greedy_path,
+    greedy_rollout,
     rollout,
     rollout_tile_policy,
     save_trajectory_csv,
@@ -41,6 +42,7 @@ def watch(body: WatchCreate, studio: StudioDep) -> WatchPublic:
     if isinstance(policy, TilePolicyFile):
         return _watch_tile_policy(body, studio, policy, key)
     grid = policy.grid
+    seed = start_seed(body)
     if body.start == "current":
         q_now = (
             studio.scene.current_q_robot()
@@ -49,23 +51,22 @@ def watch(body: WatchCreate, studio: StudioDep) -> WatchPublic:
         )
         start = grid.state_of_angles(np.asarray(q_now)[: grid.joints])
     else:
-        rng = np.random.default_rng(body.seed)
         starts = grid.mdp().start_states
-        start = int(starts[rng.integers(len(starts))])
+        start = int(starts[np.random.default_rng(seed).integers(len(starts))])
     hold = np.zeros(6)
     if body.start == "current":
         hold[grid.joints :] = np.asarray(q_now)[grid.joints : 6]
     times, q = rollout(policy, start, ROLLOUT_RATE_HZ, hold=hold)
     states = greedy_path(policy, start)
-    with studio.watch_lock:
-        studio.last_rollout = (times, q)
-        studio.watching = key
+    studio.keep_rollout(key, times, q)
     if studio.scene is not None:
         goal = np.zeros(6)
         goal[: grid.joints] = grid.angles_of(grid.goal_state)
         studio.scene.set_goal(goal)
         studio.scene.play_trajectory(times, q, states)
     return WatchPublic(
+        steps=len(states) - 1,
+        seed=seed,
         states=states,
         times=np.round(times, ROUND_DECIMALS).tolist(),
         q_robot=np.round(q, ROUND_DECIMALS).tolist(),
@@ -82,6 +83,7 @@ def _watch_tile_policy(
         raise ConflictError(
             f"This policy was trained on {policy.env_id or 'another environment'}, not the arm; only arm policies can be watched."
         )
+    seed = start_seed(body)
     if body.start == "current":
         q_now = np.asarray(
             studio.scene.current_q_robot()
@@ -90,11 +92,11 @@ def _watch_tile_policy(
         )
         start = np.clip(q_now[: task.joints], task.lower, task.upper)
     else:
-        start = task.random_start(np.random.default_rng(body.seed))
+        start = task.random_start(np.random.default_rng(seed))
     times, q, reached = rollout_tile_policy(policy, start, ROLLOUT_RATE_HZ, TILE_WATCH_MAX_STEPS)
-    with studio.watch_lock:
-        studio.last_rollout = (times, q)
-        studio.watching = key
+    # the joint path the trajectory was sampled from (deterministic: the same greedy steps)
+    path, _ = greedy_rollout(task, policy.coder, policy.weights, start, TILE_WATCH_MAX_STEPS)
+    studio.keep_rollout(key, times, q)
     if studio.scene is not None:
         studio.scene.set_goal(np.asarray(task.goal))
         studio.scene.clear_path(TILE_DEMONSTRATION_PATH)
@@ -109,6 +111,8 @@ def _watch_tile_policy(
             studio.scene.show_path(TILE_DEMONSTRATION_PATH, path)
         studio.scene.play_trajectory(times, q)
     return WatchPublic(
+        steps=len(path) - 1,
+        seed=seed,
         states=[],
         times=np.round(times, ROUND_DECIMALS).tolist(),
         q_robot=np.round(q, ROUND_DECIMALS).tolist(),
@@ -127,19 +131,42 @@ def stop_watch(studio: StudioDep) -> Response:
 
 
 @router.get("/trajectory.csv", response_class=Response, responses=file_responses("text/csv"))
-def download_trajectory(studio: StudioDep) -> Response:
-    """The last rollout as CSV: ``time,q1..q6`` (seconds, radians); 409 before any watch."""
-    with studio.watch_lock:
-        last = studio.last_rollout
+def download_trajectory(
+    studio: StudioDep, run: str | None = None, policy: str | None = None
+) -> Response:
+    """The rollout last watched of a run's policy (``?run=<id>``) or an uploaded one
+    (``?policy=<name>``), or with neither the last rollout watched, as CSV: ``time,q1..q6``
+    (seconds, radians), named ``<run id or policy name>.rollout.csv`` as ``studio export``
+    names it. 409 when that policy has not been watched yet."""
+    key = None if run is None and policy is None else studio.policy_file(run, policy)[1]
+    last = studio.watched_rollout(key)
     if last is None:
-        raise ConflictError("Nothing has been watched yet; watch a policy first, then download.")
-    times, q = last
+        if key is None:
+            raise ConflictError(
+                "Nothing has been watched yet; watch a policy first, then download."
+            )
+        kind, name = key.split(":", 1)
+        raise ConflictError(
+            f"{'Run' if kind == 'run' else 'Policy'} {name} has not been watched yet; watch it first, then download its rollout."
+        )
+    key, times, q = last
+    filename = f"{key.split(':', 1)[-1]}.rollout.csv"
     with tempfile.TemporaryDirectory() as folder:  # the learning package's CSV format, as is
-        path = Path(folder) / "rollout.csv"
+        path = Path(folder) / filename
         save_trajectory_csv(path, times, q)
         text = path.read_text()
     return Response(
         text,
         media_type="text/csv",
-        headers={"Content-Disposition": 'attachment; filename="rollout.csv"'},
+        headers={"Content-Disposition": f'attachment; filename="{filename}"'},
     )
+
+
+def start_seed(body: WatchCreate) -> int | None:
+    """The seed of a random start: the one asked for, else a fresh one the answer reports (so
+    the same start can be watched again); None for a start from the current pose."""
+    if body.start != "random":
+        return None
+    if body.seed is not None:
+        return body.seed
+    return int(np.random.default_rng().integers(2**31))

@@ -748,6 +748,7 @@ async function loadRuns() {
     renderRuns();
     await Promise.all([...S.shown].filter((id) => !S.curves.has(id)).map(loadCurve));
     renderWatchChoices();
+    renderPolicies(); // a run's policy is listed under the run's name
   });
 }
 
@@ -1265,25 +1266,50 @@ async function loadPolicies() {
   });
 }
 
+// One name per policy: a run's policy goes by its run's label (as in the runs list), an
+// uploaded one by its file name.
+function policyLabel(p) {
+  const run = p.source === "run" && p.run ? S.runs.find((r) => r.id === p.run) : null;
+  return run ? runLabel(run) : p.name;
+}
+
+function policyKey(p) {
+  return p.source === "run" && p.run ? `run:${p.run}` : `policy:${p.name}`;
+}
+
+// What a policy acts on, from its listing's task: the paper's grid or the continuous joints.
+function policyTask(p) {
+  const t = p.task || {};
+  if (t.kind === "arm-grid") return `grid ${t.joints}×${t.bins}`;
+  if (t.kind === "arm-reach") return `continuous ${t.joints} joints`;
+  return t.kind || "";
+}
+
 function renderPolicies() {
   const body = $("policies-body");
   if (!S.policies.length) {
     body.replaceChildren(emptyRow(4, "No policies: finish a run, or upload a .policy.npz."));
     return;
   }
-  body.replaceChildren(...S.policies.map((p) => el("tr", { "data-name": p.name, testid: "policy-row" },
-    el("td", { class: "name", title: p.notes || p.name, text: p.name }),
-    el("td", { text: p.planning }),
-    el("td", { class: "muted", title: p.run || "", text: p.source === "run" ? "run" : "upload" }),
-    el("td", { class: "actions" },
-      el("button", { class: "icon", title: "watch", testid: "policy-watch", onclick: () => { selectWatch(p); watch(); } }, "▶"),
-      p.source === "upload" ? el("button", { class: "icon", title: "delete", testid: "policy-delete", onclick: () => deletePolicy(p.name) }, "✕") : null,
-    ),
-  )));
+  body.replaceChildren(...S.policies.map((p) => {
+    const label = policyLabel(p);
+    const what = p.error
+      ? el("span", { class: "badge failed", text: "unreadable", title: p.error, testid: "policy-damaged" })
+      : el("span", { title: policyTask(p), text: `${p.planning} · ${policyTask(p)}` });
+    return el("tr", { "data-name": p.name, "data-key": policyKey(p), testid: "policy-row", title: p.error || "" },
+      el("td", { class: "name", title: [label, p.run && `run ${p.run}`, p.notes].filter(Boolean).join("\n"), text: label }),
+      el("td", { testid: "policy-task" }, what),
+      el("td", { class: "muted", title: p.run || "", text: p.source === "run" ? "run" : "upload" }),
+      el("td", { class: "actions" },
+        p.error ? null : el("button", { class: "icon", title: "watch", testid: "policy-watch", onclick: () => { selectWatch(p); watch(); } }, "▶"),
+        p.source === "upload" ? el("button", { class: "icon", title: "delete", testid: "policy-delete", onclick: () => deletePolicy(p.name) }, "✕") : null,
+      ),
+    );
+  }));
 }
 
 function selectWatch(p) {
-  $("watch-policy").value = p.source === "run" && p.run ? `run:${p.run}` : `policy:${p.name}`;
+  $("watch-policy").value = policyKey(p);
 }
 
 function renderWatchChoices() {
@@ -1293,8 +1319,8 @@ function renderWatchChoices() {
     if (r.has_policy) { items.push([`run:${r.id}`, `run ${runLabel(r)}`]); seenRuns.add(r.id); }
   }
   for (const p of S.policies) {
-    if (p.source === "run" && p.run && seenRuns.has(p.run)) continue;
-    items.push([p.source === "run" && p.run ? `run:${p.run}` : `policy:${p.name}`, `${p.source === "upload" ? "file" : "run"} ${p.name}`]);
+    if ((p.source === "run" && p.run && seenRuns.has(p.run)) || p.error) continue;
+    items.push([policyKey(p), `${p.source === "upload" ? "file" : "run"} ${policyLabel(p)}`]);
   }
   if (!items.length) items.push(["", "(no policy yet)"]);
   fillSelect($("watch-policy"), items);
@@ -1316,9 +1342,9 @@ async function watch() {
   setText("watch-result", "");
   await guarded("watch-error", async () => {
     const w = await api("POST", "/api/watch", body);
-    const steps = Math.max(0, (w.states || []).length - 1);
     const secs = w.times && w.times.length ? w.times[w.times.length - 1] : 0;
-    setText("watch-result", `${steps} steps, ${secs.toFixed(1)} s — ${w.reached_goal ? "reaches the goal" : "does not reach the goal"}`);
+    const from = w.seed == null ? "from the current pose" : `from a random start (seed ${w.seed})`;
+    setText("watch-result", `${w.steps} steps, ${secs.toFixed(1)} s ${from} — ${w.reached_goal ? "reaches the goal" : "does not reach the goal"}`);
     S.watchedRun = t;
   }, $("watch-go"));
 }
@@ -1347,8 +1373,10 @@ async function uploadPolicy(input) {
 
 function exportFile(kind) {
   const t = watchTarget();
-  if (kind === "rollout") return download("/api/watch/trajectory.csv", "rollout.csv", "export-error");
   if (!t) { showError("export-error", "Choose a run or a policy first."); return; }
+  if (kind === "rollout") { // the selected policy's rollout as last watched, named after it
+    return download(`/api/watch/trajectory.csv?${t.type === "run" ? "run" : "policy"}=${enc(t.id)}`, `${t.id}.rollout.csv`, "export-error");
+  }
   if (kind === "policy") {
     if (t.type === "run") return download(`/api/runs/${enc(t.id)}/policy`, `${t.id}.policy.npz`, "export-error");
     return download(`/api/policies/${enc(t.id)}/file`, `${t.id}.policy.npz`, "export-error");
