@@ -1,4 +1,4 @@
-"""Kinematics: Puma560 and human-arm models, tape reconstruction, arm fitting, retargeting.
+"""Kinematics: Puma560 and human-arm models, tape and pose-landmark fitting, retargeting.
 
 The public names are listed in ``docs/architecture.md``.
 """
@@ -14,6 +14,9 @@ from ._meshes import HumanBody as HumanBody
 from ._meshes import MeshConfig as MeshConfig
 from ._meshes import MeshPart as MeshPart
 from ._meshes import puma560_meshes as puma560_meshes
+from ._pose import PoseConfig as PoseConfig
+from ._pose import PoseFit as PoseFit
+from ._pose import fit_pose_landmarks as fit_pose_landmarks
 from ._puma import PUMA_QN as PUMA_QN
 from ._puma import PUMA_QR as PUMA_QR
 from ._puma import PUMA_QS as PUMA_QS
@@ -24,6 +27,9 @@ from ._puma import LinkVisual as LinkVisual
 from ._puma import Puma560 as Puma560
 from ._retarget import RetargetConfig as RetargetConfig
 from ._retarget import Retargeter as Retargeter
+from ._synthetic import BodyShape as BodyShape
+from ._synthetic import arm_motion as arm_motion
+from ._synthetic import landmarks_from_arm as landmarks_from_arm
 from ._tape import TapeConfig as TapeConfig
 from ._tape import TapeShape as TapeShape
 from ._tape import reconstruct as reconstruct
