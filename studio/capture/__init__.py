@@ -44,6 +44,7 @@ from ._network import stream_source as stream_source
 from ._observation_format import HAND_SUFFIX as HAND_SUFFIX
 from ._observation_format import POSE_SUFFIX as POSE_SUFFIX
 from ._observation_format import RECORDING_SUFFIXES as RECORDING_SUFFIXES
+from ._observation_format import recording_suffix as recording_suffix
 from ._observation_recording import ObservationRecording as ObservationRecording
 from ._observation_recording import ObservationWriter as ObservationWriter
 from ._observation_recording import read_any_recording as read_any_recording
@@ -77,6 +78,7 @@ from ._recording_reader import read_header as read_header
 from ._recording_reader import read_recording as read_recording
 from ._recording_reader import recording_bytes as recording_bytes
 from ._recording_reader import summarize_recording as summarize_recording
+from ._recording_writer import AppendWriter as AppendWriter
 from ._recording_writer import RecordingWriter as RecordingWriter
 from ._recording_writer import recording_meta as recording_meta
 from ._segments import trigger_segments as trigger_segments

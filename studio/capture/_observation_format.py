@@ -91,6 +91,11 @@ RECORDING_SUFFIXES = tuple(kind.suffix for kind in RECORDING_KINDS.values())
 """Every recording file's ending (the tape's first)."""
 
 
+def recording_suffix(kind: str) -> str:
+    """The file name ending of recordings of ``kind`` (``"tape"``, ``"pose"`` or ``"hand"``)."""
+    return RECORDING_KINDS[kind].suffix
+
+
 def kind_of_name(filename: str) -> RecordingKind | None:
     """The recording kind a file name's ending says, or None."""
     return next((k for k in RECORDING_KINDS.values() if filename.endswith(k.suffix)), None)

@@ -51,6 +51,7 @@ from ._recording_reader import (
     read_recording,
     summarize_recording,
 )
+from ._recording_reader import _parse_header as _parse_tape_header
 from ._recording_writer import DEFAULT_FLUSH_SECONDS, AppendWriter, RecordingWriter
 
 MAX_FIELD_BYTES = 32
@@ -232,6 +233,18 @@ def _parse_header(path: Path, kind: RecordingKind, line: str) -> dict[str, Any]:
             f"{path}, line 1: the header's side is {_short(meta.get('side'))}; it must be 'right' or 'left'."
         )
     return meta
+
+
+def parse_any_header(path: Path, line: str) -> tuple[dict[str, Any], str]:
+    """The checked header of a recording of any kind from its line 1, and line 1's prefix.
+
+    Raises:
+        RecordingError: a header that is not a recording's, or out of its bounds.
+    """
+    for kind in RECORDING_KINDS.values():
+        if kind.name != "tape" and line.startswith(kind.prefix):
+            return _parse_header(path, kind, line), kind.prefix
+    return _parse_tape_header(path, line), RECORDING_KINDS["tape"].prefix
 
 
 def _parse_lines(

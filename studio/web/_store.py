@@ -36,9 +36,10 @@ from studio import StudioError, human_size
 from studio.capture import (
     DEMO_SUFFIX,
     RECORDING_SUFFIX,
+    RECORDING_SUFFIXES,
     Demonstration,
     load_demonstration,
-    summarize_recording,
+    summarize_any_recording,
 )
 from studio.learning import POLICY_SUFFIX, PolicyFile, load_policy
 from studio.samples import SAMPLES_DIR
@@ -84,7 +85,7 @@ def clean_upload_name(filename: str | None, suffix: str, fallback: str) -> str:
             f"The file name {filename!r} contains a path separator or '..'; upload a file with a plain name."
         )
     stem = filename[: -len(suffix)] if filename.endswith(suffix) else Path(filename).stem
-    for extra in (".tape", ".policy", ".demo"):
+    for extra in (".tape", ".pose", ".hand", ".policy", ".demo"):
         stem = stem.removesuffix(extra)
     stem = re.sub(r"[^A-Za-z0-9_.-]+", "-", stem).strip("-.")[:80]
     return _user_name(stem) or fallback
@@ -219,6 +220,8 @@ class FolderStore(Generic[T]):
             changes.
         samples: a read-only folder of shipped samples (names starting with ``sample-``), or None.
         sample_fix: what to do instead of changing a sample, the second half of the refusal.
+        also: further suffixes of the same kind (recordings of landmarks and hand poses beside
+            the tape's); a name is unique across all of them.
     """
 
     def __init__(
@@ -231,9 +234,11 @@ class FolderStore(Generic[T]):
         load: Callable[[Path], T],
         samples: Path | None = None,
         sample_fix: str = "copy it to make your own",
+        also: tuple[str, ...] = (),
     ) -> None:
         self.folder = folder
         self.suffix = suffix
+        self.suffixes = (suffix, *(s for s in also if s != suffix))
         self.what = what
         self.plural = plural
         self.samples = samples
@@ -247,19 +252,26 @@ class FolderStore(Generic[T]):
     def _stems(self, folder: Path | None) -> list[str]:
         if folder is None or not folder.is_dir():
             return []
-        stems = (p.name[: -len(self.suffix)] for p in folder.glob(f"*{self.suffix}"))
+        stems = (
+            p.name[: -len(suffix)] for suffix in self.suffixes for p in folder.glob(f"*{suffix}")
+        )
         return [s for s in stems if NAME_PATTERN.match(s)]
 
     def _find(self, name: str) -> Path | None:
         for folder in (self.folder, self.samples):
-            if folder is not None and (folder / f"{name}{self.suffix}").is_file():
-                return folder / f"{name}{self.suffix}"
+            for suffix in self.suffixes:
+                if folder is not None and (folder / f"{name}{suffix}").is_file():
+                    return folder / f"{name}{suffix}"
         return None
+
+    def suffix_of(self, filename: str) -> str:
+        """The suffix of this store that ``filename`` ends with (the main one if none)."""
+        return next((s for s in self.suffixes if filename.endswith(s)), self.suffix)
 
     def names(self) -> list[str]:
         """Every name: the samples first, then the user's files, each group alphabetical."""
         samples = [s for s in self._stems(self.samples) if s.startswith(SAMPLE_PREFIX)]
-        names = set(self._stems(self.folder)) | set(samples)
+        names = set(self._stems(self.folder)) | set(samples)  # a stem with two suffixes: once
         return sorted(names, key=lambda n: (not self.is_sample(n), n))
 
     def exists(self, name: str) -> bool:
@@ -386,7 +398,8 @@ class FolderStore(Generic[T]):
         """
         label = filename or "the upload"
         try:
-            base = clean_upload_name(filename, self.suffix, self.what)
+            suffix = self.suffix_of(filename or "")
+            base = clean_upload_name(filename, suffix, self.what)
             try:
                 self._read(tmp)
             except StudioError as err:
@@ -394,7 +407,7 @@ class FolderStore(Generic[T]):
                 raise InvalidError(
                     f"{label} is not a valid Teach Studio {self.what}: {message}"
                 ) from None
-            return self._claim(tmp, base, taken or self.exists)
+            return self._claim(tmp, base, taken or self.exists, suffix)
         finally:
             tmp.unlink(missing_ok=True)
 
@@ -427,20 +440,23 @@ class FolderStore(Generic[T]):
                     )
                 if prepare is not None:
                     prepare(tmp, final)
-                os.replace(tmp, self.folder / f"{final}{self.suffix}")
+                os.replace(tmp, self.folder / f"{final}{self.suffix_of(source.name)}")
             return final
         finally:
             tmp.unlink(missing_ok=True)
 
-    def _claim(self, tmp: Path, base: str, taken: Callable[[str], bool]) -> str:
+    def _claim(
+        self, tmp: Path, base: str, taken: Callable[[str], bool], suffix: str | None = None
+    ) -> str:
         with self._claim_lock:
             name = unique_name(base, lambda n: taken(n) or self.exists(n))
-            os.replace(tmp, self.folder / f"{name}{self.suffix}")
+            os.replace(tmp, self.folder / f"{name}{suffix or self.suffix}")
         return name
 
 
 def recording_store(folder: Path) -> FolderStore[dict[str, Any]]:
-    """Recordings ``<folder>/<name>.tape.csv``, each cached as the capture package's summary.
+    """Recordings ``<folder>/<name>.tape.csv`` (and ``.pose.csv``, ``.hand.csv``), each cached as
+    the capture package's summary.
 
     :func:`studio.capture.summarize_recording` streams the whole file (so damage shows) in one
     block of memory, however long the recording.
@@ -450,9 +466,10 @@ def recording_store(folder: Path) -> FolderStore[dict[str, Any]]:
         suffix=RECORDING_SUFFIX,
         what="recording",
         plural="recordings",
-        load=summarize_recording,
+        load=summarize_any_recording,
         samples=SAMPLES_DIR,
         sample_fix="copy it to your recordings to change it",
+        also=RECORDING_SUFFIXES,
     )
 
 
