@@ -97,7 +97,7 @@ def describe(summary: dict[str, Any]) -> str:
     lines = [
         f"{summary['path']}",
         f"  name      {summary['name']}",
-        f"  frames    {summary['frames']} ({summary['duration']:.2f} s at {summary['rate_hz']:g} Hz, {summary['regions']} regions)",
+        f"  frames    {summary['frames']} ({summary['duration']:.2f} s at {summary['rate_hz']:g} Hz, {_what(summary)})",
         f"  source    {summary['source']}",
         f"  operator  {summary['operator'] or '-'}",
         f"  created   {summary['created']}",
@@ -108,6 +108,16 @@ def describe(summary: dict[str, Any]) -> str:
     for problem in summary["problems"]:
         lines.append(f"  problem   {problem}")
     return "\n".join(lines)
+
+
+def _what(summary: dict[str, Any]) -> str:
+    """What each frame holds, by the recording's kind."""
+    kind = summary.get("kind", "tape")
+    if kind == "pose":
+        return "pose landmarks from a camera, no images"
+    if kind == "hand":
+        return "hand-guide poses"
+    return f"{summary['regions']} regions"
 
 
 def _recovered_text(summary: dict[str, Any]) -> str:
