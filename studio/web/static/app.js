@@ -227,11 +227,12 @@ function renderSource() {
   }
   renderCaptureButton();
   updateMarkButton();
+  document.dispatchEvent(new CustomEvent("studio:source", { detail: s })); // camera.js follows it
 }
 
 function syncKindOptions() {
   const kind = $("source-kind").value;
-  for (const e of document.querySelectorAll(".kind-opt")) e.hidden = e.dataset.kind !== kind;
+  for (const e of document.querySelectorAll(".kind-opt")) e.hidden = !e.dataset.kind.split(" ").includes(kind);
 }
 
 async function applySource() {
@@ -247,6 +248,8 @@ async function applySource() {
   } else if (kind === "serial") {
     body.device = $("source-device").value.trim();
     if ($("source-calibration").value.trim()) body.calibration = $("source-calibration").value.trim();
+  } else if (kind === "camera" || kind === "hand") {
+    body.side = $("source-side").value;
   } else if ($("source-seed").value !== "") {
     body.seed = Number($("source-seed").value);
   }
@@ -320,6 +323,7 @@ async function toggleCapture() {
       flashRow("recordings-body", rec && rec.name);
     }, b);
   } else {
+    if (window.recordCountdown && !(await window.recordCountdown())) return; // camera.js: cancelled
     const body = {};
     if ($("capture-name").value.trim()) body.name = $("capture-name").value.trim();
     if ($("capture-operator").value.trim()) body.operator = $("capture-operator").value.trim();
