@@ -108,7 +108,9 @@ def figure_elbow_deg(index: int, frames: int) -> float:
     return straight + (bent - straight) * phase
 
 
-def _capsule(draw: object, a: tuple[float, float], b: tuple[float, float], r: float, fill: str) -> None:
+def _capsule(
+    draw: object, a: tuple[float, float], b: tuple[float, float], r: float, fill: str
+) -> None:
     draw.line([a, b], fill=fill, width=int(2 * r))  # type: ignore[attr-defined]
     for x, y in (a, b):
         draw.ellipse([x - r, y - r, x + r, y + r], fill=fill)  # type: ignore[attr-defined]
@@ -126,7 +128,7 @@ def draw_figure(elbow_deg: float) -> np.ndarray:
     d = ImageDraw.Draw(img)
     skin, shirt, trousers = "#e0ac89", "#3a6ea5", "#3b3b4f"
     cx = WIDTH / 2
-    neck, hips = (cx, 150.0), (cx, 285.0)
+    neck = (cx, 150.0)
     r_sh, l_sh = (cx - 52, 162.0), (cx + 52, 162.0)
     r_hip, l_hip = (cx - 30, 285.0), (cx + 30, 285.0)
     upper, fore = 88.0, 82.0
@@ -158,7 +160,10 @@ def draw_figure(elbow_deg: float) -> np.ndarray:
     u = (-math.sin(abduction), math.cos(abduction))  # from shoulder to elbow (y down)
     el = (r_sh[0] + upper * u[0], r_sh[1] + upper * u[1])
     turn = -math.radians(180 - elbow_deg)  # the forearm turns up from the upper arm's line
-    f = (u[0] * math.cos(turn) + u[1] * math.sin(turn), -u[0] * math.sin(turn) + u[1] * math.cos(turn))
+    f = (
+        u[0] * math.cos(turn) + u[1] * math.sin(turn),
+        -u[0] * math.sin(turn) + u[1] * math.cos(turn),
+    )
     wr = (el[0] + fore * f[0], el[1] + fore * f[1])
     _capsule(d, r_sh, el, 11, shirt)
     _capsule(d, el, wr, 9, skin)
