@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from typing import Literal
 
-from pydantic import BaseModel, ConfigDict, Field, StrictBool
+from pydantic import BaseModel, ConfigDict, Field, StrictBool, StrictInt
 
 from studio.learning import (
     DEFAULT_EPISODES,
@@ -114,7 +114,7 @@ class SourceUpdate(_Body):
 
     kind: SourceKind
     recording: str | None = None
-    port: int | None = Field(None, ge=1, le=65535)
+    port: StrictInt | None = Field(None, ge=1, le=65535)
     device: str | None = None
     calibration: str | None = Field(
         None,
@@ -123,7 +123,7 @@ class SourceUpdate(_Body):
     )
     speed: float | None = Field(None, gt=0, le=100)
     loop: StrictBool | None = None
-    seed: int | None = Field(None, ge=0)
+    seed: StrictInt | None = Field(None, ge=0)
     side: Side | None = Field(None, description="camera and hand: the teaching arm (default right)")
 
 
@@ -143,7 +143,7 @@ class LandmarksFrame(_Body):
     model: Literal["lite", "full", "heavy"] | None = None
 
 
-class LandmarksAccepted(BaseModel):
+class LandmarksPublic(BaseModel):
     """What the studio made of one landmark frame."""
 
     person_detected: bool
@@ -160,7 +160,7 @@ class HandTarget(_Body):
     wxyz: list[float] | None = Field(None, max_length=4, description="unit quaternion, or null")
 
 
-class HandAccepted(BaseModel):
+class HandPublic(BaseModel):
     """The arm and robot the hand guide reached."""
 
     q_human: list[float]

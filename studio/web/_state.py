@@ -259,7 +259,7 @@ class Studio:
 
     def hand_moved(self, position: Any, wxyz: Any = None) -> dict[str, Any]:
         """Move the operator's hand to a pose (``HandTarget``): what dragging the scene's handle
-        does. Returns the arm and robot reached (``HandAccepted``).
+        does. Returns the arm and robot reached (``HandPublic``).
 
         Raises:
             ConflictError: the live source is not the hand guide.

@@ -7,9 +7,9 @@ from fastapi import APIRouter
 
 from .._deps import StudioDep
 from .._schemas import (
-    HandAccepted,
+    HandPublic,
     HandTarget,
-    LandmarksAccepted,
+    LandmarksPublic,
     LandmarksFrame,
     PlaybackAction,
     ReachAction,
@@ -62,15 +62,15 @@ def simulator_reach(body: ReachAction, studio: StudioDep) -> SourcePublic:
 
 
 @router.post("/landmarks")
-def post_landmarks(body: LandmarksFrame, studio: StudioDep) -> LandmarksAccepted:
+def post_landmarks(body: LandmarksFrame, studio: StudioDep) -> LandmarksPublic:
     """One frame of pose landmarks from the page's camera: fitted, shown, and recorded while a
     capture runs (409 unless the source is the camera; 422 for NaN or wrong sizes; 429 for a
     flood, the frame dropped and the studio running on)."""
-    return LandmarksAccepted.model_validate(studio.post_landmarks(body.model_dump()))
+    return LandmarksPublic.model_validate(studio.post_landmarks(body.model_dump()))
 
 
 @router.post("/hand")
-def post_hand(body: HandTarget, studio: StudioDep) -> HandAccepted:
+def post_hand(body: HandTarget, studio: StudioDep) -> HandPublic:
     """Move the operator's hand (arm frame, metres): exactly what dragging the scene's handle
     does (409 unless the source is the hand guide; 422 for NaN or wrong sizes; 429 for a flood)."""
-    return HandAccepted.model_validate(studio.hand_moved(body.position, body.wxyz))
+    return HandPublic.model_validate(studio.hand_moved(body.position, body.wxyz))
