@@ -230,3 +230,14 @@ def test_a_hand_recording_cuts_into_a_demonstration(tmp_path: Path) -> None:
     assert demo.default_path().name.startswith("reach.") and demo.recording == path
     saved = demo.save(tmp_path / "reach.demo.json")
     assert os.path.getsize(saved) > 0
+
+
+def test_recording_a_pose_playback_gives_the_same_landmarks(tmp_path: Path) -> None:
+    from studio.capture import capture
+
+    frames = pose_frames()
+    path = write(tmp_path / "a.pose.csv", "pose", frames)
+    out = capture(PlaybackSource(path, speed=None), tmp_path / "again.pose.csv")
+    again = read_any_recording(out)
+    assert again.kind.name == "pose" and again.side == "left" and len(again) == len(frames)
+    assert np.array_equal(again.data, read_any_recording(path).data, equal_nan=True)
