@@ -192,10 +192,9 @@ class LandmarkFitter(_Retargeted):
                 image_landmarks=frame.image,
                 image_size=(frame.width, frame.height),
             )
-        except KinematicsError:
-            return self._fitted(
-                self.q_human, 0.0, False, observable=hidden, warning=arm_out_warning(self.side)
-            )
+        except KinematicsError as err:  # the arm not seen, or landmarks the fit refuses
+            why = warning or str(err)
+            return self._fitted(self.q_human, 0.0, False, observable=hidden, warning=why)
         observable = np.asarray(pose.observable, dtype=bool)
         return self._fitted(
             pose.q_human,

@@ -110,9 +110,10 @@ class PushSource(ThreadedSource):
         return counter, now
 
     def _stream_time(self, t: float) -> float:
-        """``t`` on a clock that never goes back (a reloaded page restarts its own)."""
+        """``t`` on a clock that always moves forward (a reloaded page restarts its own; a
+        repeated time stamp moves on too, as the landmark filter needs)."""
         with self._admit_lock:
-            if self._last_t is not None and t + self._offset < self._last_t:
+            if self._last_t is not None and t + self._offset <= self._last_t:
                 self._offset = self._last_t + RESTART_STEP_S - t
             self._last_t = t + self._offset
             return self._last_t
