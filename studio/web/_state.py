@@ -24,7 +24,6 @@ from ._runs import RunQueue
 from ._settings import Settings
 from ._store import (
     DEMONSTRATION_SUFFIX,
-    RECORDING_SUFFIX,
     demonstration_store,
     policy_store,
     recording_store,
@@ -118,10 +117,10 @@ class Studio:
         if path.is_file() and path.resolve().parent != self.settings.recordings_dir.resolve():
             from studio.capture import PlaybackSource
 
-            name = path.name.removesuffix(RECORDING_SUFFIX)
+            name = self.recordings.stem_of(path.name)
             self.pipeline.set_source(PlaybackSource(path, loop=True), "recording", name)
             return
-        name = path.name.removesuffix(RECORDING_SUFFIX) if path.is_file() else source
+        name = self.recordings.stem_of(path.name) if path.is_file() else source
         self.set_source(kind="recording", recording=name, loop=True)
 
     def set_source(

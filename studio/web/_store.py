@@ -264,6 +264,10 @@ class FolderStore(Generic[T]):
                     return folder / f"{name}{suffix}"
         return None
 
+    def stem_of(self, filename: str) -> str:
+        """``filename`` without the store's suffix it ends with (the name it is listed under)."""
+        return filename.removesuffix(self.suffix_of(filename))
+
     def suffix_of(self, filename: str) -> str:
         """The suffix of this store that ``filename`` ends with (the main one if none)."""
         return next((s for s in self.suffixes if filename.endswith(s)), self.suffix)

@@ -203,3 +203,20 @@ def test_hand_guide_recording_cuts_into_a_demonstration(client: TestClient) -> N
     assert r.status_code == 201, r.text
     demo = client.get(f"/api/demonstrations/{r.json()['name']}").json()
     assert demo["steps"] >= 1
+
+
+def test_a_pose_recording_plays_back_as_the_source(open_client, tmp_path) -> None:
+    from studio.capture import ObservationWriter, landmark_frame
+
+    folder = tmp_path / "recordings"
+    folder.mkdir(parents=True, exist_ok=True)
+    with ObservationWriter(folder / "seen.pose.csv", "pose") as writer:
+        writer.write_many([landmark_frame(i / 30, i, None, None, 640, 480) for i in range(30)])
+    client = open_client(source=str(folder / "seen.pose.csv"))
+    source = client.get("/api/source").json()
+    assert source["kind"] == "recording" and source["recording"] == "seen"
+    assert source["playback"]["duration"] > 0.9
+    listed = {r["name"]: r for r in client.get("/api/recordings").json()}
+    assert listed["seen"]["frames"] == 30 and listed["seen"]["error"] is None
+    r = client.get("/api/recordings/seen/file")
+    assert r.status_code == 200 and "seen.pose.csv" in r.headers["content-disposition"]
