@@ -15,7 +15,11 @@ HELP = "Show a recording's or demonstration's metadata, length and any problems.
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
-        "files", type=Path, nargs="+", metavar="FILE", help="*.tape.csv, *.pose.csv, *.hand.csv or *.demo.json files"
+        "files",
+        type=Path,
+        nargs="+",
+        metavar="FILE",
+        help="*.tape.csv, *.pose.csv, *.hand.csv or *.demo.json files",
     )
     parser.add_argument("--json", action="store_true", help="print JSON instead of text")
     parser.add_argument(

@@ -25,7 +25,7 @@ from studio.capture import (
 PROGRESS_SECONDS = 0.2
 """How often the progress line is redrawn."""
 NAME = "record"
-HELP = "Record tape frames (simulator, recording, UDP or serial) into a *.tape.csv file."
+HELP = "Record a source (simulator, recording, UDP or serial) into a recording file."
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

@@ -9,8 +9,8 @@ from .._deps import StudioDep
 from .._schemas import (
     HandPublic,
     HandTarget,
-    LandmarksPublic,
     LandmarksFrame,
+    LandmarksPublic,
     PlaybackAction,
     ReachAction,
     RetargetUpdate,
