@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import logging
 import threading
+import time
 from collections.abc import Callable
 from typing import Any
 
@@ -25,6 +26,10 @@ HANDLE_NAME = "/hand_guide"
 """The handle's node in the scene tree."""
 HANDLE_SCALE = 0.22
 """Size of the gizmo (m): about a hand's length, so it is easy to grab and hides little."""
+
+MIN_INTERVAL_S = 1.0 / 60.0
+"""Drag updates closer together than this are skipped (the release is always handed on), so a
+fast mouse stays well under the hand source's flood limit and the IK keeps up."""
 
 HandMoved = Callable[[np.ndarray, np.ndarray], Any]
 """Called with a hand position (3,) and orientation wxyz (4,) in the arm frame."""
@@ -52,6 +57,7 @@ class HandHandle:
         self._worldMbase = np.eye(4)
         self._on_move: HandMoved | None = None
         self.moves = 0  # drags handed on, for tests
+        self._last_move = 0.0
 
     @property
     def visible(self) -> bool:
@@ -87,6 +93,10 @@ class HandHandle:
         self._on_move = None
 
     def _dragged(self, event: Any) -> None:
+        now = time.monotonic()
+        if getattr(event, "phase", "update") == "update" and now - self._last_move < MIN_INTERVAL_S:
+            return
+        self._last_move = now
         target = event.target
         self.move(np.asarray(target.position, dtype=float), np.asarray(target.wxyz, dtype=float))
 
