@@ -220,3 +220,44 @@ def test_a_pose_recording_plays_back_as_the_source(open_client, tmp_path) -> Non
     assert listed["seen"]["frames"] == 30 and listed["seen"]["error"] is None
     r = client.get("/api/recordings/seen/file")
     assert r.status_code == 200 and "seen.pose.csv" in r.headers["content-disposition"]
+
+
+def arm_motion(n: int = 30) -> list[dict]:
+    """Landmark frames of a right arm raising forward and bending (the studio's own arm model)."""
+    from studio.kinematics import HumanArm, landmarks_from_arm
+
+    arm = HumanArm("right")
+    out = []
+    for i, s in enumerate(np.linspace(0.0, 1.0, n)):
+        q = np.zeros(7)
+        q[1], q[3] = 1.1 * s, 0.9 * s
+        world, image = landmarks_from_arm(q, arm)
+        out.append({**landmarks(), "t": i / 30, "world": world.tolist(), "image": image.tolist()})
+    return out
+
+
+def test_camera_frames_move_the_robot_and_cut_into_a_demonstration(client: TestClient) -> None:
+    camera(client)
+    client.put("/api/source/retarget", json={"mode": "joint", "mirror": True})
+    assert client.post("/api/capture/start", json={"name": "cam-reach"}).status_code in (200, 201)
+    answers = []
+    for frame in arm_motion():
+        r = client.post("/api/source/landmarks", json=frame)
+        assert r.status_code == 200, r.text
+        answers.append(r.json())
+    assert all(a["person_detected"] for a in answers)
+    assert answers[-1]["observable"][3]  # a bent elbow is seen
+    first, last = np.array(answers[0]["q_robot"]), np.array(answers[-1]["q_robot"])
+    assert np.abs(last - first).max() > 0.3
+    source = client.get("/api/source").json()
+    assert source["frames"] == 30 and source["observable"] == answers[-1]["observable"]
+    assert np.allclose(source["q_robot"], answers[-1]["q_robot"])
+    client.post("/api/capture/stop")
+    recording = read_any_recording(client.app.state.studio.recordings.path("cam-reach"))
+    kept = pd.read_csv(recording.path, comment="#").filter(regex="^observable_").to_numpy()
+    assert kept[-1].astype(bool).tolist() == answers[-1]["observable"]
+    r = client.post(
+        "/api/demonstrations",
+        json={"recording": "cam-reach", "t0": 0, "t1": recording.duration, "goal_from_end": True},
+    )
+    assert r.status_code == 201, r.text
