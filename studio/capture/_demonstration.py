@@ -275,16 +275,7 @@ def extract_demonstration(
             f"the arm fits the tape badly at {times[worst]:.2f} s (residual {residual[worst] * 100:.1f} cm > {max_residual * 100:.1f} cm); check the tape config's shoulder and wrist regions or choose another segment.",
             "bad_fit",
         )
-    robot = Puma560()
-    at_limit = (q_robot <= robot.lower + LIMIT_TOLERANCE_RAD) | (
-        q_robot >= robot.upper - LIMIT_TOLERANCE_RAD
-    )
-    if at_limit.any():
-        i, j = np.argwhere(at_limit)[0]
-        raise DemonstrationError(
-            f"the motion drives Puma560 joint {j + 1} to its limit at {times[i]:.2f} s; choose a segment that stays inside the robot's range.",
-            "leaves_joint_range",
-        )
+    _check_joint_range(q_robot, times)
     # the demonstration holds what its file holds, so a path traced again from the saved
     # trajectory (the page's run queue does) is this very path
     q_robot = np.round(q_robot, TRAJECTORY_DECIMALS)
@@ -320,6 +311,20 @@ def extract_demonstration(
         residual_mean=float(residual.mean()),
         name=name or f"{rec.name} {t0:.2f}-{t1:.2f} s",
     )
+
+
+def _check_joint_range(q_robot: np.ndarray, times: np.ndarray) -> None:
+    """Refuse a path that drives a Puma560 joint to its limit (retargeting clamped it there)."""
+    robot = Puma560()
+    at_limit = (q_robot <= robot.lower + LIMIT_TOLERANCE_RAD) | (
+        q_robot >= robot.upper - LIMIT_TOLERANCE_RAD
+    )
+    if at_limit.any():
+        i, j = np.argwhere(at_limit)[0]
+        raise DemonstrationError(
+            f"the motion drives Puma560 joint {j + 1} to its limit at {times[i]:.2f} s; choose a segment that stays inside the robot's range.",
+            "leaves_joint_range",
+        )
 
 
 def _track_segment(
