@@ -235,6 +235,9 @@ class RecordingPublic(BaseModel):
     size_bytes: int
     sample: bool
     error: str | None = None
+    kind: Literal["tape", "pose", "hand"] = Field(
+        "tape", description="what it records: tape frames, camera landmarks or hand-guide poses"
+    )
 
 
 class RecordingCopy(_Body):

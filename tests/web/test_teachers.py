@@ -218,6 +218,7 @@ def test_a_pose_recording_plays_back_as_the_source(open_client, tmp_path) -> Non
     assert source["playback"]["duration"] > 0.9
     listed = {r["name"]: r for r in client.get("/api/recordings").json()}
     assert listed["seen"]["frames"] == 30 and listed["seen"]["error"] is None
+    assert listed["seen"]["kind"] == "pose"
     r = client.get("/api/recordings/seen/file")
     assert r.status_code == 200 and "seen.pose.csv" in r.headers["content-disposition"]
 
