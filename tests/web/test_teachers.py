@@ -189,7 +189,7 @@ def test_hand_guide_recording_cuts_into_a_demonstration(client: TestClient) -> N
     assert client.post("/api/capture/start", json={"name": "guide"}).status_code in (200, 201)
     for k in range(30):
         s = k / 29
-        target = {"position": [0.1 + 0.3 * s, 0.05, -0.6 + 0.4 * s], "wxyz": None}
+        target = {"position": [0.3 + 0.15 * s, 0.05 + 0.05 * s, -0.4 + 0.35 * s], "wxyz": None}
         assert client.post("/api/source/hand", json=target).status_code == 200
     client.post("/api/capture/stop")
     path = client.app.state.studio.recordings.path("guide")
