@@ -4,6 +4,7 @@ The public names are listed in ``docs/architecture.md``.
 """
 
 from ._errors import KinematicsError as KinematicsError
+from ._filter import OneEuroFilter as OneEuroFilter
 from ._fit import ArmFit as ArmFit
 from ._fit import ArmFitter as ArmFitter
 from ._fit import FitConfig as FitConfig
@@ -17,6 +18,8 @@ from ._meshes import puma560_meshes as puma560_meshes
 from ._pose import PoseConfig as PoseConfig
 from ._pose import PoseFit as PoseFit
 from ._pose import fit_pose_landmarks as fit_pose_landmarks
+from ._pose_stream import PoseStreamFitter as PoseStreamFitter
+from ._pose_stream import StreamConfig as StreamConfig
 from ._puma import PUMA_QN as PUMA_QN
 from ._puma import PUMA_QR as PUMA_QR
 from ._puma import PUMA_QS as PUMA_QS

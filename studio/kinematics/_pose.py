@@ -49,12 +49,13 @@ from __future__ import annotations
 
 import functools
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
 import pinocchio as pin
 
-from ._checks import check_side, positive_number, real_array
+from ._checks import check_side, positive_number, real_array, whole_number
 from ._errors import KinematicsError
 from ._human import HumanArm
 
@@ -72,6 +73,9 @@ HIPS = {"left": 23, "right": 24}
 
 ARM_POINTS = ("shoulder", "elbow", "wrist")
 """The points a side's arm needs to be fitted at all."""
+
+LIMBS = (("shoulder", "elbow"), ("elbow", "wrist"))
+"""The upper arm and the forearm, by their end points."""
 
 HUMERAL_ROTATION, FOREARM_ROTATION = 2, 4
 """Indices of ``shoulder_Y`` and ``elbow_Y`` in ``q_human``."""
@@ -94,6 +98,10 @@ class PoseConfig:
         camera_fov: the camera's horizontal field of view (rad), to undo perspective when
             combining image and world landmarks (a laptop camera's is 55-70 degrees; an error
             here changes the result little, the body's depth is much larger than the arm's).
+        depth_noise: how many times noisier the landmarks' depth is than their x and y
+            (MediaPipe's published depth errors exceed 10 cm): the limbs are refined at their
+            known lengths weighing depth that much less.
+        refine_iterations: Gauss-Newton iterations of that refinement (0: plain geometry).
     """
 
     min_visibility: float = 0.5
@@ -101,9 +109,19 @@ class PoseConfig:
     palm_axis: float = 0.5
     min_segment: float = 0.01
     camera_fov: float = math.radians(60.0)
+    depth_noise: float = 3.0
+    refine_iterations: int = 4
 
     def __post_init__(self) -> None:
-        for name in ("min_visibility", "bent_elbow", "palm_axis", "min_segment", "camera_fov"):
+        whole_number(self.refine_iterations, "PoseConfig.refine_iterations", 0)
+        for name in (
+            "min_visibility",
+            "bent_elbow",
+            "palm_axis",
+            "min_segment",
+            "camera_fov",
+            "depth_noise",
+        ):
             positive_number(getattr(self, name), f"PoseConfig.{name}")
 
 
@@ -141,6 +159,7 @@ class _Reading:
     palm: np.ndarray | None
     palm_sine: float  # how clearly the palm's width axis lies across the hand (0 to 1)
     points: np.ndarray  # shoulder, elbow, wrist, hand centre (arm base frame, m)
+    lengths: np.ndarray  # this frame's upper-arm and forearm lengths (m, both arms' mean)
 
 
 @functools.lru_cache(maxsize=2)
@@ -258,6 +277,66 @@ def _torso_rotation(points: np.ndarray, hips_seen: bool) -> np.ndarray:
     return np.column_stack([np.cross(left, up), left, up])
 
 
+def check_arm_seen(visibility: np.ndarray | None, side: str, cfg: PoseConfig) -> None:
+    """Raise one sentence when ``side``'s shoulder, elbow or wrist is not visible enough."""
+    if visibility is None:
+        return
+    for name in ARM_POINTS:
+        i = LANDMARKS[side][name]
+        if visibility[i] < cfg.min_visibility:
+            raise KinematicsError(
+                f"The person's {side} {name} is out of view (visibility {visibility[i]:.2f}); "
+                f"show the whole {side} arm to the camera."
+            )
+
+
+def _refine_limbs(
+    points: np.ndarray, lengths: np.ndarray, weights: np.ndarray, iterations: int
+) -> np.ndarray:
+    """Shoulder, elbow and wrist ``(3, 3)`` on limbs of ``lengths``, nearest ``points``.
+
+    The maximum-likelihood chain under anisotropic noise (``weights``: one over each camera
+    axis's noise): Gauss-Newton over the shoulder and the two limb directions, each direction
+    moved in its tangent plane. With MediaPipe's depth several times noisier than x and y, the
+    known limb lengths pull a limb's depth toward what its image-plane length implies.
+    """
+    S = points[0].copy()
+    dirs = [_unit(points[1] - points[0]), _unit(points[2] - points[1])]
+    J = np.zeros((9, 7))
+    for _ in range(iterations):
+        E = S + lengths[0] * dirs[0]
+        W = E + lengths[1] * dirs[1]
+        r = (np.stack([S, E, W]) - points) * weights
+        J[:] = 0.0
+        for k in range(3):
+            J[3 * k : 3 * k + 3, 0:3] = np.diag(weights)
+        for d, u in enumerate(dirs):
+            basis = np.linalg.svd(u[None, :])[2][1:]  # two unit vectors across u
+            for k in range(d + 1, 3):
+                J[3 * k : 3 * k + 3, 3 + 2 * d : 5 + 2 * d] = (weights * lengths[d])[
+                    :, None
+                ] * basis.T
+        step = np.linalg.lstsq(J, -r.reshape(-1), rcond=None)[0]
+        S = S + step[:3]
+        for d in range(2):
+            basis = np.linalg.svd(dirs[d][None, :])[2][1:]
+            dirs[d] = _unit(dirs[d] + step[3 + 2 * d : 5 + 2 * d] @ basis)
+    E = S + lengths[0] * dirs[0]
+    return np.stack([S, E, E + lengths[1] * dirs[1]])
+
+
+def measured_lengths(points: np.ndarray, seen: Callable[[int], bool], side: str) -> np.ndarray:
+    """Upper-arm and forearm lengths (m) in one frame: both arms' mean when the other is seen."""
+    arms = [side] + [
+        s for s in LANDMARKS if s != side and all(seen(LANDMARKS[s][n]) for n in ARM_POINTS)
+    ]
+    per_arm = [
+        [np.linalg.norm(points[LANDMARKS[s][b]] - points[LANDMARKS[s][a]]) for a, b in LIMBS]
+        for s in arms
+    ]
+    return np.mean(per_arm, axis=0)
+
+
 def _read(
     world: np.ndarray,
     pixels: np.ndarray | None,
@@ -265,6 +344,7 @@ def _read(
     visibility: np.ndarray | None,
     side: str,
     cfg: PoseConfig,
+    lengths: np.ndarray | None = None,
 ) -> _Reading:
     """The limb directions in the arm base frame, or a KinematicsError for a missing arm."""
     idx = LANDMARKS[side]
@@ -272,21 +352,22 @@ def _read(
     def seen(i: int) -> bool:
         return visibility is None or bool(visibility[i] >= cfg.min_visibility)
 
-    for name in ARM_POINTS:
-        if not seen(idx[name]):
-            raise KinematicsError(
-                f"The person's {side} {name} is out of view (visibility "
-                f"{visibility[idx[name]]:.2f}); show the whole {side} arm to the camera."
-            )
+    check_arm_seen(visibility, side, cfg)
     points = world if pixels is None else _merge_image(world, pixels, size, cfg)
-    R = _torso_rotation(points, seen(HIPS["left"]) and seen(HIPS["right"]))
-    S, E, W = (R.T @ points[idx[name]] for name in ARM_POINTS)
-    for a, b, what in ((S, E, "upper arm"), (E, W, "forearm")):
-        if np.linalg.norm(b - a) < cfg.min_segment:
+    arm_points = points[[idx[name] for name in ARM_POINTS]]
+    for (a, b), what in zip(LIMBS, ("upper arm", "forearm"), strict=True):
+        if np.linalg.norm(points[idx[b]] - points[idx[a]]) < cfg.min_segment:
             raise KinematicsError(
                 f"The {side} {what}'s landmarks coincide, so its direction is unknown; pass "
                 "a person's landmarks."
             )
+    frame_lengths = measured_lengths(points, seen, side)
+    weights = np.array([1.0, 1.0, 1.0 / cfg.depth_noise])
+    arm_points = _refine_limbs(
+        arm_points, frame_lengths if lengths is None else lengths, weights, cfg.refine_iterations
+    )
+    R = _torso_rotation(points, seen(HIPS["left"]) and seen(HIPS["right"]))
+    S, E, W = arm_points @ R
     hand = palm = None
     palm_sine = 0.0
     H = W
@@ -302,7 +383,7 @@ def _read(
                 palm = _unit(across)
                 palm_sine = float(np.linalg.norm(across) / np.linalg.norm(width))
     rel = np.stack([S, E, W, H]) - S
-    return _Reading(_unit(E - S), _unit(W - E), hand, palm, palm_sine, rel)
+    return _Reading(_unit(E - S), _unit(W - E), hand, palm, palm_sine, rel, frame_lengths)
 
 
 def _axis_sign(model: pin.Model, data: pin.Data, joint: int, axis: int) -> float:

@@ -80,13 +80,13 @@ def _body_points(arm: HumanArm, q_human: np.ndarray, body: BodyShape) -> np.ndar
     for name, local in HAND_POINTS.items():
         offset = pose.wrist[:3, :3] @ (arm.hand_length * np.asarray(local))
         pts[idx[name]] = pts[idx["wrist"]] + offset
-    # The other arm hangs at the default arm's lengths.
+    # The other arm (the same lengths: people are nearly symmetric) hangs.
     down = np.array([0.0, 0.0, -1.0])
     o = LANDMARKS[other]
-    pts[o["elbow"]] = shoulder[other] + 0.28 * down
-    pts[o["wrist"]] = pts[o["elbow"]] + 0.27 * down
+    pts[o["elbow"]] = shoulder[other] + arm.upper_arm_length * down
+    pts[o["wrist"]] = pts[o["elbow"]] + arm.forearm_length * down
     for name, local in HAND_POINTS.items():
-        pts[o[name]] = pts[o["wrist"]] + 0.15 * np.array([local[0], 0.0, local[1]])
+        pts[o[name]] = pts[o["wrist"]] + arm.hand_length * np.array([local[0], 0.0, local[1]])
     # Face: nose, eyes (inner, centre, outer), ears, mouth; legs: knees, ankles, heels, toes.
     head = np.array([0.06, 0.0, h + 0.2])
     pts[0] = head + (0.05, 0.0, 0.0)

@@ -209,7 +209,7 @@ def good_world() -> np.ndarray:
         (lambda w: w.astype(str), "text"),
         (lambda w: hide(w, 13), "left elbow is out of view"),
         (lambda w: hide(w, 11), "left shoulder is out of view"),
-        (lambda w: np.zeros((33, 4)) + [0, 0, 0, 1], "one point"),
+        (lambda w: np.zeros((33, 4)) + [0, 0, 0, 1], "coincide"),
     ],
 )
 def test_bad_landmarks_raise_one_sentence(change, words: str) -> None:
