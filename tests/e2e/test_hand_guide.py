@@ -51,12 +51,16 @@ def test_the_hand_guide_moves_the_robot(page: Any, studio_server: Studio) -> Non
     assert source["frames"] >= 1
     assert np.allclose(after, answer["body"]["q_robot"])
     assert np.abs(after - before).max() > np.radians(5)
+    # the page's source line shows the robot's joints in degrees (about 4 source events a second)
     page.wait_for_function(
-        "before => document.querySelector('#src-q').textContent !== before",
-        arg=shown_before,
+        """want => {
+            const text = document.querySelector('#src-q').textContent.replace('°', '');
+            const shown = text.trim().split(/\\s+/).map(Number);
+            return shown.length === want.length && shown.every((v, i) => Math.abs(v - want[i]) <= 1);
+        }""",
+        arg=[float(x) for x in np.degrees(after)],
         timeout=T,
     )
-    degrees = [float(x) for x in page.inner_text("#src-q").replace("°", "").split()]
-    assert np.allclose(degrees, np.degrees(after), atol=1.0)
-    shot(page, "hand-guide", "source")
+    assert page.inner_text("#src-q") != shown_before
+    shot(page, "hand-guide", "sec-source")
     assert not page.errors  # type: ignore[attr-defined]
