@@ -8,6 +8,9 @@ from ._filter import OneEuroFilter as OneEuroFilter
 from ._fit import ArmFit as ArmFit
 from ._fit import ArmFitter as ArmFitter
 from ._fit import FitConfig as FitConfig
+from ._hand_ik import HandFit as HandFit
+from ._hand_ik import HandIKConfig as HandIKConfig
+from ._hand_ik import fit_hand_pose as fit_hand_pose
 from ._human import ArmPose as ArmPose
 from ._human import HumanArm as HumanArm
 from ._human import mirror_human_q as mirror_human_q
