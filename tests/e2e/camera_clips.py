@@ -23,14 +23,14 @@ STAMP_CELL = 12
 STAMP_Y = 6
 """Top of the stamp row in pixels."""
 
-READ_STAMP_JS = f"""(video) => {{
+READ_STAMP_JS = f"""(frame) => {{
     // The frame index stamped in the top-left corner of a test clip (tests/e2e/camera_clips.py).
     const cell = {STAMP_CELL}, bits = {STAMP_BITS}, top = {STAMP_Y};
     const c = window.__stampCanvas || (window.__stampCanvas = document.createElement("canvas"));
     c.width = cell * (bits + 1); c.height = cell;
     const ctx = c.getContext("2d", {{ willReadFrequently: true }});
-    const sx = video.videoWidth / {WIDTH}, sy = video.videoHeight / {HEIGHT};
-    ctx.drawImage(video, 0, top * sy, c.width * sx, cell * sy, 0, 0, c.width, cell);
+    const sx = frame.width / {WIDTH}, sy = frame.height / {HEIGHT};
+    ctx.drawImage(frame, 0, top * sy, c.width * sx, cell * sy, 0, 0, c.width, cell);
     const px = ctx.getImageData(0, 0, c.width, cell).data;
     const at = (i) => {{ const o = 4 * (Math.floor(cell / 2) * c.width + i * cell + Math.floor(cell / 2)); return px[o + 1]; }};
     if (at(0) < 128) return null; // no start cell: not a stamped clip
@@ -38,7 +38,14 @@ READ_STAMP_JS = f"""(video) => {{
     for (let b = 0; b < bits; b++) n |= (at(b + 1) >= 128 ? 1 : 0) << b;
     return n;
 }}"""
-"""A page-side function(video) -> the stamped frame index, or null (camera.js calls it as ``probe``)."""
+"""A page-side function(canvas) -> the stamped frame index, or null (camera.js's ``probe``)."""
+
+COLLECT_FRAMES_JS = f"""() => {{
+    window.__frames = [];
+    window.studio.camera.probe = {READ_STAMP_JS};
+    document.addEventListener("studio:landmarks", (e) => window.__frames.push(e.detail));
+}}"""
+"""Run in the studio page: every answered frame, with the stamp of its picture, in ``__frames``."""
 
 
 def stamp(rgb: np.ndarray, index: int) -> np.ndarray:

@@ -22,7 +22,7 @@ import pytest
 from tests.conftest import require
 from tests.e2e.camera_clips import (
     CLIPS,
-    READ_STAMP_JS,
+    COLLECT_FRAMES_JS,
     figure_clip,
     figure_elbow_deg,
     image_elbow_deg,
@@ -118,14 +118,7 @@ def open_camera(browser: Any, studio_server: Studio) -> Iterator[Callable[..., C
         page.on("request", lambda r: requests.append(r.url))
         page.goto(studio_server.base + "/")
         page.wait_for_selector("body[data-ready='1']", timeout=READY_TIMEOUT_MS)
-        # Every answered frame, with the stamp of the picture it came from.
-        page.evaluate(
-            f"""() => {{
-                window.__frames = [];
-                window.studio.camera.probe = {READ_STAMP_JS};
-                document.addEventListener("studio:landmarks", (e) => window.__frames.push(e.detail));
-            }}"""
-        )
+        page.evaluate(COLLECT_FRAMES_JS)
         return CameraPage(page, requests)
 
     try:

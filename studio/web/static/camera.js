@@ -18,10 +18,14 @@ const MODELS = { lite: 0, full: 1 }; // BlazePose modelComplexity
 const DEFAULT_MODEL = "lite";
 const CAMERA_SIZE = { width: 640, height: 480 }; // asked of the camera; BlazePose works on 256 px
 const ARM_LANDMARKS = { right: [12, 14, 16], left: [11, 13, 15] }; // shoulder, elbow, wrist
-const VISIBLE = 0.5; // a landmark with less visibility is taken as not in the picture
+const VISIBLE = 0.5; // a bone with a less visible end is not drawn
 // Human-arm joints in HumanArm's order (studio.kinematics ARM_JOINTS), as the page names them.
 const JOINT_LABELS = ["shoulder Z", "shoulder X", "shoulder Y", "elbow Z", "elbow Y", "wrist Z", "wrist X"];
-const FPS_WINDOW_S = 2; // the achieved frame rate is counted over this many seconds
+// The achieved frame rate is counted over the last FPS_FRAMES results within FPS_WINDOW_S: a few
+// seconds at camera rate, and still a figure on a busy machine without a GPU (a frame in seconds).
+const FPS_FRAMES = 10;
+const FPS_WINDOW_S = 20;
+const CAPTURE_AGE_MS = 5000; // a frame's captureTime older than this is taken as another clock's
 const FRAME_WAIT_MS = 100; // wait at most this long for the next video frame (hidden tabs, old browsers)
 const PREFS_KEY = "studio.camera";
 
@@ -36,13 +40,14 @@ const C = {
   fps: null,
   frames: 0, // results drawn
   sent: 0, // landmark frames the studio accepted
-  times: [], // result times (s) in the last FPS_WINDOW_S
+  times: [], // the last result times (s), for the frame rate
   inflight: false, // one landmark POST at a time; the newest frame waits, older ones are dropped
   pending: null,
   status: null, // {text, level}: one sentence about what the camera sees or why it cannot
   answer: null, // the studio's last answer: {person_detected, observable, warning, ...}
-  probe: null, // tests and benchmarks: a function(video) whose value travels with the frame
-  lastSeen: null, // what the page saw in the last frame: {person, armVisible}
+  studioSide: null, // the teaching arm the studio last reported
+  probe: null, // tests and benchmarks: a function(canvas) of the frame; its value travels with it
+  grabbed: null, // the canvas each frame is copied into
 };
 S.camera = C;
 
@@ -66,22 +71,15 @@ function setStatus(text, level = "notice") {
   renderStatus();
 }
 
-/** One sentence: the camera's own trouble first, then the studio's word on the frame, then the page's. */
+/** One sentence: the camera's own trouble first, then the studio's word on the last frame (no
+ * person in view, the arm out of the picture: the studio's fit decides, the page only shows it). */
 function renderStatus() {
   let status = C.status;
   if (!status && C.answer && C.answer.warning) status = { text: C.answer.warning, level: "notice" };
-  if (!status && C.lastSeen) status = seenStatus(C.lastSeen);
   const box = $("camera-status");
   setProp(box, "hidden", !status);
   setText(box, status ? status.text : "");
   setProp(box, "className", status && status.level === "error" ? "err" : "notice");
-}
-
-function seenStatus(seen) {
-  const side = $("source-side").value;
-  if (!seen.person) return { text: "No person in view: step back until your head, shoulders and hips are in the picture.", level: "notice" };
-  if (!seen.armVisible) return { text: `Your ${side} arm is out of the picture: step back or turn the camera until shoulder, elbow and wrist show.`, level: "notice" };
-  return null;
 }
 
 function cameraErrorSentence(e) {
@@ -184,7 +182,6 @@ function stop() {
   stopStream();
   C.fps = null;
   C.answer = null;
-  C.lastSeen = null;
   setStatus(null);
   renderFps();
   renderObservable(null);
@@ -204,22 +201,34 @@ function nextFrame(video) {
   });
 }
 
+/** The video's current picture, copied into a canvas kept for the next frames. */
+function grab(video) {
+  const canvas = C.grabbed || (C.grabbed = document.createElement("canvas"));
+  if (canvas.width !== video.videoWidth) canvas.width = video.videoWidth;
+  if (canvas.height !== video.videoHeight) canvas.height = video.videoHeight;
+  canvas.getContext("2d").drawImage(video, 0, 0);
+  return canvas;
+}
+
 async function loop() {
   const video = $("camera-video");
   while (C.running) {
     const meta = await nextFrame(video);
     if (!C.running) break;
     if (video.readyState < 2 || !video.videoWidth) continue;
-    if (C.poseModel !== $("camera-model").value) {
-      setStatus("Loading the pose model (a few seconds)…", "info");
-      await ensurePose($("camera-model").value);
-      setStatus(null);
-    }
-    // The page's clock when the camera took the picture, if the browser says; else now.
-    const captured = meta && meta.captureTime ? meta.captureTime : performance.now();
-    C.current = { t: captured / 1000, tag: C.probe ? C.probe(video) : null, width: video.videoWidth, height: video.videoHeight };
+    // The page's clock when the camera took the picture, if the browser says so; else now.
+    const now = performance.now();
+    const captured = meta && meta.captureTime > now - CAPTURE_AGE_MS && meta.captureTime <= now ? meta.captureTime : now;
+    // One copy of the frame for the model, the drawing and its time: the video moves on meanwhile.
+    const frame = grab(video);
+    C.current = { t: captured / 1000, tag: C.probe ? C.probe(frame) : null, width: frame.width, height: frame.height };
     try {
-      await C.pose.send({ image: video });
+      if (C.poseModel !== $("camera-model").value) { // the user switched lite/full
+        setStatus("Loading the pose model (a few seconds)…", "info");
+        await ensurePose($("camera-model").value);
+        setStatus(null);
+      }
+      await C.pose.send({ image: frame });
     } catch (e) {
       setStatus(`Pose estimation stopped (${(e && e.message) || e}): press Apply to start the camera again.`, "error");
       C.running = false;
@@ -234,19 +243,11 @@ function onResults(results) {
   const now = performance.now() / 1000;
   C.frames += 1;
   C.times.push(now);
-  while (C.times.length && C.times[0] < now - FPS_WINDOW_S) C.times.shift();
+  while (C.times.length > FPS_FRAMES || (C.times.length && C.times[0] < now - FPS_WINDOW_S)) C.times.shift();
   C.fps = C.times.length > 1 ? (C.times.length - 1) / (C.times[C.times.length - 1] - C.times[0]) : null;
   const image = results.poseLandmarks || null;
   const world = results.poseWorldLandmarks || null;
-  const side = $("source-side").value;
-  C.lastSeen = {
-    person: !!(image && world),
-    armVisible: !!image && ARM_LANDMARKS[side].every((i) => {
-      const p = image[i];
-      return p.visibility >= VISIBLE && p.x >= 0 && p.x <= 1 && p.y >= 0 && p.y <= 1;
-    }),
-  };
-  draw(results, side);
+  draw(results, $("source-side").value);
   renderFps();
   send({
     t: frame.t,
@@ -382,7 +383,8 @@ window.recordCountdown = recordCountdown;
 /* ------------------------------------------------------------------ following the source */
 function onSource(s) {
   if (!s) return;
-  if (s.side && document.activeElement !== $("source-side")) setProp("source-side", "value", s.side);
+  // Follow the studio's side when it changes there, not on every status: a choice not yet applied stays.
+  if (s.side && s.side !== C.studioSide) { C.studioSide = s.side; setProp("source-side", "value", s.side); }
   if (s.kind === "camera" && !C.running && !C.starting) start();
   else if (s.kind !== "camera" && (C.running || C.starting || C.stream)) stop();
 }
@@ -394,7 +396,6 @@ function wire() {
   if (typeof prefs.mirror === "boolean") $("camera-mirror").checked = prefs.mirror;
   if (prefs.countdown !== undefined && prefs.countdown !== "") $("capture-countdown").value = prefs.countdown;
   for (const id of ["camera-model", "camera-mirror", "capture-countdown"]) $(id).addEventListener("change", savePrefs);
-  $("source-side").addEventListener("change", renderStatus);
   document.addEventListener("studio:source", (e) => onSource(e.detail));
   renderObservable(null);
   renderFps();
