@@ -345,8 +345,14 @@ def _read(
     side: str,
     cfg: PoseConfig,
     lengths: np.ndarray | None = None,
+    torso: np.ndarray | None = None,
 ) -> _Reading:
-    """The limb directions in the arm base frame, or a KinematicsError for a missing arm."""
+    """The limb directions in the arm base frame, or a KinematicsError for a missing arm.
+
+    ``lengths`` (m, upper arm and forearm) replace this frame's measured ones, and ``torso``
+    (world landmarks, (33, 3)) this frame's points for the torso's frame: a stream smooths both
+    more than the arm, as the body turns and the limbs change length slowly or never.
+    """
     idx = LANDMARKS[side]
 
     def seen(i: int) -> bool:
@@ -366,7 +372,9 @@ def _read(
     arm_points = _refine_limbs(
         arm_points, frame_lengths if lengths is None else lengths, weights, cfg.refine_iterations
     )
-    R = _torso_rotation(points, seen(HIPS["left"]) and seen(HIPS["right"]))
+    R = _torso_rotation(
+        points if torso is None else torso, seen(HIPS["left"]) and seen(HIPS["right"])
+    )
     S, E, W = arm_points @ R
     hand = palm = None
     palm_sine = 0.0
