@@ -239,7 +239,8 @@ def test_a_busy_camera_says_so(open_camera: Callable[..., CameraPage]) -> None:
 def test_hand_guide_countdown_and_named_controls(
     open_camera: Callable[..., CameraPage], studio_server: Studio
 ) -> None:
-    """The hand guide says what to do; Record counts down first, and pressing it again cancels."""
+    """The hand guide says what to do; Record counts down first (pressing it again cancels), and
+    the recording is listed as the hand guide's."""
     cam = open_camera(None)
     page = cam.page
     for name in ("Teaching arm", "Pose model", "Mirror picture", "Countdown"):
@@ -260,3 +261,16 @@ def test_hand_guide_countdown_and_named_controls(
     left.wait_for(state="hidden")
     assert studio_server.get("/api/capture")["active"] is False
     assert page.get_attribute("[data-testid='capture-toggle']", "data-active") == "0"
+
+    # Counted down to the end, the recording starts; the list says what it holds.
+    page.get_by_label("Countdown", exact=True).fill("1")
+    page.fill("[data-testid='capture-name']", "hand-countdown")
+    page.click("[data-testid='capture-toggle']")
+    page.wait_for_selector("[data-testid='capture-toggle'][data-active='1']")
+    studio_server.send("POST", "/api/source/hand", {"position": [0.25, -0.1, -0.3], "wxyz": None})
+    page.click("[data-testid='capture-toggle']")
+    page.wait_for_selector("[data-testid='capture-toggle'][data-active='0']")
+    row = page.locator("[data-testid='recording-row'][data-name='hand-countdown']")
+    row.wait_for()
+    assert row.locator("[data-testid='recording-kind']").inner_text() == "hand guide"
+    studio_server.send("DELETE", "/api/recordings/hand-countdown")  # the stories start clean

@@ -350,6 +350,7 @@ async function loadRecordings() {
 function recordingRow(r) {
   const flags = [];
   if (r.sample) flags.push(el("span", { class: "badge", text: "sample", title: "shipped with the studio: read-only" }));
+  if (r.kind === "pose" || r.kind === "hand") flags.push(el("span", { class: "badge", testid: "recording-kind", text: r.kind === "pose" ? "camera" : "hand guide", title: r.kind === "pose" ? "body landmarks from the camera, per frame (no image)" : "hand poses from the hand guide, per frame" }));
   if (r.recovered) flags.push(el("span", { class: "badge warn", text: "recovered", title: "the capture did not close cleanly; every frame written is kept" }));
   if (r.error) flags.push(el("span", { class: "badge failed", text: "unreadable", title: r.error, testid: "recording-damaged" }));
   const title = [r.error, r.notes, r.operator && `operator: ${r.operator}`, r.created].filter(Boolean).join("\n");
@@ -360,7 +361,7 @@ function recordingRow(r) {
   } else {
     actions.push(el("button", { class: "icon", title: "rename / notes", testid: "recording-edit", onclick: () => editRecording(r) }, "✎"));
   }
-  actions.push(el("button", { class: "icon", title: "download", testid: "recording-download", onclick: () => download(`/api/recordings/${enc(r.name)}/file`, `${r.name}.tape.csv`, "recordings-error") }, "⤓"));
+  actions.push(el("button", { class: "icon", title: "download", testid: "recording-download", onclick: () => download(`/api/recordings/${enc(r.name)}/file`, `${r.name}.${r.kind || "tape"}.csv`, "recordings-error") }, "⤓"));
   if (!r.sample) actions.push(el("button", { class: "icon", title: "delete", testid: "recording-delete", onclick: () => deleteRecording(r.name) }, "✕"));
   return el("tr", { "data-name": r.name, testid: "recording-row", title },
     el("td", { class: "name" }, el("span", { text: r.name, testid: "recording-name" }), " ", ...flags),
