@@ -262,3 +262,15 @@ def test_camera_frames_move_the_robot_and_cut_into_a_demonstration(client: TestC
         json={"recording": "cam-reach", "t0": 0, "t1": recording.duration, "goal_from_end": True},
     )
     assert r.status_code == 201, r.text
+
+
+def test_with_a_token_landmarks_and_hand_poses_need_it(open_client) -> None:
+    client = open_client(token="t0k-en")
+    auth = {"Authorization": "token t0k-en"}
+    assert client.put("/api/source", json={"kind": "camera"}, headers=auth).status_code == 200
+    no_one = {**landmarks(), "world": None, "image": None}
+    assert client.post("/api/source/landmarks", json=no_one).status_code == 403
+    assert client.post("/api/source/landmarks", json=no_one, headers=auth).status_code == 200
+    assert client.put("/api/source", json={"kind": "hand"}, headers=auth).status_code == 200
+    assert client.post("/api/source/hand", json=REACH).status_code == 403
+    assert client.post("/api/source/hand", json=REACH, headers=auth).status_code == 200
