@@ -32,7 +32,10 @@ MIN_INTERVAL_S = 1.0 / 60.0
 fast mouse stays well under the hand source's flood limit and the IK keeps up."""
 
 HandMoved = Callable[[np.ndarray, np.ndarray], Any]
-"""Called with a hand position (3,) and orientation wxyz (4,) in the arm frame."""
+"""Called with a hand position (3,) and orientation wxyz (4,) in the arm frame; returns the
+``HandPublic`` fields (``q_human``, ``reached``, ...)."""
+HandOf = Callable[[np.ndarray], np.ndarray]
+"""The hand's 4x4 pose in the arm frame for a ``q_human``."""
 
 
 def pose_in_base(worldMbase: np.ndarray, position: np.ndarray, wxyz: np.ndarray) -> np.ndarray:
@@ -56,6 +59,7 @@ class HandHandle:
         self._handle: viser.TransformControlsHandle | None = None
         self._worldMbase = np.eye(4)
         self._on_move: HandMoved | None = None
+        self._hand_of: HandOf | None = None
         self.moves = 0  # drags handed on, for tests
         self._last_move = 0.0
 
@@ -64,13 +68,24 @@ class HandHandle:
         """Whether the handle is shown."""
         return self._handle is not None
 
-    def show(self, worldMbase: np.ndarray, baseMhand: np.ndarray, on_move: HandMoved) -> None:
-        """Show the handle at ``baseMhand`` (the hand in the arm base frame at ``worldMbase``)."""
+    def show(
+        self,
+        worldMbase: np.ndarray,
+        baseMhand: np.ndarray,
+        on_move: HandMoved,
+        hand_of: HandOf | None = None,
+    ) -> None:
+        """Show the handle at ``baseMhand`` (the hand in the arm base frame at ``worldMbase``).
+
+        ``hand_of`` gives the hand's pose for an arm pose: when a drag ends out of reach, the
+        handle goes back onto the hand, where the arm stopped.
+        """
         worldMhand = worldMbase @ baseMhand
         with self._lock:
             self.hide_locked()
             self._worldMbase = np.array(worldMbase, dtype=float)
             self._on_move = on_move
+            self._hand_of = hand_of
             handle = self.server.scene.add_transform_controls(
                 HANDLE_NAME,
                 scale=HANDLE_SCALE,
@@ -98,17 +113,35 @@ class HandHandle:
             return
         self._last_move = now
         target = event.target
-        self.move(np.asarray(target.position, dtype=float), np.asarray(target.wxyz, dtype=float))
+        position = np.asarray(target.position, dtype=float)
+        reached = self.move(position, np.asarray(target.wxyz, dtype=float))
+        if getattr(event, "phase", "update") == "end" and reached is not None:
+            self.snap(reached)
 
-    def move(self, position: np.ndarray, wxyz: np.ndarray) -> None:
-        """The handle was dragged to a world pose: hand it on in the arm frame."""
+    def snap(self, answer: dict[str, Any]) -> None:
+        """Put the handle back on the hand when the arm stopped short of it (out of reach)."""
+        with self._lock:
+            handle, hand_of, worldMbase = self._handle, self._hand_of, self._worldMbase
+        if handle is None or hand_of is None or answer.get("reached", True):
+            return
+        worldMhand = worldMbase @ hand_of(np.asarray(answer["q_human"], dtype=float))
+        handle.position = worldMhand[:3, 3]
+        handle.wxyz = vtf.SO3.from_matrix(worldMhand[:3, :3]).wxyz
+
+    def move(self, position: np.ndarray, wxyz: np.ndarray) -> dict[str, Any] | None:
+        """The handle was dragged to a world pose: hand it on in the arm frame.
+
+        Returns what the hand guide reached, or None when the update was refused.
+        """
         with self._lock:
             on_move, worldMbase = self._on_move, self._worldMbase
         if on_move is None:
-            return
+            return None
         baseMhand = pose_in_base(worldMbase, position, wxyz)
         try:
-            on_move(baseMhand[:3, 3], vtf.SO3.from_matrix(baseMhand[:3, :3]).wxyz)
-            self.moves += 1
+            answer = on_move(baseMhand[:3, 3], vtf.SO3.from_matrix(baseMhand[:3, :3]).wxyz)
         except StudioError as err:  # a flood or a switched source: the next drag tries again
             log.debug("hand handle update refused: %s", err)
+            return None
+        self.moves += 1
+        return answer if isinstance(answer, dict) else None

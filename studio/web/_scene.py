@@ -689,7 +689,9 @@ class StudioScene:
             operator = self._operator
         arm = self._arms.get(side) or self._arms.setdefault(side, HumanArm(side=side))
         baseMhand = arm.forward(self.current_q_human()).hand
-        self.hand_handle.show(operator.worldMbase, baseMhand, on_move)
+        self.hand_handle.show(
+            operator.worldMbase, baseMhand, on_move, lambda q: arm.forward(q).hand
+        )
 
     @property
     def shown_side(self) -> str:

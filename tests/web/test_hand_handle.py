@@ -56,3 +56,20 @@ def test_the_handle_is_on_the_hand_and_dragging_it_moves_the_robot(scene_client)
     assert not handle.visible
     handle.move(worldMtarget[:3, 3], vtf.SO3.from_matrix(worldMtarget[:3, :3]).wxyz)
     assert handle.moves == 1  # a hidden handle hands nothing on
+
+
+def test_a_drag_released_out_of_reach_puts_the_handle_back_on_the_hand(scene_client) -> None:
+    from types import SimpleNamespace
+
+    client, scene = scene_client
+    assert client.put("/api/source", json={"kind": "hand"}).status_code == 200
+    handle = scene.hand_handle
+    worldMbase = scene._operator.worldMbase
+    far = worldMbase @ np.array([[1, 0, 0, 2.0], [0, 1, 0, 0.0], [0, 0, 1, 0.0], [0, 0, 0, 1]])
+    gizmo = handle._handle
+    gizmo.position = far[:3, 3]
+    handle._dragged(SimpleNamespace(phase="end", target=gizmo))
+    q_human = client.app.state.studio.pipeline._q_human
+    hand = worldMbase @ HumanArm("right").forward(q_human).hand
+    assert np.allclose(gizmo.position, hand[:3, 3], atol=1e-6)
+    assert np.linalg.norm(hand[:3, 3] - far[:3, 3]) > 1.0  # the arm stopped short, as it must
