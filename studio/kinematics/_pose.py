@@ -15,8 +15,15 @@ landmarks named "left" are the person's left. The fit reads, for the chosen side
 **Image plane and depth.** World landmarks read bent elbows 11-24 degrees too straight, while
 the image landmarks are within 3-8 degrees in the image plane. Given the image landmarks, each
 point's x, y are taken from the image (in pixels, scaled to metres by the least-squares scale
-between the image and world positions of the shoulders and hips, a weak-perspective camera),
-and only its depth z from the world landmarks.
+between the image and world positions of the shoulders and hips, and corrected for each point's
+depth through a pinhole camera of field of view ``PoseConfig.camera_fov``), and only its depth z
+from the world landmarks.
+
+**Limb lengths.** MediaPipe's depth is several times noisier than its x and y. The shoulder,
+elbow and wrist are moved to the nearest chain (depth weighed ``1 / PoseConfig.depth_noise``)
+whose limbs have the person's lengths: one frame alone measures them on both arms (people are
+nearly symmetric) and takes the mean; a stream takes the running median. A limb's known length
+then pulls its depth toward what its image-plane length implies.
 
 **Closed form.** Shoulder flexion and abduction follow from the upper arm's direction, elbow
 flexion from the angle between the limbs, humeral rotation from the forearm's direction about

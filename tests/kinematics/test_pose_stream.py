@@ -176,3 +176,21 @@ def test_a_long_gap_restarts_the_filter() -> None:
     after_gap = fitter.update(10.0, landmarks_from_arm(b, arm)[0])
     _, e_upper, e_fore = errors(arm, b, after_gap.q_human)
     assert e_upper < 1e-3 and e_fore < 1e-3
+
+
+def test_the_stream_takes_image_landmarks_and_switches_between_kinds() -> None:
+    """Image landmarks join and leave the stream (a page that stops sending them) cleanly."""
+    arm = HumanArm("left", **PERSON)
+    fitter = PoseStreamFitter("left")
+    q = np.array([0.7, 0.4, 0.3, 1.3, 1.0, 0.2, -0.1])
+    world, image = landmarks_from_arm(q, arm)
+    for k in range(90):
+        with_image = k % 30 < 15
+        fit = fitter.update(
+            k / RATE_HZ,
+            world,
+            image if with_image else None,
+            (640, 480) if with_image else None,
+        )
+    _, e_upper, e_fore = errors(arm, q, fit.q_human)
+    assert e_upper < 0.5 and e_fore < 0.5
