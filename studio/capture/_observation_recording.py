@@ -10,6 +10,8 @@ in bounded blocks like the tape reader, names the file, the line and the problem
 from __future__ import annotations
 
 import os
+import re
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
@@ -44,6 +46,7 @@ from ._recording_reader import (
     _first_line,
     _Lines,
     _open,
+    _plain,
     _Problems,
     _short,
     _summary,
@@ -254,9 +257,9 @@ def _parse_lines(
     width: int,
     problems: _Problems,
     end: dict[str, Any] | None,
-) -> tuple[list[list[float]], list[int], dict[str, Any] | None]:
+) -> tuple[np.ndarray, list[int], dict[str, Any] | None]:
     """Rows of one block as floats (empty fields NaN), their line numbers, and the end line."""
-    rows: list[list[float]] = []
+    rows: list[str] = []
     numbers: list[int] = []
     for index, line in enumerate(lines):
         number = first_number + index
@@ -280,18 +283,50 @@ def _parse_lines(
             continue
         if not line.strip():
             continue
-        fields = line.split(",")
-        if len(fields) != width:
-            problems.add(number, f"{len(fields)} columns where {width} were expected")
+        count = line.count(",") + 1
+        if count != width:
+            problems.add(number, f"{count} columns where {width} were expected")
             continue
+        rows.append(line)
+        numbers.append(number)
+    data, numbers = _to_floats(rows, numbers, width, problems)
+    return data, numbers, end
+
+
+_EMPTY_FIELD = re.compile(r"(?<=,)(?=,|\n|$)")
+"""An empty field (never the first one, the time): read as NaN."""
+
+
+def _to_floats(
+    rows: list[str], numbers: list[int], width: int, problems: _Problems
+) -> tuple[np.ndarray, list[int]]:
+    """Rows as a float array: numpy's C parser for plain rows, else field by field (naming the
+    line and the field that is not a number)."""
+    if not rows:
+        return np.zeros((0, width)), []
+    joined = "\n".join(rows)
+    if _plain(joined.replace("\n", ",")):
+        text = _EMPTY_FIELD.sub("nan", joined).replace("\n", ",")
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", DeprecationWarning)
+            try:
+                flat = np.fromstring(text, dtype=np.float64, sep=",")
+            except ValueError:
+                flat = np.zeros(0)
+        if flat.size == len(rows) * width:
+            return flat.reshape(len(rows), width), numbers
+    good: list[list[float]] = []
+    kept: list[int] = []
+    for line, number in zip(rows, numbers, strict=True):
+        fields = line.split(",")
         try:
-            rows.append([float(x) if x else float("nan") for x in fields])
+            good.append([float(x) if x else float("nan") for x in fields])
         except ValueError:
             bad = next(x for x in fields if x and not _float(x))
             problems.add(number, f"'{bad[:20]}' is not a number")
             continue
-        numbers.append(number)
-    return rows, numbers, end
+        kept.append(number)
+    return np.array(good, dtype=np.float64).reshape(-1, width), kept
 
 
 def _float(text: str) -> bool:
@@ -324,8 +359,7 @@ def _scan_observations(
             )
         for block, first, complete in _Lines(stream, width * MAX_FIELD_BYTES, problems):
             text = b"\n".join(block).decode("utf-8", errors="replace").split("\n")
-            rows, numbers, end = _parse_lines(text, first, complete, width, problems, end)
-            data = np.array(rows, dtype=np.float64).reshape(-1, width)
+            data, numbers, end = _parse_lines(text, first, complete, width, problems, end)
             why = check(data)
             for i in np.flatnonzero(why != ""):
                 problems.add(numbers[i], str(why[i]))
