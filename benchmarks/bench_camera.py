@@ -48,6 +48,9 @@ come from the same server, as for the studio page); the studio itself never serv
 
 API_GOAL_P99_MS = 250.0
 SLOWDOWN_GOAL = 0.10
+IDLE_SOURCE = {"kind": "hand", "side": "right"}
+"""The studio's source between its windows: the hand guide, untouched, moves nothing in the scene,
+so the bare package's windows run beside a still studio page."""
 WARMUP_FRAMES = 3
 """Frames dropped after each (re)start: the first inferences compile shaders and warm caches."""
 
@@ -177,6 +180,8 @@ def main() -> int:
             page.goto(base + "/")
             page.wait_for_selector("body[data-ready='1']", timeout=120_000)
             page.evaluate(COLLECT_FRAMES_JS)
+            page.select_option("[data-testid='source-kind']", "camera")  # shows its controls
+            http("PUT", base + "/api/source", IDLE_SOURCE)
             for model in ("lite", "full"):
                 results[model] = {"bare": [], "studio": []}
                 bare.evaluate(f"() => setModel('{model}')")
@@ -205,7 +210,7 @@ def main() -> int:
                                 args.frames,
                                 args.timeout,
                             )
-                            http("PUT", base + "/api/source", {"kind": "simulator"})
+                            http("PUT", base + "/api/source", IDLE_SOURCE)
                             probe.on.clear()
                             frames = page.evaluate("() => window.__frames")[WARMUP_FRAMES:]
                             latency["landmarks"] += [
