@@ -17,7 +17,10 @@ the image landmarks are within 3-8 degrees in the image plane. Given the image l
 point's x, y are taken from the image (in pixels, scaled to metres by the least-squares scale
 between the image and world positions of the shoulders and hips, and corrected for each point's
 depth through a pinhole camera of field of view ``PoseConfig.camera_fov``), and only its depth z
-from the world landmarks.
+from the world landmarks. Depth alone also bends straight arms: where the picture shows the
+arm straight, an elbow less than ``PoseConfig.depth_bend_noise`` off the shoulder-wrist line in
+depth is put back on it (a larger depth bend is kept, from twice that in full), so the picture
+decides the elbow angle unless depth clearly says otherwise.
 
 **Limb lengths.** MediaPipe's depth is several times noisier than its x and y. The shoulder,
 elbow and wrist are moved to the nearest chain (depth weighed ``1 / PoseConfig.depth_noise``)
@@ -109,6 +112,14 @@ class PoseConfig:
             (MediaPipe's published depth errors exceed 10 cm): the limbs are refined at their
             known lengths weighing depth that much less.
         refine_iterations: Gauss-Newton iterations of that refinement (0: plain geometry).
+        depth_bend_noise: with image landmarks, how far (m) MediaPipe's depth alone puts an
+            elbow off the shoulder-wrist line when the arm is straight (it reads flat arms bent
+            by 20 degrees and more). An elbow that the image shows on that line is bent in
+            depth only by what exceeds this: nothing up to it, in full from twice it on.
+        straight_image: the image shows the arm straight when the shoulder-wrist distance in
+            the picture is at least this fraction of the two limbs' lengths in the picture;
+            from there down to halfway to 1 - 2 (1 - straight_image), depth bends it less
+            and less doubted.
     """
 
     min_visibility: float = 0.5
@@ -118,6 +129,8 @@ class PoseConfig:
     camera_fov: float = math.radians(60.0)
     depth_noise: float = 3.0
     refine_iterations: int = 4
+    depth_bend_noise: float = 0.04
+    straight_image: float = 0.95
 
     def __post_init__(self) -> None:
         whole_number(self.refine_iterations, "PoseConfig.refine_iterations", 0)
@@ -128,8 +141,14 @@ class PoseConfig:
             "min_segment",
             "camera_fov",
             "depth_noise",
+            "depth_bend_noise",
+            "straight_image",
         ):
             positive_number(getattr(self, name), f"PoseConfig.{name}")
+        if self.straight_image >= 1.0:
+            raise KinematicsError(
+                f"PoseConfig.straight_image must be below 1; got {self.straight_image!r}."
+            )
 
 
 @dataclass(frozen=True)
@@ -259,6 +278,45 @@ def _merge_image(
     return merged
 
 
+def _smoothstep(x: float) -> float:
+    """0 below 0, 1 above 1, a smooth S between."""
+    x = min(max(x, 0.0), 1.0)
+    return x * x * (3.0 - 2.0 * x)
+
+
+def doubt_depth_bends(merged: np.ndarray, cfg: PoseConfig) -> np.ndarray:
+    """``merged`` with each elbow's depth bend doubted where the image shows the arm straight.
+
+    The depth bend is how far (m) the elbow's depth lies off the shoulder-wrist line (at the
+    elbow's place along it in the picture). Where the picture shows the arm straight, MediaPipe's
+    depth alone bends it by up to ``PoseConfig.depth_bend_noise``, so a bend that small is
+    dropped and one up to twice it shrunk; the image plane then decides the elbow angle. Where
+    the picture shows the arm bent, or the depth bend is large, depth is kept as it is.
+    """
+    out = merged
+    for idx in LANDMARKS.values():
+        S, E, W = (merged[idx[name]] for name in ARM_POINTS)
+        chord = W[:2] - S[:2]
+        limbs = float(np.linalg.norm(E[:2] - S[:2]) + np.linalg.norm(W[:2] - E[:2]))
+        reach = float(chord @ chord)
+        if limbs <= 0.0 or reach <= 0.0:
+            continue
+        straightness = math.sqrt(reach) / limbs
+        doubt = _smoothstep(
+            (straightness - (2 * cfg.straight_image - 1)) / (1 - cfg.straight_image)
+        )
+        if doubt == 0.0:
+            continue
+        along = min(max(float((E[:2] - S[:2]) @ chord) / reach, 0.0), 1.0)
+        line = S[2] + along * (W[2] - S[2])
+        bend = E[2] - line
+        keep = _smoothstep(abs(bend) / cfg.depth_bend_noise - 1.0)
+        if out is merged:
+            out = merged.copy()
+        out[idx["elbow"], 2] = line + bend * (1.0 - doubt * (1.0 - keep))
+    return out
+
+
 def _torso_rotation(points: np.ndarray, hips_seen: bool) -> np.ndarray:
     """Columns: the torso's forward, left and up axes in MediaPipe's axes."""
     ls, rs = points[LANDMARKS["left"]["shoulder"]], points[LANDMARKS["right"]["shoulder"]]
@@ -366,7 +424,10 @@ def _read(
         return visibility is None or bool(visibility[i] >= cfg.min_visibility)
 
     check_arm_seen(visibility, side, cfg)
-    points = world if pixels is None else _merge_image(world, pixels, size, cfg)
+    if pixels is None:
+        points = world
+    else:
+        points = doubt_depth_bends(_merge_image(world, pixels, size, cfg), cfg)
     arm_points = points[[idx[name] for name in ARM_POINTS]]
     for (a, b), what in zip(LIMBS, ("upper arm", "forearm"), strict=True):
         if np.linalg.norm(points[idx[b]] - points[idx[a]]) < cfg.min_segment:

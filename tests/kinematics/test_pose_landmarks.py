@@ -24,6 +24,7 @@ from studio.kinematics import (
     fit_pose_landmarks,
     landmarks_from_arm,
 )
+from studio.kinematics._pose import LANDMARKS
 
 PERSON = {"upper_arm": 0.31, "forearm": 0.25, "hand": 0.17}
 """A person whose limbs are not the model's defaults (0.276, 0.287, 0.153 m)."""
@@ -89,12 +90,37 @@ def test_exact_landmarks_give_the_arm_one_frame_at_a_time(person: HumanArm) -> N
 
 
 def test_image_landmarks_give_the_arm_with_world_depth(person: HumanArm) -> None:
+    """Exact, except small depth bends of an arm the picture shows straight, which are doubted."""
+    rows = []
     for q in motion(person, 10.0, 7):
         body = BodyShape(yaw=0.3)
         world, image = landmarks_from_arm(q, person, body)
         fit = fit_pose_landmarks(world, image, person.side, image_size=body.image_size)
-        e_flex, e_upper, e_fore = errors(person, q, fit.q_human)
-        assert abs(e_flex) <= 0.5 and e_upper <= 0.5 and e_fore <= 0.5
+        rows.append(errors(person, q, fit.q_human))
+    e = np.abs(rows)
+    assert np.median(e, axis=0).max() <= 0.5
+    assert math.sqrt(np.mean(e[:, 0] ** 2)) <= 3.0
+
+
+def test_depth_alone_does_not_bend_an_arm_the_picture_shows_straight() -> None:
+    """MediaPipe's depth puts a straight arm's elbow centimetres off the shoulder-wrist line."""
+    arm = HumanArm("right", **PERSON)
+    for flexion_deg in (0.0, 5.0, 10.0):
+        # Out to the side, the upper arm turned so the elbow bends in the picture's plane.
+        q = np.array([0.0, 1.2, -1.5, math.radians(flexion_deg), 0.0, 0.0, 0.0])
+        world, image = landmarks_from_arm(q, arm)
+        for offset in (-0.05, -0.03, 0.03, 0.05):
+            bad_world = world.copy()
+            bad_world[LANDMARKS["right"]["elbow"], 2] += offset
+            fit = fit_pose_landmarks(bad_world, image, "right", image_size=(640, 480))
+            assert abs(errors(arm, q, fit.q_human)[0]) <= 5.0, (flexion_deg, offset)
+    # Bent in the picture, the same depth errors leave the angle the picture shows.
+    q = np.array([0.0, 1.2, -1.5, math.radians(60.0), 0.0, 0.0, 0.0])
+    world, image = landmarks_from_arm(q, arm)
+    bad_world = world.copy()
+    bad_world[LANDMARKS["right"]["elbow"], 2] += 0.05
+    fit = fit_pose_landmarks(bad_world, image, "right", image_size=(640, 480))
+    assert abs(errors(arm, q, fit.q_human)[0]) <= 5.0
 
 
 def test_image_landmarks_correct_world_landmarks_that_read_the_elbow_too_straight() -> None:
