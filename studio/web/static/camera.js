@@ -292,14 +292,17 @@ async function post(body, info) {
 
 /* ------------------------------------------------------------------ drawing */
 function draw(results, side) {
+  // The frame the model saw, from the page's own copy: drawing the model's WebGL output
+  // (results.image) would read it back from the GPU, stalling it with software WebGL.
+  const picture = C.grabbed;
   const canvas = $("camera-view");
   const w = canvas.width;
-  const h = Math.round((w * results.image.height) / results.image.width) || canvas.height;
+  const h = Math.round((w * picture.height) / picture.width) || canvas.height;
   if (canvas.height !== h) canvas.height = h;
   const ctx = canvas.getContext("2d");
   ctx.save();
   if ($("camera-mirror").checked) { ctx.translate(w, 0); ctx.scale(-1, 1); }
-  ctx.drawImage(results.image, 0, 0, w, h);
+  ctx.drawImage(picture, 0, 0, w, h);
   const lm = results.poseLandmarks;
   if (lm) {
     ctx.lineWidth = 2;
