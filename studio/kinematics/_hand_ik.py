@@ -14,6 +14,7 @@ solution) and damping bounds each step.
 from __future__ import annotations
 
 import math
+import threading
 from dataclasses import dataclass
 
 import numpy as np
@@ -22,7 +23,7 @@ import pinocchio as pin
 from ._checks import check_side, instance_of, positive_number, real_array, whole_number
 from ._errors import KinematicsError
 from ._human import HumanArm, _as_q
-from ._pose import _closed_form, _Reading, default_arm
+from ._pose import _closed_form, _cross, _Reading, default_arm
 
 SWIVELS = 8
 """Elbow positions tried around the shoulder-wrist axis for a cold start (evenly spaced)."""
@@ -109,13 +110,26 @@ def _check_target(oMhand: object) -> np.ndarray:
     return M
 
 
+_scratch = threading.local()
+
+
+def _data(side: str) -> pin.Data:
+    """This thread's Pinocchio data of ``side``'s default arm, made once (not per solve)."""
+    cache = getattr(_scratch, "data", None)
+    if cache is None:
+        cache = _scratch.data = {}
+    if side not in cache:
+        cache[side] = default_arm(side).model.createData()
+    return cache[side]
+
+
 class _Solver:
     """One DLS run's scratch: the arm's model, a data, the target."""
 
     def __init__(self, side: str, target: np.ndarray, cfg: HandIKConfig) -> None:
         self.arm = default_arm(side)
         self.model = self.arm.model
-        self.data = self.model.createData()
+        self.data = _data(side)
         self.frame = self.arm.hand_frame
         self.p_des = target[:3, 3]
         self.R_des = target[:3, :3]
@@ -160,7 +174,7 @@ class _Solver:
         if np.linalg.norm(down) < 1e-6:
             down = np.array([1.0, 0.0, 0.0]) - axis[0] * axis
         b1 = down / np.linalg.norm(down)
-        b2 = np.cross(axis, b1)
+        b2 = _cross(axis, b1)
         candidates = []
         # Elbow down first, then swivelling out both ways: a natural arm is usually found first.
         for k in sorted(range(SWIVELS), key=lambda k: min(k, SWIVELS - k)):

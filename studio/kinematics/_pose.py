@@ -198,6 +198,18 @@ def _unit(v: np.ndarray) -> np.ndarray:
     return v / np.linalg.norm(v)
 
 
+def _clamp(x: float, low: float = -1.0, high: float = 1.0) -> float:
+    """``x`` within ``[low, high]``, a plain float (np.clip costs microseconds per scalar)."""
+    return min(max(float(x), low), high)
+
+
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """The cross product of two 3-vectors (np.cross's axis handling is slow for one pair)."""
+    return np.array(
+        [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+    )
+
+
 def _landmark_array(value: object, what: str, columns: str, fix: str) -> np.ndarray:
     """``value`` as a finite (33, k) float array, k the count of ``columns``, or an error."""
     array = real_array(value, what, fix)
@@ -497,12 +509,12 @@ def _closed_form(
     q = q_hold.copy()
     u = reading.upper
     lateral = -1.0 if arm.side == "right" else 1.0  # abduction moves the arm along -y / +y
-    q[1] = math.asin(float(np.clip(lateral * u[1], -1.0, 1.0)))
+    q[1] = math.asin(_clamp(lateral * u[1]))
     q[0] = math.atan2(u[0], -u[2])
     if overhead:
         q[1] = math.pi - q[1]
         q[0] -= math.copysign(math.pi, q[0])
-    q[3] = math.acos(float(np.clip(u @ reading.fore, -1.0, 1.0)))
+    q[3] = math.acos(_clamp(u @ reading.fore))
     if math.sin(q[3]) > _SEEN:  # read even when weakly observable; a stream weighs it
         q[2] = 0.0
         pin.forwardKinematics(model, data, q)
@@ -516,17 +528,17 @@ def _closed_form(
     pin.forwardKinematics(model, data, q)
     if reading.palm is not None:
         hand_axes = np.column_stack(
-            [reading.palm, -reading.hand, np.cross(reading.palm, -reading.hand)]
+            [reading.palm, -reading.hand, _cross(reading.palm, -reading.hand)]
         )
         rel = data.oMi[4].rotation.T @ hand_axes  # = Ry(s4 q4) Rz(q5) Rx(s6 q6)
-        q[5] = math.asin(float(np.clip(rel[1, 0], -1.0, 1.0)))
+        q[5] = math.asin(_clamp(rel[1, 0]))
         q[6] = s6 * math.atan2(-rel[1, 2], rel[1, 1])
         q[4] = s4 * math.atan2(-rel[2, 0], rel[0, 0])
     else:  # the hand's direction only: forearm rotation held, the wrist follows
         q[4] = min(max(q[4], lower[4]), upper[4])
         pin.forwardKinematics(model, data, q)
         h = data.oMi[5].rotation.T @ reading.hand  # = Rz(q5) Rx(s6 q6) (0, -1, 0)
-        q[6] = s6 * math.asin(float(np.clip(-h[2], -1.0, 1.0)))
+        q[6] = s6 * math.asin(_clamp(-h[2]))
         q[5] = math.atan2(h[0], -h[1])
     return np.clip(q, lower, upper)
 
