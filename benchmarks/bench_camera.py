@@ -12,7 +12,9 @@ drawn figure raising its arm), every frame stamped with its index.
    video frame's ``captureTime``, else when the page took it) to the landmarks (the model's
    result) and to the answer of ``POST /api/source/landmarks``, which the studio sends after it
    has fitted the arm and retargeted the robot (``q_robot``, then in ``GET /api/source`` and the
-   scene); p50 and p99.
+   scene); p50 and p99. The page hears that answer only when its main thread is free, and the
+   next inference starts right after a result, so without a GPU the second figure is an upper
+   bound: the studio's own share is the API's latency below.
 3. The API while it runs: ``GET /api/source`` and ``GET /api/runs`` latencies, p50 and p99 (goal:
    p99 < 250 ms).
 
@@ -243,7 +245,8 @@ def main() -> int:
         lite = statistics.median(results["lite"]["studio"])
         full = statistics.median(results["full"]["studio"])
         print(f"  lite / full in the studio page: {lite / full:.2f}x")
-    print("\nCamera-to-studio latency while the studio page runs (ms):")
+    print("\nCamera-to-studio latency while the studio page runs (ms; the answer is heard late")
+    print("when the page's main thread is busy with the next inference, an upper bound):")
     for name, values in latency.items():
         print(
             f"  capture -> {name:9s} p50 {pct(values, 50):7.0f}   p99 {pct(values, 99):7.0f}   (n={len(values)})"
