@@ -6,7 +6,8 @@
     sides, over ``arm_motion`` (a known teaching motion):
     - exact landmarks, one frame at a time. Goals: elbow RMSE <= 2 deg, directions <= 2 deg;
     - noisy (sigma 1 cm x, y; 3 cm z), one frame at a time. Goals: elbow RMSE <= 10, medians <= 7;
-    - a 30 Hz stream through ``PoseStreamFitter`` (sigma 3 cm x, y; 8 cm z). Goals: elbow RMSE
+    - a 30 Hz stream through ``PoseStreamFitter`` (sigma 3 cm x, y; 8 cm z), world landmarks
+      alone and with image landmarks (3 px jitter), as the page sends them. Goals: elbow RMSE
       <= 10, medians <= 8; Puma560 joints 1-3 (joint-mode retargeting) in the same ArmGrid cell
       as with the true arm in >= 90% of frames.
     The filter's lag: ``lag_s`` as reported, and as measured (the time shift that best aligns the
@@ -49,6 +50,8 @@ CLIK_EPS = 1e-4
 CLIK_STEP = 1e-1
 CLIK_DAMP = 1e-12
 IK_TARGET_S = 5e-3
+IMAGE_SIZE = (640, 480)
+IMAGE_NOISE_PX = 3.0  # MediaPipe's image landmarks jitter by a few pixels on a still person
 
 
 def limb_directions(arm: HumanArm, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -90,8 +93,25 @@ def single_frames(arm: HumanArm, seconds: float, noise: tuple[float, float], see
     return rows
 
 
-def stream(arm: HumanArm, seconds: float, noise: tuple[float, float], seed: int):
-    """(error rows, fraction of frames in the same Puma cell, true and fitted elbow angles)."""
+def noisy_image(image: np.ndarray, rng: np.random.Generator, pixels: float) -> np.ndarray:
+    """Normalised image landmarks with ``pixels`` of jitter (s.d.) in a 640 x 480 picture."""
+    out = image.copy()
+    out[:, :2] += rng.normal(0.0, pixels, (len(out), 2)) / np.array(IMAGE_SIZE)
+    return out
+
+
+def stream(
+    arm: HumanArm,
+    seconds: float,
+    noise: tuple[float, float],
+    seed: int,
+    image_px: float | None = None,
+):
+    """(error rows, fraction of frames in the same Puma cell, true and fitted elbow angles).
+
+    With ``image_px``, each frame also gives image landmarks with that jitter, as the page sends
+    both.
+    """
     rng = np.random.default_rng(seed)
     fitter = PoseStreamFitter(arm.side)
     retarget = Retargeter("joint", arm=HumanArm(arm.side))
@@ -99,7 +119,13 @@ def stream(arm: HumanArm, seconds: float, noise: tuple[float, float], seed: int)
     rows, same, elbows = [], [], []
     for t in np.arange(0.0, seconds, 1.0 / RATE_HZ):
         q = arm_motion(t, arm)
-        fit = fitter.update(float(t), noisy(landmarks_from_arm(q, arm)[0], rng, *noise))
+        world, image = landmarks_from_arm(q, arm)
+        world = noisy(world, rng, *noise)
+        if image_px is None:
+            fit = fitter.update(float(t), world)
+        else:
+            image = noisy_image(image, rng, image_px)
+            fit = fitter.update(float(t), world, image, image_size=IMAGE_SIZE)
         if t < WARM_UP_S:
             continue
         rows.append(errors(arm, q, fit.q_human))
@@ -137,6 +163,13 @@ def accuracy(seconds: float) -> None:
             f"  {side:5s} 30 Hz stream 3/8 cm:     elbow {streamed[0]:.2f}, medians "
             f"{streamed[1]:.2f} / {streamed[2]:.2f}   (goal <= 10, <= 8); Puma joints 1-3 in the "
             f"same cell {100 * same:.1f}% of frames (goal >= 90%)"
+        )
+        rows, same, _, _ = stream(arm, seconds, (0.03, 0.08), 2, IMAGE_NOISE_PX)
+        streamed = summary(rows)
+        print(
+            f"  {side:5s} 30 Hz stream 3/8 cm + image {IMAGE_NOISE_PX:.0f} px: elbow "
+            f"{streamed[0]:.2f}, medians {streamed[1]:.2f} / {streamed[2]:.2f}   (goal <= 10, <= 8);"
+            f" Puma joints 1-3 in the same cell {100 * same:.1f}% of frames (goal >= 90%)"
         )
         _, same_clean, elbows, _ = stream(arm, seconds, (0.0, 0.0), 3)
         print(

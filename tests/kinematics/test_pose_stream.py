@@ -78,23 +78,34 @@ def person(request: pytest.FixtureRequest) -> HumanArm:
     return HumanArm(request.param, **PERSON)
 
 
-def stream_errors(person: HumanArm, seconds: float, seed: int):
-    """Per frame after the warm-up: (true q, fitted q, elbow, upper, forearm errors)."""
+def stream_errors(person: HumanArm, seconds: float, seed: int, image_px: float | None = None):
+    """Per frame after the warm-up: (true q, fitted q, elbow, upper, forearm errors).
+
+    With ``image_px``, each frame also gives image landmarks jittering by that many pixels
+    (s.d.), as the page sends both.
+    """
     rng = np.random.default_rng(seed)
     fitter = PoseStreamFitter(person.side)
     rows = []
+    size = (640, 480)
     for t in np.arange(0.0, seconds, 1.0 / RATE_HZ):
         q = arm_motion(t, person)
-        world, _ = landmarks_from_arm(q, person)
-        fit = fitter.update(float(t), noisy(world, rng, 0.03, 0.08))
+        world, image = landmarks_from_arm(q, person)
+        world = noisy(world, rng, 0.03, 0.08)
+        if image_px is None:
+            fit = fitter.update(float(t), world)
+        else:
+            image[:, :2] += rng.normal(0.0, image_px, (len(image), 2)) / np.array(size)
+            fit = fitter.update(float(t), world, image, image_size=size)
         if t >= WARM_UP_S:
             rows.append((q, fit.q_human, *errors(person, q, fit.q_human)))
     return rows
 
 
-def test_noisy_30_hz_stream_through_the_filter(person: HumanArm) -> None:
+@pytest.mark.parametrize("image_px", [None, 3.0], ids=["world", "world+image"])
+def test_noisy_30_hz_stream_through_the_filter(person: HumanArm, image_px: float | None) -> None:
     """sigma 3 cm in x and y, 8 cm in z: elbow RMSE <= 10 deg, median direction errors <= 8."""
-    rows = stream_errors(person, 40.0, seed=11)
+    rows = stream_errors(person, 40.0, seed=11, image_px=image_px)
     flexion = np.array([r[2] for r in rows])
     assert math.sqrt(np.mean(flexion**2)) <= 10.0
     assert np.median([r[3] for r in rows]) <= 8.0
