@@ -1,4 +1,5 @@
-"""Capture: tape frames, sources (simulator, playback, network, serial), recordings, demonstrations.
+"""Capture: observations of the arm (tape frames, pose landmarks, hand poses), sources (simulator,
+playback, network, serial, camera, hand guide), recordings, demonstrations.
 
 See ``docs/architecture.md`` for the public names and :mod:`._recording_format` for the file format::
 
@@ -26,6 +27,12 @@ from ._emulator import ShapeTapeEmulator as ShapeTapeEmulator
 from ._errors import CaptureError as CaptureError
 from ._errors import DemonstrationError as DemonstrationError
 from ._errors import RecordingError as RecordingError
+from ._fitters import Fitted as Fitted
+from ._fitters import HandFitter as HandFitter
+from ._fitters import LandmarkFitter as LandmarkFitter
+from ._fitters import ObservationFitter as ObservationFitter
+from ._fitters import TapeFitter as TapeFitter
+from ._fitters import fitter_for as fitter_for
 from ._frames import SWITCH0_BIT as SWITCH0_BIT
 from ._frames import SWITCH1_BIT as SWITCH1_BIT
 from ._frames import TRIGGER_BIT as TRIGGER_BIT
@@ -34,7 +41,26 @@ from ._frames import frames_to_arrays as frames_to_arrays
 from ._network import FrameSender as FrameSender
 from ._network import NetworkSource as NetworkSource
 from ._network import stream_source as stream_source
+from ._observation_format import HAND_SUFFIX as HAND_SUFFIX
+from ._observation_format import POSE_SUFFIX as POSE_SUFFIX
+from ._observation_format import RECORDING_SUFFIXES as RECORDING_SUFFIXES
+from ._observation_format import recording_suffix as recording_suffix
+from ._observation_recording import ObservationRecording as ObservationRecording
+from ._observation_recording import ObservationWriter as ObservationWriter
+from ._observation_recording import read_any_recording as read_any_recording
+from ._observation_recording import read_observation_recording as read_observation_recording
+from ._observation_recording import recording_kind as recording_kind
+from ._observation_recording import recording_writer as recording_writer
+from ._observation_recording import summarize_any_recording as summarize_any_recording
+from ._observations import HandPose as HandPose
+from ._observations import LandmarkFrame as LandmarkFrame
+from ._observations import Observation as Observation
+from ._observations import hand_pose as hand_pose
+from ._observations import landmark_frame as landmark_frame
 from ._playback import PlaybackSource as PlaybackSource
+from ._push_sources import CameraSource as CameraSource
+from ._push_sources import FloodError as FloodError
+from ._push_sources import HandSource as HandSource
 from ._raw_import import import_raw as import_raw
 from ._raw_import import read_raw_text as read_raw_text
 from ._recording_edit import DEMO_SUFFIX as DEMO_SUFFIX
@@ -53,6 +79,7 @@ from ._recording_reader import read_header as read_header
 from ._recording_reader import read_recording as read_recording
 from ._recording_reader import recording_bytes as recording_bytes
 from ._recording_reader import summarize_recording as summarize_recording
+from ._recording_writer import AppendWriter as AppendWriter
 from ._recording_writer import RecordingWriter as RecordingWriter
 from ._recording_writer import recording_meta as recording_meta
 from ._segments import trigger_segments as trigger_segments

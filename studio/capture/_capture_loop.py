@@ -8,8 +8,9 @@ from pathlib import Path
 from typing import Any
 
 from ._errors import CaptureError
+from ._observation_recording import ObservationWriter
 from ._recording_format import DEFAULT_RATE_HZ, DEFAULT_REGIONS
-from ._recording_writer import RecordingWriter
+from ._recording_writer import AppendWriter, RecordingWriter
 from ._source import SourceStatus, ThreadedSource
 
 READ_TIMEOUT_SECONDS = 0.1
@@ -34,7 +35,8 @@ def capture(
 
     Args:
         source: an unstarted source (started and stopped here).
-        out: the new ``*.tape.csv`` file.
+        out: the new ``*.tape.csv`` file (``*.pose.csv``, ``*.hand.csv`` for a source of
+            landmarks or hand poses).
         seconds: frames' duration to record (``None``: until the source ends or ``stop()``).
         operator: who wore the tape.
         notes: free text.
@@ -51,15 +53,23 @@ def capture(
     config = getattr(source, "config", None)
     regions = int(getattr(config, "regions", DEFAULT_REGIONS) or DEFAULT_REGIONS)
     rate = float(getattr(source, "rate_hz", DEFAULT_RATE_HZ) or DEFAULT_RATE_HZ)
-    writer = RecordingWriter(
-        out,
-        regions,
-        config=config,
-        operator=operator,
-        notes=notes,
-        rate_hz=rate,
-        source=source_name or source.kind,
-    )
+    kind = getattr(source, "observation_kind", "tape")
+    writer: AppendWriter
+    if kind == "tape":
+        writer = RecordingWriter(
+            out,
+            regions,
+            config=config,
+            operator=operator,
+            notes=notes,
+            rate_hz=rate,
+            source=source_name or source.kind,
+        )
+    else:  # a pose or hand recording played back (or any fed source): the same kind again
+        side = str(getattr(source, "side", "right"))
+        writer = ObservationWriter(
+            out, kind, side=side, operator=operator, notes=notes, source=source_name or source.kind
+        )
     first_t: float | None = None
     try:
         source.start()
@@ -97,7 +107,7 @@ def describe(summary: dict[str, Any]) -> str:
     lines = [
         f"{summary['path']}",
         f"  name      {summary['name']}",
-        f"  frames    {summary['frames']} ({summary['duration']:.2f} s at {summary['rate_hz']:g} Hz, {summary['regions']} regions)",
+        f"  frames    {summary['frames']} ({summary['duration']:.2f} s at {summary['rate_hz']:g} Hz, {_what(summary)})",
         f"  source    {summary['source']}",
         f"  operator  {summary['operator'] or '-'}",
         f"  created   {summary['created']}",
@@ -108,6 +118,16 @@ def describe(summary: dict[str, Any]) -> str:
     for problem in summary["problems"]:
         lines.append(f"  problem   {problem}")
     return "\n".join(lines)
+
+
+def _what(summary: dict[str, Any]) -> str:
+    """What each frame holds, by the recording's kind."""
+    kind = summary.get("kind", "tape")
+    if kind == "pose":
+        return "pose landmarks from a camera, no images"
+    if kind == "hand":
+        return "hand-guide poses"
+    return f"{summary['regions']} regions"
 
 
 def _recovered_text(summary: dict[str, Any]) -> str:

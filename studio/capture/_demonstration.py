@@ -36,13 +36,16 @@ from typing import Any
 import numpy as np
 
 from studio import StudioError, read_json
-from studio.kinematics import ArmTracker, TrackerConfig
+from studio.kinematics import ArmTracker, Puma560, TrackerConfig
 from studio.learning import ArmGrid, LearningError
 
 from ._errors import DemonstrationError
+from ._fitters import fitter_for
+from ._observation_format import kind_of_name
+from ._observation_recording import ObservationRecording, read_any_recording
 from ._recording_edit import DEMO_SUFFIX, atomic_write_text
 from ._recording_format import RECORDING_SUFFIX
-from ._recording_reader import Recording, read_recording
+from ._recording_reader import Recording
 
 DEMO_FORMAT = "teach-studio-demonstration"
 """The ``format`` value of demonstration files."""
@@ -103,7 +106,8 @@ class Demonstration:
 
     def default_path(self) -> Path:
         """Where :meth:`save` writes by default: ``<recording stem>.<t0>-<t1>.demo.json``."""
-        stem = self.recording.name.removesuffix(RECORDING_SUFFIX)
+        kind = kind_of_name(self.recording.name)
+        stem = self.recording.name.removesuffix(kind.suffix if kind else RECORDING_SUFFIX)
         return self.recording.with_name(f"{stem}.{self.t0:.2f}-{self.t1:.2f}{DEMO_SUFFIX}")
 
     def to_dict(self) -> dict[str, Any]:
@@ -213,7 +217,7 @@ def load_demonstration(path: str | os.PathLike[str]) -> Demonstration:
 
 
 def extract_demonstration(
-    recording: Recording | str | os.PathLike[str],
+    recording: Recording | ObservationRecording | str | os.PathLike[str],
     t0: float,
     t1: float,
     grid: ArmGrid | None = None,
@@ -227,14 +231,18 @@ def extract_demonstration(
     """Turn the segment ``[t0, t1]`` of a recording into a demonstration.
 
     Args:
-        recording: a :class:`Recording` or a path.
+        recording: a recording of any kind (tape, pose landmarks, hand poses) or its path; each
+            kind's observations go through their own fitter (:func:`fitter_for`) into the human
+            arm, then the one retargeting.
         t0: segment start (s after the recording's first frame, as playback's ``seek``).
         t1: segment end (s after the first frame).
         grid: the :class:`studio.learning.ArmGrid` (default ``ArmGrid()``, the paper's task);
             its goal is where the path is cut (the first visit).
         mode: retargeting mode, ``"joint"`` or ``"cartesian"``.
         goal_from_end: instead of refusing a segment that misses the goal, make its end the goal.
-        max_residual: worst allowed fit residual (m).
+        max_residual: worst allowed fit residual (m) of a tape recording (a camera's fit holds
+            what it cannot see and a hand guide's arm stops at its nearest pose, so those are
+            judged by where the robot goes).
         tracker: the :class:`studio.kinematics.ArmTracker` to track the frames with, for this
             recording's tape (default: a mirroring one for the recording's tape); it is reset
             and set to ``mode`` first.
@@ -247,7 +255,11 @@ def extract_demonstration(
         DemonstrationError: with ``reason`` ``too_short``, ``bad_fit``, ``leaves_joint_range`` or
             ``never_reaches_goal``, and one sentence saying what to change.
     """
-    rec = recording if isinstance(recording, Recording) else read_recording(recording)
+    rec = (
+        recording
+        if isinstance(recording, Recording | ObservationRecording)
+        else read_any_recording(recording)
+    )
     grid = grid if grid is not None else ArmGrid()
     rows = rec.segment(t0, t1)
     times = rec.t[rows]
@@ -256,40 +268,14 @@ def extract_demonstration(
             f"the segment [{t0:.2f}, {t1:.2f}] s of {rec.path.name} holds {times.shape[0]} frames; choose a longer segment inside 0-{rec.duration:.2f} s.",
             "too_short",
         )
-    if tracker is None:
-        tracker = ArmTracker(TrackerConfig(tape=rec.config, mode=mode))
-    elif tracker.tape != rec.config:
-        raise DemonstrationError(
-            f"the tracker follows another tape than {rec.path.name}'s; pass a tracker built for the recording's tape config, or none.",
-            "bad_fit",
-        )
-    tracker.reset()
-    tracker.mode = mode
-    bend, twist = rec.bend[rows], rec.twist[rows]
-    q_robot = np.empty((times.shape[0], 6))
-    residual = np.empty(times.shape[0])
-    for i in range(times.shape[0]):
-        tracked = tracker.track(bend[i], twist[i])
-        q_robot[i] = tracked.q_robot
-        # the residual (tape against the fitted arm) is the fit's quality; ``success`` also asks
-        # for millimetre landmark agreement, which sensor noise alone can exceed
-        residual[i] = tracked.residual if np.isfinite(tracked.residual) else np.inf
+    q_robot, residual = _track_segment(rec, rows, mode, tracker)
     worst = int(np.argmax(residual))
-    if not residual[worst] <= max_residual:
+    if isinstance(rec, Recording) and not residual[worst] <= max_residual:
         raise DemonstrationError(
             f"the arm fits the tape badly at {times[worst]:.2f} s (residual {residual[worst] * 100:.1f} cm > {max_residual * 100:.1f} cm); check the tape config's shoulder and wrist regions or choose another segment.",
             "bad_fit",
         )
-    robot = tracker.robot
-    at_limit = (q_robot <= robot.lower + LIMIT_TOLERANCE_RAD) | (
-        q_robot >= robot.upper - LIMIT_TOLERANCE_RAD
-    )
-    if at_limit.any():
-        i, j = np.argwhere(at_limit)[0]
-        raise DemonstrationError(
-            f"the motion drives Puma560 joint {j + 1} to its limit at {times[i]:.2f} s; choose a segment that stays inside the robot's range.",
-            "leaves_joint_range",
-        )
+    _check_joint_range(q_robot, times)
     # the demonstration holds what its file holds, so a path traced again from the saved
     # trajectory (the page's run queue does) is this very path
     q_robot = np.round(q_robot, TRAJECTORY_DECIMALS)
@@ -325,6 +311,54 @@ def extract_demonstration(
         residual_mean=float(residual.mean()),
         name=name or f"{rec.name} {t0:.2f}-{t1:.2f} s",
     )
+
+
+def _check_joint_range(q_robot: np.ndarray, times: np.ndarray) -> None:
+    """Refuse a path that drives a Puma560 joint to its limit (retargeting clamped it there)."""
+    robot = Puma560()
+    at_limit = (q_robot <= robot.lower + LIMIT_TOLERANCE_RAD) | (
+        q_robot >= robot.upper - LIMIT_TOLERANCE_RAD
+    )
+    if at_limit.any():
+        i, j = np.argwhere(at_limit)[0]
+        raise DemonstrationError(
+            f"the motion drives Puma560 joint {j + 1} to its limit at {times[i]:.2f} s; choose a segment that stays inside the robot's range.",
+            "leaves_joint_range",
+        )
+
+
+def _track_segment(
+    rec: Recording | ObservationRecording, rows: slice, mode: str, tracker: ArmTracker | None
+) -> tuple[np.ndarray, np.ndarray]:
+    """The Puma560 path ``(N, 6)`` and fit residuals ``(N,)`` of a recording's rows."""
+    n = len(range(*rows.indices(len(rec))))
+    q_robot = np.empty((n, 6))
+    residual = np.empty(n)
+    if isinstance(rec, Recording):
+        if tracker is None:
+            tracker = ArmTracker(TrackerConfig(tape=rec.config, mode=mode))
+        elif tracker.tape != rec.config:
+            raise DemonstrationError(
+                f"the tracker follows another tape than {rec.path.name}'s; pass a tracker built for the recording's tape config, or none.",
+                "bad_fit",
+            )
+        tracker.reset()
+        tracker.mode = mode
+        bend, twist = rec.bend[rows], rec.twist[rows]
+        for i in range(n):
+            tracked = tracker.track(bend[i], twist[i])
+            q_robot[i] = tracked.q_robot
+            # the residual (tape against the fitted arm) is the fit's quality; ``success`` also
+            # asks for millimetre landmark agreement, which sensor noise alone can exceed
+            residual[i] = tracked.residual if np.isfinite(tracked.residual) else np.inf
+        return q_robot, residual
+    observations = [rec.frame_at(i) for i in range(*rows.indices(len(rec)))]
+    fitter = fitter_for(observations[0], side=rec.side, mode=mode) if observations else None
+    for i, observation in enumerate(observations):
+        assert fitter is not None
+        fitted = fitter.fit(observation)
+        q_robot[i], residual[i] = fitted.q_robot, fitted.residual
+    return q_robot, residual
 
 
 def demonstrations_for(recording_path: str | os.PathLike[str]) -> list[Path]:

@@ -2,14 +2,16 @@
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import queue
 import threading
 import time
+from typing import Any
 
 from ._errors import CaptureError
-from ._frames import TapeFrame
-from ._recording_reader import Recording, read_recording
+from ._observation_recording import ObservationRecording, read_any_recording
+from ._recording_reader import Recording
 from ._source import DEFAULT_QUEUE_FRAMES, ThreadedSource
 
 MAX_SLEEP_SECONDS = 0.05
@@ -19,10 +21,12 @@ PUT_RETRY_SECONDS = 0.1
 
 
 class PlaybackSource(ThreadedSource):
-    """Replay a recording's frames with their original timing.
+    """Replay a recording's observations (tape frames, landmark frames or hand poses, whichever
+    the file holds) with their original timing.
 
     Args:
-        recording: a :class:`Recording` or the path of a ``*.tape.csv`` file.
+        recording: a :class:`Recording`, an :class:`ObservationRecording`, or the path of a
+            ``*.tape.csv``, ``*.pose.csv`` or ``*.hand.csv`` file.
         speed: playback speed (1.0 real time, 2.0 twice as fast), or ``None`` for as fast as the
             consumer reads.
         loop: start over at the end (times and frame counters keep increasing).
@@ -37,14 +41,16 @@ class PlaybackSource(ThreadedSource):
 
     def __init__(
         self,
-        recording: Recording | str | os.PathLike[str],
+        recording: Recording | ObservationRecording | str | os.PathLike[str],
         speed: float | None = 1.0,
         loop: bool = False,
         queue_frames: int = DEFAULT_QUEUE_FRAMES,
     ) -> None:
         super().__init__(queue_frames)
         self.recording = (
-            recording if isinstance(recording, Recording) else read_recording(recording)
+            recording
+            if isinstance(recording, Recording | ObservationRecording)
+            else read_any_recording(recording)
         )
         if len(self.recording) == 0:
             raise CaptureError(
@@ -65,8 +71,20 @@ class PlaybackSource(ThreadedSource):
 
     @property
     def config(self) -> object:
-        """The recording's tape config."""
+        """The recording's tape config (None for a pose or hand recording)."""
         return self.recording.config
+
+    @property
+    def side(self) -> str:
+        """The teaching arm (a pose or hand recording's; the tape's for a tape)."""
+        side = getattr(self.recording, "side", None)
+        return str(side if side is not None else self.recording.config.side)
+
+    @property
+    def observation_kind(self) -> str:
+        """``"tape"``, ``"pose"`` or ``"hand"``: what the recording holds."""
+        kind = getattr(self.recording, "kind", None)
+        return "tape" if kind is None else str(kind.name)
 
     @property
     def rate_hz(self) -> float:
@@ -135,12 +153,8 @@ class PlaybackSource(ThreadedSource):
             frame = rec.frame_at(i)
             if self._cycles:
                 shift = self._cycles * (rec.duration + period)
-                frame = TapeFrame(
-                    frame.t + shift,
-                    frame.frame + self._cycles * n,
-                    frame.bend,
-                    frame.twist,
-                    frame.status,
+                frame = dataclasses.replace(
+                    frame, t=frame.t + shift, frame=frame.frame + self._cycles * n
                 )
             if not self._put(frame):
                 return
@@ -148,7 +162,7 @@ class PlaybackSource(ThreadedSource):
                 if self._index == i:
                     self._index = i + 1
 
-    def _put(self, frame: TapeFrame) -> bool:
+    def _put(self, frame: Any) -> bool:
         while not self._stop_event.is_set():
             try:
                 self._queue.put(frame, timeout=PUT_RETRY_SECONDS)

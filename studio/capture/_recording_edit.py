@@ -30,7 +30,7 @@ from ._recording_format import (
     format_row,
     header_line,
 )
-from ._recording_reader import READ_BLOCK_BYTES, Recording, _first_line, _open, _parse_header
+from ._recording_reader import READ_BLOCK_BYTES, Recording, _first_line, _open
 
 EDITABLE_KEYS = ("name", "operator", "notes")
 """Header keys :func:`update_recording_meta` may change (the rest describe the data)."""
@@ -142,11 +142,13 @@ def update_recording_meta(path: str | os.PathLike[str], **changes: Any) -> dict[
             )
         if not isinstance(value, str):
             raise RecordingError(f"{key} must be text, got {type(value).__name__}; give a string.")
+    from ._observation_recording import parse_any_header
+
     with _not_recording(path) as source:
-        meta = _parse_header(path, _first_line(path, source))
+        meta, prefix = parse_any_header(path, _first_line(path, source))
         meta.update(changes)
         meta["edited"] = datetime.now(UTC).isoformat(timespec="seconds")
-        header = header_line(meta).encode("utf-8")
+        header = header_line(meta, prefix).encode("utf-8")
 
         def write(out: BinaryIO) -> None:  # the frames are copied as bytes, block by block
             out.write(header)
@@ -157,7 +159,8 @@ def update_recording_meta(path: str | os.PathLike[str], **changes: Any) -> dict[
 
 
 def rename_recording(path: str | os.PathLike[str], new_name: str) -> Path:
-    """Rename a recording's file to ``<new_name>.tape.csv`` and its display name to ``new_name``.
+    """Rename a recording's file to ``<new_name>`` and its ending (``.tape.csv``, ``.pose.csv``,
+    ``.hand.csv``) and its display name to ``new_name``.
 
     The header is rewritten (atomic replace) and the file moved without overwriting anything;
     demonstrations in the same folder that reference the old file are updated to the new one.
@@ -168,13 +171,17 @@ def rename_recording(path: str | os.PathLike[str], new_name: str) -> Path:
     Raises:
         RecordingError: a name with a path separator, an existing target, or a capture in progress.
     """
+    from ._observation_format import kind_of_name
+
     path = Path(path)
-    new_name = new_name.removesuffix(RECORDING_SUFFIX).strip()
+    kind = kind_of_name(path.name)
+    suffix = kind.suffix if kind is not None else RECORDING_SUFFIX
+    new_name = new_name.removesuffix(suffix).strip()
     if not new_name or "/" in new_name or "\\" in new_name or new_name.startswith("."):
         raise RecordingError(
             f"'{new_name}' is not a usable file name; give a plain name without '/'."
         )
-    target = path.with_name(new_name + RECORDING_SUFFIX)
+    target = path.with_name(new_name + suffix)
     if target == path:
         update_recording_meta(path, name=new_name)
         return path

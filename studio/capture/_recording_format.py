@@ -77,13 +77,13 @@ def columns(regions: int) -> list[str]:
     ]
 
 
-def header_line(meta: dict[str, Any]) -> str:
-    """Line 1 of a recording (with its newline).
+def header_line(meta: dict[str, Any], prefix: str = HEADER_PREFIX) -> str:
+    """Line 1 of a recording (with its newline); ``prefix`` names the format (tape by default).
 
     Raises:
         RecordingError: the header would be longer than :data:`MAX_HEADER_BYTES` (long notes).
     """
-    line = HEADER_PREFIX + json.dumps(meta, separators=(", ", ": ")) + "\n"
+    line = prefix + json.dumps(meta, separators=(", ", ": ")) + "\n"
     if len(line.encode("utf-8")) > MAX_HEADER_BYTES:
         raise RecordingError(
             f"the recording's header would be {len(line.encode('utf-8')):,} bytes, over the limit "

@@ -41,8 +41,45 @@ READ_BLOCK_BYTES = 1024 * 1024
 """Bytes read at a time: memory beyond the frames themselves stays about this size."""
 
 
+class RecordingTimeline:
+    """What every recording kind shares: a path, a header, times and the rows of a segment.
+
+    Subclasses are dataclasses with ``path``, ``meta``, ``t``, ``recovered``, ``problems`` and
+    :meth:`frame_at`.
+    """
+
+    path: Path
+    meta: dict[str, Any]
+    t: np.ndarray
+
+    def __len__(self) -> int:
+        return int(self.t.shape[0])
+
+    @property
+    def duration(self) -> float:
+        """Seconds from the first to the last frame (0 for fewer than two)."""
+        return float(self.t[-1] - self.t[0]) if len(self) >= 2 else 0.0
+
+    @property
+    def rate_hz(self) -> float:
+        """The nominal sample rate from the header."""
+        return float(self.meta.get("rate_hz", 0.0))
+
+    @property
+    def name(self) -> str:
+        """Display name (the header's ``name``, else the file name)."""
+        return str(self.meta.get("name") or self.path.name)
+
+    def segment(self, t0: float, t1: float) -> slice:
+        """The rows from ``t0`` to ``t1`` seconds after the first frame (inclusive), as a slice."""
+        start = float(self.t[0]) if len(self) else 0.0
+        lo = int(np.searchsorted(self.t, start + t0, side="left"))
+        hi = int(np.searchsorted(self.t, start + t1, side="right"))
+        return slice(lo, hi)
+
+
 @dataclass(eq=False)
-class Recording:
+class Recording(RecordingTimeline):
     """A recording in memory.
 
     Attributes:
@@ -69,28 +106,10 @@ class Recording:
     problems: list[str] = field(default_factory=list)
     end: dict[str, Any] | None = None
 
-    def __len__(self) -> int:
-        return int(self.t.shape[0])
-
     @property
     def regions(self) -> int:
         """Bend/twist regions per frame."""
         return int(self.meta["regions"])
-
-    @property
-    def duration(self) -> float:
-        """Seconds from the first to the last frame (0 for fewer than two)."""
-        return float(self.t[-1] - self.t[0]) if len(self) >= 2 else 0.0
-
-    @property
-    def rate_hz(self) -> float:
-        """The nominal sample rate from the header."""
-        return float(self.meta.get("rate_hz", 0.0))
-
-    @property
-    def name(self) -> str:
-        """Display name (the header's ``name``, else the file name)."""
-        return str(self.meta.get("name") or self.path.name)
 
     @property
     def config(self) -> Any:
@@ -112,13 +131,6 @@ class Recording:
             self.twist[index].copy(),
             int(self.status[index]),
         )
-
-    def segment(self, t0: float, t1: float) -> slice:
-        """The rows from ``t0`` to ``t1`` seconds after the first frame (inclusive), as a slice."""
-        start = float(self.t[0]) if len(self) else 0.0
-        lo = int(np.searchsorted(self.t, start + t0, side="left"))
-        hi = int(np.searchsorted(self.t, start + t1, side="right"))
-        return slice(lo, hi)
 
     def summary(self) -> dict[str, Any]:
         """JSON-ready facts for listings (``studio info``, the web page)."""
@@ -532,14 +544,16 @@ def _summary(
     duration: float,
     recovered: bool,
     problems: list[str],
+    kind: str = "tape",
 ) -> dict[str, Any]:
-    """The JSON-ready facts of a recording (one definition for both readers)."""
+    """The JSON-ready facts of a recording (one definition for every reader and kind)."""
     return {
         "path": str(path),
+        "kind": kind,
         "name": str(meta.get("name") or path.name),
         "frames": frames,
         "duration": duration,
-        "regions": int(meta["regions"]),
+        "regions": int(meta.get("regions", 0)),
         "rate_hz": float(meta.get("rate_hz", 0.0)),
         "source": meta.get("source", ""),
         "operator": meta.get("operator", ""),

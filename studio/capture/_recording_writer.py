@@ -18,17 +18,18 @@ import os
 import secrets
 import threading
 import time
+from collections.abc import Sequence
 from datetime import UTC, datetime
 from pathlib import Path
-from typing import Any
+from typing import Any, Self
 
 from ._errors import RecordingError
-from ._frames import TapeFrame
 from ._recording_format import (
     DEFAULT_RATE_HZ,
     DEFAULT_REGIONS,
     FORMAT_NAME,
     FORMAT_VERSION,
+    HEADER_PREFIX,
     MAX_REGIONS,
     RECORDING_SUFFIX,
     columns,
@@ -114,64 +115,42 @@ def _create_locked(path: Path) -> int:
     return fd
 
 
-class RecordingWriter:
-    """Append frames to a new ``*.tape.csv`` file, crash-safely.
+class AppendWriter:
+    """The crash-safe appender every recording format shares (see the module docstring).
 
-    Frames are buffered in memory and written, flushed and fsynced by :meth:`write` or by a
-    background flusher at least every ``flush_seconds``, so a killed process loses at most that
-    much. :meth:`close` writes the ``# end`` line.
+    A subclass builds its header dict and column names, calls :meth:`_open`, and turns
+    observations into rows in :meth:`_rows`; buffering, the 0.5 s flush, fsync, the lock, the
+    ``# end`` line and the one-time error report are here, once.
 
-    Args:
-        path: the new file (must not exist: a recording is never overwritten).
-        regions: bend/twist regions per frame (``config.regions`` when ``config`` is given).
-        config: the :class:`studio.kinematics.TapeConfig` (stored in the header).
-        operator: who wore the tape.
-        notes: free text.
-        name: display name (default: the file name without ``.tape.csv``).
-        rate_hz: nominal sample rate.
-        source: where the frames came from (``"simulator"``, ``"serial:/dev/ttyUSB0"``, ...).
-        flush_seconds: longest time a frame stays in memory.
-        extra: more header keys (JSON-ready).
-
-    Raises:
-        RecordingError: the file exists or cannot be created.
+    Attributes:
+        path: the file.
+        meta: its header.
+        flush_seconds: longest time a row stays in memory.
     """
 
-    def __init__(
+    suffix = RECORDING_SUFFIX
+
+    def _open(
         self,
-        path: str | os.PathLike[str],
-        regions: int | None = None,
-        *,
-        config: Any = None,
-        operator: str = "",
-        notes: str = "",
-        name: str | None = None,
-        rate_hz: float = DEFAULT_RATE_HZ,
-        source: str = "",
-        flush_seconds: float = DEFAULT_FLUSH_SECONDS,
-        extra: dict[str, Any] | None = None,
+        path: Path,
+        meta: dict[str, Any],
+        column_names: list[str],
+        flush_seconds: float,
+        prefix: str = HEADER_PREFIX,
     ) -> None:
-        self.path = Path(path)
-        if regions is None:
-            regions = int(config.regions) if config is not None else DEFAULT_REGIONS
-        self.regions = int(regions)
+        """Create the file (never over an existing one), lock it and write its first two lines.
+
+        Raises:
+            RecordingError: the file exists or cannot be created, or the disk refuses the header.
+        """
+        self.path = path
+        self.meta = meta
         if flush_seconds <= 0:
             raise RecordingError(f"flush_seconds is {flush_seconds}; give a positive number.")
         self.flush_seconds = float(flush_seconds)
-        stem = self.path.name.removesuffix(RECORDING_SUFFIX)
-        self.meta = recording_meta(
-            self.regions,
-            tape=config,
-            operator=operator,
-            notes=notes,
-            name=stem if name is None else name,
-            rate_hz=rate_hz,
-            source=source,
-            **(extra or {}),
-        )
         self._fd = _create_locked(self.path)
         self._lock = threading.Lock()
-        self._buffer: list[str] = [header_line(self.meta), ",".join(columns(self.regions)) + "\n"]
+        self._buffer: list[str] = [header_line(meta, prefix), ",".join(column_names) + "\n"]
         self._frames = 0
         self._lines_on_disk = 0
         self._first_t: float | None = None
@@ -195,6 +174,11 @@ class RecordingWriter:
             target=self._flush_loop, name="studio-recorder", daemon=True
         )
         self._flusher.start()
+
+    def _rows(self, observations: Sequence[Any]) -> list[str]:
+        """The CSV rows of ``observations`` (raise :class:`RecordingError` for one that does not
+        belong in this file)."""
+        raise NotImplementedError
 
     @property
     def frames(self) -> int:
@@ -223,32 +207,26 @@ class RecordingWriter:
         """Why writing stopped (a full or failing disk), or ``None``."""
         return self._error
 
-    def write(self, frame: TapeFrame) -> None:
-        """Append one frame."""
+    def write(self, frame: Any) -> None:
+        """Append one observation."""
         self.write_many((frame,))
 
-    def write_many(self, frames: list[TapeFrame] | tuple[TapeFrame, ...]) -> None:
-        """Append frames in order (flushing to disk when the last flush is ``flush_seconds`` old).
+    def write_many(self, frames: Sequence[Any]) -> None:
+        """Append observations in order (flushing to disk when the last flush is ``flush_seconds``
+        old).
 
         Raises:
-            RecordingError: the writer is closed, a frame has the wrong number of regions, or the
-                disk is full or failing (the frames written before are kept in the file).
+            RecordingError: the writer is closed, an observation does not fit the file (a tape
+                frame of another width), or the disk is full or failing (the rows written before
+                are kept in the file).
         """
         if not frames:
             return
-        rows = []
-        for frame in frames:
-            if frame.bend.shape != (self.regions,) or frame.twist.shape != (self.regions,):
-                raise RecordingError(
-                    f"{self.path}: a frame has {frame.bend.shape[0]} regions but the recording has {self.regions}; record each tape into its own file."
-                )
-            rows.append(format_row(frame.t, frame.frame, frame.status, frame.bend, frame.twist))
+        rows = self._rows(frames)
         with self._lock:
             self._check()
             if self._closed:
-                raise RecordingError(
-                    f"{self.path} is closed; open a new RecordingWriter to record more."
-                )
+                raise RecordingError(f"{self.path} is closed; open a new writer to record more.")
             self._buffer.extend(rows)
             self._frames += len(rows)
             if self._first_t is None:
@@ -299,7 +277,7 @@ class RecordingWriter:
             raise RecordingError(self._error)
         return self.path
 
-    def __enter__(self) -> RecordingWriter:
+    def __enter__(self) -> Self:
         return self
 
     def __exit__(self, *exc: object) -> None:
@@ -350,3 +328,68 @@ class RecordingWriter:
                     self._flush_locked()  # a failure waits for the caller's next call
                 if self._error is not None:
                     return
+
+
+class RecordingWriter(AppendWriter):
+    """Append frames to a new ``*.tape.csv`` file, crash-safely.
+
+    Frames are buffered in memory and written, flushed and fsynced by :meth:`write` or by a
+    background flusher at least every ``flush_seconds``, so a killed process loses at most that
+    much. :meth:`close` writes the ``# end`` line.
+
+    Args:
+        path: the new file (must not exist: a recording is never overwritten).
+        regions: bend/twist regions per frame (``config.regions`` when ``config`` is given).
+        config: the :class:`studio.kinematics.TapeConfig` (stored in the header).
+        operator: who wore the tape.
+        notes: free text.
+        name: display name (default: the file name without ``.tape.csv``).
+        rate_hz: nominal sample rate.
+        source: where the frames came from (``"simulator"``, ``"serial:/dev/ttyUSB0"``, ...).
+        flush_seconds: longest time a frame stays in memory.
+        extra: more header keys (JSON-ready).
+
+    Raises:
+        RecordingError: the file exists or cannot be created.
+    """
+
+    def __init__(
+        self,
+        path: str | os.PathLike[str],
+        regions: int | None = None,
+        *,
+        config: Any = None,
+        operator: str = "",
+        notes: str = "",
+        name: str | None = None,
+        rate_hz: float = DEFAULT_RATE_HZ,
+        source: str = "",
+        flush_seconds: float = DEFAULT_FLUSH_SECONDS,
+        extra: dict[str, Any] | None = None,
+    ) -> None:
+        path = Path(path)
+        if regions is None:
+            regions = int(config.regions) if config is not None else DEFAULT_REGIONS
+        self.regions = int(regions)
+        stem = path.name.removesuffix(RECORDING_SUFFIX)
+        meta = recording_meta(
+            self.regions,
+            tape=config,
+            operator=operator,
+            notes=notes,
+            name=stem if name is None else name,
+            rate_hz=rate_hz,
+            source=source,
+            **(extra or {}),
+        )
+        self._open(path, meta, columns(self.regions), flush_seconds)
+
+    def _rows(self, observations: Sequence[Any]) -> list[str]:
+        rows = []
+        for frame in observations:
+            if frame.bend.shape != (self.regions,) or frame.twist.shape != (self.regions,):
+                raise RecordingError(
+                    f"{self.path}: a frame has {frame.bend.shape[0]} regions but the recording has {self.regions}; record each tape into its own file."
+                )
+            rows.append(format_row(frame.t, frame.frame, frame.status, frame.bend, frame.twist))
+        return rows

@@ -12,11 +12,13 @@ import collections
 import queue
 import threading
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any, Protocol, runtime_checkable
 
 from ._errors import CaptureError
 from ._frames import TapeFrame
+from ._observations import Observation
 
 DEFAULT_QUEUE_FRAMES = 4096
 """Frames a source buffers before it drops (37 s at 110 Hz: a consumer may stall that long)."""
@@ -70,7 +72,8 @@ class SourceStatus:
 
 @runtime_checkable
 class FrameSource(Protocol):
-    """The lifecycle every source follows."""
+    """The lifecycle every source follows; it yields observations of the arm: tape frames
+    (:class:`TapeFrame`), landmark frames or hand poses (see :mod:`._observations`)."""
 
     def start(self) -> None:
         """Start producing frames in the source's own thread."""
@@ -78,8 +81,8 @@ class FrameSource(Protocol):
     def stop(self) -> None:
         """Stop producing and release the device."""
 
-    def read(self, timeout: float | None = 0.0) -> list[TapeFrame]:
-        """All frames since the last call, waiting up to ``timeout`` s for the first one."""
+    def read(self, timeout: float | None = 0.0) -> Sequence[Observation]:
+        """All observations since the last call, waiting up to ``timeout`` s for the first one."""
 
     def status(self) -> SourceStatus:
         """The source's health."""
@@ -93,6 +96,8 @@ class ThreadedSource:
     """
 
     kind = "source"
+    observation_kind = "tape"
+    """What the source yields: ``"tape"``, ``"pose"`` or ``"hand"`` (the recording format)."""
 
     def __init__(self, queue_frames: int = DEFAULT_QUEUE_FRAMES) -> None:
         if queue_frames < 1:

@@ -15,7 +15,9 @@ from ._errors import CaptureError
 from ._source import ThreadedSource
 from ._wire import DEFAULT_PORT
 
-SOURCE_SPECS = "simulator[:SEED] | FILE.tape.csv | udp[:[HOST:]PORT] | serial:PORT"
+SOURCE_SPECS = (
+    "simulator[:SEED] | FILE.tape.csv|.pose.csv|.hand.csv | udp[:[HOST:]PORT] | serial:PORT"
+)
 """What :func:`source_from_spec` accepts (for help texts)."""
 
 

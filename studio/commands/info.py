@@ -1,4 +1,5 @@
-"""``studio info``: what a recording (``*.tape.csv``) or demonstration (``*.demo.json``) holds."""
+"""``studio info``: what a recording (``*.tape.csv``, ``*.pose.csv``, ``*.hand.csv``) or a
+demonstration (``*.demo.json``) holds."""
 
 from __future__ import annotations
 
@@ -6,7 +7,7 @@ import argparse
 import json
 from pathlib import Path
 
-from studio.capture import being_recorded, describe, summarize_recording
+from studio.capture import being_recorded, describe, summarize_any_recording
 
 NAME = "info"
 HELP = "Show a recording's or demonstration's metadata, length and any problems."
@@ -14,7 +15,11 @@ HELP = "Show a recording's or demonstration's metadata, length and any problems.
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
-        "files", type=Path, nargs="+", metavar="FILE", help="*.tape.csv or *.demo.json files"
+        "files",
+        type=Path,
+        nargs="+",
+        metavar="FILE",
+        help="*.tape.csv, *.pose.csv, *.hand.csv or *.demo.json files",
     )
     parser.add_argument("--json", action="store_true", help="print JSON instead of text")
     parser.add_argument(
@@ -35,7 +40,7 @@ def run(args: argparse.Namespace) -> int:
             )
         else:
             # streamed: memory stays one block however long (or damaged) the file is
-            summary = summarize_recording(path, strict=not args.lenient)
+            summary = summarize_any_recording(path, strict=not args.lenient)
             # a file still being captured has no '# end' line yet, but it was not interrupted
             summary["live"] = summary["recovered"] and being_recorded(path)
             if summary["live"]:

@@ -18,14 +18,14 @@ from studio.capture import (
     capture,
     cli_speed,
     describe,
-    read_recording,
     source_from_spec,
+    summarize_any_recording,
 )
 
 PROGRESS_SECONDS = 0.2
 """How often the progress line is redrawn."""
 NAME = "record"
-HELP = "Record tape frames (simulator, recording, UDP or serial) into a *.tape.csv file."
+HELP = "Record a source (simulator, recording, UDP or serial) into a recording file."
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -98,5 +98,5 @@ def run(args: argparse.Namespace) -> int:
             print(file=sys.stderr)
         raise
     print(file=sys.stderr)
-    print(describe(read_recording(path).summary()))
+    print(describe(summarize_any_recording(path)))
     return 0

@@ -1,12 +1,16 @@
-"""Kinematics: Puma560 and human-arm models, tape reconstruction, arm fitting, retargeting.
+"""Kinematics: Puma560 and human-arm models, tape and pose-landmark fitting, retargeting.
 
 The public names are listed in ``docs/architecture.md``.
 """
 
 from ._errors import KinematicsError as KinematicsError
+from ._filter import OneEuroFilter as OneEuroFilter
 from ._fit import ArmFit as ArmFit
 from ._fit import ArmFitter as ArmFitter
 from ._fit import FitConfig as FitConfig
+from ._hand_ik import HandFit as HandFit
+from ._hand_ik import HandIKConfig as HandIKConfig
+from ._hand_ik import fit_hand_pose as fit_hand_pose
 from ._human import ArmPose as ArmPose
 from ._human import HumanArm as HumanArm
 from ._human import mirror_human_q as mirror_human_q
@@ -14,6 +18,11 @@ from ._meshes import HumanBody as HumanBody
 from ._meshes import MeshConfig as MeshConfig
 from ._meshes import MeshPart as MeshPart
 from ._meshes import puma560_meshes as puma560_meshes
+from ._pose import PoseConfig as PoseConfig
+from ._pose import PoseFit as PoseFit
+from ._pose import fit_pose_landmarks as fit_pose_landmarks
+from ._pose_stream import PoseStreamFitter as PoseStreamFitter
+from ._pose_stream import StreamConfig as StreamConfig
 from ._puma import PUMA_QN as PUMA_QN
 from ._puma import PUMA_QR as PUMA_QR
 from ._puma import PUMA_QS as PUMA_QS
@@ -24,6 +33,9 @@ from ._puma import LinkVisual as LinkVisual
 from ._puma import Puma560 as Puma560
 from ._retarget import RetargetConfig as RetargetConfig
 from ._retarget import Retargeter as Retargeter
+from ._synthetic import BodyShape as BodyShape
+from ._synthetic import arm_motion as arm_motion
+from ._synthetic import landmarks_from_arm as landmarks_from_arm
 from ._tape import TapeConfig as TapeConfig
 from ._tape import TapeShape as TapeShape
 from ._tape import reconstruct as reconstruct

@@ -197,6 +197,15 @@ def validation_sentence(errors: list[dict[str, Any]]) -> str:
     return f"{field} is {shown}: {message[0].lower()}{message[1:]}; fix {field} and try again."
 
 
+FRAME_BODY_LIMIT_BYTES = 64_000
+"""Largest body of one landmark frame or hand pose (a frame is about 2 KB of JSON)."""
+ROUTE_BODY_LIMITS = {
+    "/api/source/landmarks": FRAME_BODY_LIMIT_BYTES,
+    "/api/source/hand": FRAME_BODY_LIMIT_BYTES,
+}
+"""Routes whose bodies are far smaller than an upload: their own limit (413 above it)."""
+
+
 class UploadLimitMiddleware:
     """Refuse request bodies larger than the upload limit (413), without storing them.
 
@@ -205,18 +214,24 @@ class UploadLimitMiddleware:
     the limit (plus the multipart framing) is ever received.
     """
 
-    def __init__(self, app: ASGIApp, limit: int) -> None:
+    def __init__(
+        self, app: ASGIApp, limit: int, route_limits: dict[str, int] | None = None
+    ) -> None:
         self.app = app
         self.limit = limit
+        self.route_limits = dict(ROUTE_BODY_LIMITS if route_limits is None else route_limits)
 
-    def _sentence(self, size: str) -> str:
+    def _sentence(self, size: str, path: str = "") -> str:
+        if path in self.route_limits:
+            return f"The request body is {size}, over the limit of {human_size(self.route_limits[path])} for {path}; send one frame or pose per request."
         return f"The upload is {size}, over the limit of {human_size(self.limit)}; upload a smaller file or start the studio with a larger limit."
 
     async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
         if scope["type"] != "http":
             await self.app(scope, receive, send)
             return
-        allowed = self.limit + MULTIPART_OVERHEAD_BYTES
+        path = scope.get("path", "")
+        allowed = self.route_limits.get(path, self.limit + MULTIPART_OVERHEAD_BYTES)
         for key, value in scope.get("headers", ()):
             if key == b"content-length":
                 try:
@@ -225,7 +240,7 @@ class UploadLimitMiddleware:
                     size = 0
                 if size > allowed:
                     response = JSONResponse(
-                        {"detail": self._sentence(human_size(size))}, status_code=413
+                        {"detail": self._sentence(human_size(size), path)}, status_code=413
                     )
                     await response(scope, receive, send)
                     return
@@ -241,7 +256,9 @@ class UploadLimitMiddleware:
                     # An HTTPException passes FastAPI's body parsing unchanged, and whatever
                     # was read so far (Starlette's spooled parts, an upload's temporary file)
                     # is dropped on the way out.
-                    raise BodyTooLarge(413, self._sentence(f"more than {human_size(allowed)}"))
+                    raise BodyTooLarge(
+                        413, self._sentence(f"more than {human_size(allowed)}", path)
+                    )
             return message
 
         async def tracked_send(message: Message) -> None:

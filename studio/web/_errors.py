@@ -49,6 +49,12 @@ class TooLargeError(WebError):
     status_code = 413
 
 
+class TooManyRequestsError(WebError):
+    """A flood of updates from one client (the studio keeps running; the update is dropped)."""
+
+    status_code = 429
+
+
 class StorageError(WebError):
     """The disk refused a write: full, over quota, read-only, or not the studio's to write."""
 

@@ -1,9 +1,12 @@
-"""The live pipeline: frames from the current source through the kinematics into the scene.
+"""The live pipeline: observations from the current source through their fitter into the scene.
 
-One thread reads the current :class:`studio.capture.FrameSource`; every raw frame goes to the
-capture writer (when recording), and frames are turned into poses by the kinematics package's
-:class:`studio.kinematics.ArmTracker` (warm-started frame to frame), the same chain demonstration
-extraction uses.
+One thread reads the current :class:`studio.capture.FrameSource`; every raw observation goes to
+the capture writer (when recording), and observations are turned into poses by their kind's
+fitter (:func:`studio.capture.fitter_for`: the tape's :class:`studio.kinematics.ArmTracker`, the
+landmarks' stream fitter, the hand guide's IK; warm-started observation to observation), the same
+chain demonstration extraction uses. Sources fed by calls (the camera, the hand guide) hand each
+observation to :meth:`Pipeline.observe`, which fits and records it at once and says what the fit
+made of it.
 The newest pose goes to the scene with ``update_live`` (latest wins, never blocks). When the
 kinematics fall behind the stream, only the newest frames of a batch are fitted: the recording
 still gets every frame, the scene the newest pose.
@@ -15,16 +18,26 @@ studio keeps running.
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import threading
 import time
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 
 from studio import StudioError
-from studio.kinematics import ArmTracker, TapeConfig, TrackerConfig
+from studio.capture import (
+    AppendWriter,
+    Fitted,
+    FrameSource,
+    Observation,
+    ObservationFitter,
+    fitter_for,
+)
+from studio.kinematics import TapeConfig
 
 from ._errors import ConflictError, storage_sentence
 
@@ -37,57 +50,18 @@ MAX_FITS_PER_BATCH = 32
 IDLE_SLEEP_S = 0.05
 """Sleep between polls when there is no source or it failed."""
 ROBOT_JOINTS = 6
-FIT_WARNING_AFTER_S = 0.5
-"""The arm model must miss the tape by more than the fit's ``max_residual`` for this long (in the
-tape's own time) before the user is warned: a tape that lies wrong stays wrong, while sensor noise
-and an arm passing through a hard pose last a few frames."""
-FIT_WARNING_CLEAR_FRACTION = 0.5
-"""Once shown, the warning stays until the residual falls below this fraction of ``max_residual``,
-so a residual hovering at the threshold shows one steady warning instead of a flickering one."""
 
 
-def fit_warning(residual_m: float) -> str:
-    """What to tell the user when the arm model cannot follow the tape."""
-    return (
-        f"The arm model misses the tape by {residual_m * 1000.0:.0f} mm (RMS); check that the "
-        "tape lies along the arm and that its shoulder and wrist regions fit this operator."
-    )
+class LiveScene(Protocol):
+    """What the pipeline asks of the scene."""
 
+    def update_live(
+        self, q_human: np.ndarray, q_robot: np.ndarray, tape_positions: np.ndarray | None = None
+    ) -> None:
+        """Show the newest live pose."""
 
-class FitWatch:
-    """Decides, frame by frame, whether the arm fit is bad enough to tell the user.
-
-    The warning is about what it says, the residual: it shows once the residual has stayed above
-    the fit's ``max_residual`` for :data:`FIT_WARNING_AFTER_S`, and clears once it falls below
-    :data:`FIT_WARNING_CLEAR_FRACTION` of it. The threshold is the fitter's own (one definition,
-    :class:`studio.kinematics.FitConfig`), set above what sensor noise gives: a tape with the
-    simulator's noise (0.002 rad per angle) is fitted to 2 mm RMS typically and under 13 mm at
-    worst. A single frame whose fit misses its landmarks by a millimetre is not a warning.
-
-    Args:
-        max_residual: the fit's ``max_residual`` (m).
-    """
-
-    def __init__(self, max_residual: float) -> None:
-        self.on = float(max_residual)
-        self.off = float(max_residual) * FIT_WARNING_CLEAR_FRACTION
-        self._above_since: float | None = None
-        self.warning: str | None = None
-
-    def update(self, t: float, residual: float) -> str | None:
-        """Take the residual (m) of the frame at time ``t`` (s); return the warning to show."""
-        if residual > self.on:
-            if self._above_since is None or t < self._above_since:  # a looped recording restarts
-                self._above_since = t
-            if t - self._above_since >= FIT_WARNING_AFTER_S or self.warning is not None:
-                self.warning = fit_warning(residual)
-            return self.warning
-        self._above_since = None
-        if self.warning is not None and residual < self.off:
-            self.warning = None
-        elif self.warning is not None:
-            self.warning = fit_warning(residual)
-        return self.warning
+    def set_side(self, side: str) -> None:
+        """Make ``side`` the operator's arm that follows the fit."""
 
 
 class Pipeline:
@@ -97,22 +71,23 @@ class Pipeline:
         scene: the :class:`studio.web._scene.StudioScene` to feed, or None (headless, tests).
     """
 
-    def __init__(self, scene: Any = None) -> None:
+    def __init__(self, scene: LiveScene | None = None) -> None:
         self.scene = scene
         self._lock = threading.RLock()
-        self._source: Any = None
+        self._fit_lock = threading.Lock()  # one fit at a time (the thread, or a fed source's call)
+        self._source: FrameSource | None = None
         self._kind: str | None = None
         self._recording: str | None = None
         self._start_error: str | None = None
         self._mode = "joint"
         self._mirror = True
-        self._tracker: ArmTracker | None = None  # the live chain for the source's tape
-        self._fit_watch: FitWatch | None = None  # when the tracker's fit is worth a warning
+        self._fitter: ObservationFitter | None = None  # the live chain for the source's kind
         self._q_human: np.ndarray | None = None
         self._q_robot = np.zeros(ROBOT_JOINTS)
         self._residual: float | None = None
         self._last_t: float | None = None
-        self._writer: Any = None
+        self._observable: np.ndarray | None = None  # what the camera's fit could see
+        self._writer: AppendWriter | None = None
         self._capture_name: str | None = None
         self._capture_path: Path | None = None
         self._capture_frames = 0
@@ -147,7 +122,9 @@ class Pipeline:
 
     # ------------------------------------------------------------------ source
 
-    def set_source(self, source: Any, kind: str, recording: str | None = None) -> None:
+    def set_source(
+        self, source: FrameSource | None, kind: str | None, recording: str | None = None
+    ) -> None:
         """Switch to ``source`` (already constructed, not started); stops the old one first.
 
         Raises:
@@ -161,8 +138,8 @@ class Pipeline:
             self._stop_source()
             self._kind, self._recording, self._source = kind, recording, source
             self._start_error = None
-            self._tracker = None
-            self._fit_watch = None
+            self._fitter = None
+            self._observable = None
             self._kin_error = None
             self._fit_warning = None
             self._residual = None
@@ -191,7 +168,7 @@ class Pipeline:
 
     def clear_source(self) -> None:
         """Stop the source and run without one."""
-        self.set_source(None, None)  # type: ignore[arg-type]
+        self.set_source(None, None)
 
     def _stop_source(self) -> None:
         source = self._source
@@ -203,7 +180,7 @@ class Pipeline:
                 log.exception("stopping the %s source failed", self._kind)
 
     @property
-    def source(self) -> Any:
+    def source(self) -> Any:  # the concrete source: the state calls its kind's own methods
         """The current source object (None without one)."""
         return self._source
 
@@ -223,9 +200,9 @@ class Pipeline:
             self._mode = mode
             if mirror is not None:
                 self._mirror = bool(mirror)
-            if self._tracker is not None:
-                self._tracker.mode = mode
-                self._tracker.mirror = self._mirror
+            if self._fitter is not None:
+                self._fitter.mode = mode
+                self._fitter.mirror = self._mirror
 
     @property
     def retarget_mode(self) -> str:
@@ -259,6 +236,13 @@ class Pipeline:
                 "fit_residual_mm": None if self._residual is None else self._residual * 1000.0,
                 "q_robot": [float(x) for x in self._q_robot],
                 "recording_active": self._writer is not None,
+                "side": self.side() if source is not None else None,
+                "person_detected": getattr(source, "person_detected", None),
+                "observable": None
+                if self._observable is None
+                else [bool(b) for b in self._observable],
+                "camera_fps": getattr(source, "camera_fps", None),
+                "model": getattr(source, "model", None),
             }
 
     def tape_config(self) -> TapeConfig:
@@ -289,7 +273,7 @@ class Pipeline:
 
     # ------------------------------------------------------------------ capture
 
-    def start_capture(self, writer: Any, name: str, path: Path) -> None:
+    def start_capture(self, writer: AppendWriter, name: str, path: Path) -> None:
         """Send every raw frame to ``writer`` from now on.
 
         Raises:
@@ -415,7 +399,7 @@ class Pipeline:
             return None
         return f"{self._capture_rejected} frames of another tape width were left out of the recording; check that one tape sends."
 
-    def _record(self, frames: list[Any]) -> None:
+    def _record(self, frames: Sequence[Any]) -> None:
         """Append frames to the capture; a frame of another width than the recording's is left
         out and counted (one odd frame never ends a capture); a failed write ends it, with the
         reason kept in ``capture_status()["error"]`` until dismissed."""
@@ -425,7 +409,11 @@ class Pipeline:
                 return
             regions = getattr(writer, "regions", None)
             if regions is not None:
-                fits = [f for f in frames if np.shape(f.bend) == (regions,) == np.shape(f.twist)]
+                fits = [
+                    f
+                    for f in frames
+                    if np.shape(getattr(f, "bend", None)) == (regions,) == np.shape(f.twist)
+                ]
                 self._capture_rejected += len(frames) - len(fits)
                 frames = fits
                 if not frames:
@@ -444,33 +432,39 @@ class Pipeline:
             self._capture_last_t = float(frames[-1].t)
             self._capture_frames += len(frames)
 
-    def _live_tracker(self) -> tuple[ArmTracker, FitWatch]:
-        """The tracker for the current source's tape and its fit watch, built on its first frame."""
-        tracker, watch = self._tracker, self._fit_watch
-        if tracker is None or watch is None:
-            config = TrackerConfig(tape=self.tape_config(), mode=self._mode, mirror=self._mirror)
-            tracker = ArmTracker(config)  # the arm the tape is strapped to
-            watch = FitWatch(config.fit.max_residual)
-            if self.scene is not None:  # and the scene draws that arm following, the tape on it
-                self.scene.set_side(config.tape.side)
-            self._tracker, self._fit_watch = tracker, watch
-        return tracker, watch
+    def _live_fitter(self, observation: Observation) -> ObservationFitter:
+        """The fitter for the current source's observations, built on its first one."""
+        fitter = self._fitter
+        if fitter is None:
+            tape = self.tape_config()
+            side = self.side()
+            fitter = fitter_for(
+                observation, tape=tape, side=side, mode=self._mode, mirror=self._mirror
+            )
+            if self.scene is not None:  # the scene draws that arm following (the tape on it)
+                self.scene.set_side(side)
+            self._fitter = fitter
+        return fitter
 
-    def _fit(self, source: Any, frames: list[Any]) -> None:
+    def _fit(self, source: FrameSource, observations: Sequence[Observation]) -> Fitted | None:
+        """Fit observations in order and show the newest pose; a failing fit is shown, not fatal."""
         try:
-            tracker, watch = self._live_tracker()
-            tracked = None
-            for frame in frames:
-                tracked = tracker.track(frame.bend, frame.twist)
-                with self._lock:
-                    self._q_human = tracked.q_human
-                    self._q_robot = tracked.q_robot
-                    self._residual = tracked.residual
-                    self._last_t = float(frame.t)
-                    self._kin_error = None
-                    self._fit_warning = watch.update(float(frame.t), tracked.residual)
-            if self.scene is not None and tracked is not None:
-                self.scene.update_live(tracked.q_human, tracked.q_robot, tracked.tape_points)
+            with self._fit_lock:
+                fitter = self._live_fitter(observations[0])
+                fitted = None
+                for observation in observations:
+                    fitted = fitter.fit(observation)
+                    with self._lock:
+                        self._q_human = fitted.q_human
+                        self._q_robot = fitted.q_robot
+                        self._residual = fitted.residual
+                        self._observable = fitted.observable
+                        self._last_t = float(observation.t)
+                        self._kin_error = None
+                        self._fit_warning = fitted.warning
+            if self.scene is not None and fitted is not None:
+                self.scene.update_live(fitted.q_human, fitted.q_robot, fitted.tape_points)
+            return fitted
         except StudioError as err:
             with self._lock:
                 self._kin_error = str(err)
@@ -480,3 +474,24 @@ class Pipeline:
                 log.exception("the kinematics failed on a frame")
             with self._lock:
                 self._kin_error = message
+        return None
+
+    def observe(self, observation: Observation) -> Fitted | None:
+        """Fit and record one observation handed in by a fed source (camera, hand guide).
+
+        The recording keeps what the fit saw (a landmark frame's ``observable``). Returns the fit,
+        or None when it failed (the reason is in :meth:`status`).
+        """
+        source = self._source
+        if source is None:
+            return None
+        fitted = self._fit(source, [observation])
+        if fitted is not None and fitted.observable is not None:
+            observation = dataclasses.replace(observation, observable=fitted.observable)  # type: ignore[type-var]
+        self._record([observation])
+        return fitted
+
+    def side(self) -> str:
+        """The teaching arm: a fed or recorded source's ``side``, else the tape's."""
+        side = getattr(self._source, "side", None)
+        return str(side) if side in ("right", "left") else self.tape_config().side

@@ -34,7 +34,9 @@ import numpy as np
 import viser
 import viser.transforms as vtf
 
-from studio.kinematics import HumanBody, MeshConfig, MeshPart, Puma560, puma560_meshes
+from studio.kinematics import HumanArm, HumanBody, MeshConfig, MeshPart, Puma560, puma560_meshes
+
+from ._hand_handle import HandHandle, HandMoved
 
 log = logging.getLogger(__name__)
 
@@ -296,6 +298,8 @@ class StudioScene:
         self._closed = threading.Event()
 
         self._build()
+        self.hand_handle = HandHandle(server)
+        self._arms: dict[str, HumanArm] = {}  # the hand guide's arm model per side
         self._thread = threading.Thread(target=self._loop, name="studio-scene", daemon=True)
         self._thread.start()
 
@@ -698,6 +702,21 @@ class StudioScene:
                 self._operator = operator
                 self._live = None
         self._wake.set()
+
+    def show_hand_handle(self, side: str | None, on_move: HandMoved | None) -> None:
+        """Show the hand guide's handle on the ``side`` hand (None hides it); dragging it calls
+        ``on_move(position, wxyz)`` with the hand pose in the arm frame."""
+        if side is None or on_move is None:
+            self.hand_handle.hide()
+            return
+        self.set_side(side)
+        with self._lock:
+            operator = self._operator
+        arm = self._arms.get(side) or self._arms.setdefault(side, HumanArm(side=side))
+        baseMhand = arm.forward(self.current_q_human()).hand
+        self.hand_handle.show(
+            operator.worldMbase, baseMhand, on_move, lambda q: arm.forward(q).hand
+        )
 
     @property
     def shown_side(self) -> str:

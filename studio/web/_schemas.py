@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from typing import Literal
 
-from pydantic import BaseModel, ConfigDict, Field, StrictBool
+from pydantic import BaseModel, ConfigDict, Field, StrictBool, StrictInt
 
 from studio.learning import (
     DEFAULT_EPISODES,
@@ -25,7 +25,8 @@ from studio.learning import (
 
 PlanningName = Literal["zero", "full", "soft", "prioritized"]
 RunStatus = Literal["queued", "running", "done", "stopped", "failed", "damaged"]
-SourceKind = Literal["simulator", "recording", "network", "serial"]
+SourceKind = Literal["simulator", "recording", "network", "serial", "camera", "hand"]
+Side = Literal["right", "left"]
 
 DEFAULT_GOAL_DEG = DEFAULT_GOAL_JOINTS_DEG
 """The learning package's default goal for joints 1-3 (an arm reaching forward and down)."""
@@ -100,6 +101,15 @@ class SourcePublic(BaseModel):
     fit_residual_mm: float | None
     q_robot: list[float]
     recording_active: bool
+    side: Side | None = Field(None, description="the teaching arm (the tape's for a tape source)")
+    person_detected: bool | None = Field(
+        None, description="camera: whether the last frame saw a person (null for other kinds)"
+    )
+    observable: list[bool] | None = Field(
+        None, description="camera: which of the 7 arm joints the last frame determined"
+    )
+    camera_fps: float | None = Field(None, description="camera: the frame rate the page reported")
+    model: str | None = Field(None, description="camera: the pose model the page reported")
 
 
 class SourceUpdate(_Body):
@@ -107,7 +117,7 @@ class SourceUpdate(_Body):
 
     kind: SourceKind
     recording: str | None = None
-    port: int | None = Field(None, ge=1, le=65535)
+    port: StrictInt | None = Field(None, ge=1, le=65535)
     device: str | None = None
     calibration: str | None = Field(
         None,
@@ -116,7 +126,51 @@ class SourceUpdate(_Body):
     )
     speed: float | None = Field(None, gt=0, le=100)
     loop: StrictBool | None = None
-    seed: int | None = Field(None, ge=0)
+    seed: StrictInt | None = Field(None, ge=0)
+    side: Side | None = Field(None, description="camera and hand: the teaching arm (default right)")
+
+
+class LandmarksFrame(_Body):
+    """One frame of MediaPipe Pose landmarks from the page (see docs/api.md)."""
+
+    t: float = Field(description="the page's clock, seconds")
+    world: list[list[float]] | None = Field(
+        None, max_length=33, description="33 x [x, y, z, visibility], metres; null: no person"
+    )
+    image: list[list[float]] | None = Field(
+        None, max_length=33, description="33 x [x, y, visibility], normalised image coordinates"
+    )
+    width: int = Field(description="image width, pixels")
+    height: int = Field(description="image height, pixels")
+    fps: float | None = None
+    model: Literal["lite", "full", "heavy"] | None = None
+
+
+class LandmarksPublic(BaseModel):
+    """What the studio made of one landmark frame."""
+
+    person_detected: bool
+    observable: list[bool] | None
+    warning: str | None
+    q_human: list[float] | None = Field(None, description="this frame's fitted arm (rad)")
+    q_robot: list[float] | None = Field(None, description="this frame's robot pose (rad)")
+
+
+class HandTarget(_Body):
+    """A pose of the operator's hand for the hand guide (arm frame, metres)."""
+
+    position: list[float] = Field(max_length=3, description="[x, y, z] in the arm's frame, m")
+    wxyz: list[float] | None = Field(None, max_length=4, description="unit quaternion, or null")
+
+
+class HandPublic(BaseModel):
+    """The arm and robot the hand guide reached."""
+
+    q_human: list[float]
+    q_robot: list[float]
+    position_error_m: float
+    reached: bool
+    warning: str | None
 
 
 class PlaybackAction(_Body):
@@ -187,6 +241,9 @@ class RecordingPublic(BaseModel):
     capturing: bool = False
     """Another studio (or ``studio record``) on the same data folder is writing it now: its
     frames so far are not counted, and it is neither recovered nor deletable."""
+    kind: Literal["tape", "pose", "hand"] = Field(
+        "tape", description="what it records: tape frames, camera landmarks or hand-guide poses"
+    )
 
 
 class RecordingCopy(_Body):

@@ -20,12 +20,11 @@ from studio import StudioError
 from studio.capture import being_recorded
 from studio.learning import GOAL_JOINTS, check_goal_deg
 
-from ._errors import ConflictError, InvalidError, NotFoundError
+from ._errors import ConflictError, InvalidError, NotFoundError, TooManyRequestsError
 from ._pipeline import Pipeline
 from ._runs import RunQueue
 from ._settings import Settings
 from ._store import (
-    RECORDING_SUFFIX,
     demonstration_store,
     policy_store,
     recording_store,
@@ -122,10 +121,10 @@ class Studio:
         if path.is_file() and path.resolve().parent != self.settings.recordings_dir.resolve():
             from studio.capture import PlaybackSource
 
-            name = path.name.removesuffix(RECORDING_SUFFIX)
+            name = self.recordings.stem_of(path.name)
             self.pipeline.set_source(PlaybackSource(path, loop=True), "recording", name)
             return
-        name = path.name.removesuffix(RECORDING_SUFFIX) if path.is_file() else source
+        name = self.recordings.stem_of(path.name) if path.is_file() else source
         self.set_source(kind="recording", recording=name, loop=True)
 
     def set_source(
@@ -138,8 +137,19 @@ class Studio:
         speed: float | None = None,
         loop: bool | None = None,
         seed: int | None = None,
+        side: str | None = None,
     ) -> None:
         """Build a source of ``kind`` and make it the live one."""
+        if kind in ("camera", "hand"):
+            from studio.capture import CameraSource, HandSource
+
+            fed = CameraSource if kind == "camera" else HandSource
+            self.pipeline.set_source(fed(side or "right"), kind)
+            if kind == "hand" and self.scene is not None:
+                self.scene.show_hand_handle(self.pipeline.side(), self.hand_moved)
+            return
+        if self.scene is not None:
+            self.scene.show_hand_handle(None, None)
         if kind == "simulator":
             from studio.capture import SimulatorSource
 
@@ -196,7 +206,9 @@ class Studio:
                 return
             self.pipeline.set_source(source, kind)
         else:  # the schema allows only the kinds above
-            raise InvalidError(f"kind is {kind!r}; give simulator, recording, network or serial.")
+            raise InvalidError(
+                f"kind is {kind!r}; give simulator, recording, network, serial, camera or hand."
+            )
 
     def simulator_reach(self, action: str, goal_deg: list[float]) -> None:
         """Make the simulator reach a robot goal (``goal_deg``, joints 1-3) or wander again.
@@ -217,6 +229,71 @@ class Studio:
         source.reach(q)
         if self.scene is not None:
             self.scene.set_goal(q)
+
+    def _fed_source(self, kind: str) -> Any:
+        source = self.pipeline.source
+        if self.pipeline.kind != kind or source is None:
+            label = "camera" if kind == "camera" else "hand guide"
+            raise ConflictError(
+                f"The live source is not the {label}; switch the source to {kind} first."
+            )
+        return source
+
+    def post_landmarks(self, frame: dict[str, Any]) -> dict[str, Any]:
+        """Fit and record one frame of landmarks from the page (``LandmarksFrame``).
+
+        Raises:
+            ConflictError: the live source is not the camera.
+            TooManyRequestsError: a flood (the frame is dropped).
+            CaptureError: NaN or wrong sizes (422).
+        """
+        from studio.capture import FloodError
+
+        source = self._fed_source("camera")
+        try:
+            observation = source.submit(**frame)
+        except FloodError as err:
+            raise TooManyRequestsError(str(err)) from None
+        fitted = self.pipeline.observe(observation)
+        observable = None if fitted is None or fitted.observable is None else fitted.observable
+        warning = fitted.warning if fitted is not None else self.pipeline.status()["error"]
+        return {
+            "person_detected": observation.person,
+            "observable": None if observable is None else [bool(b) for b in observable],
+            "warning": warning,
+            "q_human": None if fitted is None else [float(x) for x in fitted.q_human],
+            "q_robot": None if fitted is None else [float(x) for x in fitted.q_robot],
+        }
+
+    def hand_moved(self, position: Any, wxyz: Any = None) -> dict[str, Any]:
+        """Move the operator's hand to a pose (``HandTarget``): what dragging the scene's handle
+        does. Returns the arm and robot reached (``HandPublic``).
+
+        Raises:
+            ConflictError: the live source is not the hand guide.
+            TooManyRequestsError: a flood (the update is dropped).
+            CaptureError: NaN or wrong sizes (422).
+        """
+        from studio.capture import FloodError
+
+        source = self._fed_source("hand")
+        try:
+            observation = source.submit(position, wxyz)
+        except FloodError as err:
+            raise TooManyRequestsError(str(err)) from None
+        fitted = self.pipeline.observe(observation)
+        if fitted is None:
+            raise InvalidError(
+                self.pipeline.status()["error"]
+                or "The hand guide could not solve this pose; drag the handle elsewhere."
+            )
+        return {
+            "q_human": [float(x) for x in fitted.q_human],
+            "q_robot": [float(x) for x in fitted.q_robot],
+            "position_error_m": float(fitted.residual),
+            "reached": bool(fitted.success),
+            "warning": fitted.warning,
+        }
 
     def source_public(self) -> dict[str, Any]:
         """``SourcePublic``: the pipeline status plus the playback state."""
@@ -257,7 +334,7 @@ class Studio:
         Raises:
             ConflictError: a capture is already running, or there is no running source.
         """
-        from studio.capture import RecordingWriter
+        from studio.capture import recording_suffix, recording_writer
 
         if self.pipeline.capture_name is not None:
             raise ConflictError(
@@ -270,10 +347,13 @@ class Studio:
         if name is not None:
             self.recordings.check_new_name(name)
         final = self.recordings.new_name(base)
-        path = self.settings.recordings_dir / f"{final}{RECORDING_SUFFIX}"
-        writer = RecordingWriter(
+        kind = getattr(source, "observation_kind", "tape")
+        path = self.settings.recordings_dir / f"{final}{recording_suffix(kind)}"
+        writer = recording_writer(
+            kind,
             path,
             config=self.pipeline.tape_config(),
+            side=self.pipeline.side(),
             operator=operator or "",
             notes=notes or "",
             source=self.pipeline.source_label(),

@@ -41,10 +41,11 @@ from studio import StudioError, human_size
 from studio.capture import (
     DEMO_SUFFIX,
     RECORDING_SUFFIX,
+    RECORDING_SUFFIXES,
     Demonstration,
     delete_recording,
     load_demonstration,
-    summarize_recording,
+    summarize_any_recording,
 )
 from studio.learning import POLICY_SUFFIX, PolicyFile, TilePolicyFile, load_any_policy
 from studio.samples import SAMPLES_DIR
@@ -108,7 +109,7 @@ def clean_upload_name(filename: str | None, suffix: str, fallback: str) -> str:
             f"The file name {filename!r} contains a path separator or '..'; upload a file with a plain name."
         )
     stem = filename[: -len(suffix)] if filename.endswith(suffix) else Path(filename).stem
-    for extra in (".tape", ".policy", ".demo"):
+    for extra in (".tape", ".pose", ".hand", ".policy", ".demo"):
         stem = stem.removesuffix(extra)
     stem = re.sub(r"[^A-Za-z0-9_.-]+", "-", stem).strip("-.")[:80]
     return _user_name(stem) or fallback
@@ -245,6 +246,8 @@ class FolderStore(Generic[T]):
         sample_fix: what to do instead of changing a sample, the second half of the refusal.
         remove: deletes one of the user's files (default: unlink it); raises a
             :class:`studio.StudioError` to refuse.
+        also: further suffixes of the same kind (recordings of landmarks and hand poses beside
+            the tape's); a name is unique across all of them.
     """
 
     def __init__(
@@ -258,9 +261,11 @@ class FolderStore(Generic[T]):
         samples: Path | None = None,
         sample_fix: str = "copy it to make your own",
         remove: Callable[[Path], None] = Path.unlink,
+        also: tuple[str, ...] = (),
     ) -> None:
         self.folder = folder
         self.suffix = suffix
+        self.suffixes = (suffix, *(s for s in also if s != suffix))
         self.what = what
         self.plural = plural
         self.samples = samples
@@ -275,7 +280,9 @@ class FolderStore(Generic[T]):
     def _stems(self, folder: Path | None) -> list[str]:
         if folder is None or not folder.is_dir():
             return []
-        stems = (p.name[: -len(self.suffix)] for p in folder.glob(f"*{self.suffix}"))
+        stems = (
+            p.name[: -len(suffix)] for suffix in self.suffixes for p in folder.glob(f"*{suffix}")
+        )
         return [s for s in stems if NAME_PATTERN.match(s)]
 
     def _find(self, name: str) -> Path | None:
@@ -283,15 +290,24 @@ class FolderStore(Generic[T]):
         for folder in (self.folder, self.samples):
             if folder is None:
                 continue
-            path = folder / f"{name}{self.suffix}"
-            if path.is_symlink() or path.is_file():
-                return path
+            for suffix in self.suffixes:
+                path = folder / f"{name}{suffix}"
+                if path.is_symlink() or path.is_file():
+                    return path
         return None
+
+    def stem_of(self, filename: str) -> str:
+        """``filename`` without the store's suffix it ends with (the name it is listed under)."""
+        return filename.removesuffix(self.suffix_of(filename))
+
+    def suffix_of(self, filename: str) -> str:
+        """The suffix of this store that ``filename`` ends with (the main one if none)."""
+        return next((s for s in self.suffixes if filename.endswith(s)), self.suffix)
 
     def names(self) -> list[str]:
         """Every name: the samples first, then the user's files, each group alphabetical."""
         samples = [s for s in self._stems(self.samples) if s.startswith(SAMPLE_PREFIX)]
-        names = set(self._stems(self.folder)) | set(samples)
+        names = set(self._stems(self.folder)) | set(samples)  # a stem with two suffixes: once
         return sorted(names, key=lambda n: (not self.is_sample(n), n))
 
     def exists(self, name: str) -> bool:
@@ -444,7 +460,8 @@ class FolderStore(Generic[T]):
         """
         label = filename or "the upload"
         try:
-            base = clean_upload_name(filename, self.suffix, self.what)
+            suffix = self.suffix_of(filename or "")
+            base = clean_upload_name(filename, suffix, self.what)
             try:
                 self._read(tmp)
             except StudioError as err:
@@ -452,7 +469,7 @@ class FolderStore(Generic[T]):
                 raise InvalidError(
                     f"{label} is not a valid Teach Studio {self.what}: {message}"
                 ) from None
-            return self.claim(tmp, base, taken)
+            return self.claim(tmp, base, taken, suffix=suffix)
         finally:
             tmp.unlink(missing_ok=True)
 
@@ -481,7 +498,9 @@ class FolderStore(Generic[T]):
                 final = new_name or self.new_name(name)
                 if prepare is not None:
                     prepare(tmp, final)
-                if self.exists(final) or not link_new(tmp, self.folder / f"{final}{self.suffix}"):
+                if self.exists(final) or not link_new(
+                    tmp, self.folder / f"{final}{self.suffix_of(source.name)}"
+                ):
                     raise ConflictError(
                         f"A {self.what} named {final!r} already exists; choose another name."
                     )
@@ -490,13 +509,18 @@ class FolderStore(Generic[T]):
             tmp.unlink(missing_ok=True)
 
     def claim(
-        self, tmp: Path, base: str, taken: Callable[[str], bool] | None = None, exact: bool = False
+        self,
+        tmp: Path,
+        base: str,
+        taken: Callable[[str], bool] | None = None,
+        exact: bool = False,
+        suffix: str | None = None,
     ) -> str:
         """Give the finished file ``tmp`` (in this store's folder) a free name; returns it.
 
         The name is ``base``, else ``base-2``, ``base-3``, ... ; with ``exact`` only ``base``
-        (409 when taken). A name taken meanwhile, by another studio too, is never replaced.
-        ``tmp`` is removed either way.
+        (409 when taken). The file gets ``suffix`` (default: the store's main one). A name taken
+        meanwhile, by another studio too, is never replaced. ``tmp`` is removed either way.
         """
         taken = taken or self.exists
         try:
@@ -506,7 +530,7 @@ class FolderStore(Generic[T]):
                         base if exact else unique_name(base, lambda n: taken(n) or self.exists(n))
                     )
                     if not (exact and taken(name)) and link_new(
-                        tmp, self.folder / f"{name}{self.suffix}"
+                        tmp, self.folder / f"{name}{suffix or self.suffix}"
                     ):
                         return name
                     if exact:
@@ -518,7 +542,8 @@ class FolderStore(Generic[T]):
 
 
 def recording_store(folder: Path) -> FolderStore[dict[str, Any]]:
-    """Recordings ``<folder>/<name>.tape.csv``, each cached as the capture package's summary.
+    """Recordings ``<folder>/<name>.tape.csv`` (and ``.pose.csv``, ``.hand.csv``), each cached as
+    the capture package's summary.
 
     :func:`studio.capture.summarize_recording` streams the whole file (so damage shows) in one
     block of memory, however long the recording.
@@ -528,10 +553,11 @@ def recording_store(folder: Path) -> FolderStore[dict[str, Any]]:
         suffix=RECORDING_SUFFIX,
         what="recording",
         plural="recordings",
-        load=summarize_recording,
+        load=summarize_any_recording,
         samples=SAMPLES_DIR,
         sample_fix="copy it to your recordings to change it",
         remove=delete_recording,
+        also=RECORDING_SUFFIXES,
     )
 
 

@@ -27,6 +27,9 @@ class FakeScene:
     def set_side(self, side) -> None:
         self.calls.append(("set_side", (side,)))
 
+    def show_hand_handle(self, side, on_move) -> None:
+        self.calls.append(("show_hand_handle", (side, on_move)))
+
     def set_goal(self, q_robot_goal) -> None:
         self.calls.append(("set_goal", (q_robot_goal,)))
 

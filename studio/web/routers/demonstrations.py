@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from fastapi import APIRouter, Response
 
-from studio.capture import RECORDING_SUFFIX, Demonstration
+from studio.capture import RECORDING_SUFFIX, RECORDING_SUFFIXES, Demonstration
 from studio.learning import goal_degrees, has_default_goal
 
 from .._deps import StudioDep
@@ -50,7 +50,11 @@ def demonstration_public(entry: StoredFile[Demonstration]) -> DemonstrationPubli
     grid = demo.arm_grid()
     return DemonstrationPublic(
         name=entry.name,
-        recording=demo.recording.name.removesuffix(RECORDING_SUFFIX),
+        recording=demo.recording.name.removesuffix(
+            next(
+                (x for x in RECORDING_SUFFIXES if demo.recording.name.endswith(x)), RECORDING_SUFFIX
+            )
+        ),
         t0=demo.t0,
         t1=demo.t1,
         steps=max(0, len(demo.grid_path) - 1),

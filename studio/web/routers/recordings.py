@@ -13,7 +13,6 @@ from fastapi.responses import StreamingResponse
 from starlette.concurrency import run_in_threadpool
 
 from studio.capture import (
-    RECORDING_SUFFIX,
     RecordingError,
     recording_bytes,
     rename_recording,
@@ -47,6 +46,7 @@ def recording_public(entry: StoredFile[dict[str, Any]]) -> RecordingPublic:
         size_bytes=entry.size_bytes,
         sample=entry.sample,
         error=entry.error,
+        kind=summary.get("kind", "tape"),
     )
 
 
@@ -120,15 +120,16 @@ def read_recording(name: str, studio: StudioDep) -> RecordingPublic:
 
 @router.get("/{name}/file", response_class=StreamingResponse, responses=file_responses("text/csv"))
 def download_recording(name: str, studio: StudioDep) -> StreamingResponse:
-    """The ``.tape.csv`` file, up to its last complete line (a capture in progress may be
+    """The ``.tape.csv`` (``.pose.csv``, ``.hand.csv``) file, up to its last complete line (a capture in progress may be
     downloaded: its length is fixed when the download starts, so it is a valid recovered file)."""
-    snapshot = recording_bytes(studio.recordings.path(name))
+    path = studio.recordings.path(name)
+    snapshot = recording_bytes(path)
     return StreamingResponse(
         snapshot,
         media_type="text/csv",
         headers={
             "Content-Length": str(snapshot.size),
-            "Content-Disposition": f'attachment; filename="{name}{RECORDING_SUFFIX}"',
+            "Content-Disposition": f'attachment; filename="{path.name}"',
         },
     )
 

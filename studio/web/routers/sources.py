@@ -1,5 +1,5 @@
-"""``/api/source``: the live source (simulator, recording, network bridge, serial), playback and
-the human-to-robot mapping."""
+"""``/api/source``: the live source (simulator, recording, network bridge, serial, camera, hand
+guide), playback, the human-to-robot mapping, and the observations the page hands in."""
 
 from __future__ import annotations
 
@@ -7,6 +7,10 @@ from fastapi import APIRouter
 
 from .._deps import StudioDep
 from .._schemas import (
+    HandPublic,
+    HandTarget,
+    LandmarksFrame,
+    LandmarksPublic,
     PlaybackAction,
     ReachAction,
     RetargetUpdate,
@@ -57,3 +61,18 @@ def simulator_reach(body: ReachAction, studio: StudioDep) -> SourcePublic:
     not the simulator). Handy for recording demonstrations that end at the goal."""
     studio.simulator_reach(body.action, body.goal_deg)
     return SourcePublic.model_validate(studio.source_public())
+
+
+@router.post("/landmarks")
+def post_landmarks(body: LandmarksFrame, studio: StudioDep) -> LandmarksPublic:
+    """One frame of pose landmarks from the page's camera: fitted, shown, and recorded while a
+    capture runs (409 unless the source is the camera; 422 for NaN or wrong sizes; 429 for a
+    flood, the frame dropped and the studio running on)."""
+    return LandmarksPublic.model_validate(studio.post_landmarks(body.model_dump()))
+
+
+@router.post("/hand")
+def post_hand(body: HandTarget, studio: StudioDep) -> HandPublic:
+    """Move the operator's hand (arm frame, metres): exactly what dragging the scene's handle
+    does (409 unless the source is the hand guide; 422 for NaN or wrong sizes; 429 for a flood)."""
+    return HandPublic.model_validate(studio.hand_moved(body.position, body.wxyz))

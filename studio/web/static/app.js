@@ -227,11 +227,12 @@ function renderSource() {
   }
   renderCaptureButton();
   updateMarkButton();
+  document.dispatchEvent(new CustomEvent("studio:source", { detail: s })); // camera.js follows it
 }
 
 function syncKindOptions() {
   const kind = $("source-kind").value;
-  for (const e of document.querySelectorAll(".kind-opt")) e.hidden = e.dataset.kind !== kind;
+  for (const e of document.querySelectorAll(".kind-opt")) e.hidden = !e.dataset.kind.split(" ").includes(kind);
 }
 
 async function applySource() {
@@ -247,6 +248,8 @@ async function applySource() {
   } else if (kind === "serial") {
     body.device = $("source-device").value.trim();
     if ($("source-calibration").value.trim()) body.calibration = $("source-calibration").value.trim();
+  } else if (kind === "camera" || kind === "hand") {
+    body.side = $("source-side").value;
   } else if ($("source-seed").value !== "") {
     body.seed = Number($("source-seed").value);
   }
@@ -327,6 +330,7 @@ async function toggleCapture() {
       flashRow("recordings-body", rec && rec.name);
     }, b);
   } else {
+    if (window.recordCountdown && !(await window.recordCountdown())) return; // camera.js: cancelled
     const body = {};
     if ($("capture-name").value.trim()) body.name = $("capture-name").value.trim();
     if ($("capture-operator").value.trim()) body.operator = $("capture-operator").value.trim();
@@ -353,6 +357,7 @@ async function loadRecordings() {
 function recordingRow(r) {
   const flags = [];
   if (r.sample) flags.push(el("span", { class: "badge", text: "sample", title: "shipped with the studio: read-only" }));
+  if (r.kind === "pose" || r.kind === "hand") flags.push(el("span", { class: "badge", testid: "recording-kind", text: r.kind === "pose" ? "camera" : "hand guide", title: r.kind === "pose" ? "body landmarks from the camera, per frame (no image)" : "hand poses from the hand guide, per frame" }));
   if (r.recovered) flags.push(el("span", { class: "badge warn", text: "recovered", title: "the capture did not close cleanly; every frame written is kept" }));
   if (r.error) flags.push(el("span", { class: "badge failed", text: "unreadable", title: r.error, testid: "recording-damaged" }));
   if (r.capturing) flags.push(el("span", { class: "badge warn", text: "being captured", title: "another studio on this data folder is recording it; it can be changed once that capture stops", testid: "recording-capturing" }));
@@ -364,7 +369,7 @@ function recordingRow(r) {
   } else if (!r.capturing) {
     actions.push(el("button", { class: "icon", title: "rename / notes", testid: "recording-edit", onclick: () => editRecording(r) }, "✎"));
   }
-  actions.push(el("button", { class: "icon", title: "download", testid: "recording-download", onclick: () => download(`/api/recordings/${enc(r.name)}/file`, `${r.name}.tape.csv`, "recordings-error") }, "⤓"));
+  actions.push(el("button", { class: "icon", title: "download", testid: "recording-download", onclick: () => download(`/api/recordings/${enc(r.name)}/file`, `${r.name}.${r.kind || "tape"}.csv`, "recordings-error") }, "⤓"));
   if (!r.sample && !r.capturing) actions.push(el("button", { class: "icon", title: "delete", testid: "recording-delete", onclick: () => deleteRecording(r.name) }, "✕"));
   return el("tr", { "data-name": r.name, testid: "recording-row", title },
     el("td", { class: "name", title: [r.name, title].filter(Boolean).join("\n") }, el("span", { text: r.name, testid: "recording-name" }), " ", ...flags),

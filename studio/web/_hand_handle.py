@@ -1,0 +1,147 @@
+"""The hand guide's handle: viser transform controls on the operator's hand.
+
+Shown only while the hand guide is the source. Dragging it (in any browser showing the scene)
+hands the new hand pose, in the operator's arm frame, to the same function ``POST
+/api/source/hand`` calls (:meth:`studio.web._state.Studio.hand_moved`): the arm follows by IK and
+the robot mirrors it through the live pipeline.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+import time
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+import viser
+import viser.transforms as vtf
+
+from studio import StudioError
+
+log = logging.getLogger(__name__)
+
+HANDLE_NAME = "/hand_guide"
+"""The handle's node in the scene tree."""
+HANDLE_SCALE = 0.22
+"""Size of the gizmo (m): about a hand's length, so it is easy to grab and hides little."""
+
+MIN_INTERVAL_S = 1.0 / 60.0
+"""Drag updates closer together than this are skipped (the release is always handed on), so a
+fast mouse stays well under the hand source's flood limit and the IK keeps up."""
+
+HandMoved = Callable[[np.ndarray, np.ndarray], Any]
+"""Called with a hand position (3,) and orientation wxyz (4,) in the arm frame; returns the
+``HandPublic`` fields (``q_human``, ``reached``, ...)."""
+HandOf = Callable[[np.ndarray], np.ndarray]
+"""The hand's 4x4 pose in the arm frame for a ``q_human``."""
+
+
+def pose_in_base(worldMbase: np.ndarray, position: np.ndarray, wxyz: np.ndarray) -> np.ndarray:
+    """A world pose (the handle's) in the arm base frame, as a 4x4."""
+    worldMhand = np.eye(4)
+    worldMhand[:3, :3] = vtf.SO3(np.asarray(wxyz, dtype=float)).as_matrix()
+    worldMhand[:3, 3] = position
+    return np.linalg.inv(worldMbase) @ worldMhand
+
+
+class HandHandle:
+    """One transform-controls handle, placed at the operator's hand in world coordinates.
+
+    Args:
+        server: the viser server.
+    """
+
+    def __init__(self, server: viser.ViserServer) -> None:
+        self.server = server
+        self._lock = threading.Lock()
+        self._handle: viser.TransformControlsHandle | None = None
+        self._worldMbase = np.eye(4)
+        self._on_move: HandMoved | None = None
+        self._hand_of: HandOf | None = None
+        self.moves = 0  # drags handed on, for tests
+        self._last_move = 0.0
+
+    @property
+    def visible(self) -> bool:
+        """Whether the handle is shown."""
+        return self._handle is not None
+
+    def show(
+        self,
+        worldMbase: np.ndarray,
+        baseMhand: np.ndarray,
+        on_move: HandMoved,
+        hand_of: HandOf | None = None,
+    ) -> None:
+        """Show the handle at ``baseMhand`` (the hand in the arm base frame at ``worldMbase``).
+
+        ``hand_of`` gives the hand's pose for an arm pose: when a drag ends out of reach, the
+        handle goes back onto the hand, where the arm stopped.
+        """
+        worldMhand = worldMbase @ baseMhand
+        with self._lock:
+            self.hide_locked()
+            self._worldMbase = np.array(worldMbase, dtype=float)
+            self._on_move = on_move
+            self._hand_of = hand_of
+            handle = self.server.scene.add_transform_controls(
+                HANDLE_NAME,
+                scale=HANDLE_SCALE,
+                position=worldMhand[:3, 3],
+                wxyz=vtf.SO3.from_matrix(worldMhand[:3, :3]).wxyz,
+                depth_test=False,
+            )
+            handle.on_update(self._dragged)
+            self._handle = handle
+
+    def hide(self) -> None:
+        """Remove the handle (another source is live)."""
+        with self._lock:
+            self.hide_locked()
+
+    def hide_locked(self) -> None:
+        if self._handle is not None:
+            self._handle.remove()
+            self._handle = None
+        self._on_move = None
+
+    def _dragged(self, event: Any) -> None:
+        now = time.monotonic()
+        if getattr(event, "phase", "update") == "update" and now - self._last_move < MIN_INTERVAL_S:
+            return
+        self._last_move = now
+        target = event.target
+        position = np.asarray(target.position, dtype=float)
+        reached = self.move(position, np.asarray(target.wxyz, dtype=float))
+        if getattr(event, "phase", "update") == "end" and reached is not None:
+            self.snap(reached)
+
+    def snap(self, answer: dict[str, Any]) -> None:
+        """Put the handle back on the hand when the arm stopped short of it (out of reach)."""
+        with self._lock:
+            handle, hand_of, worldMbase = self._handle, self._hand_of, self._worldMbase
+        if handle is None or hand_of is None or answer.get("reached", True):
+            return
+        worldMhand = worldMbase @ hand_of(np.asarray(answer["q_human"], dtype=float))
+        handle.position = worldMhand[:3, 3]
+        handle.wxyz = vtf.SO3.from_matrix(worldMhand[:3, :3]).wxyz
+
+    def move(self, position: np.ndarray, wxyz: np.ndarray) -> dict[str, Any] | None:
+        """The handle was dragged to a world pose: hand it on in the arm frame.
+
+        Returns what the hand guide reached, or None when the update was refused.
+        """
+        with self._lock:
+            on_move, worldMbase = self._on_move, self._worldMbase
+        if on_move is None:
+            return None
+        baseMhand = pose_in_base(worldMbase, position, wxyz)
+        try:
+            answer = on_move(baseMhand[:3, 3], vtf.SO3.from_matrix(baseMhand[:3, :3]).wxyz)
+        except StudioError as err:  # a flood or a switched source: the next drag tries again
+            log.debug("hand handle update refused: %s", err)
+            return None
+        self.moves += 1
+        return answer if isinstance(answer, dict) else None

@@ -1,0 +1,276 @@
+"""The camera teacher in a real browser: Chromium's fake camera plays a clip made at test time.
+
+Each clip (``tests/e2e/camera_clips.py``) carries its frame index in a corner, which the page
+reads back for every frame it estimates, so results are matched to what was drawn. Pose
+estimation runs in the page (the vendored BlazePose); only landmarks reach the studio.
+
+Without a GPU BlazePose runs at a few frames a second, far fewer on a busy machine: these tests
+wait for events (frames estimated, answers received), never for a time.
+"""
+
+from __future__ import annotations
+
+import math
+import statistics
+from collections.abc import Callable, Iterator
+from pathlib import Path
+from typing import Any
+from urllib.parse import urlsplit
+
+import pytest
+
+from tests.conftest import require
+from tests.e2e.camera_clips import (
+    CLIPS,
+    COLLECT_FRAMES_JS,
+    figure_clip,
+    figure_elbow_deg,
+    image_elbow_deg,
+)
+from tests.e2e.conftest import CHROMIUM, CHROMIUM_FLAGS, Studio, shot
+
+READY_TIMEOUT_MS = 60_000
+ESTIMATE_TIMEOUT_MS = 420_000
+"""Loading the model and estimating the first frames: seconds alone, minutes on a shared machine."""
+STATUS_TIMEOUT_MS = 240_000
+FIGURE_FRAMES = 120
+"""Frames of the drawn-figure clip (12 s at 10 frames/s, one raise and lower, looped)."""
+FIGURE_SAMPLES = 12
+"""Estimated frames of the drawn figure compared with the drawing."""
+ELBOW_MAE_DEG = 10.0
+LOOPBACK = {"127.0.0.1", "localhost", "::1", "[::1]"}
+POSE_FILES = "/static/vendor/mediapipe-pose/"
+
+
+@pytest.fixture(scope="module")
+def clip_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    return tmp_path_factory.mktemp("camera-clips")
+
+
+@pytest.fixture(scope="module")
+def make_clip(clip_dir: Path) -> Callable[[str], Path]:
+    made: dict[str, Path] = {}
+
+    def make(name: str) -> Path:
+        if name not in made:
+            if name == "astronaut":
+                try:
+                    import skimage.data  # noqa: F401
+                except ImportError:
+                    require(False, "scikit-image is not installed (pip install -e .[test])")
+            path = clip_dir / f"{name}.y4m"
+            made[name] = figure_clip(path, FIGURE_FRAMES) if name == "figure" else CLIPS[name](path)
+        return made[name]
+
+    return make
+
+
+class CameraPage:
+    """The studio page in a Chromium whose camera plays a clip, and every request it made."""
+
+    def __init__(self, page: Any, requests: list[str]) -> None:
+        self.page = page
+        self.requests = requests
+
+    def use_camera(self, side: str = "right") -> None:
+        self.page.select_option("[data-testid='source-kind']", "camera")
+        self.page.select_option("[data-testid='source-side']", side)
+        self.page.click("[data-testid='source-apply']")
+
+    def frames(self, count: int, where: str = "true") -> list[dict[str, Any]]:
+        """Wait for ``count`` answered frames satisfying ``where`` (a JS test of ``f``)."""
+        test = f"(f) => {where}"
+        self.page.wait_for_function(
+            f"() => window.__frames.filter({test}).length >= {count}",
+            timeout=ESTIMATE_TIMEOUT_MS,
+        )
+        return self.page.evaluate(f"() => window.__frames.filter({test})")
+
+    def status(self) -> str:
+        return self.page.locator("[data-testid='camera-status']").inner_text().strip()
+
+
+def camera_browser(browser: Any, clip: Path | None, *, allow: bool = True) -> Any:
+    """A Chromium whose fake camera plays ``clip`` (a test pattern without), allowed or refused."""
+    args = [*CHROMIUM_FLAGS, "--use-fake-device-for-media-stream"]
+    if allow:
+        args.append("--use-fake-ui-for-media-stream")
+    if clip is not None:
+        args.append(f"--use-file-for-fake-video-capture={clip}")
+    return browser.browser_type.launch(executable_path=CHROMIUM, args=args, headless=True)
+
+
+@pytest.fixture
+def open_camera(browser: Any, studio_server: Studio) -> Iterator[Callable[..., CameraPage]]:
+    """Open the studio in a Chromium with a fake camera; the source goes back to the simulator."""
+    opened: list[Any] = []
+
+    def open_(
+        clip: Path | None, *, allow: bool = True, init_script: str | None = None
+    ) -> CameraPage:
+        chromium = camera_browser(browser, clip, allow=allow)
+        opened.append(chromium)
+        context = chromium.new_context(viewport={"width": 1440, "height": 900})
+        if init_script:
+            context.add_init_script(init_script)
+        page = context.new_page()
+        requests: list[str] = []
+        page.on("request", lambda r: requests.append(r.url))
+        page.goto(studio_server.base + "/")
+        page.wait_for_selector("body[data-ready='1']", timeout=READY_TIMEOUT_MS)
+        page.evaluate(COLLECT_FRAMES_JS)
+        return CameraPage(page, requests)
+
+    try:
+        yield open_
+    finally:
+        for chromium in opened:
+            chromium.close()
+        studio_server.send("PUT", "/api/source", {"kind": "simulator"})
+
+
+def one_sentence(text: str) -> bool:
+    return text.endswith(".") and ". " not in text and "\n" not in text
+
+
+def studio_elbow_deg(q_human: list[float]) -> float:
+    """The interior elbow angle from the human arm's elbow flexion (elbow_Z; 0 is straight)."""
+    return 180.0 - abs(math.degrees(q_human[3]))
+
+
+def test_a_photograph_is_seen_and_only_landmarks_reach_the_studio(
+    open_camera: Callable[..., CameraPage], make_clip: Callable[[str], Path], studio_server: Studio
+) -> None:
+    cam = open_camera(make_clip("astronaut"))
+    cam.use_camera("right")
+    seen = cam.frames(3, "f.answer && f.answer.person_detected")
+    assert all(f["body"]["world"] and len(f["body"]["world"]) == 33 for f in seen)
+    assert all(f["body"]["width"] == 640 and f["body"]["height"] == 480 for f in seen)
+    assert {f["body"]["model"] for f in seen} == {"lite"}
+
+    source = studio_server.get("/api/source")
+    assert source["kind"] == "camera" and source["person_detected"] is True
+    assert source["frames"] >= 3 and source["model"] == "lite"
+    # The page shows the frame rate it achieves and which joints the camera sees.
+    cam.page.wait_for_function(
+        "() => /^[0-9.]+$/.test(document.querySelector(\"[data-testid='camera-fps']\").textContent)",
+        timeout=STATUS_TIMEOUT_MS,
+    )
+    assert len(cam.page.get_attribute("[data-testid='camera-observable']", "data-observable")) == 7
+    privacy = cam.page.locator("[data-testid='camera-privacy']")
+    assert privacy.is_visible() and "No camera image is stored" in privacy.inner_text()
+    shot(cam.page, "camera-astronaut", "sec-source")
+
+    # Nothing left this machine: the model, the wasm and the page all came from the studio.
+    assert any(POSE_FILES + "pose_landmark_lite.tflite" in url for url in cam.requests)
+    outside = [
+        url
+        for url in cam.requests
+        if urlsplit(url).scheme not in ("blob", "data") and urlsplit(url).hostname not in LOOPBACK
+    ]
+    assert outside == []
+
+
+def test_the_studio_tracks_a_drawn_elbow(
+    open_camera: Callable[..., CameraPage], make_clip: Callable[[str], Path]
+) -> None:
+    """A drawn figure bends its right elbow 170 -> 60 degrees: the studio's elbow follows the drawing."""
+    cam = open_camera(make_clip("figure"))
+    cam.use_camera("right")
+    frames = cam.frames(
+        FIGURE_SAMPLES + 2,
+        "f.tag !== null && f.answer && f.answer.person_detected && f.answer.q_human",
+    )[2:]  # the first two settle the studio's filter
+    drawn = [figure_elbow_deg(f["tag"], FIGURE_FRAMES) for f in frames]
+    studio = [studio_elbow_deg(f["answer"]["q_human"]) for f in frames]
+    image = [image_elbow_deg(f["body"]["image"]) for f in frames]
+    mae = statistics.fmean(abs(a - b) for a, b in zip(studio, drawn, strict=True))
+    mae_image = statistics.fmean(abs(a - b) for a, b in zip(image, drawn, strict=True))
+    print(
+        f"elbow MAE over {len(frames)} frames: studio {mae:.1f} deg, "
+        f"image landmarks alone {mae_image:.1f} deg (drawn {min(drawn):.0f}-{max(drawn):.0f} deg)"
+    )
+    assert max(drawn) - min(drawn) > 30, "the samples do not span the motion"
+    assert mae <= ELBOW_MAE_DEG
+
+
+def test_no_person_in_view_says_so(
+    open_camera: Callable[..., CameraPage], make_clip: Callable[[str], Path], studio_server: Studio
+) -> None:
+    cam = open_camera(make_clip("blank"))
+    cam.use_camera()
+    cam.frames(2, "f.body.world === null")
+    cam.page.wait_for_function(
+        "() => /No person/.test(document.querySelector(\"[data-testid='camera-status']\").textContent)",
+        timeout=STATUS_TIMEOUT_MS,
+    )
+    assert one_sentence(cam.status())
+    assert studio_server.get("/api/source")["person_detected"] is False
+
+
+def test_a_refused_camera_says_so(open_camera: Callable[..., CameraPage]) -> None:
+    cam = open_camera(None, allow=False)
+    cam.use_camera()
+    cam.page.wait_for_function(
+        "() => /refused the camera/.test(document.querySelector(\"[data-testid='camera-status']\").textContent)",
+        timeout=STATUS_TIMEOUT_MS,
+    )
+    assert one_sentence(cam.status())
+
+
+BUSY_CAMERA = """
+navigator.mediaDevices.getUserMedia = () =>
+    Promise.reject(new DOMException("Could not start video source", "NotReadableError"));
+"""
+"""What Chromium answers when another program holds the camera."""
+
+
+def test_a_busy_camera_says_so(open_camera: Callable[..., CameraPage]) -> None:
+    cam = open_camera(None, init_script=BUSY_CAMERA)
+    cam.use_camera()
+    cam.page.wait_for_function(
+        "() => /camera is busy/.test(document.querySelector(\"[data-testid='camera-status']\").textContent)",
+        timeout=STATUS_TIMEOUT_MS,
+    )
+    assert one_sentence(cam.status())
+    assert cam.page.evaluate("() => window.studio.camera.running") is False
+
+
+def test_hand_guide_countdown_and_named_controls(
+    open_camera: Callable[..., CameraPage], studio_server: Studio
+) -> None:
+    """The hand guide says what to do; Record counts down first (pressing it again cancels), and
+    the recording is listed as the hand guide's."""
+    cam = open_camera(None)
+    page = cam.page
+    for name in ("Teaching arm", "Pose model", "Mirror picture", "Countdown"):
+        assert page.get_by_label(name, exact=True).count() == 1, name
+    page.select_option("[data-testid='source-kind']", "hand")
+    page.click("[data-testid='source-apply']")
+    page.wait_for_function("() => window.studio.source && window.studio.source.kind === 'hand'")
+    note = page.locator("[data-testid='hand-guide-note']")
+    assert note.is_visible() and "Drag the handle" in note.inner_text()
+    assert not page.locator("[data-testid='camera-panel']").is_visible()
+
+    page.get_by_label("Countdown", exact=True).fill("5")
+    page.click("[data-testid='capture-toggle']")
+    left = page.locator("[data-testid='capture-countdown-left']")
+    left.wait_for(state="visible")
+    assert "Recording in 5 s" in left.inner_text()
+    page.click("[data-testid='capture-toggle']")  # cancel
+    left.wait_for(state="hidden")
+    assert studio_server.get("/api/capture")["active"] is False
+    assert page.get_attribute("[data-testid='capture-toggle']", "data-active") == "0"
+
+    # Counted down to the end, the recording starts; the list says what it holds.
+    page.get_by_label("Countdown", exact=True).fill("1")
+    page.fill("[data-testid='capture-name']", "hand-countdown")
+    page.click("[data-testid='capture-toggle']")
+    page.wait_for_selector("[data-testid='capture-toggle'][data-active='1']")
+    studio_server.send("POST", "/api/source/hand", {"position": [0.25, -0.1, -0.3], "wxyz": None})
+    page.click("[data-testid='capture-toggle']")
+    page.wait_for_selector("[data-testid='capture-toggle'][data-active='0']")
+    row = page.locator("[data-testid='recording-row'][data-name='hand-countdown']")
+    row.wait_for()
+    assert row.locator("[data-testid='recording-kind']").inner_text() == "hand guide"
+    studio_server.send("DELETE", "/api/recordings/hand-countdown")  # the stories start clean
