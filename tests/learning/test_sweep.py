@@ -171,6 +171,31 @@ def test_a_bad_spec_is_one_sentence_naming_the_field(change: dict, field: str) -
     assert "\n" not in message and message.endswith("."), message
 
 
+def test_a_huge_seed_count_is_refused_before_any_seed_is_listed() -> None:
+    """seeds = 1000000000 is refused by counting; the address space of the process that parses it
+    is capped at 256 MB above what it holds, so building the list of seeds would fail."""
+    script = (
+        "import resource\n"
+        "from studio.learning._sweep import SweepError, parse_sweep_spec\n"
+        "from tests.learning.test_sweep import spec_dict\n"
+        "size = next(int(line.split()[1]) * 1024 for line in open('/proc/self/status')\n"
+        "            if line.startswith('VmSize:'))\n"
+        "resource.setrlimit(resource.RLIMIT_AS, (size + 256 * 2**20, resource.RLIM_INFINITY))\n"
+        "try:\n"
+        "    parse_sweep_spec(spec_dict(seeds=1_000_000_000), 'big.toml')\n"
+        "except SweepError as err:\n"
+        "    print(err)\n"
+    )
+    proc = subprocess.run(
+        [sys.executable, "-c", script], capture_output=True, text=True, timeout=WAIT_SECONDS,
+        cwd=REPO, env={**os.environ, "PYTHONPATH": str(REPO)},
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.strip() == (
+        "big.toml makes 2,000,000,000 trials, over the limit of 100,000; sweep fewer values or seeds."
+    ), proc.stdout
+
+
 def test_a_spec_file_that_is_not_toml_is_refused(tmp_path: Path) -> None:
     path = write_spec(tmp_path / "broken.toml", "task = arm-grid\n")
     with pytest.raises(SweepError, match="not valid TOML"):
