@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import time
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -11,6 +12,7 @@ from ._errors import CaptureError
 from ._recording_format import DEFAULT_RATE_HZ, DEFAULT_REGIONS
 from ._recording_writer import RecordingWriter
 from ._source import SourceStatus, ThreadedSource
+from ._source_spec import check_seconds
 
 READ_TIMEOUT_SECONDS = 0.1
 """How long one read waits for frames (bounds how late a stop request is seen)."""
@@ -26,6 +28,7 @@ def capture(
     source_name: str | None = None,
     on_progress: Callable[[int, SourceStatus], None] | None = None,
     stop: Callable[[], bool] | None = None,
+    give_up_seconds: float | None = None,
 ) -> Path:
     """Record ``source`` into a new recording until ``seconds`` of frames, its end, or ``stop()``.
 
@@ -35,19 +38,26 @@ def capture(
     Args:
         source: an unstarted source (started and stopped here).
         out: the new ``*.tape.csv`` file.
-        seconds: frames' duration to record (``None``: until the source ends or ``stop()``).
+        seconds: the duration of frames to record, by the frames' own time stamps from the first
+            frame on; waiting for a first frame does not count (``None``: until the source ends
+            or ``stop()``).
         operator: who wore the tape.
         notes: free text.
         source_name: stored in the header (default: the source's kind).
         on_progress: called with ``(frames written, source status)`` after each batch.
         stop: polled after each batch; true ends the capture.
+        give_up_seconds: end with an error when no frame arrives for this long (a network
+            sender that never starts or went away); a capture that got no frame leaves no file.
 
     Returns:
         The recording's path.
 
     Raises:
-        CaptureError: the source failed (the frames up to then are kept in the file).
+        CaptureError: the source failed or went silent for ``give_up_seconds`` (the frames up to
+            then are kept in the file), or a bad ``seconds``.
     """
+    check_seconds(seconds)
+    check_seconds(give_up_seconds, "the wait for frames")
     config = getattr(source, "config", None)
     regions = int(getattr(config, "regions", DEFAULT_REGIONS) or DEFAULT_REGIONS)
     rate = float(getattr(source, "rate_hz", DEFAULT_RATE_HZ) or DEFAULT_RATE_HZ)
@@ -61,11 +71,14 @@ def capture(
         source=source_name or source.kind,
     )
     first_t: float | None = None
+    silent = False
     try:
         source.start()
+        last_frame = time.monotonic()
         while True:
             frames = source.read(timeout=READ_TIMEOUT_SECONDS)
             if frames:
+                last_frame = time.monotonic()
                 if first_t is None:
                     first_t = frames[0].t
                 if seconds is not None:
@@ -76,6 +89,17 @@ def capture(
                 on_progress(writer.frames, status)
             if status.error and not status.running:  # a running source may recover (network)
                 raise CaptureError(f"{status.error} ({writer.frames} frames kept in {writer.path})")
+            quiet = time.monotonic() - last_frame
+            if give_up_seconds is not None and quiet >= give_up_seconds:
+                silent = True
+                kept = (
+                    f"{writer.frames} frames kept in {writer.path}"
+                    if writer.frames
+                    else "nothing was recorded"
+                )
+                raise CaptureError(
+                    f"no frame arrived from the {source.kind} source for {quiet:.0f} s, so the capture gave up ({kept}); start the sender first (for the network bridge: studio bridge --to HOST:PORT)."
+                )
             if (
                 seconds is not None
                 and first_t is not None
@@ -89,6 +113,8 @@ def capture(
     finally:
         source.stop()
         writer.close()
+        if silent and writer.frames == 0:  # an empty recording would only clutter the list
+            writer.path.unlink(missing_ok=True)
     return writer.path
 
 

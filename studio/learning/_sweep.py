@@ -30,7 +30,6 @@ from __future__ import annotations
 import contextlib
 import csv
 import io
-import ipaddress
 import itertools
 import json
 import logging
@@ -47,7 +46,14 @@ from typing import Any
 
 import numpy as np
 
-from studio import MAX_JSON_BYTES, StudioError, read_bytes_bounded, read_json, read_toml
+from studio import (
+    MAX_JSON_BYTES,
+    StudioError,
+    is_loopback,
+    read_bytes_bounded,
+    read_json,
+    read_toml,
+)
 
 from ._arm import ArmGrid
 from ._config import DynaQConfig
@@ -1187,7 +1193,7 @@ def _connect(ray: Any, address: str | None, workers: int | None) -> bool:
         cpus = workers or os.cpu_count() or 1
         ray.init(address="local", num_cpus=cpus, include_dashboard=False, **quiet)
         node_ip = ray.util.get_node_ip_address()
-        if not ipaddress.ip_address(node_ip).is_loopback:  # Ray imported before the switch was set
+        if not is_loopback(node_ip):  # Ray was imported before the switch was set
             ray.shutdown()
             raise SweepError(
                 f"The local Ray would listen on {node_ip}, beyond this machine; run the sweep in a new process (studio sweep), or join a cluster you secured with --address."

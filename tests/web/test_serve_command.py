@@ -189,3 +189,13 @@ def test_two_studios_each_embed_their_own_scene(tmp_path):
             proc.terminate()
         for proc in procs:
             proc.wait(timeout=20)
+
+
+def test_a_data_folder_under_a_missing_folder_is_refused_not_created(tmp_path):
+    from studio.web._serve import ServeError, prepare_data_dir
+
+    with pytest.raises(ServeError, match="does not exist; create it first"):
+        prepare_data_dir(tmp_path / "missing" / "data")
+    assert not (tmp_path / "missing").exists()
+    prepare_data_dir(tmp_path / "data")  # the last level is created, with its subfolders
+    assert (tmp_path / "data" / "recordings").is_dir()
