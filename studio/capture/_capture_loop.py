@@ -133,6 +133,8 @@ def describe(summary: dict[str, Any]) -> str:
         lines.append(f"  notes     {summary['notes']}")
     for problem in summary["problems"]:
         lines.append(f"  problem   {problem}")
+    for warning in summary.get("warnings", []):
+        lines.append(f"  warning   {warning}")
     return "\n".join(lines)
 
 

@@ -56,6 +56,8 @@ class Recording:
         recovered: the capture was interrupted (no ``# end`` line); the flushed frames are here.
         problems: what was skipped when read with ``strict=False`` (``"line 12: ..."``).
         end: the ``# end`` line's data, or ``None``.
+        warnings: what loads but looks wrong: negative times, or times that go backwards (a
+            sender's clock that jumped); the frames are kept as they are.
     """
 
     path: Path
@@ -68,6 +70,7 @@ class Recording:
     recovered: bool = False
     problems: list[str] = field(default_factory=list)
     end: dict[str, Any] | None = None
+    warnings: list[str] = field(default_factory=list)
 
     def __len__(self) -> int:
         return int(self.t.shape[0])
@@ -123,7 +126,13 @@ class Recording:
     def summary(self) -> dict[str, Any]:
         """JSON-ready facts for listings (``studio info``, the web page)."""
         return _summary(
-            self.path, self.meta, len(self), self.duration, self.recovered, self.problems
+            self.path,
+            self.meta,
+            len(self),
+            self.duration,
+            self.recovered,
+            self.problems,
+            self.warnings,
         )
 
 
@@ -246,6 +255,25 @@ class _Scan:
     last_t: float | None = None
     end: dict[str, Any] | None = None
     problems: list[str] = field(default_factory=list)
+    negative: int = 0
+    first_negative: int | None = None
+    backwards: int = 0
+    first_backward: tuple[int, float, float] | None = None
+
+    @property
+    def warnings(self) -> list[str]:
+        """The time checks' findings as sentences (see :attr:`Recording.warnings`)."""
+        out = []
+        if self.negative:
+            out.append(
+                f"{self.negative} frame{'s' if self.negative > 1 else ''} with a negative time (first at line {self.first_negative}); the frames are kept as recorded"
+            )
+        if self.first_backward is not None:
+            line, t, before = self.first_backward
+            out.append(
+                f"time goes backwards {self.backwards} time{'s' if self.backwards > 1 else ''} (first at line {line}: {t:.3f} s after {before:.3f} s), so durations and cuts may be wrong; check the sender's clock"
+            )
+        return out
 
     @property
     def duration(self) -> float:
@@ -405,12 +433,30 @@ def _scan_block(
             problems.add(row_lines[i], what)
         data = data[good]
     if data.shape[0]:
+        _check_times(data[:, 0], np.asarray(row_lines)[good], scan)
         if scan.first_t is None:
             scan.first_t = float(data[0, 0])
         scan.last_t = float(data[-1, 0])
         scan.count += int(data.shape[0])
         if scan.keep_rows:
             scan.blocks.append(data)
+
+
+def _check_times(t: np.ndarray, lines: Any, scan: _Scan) -> None:
+    """Count negative times and steps back in time (from the previous block's last time on)."""
+    negative = np.flatnonzero(t < 0)
+    if negative.size:
+        scan.negative += int(negative.size)
+        if scan.first_negative is None:
+            scan.first_negative = int(lines[negative[0]])
+    before = np.concatenate([[scan.last_t], t[:-1]]) if scan.last_t is not None else t[:-1]
+    after = t if scan.last_t is not None else t[1:]
+    back = np.flatnonzero(after < before)
+    if back.size:
+        scan.backwards += int(back.size)
+        if scan.first_backward is None:
+            i = int(back[0]) + (0 if scan.last_t is not None else 1)
+            scan.first_backward = (int(lines[i]), float(t[i]), float(before[back[0]]))
 
 
 def read_recording(path: str | os.PathLike[str], strict: bool = True) -> Recording:
@@ -449,6 +495,7 @@ def read_recording(path: str | os.PathLike[str], strict: bool = True) -> Recordi
         recovered=scan.end is None,
         problems=scan.problems,
         end=scan.end,
+        warnings=scan.warnings,
     )
 
 
@@ -462,7 +509,9 @@ def summarize_recording(path: str | os.PathLike[str], strict: bool = True) -> di
     """
     path = Path(path)
     scan = _scan(path, strict, keep_rows=False)
-    return _summary(path, scan.meta, scan.count, scan.duration, scan.end is None, scan.problems)
+    return _summary(
+        path, scan.meta, scan.count, scan.duration, scan.end is None, scan.problems, scan.warnings
+    )
 
 
 class RecordingBytes:
@@ -532,6 +581,7 @@ def _summary(
     duration: float,
     recovered: bool,
     problems: list[str],
+    warnings: list[str],
 ) -> dict[str, Any]:
     """The JSON-ready facts of a recording (one definition for both readers)."""
     return {
@@ -547,6 +597,7 @@ def _summary(
         "created": meta.get("created", ""),
         "recovered": recovered,
         "problems": list(problems),
+        "warnings": list(warnings),
     }
 
 

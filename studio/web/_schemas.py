@@ -181,6 +181,9 @@ class RecordingPublic(BaseModel):
     size_bytes: int
     sample: bool
     error: str | None = None
+    warnings: list[str] = Field(
+        default_factory=list, description="what loads but looks wrong (times going backwards)"
+    )
 
 
 class RecordingCopy(_Body):

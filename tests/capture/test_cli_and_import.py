@@ -211,3 +211,15 @@ def test_record_creates_only_the_last_folder_of_out(tmp_path, capsys):
     out = tmp_path / "new" / "x.tape.csv"  # one new level is what --out asks for
     assert main(["record", "--seconds", "0.1", "--out", str(out)]) == 0
     assert len(read_recording(out)) == 11
+
+
+def test_info_shows_a_demonstrations_times_in_seconds_and_its_fit_in_millimetres(capsys):
+    from studio.samples import SAMPLES_DIR
+
+    assert main(["info", str(SAMPLES_DIR / "sample-reach-2.demo.json")]) == 0
+    out = capsys.readouterr().out
+    assert "segment       1.000 s to 3.491 s (2.491 s)" in out
+    assert "reached_at    2.255 s" in out and "residual_max  9.7 mm" in out
+    assert "3.4909090909090907" not in out and "np.float64" not in out
+    assert main(["info", "--json", str(SAMPLES_DIR / "sample-reach-2.demo.json")]) == 0
+    assert json.loads(capsys.readouterr().out)["segment"] == [1.0, 3.4909090909090907]

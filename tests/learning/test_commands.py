@@ -30,6 +30,18 @@ from studio.web import create_app
 from tests.web.conftest import TINY_RUN, make_settings, wait_run
 
 
+def test_the_readme_and_the_help_count_the_configurations_reproduce_writes() -> None:
+    words = {1: "one", 6: "six", 7: "seven"}
+    readme = (Path(__file__).resolve().parents[2] / "README.md").read_text()
+    line = next(row for row in readme.splitlines() if row.startswith("studio reproduce"))
+    paper, beyond = words[len(CONFIGURATIONS)], words[len(EXTENSIONS)]
+    assert f"{paper} configurations and {beyond} beyond it" in line, line
+    from studio.commands import reproduce as command
+
+    total = words[len(CONFIGURATIONS) + len(EXTENSIONS)]
+    assert f"{paper} Dyna-Q configurations" in command.HELP and f"({total})" in command.HELP
+
+
 def test_reproduce_tiny_budget(tmp_path, capsys) -> None:
     out = tmp_path / "repro"
     code = main(

@@ -267,3 +267,13 @@ def test_a_chunked_upload_is_stopped_at_the_limit(
     assert "over the limit" in body.decode()
     assert read <= limit + MULTIPART_OVERHEAD_BYTES + len(chunk)
     assert list((tmp_path / "recordings").iterdir()) == []
+
+
+def test_the_api_doc_gives_the_status_a_missing_token_gets(
+    open_client: Callable[..., TestClient],
+) -> None:
+    client = open_client(token="t0k-en")
+    status = client.get("/api/config").status_code
+    doc = (Path(__file__).resolve().parents[2] / "docs" / "api.md").read_text()
+    assert f"{status}: a missing or wrong token" in doc
+    assert "401" not in doc  # no status the studio never answers

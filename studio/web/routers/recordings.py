@@ -46,6 +46,7 @@ def recording_public(entry: StoredFile[dict[str, Any]]) -> RecordingPublic:
         size_bytes=entry.size_bytes,
         sample=entry.sample,
         error=entry.error,
+        warnings=summary.get("warnings") or [],
     )
 
 
