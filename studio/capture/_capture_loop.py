@@ -8,6 +8,8 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+from studio import StudioError
+
 from ._errors import CaptureError
 from ._recording_format import DEFAULT_RATE_HZ, DEFAULT_REGIONS
 from ._recording_writer import RecordingWriter
@@ -47,7 +49,8 @@ def capture(
         on_progress: called with ``(frames written, source status)`` after each batch.
         stop: polled after each batch; true ends the capture.
         give_up_seconds: end with an error when no frame arrives for this long (a network
-            sender that never starts or went away); a capture that got no frame leaves no file.
+            sender that never starts or went away). A capture that fails before its first frame
+            leaves no file.
 
     Returns:
         The recording's path.
@@ -71,7 +74,15 @@ def capture(
         source=source_name or source.kind,
     )
     first_t: float | None = None
-    silent = False
+    failed = False
+
+    def kept() -> str:
+        return (
+            f"{writer.frames} frames kept in {writer.path}"
+            if writer.frames
+            else "nothing was recorded"
+        )
+
     try:
         source.start()
         last_frame = time.monotonic()
@@ -88,17 +99,11 @@ def capture(
             if on_progress is not None:
                 on_progress(writer.frames, status)
             if status.error and not status.running:  # a running source may recover (network)
-                raise CaptureError(f"{status.error} ({writer.frames} frames kept in {writer.path})")
+                raise CaptureError(f"{status.error} ({kept()})")
             quiet = time.monotonic() - last_frame
             if give_up_seconds is not None and quiet >= give_up_seconds:
-                silent = True
-                kept = (
-                    f"{writer.frames} frames kept in {writer.path}"
-                    if writer.frames
-                    else "nothing was recorded"
-                )
                 raise CaptureError(
-                    f"no frame arrived from the {source.kind} source for {quiet:.0f} s, so the capture gave up ({kept}); start the sender first (for the network bridge: studio bridge --to HOST:PORT)."
+                    f"no frame arrived from the {source.kind} source for {quiet:.0f} s, so the capture gave up ({kept()}); start the sender first (for the network bridge: studio bridge --to HOST:PORT)."
                 )
             if (
                 seconds is not None
@@ -110,10 +115,13 @@ def capture(
                 break
             if stop is not None and stop():
                 break
+    except StudioError:
+        failed = True
+        raise
     finally:
         source.stop()
         writer.close()
-        if silent and writer.frames == 0:  # an empty recording would only clutter the list
+        if failed and writer.frames == 0:  # a capture that got no frame leaves no empty file
             writer.path.unlink(missing_ok=True)
     return writer.path
 

@@ -223,3 +223,10 @@ def test_info_shows_a_demonstrations_times_in_seconds_and_its_fit_in_millimetres
     assert "3.4909090909090907" not in out and "np.float64" not in out
     assert main(["info", "--json", str(SAMPLES_DIR / "sample-reach-2.demo.json")]) == 0
     assert json.loads(capsys.readouterr().out)["segment"] == [1.0, 3.4909090909090907]
+
+
+def test_record_beyond_loopback_needs_a_token_and_leaves_no_file(tmp_path, capsys, monkeypatch):
+    monkeypatch.delenv("STUDIO_TOKEN", raising=False)
+    out = tmp_path / "x.tape.csv"
+    assert main(["record", "--source", "udp:0.0.0.0:0", "--out", str(out)]) == 2
+    assert "needs a token" in _one_sentence(capsys, "record") and not out.exists()
