@@ -39,7 +39,7 @@ import re
 import shutil
 import socket
 import time
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any
@@ -166,7 +166,8 @@ a single-machine Ray: the node's address is then loopback, so the GCS, the rayle
 the agents all listen on 127.0.0.1 only. Without it every one of them listens on all interfaces,
 and anyone who reaches the machine could join the Ray and run code as the user. (Ray turns
 ``ray.init(_node_ip_address="127.0.0.1")`` back into the machine's network address, so that is no
-way to do it.) The workers a local Ray starts inherit the driver's environment."""
+way to do it.) Set while Ray is imported and while it starts its processes, which inherit it;
+then put back, so that nothing else the process starts inherits it."""
 
 
 class SweepError(LearningError):
@@ -1153,15 +1154,30 @@ def _set_ray_environment() -> None:
         os.environ.setdefault(key, value)
 
 
+@contextlib.contextmanager
+def _environment(values: Mapping[str, str]) -> Iterator[None]:
+    """``values`` set in this process's environment for the block, then put back as they were
+    (so that nothing else this process starts, e.g. a later ``ray start``, inherits them)."""
+    before = {key: os.environ.get(key) for key in values}
+    os.environ.update(values)
+    try:
+        yield
+    finally:
+        for key, value in before.items():
+            if value is None:
+                os.environ.pop(key, None)
+            else:
+                os.environ[key] = value
+
+
 def _import_ray(local: bool = False) -> Any:
     """Import Ray (with :data:`RAY_ENVIRONMENT` set); ``local``: the sweep starts its own Ray, on
-    loopback only (:data:`LOCAL_RAY_ENVIRONMENT`)."""
+    loopback only (:data:`LOCAL_RAY_ENVIRONMENT`, read by Ray when it is imported)."""
     _set_ray_environment()
-    if local:
-        os.environ.update(LOCAL_RAY_ENVIRONMENT)
     try:
-        import ray
-        from ray import tune  # noqa: F401
+        with _environment(LOCAL_RAY_ENVIRONMENT if local else {}):
+            import ray
+            from ray import tune  # noqa: F401
     except ImportError:
         raise SweepError(f"Sweeps run on Ray Tune, which is not installed; {RAY_HINT}.") from None
     return ray
@@ -1191,7 +1207,8 @@ def _connect(ray: Any, address: str | None, workers: int | None) -> bool:
     quiet = {"log_to_driver": False, "configure_logging": True, "logging_level": "ERROR"}
     if address is None:
         cpus = workers or os.cpu_count() or 1
-        ray.init(address="local", num_cpus=cpus, include_dashboard=False, **quiet)
+        with _environment(LOCAL_RAY_ENVIRONMENT):  # the processes it starts inherit it
+            ray.init(address="local", num_cpus=cpus, include_dashboard=False, **quiet)
         node_ip = ray.util.get_node_ip_address()
         if not is_loopback(node_ip):  # Ray was imported before the switch was set
             ray.shutdown()

@@ -432,8 +432,8 @@ def test_a_running_sweep_listens_on_loopback_only_and_cannot_be_resumed_twice(
     require(ray is not None, "ray[tune] is not installed (pip install -e '.[cluster]')")
     spec_path = write_spec(
         tmp_path / "long.toml",
-        'task = "arm-grid"\nseeds = [0]\nexperiments = 1\nepisodes = 5000\n'
-        '[fixed]\nplanning_steps = 100\n[space]\nplanning = ["full"]\n',
+        'task = "arm-grid"\nseeds = [0]\nexperiments = 4\nepisodes = 100000\n'
+        '[fixed]\nplanning_steps = 1000\n[space]\nplanning = ["full"]\n',
     )  # fmt: skip
     data = tmp_path / "data"
     env = {**os.environ, "RAY_USAGE_STATS_ENABLED": "0"}
