@@ -15,6 +15,7 @@ import pkgutil
 import sys
 from collections.abc import Sequence
 from types import ModuleType
+from typing import NoReturn
 
 from . import __version__, commands
 from ._errors import StudioError
@@ -32,9 +33,17 @@ def _verb_modules() -> dict[str, ModuleType]:
     return modules
 
 
+class _Parser(argparse.ArgumentParser):
+    """An argument parser whose usage errors are one line: the problem and where help is (not
+    argparse's usage block, which buries the one line that matters)."""
+
+    def error(self, message: str) -> NoReturn:
+        self.exit(2, f"{self.prog}: {message}; see {self.prog} --help.\n")
+
+
 def build_parser() -> tuple[argparse.ArgumentParser, dict[str, ModuleType]]:
     """The argument parser with one sub-parser per verb."""
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="studio",
         description="Teach Studio: teach a robot arm by showing it a motion. "
         f"With no verb, runs `studio {DEFAULT_VERB}`.",
@@ -54,7 +63,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser, modules = build_parser()
     if not argv or (argv[0].startswith("-") and argv[0] not in ("-h", "--help", "--version")):
         argv = [DEFAULT_VERB, *argv]
-    args = parser.parse_args(argv)
+    args, unknown = parser.parse_known_args(argv)
+    if unknown:
+        where = f"studio {args.verb}"
+        parser.exit(
+            2, f"{where}: unrecognized arguments: {' '.join(unknown)}; see {where} --help.\n"
+        )
     try:
         return int(modules[args.verb].run(args) or 0)
     except StudioError as err:

@@ -60,3 +60,22 @@ def test_train_finds_a_demonstration_by_name_from_a_fresh_data_folder(tmp_path, 
         == [mine.grid_path]
         != [load_demonstration(SAMPLES_DIR / "sample-reach-2.demo.json").grid_path]
     )
+
+
+@pytest.mark.parametrize(
+    ("argv", "says"),
+    [
+        (["record", "--seconds", "x", "--out", "x.tape.csv"], "studio record: argument --seconds"),
+        (["record"], "studio record: the following arguments are required: --out"),
+        (["record", "--out", "x.tape.csv", "--bogus"], "studio record: unrecognized arguments"),
+        (["no-such-verb"], "studio: argument VERB: invalid choice"),
+    ],
+)
+def test_a_usage_error_is_one_line_pointing_to_help(argv, says, capsys) -> None:
+    with pytest.raises(SystemExit) as exc:
+        main(argv)
+    assert exc.value.code == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith(says), err
+    verb = "studio" if argv[0] == "no-such-verb" else f"studio {argv[0]}"
+    assert err.rstrip().endswith(f"see {verb} --help."), err

@@ -3,15 +3,19 @@
 from __future__ import annotations
 
 import os
+import time
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
+
+from studio import StudioError
 
 from ._errors import CaptureError
 from ._observation_recording import ObservationWriter
 from ._recording_format import DEFAULT_RATE_HZ, DEFAULT_REGIONS
 from ._recording_writer import AppendWriter, RecordingWriter
 from ._source import SourceStatus, ThreadedSource
+from ._source_spec import check_seconds
 
 READ_TIMEOUT_SECONDS = 0.1
 """How long one read waits for frames (bounds how late a stop request is seen)."""
@@ -27,6 +31,7 @@ def capture(
     source_name: str | None = None,
     on_progress: Callable[[int, SourceStatus], None] | None = None,
     stop: Callable[[], bool] | None = None,
+    give_up_seconds: float | None = None,
 ) -> Path:
     """Record ``source`` into a new recording until ``seconds`` of frames, its end, or ``stop()``.
 
@@ -37,19 +42,27 @@ def capture(
         source: an unstarted source (started and stopped here).
         out: the new ``*.tape.csv`` file (``*.pose.csv``, ``*.hand.csv`` for a source of
             landmarks or hand poses).
-        seconds: frames' duration to record (``None``: until the source ends or ``stop()``).
+        seconds: the duration of frames to record, by the frames' own time stamps from the first
+            frame on; waiting for a first frame does not count (``None``: until the source ends
+            or ``stop()``).
         operator: who wore the tape.
         notes: free text.
         source_name: stored in the header (default: the source's kind).
         on_progress: called with ``(frames written, source status)`` after each batch.
         stop: polled after each batch; true ends the capture.
+        give_up_seconds: end with an error when no frame arrives for this long (a network
+            sender that never starts or went away). A capture that fails before its first frame
+            leaves no file.
 
     Returns:
         The recording's path.
 
     Raises:
-        CaptureError: the source failed (the frames up to then are kept in the file).
+        CaptureError: the source failed or went silent for ``give_up_seconds`` (the frames up to
+            then are kept in the file), or a bad ``seconds``.
     """
+    check_seconds(seconds)
+    check_seconds(give_up_seconds, "the wait for frames")
     config = getattr(source, "config", None)
     regions = int(getattr(config, "regions", DEFAULT_REGIONS) or DEFAULT_REGIONS)
     rate = float(getattr(source, "rate_hz", DEFAULT_RATE_HZ) or DEFAULT_RATE_HZ)
@@ -71,11 +84,22 @@ def capture(
             out, kind, side=side, operator=operator, notes=notes, source=source_name or source.kind
         )
     first_t: float | None = None
+    failed = False
+
+    def kept() -> str:
+        return (
+            f"{writer.frames} frames kept in {writer.path}"
+            if writer.frames
+            else "nothing was recorded"
+        )
+
     try:
         source.start()
+        last_frame = time.monotonic()
         while True:
             frames = source.read(timeout=READ_TIMEOUT_SECONDS)
             if frames:
+                last_frame = time.monotonic()
                 if first_t is None:
                     first_t = frames[0].t
                 if seconds is not None:
@@ -85,7 +109,12 @@ def capture(
             if on_progress is not None:
                 on_progress(writer.frames, status)
             if status.error and not status.running:  # a running source may recover (network)
-                raise CaptureError(f"{status.error} ({writer.frames} frames kept in {writer.path})")
+                raise CaptureError(f"{status.error} ({kept()})")
+            quiet = time.monotonic() - last_frame
+            if give_up_seconds is not None and quiet >= give_up_seconds:
+                raise CaptureError(
+                    f"no frame arrived from the {source.kind} source for {quiet:.0f} s, so the capture gave up ({kept()}); start the sender first (for the network bridge: studio bridge --to HOST:PORT)."
+                )
             if (
                 seconds is not None
                 and first_t is not None
@@ -96,9 +125,14 @@ def capture(
                 break
             if stop is not None and stop():
                 break
+    except StudioError:
+        failed = True
+        raise
     finally:
         source.stop()
         writer.close()
+        if failed and writer.frames == 0:  # a capture that got no frame leaves no empty file
+            writer.path.unlink(missing_ok=True)
     return writer.path
 
 
@@ -117,6 +151,8 @@ def describe(summary: dict[str, Any]) -> str:
         lines.append(f"  notes     {summary['notes']}")
     for problem in summary["problems"]:
         lines.append(f"  problem   {problem}")
+    for warning in summary.get("warnings", []):
+        lines.append(f"  warning   {warning}")
     return "\n".join(lines)
 
 

@@ -178,27 +178,59 @@ def load_demonstration(path: str | os.PathLike[str]) -> Demonstration:
             f"{path} has demonstration version {data.get('version')!r}; this studio reads 1 to {DEMO_VERSION}, update Teach Studio.",
             "bad_file",
         )
+    fit = data.get("fit", {})
+
+    def read(key: str, what: str, convert: Any, value: Any = None) -> Any:
+        """``convert`` of field ``key`` (or of ``value``, a part of it); numbers must be finite."""
+        try:
+            out = convert(data[key] if value is None else value)
+            numeric = convert not in (dict, _text)
+            finite = not numeric or np.isfinite(np.asarray(out, dtype=np.float64)).all()
+        except (KeyError, IndexError, TypeError, ValueError, OverflowError):
+            finite = None
+        if not finite:
+            problem = (
+                "is missing or is not" if finite is None else "holds NaN or infinite values in"
+            )
+            raise DemonstrationError(
+                f"{path}: {key} {problem} {what}; re-extract the demonstration.", "bad_file"
+            )
+        return out
+
+    trajectory = read("trajectory", "a table of t and q_robot", dict)
+    times = read("trajectory", "a list of times in seconds (t)", _floats, trajectory.get("t"))
+    q_robot = read(
+        "trajectory",
+        "rows of 6 robot joint angles (q_robot)",
+        _joint_rows,
+        trajectory.get("q_robot"),
+    )
+    reached_at = data.get("reached_at")
     try:
-        trajectory = data["trajectory"]
         demo = Demonstration(
-            recording=path.with_name(data["recording"]),
-            t0=float(data["segment"][0]),
-            t1=float(data["segment"][1]),
-            times=np.asarray(trajectory["t"], dtype=np.float64),
-            q_robot=np.asarray(trajectory["q_robot"], dtype=np.float64).reshape(-1, 6),
-            grid_path=[int(s) for s in data["grid_path"]],
-            grid=dict(data["grid"]),
-            goal=tuple(int(b) for b in data["goal"]),
+            recording=path.with_name(read("recording", "a recording's file name", _text)),
+            t0=float(read("segment", "two times in seconds", _floats)[0]),
+            t1=float(read("segment", "two times in seconds", _floats)[1]),
+            times=times,
+            q_robot=q_robot,
+            grid_path=read("grid_path", "a list of whole grid states", _whole_numbers),
+            grid=read("grid", "a table of grid settings", dict),
+            goal=tuple(read("goal", "whole grid bins, one per joint", _whole_numbers)),
             mode=str(data.get("mode", "joint")),
-            reached_at=data.get("reached_at"),
-            residual_max=float(data.get("fit", {}).get("residual_max", 0.0)),
-            residual_mean=float(data.get("fit", {}).get("residual_mean", 0.0)),
+            reached_at=None if reached_at is None else float(read("reached_at", "a time", float)),
+            residual_max=float(
+                read("fit", "residuals in metres", float, fit.get("residual_max", 0))
+            ),
+            residual_mean=float(
+                read("fit", "residuals in metres", float, fit.get("residual_mean", 0))
+            ),
             name=str(data.get("name", "")),
             created=str(data.get("created", "")),
         )
-    except (KeyError, IndexError, TypeError, ValueError) as err:
+    except IndexError:  # a segment of fewer than two times
         raise DemonstrationError(
-            f"{path} lacks or garbles a field ({err}); re-extract the demonstration.", "bad_file"
+            f"{path}: segment is missing or is not two times in seconds; re-extract the demonstration.",
+            "bad_file",
         ) from None
     if demo.q_robot.shape[0] > 0:
         # The grid path is derived from the trajectory by the one path function; a file written
@@ -214,6 +246,32 @@ def load_demonstration(path: str | os.PathLike[str]) -> Demonstration:
         if trace.reaches_goal and trace.steps >= 1:
             demo.grid_path = trace.states
     return demo
+
+
+def _floats(value: Any) -> np.ndarray:
+    if not isinstance(value, list) or any(isinstance(v, str | bool) for v in value):
+        raise TypeError("not a list of numbers")
+    return np.asarray(value, dtype=np.float64)
+
+
+def _joint_rows(value: Any) -> np.ndarray:
+    if not isinstance(value, list) or any(not isinstance(row, list) for row in value):
+        raise TypeError("not a list of rows")
+    rows = [_floats(row) for row in value]
+    return np.asarray(rows, dtype=np.float64).reshape(-1, 6)
+
+
+def _whole_numbers(value: Any) -> list[int]:
+    numbers = _floats(value)
+    if not np.isfinite(numbers).all() or (numbers != np.round(numbers)).any():
+        raise ValueError("not whole numbers")
+    return [int(v) for v in numbers]
+
+
+def _text(value: Any) -> str:
+    if not isinstance(value, str):
+        raise TypeError("not text")
+    return value
 
 
 def extract_demonstration(

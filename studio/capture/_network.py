@@ -9,6 +9,10 @@ So is a well-formed datagram of another tape: the stream's region count is fixed
 has a fixed width.
 UDP has no connection to lose: while no datagram arrives for :data:`SILENCE_SECONDS`, the
 source keeps listening and ``status().error`` says so; the first datagram clears it.
+
+The source listens on loopback unless told otherwise. Listening beyond loopback needs a token:
+then only datagrams signed with it (:func:`._wire.bridge_key`) are taken, since anyone who
+reaches the port could otherwise drive the live tape and so what is recorded.
 """
 
 from __future__ import annotations
@@ -16,10 +20,13 @@ from __future__ import annotations
 import socket
 import time
 
+from studio import is_loopback
+
 from ._errors import CaptureError
 from ._frames import TapeFrame
 from ._source import DEFAULT_QUEUE_FRAMES, ThreadedSource
-from ._wire import DEFAULT_PORT, WireError, decode_frame, encode_frame
+from ._source_spec import check_seconds
+from ._wire import DEFAULT_PORT, WireError, bridge_key, decode_frame, encode_frame
 
 RECEIVE_POLL_SECONDS = 0.1
 """Socket timeout: how quickly the receiver notices a stop request."""
@@ -35,14 +42,18 @@ class NetworkSource(ThreadedSource):
     """Tape frames from UDP datagrams (wire format in :mod:`studio.capture._wire`).
 
     Args:
-        host: address to listen on (loopback by default; ``"0.0.0.0"`` for a device on the LAN).
+        host: address to listen on (loopback by default; ``"0.0.0.0"`` for a device on the LAN,
+            which needs a ``token``).
         port: UDP port (0 picks a free one; see :attr:`address`).
         config: the tape config the frames belong to; its ``regions`` fixes the region count
             every datagram must have (default: the first datagram's count).
         queue_frames: frames buffered before dropping.
+        token: when given, only datagrams signed with it are taken (``studio bridge --token``,
+            :class:`FrameSender` ``token=``); required to listen beyond loopback.
 
     Raises:
-        CaptureError: from :meth:`start` when the port cannot be bound.
+        CaptureError: from :meth:`start` when the port cannot be bound, or the host is not
+            loopback and there is no token.
     """
 
     kind = "network"
@@ -53,10 +64,12 @@ class NetworkSource(ThreadedSource):
         port: int = DEFAULT_PORT,
         config: object = None,
         queue_frames: int = DEFAULT_QUEUE_FRAMES,
+        token: str | None = None,
     ) -> None:
         super().__init__(queue_frames)
         self.host, self.port = host, int(port)
         self.config = config
+        self._key = bridge_key(token) if token else None
         self._sock: socket.socket | None = None
         self._last_counter: int | None = None
         self._regions: int | None = None
@@ -78,6 +91,10 @@ class NetworkSource(ThreadedSource):
         self._regions = None  # a restarted stream may come from another tape
         if self._sock is not None:
             return
+        if self._key is None and not is_loopback(self.host):
+            raise CaptureError(
+                f"listening for tape frames on UDP {self.host} opens the bridge to other machines, which needs a token to sign the frames; give one (studio record --token, and the same to studio bridge --token), or listen on 127.0.0.1."
+            )
         sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
         sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 1 << 20)
         try:
@@ -124,7 +141,7 @@ class NetworkSource(ThreadedSource):
                 with self._lock:
                     self._error = None  # the sender is back
             try:
-                frame = decode_frame(data)
+                frame = decode_frame(data, self._key)
             except WireError as err:
                 self._reject(f"rejected a datagram from {sender[0]}:{sender[1]}: {err}.")
                 continue
@@ -151,16 +168,38 @@ class FrameSender:
     Args:
         host: the receiver's address.
         port: the receiver's UDP port.
+        token: the receiving studio's token: every datagram is signed with it (a source
+            listening beyond loopback takes only signed frames).
     """
 
-    def __init__(self, host: str = "127.0.0.1", port: int = DEFAULT_PORT) -> None:
-        self.target = (host, int(port))
+    def __init__(
+        self, host: str = "127.0.0.1", port: int = DEFAULT_PORT, token: str | None = None
+    ) -> None:
+        try:
+            found = socket.getaddrinfo(host, int(port), socket.AF_INET, socket.SOCK_DGRAM)
+        except (OSError, OverflowError, UnicodeError) as err:  # gaierror is an OSError
+            reason = getattr(err, "strerror", None) or err
+            raise CaptureError(
+                f"{host}:{port} is not an address to send to ({reason}); give the receiver's HOST:PORT, e.g. 127.0.0.1:{DEFAULT_PORT}."
+            ) from None
+        self.target = found[0][4]
+        self._key = bridge_key(token) if token else None
         self._sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
         self.sent = 0
 
     def send(self, frame: TapeFrame) -> None:
-        """Send one frame as one datagram."""
-        self._sock.sendto(encode_frame(frame), self.target)
+        """Send one frame as one datagram.
+
+        Raises:
+            CaptureError: the datagram cannot be sent (no route to the receiver, ...).
+        """
+        try:
+            self._sock.sendto(encode_frame(frame, self._key), self.target)
+        except OSError as err:
+            host, port = self.target
+            raise CaptureError(
+                f"cannot send to {host}:{port} ({err.strerror or err}); check the address and the network."
+            ) from None
         self.sent += 1
 
     def close(self) -> None:
@@ -180,6 +219,7 @@ def stream_source(
     port: int,
     seconds: float | None = None,
     on_frames: object = None,
+    token: str | None = None,
 ) -> int:
     """Forward every frame of ``source`` to ``host:port`` until it ends or ``seconds`` pass.
 
@@ -189,6 +229,7 @@ def stream_source(
         port: the receiver's UDP port.
         seconds: how long to stream (``None``: until the source ends).
         on_frames: optional callable given each batch of frames sent (for progress).
+        token: the receiving studio's token, to sign every frame with (see :class:`FrameSender`).
 
     Returns:
         Frames sent.
@@ -196,8 +237,9 @@ def stream_source(
     Raises:
         CaptureError: the source reported an error.
     """
+    seconds = check_seconds(seconds)
     deadline = None if seconds is None else time.monotonic() + seconds
-    with FrameSender(host, port) as sender:
+    with FrameSender(host, port, token) as sender:
         source.start()
         try:
             while deadline is None or time.monotonic() < deadline:

@@ -51,6 +51,7 @@ from ._recording_reader import (
     _short,
     _summary,
     _whole,
+    array_time_warnings,
     read_recording,
     summarize_recording,
 )
@@ -193,6 +194,7 @@ class ObservationRecording(RecordingTimeline):
             self.duration,
             self.recovered,
             self.problems,
+            array_time_warnings(self.t),
             self.kind.name,
         )
 

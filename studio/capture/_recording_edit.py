@@ -31,6 +31,7 @@ from ._recording_format import (
     header_line,
 )
 from ._recording_reader import READ_BLOCK_BYTES, Recording, _first_line, _open
+from ._recording_writer import make_folder_of
 
 EDITABLE_KEYS = ("name", "operator", "notes")
 """Header keys :func:`update_recording_meta` may change (the rest describe the data)."""
@@ -238,7 +239,7 @@ def write_recording(
         )
     if path.exists() and not overwrite:
         raise RecordingError(f"{path} already exists; choose another file name.")
-    path.parent.mkdir(parents=True, exist_ok=True)
+    make_folder_of(path)
     parts = [header_line(meta), ",".join(columns(regions)) + "\n"]
     parts.extend(format_row(t[i], frame[i], status[i], bend[i], twist[i]) for i in range(n))
     duration = float(t[-1] - t[0]) if n >= 2 else 0.0

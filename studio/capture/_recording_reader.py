@@ -93,6 +93,8 @@ class Recording(RecordingTimeline):
         recovered: the capture was interrupted (no ``# end`` line); the flushed frames are here.
         problems: what was skipped when read with ``strict=False`` (``"line 12: ..."``).
         end: the ``# end`` line's data, or ``None``.
+        warnings: what loads but looks wrong: negative times, or times that go backwards (a
+            sender's clock that jumped); the frames are kept as they are.
     """
 
     path: Path
@@ -105,6 +107,7 @@ class Recording(RecordingTimeline):
     recovered: bool = False
     problems: list[str] = field(default_factory=list)
     end: dict[str, Any] | None = None
+    warnings: list[str] = field(default_factory=list)
 
     @property
     def regions(self) -> int:
@@ -135,7 +138,13 @@ class Recording(RecordingTimeline):
     def summary(self) -> dict[str, Any]:
         """JSON-ready facts for listings (``studio info``, the web page)."""
         return _summary(
-            self.path, self.meta, len(self), self.duration, self.recovered, self.problems
+            self.path,
+            self.meta,
+            len(self),
+            self.duration,
+            self.recovered,
+            self.problems,
+            self.warnings,
         )
 
 
@@ -233,6 +242,45 @@ def _parse_header(path: Path, line: str) -> dict[str, Any]:
     return meta
 
 
+def time_warnings(
+    negative: int,
+    first_negative: str | None,
+    backwards: int,
+    first_backward: tuple[str, float, float] | None,
+) -> list[str]:
+    """The sentences for times below zero or going backwards (every recording kind's one wording).
+
+    Args:
+        negative: how many frames have a negative time; ``first_negative`` where the first is
+            (``"line 12"``).
+        backwards: how many times the time goes back; ``first_backward`` where the first is, its
+            time and the time before it.
+    """
+    out = []
+    if negative:
+        out.append(
+            f"{negative} frame{'s' if negative > 1 else ''} with a negative time (first at {first_negative}); the frames are kept as recorded"
+        )
+    if first_backward is not None:
+        where, t, before = first_backward
+        out.append(
+            f"time goes backwards {backwards} time{'s' if backwards > 1 else ''} (first at {where}: {t:.3f} s after {before:.3f} s), so durations and cuts may be wrong; check the sender's clock"
+        )
+    return out
+
+
+def array_time_warnings(t: np.ndarray) -> list[str]:
+    """:func:`time_warnings` of a whole column of times (frames counted from 0)."""
+    below = np.flatnonzero(t < 0)
+    back = np.flatnonzero(np.diff(t) < 0) + 1
+    first_back = (
+        None if not back.size else (f"frame {back[0]}", float(t[back[0]]), float(t[back[0] - 1]))
+    )
+    return time_warnings(
+        int(below.size), f"frame {below[0]}" if below.size else None, int(back.size), first_back
+    )
+
+
 TEXT_KEYS = ("name", "operator", "notes", "source", "created")
 """Header keys that hold text (a listing shows them as they are)."""
 
@@ -258,6 +306,20 @@ class _Scan:
     last_t: float | None = None
     end: dict[str, Any] | None = None
     problems: list[str] = field(default_factory=list)
+    negative: int = 0
+    first_negative: int | None = None
+    backwards: int = 0
+    first_backward: tuple[int, float, float] | None = None
+
+    @property
+    def warnings(self) -> list[str]:
+        """The time checks' findings as sentences (see :attr:`Recording.warnings`)."""
+        backward = None
+        if self.first_backward is not None:
+            line, t, before = self.first_backward
+            backward = (f"line {line}", t, before)
+        negative = None if self.first_negative is None else f"line {self.first_negative}"
+        return time_warnings(self.negative, negative, self.backwards, backward)
 
     @property
     def duration(self) -> float:
@@ -417,12 +479,30 @@ def _scan_block(
             problems.add(row_lines[i], what)
         data = data[good]
     if data.shape[0]:
+        _check_times(data[:, 0], np.asarray(row_lines)[good], scan)
         if scan.first_t is None:
             scan.first_t = float(data[0, 0])
         scan.last_t = float(data[-1, 0])
         scan.count += int(data.shape[0])
         if scan.keep_rows:
             scan.blocks.append(data)
+
+
+def _check_times(t: np.ndarray, lines: Any, scan: _Scan) -> None:
+    """Count negative times and steps back in time (from the previous block's last time on)."""
+    negative = np.flatnonzero(t < 0)
+    if negative.size:
+        scan.negative += int(negative.size)
+        if scan.first_negative is None:
+            scan.first_negative = int(lines[negative[0]])
+    before = np.concatenate([[scan.last_t], t[:-1]]) if scan.last_t is not None else t[:-1]
+    after = t if scan.last_t is not None else t[1:]
+    back = np.flatnonzero(after < before)
+    if back.size:
+        scan.backwards += int(back.size)
+        if scan.first_backward is None:
+            i = int(back[0]) + (0 if scan.last_t is not None else 1)
+            scan.first_backward = (int(lines[i]), float(t[i]), float(before[back[0]]))
 
 
 def read_recording(path: str | os.PathLike[str], strict: bool = True) -> Recording:
@@ -461,6 +541,7 @@ def read_recording(path: str | os.PathLike[str], strict: bool = True) -> Recordi
         recovered=scan.end is None,
         problems=scan.problems,
         end=scan.end,
+        warnings=scan.warnings,
     )
 
 
@@ -474,7 +555,9 @@ def summarize_recording(path: str | os.PathLike[str], strict: bool = True) -> di
     """
     path = Path(path)
     scan = _scan(path, strict, keep_rows=False)
-    return _summary(path, scan.meta, scan.count, scan.duration, scan.end is None, scan.problems)
+    return _summary(
+        path, scan.meta, scan.count, scan.duration, scan.end is None, scan.problems, scan.warnings
+    )
 
 
 class RecordingBytes:
@@ -544,6 +627,7 @@ def _summary(
     duration: float,
     recovered: bool,
     problems: list[str],
+    warnings: list[str],
     kind: str = "tape",
 ) -> dict[str, Any]:
     """The JSON-ready facts of a recording (one definition for every reader and kind)."""
@@ -561,6 +645,7 @@ def _summary(
         "created": meta.get("created", ""),
         "recovered": recovered,
         "problems": list(problems),
+        "warnings": list(warnings),
     }
 
 

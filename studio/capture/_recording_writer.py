@@ -45,6 +45,25 @@ HEADER_LINES = 2
 """The JSON header line and the column row come before the frames."""
 
 
+def make_folder_of(path: Path) -> None:
+    """Create the folder a new recording goes into: the last level only, so a mistyped path
+    (``/nonexistent/dir/x.tape.csv``) makes no tree of folders.
+
+    Raises:
+        RecordingError: its parent folder does not exist, or it cannot be created.
+    """
+    try:
+        path.parent.mkdir(exist_ok=True)
+    except FileNotFoundError:
+        raise RecordingError(
+            f"cannot create {path}: the folder {path.parent.parent} does not exist; create it first, or choose another place."
+        ) from None
+    except OSError as err:
+        raise RecordingError(
+            f"cannot create {path} ({err.strerror or err}); choose a writable folder."
+        ) from None
+
+
 def recording_meta(
     regions: int,
     *,
@@ -90,8 +109,8 @@ def _create_locked(path: Path) -> int:
     unlocked and takes it for an interrupted capture it may delete.
     """
     tmp = path.with_name(f".{path.name}.{secrets.token_hex(4)}.tmp")
+    make_folder_of(path)
     try:
-        path.parent.mkdir(parents=True, exist_ok=True)
         fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_APPEND, 0o644)
     except OSError as err:
         raise RecordingError(

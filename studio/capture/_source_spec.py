@@ -7,6 +7,7 @@ Specs: ``simulator`` (or ``simulator:SEED``), a recording path (``*.tape.csv``, 
 
 from __future__ import annotations
 
+import math
 import os
 from pathlib import Path
 from typing import Any
@@ -19,6 +20,8 @@ SOURCE_SPECS = (
     "simulator[:SEED] | FILE.tape.csv|.pose.csv|.hand.csv | udp[:[HOST:]PORT] | serial:PORT"
 )
 """What :func:`source_from_spec` accepts (for help texts)."""
+MAX_PORT = 65535
+"""The largest UDP port number."""
 
 
 def source_from_spec(
@@ -56,9 +59,11 @@ def source_from_spec(
             try:
                 port = int(port_part)
             except ValueError:
+                port = -1
+            if not 0 <= port <= MAX_PORT:
                 raise CaptureError(
-                    f"'{spec}' has no valid port; write udp:PORT or udp:HOST:PORT."
-                ) from None
+                    f"'{spec}' has no valid port; write udp:PORT or udp:HOST:PORT with a port from 0 to {MAX_PORT}."
+                )
         from ._network import NetworkSource
 
         return NetworkSource(host, port, **kwargs)
@@ -81,17 +86,33 @@ def parse_host_port(text: str, default_port: int = DEFAULT_PORT) -> tuple[str, i
     """``HOST:PORT`` (or ``HOST``, or ``:PORT``) as a tuple.
 
     Raises:
-        CaptureError: the port is not a number.
+        CaptureError: the port is not a number from 1 to 65535.
     """
     host, sep, port = text.rpartition(":")
     if not sep:
         return text or "127.0.0.1", default_port
     try:
-        return host or "127.0.0.1", int(port)
+        number = int(port)
     except ValueError:
+        number = 0
+    if not 1 <= number <= MAX_PORT:
         raise CaptureError(
-            f"'{text}' has no valid port; write HOST:PORT, e.g. 127.0.0.1:{default_port}."
-        ) from None
+            f"'{text}' has no valid port; write HOST:PORT with a port from 1 to {MAX_PORT}, e.g. 127.0.0.1:{default_port}."
+        )
+    return host or "127.0.0.1", number
+
+
+def check_seconds(seconds: float | None, what: str = "--seconds") -> float | None:
+    """A duration to capture or stream for: ``None`` (no limit) or a positive, finite number.
+
+    Raises:
+        CaptureError: zero, negative, NaN or infinite.
+    """
+    if seconds is not None and not (seconds > 0 and math.isfinite(seconds)):
+        raise CaptureError(
+            f"{what} is {seconds:g}; give a positive number of seconds, or leave it out to go on until Ctrl-C."
+        )
+    return seconds
 
 
 def cli_speed(speed: float) -> float | None:

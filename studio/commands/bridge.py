@@ -7,11 +7,21 @@ run ``studio bridge --source simulator --to 127.0.0.1:47110`` and pick the ``udp
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import time
 
 from studio import StudioError
-from studio.capture import DEFAULT_PORT, cli_speed, parse_host_port, source_from_spec, stream_source
+from studio.capture import (
+    DEFAULT_PORT,
+    check_seconds,
+    cli_speed,
+    parse_host_port,
+    source_from_spec,
+    stream_source,
+)
+
+from .serve import TOKEN_ENV
 
 PROGRESS_SECONDS = 0.2
 """How often the progress line is redrawn."""
@@ -46,10 +56,18 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "0 as fast as possible (default: 1)",
     )
     parser.add_argument("--loop", action="store_true", help="loop a recording")
+    parser.add_argument(
+        "--token",
+        default=None,
+        help="the receiving studio's token, to sign every frame with (needed when its bridge "
+        f"listens beyond loopback; default: ${TOKEN_ENV})",
+    )
 
 
 def run(args: argparse.Namespace) -> int:
     host, port = parse_host_port(args.to)
+    check_seconds(args.seconds)
+    token = args.token if args.token is not None else os.environ.get(TOKEN_ENV) or None
     source = source_from_spec(
         args.source, seed=args.seed, speed=cli_speed(args.speed), loop=args.loop
     )
@@ -65,7 +83,7 @@ def run(args: argparse.Namespace) -> int:
         print(f"\rsent {sent[0]} frames to {host}:{port}", end="", file=sys.stderr, flush=True)
 
     try:
-        total = stream_source(source, host, port, args.seconds, on_frames=progress)
+        total = stream_source(source, host, port, args.seconds, on_frames=progress, token=token)
     except KeyboardInterrupt:
         total = sent[0]
     except StudioError:

@@ -35,9 +35,8 @@ def run(args: argparse.Namespace) -> int:
             from studio.capture import load_demonstration
 
             summary = load_demonstration(path).summary()
-            text = "\n".join(
-                [str(path), *(f"  {k:<13} {v}" for k, v in summary.items() if k != "path")]
-            )
+            shown = {k: _shown(k, v) for k, v in summary.items() if k != "path"}
+            text = "\n".join([str(path), *(f"  {k:<13} {v}" for k, v in shown.items())])
         else:
             # streamed: memory stays one block however long (or damaged) the file is
             summary = summarize_any_recording(path, strict=not args.lenient)
@@ -48,3 +47,15 @@ def run(args: argparse.Namespace) -> int:
             text = describe(summary)
         print(json.dumps(summary) if args.json else text)
     return 0
+
+
+def _shown(key: str, value: object) -> object:
+    """A demonstration's summary field as text: times in seconds to the millisecond, the fit's
+    residual in millimetres (``--json`` keeps the exact values)."""
+    if key == "segment" and isinstance(value, list) and len(value) == 2:
+        return f"{value[0]:.3f} s to {value[1]:.3f} s ({value[1] - value[0]:.3f} s)"
+    if key == "reached_at" and isinstance(value, float):
+        return f"{value:.3f} s"
+    if key == "residual_max" and isinstance(value, float):
+        return f"{value * 1000:.1f} mm"
+    return value

@@ -6,6 +6,7 @@ Ctrl-C ends the capture early and keeps every frame captured so far (the file is
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import time
 from pathlib import Path
@@ -16,14 +17,19 @@ from studio.capture import (
     SOURCE_SPECS,
     SourceStatus,
     capture,
+    check_seconds,
     cli_speed,
     describe,
     source_from_spec,
     summarize_any_recording,
 )
 
+from .serve import TOKEN_ENV
+
 PROGRESS_SECONDS = 0.2
 """How often the progress line is redrawn."""
+WAIT_SECONDS = 10.0
+"""``--wait``'s default: how long a capture waits for a frame before it gives up."""
 NAME = "record"
 HELP = "Record a source (simulator, recording, UDP or serial) into a recording file."
 
@@ -36,7 +42,21 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--seconds",
         type=float,
         default=None,
-        help="how long to record (default: until Ctrl-C or the source ends)",
+        help="seconds of frames to record, by their time stamps from the first frame on (waiting "
+        "for a first frame does not count; default: until Ctrl-C or the source ends)",
+    )
+    parser.add_argument(
+        "--wait",
+        type=float,
+        default=WAIT_SECONDS,
+        help=f"give up when no frame arrives for this many seconds, e.g. a network sender that "
+        f"never starts (default: {WAIT_SECONDS:g})",
+    )
+    parser.add_argument(
+        "--token",
+        default=None,
+        help=f"for udp:HOST:PORT beyond loopback: take only frames signed with this token "
+        f"(studio bridge --token; default: ${TOKEN_ENV})",
     )
     parser.add_argument(
         "--out", type=Path, required=True, help="the new recording, e.g. recordings/x.tape.csv"
@@ -55,11 +75,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    check_seconds(args.seconds)
+    check_seconds(args.wait, "--wait")
+    token = args.token if args.token is not None else os.environ.get(TOKEN_ENV) or None
     source = source_from_spec(
         args.source,
         seed=args.seed,
         speed=cli_speed(args.speed),
         calibration=args.calibration,
+        **({"token": token} if args.source.startswith("udp") else {}),
     )
     total = f"/{args.seconds:g} s" if args.seconds else ""
     nominal = float(getattr(source, "rate_hz", 0.0) or DEFAULT_RATE_HZ)
@@ -89,6 +113,7 @@ def run(args: argparse.Namespace) -> int:
             notes=args.notes,
             source_name=args.source,
             on_progress=progress,
+            give_up_seconds=args.wait,
         )
     except KeyboardInterrupt:
         print(f"\nstopped: every captured frame is kept in {args.out}.", file=sys.stderr)

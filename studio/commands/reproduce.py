@@ -1,4 +1,5 @@
-"""``studio reproduce``: rerun the paper's six learning experiments and judge its claims."""
+"""``studio reproduce``: rerun the paper's six learning configurations (and one beyond it) and
+judge its claims."""
 
 from __future__ import annotations
 
@@ -9,8 +10,9 @@ from studio.learning import DEFAULT_EPISODES, DEFAULT_EXPERIMENTS, DEFAULT_SEED,
 
 NAME = "reproduce"
 HELP = (
-    "Rerun the paper's six Dyna-Q experiments (supervised/unsupervised x zero/full/soft planning) "
-    "and write a run folder per configuration, curves, Fig. 5/8/9 analogues and a claim-by-claim "
+    "Rerun the paper's six Dyna-Q configurations (supervised/unsupervised x zero/full/soft "
+    "planning) and one beyond it (prioritized sweeping), and write a run folder per "
+    "configuration (seven), curves, Fig. 5/8/9 analogues and a claim-by-claim "
     "REPORT.md (--out runs/NAME in a data folder lists the runs in the page)."
 )
 

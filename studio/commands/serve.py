@@ -51,6 +51,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help=f"the secret the page, API and scene require (default: ${TOKEN_ENV}; generated and "
         "printed when --host is not loopback, where one is required)",
     )
+    parser.add_argument(
+        "--bridge-host",
+        default="127.0.0.1",
+        help="address the network-bridge source listens on (default: loopback); beyond loopback "
+        "it takes only frames signed with the token (studio bridge --token)",
+    )
     parser.add_argument("--no-browser", action="store_true", help="do not open a browser")
 
 
@@ -73,8 +79,9 @@ def run(args: argparse.Namespace) -> int:
             "studio is safer still; see the README).",
             file=sys.stderr,
         )
-        if token is None:
-            token = secrets.token_urlsafe(TOKEN_BYTES)
+    opened = not is_loopback(args.host) or not is_loopback(args.bridge_host)
+    if opened and token is None:
+        token = secrets.token_urlsafe(TOKEN_BYTES)
     allowed = list(args.allow_host)
     if not is_loopback(args.host):
         import socket
@@ -99,6 +106,7 @@ def run(args: argparse.Namespace) -> int:
         source=source,
         allowed_hosts=tuple(allowed),
         token=token,
+        bridge_host=args.bridge_host,
     )
     serve(settings, open_browser=not args.no_browser)
     return 0

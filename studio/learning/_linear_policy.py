@@ -55,6 +55,7 @@ from ._policy import (
     PolicyFile,
     curve_header,
     load_policy,
+    read_curve_header,
 )
 from ._reach import ArmReach
 from ._tiles import TileCoder, TileCoding
@@ -193,13 +194,9 @@ def load_tile_policy(path: str | Path) -> TilePolicyFile:
         weights = archive.read("weights", (coder.size, n_actions), "f").astype(np.float64)
     if not np.all(np.isfinite(weights)):
         raise PolicyFileError(f"{name} holds invalid weights; export the policy again.")
-    curve = header.get("curve") or {}
     try:
-        mean_steps = np.array(
-            [np.nan if x is None else x for x in curve.get("mean_steps", [])], dtype=np.float64
-        )
-        experiments = int(curve.get("experiments", 1))
-    except (TypeError, ValueError, AttributeError) as err:
+        mean_steps, experiments = read_curve_header(header.get("curve") or {})
+    except ValueError as err:
         raise PolicyFileError(
             f"{name} has a damaged curve ({err}); export the policy again."
         ) from None
@@ -258,7 +255,7 @@ def _check_header(name: str, header: Any) -> tuple[TileCoder, DynaQConfig, ArmRe
             raise ValueError(f"{n_actions} actions where the arm task has {task.n_actions}")
         if int(bound["size"]) != coder.size or bool(bound["hashed"]) != coder.hashed:
             raise ValueError("its feature table does not match its tile coding")
-    except (KeyError, TypeError, ValueError, AttributeError, LearningError) as err:
+    except (KeyError, TypeError, ValueError, AttributeError, OverflowError, LearningError) as err:
         raise PolicyFileError(
             f"{name} has a damaged header ({err}); export the policy again."
         ) from None

@@ -279,6 +279,28 @@ def curve_header(mean_steps: np.ndarray, experiments: int) -> dict[str, Any]:
     }
 
 
+def read_curve_header(curve: Any) -> tuple[np.ndarray, int]:
+    """The ``(mean_steps, experiments)`` of a policy header's ``curve`` (:func:`curve_header`).
+
+    Raises:
+        ValueError: not a list of numbers (null for none) and a whole number of experiments.
+    """
+    if not isinstance(curve, dict):
+        raise ValueError("its curve is not a table")
+    values = curve.get("mean_steps", [])
+    if not isinstance(values, list) or any(
+        x is not None and (isinstance(x, bool) or not isinstance(x, int | float)) for x in values
+    ):
+        raise ValueError("its curve is not a list of numbers")
+    mean_steps = np.array([np.nan if x is None else x for x in values], dtype=np.float64)
+    if np.isinf(mean_steps).any():
+        raise ValueError("its curve holds an infinite value")
+    experiments = curve.get("experiments", 1)
+    if not isinstance(experiments, int) or isinstance(experiments, bool) or experiments < 1:
+        raise ValueError(f"experiments is {experiments!r}, not a whole number of at least 1")
+    return mean_steps, experiments
+
+
 def greedy_actions(q: np.ndarray) -> np.ndarray:
     """Greedy action per state, ties going to the lowest action index (deterministic)."""
     return np.argmax(q, axis=1).astype(np.int64)
@@ -403,19 +425,11 @@ def _check_header(name: str, header: Any) -> tuple[ArmGrid, DynaQConfig, np.ndar
     try:
         grid = ArmGrid(**{**header["grid"], "goal": tuple(header["grid"]["goal"])})
         config = DynaQConfig.from_dict(header["config"])
-        curve = header.get("curve", {})
-        mean_steps = np.array(
-            [np.nan if x is None else x for x in curve.get("mean_steps", [])], dtype=np.float64
-        )
-        experiments = int(curve.get("experiments", 1))
-    except (KeyError, TypeError, ValueError, AttributeError, LearningError) as err:
+        mean_steps, experiments = read_curve_header(header.get("curve", {}))
+    except (KeyError, TypeError, ValueError, AttributeError, OverflowError, LearningError) as err:
         raise PolicyFileError(
             f"{name} has a damaged header ({err}); export the policy again."
         ) from None
-    if mean_steps.ndim != 1:
-        raise PolicyFileError(
-            f"{name} has a damaged header (its curve is not a list of numbers); export the policy again."
-        )
     return grid, config, mean_steps, experiments
 
 

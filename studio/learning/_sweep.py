@@ -39,14 +39,21 @@ import re
 import shutil
 import socket
 import time
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from studio import MAX_JSON_BYTES, StudioError, read_bytes_bounded, read_json, read_toml
+from studio import (
+    MAX_JSON_BYTES,
+    StudioError,
+    is_loopback,
+    read_bytes_bounded,
+    read_json,
+    read_toml,
+)
 
 from ._arm import ArmGrid
 from ._config import DynaQConfig
@@ -153,6 +160,14 @@ RAY_ENVIRONMENT = {
 }
 """Set (unless already set) before Ray is imported, in the driver and in every worker (a cluster's
 workers do not inherit the driver's environment)."""
+LOCAL_RAY_ENVIRONMENT = {"RAY_ENABLE_WINDOWS_OR_OSX_CLUSTER": "0"}
+"""Set (always) before Ray is imported when the sweep starts its own Ray. This is Ray's switch for
+a single-machine Ray: the node's address is then loopback, so the GCS, the raylet, the workers and
+the agents all listen on 127.0.0.1 only. Without it every one of them listens on all interfaces,
+and anyone who reaches the machine could join the Ray and run code as the user. (Ray turns
+``ray.init(_node_ip_address="127.0.0.1")`` back into the machine's network address, so that is no
+way to do it.) Set while Ray is imported and while it starts its processes, which inherit it;
+then put back, so that nothing else the process starts inherits it."""
 
 
 class SweepError(LearningError):
@@ -408,6 +423,14 @@ def parse_sweep_spec(data: Mapping[str, Any], source: str = "the sweep spec") ->
         raise SweepError(f"{source} [search] seed is {search_seed!r}; give a whole number >= 0.")
 
     seeds = data.get("seeds", [0])
+    # Count the trials before anything is listed: seeds = 1000000000 must not build that list.
+    seed_count = seeds if _is_int(seeds) else len(seeds) if isinstance(seeds, list) else 0
+    combos = math.prod(len(v) if isinstance(v, list) else 1 for v in space.values())
+    count = (combos if kind == "grid" else samples) * seed_count
+    if count > MAX_TRIALS:
+        raise SweepError(
+            f"{source} makes {count:,} trials, over the limit of {MAX_TRIALS:,}; sweep fewer values or seeds."
+        )
     if _is_int(seeds) and seeds >= 1:
         seeds = list(range(seeds))
     if not isinstance(seeds, list) or not seeds:
@@ -514,13 +537,6 @@ def parse_sweep_spec(data: Mapping[str, Any], source: str = "the sweep spec") ->
         scheduler=scheduler,
         cpus_per_trial=int(cpus),
     )
-    count = (math.prod(len(v) for v in space.values()) if kind == "grid" else spec.samples) * len(
-        seeds
-    )
-    if count > MAX_TRIALS:
-        raise SweepError(
-            f"{source} makes {count:,} trials, over the limit of {MAX_TRIALS:,}; sweep fewer values or seeds."
-        )
     for trial in spec.trials():  # combinations can fail where single values pass (table size)
         _check(
             task,
@@ -1088,7 +1104,7 @@ def load_sweep(data_dir: Path, sweep_id: str) -> SweepInfo:
         sorted(p.name for p in runs_parent.iterdir() if p.is_dir()) if runs_parent.is_dir() else []
     )
     status = str(data.get("status", "interrupted"))
-    if status == "running" and not pid_alive(data.get("pid"), data.get("host")):  # driver died
+    if status == "running" and not _driver_alive(data):  # its driver died
         status = "interrupted"
     return SweepInfo(
         id=sweep_id,
@@ -1118,10 +1134,10 @@ def list_sweeps(data_dir: Path) -> list[SweepInfo]:
 def resume_target(data_dir: Path, what: str | None) -> SweepSpec:
     """The spec of the sweep to resume: by id, or the most recent unfinished one."""
     if what is None:
-        unfinished = [s for s in list_sweeps(data_dir) if s.status != "done"]
+        unfinished = [s for s in list_sweeps(data_dir) if s.status not in ("done", "running")]
         if not unfinished:
             raise SweepError(
-                f"There is no unfinished sweep in {Path(data_dir) / SWEEPS_DIR}; start one with studio sweep SPEC."
+                f"There is no unfinished sweep in {Path(data_dir) / SWEEPS_DIR} that is not running; start one with studio sweep SPEC."
             )
         info = unfinished[0]
     else:
@@ -1138,11 +1154,30 @@ def _set_ray_environment() -> None:
         os.environ.setdefault(key, value)
 
 
-def _import_ray() -> Any:
+@contextlib.contextmanager
+def _environment(values: Mapping[str, str]) -> Iterator[None]:
+    """``values`` set in this process's environment for the block, then put back as they were
+    (so that nothing else this process starts, e.g. a later ``ray start``, inherits them)."""
+    before = {key: os.environ.get(key) for key in values}
+    os.environ.update(values)
+    try:
+        yield
+    finally:
+        for key, value in before.items():
+            if value is None:
+                os.environ.pop(key, None)
+            else:
+                os.environ[key] = value
+
+
+def _import_ray(local: bool = False) -> Any:
+    """Import Ray (with :data:`RAY_ENVIRONMENT` set); ``local``: the sweep starts its own Ray, on
+    loopback only (:data:`LOCAL_RAY_ENVIRONMENT`, read by Ray when it is imported)."""
     _set_ray_environment()
     try:
-        import ray
-        from ray import tune  # noqa: F401
+        with _environment(LOCAL_RAY_ENVIRONMENT if local else {}):
+            import ray
+            from ray import tune  # noqa: F401
     except ImportError:
         raise SweepError(f"Sweeps run on Ray Tune, which is not installed; {RAY_HINT}.") from None
     return ray
@@ -1172,7 +1207,14 @@ def _connect(ray: Any, address: str | None, workers: int | None) -> bool:
     quiet = {"log_to_driver": False, "configure_logging": True, "logging_level": "ERROR"}
     if address is None:
         cpus = workers or os.cpu_count() or 1
-        ray.init(address="local", num_cpus=cpus, include_dashboard=False, **quiet)
+        with _environment(LOCAL_RAY_ENVIRONMENT):  # the processes it starts inherit it
+            ray.init(address="local", num_cpus=cpus, include_dashboard=False, **quiet)
+        node_ip = ray.util.get_node_ip_address()
+        if not is_loopback(node_ip):  # Ray was imported before the switch was set
+            ray.shutdown()
+            raise SweepError(
+                f"The local Ray would listen on {node_ip}, beyond this machine; run the sweep in a new process (studio sweep), or join a cluster you secured with --address."
+            )
         return True
     try:
         ray.init(address=address, **quiet)
@@ -1187,6 +1229,10 @@ def _prepare(data_dir: Path, spec: SweepSpec, resume: bool) -> Path:
     folder = sweep_folder(data_dir, spec.name)
     stored = _read_json(folder / SWEEP_FILE)
     if isinstance(stored, dict):
+        if _driver_alive(stored):  # two drivers would train the same trials into the same folders
+            raise SweepError(
+                f"Sweep {spec.name!r} is still running (process {stored.get('pid')} on {_hostname(stored)}); wait for it to end, or stop it with Ctrl-C and then studio sweep --resume {spec.name}."
+            )
         if not resume:
             state = "finished" if stored.get("status") == "done" else "unfinished"
             raise SweepError(
@@ -1220,6 +1266,17 @@ def _prepare(data_dir: Path, spec: SweepSpec, resume: bool) -> Path:
     stored["pid"], stored["host"] = os.getpid(), this_host()
     _write_json(folder / SWEEP_FILE, stored)
     return folder
+
+
+def _driver_alive(stored: Mapping[str, Any]) -> bool:
+    """Whether the driver that ``sweep.json`` names as running still runs."""
+    return stored.get("status") == "running" and pid_alive(stored.get("pid"), stored.get("host"))
+
+
+def _hostname(stored: Mapping[str, Any]) -> str:
+    host = stored.get("host")
+    name = host.get("hostname") if isinstance(host, dict) else None
+    return name if isinstance(name, str) else "this machine"
 
 
 def _set_status(folder: Path, status: str, **fields: Any) -> None:
@@ -1259,7 +1316,8 @@ def run_sweep(
     """
     if workers is not None and (not _is_int(workers) or workers < 1):
         raise SweepError(f"--workers is {workers!r}; give a whole number of cores, at least 1.")
-    ray = _import_ray()  # before anything is written: a missing Ray or cluster leaves no trace
+    # before anything is written: a missing Ray or cluster leaves no trace
+    ray = _import_ray(local=address is None)
     if address is not None and not ray.is_initialized():
         _check_address(address)
     data_dir = Path(data_dir).resolve()

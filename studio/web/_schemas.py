@@ -244,6 +244,9 @@ class RecordingPublic(BaseModel):
     kind: Literal["tape", "pose", "hand"] = Field(
         "tape", description="what it records: tape frames, camera landmarks or hand-guide poses"
     )
+    warnings: list[str] = Field(
+        default_factory=list, description="what loads but looks wrong (times going backwards)"
+    )
 
 
 class RecordingCopy(_Body):

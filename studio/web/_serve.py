@@ -24,7 +24,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 from urllib.parse import urlsplit
 
-from studio import StudioError
+from studio import StudioError, is_loopback
 from studio.learning import prepare_in_background
 
 from ._guard import SiteRule
@@ -270,8 +270,13 @@ def prepare_data_dir(data_dir: Path) -> None:
     """
     probe = Settings(data_dir=data_dir)
     try:
-        for folder in (probe.recordings_dir, probe.runs_dir, probe.policies_dir):
-            folder.mkdir(parents=True, exist_ok=True)
+        # The data folder itself, not its parents: a mistyped path makes no tree of folders.
+        for folder in (data_dir, probe.recordings_dir, probe.runs_dir, probe.policies_dir):
+            folder.mkdir(exist_ok=True)
+    except FileNotFoundError:
+        raise ServeError(
+            f"The data folder {data_dir} cannot be created: {data_dir.parent} does not exist; create it first, or give --data-dir a folder that exists."
+        ) from None
     except OSError as err:
         reason = err.strerror or type(err).__name__
         raise ServeError(
@@ -308,6 +313,10 @@ def serve(settings: Settings, open_browser: bool = True) -> None:
         raise ServeError(
             f"--host {settings.host} opens the studio to other machines, which needs a token; give --token (or set STUDIO_TOKEN), or keep --host 127.0.0.1 and use an SSH tunnel."
         )
+    if not is_loopback(settings.bridge_host) and not settings.token:
+        raise ServeError(
+            f"--bridge-host {settings.bridge_host} opens the network bridge to other machines, which needs a token to sign the frames; give --token (or set STUDIO_TOKEN), or keep the bridge on 127.0.0.1."
+        )
     prepare_data_dir(settings.data_dir)
     # A live pose hops across four Python threads (source, pipeline, scene, viser's loop) before
     # it reaches the browser; at each hop the next thread may wait for the GIL for a whole
@@ -340,6 +349,11 @@ def serve(settings: Settings, open_browser: bool = True) -> None:
             f"Teach Studio: open {url}  (scene at {settings.scene_url()}, data in {settings.data_dir.resolve()})",
             flush=True,
         )
+        if not is_loopback(settings.bridge_host):
+            print(
+                f"The network bridge listens on {settings.bridge_host} and takes only frames signed with the token: studio bridge --to HOST:PORT --token TOKEN",
+                flush=True,
+            )
         if open_browser:
             threading.Timer(1.0, lambda: webbrowser.open(url)).start()
         threading.Thread(target=_prepare_when_up, args=(http,), daemon=True).start()

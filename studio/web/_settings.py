@@ -7,10 +7,11 @@
 
 from __future__ import annotations
 
-import ipaddress
 from pathlib import Path
 
 from pydantic import BaseModel, ConfigDict, Field
+
+from studio import is_loopback
 
 DEFAULT_UPLOAD_LIMIT_BYTES = 50_000_000
 """Largest accepted upload (recordings, policies): 50 MB, about 40 minutes of 110 Hz tape frames."""
@@ -39,8 +40,10 @@ class Settings(BaseModel):
             page checks it so that it never embeds another program's scene (set by
             :func:`studio.web.serve`; None: no scene, or not checked).
         token: when set, the scene answers only requests carrying it (``?token=`` or the cookie
-            it sets); required when ``host`` is not loopback. The API's own check reads the
-            same field.
+            it sets); required when ``host`` or ``bridge_host`` is not loopback. The API's own
+            check reads the same field.
+        bridge_host: address the network-bridge source listens on: loopback unless the user
+            asks otherwise; beyond loopback it takes only frames signed with ``token``.
     """
 
     model_config = ConfigDict(frozen=True)
@@ -56,6 +59,7 @@ class Settings(BaseModel):
     run_workers: int | None = Field(None, ge=1)
     scene_instance: str | None = None
     token: str | None = None
+    bridge_host: str = "127.0.0.1"
 
     @property
     def recordings_dir(self) -> Path:
@@ -93,16 +97,6 @@ class Settings(BaseModel):
             host = f"[{host}]"
         url = f"http://{host}:{self.viser_port}"
         return f"{url}/?token={self.token}" if self.token else url
-
-
-def is_loopback(host: str) -> bool:
-    """Whether ``host`` (an address or ``localhost``) is reachable from this machine only."""
-    if host == "localhost":
-        return True
-    try:
-        return ipaddress.ip_address(host.strip("[]")).is_loopback
-    except ValueError:
-        return False
 
 
 def get_settings() -> Settings:

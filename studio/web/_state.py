@@ -16,8 +16,8 @@ from typing import Any
 
 import numpy as np
 
-from studio import StudioError
-from studio.capture import being_recorded
+from studio import StudioError, is_loopback
+from studio.capture import DEFAULT_PORT, being_recorded
 from studio.learning import GOAL_JOINTS, check_goal_deg
 
 from ._errors import ConflictError, InvalidError, NotFoundError, TooManyRequestsError
@@ -184,10 +184,11 @@ class Studio:
         elif kind == "network":
             from studio.capture import NetworkSource
 
-            source = NetworkSource(port=port) if port is not None else NetworkSource()
-            # the bridge listens on loopback unless the studio itself is opened up
-            if not self.settings.is_loopback:
-                source.host = "0.0.0.0"
+            # Loopback unless the user asked for another address (serve --bridge-host); beyond
+            # loopback only frames signed with the studio's token are taken.
+            host = self.settings.bridge_host
+            token = None if is_loopback(host) else self.settings.token
+            source = NetworkSource(host, DEFAULT_PORT if port is None else port, token=token)
             self.pipeline.set_source(source, kind)
         elif kind == "serial":
             if not device:

@@ -466,9 +466,9 @@ class FolderStore(Generic[T]):
                 self._read(tmp)
             except StudioError as err:
                 message = str(err).replace(str(tmp), label).replace(tmp.name, label)
-                raise InvalidError(
-                    f"{label} is not a valid Teach Studio {self.what}: {message}"
-                ) from None
+                if not message.startswith(label):  # the reader's sentence names the file itself
+                    message = f"{label} is not a valid Teach Studio {self.what}: {message}"
+                raise InvalidError(message) from None
             return self.claim(tmp, base, taken, suffix=suffix)
         finally:
             tmp.unlink(missing_ok=True)

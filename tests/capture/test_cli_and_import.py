@@ -157,3 +157,76 @@ def test_info_tells_a_capture_in_progress_from_an_interrupted_one(tmp_path, caps
     assert main(["info", "--json", str(killed)]) == 0
     gone = json.loads(capsys.readouterr().out)
     assert gone["recovered"] and not gone["live"]
+
+
+def _one_sentence(capsys, verb: str) -> str:
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith(f"studio {verb}: ") and "Traceback" not in err[0]
+    return err[0]
+
+
+@pytest.mark.parametrize(
+    ("to", "says"),
+    [
+        ("notanaddress", "notanaddress:47110 is not an address"),
+        ("256.1.1.1:8650", "256.1.1.1:8650 is not an address"),
+        ("127.0.0.1:99999", "no valid port"),
+        ("127.0.0.1:0", "no valid port"),
+    ],
+)
+def test_a_bad_bridge_address_is_one_sentence(to, says, capsys):
+    assert main(["bridge", "--to", to, "--seconds", "1"]) == 2
+    assert says in _one_sentence(capsys, "bridge")
+
+
+@pytest.mark.parametrize("seconds", ["-3", "0", "nan", "inf"])
+def test_record_refuses_a_duration_that_is_not_positive(seconds, tmp_path, capsys):
+    out = tmp_path / "x.tape.csv"
+    assert main(["record", "--seconds", seconds, "--out", str(out)]) == 2
+    assert "--seconds is" in _one_sentence(capsys, "record")
+    assert not out.exists()  # no empty recording
+
+
+def test_record_from_a_silent_network_gives_up_with_a_sentence(tmp_path, capsys):
+    """--seconds counts the frames' time from the first frame on, so without a sender it would
+    never end: --wait gives up, and leaves no empty recording behind."""
+    import socket
+
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as probe:
+        probe.bind(("127.0.0.1", 0))
+        port = probe.getsockname()[1]
+    out = tmp_path / "x.tape.csv"
+    args = ["record", "--source", f"udp:{port}", "--seconds", "3", "--wait", "0.5"]
+    assert main([*args, "--out", str(out)]) == 2
+    line = capsys.readouterr().err.strip().splitlines()[-1]
+    assert "no frame arrived from the network source" in line and "nothing was recorded" in line
+    assert "studio bridge" in line and not out.exists()
+
+
+def test_record_creates_only_the_last_folder_of_out(tmp_path, capsys):
+    out = tmp_path / "missing" / "dir" / "x.tape.csv"
+    assert main(["record", "--seconds", "0.1", "--out", str(out)]) == 2
+    assert f"the folder {tmp_path / 'missing'} does not exist" in _one_sentence(capsys, "record")
+    assert not (tmp_path / "missing").exists()
+    out = tmp_path / "new" / "x.tape.csv"  # one new level is what --out asks for
+    assert main(["record", "--seconds", "0.1", "--out", str(out)]) == 0
+    assert len(read_recording(out)) == 11
+
+
+def test_info_shows_a_demonstrations_times_in_seconds_and_its_fit_in_millimetres(capsys):
+    from studio.samples import SAMPLES_DIR
+
+    assert main(["info", str(SAMPLES_DIR / "sample-reach-2.demo.json")]) == 0
+    out = capsys.readouterr().out
+    assert "segment       1.000 s to 3.491 s (2.491 s)" in out
+    assert "reached_at    2.255 s" in out and "residual_max  9.7 mm" in out
+    assert "3.4909090909090907" not in out and "np.float64" not in out
+    assert main(["info", "--json", str(SAMPLES_DIR / "sample-reach-2.demo.json")]) == 0
+    assert json.loads(capsys.readouterr().out)["segment"] == [1.0, 3.4909090909090907]
+
+
+def test_record_beyond_loopback_needs_a_token_and_leaves_no_file(tmp_path, capsys, monkeypatch):
+    monkeypatch.delenv("STUDIO_TOKEN", raising=False)
+    out = tmp_path / "x.tape.csv"
+    assert main(["record", "--source", "udp:0.0.0.0:0", "--out", str(out)]) == 2
+    assert "needs a token" in _one_sentence(capsys, "record") and not out.exists()

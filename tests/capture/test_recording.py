@@ -398,3 +398,39 @@ def test_kill_9_of_studio_record_leaves_a_recovered_recording(tmp_path):
     assert rec.recovered and len(rec) >= seen >= 120
     assert np.array_equal(rec.frame, np.arange(len(rec)))  # every flushed frame, in order
     assert rec.meta["source"] == "simulator"
+
+
+def _with_times(path, changes: dict[int, float]):
+    """A copy of a shipped sample with the times of some rows (0-based) changed."""
+    from studio.samples import SAMPLES_DIR
+
+    lines = (SAMPLES_DIR / "sample-reach-1.tape.csv").read_text().split("\n")
+    for row, t in changes.items():
+        cells = lines[2 + row].split(",")
+        cells[0] = repr(t)
+        lines[2 + row] = ",".join(cells)
+    path.write_text("\n".join(lines))
+    return path
+
+
+def test_negative_or_backward_times_load_with_a_warning(tmp_path):
+    from studio.capture import summarize_recording
+
+    odd = _with_times(tmp_path / "odd.tape.csv", {0: -0.5, 38: 0.01, 200: 0.02})
+    rec = read_recording(odd)
+    assert len(rec) == 385 and not rec.problems  # every frame kept, nothing refused
+    negative, backwards = rec.warnings
+    assert negative.startswith("1 frame with a negative time (first at line 3)")
+    assert backwards.startswith("time goes backwards 2 times (first at line 41: 0.010 s after")
+    assert summarize_recording(odd)["warnings"] == rec.warnings == rec.summary()["warnings"]
+    fine = _with_times(tmp_path / "fine.tape.csv", {})
+    assert read_recording(fine).warnings == [] and summarize_recording(fine)["warnings"] == []
+
+
+def test_studio_info_shows_time_warnings(tmp_path, capsys):
+    from studio.cli import main
+
+    odd = _with_times(tmp_path / "odd.tape.csv", {5: 0.0})
+    assert main(["info", str(odd)]) == 0
+    out = capsys.readouterr().out
+    assert "  warning   time goes backwards 1 time (first at line 8" in out

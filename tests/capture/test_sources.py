@@ -20,6 +20,7 @@ from studio.capture import (
     SerialSource,
     ShapeTapeEmulator,
     TapeFrame,
+    bridge_key,
     decode_frame,
     encode_frame,
     read_recording,
@@ -425,3 +426,45 @@ def test_a_datagram_built_from_the_readme_layout_decodes():
     assert np.array_equal(frame.bend, bend.astype(np.float32))
     assert np.array_equal(frame.twist, twist.astype(np.float32))
     assert encode_frame(frame) == datagram
+
+
+def test_a_signed_datagram_decodes_only_with_its_key(frames):
+    key = bridge_key("s3cret")
+    signed = encode_frame(frames[3], key)
+    assert len(signed) == len(encode_frame(frames[3])) + 16
+    assert decode_frame(signed, key).frame == frames[3].frame
+    assert decode_frame(signed).frame == frames[3].frame  # a receiver without a key ignores it
+    with pytest.raises(WireError, match="unsigned"):
+        decode_frame(encode_frame(frames[3]), key)
+    with pytest.raises(WireError, match="another token"):
+        decode_frame(encode_frame(frames[3], bridge_key("guess")), key)
+    tampered = bytearray(signed)
+    tampered[30] ^= 1  # a bend angle changed on the way
+    with pytest.raises(WireError, match="another token"):
+        decode_frame(bytes(tampered), key)
+
+
+def test_the_bridge_listens_beyond_loopback_only_with_a_token():
+    with pytest.raises(CaptureError, match="needs a token"):
+        NetworkSource("0.0.0.0", port=0).start()
+
+
+def test_a_bridge_beyond_loopback_takes_only_frames_signed_with_its_token(frames):
+    receiver = NetworkSource("0.0.0.0", port=0, token="s3cret")
+    receiver.start()
+    port = receiver.address[1]
+    try:
+        with FrameSender("127.0.0.1", port) as unsigned:
+            unsigned.send(frames[0])
+        with FrameSender("127.0.0.1", port, token="guess") as stranger:
+            stranger.send(frames[1])
+        _wait(lambda: receiver.status().rejected >= 2)
+        with FrameSender("127.0.0.1", port, token="s3cret") as owner:
+            for frame in frames[2:12]:
+                owner.send(frame)
+        got = _drain(receiver, lambda f: len(f) >= 10)
+        status = receiver.status()
+    finally:
+        receiver.stop()
+    assert [f.frame for f in got] == [f.frame for f in frames[2:12]]
+    assert status.rejected == 2 and "another token" in status.warning

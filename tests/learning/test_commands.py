@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import csv
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -29,6 +30,18 @@ from studio.learning._reproduce import CONFIGURATIONS, EXTENSIONS, PAPER_MATLAB_
 from studio.web import create_app
 from studio.web._schemas import RunCreate
 from tests.web.conftest import TINY_RUN, make_settings, wait_run
+
+
+def test_the_readme_and_the_help_count_the_configurations_reproduce_writes() -> None:
+    words = {1: "one", 6: "six", 7: "seven"}
+    readme = (Path(__file__).resolve().parents[2] / "README.md").read_text()
+    line = next(row for row in readme.splitlines() if row.startswith("studio reproduce"))
+    paper, beyond = words[len(CONFIGURATIONS)], words[len(EXTENSIONS)]
+    assert f"{paper} configurations and {beyond} beyond it" in line, line
+    from studio.commands import reproduce as command
+
+    total = words[len(CONFIGURATIONS) + len(EXTENSIONS)]
+    assert f"{paper} Dyna-Q configurations" in command.HELP and f"({total})" in command.HELP
 
 
 def test_reproduce_tiny_budget(tmp_path, capsys) -> None:
@@ -137,6 +150,65 @@ def test_user_errors_are_one_line_not_tracebacks(tmp_path, capsys) -> None:
     bad.write_text("nope")
     assert main(["export", str(bad)]) == 2
     assert "bad.policy.npz is corrupt" in capsys.readouterr().err
+
+
+SAMPLE_DEMO = (
+    Path(__file__).resolve().parents[2] / "studio" / "samples" / "sample-reach-2.demo.json"
+)
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "says"),
+    [
+        ('"t":[1.0,', '"t":["one",', "trajectory is missing or is not a list of times"),
+        ('"t":[1.0,', '"t":[NaN,', "trajectory holds NaN or infinite values in a list of times"),
+        ('"goal":[5,6,2],"grid_path"', '"goal":[Infinity,6,2],"grid_path"', "goal is missing"),
+        ('"grid_path":[898,', '"grid_path":[1e999,', "grid_path is missing or is not"),
+        ('"reached_at":2.25', '"reached_at":1e999,"x":2.25', "reached_at holds NaN or infinite"),
+        ('"segment":[1.0,', '"segment":[-Infinity,', "segment holds NaN or infinite values"),
+    ],
+)
+def test_train_on_a_damaged_demonstration_is_one_sentence(
+    old: str, new: str, says: str, tmp_path, capsys
+) -> None:
+    """Strings, NaN, Infinity or 1e999 (JSON's way to write infinity) where a demonstration has
+    numbers: one sentence naming the field, never a traceback nor a run trained on NaN."""
+    text = SAMPLE_DEMO.read_text()
+    assert old in text
+    bad = tmp_path / "bad.demo.json"
+    bad.write_text(text.replace(old, new, 1))
+    argv = ["train", "--demos", str(bad), "--episodes", "2", "--experiments", "1", "--no-progress"]
+    assert main([*argv, "--out", str(tmp_path / "run")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and err.startswith("studio train: ") and says in err, err
+    assert not (tmp_path / "run").exists()
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "says"),
+    [
+        ('"experiments": 1', '"experiments": Infinity', "experiments is inf"),
+        ('"experiments": 1', '"experiments": 1e999', "experiments is inf"),
+        ('"mean_steps": [', '"mean_steps": [Infinity, ', "its curve holds an infinite value"),
+        ('"alpha": 0.1', '"alpha": Infinity', "alpha is inf"),
+    ],
+)
+def test_export_of_a_policy_with_infinity_in_its_header_is_one_sentence(
+    old: str, new: str, says: str, tmp_path, capsys
+) -> None:
+    args = ["--episodes", "2", "--experiments", "1", "--planning", "zero", "--no-progress"]
+    assert main(["train", "--out", str(tmp_path / "run"), *args]) == 0
+    with np.load(tmp_path / "run" / "policy.policy.npz") as archive:
+        arrays = {key: archive[key] for key in archive.files}
+    header = str(arrays["header"])
+    assert old in header
+    arrays["header"] = np.array(header.replace(old, new, 1))
+    bad = tmp_path / "bad.policy.npz"
+    np.savez_compressed(bad, **arrays)
+    capsys.readouterr()
+    assert main(["export", str(bad), "--out", str(tmp_path / "x.csv")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "damaged header" in err and says in err, err
 
 
 def _parse_train(argv: list[str]) -> argparse.Namespace:

@@ -6,6 +6,7 @@ and the two-node cluster run ``studio sweep`` in subprocesses, as a user would.
 
 from __future__ import annotations
 
+import ipaddress
 import json
 import os
 import signal
@@ -169,6 +170,31 @@ def test_a_bad_spec_is_one_sentence_naming_the_field(change: dict, field: str) -
     message = str(err.value)
     assert field in message and message.startswith("bad.toml"), message
     assert "\n" not in message and message.endswith("."), message
+
+
+def test_a_huge_seed_count_is_refused_before_any_seed_is_listed() -> None:
+    """seeds = 1000000000 is refused by counting; the address space of the process that parses it
+    is capped at 256 MB above what it holds, so building the list of seeds would fail."""
+    script = (
+        "import resource\n"
+        "from studio.learning._sweep import SweepError, parse_sweep_spec\n"
+        "from tests.learning.test_sweep import spec_dict\n"
+        "size = next(int(line.split()[1]) * 1024 for line in open('/proc/self/status')\n"
+        "            if line.startswith('VmSize:'))\n"
+        "resource.setrlimit(resource.RLIMIT_AS, (size + 256 * 2**20, resource.RLIM_INFINITY))\n"
+        "try:\n"
+        "    parse_sweep_spec(spec_dict(seeds=1_000_000_000), 'big.toml')\n"
+        "except SweepError as err:\n"
+        "    print(err)\n"
+    )
+    proc = subprocess.run(
+        [sys.executable, "-c", script], capture_output=True, text=True, timeout=WAIT_SECONDS,
+        cwd=REPO, env={**os.environ, "PYTHONPATH": str(REPO)},
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.strip() == (
+        "big.toml makes 2,000,000,000 trials, over the limit of 100,000; sweep fewer values or seeds."
+    ), proc.stdout
 
 
 def test_a_spec_file_that_is_not_toml_is_refused(tmp_path: Path) -> None:
@@ -344,6 +370,103 @@ def test_a_killed_worker_is_retried_and_the_sweep_completes(local_ray, tmp_path:
         os.kill(pid, 0)
     for trial in spec.trials():
         assert RunFolder.load(trial_run_path(tmp_path, "kill", trial.key)).status == "done"
+
+
+def descendants(pid: int) -> set[int]:
+    """``pid`` and every process under it, from ``/proc/*/stat``."""
+    children: dict[int, list[int]] = {}
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except OSError:  # the process ended meanwhile
+            continue
+        children.setdefault(int(fields[1]), []).append(int(stat.parent.name))
+    found, todo = set(), [pid]
+    while todo:
+        here = todo.pop()
+        found.add(here)
+        todo.extend(children.get(here, []))
+    return found
+
+
+def listening_sockets(pids: set[int]) -> list[tuple[str, str, int]]:
+    """Every TCP socket listening and every UDP socket bound by ``pids``: (process name, local
+    address, port), read from the processes' file descriptors and ``/proc/net/{tcp,udp}{,6}``."""
+    owner: dict[str, str] = {}
+    for pid in pids:
+        try:
+            name = Path(f"/proc/{pid}/comm").read_text().strip()
+            for fd in Path(f"/proc/{pid}/fd").iterdir():
+                link = os.readlink(fd)
+                if link.startswith("socket:["):
+                    owner[link[8:-1]] = name
+        except OSError:  # the process ended meanwhile
+            continue
+    found = []
+    for table in ("tcp", "tcp6", "udp", "udp6"):
+        lines = Path(f"/proc/net/{table}").read_text().splitlines()[1:]
+        for line in lines:
+            cols = line.split()
+            local, state, inode = cols[1], cols[3], cols[9]
+            if inode not in owner or (table.startswith("tcp") and state != "0A"):  # 0A: LISTEN
+                continue
+            address, port = local.split(":")
+            raw = b"".join(
+                bytes.fromhex(address[i : i + 8])[::-1] for i in range(0, len(address), 8)
+            )
+            found.append((owner[inode], str(ipaddress.ip_address(raw)), int(port, 16)))
+    return found
+
+
+def is_loopback(address: str) -> bool:
+    ip = ipaddress.ip_address(address)
+    mapped = getattr(ip, "ipv4_mapped", None)
+    return (mapped or ip).is_loopback
+
+
+def test_a_running_sweep_listens_on_loopback_only_and_cannot_be_resumed_twice(
+    tmp_path: Path,
+) -> None:
+    """Every socket of every process the local Ray started (GCS, raylet, agents, the worker running
+    a trial) listens on loopback; ``--resume`` of the running sweep is refused, as a second start is."""
+    require(ray is not None, "ray[tune] is not installed (pip install -e '.[cluster]')")
+    spec_path = write_spec(
+        tmp_path / "long.toml",
+        'task = "arm-grid"\nseeds = [0]\nexperiments = 4\nepisodes = 100000\n'
+        '[fixed]\nplanning_steps = 1000\n[space]\nplanning = ["full"]\n',
+    )  # fmt: skip
+    data = tmp_path / "data"
+    env = {**os.environ, "RAY_USAGE_STATS_ENABLED": "0"}
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "studio", "sweep", str(spec_path), "--data-dir", str(data),
+         "--workers", "1", "--no-progress"],
+        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, env=env,
+    )  # fmt: skip
+    try:
+        status = trial_run_path(data, "long", "t0000") / "status.json"
+        wait_for(lambda: status.is_file() and '"running"' in status.read_text(), "a running trial",
+                 proc=proc)  # fmt: skip
+        sockets = listening_sockets(descendants(proc.pid))
+        names = {name for name, _, _ in sockets}
+        assert {"gcs_server", "raylet"} <= names, sockets  # the listing sees Ray's processes
+        assert [s for s in sockets if not is_loopback(s[1])] == [], sockets
+
+        again = subprocess.run(
+            [sys.executable, "-m", "studio", "sweep", "--resume", "long", "--data-dir", str(data),
+             "--no-progress"],
+            capture_output=True, text=True, timeout=WAIT_SECONDS, env=env,
+        )  # fmt: skip
+        assert again.returncode == 2, again.stdout + again.stderr
+        line = again.stderr.strip()
+        assert "is still running" in line and "\n" not in line, line
+        assert proc.poll() is None  # the first driver goes on
+        proc.send_signal(signal.SIGINT)
+        out, _ = proc.communicate(timeout=WAIT_SECONDS)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    assert proc.returncode == 130, out
 
 
 def test_an_interrupted_sweep_resumes_with_only_the_unfinished_trials(

@@ -110,6 +110,8 @@ def test_uploads_that_are_not_recordings_are_refused(recordings, client, content
     assert r.status_code == 422
     detail = r.json()["detail"]
     assert "bad.tape.csv" in detail and ".upload-" not in detail
+    assert detail.count("bad.tape.csv") == 1, detail  # one sentence, the file named once
+    assert detail.count(";") <= 1 and detail.endswith("."), detail
     assert sorted(p.name for p in recordings.iterdir()) == before
 
 
@@ -290,3 +292,17 @@ def test_the_listing_rereads_a_file_that_changed(recordings, client):
     (recordings / "mine.tape.csv").write_text("no longer a recording\n")
     damaged = next(r for r in client.get("/api/recordings").json() if r["name"] == "mine")
     assert damaged["error"] and damaged["frames"] == 0
+
+
+def test_a_recording_whose_time_goes_backwards_is_listed_with_a_warning(recordings, client):
+    lines = (SAMPLES_DIR / "sample-reach-1.tape.csv").read_text().split("\n")
+    cells = lines[50].split(",")
+    cells[0] = "-1.0"
+    lines[50] = ",".join(cells)
+    r = upload(client, "odd.tape.csv", "\n".join(lines).encode())
+    assert r.status_code == 201, r.text
+    warnings = r.json()["warnings"]
+    assert len(warnings) == 2 and "negative time" in warnings[0] and "backwards" in warnings[1]
+    listed = {item["name"]: item for item in client.get("/api/recordings").json()}
+    assert listed["odd"]["warnings"] == warnings
+    assert listed["mine"]["warnings"] == []

@@ -124,6 +124,55 @@ def test_serving_beyond_loopback_needs_a_token(tmp_path: Path) -> None:
             serve(Settings(host=host, data_dir=tmp_path, token=""), open_browser=False)
 
 
+def _free_udp_port() -> int:
+    import socket
+
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as probe:
+        probe.bind(("127.0.0.1", 0))
+        return probe.getsockname()[1]
+
+
+def test_the_network_bridge_stays_on_loopback_in_token_mode(
+    open_client: Callable[..., TestClient],
+) -> None:
+    """A studio served beyond loopback (with its token) still listens for bridge frames on
+    loopback only, unless --bridge-host asks otherwise."""
+    client = open_client(host="0.0.0.0", token="t0k-en")
+    auth = {"Authorization": "token t0k-en"}
+    r = client.put("/api/source", json={"kind": "network", "port": _free_udp_port()}, headers=auth)
+    assert r.status_code == 200 and r.json()["error"] is None, r.text
+    assert client.app.state.studio.pipeline.source.address[0] == "127.0.0.1"
+
+
+def test_a_bridge_host_beyond_loopback_takes_only_signed_frames(
+    open_client: Callable[..., TestClient],
+) -> None:
+    from studio.capture import FrameSender, simulate
+    from tests.web.conftest import wait_for
+
+    client = open_client(token="t0k-en", bridge_host="0.0.0.0")
+    auth = {"Authorization": "token t0k-en"}
+    r = client.put("/api/source", json={"kind": "network", "port": _free_udp_port()}, headers=auth)
+    assert r.status_code == 200 and r.json()["error"] is None, r.text
+    source = client.app.state.studio.pipeline.source
+    host, port = source.address
+    assert host == "0.0.0.0"
+    frames = simulate(0.1, seed=2).frames
+    with FrameSender("127.0.0.1", port) as stranger:  # no token: nothing reaches the tape
+        for frame in frames:
+            stranger.send(frame)
+    assert wait_for(lambda: source.status().rejected >= len(frames))
+    assert source.status().frames == 0
+    with FrameSender("127.0.0.1", port, token="t0k-en") as owner:
+        owner.send(frames[0])
+    assert wait_for(lambda: source.status().frames == 1)
+
+
+def test_a_bridge_beyond_loopback_needs_a_token(tmp_path: Path) -> None:
+    with pytest.raises(ServeError, match="--bridge-host 0.0.0.0 .* needs a token"):
+        serve(Settings(bridge_host="0.0.0.0", data_dir=tmp_path, source=None), open_browser=False)
+
+
 def _serve_args(**given: object) -> argparse.Namespace:
     from studio.commands import serve as command
 
@@ -155,6 +204,9 @@ def test_the_command_generates_a_token_beyond_loopback(
     assert started[-1].token == "from-env"
     command.run(_serve_args(host="0.0.0.0", data_dir=tmp_path, token="given"))
     assert started[-1].token == "given"
+    monkeypatch.delenv(command.TOKEN_ENV)
+    command.run(_serve_args(data_dir=tmp_path, bridge_host="0.0.0.0"))  # the bridge signs with it
+    assert started[-1].token and started[-1].bridge_host == "0.0.0.0"
 
 
 def test_a_chunked_upload_is_stopped_at_the_limit(
@@ -215,3 +267,13 @@ def test_a_chunked_upload_is_stopped_at_the_limit(
     assert "over the limit" in body.decode()
     assert read <= limit + MULTIPART_OVERHEAD_BYTES + len(chunk)
     assert list((tmp_path / "recordings").iterdir()) == []
+
+
+def test_the_api_doc_gives_the_status_a_missing_token_gets(
+    open_client: Callable[..., TestClient],
+) -> None:
+    client = open_client(token="t0k-en")
+    status = client.get("/api/config").status_code
+    doc = (Path(__file__).resolve().parents[2] / "docs" / "api.md").read_text()
+    assert f"{status}: a missing or wrong token" in doc
+    assert "401" not in doc  # no status the studio never answers

@@ -209,3 +209,13 @@ def test_the_learner_is_compiled_in_the_background_once_the_api_is_up(monkeypatc
         http.should_exit = True
     waiter.join(30)
     assert calls == ([1] if comes_up else [])
+
+
+def test_a_data_folder_under_a_missing_folder_is_refused_not_created(tmp_path):
+    from studio.web._serve import ServeError, prepare_data_dir
+
+    with pytest.raises(ServeError, match="does not exist; create it first"):
+        prepare_data_dir(tmp_path / "missing" / "data")
+    assert not (tmp_path / "missing").exists()
+    prepare_data_dir(tmp_path / "data")  # the last level is created, with its subfolders
+    assert (tmp_path / "data" / "recordings").is_dir()

@@ -47,6 +47,7 @@ def recording_public(entry: StoredFile[dict[str, Any]]) -> RecordingPublic:
         sample=entry.sample,
         error=entry.error,
         kind=summary.get("kind", "tape"),
+        warnings=summary.get("warnings") or [],
     )
 
 

@@ -361,6 +361,7 @@ function recordingRow(r) {
   if (r.recovered) flags.push(el("span", { class: "badge warn", text: "recovered", title: "the capture did not close cleanly; every frame written is kept" }));
   if (r.error) flags.push(el("span", { class: "badge failed", text: "unreadable", title: r.error, testid: "recording-damaged" }));
   if (r.capturing) flags.push(el("span", { class: "badge warn", text: "being captured", title: "another studio on this data folder is recording it; it can be changed once that capture stops", testid: "recording-capturing" }));
+  if (r.warnings && r.warnings.length) flags.push(el("span", { class: "badge warn", text: "odd times", title: r.warnings.join("\n"), testid: "recording-warning" }));
   const title = [r.error, r.notes, r.operator && `operator: ${r.operator}`, r.created].filter(Boolean).join("\n");
   const actions = [];
   if (!r.error) actions.push(el("button", { class: "icon", title: "play as the live source", testid: "recording-play", onclick: () => useRecording(r.name) }, "▶"));
