@@ -99,6 +99,17 @@ def test_hand_recording_round_trips_and_plays_back(tmp_path: Path) -> None:
     assert (np.diff(times) > 0).all()  # a loop keeps time moving forward
 
 
+def test_a_hand_recording_whose_time_goes_backwards_loads_with_the_tapes_warning(
+    tmp_path: Path,
+) -> None:
+    times = [0.0, 0.1, 0.05, 0.2]
+    poses = [hand_pose(t, i, [0.0, 0.0, -0.5], [1, 0, 0, 0]) for i, t in enumerate(times)]
+    summary = summarize_any_recording(write(tmp_path / "b.hand.csv", "hand", poses))
+    assert summary["frames"] == 4  # every frame kept
+    assert len(summary["warnings"]) == 1
+    assert "time goes backwards 1 time (first at frame 2" in summary["warnings"][0]
+
+
 def test_a_killed_capture_keeps_its_flushed_frames(tmp_path: Path) -> None:
     path = tmp_path / "k.pose.csv"
     writer = ObservationWriter(path, "pose")
