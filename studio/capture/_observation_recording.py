@@ -10,8 +10,6 @@ in bounded blocks like the tape reader, names the file, the line and the problem
 from __future__ import annotations
 
 import os
-import re
-import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
@@ -46,10 +44,10 @@ from ._recording_reader import (
     _first_line,
     _Lines,
     _open,
-    _plain,
     _Problems,
     _short,
     _summary,
+    _to_array,
     _whole,
     array_time_warnings,
     read_recording,
@@ -291,52 +289,8 @@ def _parse_lines(
             continue
         rows.append(line)
         numbers.append(number)
-    data, numbers = _to_floats(rows, numbers, width, problems)
+    data, numbers = _to_array(rows, numbers, width, problems, empty_as_nan=True)
     return data, numbers, end
-
-
-_EMPTY_FIELD = re.compile(r"(?<=,)(?=,|\n|$)")
-"""An empty field (never the first one, the time): read as NaN."""
-
-
-def _to_floats(
-    rows: list[str], numbers: list[int], width: int, problems: _Problems
-) -> tuple[np.ndarray, list[int]]:
-    """Rows as a float array: numpy's C parser for plain rows, else field by field (naming the
-    line and the field that is not a number)."""
-    if not rows:
-        return np.zeros((0, width)), []
-    joined = "\n".join(rows)
-    if _plain(joined.replace("\n", ",")):
-        text = _EMPTY_FIELD.sub("nan", joined).replace("\n", ",")
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", DeprecationWarning)
-            try:
-                flat = np.fromstring(text, dtype=np.float64, sep=",")
-            except ValueError:
-                flat = np.zeros(0)
-        if flat.size == len(rows) * width:
-            return flat.reshape(len(rows), width), numbers
-    good: list[list[float]] = []
-    kept: list[int] = []
-    for line, number in zip(rows, numbers, strict=True):
-        fields = line.split(",")
-        try:
-            good.append([float(x) if x else float("nan") for x in fields])
-        except ValueError:
-            bad = next(x for x in fields if x and not _float(x))
-            problems.add(number, f"'{bad[:20]}' is not a number")
-            continue
-        kept.append(number)
-    return np.array(good, dtype=np.float64).reshape(-1, width), kept
-
-
-def _float(text: str) -> bool:
-    try:
-        float(text)
-    except ValueError:
-        return False
-    return True
 
 
 def _scan_observations(

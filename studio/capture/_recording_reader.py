@@ -649,20 +649,34 @@ def _summary(
     }
 
 
+_EMPTY_FIELD = re.compile(r"(?<=,)(?=,|\n|$)")
+"""An empty field (never the first one, the time): NaN where a format allows it."""
+
+
 def _to_array(
-    rows: list[str], row_lines: list[int], width: int, problems: _Problems
+    rows: list[str],
+    row_lines: list[int],
+    width: int,
+    problems: _Problems,
+    empty_as_nan: bool = False,
 ) -> tuple[np.ndarray, list[int]]:
+    """Rows as a float array; a row with a field that is not a number is left out and named.
+
+    ``empty_as_nan``: an empty field reads as NaN (the landmark formats leave unseen points
+    empty); otherwise it is a problem like any other non-number.
+    """
     if not rows:
         return np.zeros((0, width)), []
     # fast path: numpy's C parser (correctly rounded, so exact reprs come back exactly) over all
     # rows at once, when they hold only number characters and it reads exactly the expected count;
     # anything else takes the slow path, which names the line and the field
-    joined = ",".join(rows)
-    if _plain(joined):
+    joined = "\n".join(rows)
+    if _plain(joined.replace("\n", ",")):
+        text = (_EMPTY_FIELD.sub("nan", joined) if empty_as_nan else joined).replace("\n", ",")
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", DeprecationWarning)
             try:
-                flat = np.fromstring(joined, dtype=np.float64, sep=",")
+                flat = np.fromstring(text, dtype=np.float64, sep=",")
             except ValueError:
                 flat = np.zeros(0)
         if flat.size == len(rows) * width:
@@ -671,11 +685,13 @@ def _to_array(
     kept: list[int] = []
     for line, number in zip(rows, row_lines, strict=True):
         fields = line.split(",")
-        bad = next((x for x in fields if not _is_number(x)), None)
+        bad = next(
+            (x for x in fields if not (empty_as_nan and x == "") and not _is_number(x)), None
+        )
         if bad is not None:
             problems.add(number, f"'{bad[:20]}' is not a number")
             continue
-        good.append([float(x) for x in fields])
+        good.append([float(x) if x else float("nan") for x in fields])
         kept.append(number)
     return np.array(good, dtype=np.float64).reshape(-1, width), kept
 
