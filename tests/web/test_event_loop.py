@@ -24,7 +24,7 @@ def test_a_request_is_answered_while_an_upload_is_parsed(
     open_client: Callable[..., TestClient], monkeypatch: pytest.MonkeyPatch, kind: str
 ) -> None:
     parsing, release, finished = threading.Event(), threading.Event(), threading.Event()
-    reader = "summarize_recording" if kind == "recording" else "load_policy"
+    reader = "summarize_any_recording" if kind == "recording" else "load_any_policy"
     real = getattr(store_module, reader)
 
     def held(path: Path):  # the parser of an upload, held until the test lets it go
@@ -67,13 +67,13 @@ def test_listing_during_a_capture_never_reads_the_live_file(
     open_client: Callable[..., TestClient], monkeypatch: pytest.MonkeyPatch
 ) -> None:
     read: list[str] = []
-    real = store_module.summarize_recording
+    real = store_module.summarize_any_recording
 
     def counted(path: Path):
         read.append(path.name)
         return real(path)
 
-    monkeypatch.setattr(store_module, "summarize_recording", counted)
+    monkeypatch.setattr(store_module, "summarize_any_recording", counted)
     client = open_client(source="simulator")
     assert client.post("/api/capture/start", json={"name": "live"}).status_code == 200
     assert wait_for(lambda: client.get("/api/capture").json()["frames"] > 200)

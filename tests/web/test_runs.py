@@ -334,7 +334,10 @@ def test_run_events_send_only_what_changed_when_experiments_train_far_apart(open
     assert len(events) >= 5 and len(events[0]["curve"]["count"]) == 20_000
     later = [e for e in events[1:] if e["run"]["status"] == "running"]
     sent = [sum(p["to"] - p["from"] for p in e["pieces"]) for e in later]
-    assert later and max(sent) < 2_000, sent  # not the 20,000-episode tail again and again
+    # each event sends the episodes finished since the last one, never the tail from experiment
+    # 1's episode to the curve's end (about 20,000 episodes) again and again: how many finish
+    # between two events depends on the machine's speed, so the bound is half the curve
+    assert later and max(sent) < 10_000, sent
     assert len(replay_counts(events)) == 20_000
 
 
