@@ -107,7 +107,8 @@ def stream(
     seed: int,
     image_px: float | None = None,
 ):
-    """(error rows, fraction of frames in the same Puma cell, true and fitted elbow angles).
+    """(error rows, fraction of frames in the same Puma cell, true and fitted elbow angles, lag,
+    fraction of frames each of Puma joints 1-3 leaves the true arm's bin).
 
     With ``image_px``, each frame also gives image landmarks with that jitter, as the page sends
     both.
@@ -116,7 +117,7 @@ def stream(
     fitter = PoseStreamFitter(arm.side)
     retarget = Retargeter("joint", arm=HumanArm(arm.side))
     grid = ArmGrid()
-    rows, same, elbows = [], [], []
+    rows, same, elbows, off = [], [], [], []
     for t in np.arange(0.0, seconds, 1.0 / RATE_HZ):
         q = arm_motion(t, arm)
         world, image = landmarks_from_arm(q, arm)
@@ -131,8 +132,9 @@ def stream(
         rows.append(errors(arm, q, fit.q_human))
         cells = [grid.bins_of_angles(retarget.robot_from_human(x)[:3]) for x in (q, fit.q_human)]
         same.append(bool(np.array_equal(*cells)))
+        off.append(cells[0] != cells[1])
         elbows.append((q[3], fit.q_human[3]))
-    return rows, float(np.mean(same)), np.asarray(elbows), fitter.lag_s
+    return rows, float(np.mean(same)), np.asarray(elbows), fitter.lag_s, np.mean(off, axis=0)
 
 
 def delayed_same_cell(arm: HumanArm, seconds: float, lag_s: float) -> float:
@@ -172,21 +174,25 @@ def accuracy(seconds: float) -> None:
             f"  {side:5s} noisy 1/3 cm, one frame: elbow {single[0]:.2f}, medians "
             f"{single[1]:.2f} / {single[2]:.2f}   (goal <= 10, <= 7)"
         )
-        rows, same, _, lag = stream(arm, seconds, (0.03, 0.08), 2)
+        rows, same, _, lag, _ = stream(arm, seconds, (0.03, 0.08), 2)
         streamed = summary(rows)
         print(
             f"  {side:5s} 30 Hz stream 3/8 cm:     elbow {streamed[0]:.2f}, medians "
             f"{streamed[1]:.2f} / {streamed[2]:.2f}   (goal <= 10, <= 8); Puma joints 1-3 in the "
             f"same cell {100 * same:.1f}% of frames (goal >= 90%)"
         )
-        rows, same, _, _ = stream(arm, seconds, (0.03, 0.08), 2, IMAGE_NOISE_PX)
+        rows, same, _, _, off = stream(arm, seconds, (0.03, 0.08), 2, IMAGE_NOISE_PX)
         streamed = summary(rows)
         print(
             f"  {side:5s} 30 Hz stream 3/8 cm + image {IMAGE_NOISE_PX:.0f} px: elbow "
             f"{streamed[0]:.2f}, medians {streamed[1]:.2f} / {streamed[2]:.2f}   (goal <= 10, <= 8);"
             f" Puma joints 1-3 in the same cell {100 * same:.1f}% of frames (goal >= 90%)"
         )
-        _, same_clean, elbows, _ = stream(arm, seconds, (0.0, 0.0), 3)
+        print(
+            f"  {side:5s} frames off the true bin, Puma joint 1 / 2 / 3: "
+            + " / ".join(f"{100 * v:.1f}%" for v in off)
+        )
+        _, same_clean, elbows, _, _ = stream(arm, seconds, (0.0, 0.0), 3)
         print(
             f"  {side:5s} filter lag: reported {lag:.3f} s, measured on the noise-free stream "
             f"{measured_lag_s(elbows):.3f} s; same cell without noise {100 * same_clean:.1f}%"

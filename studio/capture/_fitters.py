@@ -6,7 +6,7 @@ the pose a demonstration cut from the same observations records:
 
 - tape frames: the kinematics package's :class:`~studio.kinematics.ArmTracker` (reconstruct, fit
   the arm to the tape, retarget);
-- pose landmarks: :class:`~studio.kinematics.PoseStreamFitter` (One Euro filtered, joints the
+- pose landmarks: :class:`~studio.kinematics.PoseStreamFitter` (Kalman filtered, joints the
   camera cannot see held smoothly), then a :class:`~studio.kinematics.Retargeter`;
 - hand poses: :func:`~studio.kinematics.fit_hand_pose` (damped least squares on the arm within
   its limits, seeded with the previous solution), then the same retargeting.

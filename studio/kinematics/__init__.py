@@ -4,6 +4,7 @@ The public names are listed in ``docs/architecture.md``.
 """
 
 from ._errors import KinematicsError as KinematicsError
+from ._filter import ConstantVelocityFilter as ConstantVelocityFilter
 from ._filter import OneEuroFilter as OneEuroFilter
 from ._fit import ArmFit as ArmFit
 from ._fit import ArmFitter as ArmFitter

@@ -32,8 +32,12 @@ then pulls its depth toward what its image-plane length implies.
 flexion from the angle between the limbs, humeral rotation from the forearm's direction about
 the upper arm, and forearm rotation and the wrist from the hand's orientation in the forearm
 frame (Y-Z-X angles about the joints' own axes). Angles are clamped at the arm's limits. The
-shoulder's second branch, ``(Z - pi, pi - X, Y + pi)``, gives the same arm; the one nearer the
-reference (the previous frame, or the neutral arm) among those meeting the landmarks best wins.
+shoulder's second branch, ``(Z - pi, pi - X, Y + pi)``, gives the same arm; among those meeting
+the landmarks best, the first branch wins while its abduction is within
+``PoseConfig.overhead_abduction`` (far from the shoulder's gimbal lock, where it is the natural
+reading), else the one nearer the reference (the previous frame, or the neutral arm). So a
+stream that passed overhead returns to the first branch once the arm comes down, rather than
+keeping an equal arm at other angles.
 
 **Observability.** Seven joints, and the landmarks do not always determine them all:
 
@@ -116,6 +120,10 @@ class PoseConfig:
             elbow off the shoulder-wrist line when the arm is straight (it reads flat arms bent
             by 20 degrees and more). An elbow that the image shows on that line is bent in
             depth only by what exceeds this: nothing up to it, in full from twice it on.
+        overhead_abduction: the shoulder's first branch (abduction within +-90 degrees) is
+            taken whenever it meets the landmarks as well as the second and its abduction is
+            within this (rad); beyond it, near the gimbal lock at 90, the branch nearer the
+            previous frame is kept, so an arm passing overhead does not flip.
         straight_image: the image shows the arm straight when the shoulder-wrist distance in
             the picture is at least this fraction of the two limbs' lengths in the picture;
             from there down to halfway to 1 - 2 (1 - straight_image), depth bends it less
@@ -131,6 +139,7 @@ class PoseConfig:
     refine_iterations: int = 4
     depth_bend_noise: float = 0.04
     straight_image: float = 0.95
+    overhead_abduction: float = math.radians(60.0)
 
     def __post_init__(self) -> None:
         whole_number(self.refine_iterations, "PoseConfig.refine_iterations", 0)
@@ -143,6 +152,7 @@ class PoseConfig:
             "depth_noise",
             "depth_bend_noise",
             "straight_image",
+            "overhead_abduction",
         ):
             positive_number(getattr(self, name), f"PoseConfig.{name}")
         if self.straight_image >= 1.0:
@@ -576,7 +586,7 @@ def fit_reading(
 ) -> PoseFit:
     """The arm fitted to one frame's directions, unobservable joints held at ``q_hold``."""
     observable = observable_joints(reading, cfg)
-    best: tuple[float, float, np.ndarray, np.ndarray] | None = None
+    best: tuple[float, bool, float, np.ndarray, np.ndarray] | None = None
     for overhead in (False, True):
         q = _closed_form(reading, arm, data, q_hold, overhead)
         fitted = _fitted_points(arm, data, q, reading)
@@ -584,12 +594,14 @@ def fit_reading(
         if reading.hand is None:
             gap = gap[:2]
         residual = math.sqrt(float(np.mean(np.sum(gap * gap, axis=1))))
-        # Meet the landmarks first (to a tenth of a millimetre), then stay near the reference.
-        key = (round(residual, 4), float(np.linalg.norm(q - q_hold)))
-        if best is None or key < best[:2]:
+        # Meet the landmarks first (to a tenth of a millimetre), then the first branch away from
+        # the gimbal lock, then stay near the reference.
+        natural = not overhead and abs(q[1]) <= cfg.overhead_abduction
+        key = (round(residual, 4), not natural, float(np.linalg.norm(q - q_hold)))
+        if best is None or key < best[:3]:
             best = (*key, q, fitted)
     assert best is not None
-    q, fitted = best[2], best[3]
+    q, fitted = best[3], best[4]
     gap = reading.points[1:] - fitted[1:]
     if reading.hand is None:
         gap = gap[:2]

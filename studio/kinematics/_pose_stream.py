@@ -1,8 +1,10 @@
 """Fit the human arm to a stream of MediaPipe Pose landmarks (a camera source).
 
-Each frame's landmarks pass a One Euro filter (:class:`OneEuroFilter`) before the fit of
-:func:`fit_pose_landmarks`; the depth, several times noisier than x and y in MediaPipe's world
-landmarks, gets a lower cutoff. The limb lengths the fit refines the arm at are the running
+Each frame's landmarks pass a constant-velocity Kalman filter (:class:`ConstantVelocityFilter`)
+before the fit of :func:`fit_pose_landmarks`: it predicts each landmark with its velocity, so it
+smooths the jitter without the lag of a low-pass filter. Its noise is set per axis: the world
+landmarks' depth, several times noisier than x and y in MediaPipe's output, is smoothed most;
+the image landmarks, steady to a few pixels, least. The limb lengths the fit refines the arm at are the running
 median of the lengths measured in recent frames. Joints the landmarks show weakly (humeral
 rotation with a nearly straight elbow, forearm rotation with the palm's axis along the hand) move
 toward their reading only by a fraction that shrinks with how weakly they are seen; joints not
@@ -12,10 +14,10 @@ never jumps where the landmarks say little.
 The torso's frame is read from a second, slower filter of the same landmarks: the body turns
 slowly, and its yaw, read from depth differences across the shoulders and hips, is noisy.
 
-Lag: for slow motion the filter delays the landmarks by ``1 / (2 pi min_cutoff)`` (the depth's,
-the largest), whatever the frame rate; faster motion raises the cutoff and lowers the lag.
-:attr:`PoseStreamFitter.lag_s` reports it (0.27 s by default; measured on the benchmark's
-motion, the fitted elbow trails the true one by about 0.13 s).
+Lag: a steady motion passes without delay; a change of speed is taken up within the depth
+filter's time constant, :attr:`PoseStreamFitter.lag_s` (0.38 s at 30 Hz by default). Measured on
+the benchmark's motion, the fitted elbow trails the true one by about 0.03 s (0.13 s with the One
+Euro filter this replaced).
 """
 
 from __future__ import annotations
@@ -28,7 +30,7 @@ import numpy as np
 
 from ._checks import check_side, instance_of, positive_number, whole_number
 from ._errors import KinematicsError
-from ._filter import OneEuroFilter
+from ._filter import ConstantVelocityFilter, OneEuroFilter
 from ._pose import (
     FOREARM_ROTATION,
     HUMERAL_ROTATION,
@@ -48,14 +50,20 @@ class StreamConfig:
     """Defaults of the landmark stream's filtering, documented once.
 
     Attributes:
-        min_cutoff_hz: the One Euro filter's cutoff for still landmarks' x and y (and the
-            image landmarks); 1 Hz: a lag of 0.16 s for slow motion.
-        depth_cutoff_hz: its cutoff for the world landmarks' depth (noisier: lower).
-        beta: how much the cutoff rises with a landmark's speed (Hz per m/s); small, because
-            MediaPipe's frame-to-frame jitter reads as speed (at 3 cm, about 1 m/s at 30 Hz).
-        d_cutoff_hz: cutoff of the speed estimate.
-        torso_cutoff_hz: cutoff of the landmarks the torso's frame is read from (the body turns
-            slowly; its yaw, read from depth differences across the shoulders, is noisy).
+        xy_noise_m: the world landmarks' jitter in x and y (s.d., m) the Kalman filter assumes.
+        depth_noise_m: their jitter in depth (s.d., m): MediaPipe's depth is several times
+            noisier than x and y, so it is smoothed more.
+        image_noise_px: the image landmarks' jitter (s.d., pixels): a few pixels, so the image
+            decides x and y.
+        acceleration: how fast a landmark's velocity may change (m/s^2 per sqrt(Hz)), the
+            filter's motion model; lower smooths more and takes up a change of speed later.
+        image_acceleration_px: the same in the picture (pixels/s^2 per sqrt(Hz)); about
+            ``acceleration`` times the pixels per metre at the person (220 at 2 m with a
+            640-pixel, 60-degree camera).
+        torso_cutoff_hz: the One Euro cutoff of the landmarks the torso's frame is read from
+            (the body turns slowly; its yaw, read from depth differences across the shoulders,
+            is noisy).
+        d_cutoff_hz: cutoff of that filter's speed estimate.
         max_gap_s: a gap between frames longer than this restarts the filter (the person left
             and came back: no smoothing across).
         length_frames: the limb lengths are the median over this many recent frames.
@@ -64,11 +72,13 @@ class StreamConfig:
         pose: the per-frame fit's defaults.
     """
 
-    min_cutoff_hz: float = 1.0
-    depth_cutoff_hz: float = 0.6
-    beta: float = 0.3
-    d_cutoff_hz: float = 1.0
+    xy_noise_m: float = 0.03
+    depth_noise_m: float = 0.08
+    image_noise_px: float = 3.0
+    acceleration: float = 0.1
+    image_acceleration_px: float = 22.0
     torso_cutoff_hz: float = 0.3
+    d_cutoff_hz: float = 1.0
     max_gap_s: float = 1.0
     length_frames: int = 90
     weak_gain: float = 0.2
@@ -76,17 +86,19 @@ class StreamConfig:
 
     def __post_init__(self) -> None:
         for name in (
-            "min_cutoff_hz",
-            "depth_cutoff_hz",
-            "d_cutoff_hz",
+            "xy_noise_m",
+            "depth_noise_m",
+            "image_noise_px",
+            "acceleration",
+            "image_acceleration_px",
             "torso_cutoff_hz",
+            "d_cutoff_hz",
             "max_gap_s",
         ):
             positive_number(getattr(self, name), f"StreamConfig.{name}")
-        for name in ("beta", "weak_gain"):
-            value = getattr(self, name)
-            if not (isinstance(value, int | float) and math.isfinite(value) and value >= 0):
-                raise KinematicsError(f"StreamConfig.{name} must be a number >= 0; got {value!r}.")
+        value = self.weak_gain
+        if not (isinstance(value, int | float) and math.isfinite(value) and value >= 0):
+            raise KinematicsError(f"StreamConfig.weak_gain must be a number >= 0; got {value!r}.")
         whole_number(self.length_frames, "StreamConfig.length_frames", 1)
         instance_of(self.pose, PoseConfig, "StreamConfig.pose")
 
@@ -109,24 +121,26 @@ class PoseStreamFitter:
         self.arm = default_arm(self.side)
         self._data = self.arm.model.createData()
         cfg = self.config
-        cutoff = np.empty((N_LANDMARKS, 3))
-        cutoff[:, :2] = cfg.min_cutoff_hz
-        cutoff[:, 2] = cfg.depth_cutoff_hz
-        self._world = OneEuroFilter(cutoff, cfg.beta, cfg.d_cutoff_hz)
-        self._image = OneEuroFilter(cfg.min_cutoff_hz, cfg.beta, cfg.d_cutoff_hz)
+        noise = np.empty((N_LANDMARKS, 3))
+        noise[:, :2] = cfg.xy_noise_m
+        noise[:, 2] = cfg.depth_noise_m
+        self._world = ConstantVelocityFilter(noise, cfg.acceleration)
+        self._image = ConstantVelocityFilter(cfg.image_noise_px, cfg.image_acceleration_px)
         self._torso = OneEuroFilter(cfg.torso_cutoff_hz, 0.0, cfg.d_cutoff_hz)
         self._lengths: deque[np.ndarray] = deque(maxlen=cfg.length_frames)
         self.reset()
 
     @property
     def lag_s(self) -> float:
-        """The filter's lag (s) for slow motion, the largest it adds (faster motion: less).
+        """The time (s) in which the filter takes up a change of the arm's speed.
 
-        ``1 / (2 pi depth_cutoff_hz)`` with the defaults (0.27 s), the same at any frame rate.
-        The torso's frame, filtered more, follows a turning body with ``1 / (2 pi
+        The world depth's Kalman time constant at the frame interval last seen (30 Hz before
+        two frames): 0.38 s with the defaults. A steady motion passes without delay, and over a
+        smooth one the arm trails far less (about 0.03 s on the benchmark's motion). The
+        torso's frame, filtered more, follows a turning body with ``1 / (2 pi
         torso_cutoff_hz)`` (0.53 s); the arm's own motion is not delayed by it.
         """
-        return self._world.lag_s()
+        return self._world.lag_s(self._dt)
 
     def reset(self) -> None:
         """Forget the past frames: a new person, a new source."""
@@ -135,6 +149,7 @@ class PoseStreamFitter:
         self._torso.reset()
         self._lengths.clear()
         self._t: float | None = None
+        self._dt = 1.0 / 30.0
         self._q: np.ndarray | None = None
         self._had_image = False
 
@@ -181,6 +196,8 @@ class PoseStreamFitter:
         world = self._world(t, world)
         if pixels is not None:
             pixels = self._image(t, pixels)
+        if self._t is not None:
+            self._dt = float(t) - self._t
         self._t = float(t)
         lengths = np.median(self._lengths, axis=0) if self._lengths else None
         reading = _read(world, pixels, size, visibility, self.side, cfg.pose, lengths, torso)
