@@ -46,7 +46,6 @@ from ._recording_reader import (
     _open,
     _Problems,
     _short,
-    _summary,
     _to_array,
     _whole,
     array_time_warnings,
@@ -183,18 +182,15 @@ class ObservationRecording(RecordingTimeline):
         """Every row as its observation."""
         return [self.frame_at(i) for i in range(len(self))]
 
-    def summary(self) -> dict[str, Any]:
-        """JSON-ready facts for listings (``studio info``, the web page)."""
-        return _summary(
-            self.path,
-            self.meta,
-            len(self),
-            self.duration,
-            self.recovered,
-            self.problems,
-            array_time_warnings(self.t),
-            self.kind.name,
-        )
+    @property
+    def kind_name(self) -> str:
+        """``"pose"`` or ``"hand"``."""
+        return self.kind.name
+
+    @property
+    def warnings(self) -> list[str]:
+        """Times below zero or going backwards, in the tape reader's words."""
+        return array_time_warnings(self.t)
 
 
 def _header_kind(path: Path) -> tuple[RecordingKind, str]:

@@ -44,13 +44,18 @@ READ_BLOCK_BYTES = 1024 * 1024
 class RecordingTimeline:
     """What every recording kind shares: a path, a header, times and the rows of a segment.
 
-    Subclasses are dataclasses with ``path``, ``meta``, ``t``, ``recovered``, ``problems`` and
-    :meth:`frame_at`.
+    Subclasses are dataclasses with ``path``, ``meta``, ``t``, ``recovered``, ``problems``,
+    ``warnings`` and :meth:`frame_at`.
     """
 
     path: Path
     meta: dict[str, Any]
     t: np.ndarray
+    recovered: bool
+    problems: list[str]
+    warnings: list[str]
+    kind_name = "tape"
+    """What the recording holds: ``"tape"``, ``"pose"`` or ``"hand"`` (the summary's ``kind``)."""
 
     def __len__(self) -> int:
         return int(self.t.shape[0])
@@ -76,6 +81,19 @@ class RecordingTimeline:
         lo = int(np.searchsorted(self.t, start + t0, side="left"))
         hi = int(np.searchsorted(self.t, start + t1, side="right"))
         return slice(lo, hi)
+
+    def summary(self) -> dict[str, Any]:
+        """JSON-ready facts for listings (``studio info``, the web page)."""
+        return _summary(
+            self.path,
+            self.meta,
+            len(self),
+            self.duration,
+            self.recovered,
+            self.problems,
+            self.warnings,
+            self.kind_name,
+        )
 
 
 @dataclass(eq=False)
@@ -133,18 +151,6 @@ class Recording(RecordingTimeline):
             self.bend[index].copy(),
             self.twist[index].copy(),
             int(self.status[index]),
-        )
-
-    def summary(self) -> dict[str, Any]:
-        """JSON-ready facts for listings (``studio info``, the web page)."""
-        return _summary(
-            self.path,
-            self.meta,
-            len(self),
-            self.duration,
-            self.recovered,
-            self.problems,
-            self.warnings,
         )
 
 
