@@ -231,14 +231,27 @@ class Studio:
         if self.scene is not None:
             self.scene.set_goal(q)
 
-    def _fed_source(self, kind: str) -> Any:
+    def _observe_fed(self, kind: str, *args: Any, **kwargs: Any) -> tuple[Any, Any]:
+        """Hand one update to the fed source ``kind`` (camera or hand) and fit it; returns the
+        observation and the fit (None when the fit failed: the pipeline's status says why).
+
+        Raises:
+            ConflictError: the live source is not ``kind``.
+            TooManyRequestsError: a flood (the update is dropped).
+        """
+        from studio.capture import FloodError
+
         source = self.pipeline.source
         if self.pipeline.kind != kind or source is None:
             label = "camera" if kind == "camera" else "hand guide"
             raise ConflictError(
                 f"The live source is not the {label}; switch the source to {kind} first."
             )
-        return source
+        try:
+            observation = source.submit(*args, **kwargs)
+        except FloodError as err:
+            raise TooManyRequestsError(str(err)) from None
+        return observation, self.pipeline.observe(observation)
 
     def post_landmarks(self, frame: dict[str, Any]) -> dict[str, Any]:
         """Fit and record one frame of landmarks from the page (``LandmarksFrame``).
@@ -248,15 +261,8 @@ class Studio:
             TooManyRequestsError: a flood (the frame is dropped).
             CaptureError: NaN or wrong sizes (422).
         """
-        from studio.capture import FloodError
-
-        source = self._fed_source("camera")
-        try:
-            observation = source.submit(**frame)
-        except FloodError as err:
-            raise TooManyRequestsError(str(err)) from None
-        fitted = self.pipeline.observe(observation)
-        observable = None if fitted is None or fitted.observable is None else fitted.observable
+        observation, fitted = self._observe_fed("camera", **frame)
+        observable = None if fitted is None else fitted.observable
         warning = fitted.warning if fitted is not None else self.pipeline.status()["error"]
         return {
             "person_detected": observation.person,
@@ -275,14 +281,7 @@ class Studio:
             TooManyRequestsError: a flood (the update is dropped).
             CaptureError: NaN or wrong sizes (422).
         """
-        from studio.capture import FloodError
-
-        source = self._fed_source("hand")
-        try:
-            observation = source.submit(position, wxyz)
-        except FloodError as err:
-            raise TooManyRequestsError(str(err)) from None
-        fitted = self.pipeline.observe(observation)
+        _, fitted = self._observe_fed("hand", position, wxyz)
         if fitted is None:
             raise InvalidError(
                 self.pipeline.status()["error"]
