@@ -11,6 +11,9 @@ from __future__ import annotations
 
 import os
 import stat
+import tempfile
+from collections.abc import Callable
+from datetime import UTC, datetime
 from pathlib import Path
 from typing import BinaryIO
 
@@ -99,3 +102,34 @@ def _too_large(what: str, size: int, limit: int) -> str:
         f"{what} is {human_size(size)}, more than the {human_size(limit)} such a file can "
         "hold; check that it is the right file."
     )
+
+
+def atomic_write(path: str | os.PathLike[str], write: Callable[[BinaryIO], None]) -> Path:
+    """Let ``write`` fill a temporary file next to ``path``, fsync it, and ``os.replace`` it in.
+
+    Readers see either the old or the new content, never half; a crash or an error while writing
+    leaves the old file and no temporary file behind. This is the one atomic write of the studio.
+    """
+    path = Path(path)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "wb") as f:
+            write(f)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    return path
+
+
+def atomic_write_text(path: str | os.PathLike[str], text: str) -> Path:
+    """Write ``text`` (UTF-8) to ``path`` with :func:`atomic_write`."""
+    data = text.encode("utf-8")
+    return atomic_write(path, lambda f: f.write(data))
+
+
+def now_iso() -> str:
+    """The current UTC time, ISO 8601 to the second: the stamp every studio file records."""
+    return datetime.now(UTC).isoformat(timespec="seconds")

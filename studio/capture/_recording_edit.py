@@ -12,8 +12,7 @@ import fcntl
 import json
 import os
 import shutil
-import tempfile
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any, BinaryIO
@@ -22,6 +21,7 @@ import numpy as np
 
 from studio import StudioError, read_json
 
+from .._files import atomic_write, atomic_write_text
 from ._errors import RecordingError
 from ._recording_format import (
     RECORDING_SUFFIX,
@@ -37,28 +37,6 @@ EDITABLE_KEYS = ("name", "operator", "notes")
 """Header keys :func:`update_recording_meta` may change (the rest describe the data)."""
 DEMO_SUFFIX = ".demo.json"
 """File name ending of demonstrations (they reference their recording by file name)."""
-
-
-def atomic_write(path: str | os.PathLike[str], write: Callable[[BinaryIO], None]) -> Path:
-    """Let ``write`` fill a temporary file next to ``path``, fsync it, and ``os.replace`` it in."""
-    path = Path(path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "wb") as f:
-            write(f)
-            f.flush()
-            os.fsync(f.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    return path
-
-
-def atomic_write_text(path: str | os.PathLike[str], text: str) -> Path:
-    """Write ``text`` to ``path`` through a fsynced temporary file and ``os.replace``."""
-    data = text.encode("utf-8")
-    return atomic_write(path, lambda f: f.write(data))
 
 
 def being_recorded(path: str | os.PathLike[str]) -> bool:

@@ -11,12 +11,12 @@ episodes) before any work starts.
 
 from __future__ import annotations
 
-import math
 from dataclasses import asdict, dataclass, fields
 from typing import Any
 
 import numpy as np
 
+from .._numbers import is_int, is_number
 from ._errors import ConfigError
 
 PLANNERS = ("zero", "full", "soft", "prioritized")
@@ -106,18 +106,6 @@ class DynaQConfig:
         return cls(**data)
 
 
-def _is_number(value: object) -> bool:
-    return (
-        isinstance(value, int | float | np.integer | np.floating)
-        and not isinstance(value, bool)
-        and math.isfinite(value)
-    )
-
-
-def _is_int(value: object) -> bool:
-    return isinstance(value, int | np.integer) and not isinstance(value, bool)
-
-
 def _problems(config: DynaQConfig) -> list[tuple[str, str]]:
     """``(field, sentence)`` per bad field of ``config``."""
     problems: list[tuple[str, str]] = []
@@ -125,12 +113,12 @@ def _problems(config: DynaQConfig) -> list[tuple[str, str]]:
     def number(name: str, low: float, high: float, low_open: bool = False) -> None:
         value = getattr(config, name)
         lo = "(" if low_open else "["
-        if not _is_number(value) or value < low or value > high or (low_open and value <= low):
+        if not is_number(value) or value < low or value > high or (low_open and value <= low):
             problems.append((name, f"{name} is {value!r}; give a number in {lo}{low}, {high}]."))
 
     def integer(name: str, low: int, high: int) -> None:
         value = getattr(config, name)
-        if not _is_int(value) or value < low or value > high:
+        if not is_int(value) or value < low or value > high:
             problems.append(
                 (name, f"{name} is {value!r}; give a whole number from {low} to {high:,}.")
             )
@@ -145,7 +133,7 @@ def _problems(config: DynaQConfig) -> list[tuple[str, str]]:
     integer("planning_steps", 0, MAX_PLANNING_STEPS)
     integer("max_steps_per_episode", 1, MAX_STEPS_PER_EPISODE)
     value = config.priority_threshold
-    if not _is_number(value) or value < 0:
+    if not is_number(value) or value < 0:
         problems.append(
             ("priority_threshold", f"priority_threshold is {value!r}; give a finite number >= 0.")
         )
@@ -171,7 +159,7 @@ def check_budget(
         ("experiments", experiments, MAX_EXPERIMENTS),
         ("episodes", episodes, MAX_EPISODES),
     ):
-        if not _is_int(value) or not 1 <= value <= high:
+        if not is_int(value) or not 1 <= value <= high:
             problems.append((name, f"{name} is {value!r}; give a whole number from 1 to {high:,}."))
     if problems:
         raise ConfigError([text for _, text in problems], [name for name, _ in problems])

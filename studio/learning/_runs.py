@@ -65,6 +65,8 @@ import numpy as np
 
 from studio import StudioError, read_bytes_bounded, read_json
 
+from .._files import atomic_write_text, now_iso
+from .._numbers import is_int
 from ._arm import ArmGrid
 from ._config import DEFAULT_SEED, MAX_STEPS_PER_EPISODE, DynaQConfig, check_budget
 from ._dynaq import ExperimentResult, LiveProgress, run_experiments
@@ -121,11 +123,6 @@ CURVE_COLUMNS = (
 """The one ``curves.csv`` layout: per episode (1-based), statistics of the real steps over the
 ``experiments`` that finished it. ``studio reproduce`` puts a ``configuration`` column first."""
 STATISTICS = CURVE_COLUMNS[1:-1]
-
-
-def now_iso() -> str:
-    """The current UTC time, ISO 8601 to the second."""
-    return datetime.now(UTC).isoformat(timespec="seconds")
 
 
 # ----------------------------------------------------------------------------- statistics
@@ -433,7 +430,7 @@ class RunRecord:
         episodes) join the task's own ``problems``; all of them raised at once."""
         if origin not in ORIGINS:
             problems.append(("origin", f"origin is {origin!r}; give one of {', '.join(ORIGINS)}."))
-        if _is_int(episodes) and len(paths) > episodes:
+        if is_int(episodes) and len(paths) > episodes:
             problems.append(
                 (
                     "demonstrations",
@@ -482,7 +479,7 @@ class RunRecord:
         problems = run_problems(experiments, episodes, seed, name)
         try:
             coder = coding.bind(task.lower, task.upper)
-            problem = _is_int(experiments) and weight_problem(experiments, coder, task.n_actions)
+            problem = is_int(experiments) and weight_problem(experiments, coder, task.n_actions)
             if problem:
                 problems.append(("tiles", problem))
         except LearningError as err:
@@ -581,7 +578,7 @@ class RunRecord:
         if not isinstance(data, dict):
             raise LearningError("config.json holds no JSON object; it is not a run folder.")
         version = data.get("version", 0)
-        if data.get("format", RUN_FORMAT) != RUN_FORMAT or not _is_int(version):
+        if data.get("format", RUN_FORMAT) != RUN_FORMAT or not is_int(version):
             raise LearningError(
                 f"config.json has format {data.get('format')!r}; it is not a {RUN_FORMAT} folder."
             )
@@ -636,10 +633,6 @@ def _text(value: object) -> str | None:
     return value if isinstance(value, str) else None
 
 
-def _is_int(value: object) -> bool:
-    return isinstance(value, int | np.integer) and not isinstance(value, bool)
-
-
 def run_problems(
     experiments: object,
     episodes: object,
@@ -656,7 +649,7 @@ def run_problems(
             check_budget(experiments, episodes, grid.n_states, grid.n_actions)
     except ConfigError as err:
         problems += list(err.by_field.items())
-    if not _is_int(seed) or not 0 <= seed < 2**63:  # type: ignore[operator]
+    if not is_int(seed) or not 0 <= seed < 2**63:  # type: ignore[operator]
         problems.append(("seed", f"seed is {seed!r}; give a whole number from 0 to 2**63 - 1."))
     if not isinstance(name, str) or (name and (not name.strip() or len(name) > 100)):
         problems.append(("name", "name must be 1 to 100 characters; give a shorter label or none."))
@@ -701,7 +694,7 @@ def pid_alive(pid: object, host: object = None, started: object = None) -> bool:
     ``started`` is when the record says its process started the work (ISO 8601): a live process
     with that pid that started later reused the pid after the recorded one ended.
     """
-    if not _is_int(pid) or pid <= 0:  # type: ignore[operator]
+    if not is_int(pid) or pid <= 0:  # type: ignore[operator]
         return False
     if not on_this_host(host):
         return True
@@ -731,17 +724,6 @@ def _started_after(pid: int, started: object) -> bool:
         return False
     began = process_started(pid)
     return began is not None and began > when + PID_CLOCK_SLACK_SECONDS
-
-
-def _atomic_write(path: Path, text: str) -> None:
-    tmp = path.with_name(f".{path.name}.{secrets.token_hex(4)}.tmp")
-    try:
-        tmp.write_text(text)
-        os.replace(tmp, path)
-    except BaseException:
-        with contextlib.suppress(OSError):
-            tmp.unlink()
-        raise
 
 
 def delete_run_folder(path: Path, owner: OwnerLock | None = None) -> None:
@@ -1065,7 +1047,7 @@ class RunFolder:
             "host": self.host if self.status in ("queued", "running") else None,
         }
         try:
-            _atomic_write(self.path / STATUS_FILE, json.dumps(status, indent=1))
+            atomic_write_text(self.path / STATUS_FILE, json.dumps(status, indent=1))
         except OSError as err:
             raise _disk_error(err, "the run's status", self.path) from None
         if self.status not in ("queued", "running") and self._owner is not None:
@@ -1077,9 +1059,9 @@ class RunFolder:
         each atomically. ``steps.csv`` is the truth; ``curves.csv`` is derived from it."""
         steps = np.asarray(steps, dtype=np.int64).copy()
         try:
-            _atomic_write(self.path / STEPS_FILE, steps_text(steps))
+            atomic_write_text(self.path / STEPS_FILE, steps_text(steps))
             if curves:
-                _atomic_write(self.path / CURVES_FILE, curves_csv(curve_statistics(steps)))
+                atomic_write_text(self.path / CURVES_FILE, curves_csv(curve_statistics(steps)))
         except OSError as err:
             raise _disk_error(err, "the run's curve", self.path) from None
         self._steps = steps

@@ -55,6 +55,8 @@ from studio import (
     read_toml,
 )
 
+from .._files import atomic_write_text, now_iso
+from .._numbers import is_int, is_number
 from ._arm import ArmGrid
 from ._config import DynaQConfig
 from ._dynaq import LiveProgress
@@ -72,7 +74,6 @@ from ._runs import (
     RunFolder,
     RunRecord,
     curve_statistics,
-    now_iso,
     pid_alive,
     this_host,
 )
@@ -414,24 +415,24 @@ def parse_sweep_spec(data: Mapping[str, Any], source: str = "the sweep spec") ->
     if kind not in SEARCH_KINDS:
         raise SweepError(f"{source} [search] kind is {kind!r}; give grid or random.")
     samples = search.get("samples", 1 if kind == "grid" else None)
-    if kind == "random" and (not _is_int(samples) or not 1 <= samples <= MAX_TRIALS):
+    if kind == "random" and (not is_int(samples) or not 1 <= samples <= MAX_TRIALS):
         raise SweepError(
             f"{source} [search] samples is {samples!r}; random search needs a whole number of draws from 1 to {MAX_TRIALS:,}."
         )
     search_seed = search.get("seed", 0)
-    if not _is_int(search_seed) or search_seed < 0:
+    if not is_int(search_seed) or search_seed < 0:
         raise SweepError(f"{source} [search] seed is {search_seed!r}; give a whole number >= 0.")
 
     seeds = data.get("seeds", [0])
     # Count the trials before anything is listed: seeds = 1000000000 must not build that list.
-    seed_count = seeds if _is_int(seeds) else len(seeds) if isinstance(seeds, list) else 0
+    seed_count = seeds if is_int(seeds) else len(seeds) if isinstance(seeds, list) else 0
     combos = math.prod(len(v) if isinstance(v, list) else 1 for v in space.values())
     count = (combos if kind == "grid" else samples) * seed_count
     if count > MAX_TRIALS:
         raise SweepError(
             f"{source} makes {count:,} trials, over the limit of {MAX_TRIALS:,}; sweep fewer values or seeds."
         )
-    if _is_int(seeds) and seeds >= 1:
+    if is_int(seeds) and seeds >= 1:
         seeds = list(range(seeds))
     if not isinstance(seeds, list) or not seeds:
         raise SweepError(
@@ -447,7 +448,7 @@ def parse_sweep_spec(data: Mapping[str, Any], source: str = "the sweep spec") ->
                 f"{source} gives no {key}; add {key} = N at the top (per trial's run)."
             )
     cpus = data.get("cpus_per_trial", DEFAULT_CPUS_PER_TRIAL)
-    if not _is_int(cpus) or not 1 <= cpus <= MAX_CPUS_PER_TRIAL:
+    if not is_int(cpus) or not 1 <= cpus <= MAX_CPUS_PER_TRIAL:
         raise SweepError(
             f"{source}: cpus_per_trial is {cpus!r}; give a whole number of cores from 1 to {MAX_CPUS_PER_TRIAL}."
         )
@@ -484,12 +485,12 @@ def parse_sweep_spec(data: Mapping[str, Any], source: str = "the sweep spec") ->
     if metric not in METRICS:
         raise SweepError(f"{source} [metric] name is {metric!r}; give one of {', '.join(METRICS)}.")
     factor = metric_table.get("convergence_factor", CONVERGENCE_FACTOR)
-    if not _is_number(factor) or factor <= 0:
+    if not is_number(factor) or factor <= 0:
         raise SweepError(
             f"{source} [metric] convergence_factor is {factor!r}; give a number above 0."
         )
     level = metric_table.get("level_steps")
-    if level is not None and (not _is_number(level) or level <= 0):
+    if level is not None and (not is_number(level) or level <= 0):
         raise SweepError(f"{source} [metric] level_steps is {level!r}; give a number above 0.")
     if metric == "episodes_to_converge" and level is None and task != TASK_ARM_GRID:
         raise SweepError(
@@ -509,12 +510,12 @@ def parse_sweep_spec(data: Mapping[str, Any], source: str = "the sweep spec") ->
                 f'{source} [scheduler] kind is {sched.get("kind")!r}; the one scheduler is "asha".'
             )
         grace = sched.get("grace_episodes", max(1, episodes // 10))
-        if not _is_int(grace) or not 1 <= grace <= episodes:
+        if not is_int(grace) or not 1 <= grace <= episodes:
             raise SweepError(
                 f"{source} [scheduler] grace_episodes is {grace!r}; give a whole number from 1 to the {episodes} episodes."
             )
         rf = sched.get("reduction_factor", DEFAULT_REDUCTION_FACTOR)
-        if not _is_int(rf) or rf < 2:
+        if not is_int(rf) or rf < 2:
             raise SweepError(
                 f"{source} [scheduler] reduction_factor is {rf!r}; give a whole number of at least 2."
             )
@@ -553,14 +554,6 @@ def _settings_of(task: str) -> tuple[str, ...]:
     return CONFIG_FIELDS + TASK_SETTINGS[task]
 
 
-def _is_int(value: object) -> bool:
-    return isinstance(value, int) and not isinstance(value, bool)
-
-
-def _is_number(value: object) -> bool:
-    return isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value)
-
-
 def _toml(value: Any) -> str:
     return json.dumps(value) if isinstance(value, str | list) else f"{value}"
 
@@ -573,7 +566,7 @@ def _check_distribution(
             f"{where} is {values!r}; give one of {', '.join(f'{{{d} = [low, high]}}' for d in DISTRIBUTIONS)}, or a list of values."
         )
     (kind, bounds), *_ = values.items()
-    numbers = _is_int if kind == "randint" else _is_number
+    numbers = is_int if kind == "randint" else is_number
     if (
         not isinstance(bounds, list)
         or len(bounds) != 2
@@ -631,7 +624,7 @@ def _record(
         grid_spec["goal"] = tuple(grid_spec["goal"])
     grid = ArmGrid(**grid_spec)
     count = settings.get("demonstrations", 0)
-    if not _is_int(count) or count < 0:
+    if not is_int(count) or count < 0:
         raise LearningError(
             f"demonstrations is {count!r}; give how many generated demonstrations to replay (0 or more)."
         )
@@ -823,12 +816,6 @@ def sweep_folder(data_dir: Path, sweep_id: str) -> Path:
     return Path(data_dir) / SWEEPS_DIR / sweep_id
 
 
-def _write_json(path: Path, data: Any) -> None:
-    tmp = path.with_name(f".{path.name}.tmp")
-    tmp.write_text(json.dumps(data, indent=1))
-    os.replace(tmp, path)
-
-
 def _read_json(path: Path) -> Any:
     """A sweep's JSON file (bounded in size and depth), or None when missing or unreadable."""
     try:
@@ -968,7 +955,7 @@ def sweep_figures(
     series = metric_by_setting(rows, spec)
     categories: list[str] = []
     numeric = all(
-        _is_number(v) for v in (spec.space[x_name] if isinstance(spec.space[x_name], list) else [0])
+        is_number(v) for v in (spec.space[x_name] if isinstance(spec.space[x_name], list) else [0])
     )
     for label, xs, means, errors in series:
         if numeric:
@@ -1264,7 +1251,7 @@ def _prepare(data_dir: Path, spec: SweepSpec, resume: bool) -> Path:
         }
     stored["status"] = "running"
     stored["pid"], stored["host"] = os.getpid(), this_host()
-    _write_json(folder / SWEEP_FILE, stored)
+    atomic_write_text(folder / SWEEP_FILE, json.dumps(stored, indent=1))
     return folder
 
 
@@ -1284,7 +1271,7 @@ def _set_status(folder: Path, status: str, **fields: Any) -> None:
     data = _read_json(folder / SWEEP_FILE)
     if isinstance(data, dict):
         data.update(status=status, **fields)
-        _write_json(folder / SWEEP_FILE, data)
+        atomic_write_text(folder / SWEEP_FILE, json.dumps(data, indent=1))
 
 
 def run_sweep(
@@ -1314,7 +1301,7 @@ def run_sweep(
     Raises:
         SweepError: Ray missing, a cluster out of reach, the sweep exists (or not, to resume).
     """
-    if workers is not None and (not _is_int(workers) or workers < 1):
+    if workers is not None and (not is_int(workers) or workers < 1):
         raise SweepError(f"--workers is {workers!r}; give a whole number of cores, at least 1.")
     # before anything is written: a missing Ray or cluster leaves no trace
     ray = _import_ray(local=address is None)
@@ -1477,6 +1464,6 @@ def _progress_callback(
             }
             if error:
                 record["error"] = str(error)
-            _write_json(folder / TRIALS_DIR / f"{key}.json", record)
+            atomic_write_text(folder / TRIALS_DIR / f"{key}.json", json.dumps(record, indent=1))
 
     return Progress()

@@ -36,6 +36,7 @@ from functools import cached_property
 import numpy as np
 from numba import njit
 
+from .._numbers import is_int
 from ._errors import LearningError
 
 DEFAULT_TILINGS = 8
@@ -97,13 +98,13 @@ class TileCoding:
     def __post_init__(self) -> None:
         for name, high in (("tilings", MAX_TILINGS), ("tiles", MAX_TILES)):
             value = getattr(self, name)
-            if not _is_int(value) or not 1 <= value <= high:
+            if not is_int(value) or not 1 <= value <= high:
                 raise LearningError(
                     f"{name} is {value!r}; give a whole number from 1 to {high:,} ({name} of zero would activate no feature)."
                 )
             object.__setattr__(self, name, int(value))
         if self.size is not None:
-            if not _is_int(self.size) or not 1 <= self.size <= MAX_SIZE:
+            if not is_int(self.size) or not 1 <= self.size <= MAX_SIZE:
                 raise LearningError(
                     f"size is {self.size!r}; give a whole number of weight rows from 1 to {MAX_SIZE:,}."
                 )
@@ -195,10 +196,6 @@ class TileCoding:
                     f"groups name dimension(s) {list(g)} but the observation has {dims} (0 to {dims - 1}); give dimensions that exist."
                 )
         return TileCoder(self, lo.astype(np.float64), hi.astype(np.float64), groups)
-
-
-def _is_int(value: object) -> bool:
-    return isinstance(value, int | np.integer) and not isinstance(value, bool)
 
 
 class TileCoder:

@@ -46,9 +46,9 @@ from studio.learning import (
     run_problems,
 )
 
+from .._files import now_iso
 from ._errors import ConflictError, InvalidError, NotFoundError
 from ._schemas import RunCreate, RunPublic
-from ._store import now_iso
 
 __all__ = ["Run", "RunQueue", "prepare_run"]
 

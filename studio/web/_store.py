@@ -31,7 +31,6 @@ import threading
 import uuid
 from collections.abc import Callable
 from dataclasses import dataclass
-from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any, Generic, TypeVar
 
@@ -130,18 +129,6 @@ def unique_name(base: str, taken: Callable[[str], bool]) -> str:
     while taken(f"{base}-{k}"):
         k += 1
     return f"{base}-{k}"
-
-
-def atomic_write_text(path: Path, text: str) -> None:
-    """Write a small file so that readers see either the old or the new content, never half."""
-    tmp = path.with_name(f".{path.name}.{uuid.uuid4().hex[:8]}.tmp")
-    tmp.write_text(text)
-    os.replace(tmp, path)
-
-
-def now_iso() -> str:
-    """The current UTC time, ISO 8601 to the second."""
-    return datetime.now(UTC).isoformat(timespec="seconds")
 
 
 async def receive_upload(upload: UploadFile, folder: Path, limit: int) -> Path:
