@@ -53,7 +53,8 @@ from pathlib import Path
 
 from studio.learning import warm_up
 from studio.learning._runs import RunFolder
-from studio.learning._sweep import _connect, _import_ray, parse_sweep_spec, run_sweep, trial_record
+from studio.learning._sweep_ray import _connect, _import_ray, run_sweep
+from studio.learning._sweep_spec import parse_sweep_spec, trial_record
 
 SIZES = (4, 16)
 REPEATS = 2

@@ -22,16 +22,14 @@ import pytest
 
 from studio.learning import ArmGrid, DynaQConfig, generate_demonstrations, run_experiments
 from studio.learning._runs import RunFolder
-from studio.learning._sweep import (
+from studio.learning._sweep_folder import (
     SUMMARY_FILE,
-    SweepError,
-    load_sweep_spec,
-    parse_sweep_spec,
-    run_sweep,
     sweep_folder,
     trial_records,
     trial_run_path,
 )
+from studio.learning._sweep_ray import run_sweep
+from studio.learning._sweep_spec import SweepError, load_sweep_spec, parse_sweep_spec
 from tests.conftest import free_port as _free_port
 from tests.conftest import require
 
@@ -177,7 +175,7 @@ def test_a_huge_seed_count_is_refused_before_any_seed_is_listed() -> None:
     is capped at 256 MB above what it holds, so building the list of seeds would fail."""
     script = (
         "import resource\n"
-        "from studio.learning._sweep import SweepError, parse_sweep_spec\n"
+        "from studio.learning._sweep_spec import SweepError, parse_sweep_spec\n"
         "from tests.learning.test_sweep import spec_dict\n"
         "size = next(int(line.split()[1]) * 1024 for line in open('/proc/self/status')\n"
         "            if line.startswith('VmSize:'))\n"
@@ -206,7 +204,7 @@ def test_a_spec_file_that_is_not_toml_is_refused(tmp_path: Path) -> None:
 
 
 def test_without_ray_the_error_says_how_to_install_it(monkeypatch, tmp_path: Path) -> None:
-    from studio.learning import _sweep
+    from studio.learning import _sweep_ray as _sweep
 
     monkeypatch.setitem(sys.modules, "ray", None)
     with pytest.raises(SweepError, match=r"pip install -e '\.\[cluster\]'"):

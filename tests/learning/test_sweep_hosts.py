@@ -21,7 +21,9 @@ from hypothesis import strategies as st
 
 from studio.learning import ArmGrid, DynaQConfig
 from studio.learning._runs import RunFolder, RunRecord, on_this_host, pid_alive, this_host
-from studio.learning._sweep import _prepare, load_sweep, parse_sweep_spec
+from studio.learning._sweep_folder import prepare_folder as _prepare
+from studio.learning._sweep_list import load_sweep
+from studio.learning._sweep_spec import parse_sweep_spec
 
 OTHER_HOST = {"hostname": f"not-{socket.gethostname()}", "node": "a0b1c2"}
 
