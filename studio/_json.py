@@ -18,7 +18,6 @@ import os
 import re
 import tomllib
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
@@ -67,7 +66,7 @@ def loads_json(
     *,
     max_bytes: int = MAX_JSON_BYTES,
     max_depth: int = MAX_JSON_DEPTH,
-) -> Any:
+) -> object:
     """Parse JSON after checking its size and nesting depth.
 
     Args:
@@ -77,7 +76,7 @@ def loads_json(
         max_depth: the deepest nesting accepted.
 
     Returns:
-        The parsed value.
+        The parsed value (a dict, list, str, int, float, bool or None: the caller checks which).
 
     Raises:
         JSONFileError: the text is too long, too deeply nested, not UTF-8 or not valid JSON.
@@ -112,7 +111,7 @@ def read_json(
     *,
     max_bytes: int = MAX_JSON_BYTES,
     max_depth: int = MAX_JSON_DEPTH,
-) -> Any:
+) -> object:
     """Read a JSON file: a regular file of at most ``max_bytes``, nested at most ``max_depth`` deep.
 
     Args:
@@ -140,7 +139,7 @@ def read_toml(
     *,
     max_bytes: int = MAX_TOML_BYTES,
     max_depth: int = MAX_JSON_DEPTH,
-) -> dict[str, Any]:
+) -> dict[str, object]:
     """Read a TOML file: a regular file of at most ``max_bytes``, tables nested at most ``max_depth``.
 
     ``tomllib`` recurses on nested inline arrays and tables (a ``RecursionError`` on hostile
@@ -160,8 +159,7 @@ def read_toml(
         raise TOMLFileError(f"{label} is not valid TOML ({err}); fix it.") from None
     except RecursionError:
         value = None
-    depth = None if value is None else value_depth(value, max_depth + 1)
-    if depth is None or depth > max_depth:
+    if value is None or value_depth(value, max_depth + 1) > max_depth:
         raise TOMLFileError(
             f"{label} nests tables or arrays more than {max_depth} levels deep; it is damaged or "
             "not a Teach Studio file."
@@ -169,7 +167,7 @@ def read_toml(
     return value
 
 
-def value_depth(value: Any, stop: int | None = None) -> int:
+def value_depth(value: object, stop: int | None = None) -> int:
     """Nesting depth of parsed lists and dicts (a scalar is 0), without recursion.
 
     Args:

@@ -22,7 +22,6 @@ import json
 import os
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
@@ -94,13 +93,19 @@ class Calibration:
 
     @classmethod
     def from_flat(
-        cls, raw: np.ndarray, gains: np.ndarray | float = DEFAULT_GAIN, **kw: Any
+        cls,
+        raw: np.ndarray,
+        gains: np.ndarray | float = DEFAULT_GAIN,
+        *,
+        serial: int | None = None,
+        notes: str = "",
     ) -> Calibration:
         """Offsets from raw frames of the flat tape (their per-channel mean), with given gains.
 
         Args:
             raw: ``(frames, channels)`` raw counts recorded with the tape held flat.
             gains: radians per count, one per channel or one for all.
+            serial, notes: as the class's.
         """
         raw = np.asarray(raw, dtype=np.float64)
         if raw.ndim != 2 or raw.shape[0] < 1:
@@ -111,7 +116,8 @@ class Calibration:
         return cls(
             offsets,
             np.broadcast_to(np.asarray(gains, dtype=np.float64), offsets.shape).copy(),
-            **kw,
+            serial,
+            notes,
         )
 
     def angles(self, raw: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -127,7 +133,7 @@ class Calibration:
         angle[..., 0::2], angle[..., 1::2] = bend, twist
         return np.clip(np.rint(angle / self.gains + self.offsets), 0, 0xFFFF).astype(np.uint16)
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, object]:
         """JSON-ready file contents."""
         return {
             "format": CALIBRATION_FORMAT,

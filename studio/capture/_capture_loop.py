@@ -6,13 +6,12 @@ import os
 import time
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any
 
 from studio import StudioError
 
 from ._errors import CaptureError
 from ._observation_recording import ObservationWriter
-from ._recording_format import DEFAULT_RATE_HZ, DEFAULT_REGIONS
+from ._recording_format import DEFAULT_RATE_HZ, DEFAULT_REGIONS, RecordingSummary
 from ._recording_writer import AppendWriter, RecordingWriter
 from ._source import SourceStatus, ThreadedSource
 from ._source_spec import check_seconds
@@ -136,7 +135,7 @@ def capture(
     return writer.path
 
 
-def describe(summary: dict[str, Any]) -> str:
+def describe(summary: RecordingSummary) -> str:
     """A few human lines about a recording summary (for ``studio info``)."""
     lines = [
         f"{summary['path']}",
@@ -156,7 +155,7 @@ def describe(summary: dict[str, Any]) -> str:
     return "\n".join(lines)
 
 
-def _what(summary: dict[str, Any]) -> str:
+def _what(summary: RecordingSummary) -> str:
     """What each frame holds, by the recording's kind."""
     kind = summary.get("kind", "tape")
     if kind == "pose":
@@ -166,7 +165,7 @@ def _what(summary: dict[str, Any]) -> str:
     return f"{summary['regions']} regions"
 
 
-def _recovered_text(summary: dict[str, Any]) -> str:
+def _recovered_text(summary: RecordingSummary) -> str:
     if summary.get("live"):
         return "no (still being recorded: the frames flushed so far are shown)"
     if summary["recovered"]:

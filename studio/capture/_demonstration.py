@@ -28,10 +28,11 @@ from __future__ import annotations
 import dataclasses
 import json
 import os
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
 from pathlib import Path
-from typing import Any
+from typing import TypedDict, TypeVar, cast
 
 import numpy as np
 
@@ -63,6 +64,34 @@ TRAJECTORY_DECIMALS = 6
 """Radians, seconds and metres are stored to a micro-unit: small files, far below the grid's
 resolution and the fit's accuracy."""
 
+T = TypeVar("T")
+
+
+class GridSpec(TypedDict, total=False):
+    """The grid a demonstration's path lives on, as ``ArmGrid.to_dict()`` writes it (a key left
+    out takes ``ArmGrid``'s default)."""
+
+    joints: int
+    bins: int
+    low_deg: float
+    high_deg: float
+    goal: list[int]
+
+
+class DemonstrationSummary(TypedDict):
+    """A demonstration's JSON-ready facts for listings (no trajectory)."""
+
+    name: str
+    recording: str
+    segment: list[float]
+    mode: str
+    goal: list[int]
+    steps: int
+    grid_path: list[int]
+    reached_at: float | None
+    residual_max: float
+    created: str
+
 
 @dataclass(eq=False)
 class Demonstration:
@@ -91,7 +120,7 @@ class Demonstration:
     times: np.ndarray
     q_robot: np.ndarray
     grid_path: list[int]
-    grid: dict[str, Any]
+    grid: GridSpec
     goal: tuple[int, ...]
     mode: str = "joint"
     reached_at: float | None = None
@@ -102,7 +131,8 @@ class Demonstration:
 
     def arm_grid(self) -> ArmGrid:
         """The :class:`studio.learning.ArmGrid` this demonstration's path lives on."""
-        return ArmGrid(**{**self.grid, "goal": tuple(self.grid["goal"])})
+        make: Callable[..., ArmGrid] = ArmGrid  # it checks each setting read from the file
+        return make(**{**self.grid, "goal": tuple(self.grid["goal"])})
 
     def default_path(self) -> Path:
         """Where :meth:`save` writes by default: ``<recording stem>.<t0>-<t1>.demo.json``."""
@@ -110,7 +140,7 @@ class Demonstration:
         stem = self.recording.name.removesuffix(kind.suffix if kind else RECORDING_SUFFIX)
         return self.recording.with_name(f"{stem}.{self.t0:.2f}-{self.t1:.2f}{DEMO_SUFFIX}")
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, object]:
         """The JSON file's contents."""
         return {
             "format": DEMO_FORMAT,
@@ -136,7 +166,7 @@ class Demonstration:
             },
         }
 
-    def summary(self) -> dict[str, Any]:
+    def summary(self) -> DemonstrationSummary:
         """JSON-ready facts for listings (no trajectory)."""
         return {
             "name": self.name,
@@ -180,11 +210,11 @@ def load_demonstration(path: str | os.PathLike[str]) -> Demonstration:
         )
     fit = data.get("fit", {})
 
-    def read(key: str, what: str, convert: Any, value: Any = None) -> Any:
+    def read(key: str, what: str, convert: Callable[[object], T], value: object = None) -> T:
         """``convert`` of field ``key`` (or of ``value``, a part of it); numbers must be finite."""
         try:
             out = convert(data[key] if value is None else value)
-            numeric = convert not in (dict, _text)
+            numeric = convert not in (_table, _text)
             finite = not numeric or np.isfinite(np.asarray(out, dtype=np.float64)).all()
         except (KeyError, IndexError, TypeError, ValueError, OverflowError):
             finite = None
@@ -197,7 +227,7 @@ def load_demonstration(path: str | os.PathLike[str]) -> Demonstration:
             )
         return out
 
-    trajectory = read("trajectory", "a table of t and q_robot", dict)
+    trajectory = read("trajectory", "a table of t and q_robot", _table)
     times = read("trajectory", "a list of times in seconds (t)", _floats, trajectory.get("t"))
     q_robot = read(
         "trajectory",
@@ -214,16 +244,13 @@ def load_demonstration(path: str | os.PathLike[str]) -> Demonstration:
             times=times,
             q_robot=q_robot,
             grid_path=read("grid_path", "a list of whole grid states", _whole_numbers),
-            grid=read("grid", "a table of grid settings", dict),
+            # the grid's values are checked by ArmGrid when the path is traced below
+            grid=cast(GridSpec, read("grid", "a table of grid settings", _table)),
             goal=tuple(read("goal", "whole grid bins, one per joint", _whole_numbers)),
             mode=str(data.get("mode", "joint")),
-            reached_at=None if reached_at is None else float(read("reached_at", "a time", float)),
-            residual_max=float(
-                read("fit", "residuals in metres", float, fit.get("residual_max", 0))
-            ),
-            residual_mean=float(
-                read("fit", "residuals in metres", float, fit.get("residual_mean", 0))
-            ),
+            reached_at=None if reached_at is None else read("reached_at", "a time", _number),
+            residual_max=read("fit", "residuals in metres", _number, fit.get("residual_max", 0)),
+            residual_mean=read("fit", "residuals in metres", _number, fit.get("residual_mean", 0)),
             name=str(data.get("name", "")),
             created=str(data.get("created", "")),
         )
@@ -248,27 +275,39 @@ def load_demonstration(path: str | os.PathLike[str]) -> Demonstration:
     return demo
 
 
-def _floats(value: Any) -> np.ndarray:
+def _table(value: object) -> dict[str, object]:
+    if not isinstance(value, dict):
+        raise TypeError("not a table")
+    return dict(value)
+
+
+def _number(value: object) -> float:
+    if not isinstance(value, int | float | str):  # what float() reads of JSON values
+        raise TypeError("not a number")
+    return float(value)
+
+
+def _floats(value: object) -> np.ndarray:
     if not isinstance(value, list) or any(isinstance(v, str | bool) for v in value):
         raise TypeError("not a list of numbers")
     return np.asarray(value, dtype=np.float64)
 
 
-def _joint_rows(value: Any) -> np.ndarray:
+def _joint_rows(value: object) -> np.ndarray:
     if not isinstance(value, list) or any(not isinstance(row, list) for row in value):
         raise TypeError("not a list of rows")
     rows = [_floats(row) for row in value]
     return np.asarray(rows, dtype=np.float64).reshape(-1, 6)
 
 
-def _whole_numbers(value: Any) -> list[int]:
+def _whole_numbers(value: object) -> list[int]:
     numbers = _floats(value)
     if not np.isfinite(numbers).all() or (numbers != np.round(numbers)).any():
         raise ValueError("not whole numbers")
     return [int(v) for v in numbers]
 
 
-def _text(value: Any) -> str:
+def _text(value: object) -> str:
     if not isinstance(value, str):
         raise TypeError("not text")
     return value
@@ -361,7 +400,7 @@ def extract_demonstration(
         times=times.copy(),
         q_robot=q_robot,
         grid_path=trace.states,
-        grid=grid.to_dict(),
+        grid=cast(GridSpec, grid.to_dict()),
         goal=tuple(grid.goal),
         mode=mode,
         reached_at=reached_at,

@@ -38,7 +38,7 @@ MAX_COUNTER_GAP = 10_000
 """A larger jump in the frame counter is a restarted sender, not lost frames."""
 
 
-class NetworkSource(ThreadedSource):
+class NetworkSource(ThreadedSource[TapeFrame]):
     """Tape frames from UDP datagrams (wire format in :mod:`studio.capture._wire`).
 
     Args:

@@ -19,7 +19,7 @@ the origin, z up), metres, with a unit quaternion.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import cast
 
 import numpy as np
 
@@ -32,7 +32,7 @@ from ._observations import (
     HandPose,
     LandmarkFrame,
 )
-from ._recording_format import FORMAT_NAME, RECORDING_SUFFIX
+from ._recording_format import FORMAT_NAME, RECORDING_SUFFIX, RecordingHeader
 
 POSE_SUFFIX = ".pose.csv"
 """File name ending of pose-landmark recordings."""
@@ -149,10 +149,10 @@ def observation_meta(
     name: str = "",
     source: str = "",
     created: str,
-    **extra: Any,
-) -> dict[str, Any]:
+    **extra: object,
+) -> RecordingHeader:
     """The header dict of a new pose or hand recording."""
-    return {
+    meta: RecordingHeader = {
         "format": kind.format,
         "version": OBSERVATION_VERSION,
         "side": side,
@@ -162,8 +162,8 @@ def observation_meta(
         "rate_hz": kind.rate_hz,
         "source": source,
         "created": created,
-        **extra,
     }
+    return cast(RecordingHeader, {**meta, **extra}) if extra else meta
 
 
 def check_pose_rows(data: np.ndarray) -> np.ndarray:

@@ -14,7 +14,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, cast
 
 import numpy as np
 
@@ -34,8 +34,15 @@ from ._observation_format import (
     pose_at,
     pose_row,
 )
-from ._observations import HandPose, LandmarkFrame
-from ._recording_format import END_PREFIX, MAX_HEADER_BYTES, MAX_RATE_HZ
+from ._observations import HandPose, LandmarkFrame, Observation
+from ._recording_format import (
+    END_PREFIX,
+    MAX_HEADER_BYTES,
+    MAX_RATE_HZ,
+    RecordingEnd,
+    RecordingHeader,
+    RecordingSummary,
+)
 from ._recording_reader import (
     FIX_HINT,
     TEXT_KEYS,
@@ -49,11 +56,15 @@ from ._recording_reader import (
     _to_array,
     _whole,
     array_time_warnings,
+    parse_end,
     read_recording,
     summarize_recording,
 )
 from ._recording_reader import _parse_header as _parse_tape_header
 from ._recording_writer import DEFAULT_FLUSH_SECONDS, AppendWriter, RecordingWriter
+
+if TYPE_CHECKING:
+    from studio.kinematics import TapeConfig
 
 MAX_FIELD_BYTES = 32
 """Longest field of a row (a float64 repr is at most 24 characters)."""
@@ -86,7 +97,7 @@ class ObservationWriter(AppendWriter):
         name: str | None = None,
         source: str = "",
         flush_seconds: float = DEFAULT_FLUSH_SECONDS,
-        extra: dict[str, Any] | None = None,
+        extra: dict[str, object] | None = None,
     ) -> None:
         if kind not in ("pose", "hand"):
             raise RecordingError(f"kind is {kind!r}; record 'pose' or 'hand' observations.")
@@ -106,16 +117,18 @@ class ObservationWriter(AppendWriter):
         )
         self._open(path, meta, list(self.kind.columns), flush_seconds, self.kind.prefix)
 
-    def _rows(self, observations: Sequence[Any]) -> list[str]:
-        expected = LandmarkFrame if self.kind is POSE_KIND else HandPose
-        row = pose_row if self.kind is POSE_KIND else hand_row
+    def _rows(self, observations: Sequence[Observation]) -> list[str]:
+        pose = self.kind is POSE_KIND
         out = []
         for obs in observations:
-            if not isinstance(obs, expected):
+            if pose and isinstance(obs, LandmarkFrame):
+                out.append(pose_row(obs))
+            elif not pose and isinstance(obs, HandPose):
+                out.append(hand_row(obs))
+            else:
                 raise RecordingError(
                     f"{self.path} records {self.kind.name} observations, not {type(obs).__name__}; record each source into its own file."
                 )
-            out.append(row(obs))
         return out
 
 
@@ -123,7 +136,7 @@ def recording_writer(
     kind: str,
     path: str | os.PathLike[str],
     *,
-    config: Any = None,
+    config: TapeConfig | None = None,
     side: str = "right",
     operator: str = "",
     notes: str = "",
@@ -153,13 +166,13 @@ class ObservationRecording(RecordingTimeline):
     """
 
     path: Path
-    meta: dict[str, Any]
+    meta: RecordingHeader
     kind: RecordingKind
     t: np.ndarray
     data: np.ndarray
     recovered: bool = False
     problems: list[str] = field(default_factory=list)
-    end: dict[str, Any] | None = None
+    end: RecordingEnd | None = None
 
     config = None
     """A pose or hand recording has no tape (sources ask; the pipeline uses the default)."""
@@ -202,7 +215,7 @@ def _header_kind(path: Path) -> tuple[RecordingKind, str]:
     return RECORDING_KINDS["tape"], line  # the tape reader explains what is wrong
 
 
-def _parse_header(path: Path, kind: RecordingKind, line: str) -> dict[str, Any]:
+def _parse_header(path: Path, kind: RecordingKind, line: str) -> RecordingHeader:
     try:
         meta = loads_json(line[len(kind.prefix) :], "the header", max_bytes=MAX_HEADER_BYTES)
     except JSONFileError as err:
@@ -231,10 +244,10 @@ def _parse_header(path: Path, kind: RecordingKind, line: str) -> dict[str, Any]:
         raise RecordingError(
             f"{path}, line 1: the header's side is {_short(meta.get('side'))}; it must be 'right' or 'left'."
         )
-    return meta
+    return cast(RecordingHeader, meta)  # every key it names was checked above
 
 
-def parse_any_header(path: Path, line: str) -> tuple[dict[str, Any], str]:
+def parse_any_header(path: Path, line: str) -> tuple[RecordingHeader, str]:
     """The checked header of a recording of any kind from its line 1, and line 1's prefix.
 
     Raises:
@@ -252,8 +265,8 @@ def _parse_lines(
     last_complete: bool,
     width: int,
     problems: _Problems,
-    end: dict[str, Any] | None,
-) -> tuple[np.ndarray, list[int], dict[str, Any] | None]:
+    end: RecordingEnd | None,
+) -> tuple[np.ndarray, list[int], RecordingEnd | None]:
     """Rows of one block as floats (empty fields NaN), their line numbers, and the end line."""
     rows: list[str] = []
     numbers: list[int] = []
@@ -261,11 +274,8 @@ def _parse_lines(
         number = first_number + index
         if line.startswith("#"):
             if line.startswith(END_PREFIX):
-                try:
-                    end = loads_json(line[len(END_PREFIX) :], "the '# end' line")
-                except JSONFileError:
-                    end = None
-                if not isinstance(end, dict):
+                end = parse_end(line[len(END_PREFIX) :])
+                if end is None:
                     problems.add(number, "the '# end' line is not valid JSON")
                     end = {}
             continue
@@ -291,12 +301,12 @@ def _parse_lines(
 
 def _scan_observations(
     path: Path, strict: bool
-) -> tuple[RecordingKind, dict[str, Any], np.ndarray, dict[str, Any] | None, list[str]]:
+) -> tuple[RecordingKind, RecordingHeader, np.ndarray, RecordingEnd | None, list[str]]:
     kind, line = _header_kind(path)
     meta = _parse_header(path, kind, line)
     problems = _Problems(path, strict)
     blocks: list[np.ndarray] = []
-    end: dict[str, Any] | None = None
+    end: RecordingEnd | None = None
     width = len(kind.columns)
     check = check_pose_rows if kind is POSE_KIND else check_hand_rows
     with _open(path) as stream:
@@ -360,7 +370,7 @@ def read_any_recording(
     return read_observation_recording(path, strict)
 
 
-def summarize_any_recording(path: str | os.PathLike[str], strict: bool = True) -> dict[str, Any]:
+def summarize_any_recording(path: str | os.PathLike[str], strict: bool = True) -> RecordingSummary:
     """The summary of a recording of any kind (``kind`` says which); a tape recording is streamed.
 
     Raises:

@@ -7,12 +7,17 @@ import os
 import queue
 import threading
 import time
-from typing import Any
+from typing import TYPE_CHECKING
 
 from ._errors import CaptureError
+from ._frames import TapeFrame
 from ._observation_recording import ObservationRecording, read_any_recording
+from ._observations import HandPose, LandmarkFrame
 from ._recording_reader import Recording
 from ._source import DEFAULT_QUEUE_FRAMES, ThreadedSource
+
+if TYPE_CHECKING:
+    from studio.kinematics import TapeConfig
 
 MAX_SLEEP_SECONDS = 0.05
 """Longest single sleep, so pause/seek/stop take effect quickly."""
@@ -20,7 +25,7 @@ PUT_RETRY_SECONDS = 0.1
 """A file is not a live device: when the consumer lags, playback waits (never drops)."""
 
 
-class PlaybackSource(ThreadedSource):
+class PlaybackSource(ThreadedSource[TapeFrame | LandmarkFrame | HandPose]):
     """Replay a recording's observations (tape frames, landmark frames or hand poses, whichever
     the file holds) with their original timing.
 
@@ -70,21 +75,21 @@ class PlaybackSource(ThreadedSource):
         self._control = threading.Lock()
 
     @property
-    def config(self) -> object:
+    def config(self) -> TapeConfig | None:
         """The recording's tape config (None for a pose or hand recording)."""
         return self.recording.config
 
     @property
     def side(self) -> str:
         """The teaching arm (a pose or hand recording's; the tape's for a tape)."""
-        side = getattr(self.recording, "side", None)
-        return str(side if side is not None else self.recording.config.side)
+        rec = self.recording
+        return rec.side if isinstance(rec, ObservationRecording) else rec.config.side
 
     @property
     def observation_kind(self) -> str:
         """``"tape"``, ``"pose"`` or ``"hand"``: what the recording holds."""
-        kind = getattr(self.recording, "kind", None)
-        return "tape" if kind is None else str(kind.name)
+        rec = self.recording
+        return rec.kind.name if isinstance(rec, ObservationRecording) else "tape"
 
     @property
     def rate_hz(self) -> float:
@@ -162,7 +167,7 @@ class PlaybackSource(ThreadedSource):
                 if self._index == i:
                     self._index = i + 1
 
-    def _put(self, frame: Any) -> bool:
+    def _put(self, frame: TapeFrame | LandmarkFrame | HandPose) -> bool:
         while not self._stop_event.is_set():
             try:
                 self._queue.put(frame, timeout=PUT_RETRY_SECONDS)

@@ -14,6 +14,7 @@ from __future__ import annotations
 import collections
 import threading
 import time
+from typing import TypeVar
 
 import numpy as np
 import viser.transforms as vtf
@@ -28,6 +29,9 @@ from ._observations import (
 )
 from ._source import ThreadedSource
 
+FedT = TypeVar("FedT", LandmarkFrame, HandPose)
+"""What a fed source takes: landmark frames (the camera) or hand poses (the hand guide)."""
+
 MAX_OBSERVATIONS_PER_SECOND = 120
 """Most observations a fed source takes in one second (4x a 30 Hz camera, 2x the scene's 60 Hz
 handle updates); more are refused as a flood."""
@@ -41,7 +45,7 @@ class FloodError(CaptureError):
     """More observations in one second than a fed source takes (the API answers 429)."""
 
 
-class PushSource(ThreadedSource):
+class PushSource(ThreadedSource[FedT]):
     """A source whose observations are handed in by calls (no producer thread, no queue).
 
     Args:
@@ -81,7 +85,7 @@ class PushSource(ThreadedSource):
         """Whether the source takes observations."""
         return self._started
 
-    def read(self, timeout: float | None = 0.0) -> list[LandmarkFrame]:
+    def read(self, timeout: float | None = 0.0) -> list[FedT]:
         """Nothing: a fed source hands its observations to the caller of ``submit``."""
         if timeout:
             self._stop_event.wait(min(timeout, 0.05))
@@ -119,7 +123,7 @@ class PushSource(ThreadedSource):
             return self._last_t
 
 
-class CameraSource(PushSource):
+class CameraSource(PushSource[LandmarkFrame]):
     """Landmark frames estimated in the page (BlazePose), handed in by ``POST
     /api/source/landmarks``.
 
@@ -169,7 +173,7 @@ class CameraSource(PushSource):
         )
 
 
-class HandSource(PushSource):
+class HandSource(PushSource[HandPose]):
     """Hand poses from the scene's handle (or ``POST /api/source/hand``): the hand guide.
 
     Attributes:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -15,6 +15,9 @@ from ._errors import RecordingError
 from ._recording_edit import write_recording
 from ._recording_format import DEFAULT_RATE_HZ
 from ._recording_writer import recording_meta
+
+if TYPE_CHECKING:
+    from studio.kinematics import TapeConfig
 
 MIN_FIELDS = 2
 """``frame`` and ``time`` come before the channels."""
@@ -106,7 +109,7 @@ def import_raw(
     calibration: Calibration | str | os.PathLike[str],
     out: str | os.PathLike[str],
     *,
-    config: Any = None,
+    config: TapeConfig | None = None,
     operator: str = "",
     notes: str = "",
     rate_hz: float | None = None,

@@ -15,7 +15,7 @@ import shutil
 from collections.abc import Iterator
 from datetime import UTC, datetime
 from pathlib import Path
-from typing import Any, BinaryIO
+from typing import BinaryIO, cast
 
 import numpy as np
 
@@ -25,6 +25,7 @@ from .._files import atomic_write, atomic_write_text
 from ._errors import RecordingError
 from ._recording_format import (
     RECORDING_SUFFIX,
+    RecordingHeader,
     columns,
     end_line,
     format_row,
@@ -97,7 +98,7 @@ def delete_recording(path: str | os.PathLike[str]) -> None:
         path.unlink()
 
 
-def update_recording_meta(path: str | os.PathLike[str], **changes: Any) -> dict[str, Any]:
+def update_recording_meta(path: str | os.PathLike[str], **changes: object) -> RecordingHeader:
     """Change a recording's ``name``, ``operator`` or ``notes`` (atomic replace, data untouched).
 
     Only line 1 changes; every other byte (frames, the ``# end`` line, or its absence in a
@@ -125,7 +126,7 @@ def update_recording_meta(path: str | os.PathLike[str], **changes: Any) -> dict[
 
     with _not_recording(path) as source:
         meta, prefix = parse_any_header(path, _first_line(path, source))
-        meta.update(changes)
+        meta = cast(RecordingHeader, {**meta, **changes})  # keys checked above
         meta["edited"] = datetime.now(UTC).isoformat(timespec="seconds")
         header = header_line(meta, prefix).encode("utf-8")
 
@@ -185,7 +186,7 @@ def rename_recording(path: str | os.PathLike[str], new_name: str) -> Path:
 
 def write_recording(
     path: str | os.PathLike[str],
-    meta: dict[str, Any],
+    meta: RecordingHeader,
     t: np.ndarray,
     frame: np.ndarray,
     status: np.ndarray,
@@ -230,8 +231,7 @@ def copy_recording(
 ) -> Path:
     """Write (a slice of) a recording to a new file, e.g. to repair a recovered one or cut a segment."""
     rows = rows or slice(None)
-    meta = dict(recording.meta)
-    meta["derived_from"] = recording.path.name
+    meta: RecordingHeader = {**recording.meta, "derived_from": recording.path.name}
     return write_recording(
         path,
         meta,

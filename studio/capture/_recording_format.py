@@ -25,11 +25,15 @@ from __future__ import annotations
 
 import dataclasses
 import json
-from typing import Any
+from collections.abc import Callable, Mapping
+from typing import TYPE_CHECKING, NotRequired, TypedDict
 
 import numpy as np
 
 from ._errors import RecordingError
+
+if TYPE_CHECKING:
+    from studio.kinematics import TapeConfig
 
 FORMAT_NAME = "teach-studio-recording"
 """The ``format`` value and the first line's tag."""
@@ -60,6 +64,65 @@ MIN_LINE_BYTES = 64 * 1024
 """Comment lines may be longer than a row, up to this."""
 
 
+class RecordingHeader(TypedDict, total=False):
+    """Line 1 of a recording of any kind, as read back after its checks (every key optional but
+    ``format`` and ``version``; a tape recording always has ``regions``).
+
+    Writers may add keys of their own; a reader keeps them, and these are the ones it knows.
+    """
+
+    format: str
+    version: int
+    regions: int
+    """Bend/twist regions per frame (tape recordings)."""
+    tape: dict[str, object] | None
+    """The :class:`studio.kinematics.TapeConfig` fields (tape recordings)."""
+    side: str
+    """The teaching arm, ``"right"`` or ``"left"`` (pose and hand recordings)."""
+    rate_hz: float
+    operator: str
+    notes: str
+    name: str
+    source: str
+    created: str
+    edited: str
+    """When the header was last edited (ISO 8601)."""
+    derived_from: str
+    """The file a cut or repair was copied from."""
+    calibration: dict[str, object]
+    """The calibration a raw import converted the counts with."""
+
+
+class RecordingEnd(TypedDict, total=False):
+    """The ``# end`` line's data (``{}`` when the line is damaged)."""
+
+    frames: int
+    duration: float
+    closed: str
+
+
+class RecordingSummary(TypedDict):
+    """The JSON-ready facts of a recording, for listings (``studio info``, the web page)."""
+
+    path: str
+    kind: str
+    """``"tape"``, ``"pose"`` or ``"hand"``."""
+    name: str
+    frames: int
+    duration: float
+    regions: int
+    rate_hz: float
+    source: str
+    operator: str
+    notes: str
+    created: str
+    recovered: bool
+    problems: list[str]
+    warnings: list[str]
+    live: NotRequired[bool]
+    """Whether a capture is still writing the file (``studio info`` adds it)."""
+
+
 def max_line_bytes(regions: int) -> int:
     """The longest line a recording of ``regions`` regions can hold after its header.
 
@@ -77,7 +140,7 @@ def columns(regions: int) -> list[str]:
     ]
 
 
-def header_line(meta: dict[str, Any], prefix: str = HEADER_PREFIX) -> str:
+def header_line(meta: Mapping[str, object], prefix: str = HEADER_PREFIX) -> str:
     """Line 1 of a recording (with its newline); ``prefix`` names the format (tape by default).
 
     Raises:
@@ -107,14 +170,16 @@ def format_row(t: float, frame: int, status: int, bend: np.ndarray, twist: np.nd
     return ",".join(values) + "\n"
 
 
-def tape_config_to_dict(config: Any) -> dict[str, Any] | None:
+def tape_config_to_dict(
+    config: TapeConfig | dict[str, object] | None,
+) -> dict[str, object] | None:
     """A JSON-ready dict of a :class:`studio.kinematics.TapeConfig` (or a dict, passed through)."""
     if config is None:
         return None
     if isinstance(config, dict):
         return dict(config)
     if dataclasses.is_dataclass(config):
-        out: dict[str, Any] = {}
+        out: dict[str, object] = {}
         for field in dataclasses.fields(config):
             value = getattr(config, field.name)
             if isinstance(value, np.ndarray):
@@ -126,7 +191,7 @@ def tape_config_to_dict(config: Any) -> dict[str, Any] | None:
     raise TypeError(f"tape config {config!r} is neither a TapeConfig nor a dict")
 
 
-def tape_config_from_dict(data: dict[str, Any] | None) -> Any:
+def tape_config_from_dict(data: Mapping[str, object] | None) -> TapeConfig:
     """The :class:`studio.kinematics.TapeConfig` a header describes (defaults when absent)."""
     from studio.kinematics import TapeConfig
 
@@ -134,4 +199,5 @@ def tape_config_from_dict(data: dict[str, Any] | None) -> Any:
         return TapeConfig()
     known = {f.name for f in dataclasses.fields(TapeConfig)}
     kwargs = {k: (np.asarray(v) if k == "base" else v) for k, v in data.items() if k in known}
-    return TapeConfig(**kwargs)
+    make: Callable[..., TapeConfig] = TapeConfig  # it checks each field read from the file
+    return make(**kwargs)

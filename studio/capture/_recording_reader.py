@@ -14,7 +14,7 @@ import warnings
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, BinaryIO
+from typing import TYPE_CHECKING, BinaryIO, TypeGuard, cast
 
 import numpy as np
 
@@ -31,9 +31,15 @@ from ._recording_format import (
     MAX_HEADER_BYTES,
     MAX_RATE_HZ,
     MAX_REGIONS,
+    RecordingEnd,
+    RecordingHeader,
+    RecordingSummary,
     columns,
     max_line_bytes,
 )
+
+if TYPE_CHECKING:
+    from studio.kinematics import TapeConfig
 
 FIX_HINT = "fix or re-export the file, or read it with strict=False to keep the good frames"
 """Second half of every strict-mode error sentence."""
@@ -49,7 +55,7 @@ class RecordingTimeline:
     """
 
     path: Path
-    meta: dict[str, Any]
+    meta: RecordingHeader
     t: np.ndarray
     recovered: bool
     problems: list[str]
@@ -82,7 +88,7 @@ class RecordingTimeline:
         hi = int(np.searchsorted(self.t, start + t1, side="right"))
         return slice(lo, hi)
 
-    def summary(self) -> dict[str, Any]:
+    def summary(self) -> RecordingSummary:
         """JSON-ready facts for listings (``studio info``, the web page)."""
         return _summary(
             self.path,
@@ -116,7 +122,7 @@ class Recording(RecordingTimeline):
     """
 
     path: Path
-    meta: dict[str, Any]
+    meta: RecordingHeader
     t: np.ndarray
     frame: np.ndarray
     status: np.ndarray
@@ -124,7 +130,7 @@ class Recording(RecordingTimeline):
     twist: np.ndarray
     recovered: bool = False
     problems: list[str] = field(default_factory=list)
-    end: dict[str, Any] | None = None
+    end: RecordingEnd | None = None
     warnings: list[str] = field(default_factory=list)
 
     @property
@@ -133,7 +139,7 @@ class Recording(RecordingTimeline):
         return int(self.meta["regions"])
 
     @property
-    def config(self) -> Any:
+    def config(self) -> TapeConfig:
         """The :class:`studio.kinematics.TapeConfig` the header describes."""
         from ._recording_format import tape_config_from_dict
 
@@ -156,7 +162,8 @@ class Recording(RecordingTimeline):
 
 class _Problems:
     def __init__(self, path: Path, strict: bool) -> None:
-        self.path, self.strict, self.items = path, strict, []
+        self.path, self.strict = path, strict
+        self.items: list[str] = []
 
     def add(self, line: int, what: str) -> None:
         if self.strict:
@@ -164,7 +171,7 @@ class _Problems:
         self.items.append(f"line {line}: {what}")
 
 
-def read_header(path: str | os.PathLike[str]) -> dict[str, Any]:
+def read_header(path: str | os.PathLike[str]) -> RecordingHeader:
     """Only the header of a recording (cheap: for listings; reads at most one bounded line).
 
     Raises:
@@ -202,7 +209,7 @@ def _first_line(path: Path, stream: BinaryIO) -> str:
         ) from None
 
 
-def _parse_header(path: Path, line: str) -> dict[str, Any]:
+def _parse_header(path: Path, line: str) -> RecordingHeader:
     """The header of line 1, every field checked against its bound before anything uses it."""
     if not line.startswith(HEADER_PREFIX):
         raise RecordingError(
@@ -245,7 +252,17 @@ def _parse_header(path: Path, line: str) -> dict[str, Any]:
         raise RecordingError(
             f"{path}, line 1: the header's tape is {_short(tape)}; it must describe a tape of {regions} regions."
         )
-    return meta
+    return cast(RecordingHeader, meta)  # every key it names was checked above
+
+
+def parse_end(text: str) -> RecordingEnd | None:
+    """The data of an ``# end`` line (``text`` without its prefix), or ``None`` when it is not a
+    JSON object (every recording kind's one reading)."""
+    try:
+        end = loads_json(text, "the '# end' line", max_bytes=MAX_HEADER_BYTES)
+    except JSONFileError:
+        return None
+    return cast(RecordingEnd, end) if isinstance(end, dict) else None
 
 
 def time_warnings(
@@ -291,11 +308,11 @@ TEXT_KEYS = ("name", "operator", "notes", "source", "created")
 """Header keys that hold text (a listing shows them as they are)."""
 
 
-def _whole(value: Any) -> bool:
+def _whole(value: object) -> TypeGuard[int]:
     return isinstance(value, int) and not isinstance(value, bool)
 
 
-def _short(value: Any) -> str:
+def _short(value: object) -> str:
     text = repr(value)
     return text if len(text) <= 40 else text[:37] + "..."
 
@@ -304,13 +321,13 @@ def _short(value: Any) -> str:
 class _Scan:
     """What one pass over a recording's lines found (rows kept only when asked)."""
 
-    meta: dict[str, Any]
+    meta: RecordingHeader
     keep_rows: bool = True
     blocks: list[np.ndarray] = field(default_factory=list)
     count: int = 0
     first_t: float | None = None
     last_t: float | None = None
-    end: dict[str, Any] | None = None
+    end: RecordingEnd | None = None
     problems: list[str] = field(default_factory=list)
     negative: int = 0
     first_negative: int | None = None
@@ -438,13 +455,8 @@ def _scan_block(
         number = first_number + index
         if line.startswith("#"):
             if line.startswith(END_PREFIX):
-                try:
-                    scan.end = loads_json(
-                        line[len(END_PREFIX) :], "the '# end' line", max_bytes=MAX_HEADER_BYTES
-                    )
-                except JSONFileError:
-                    scan.end = None
-                if not isinstance(scan.end, dict):
+                scan.end = parse_end(line[len(END_PREFIX) :])
+                if scan.end is None:
                     problems.add(number, "the '# end' line is not valid JSON")
                     scan.end = {}
             continue
@@ -494,7 +506,7 @@ def _scan_block(
             scan.blocks.append(data)
 
 
-def _check_times(t: np.ndarray, lines: Any, scan: _Scan) -> None:
+def _check_times(t: np.ndarray, lines: np.ndarray, scan: _Scan) -> None:
     """Count negative times and steps back in time (from the previous block's last time on)."""
     negative = np.flatnonzero(t < 0)
     if negative.size:
@@ -551,7 +563,7 @@ def read_recording(path: str | os.PathLike[str], strict: bool = True) -> Recordi
     )
 
 
-def summarize_recording(path: str | os.PathLike[str], strict: bool = True) -> dict[str, Any]:
+def summarize_recording(path: str | os.PathLike[str], strict: bool = True) -> RecordingSummary:
     """:meth:`Recording.summary` of a file, streamed: memory stays one block, however long the file.
 
     For ``studio info`` and listings, which need the counts but not the frames.
@@ -628,14 +640,14 @@ def recording_bytes(path: str | os.PathLike[str]) -> RecordingBytes:
 
 def _summary(
     path: Path,
-    meta: dict[str, Any],
+    meta: RecordingHeader,
     frames: int,
     duration: float,
     recovered: bool,
     problems: list[str],
     warnings: list[str],
     kind: str = "tape",
-) -> dict[str, Any]:
+) -> RecordingSummary:
     """The JSON-ready facts of a recording (one definition for every reader and kind)."""
     return {
         "path": str(path),

@@ -21,9 +21,11 @@ import time
 from collections.abc import Sequence
 from datetime import UTC, datetime
 from pathlib import Path
-from typing import Any, Self
+from typing import TYPE_CHECKING, Self, cast
 
 from ._errors import RecordingError
+from ._frames import TapeFrame
+from ._observations import Observation
 from ._recording_format import (
     DEFAULT_RATE_HZ,
     DEFAULT_REGIONS,
@@ -32,12 +34,16 @@ from ._recording_format import (
     HEADER_PREFIX,
     MAX_REGIONS,
     RECORDING_SUFFIX,
+    RecordingHeader,
     columns,
     end_line,
     format_row,
     header_line,
     tape_config_to_dict,
 )
+
+if TYPE_CHECKING:
+    from studio.kinematics import TapeConfig
 
 DEFAULT_FLUSH_SECONDS = 0.5
 """Longest time a captured frame waits in memory before it is on disk (issue: <= 0.5 s)."""
@@ -67,15 +73,15 @@ def make_folder_of(path: Path) -> None:
 def recording_meta(
     regions: int,
     *,
-    tape: Any = None,
+    tape: TapeConfig | dict[str, object] | None = None,
     operator: str = "",
     notes: str = "",
     name: str = "",
     rate_hz: float = DEFAULT_RATE_HZ,
     source: str = "",
     created: str | None = None,
-    **extra: Any,
-) -> dict[str, Any]:
+    **extra: object,
+) -> RecordingHeader:
     """The header dict of a new recording (see :mod:`._recording_format`).
 
     Raises:
@@ -86,7 +92,7 @@ def recording_meta(
         raise RecordingError(
             f"a tape of {regions!r} regions cannot be recorded; give 1 to {MAX_REGIONS} regions."
         )
-    return {
+    meta: RecordingHeader = {
         "format": FORMAT_NAME,
         "version": FORMAT_VERSION,
         "regions": int(regions),
@@ -97,8 +103,8 @@ def recording_meta(
         "rate_hz": float(rate_hz),
         "source": source,
         "created": created or datetime.now(UTC).isoformat(timespec="seconds"),
-        **extra,
     }
+    return cast(RecordingHeader, {**meta, **extra}) if extra else meta
 
 
 def _create_locked(path: Path) -> int:
@@ -152,7 +158,7 @@ class AppendWriter:
     def _open(
         self,
         path: Path,
-        meta: dict[str, Any],
+        meta: RecordingHeader,
         column_names: list[str],
         flush_seconds: float,
         prefix: str = HEADER_PREFIX,
@@ -194,7 +200,7 @@ class AppendWriter:
         )
         self._flusher.start()
 
-    def _rows(self, observations: Sequence[Any]) -> list[str]:
+    def _rows(self, observations: Sequence[Observation]) -> list[str]:
         """The CSV rows of ``observations`` (raise :class:`RecordingError` for one that does not
         belong in this file)."""
         raise NotImplementedError
@@ -226,11 +232,11 @@ class AppendWriter:
         """Why writing stopped (a full or failing disk), or ``None``."""
         return self._error
 
-    def write(self, frame: Any) -> None:
+    def write(self, frame: Observation) -> None:
         """Append one observation."""
         self.write_many((frame,))
 
-    def write_many(self, frames: Sequence[Any]) -> None:
+    def write_many(self, frames: Sequence[Observation]) -> None:
         """Append observations in order (flushing to disk when the last flush is ``flush_seconds``
         old).
 
@@ -377,14 +383,14 @@ class RecordingWriter(AppendWriter):
         path: str | os.PathLike[str],
         regions: int | None = None,
         *,
-        config: Any = None,
+        config: TapeConfig | None = None,
         operator: str = "",
         notes: str = "",
         name: str | None = None,
         rate_hz: float = DEFAULT_RATE_HZ,
         source: str = "",
         flush_seconds: float = DEFAULT_FLUSH_SECONDS,
-        extra: dict[str, Any] | None = None,
+        extra: dict[str, object] | None = None,
     ) -> None:
         path = Path(path)
         if regions is None:
@@ -399,13 +405,18 @@ class RecordingWriter(AppendWriter):
             name=stem if name is None else name,
             rate_hz=rate_hz,
             source=source,
-            **(extra or {}),
         )
+        if extra:
+            meta = cast(RecordingHeader, {**meta, **extra})
         self._open(path, meta, columns(self.regions), flush_seconds)
 
-    def _rows(self, observations: Sequence[Any]) -> list[str]:
+    def _rows(self, observations: Sequence[Observation]) -> list[str]:
         rows = []
         for frame in observations:
+            if not isinstance(frame, TapeFrame):
+                raise RecordingError(
+                    f"{self.path} records tape frames, not {type(frame).__name__}; record each source into its own file."
+                )
             if frame.bend.shape != (self.regions,) or frame.twist.shape != (self.regions,):
                 raise RecordingError(
                     f"{self.path}: a frame has {frame.bend.shape[0]} regions but the recording has {self.regions}; record each tape into its own file."

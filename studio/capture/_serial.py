@@ -12,12 +12,20 @@ from __future__ import annotations
 import contextlib
 import os
 import time
-from typing import Any
+from types import ModuleType
+from typing import Protocol
 
 from ._calibration import Calibration, load_calibration
 from ._errors import CaptureError
 from ._frames import STATUS_BITS_MASK, TapeFrame
-from ._shapetape_protocol import BAUD_RATE, REQUEST, ProtocolError, decode_reply, reply_length
+from ._shapetape_protocol import (
+    BAUD_RATE,
+    REQUEST,
+    ProtocolError,
+    RawFrame,
+    decode_reply,
+    reply_length,
+)
 from ._source import DEFAULT_QUEUE_FRAMES, ThreadedSource
 
 DEFAULT_RATE_HZ = 110.0
@@ -37,7 +45,19 @@ SILENT_SECONDS = 1.0
 """No valid reply for this long: the tape is off or unplugged (the source stops with an error)."""
 
 
-def _import_serial() -> Any:
+class _Port(Protocol):
+    """What the source uses of a ``serial.Serial`` port."""
+
+    def read(self, size: int = 1) -> bytes: ...
+
+    def write(self, data: bytes) -> int | None: ...
+
+    def reset_input_buffer(self) -> None: ...
+
+    def close(self) -> None: ...
+
+
+def _import_serial() -> ModuleType:
     try:
         import serial
     except ImportError:
@@ -48,7 +68,7 @@ def _import_serial() -> Any:
     return serial
 
 
-class SerialSource(ThreadedSource):
+class SerialSource(ThreadedSource[TapeFrame]):
     """Frames from a ShapeTape on a serial port.
 
     Args:
@@ -86,7 +106,7 @@ class SerialSource(ThreadedSource):
         self.baudrate = int(baudrate)
         self.config = config
         self.serial_number: int | None = None
-        self._port: Any = None
+        self._port: _Port | None = None
         self._reply_bytes: int | None = None
 
     def _open(self) -> None:
@@ -108,6 +128,8 @@ class SerialSource(ThreadedSource):
     def _produce(self) -> None:
         serial = self._serial_module
         port = self._port
+        if port is None:  # stopped before the port opened
+            return
         period = 1.0 / self.rate_hz
         start = time.monotonic()
         last_good = start
@@ -159,7 +181,7 @@ class SerialSource(ThreadedSource):
                 f"the tape on {self.port} was disconnected ({err}); plug it back in and restart the source."
             ) from None
 
-    def _read_reply(self, port: Any) -> Any:
+    def _read_reply(self, port: _Port) -> RawFrame | None:
         # one read of the whole reply once its length is known (fewer wake-ups per frame)
         data = port.read(self._reply_bytes or PREFIX_BYTES)
         if len(data) < PREFIX_BYTES:

@@ -19,7 +19,7 @@ from __future__ import annotations
 import threading
 import time
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -27,6 +27,10 @@ from ._errors import CaptureError
 from ._frames import TRIGGER_BIT, TapeFrame
 from ._recording_format import DEFAULT_RATE_HZ
 from ._source import DEFAULT_QUEUE_FRAMES, ThreadedSource
+
+if TYPE_CHECKING:
+    from studio.kinematics import HumanArm, Retargeter, TapeConfig
+    from studio.learning import ArmGrid
 
 CHUNK_SECONDS = 0.1
 """The live source computes frames this far ahead in one vectorised batch."""
@@ -73,7 +77,8 @@ class OperatorMotion:
         seed: seed of the motion's random draws.
         rate_hz: frames per second.
         operator: motion settings.
-        arm: the operator's :class:`studio.kinematics.HumanArm` (default: a right arm).
+        arm: the operator's :class:`studio.kinematics.HumanArm` (default: the retargeter's, else
+            a right arm).
         retargeter: the joint-mode :class:`studio.kinematics.Retargeter` that maps robot poses
             onto the arm (default: mirrored, for ``arm``).
     """
@@ -83,14 +88,16 @@ class OperatorMotion:
         seed: int = 0,
         rate_hz: float = DEFAULT_RATE_HZ,
         operator: OperatorConfig | None = None,
-        arm: Any = None,
-        retargeter: Any = None,
+        arm: HumanArm | None = None,
+        retargeter: Retargeter | None = None,
     ) -> None:
         from studio.kinematics import HumanArm, Retargeter
 
         self.operator = operator or OperatorConfig()
         self.rate_hz = float(rate_hz)
-        self.arm = arm if arm is not None else HumanArm("right")
+        if arm is None:
+            arm = retargeter.arm if retargeter is not None else HumanArm("right")
+        self.arm = arm
         self.retargeter = retargeter or Retargeter("joint", mirror=True, arm=self.arm)
         self.robot = self.retargeter.robot
         self._rng = np.random.default_rng(seed)
@@ -201,15 +208,15 @@ class _Simulation:
         self,
         seed: int,
         rate_hz: float,
-        config: Any,
+        config: TapeConfig | None,
         operator: OperatorConfig | None,
-        retargeter: Any,
+        retargeter: Retargeter | None,
     ) -> None:
         from studio.kinematics import TapeConfig, tape_from_arm
 
         seeds = np.random.SeedSequence(seed).spawn(2)
         self.motion = OperatorMotion(
-            int(seeds[0].generate_state(1)[0]), rate_hz, operator, retargeter
+            int(seeds[0].generate_state(1)[0]), rate_hz, operator, retargeter=retargeter
         )
         self.config = config if config is not None else TapeConfig()
         self.rate_hz = float(rate_hz)
@@ -253,7 +260,7 @@ class Simulated:
 
     frames: list[TapeFrame]
     q_human: np.ndarray
-    config: Any
+    config: TapeConfig
     reach_start: int | None = None
     reach_end: int | None = None
 
@@ -262,10 +269,10 @@ def simulate(
     seconds: float,
     seed: int = 0,
     rate_hz: float = DEFAULT_RATE_HZ,
-    config: Any = None,
+    config: TapeConfig | None = None,
     goal: np.ndarray | None = None,
     operator: OperatorConfig | None = None,
-    retargeter: Any = None,
+    retargeter: Retargeter | None = None,
 ) -> Simulated:
     """Simulate ``seconds`` of capture as fast as possible (the live source's frames, same seed).
 
@@ -308,7 +315,7 @@ def simulate(
     return Simulated(frames, np.concatenate(poses), sim.config, reach_start, reach_end)
 
 
-class SimulatorSource(ThreadedSource):
+class SimulatorSource(ThreadedSource[TapeFrame]):
     """The default source: a simulated operator wearing a tape, live at ``rate_hz``.
 
     Frames are computed a chunk ahead and released on absolute deadlines (``start + k / rate``),
@@ -329,9 +336,9 @@ class SimulatorSource(ThreadedSource):
         self,
         seed: int = 0,
         rate_hz: float = DEFAULT_RATE_HZ,
-        config: Any = None,
+        config: TapeConfig | None = None,
         operator: OperatorConfig | None = None,
-        retargeter: Any = None,
+        retargeter: Retargeter | None = None,
         queue_frames: int = DEFAULT_QUEUE_FRAMES,
     ) -> None:
         super().__init__(queue_frames)
@@ -373,7 +380,7 @@ GOAL_MARGIN_RAD = np.radians(4.0)
 joint at its limit is a singular pose for the fit (a straight elbow hides the arm's plane)."""
 
 
-def goal_configuration(grid: Any, retargeter: Any = None) -> np.ndarray:
+def goal_configuration(grid: ArmGrid, retargeter: Retargeter | None = None) -> np.ndarray:
     """A Puma560 configuration in the grid's goal bin that the operator can mirror comfortably.
 
     The goal bins' centres, with joints beyond ``grid.joints`` at zero, moved (within the bin) so

@@ -14,10 +14,9 @@ import threading
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any, Protocol, runtime_checkable
+from typing import Generic, Protocol, Self, TypeVar, runtime_checkable
 
 from ._errors import CaptureError
-from ._frames import TapeFrame
 from ._observations import Observation
 
 DEFAULT_QUEUE_FRAMES = 4096
@@ -56,7 +55,7 @@ class SourceStatus:
     rejected: int = 0
     warning: str | None = None
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, object]:
         """JSON-ready fields."""
         return {
             "kind": self.kind,
@@ -88,7 +87,11 @@ class FrameSource(Protocol):
         """The source's health."""
 
 
-class ThreadedSource:
+ObservationT = TypeVar("ObservationT", bound=Observation)
+"""The kind of observation a source yields (:class:`TapeFrame`, a landmark frame, a hand pose)."""
+
+
+class ThreadedSource(Generic[ObservationT]):
     """Base of the sources: subclasses implement :meth:`_produce` (the loop) and ``kind``.
 
     Args:
@@ -102,7 +105,7 @@ class ThreadedSource:
     def __init__(self, queue_frames: int = DEFAULT_QUEUE_FRAMES) -> None:
         if queue_frames < 1:
             raise CaptureError(f"queue_frames is {queue_frames}; give at least 1.")
-        self._queue: queue.Queue[TapeFrame] = queue.Queue(maxsize=queue_frames)
+        self._queue: queue.Queue[ObservationT] = queue.Queue(maxsize=queue_frames)
         self._stop_event = threading.Event()
         self._thread: threading.Thread | None = None
         self._lock = threading.Lock()
@@ -132,7 +135,7 @@ class ThreadedSource:
             thread.join(STOP_JOIN_SECONDS)
         self._close()
 
-    def __enter__(self) -> ThreadedSource:
+    def __enter__(self) -> Self:
         self.start()
         return self
 
@@ -144,7 +147,7 @@ class ThreadedSource:
         """Whether the producer thread is alive."""
         return self._thread is not None and self._thread.is_alive()
 
-    def read(self, timeout: float | None = 0.0) -> list[TapeFrame]:
+    def read(self, timeout: float | None = 0.0) -> list[ObservationT]:
         """All frames since the last call.
 
         Args:
@@ -154,7 +157,7 @@ class ThreadedSource:
         Returns:
             The frames in order, possibly none.
         """
-        out: list[TapeFrame] = []
+        out: list[ObservationT] = []
         if timeout is None:
             while not out:
                 try:
@@ -211,7 +214,7 @@ class ThreadedSource:
             self._frames += 1
             self._arrivals.append(now)
 
-    def _push(self, frame: TapeFrame) -> None:
+    def _push(self, frame: ObservationT) -> None:
         """Queue one frame (or count it dropped when the queue is full)."""
         self._record_arrival()
         try:

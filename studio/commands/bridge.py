@@ -21,6 +21,7 @@ from studio.capture import (
     stream_source,
 )
 
+from ._options import add_playback_options
 from .serve import TOKEN_ENV
 
 PROGRESS_SECONDS = 0.2
@@ -47,14 +48,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         default=None,
         help="stop after this long (default: until the source ends or Ctrl-C)",
     )
-    parser.add_argument("--seed", type=int, default=0, help="simulator seed (default: 0)")
-    parser.add_argument(
-        "--speed",
-        type=float,
-        default=1.0,
-        help="playback speed for a recording: 1 real time, 2 twice as fast, "
-        "0 as fast as possible (default: 1)",
-    )
+    add_playback_options(parser)
     parser.add_argument("--loop", action="store_true", help="loop a recording")
     parser.add_argument(
         "--token",

@@ -34,9 +34,10 @@ def run(args: argparse.Namespace) -> int:
         if path.name.endswith(".demo.json"):
             from studio.capture import load_demonstration
 
-            summary = load_demonstration(path).summary()
-            shown = {k: _shown(k, v) for k, v in summary.items() if k != "path"}
+            demo = load_demonstration(path).summary()
+            shown = {k: _shown(k, v) for k, v in demo.items()}
             text = "\n".join([str(path), *(f"  {k:<13} {v}" for k, v in shown.items())])
+            print(json.dumps(demo) if args.json else text)
         else:
             # streamed: memory stays one block however long (or damaged) the file is
             summary = summarize_any_recording(path, strict=not args.lenient)
@@ -44,8 +45,7 @@ def run(args: argparse.Namespace) -> int:
             summary["live"] = summary["recovered"] and being_recorded(path)
             if summary["live"]:
                 summary["recovered"] = False
-            text = describe(summary)
-        print(json.dumps(summary) if args.json else text)
+            print(json.dumps(summary) if args.json else describe(summary))
     return 0
 
 

@@ -24,6 +24,7 @@ from studio.capture import (
     summarize_any_recording,
 )
 
+from ._options import add_playback_options
 from .serve import TOKEN_ENV
 
 PROGRESS_SECONDS = 0.2
@@ -61,15 +62,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--out", type=Path, required=True, help="the new recording, e.g. recordings/x.tape.csv"
     )
-    parser.add_argument("--seed", type=int, default=0, help="simulator seed (default: 0)")
+    add_playback_options(parser)
     parser.add_argument("--calibration", type=Path, help="calibration JSON for serial:PORT")
-    parser.add_argument(
-        "--speed",
-        type=float,
-        default=1.0,
-        help="playback speed for a recording source: 1 real time, 2 twice as fast, "
-        "0 as fast as possible (default: 1)",
-    )
     parser.add_argument("--operator", default="", help="who wore the tape")
     parser.add_argument("--notes", default="", help="free text stored in the header")
 

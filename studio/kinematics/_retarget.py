@@ -127,10 +127,10 @@ class Retargeter:
         return self._mode
 
     @mode.setter
-    def mode(self, value: str) -> None:
-        if value not in ("joint", "cartesian"):
+    def mode(self, value: Mode) -> None:
+        if value not in ("joint", "cartesian"):  # a caller without a type checker
             raise KinematicsError(f'Retarget mode must be "joint" or "cartesian"; got {value!r}.')
-        self._mode = value  # type: ignore[assignment]
+        self._mode = value
 
     @property
     def mirror(self) -> bool:

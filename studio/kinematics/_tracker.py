@@ -137,7 +137,7 @@ class ArmTracker:
         return self.retargeter.mode
 
     @mode.setter
-    def mode(self, value: str) -> None:
+    def mode(self, value: Mode) -> None:
         self.retargeter.mode = value
 
     @property

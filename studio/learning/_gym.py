@@ -13,11 +13,12 @@ render nothing (no render modes), and pass ``gymnasium.utils.env_checker.check_e
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, TypedDict, Unpack
 
 import gymnasium
 import numpy as np
 from gymnasium import spaces
+from numpy.typing import NDArray
 
 from ._arm import ArmGrid
 from ._errors import LearningError
@@ -29,6 +30,26 @@ ARM_GRID_MAX_EPISODE_STEPS = 10_000
 """Episode cap of the registered grid environment (the paper's first episodes take ~2500)."""
 
 
+class _GridSettings(TypedDict, total=False):
+    """The keyword arguments of :class:`ArmGrid` (each checked there)."""
+
+    joints: int
+    bins: int
+    low_deg: float
+    high_deg: float
+    goal: tuple[int, ...] | None
+
+
+class _ReachSettings(TypedDict, total=False):
+    """The keyword arguments of :class:`ArmReach` (each checked there)."""
+
+    joints: int
+    step_deg: float
+    goal: tuple[float, ...] | None
+    position_tolerance: float
+    angle_tolerance_deg: float
+
+
 class ArmGridEnv(gymnasium.Env):
     """The paper's arm grid as a Gymnasium environment.
 
@@ -36,9 +57,9 @@ class ArmGridEnv(gymnasium.Env):
         joints, bins, low_deg, high_deg, goal: as :class:`ArmGrid`.
     """
 
-    metadata: dict[str, Any] = {"render_modes": []}
+    metadata = {"render_modes": []}
 
-    def __init__(self, render_mode: str | None = None, **grid: Any) -> None:
+    def __init__(self, render_mode: str | None = None, **grid: Unpack[_GridSettings]) -> None:
         if render_mode is not None:
             raise LearningError(
                 f"render_mode is {render_mode!r}; this environment renders nothing, give None."
@@ -52,7 +73,7 @@ class ArmGridEnv(gymnasium.Env):
 
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
-    ) -> tuple[int, dict[str, Any]]:
+    ) -> tuple[int, dict[str, object]]:
         """Start uniformly from every state but the goal (``options={"state": s}`` to choose)."""
         super().reset(seed=seed)
         if options and "state" in options:
@@ -63,7 +84,7 @@ class ArmGridEnv(gymnasium.Env):
             self.state = int(starts[self.np_random.integers(starts.shape[0])])
         return self.state, {}
 
-    def step(self, action: int) -> tuple[int, float, bool, bool, dict[str, Any]]:
+    def step(self, action: int) -> tuple[int, float, bool, bool, dict[str, object]]:
         """Move by ``action``; reward and termination from the grid's table."""
         a = int(action)
         reward = float(self._mdp.reward[self.state, a])
@@ -82,9 +103,9 @@ class ArmReachEnv(gymnasium.Env):
         angle_tolerance_deg: degrees.
     """
 
-    metadata: dict[str, Any] = {"render_modes": []}
+    metadata = {"render_modes": []}
 
-    def __init__(self, render_mode: str | None = None, **task: Any) -> None:
+    def __init__(self, render_mode: str | None = None, **task: Unpack[_ReachSettings]) -> None:
         if render_mode is not None:
             raise LearningError(
                 f"render_mode is {render_mode!r}; this environment renders nothing, give None."
@@ -98,7 +119,7 @@ class ArmReachEnv(gymnasium.Env):
 
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
-    ) -> tuple[np.ndarray, dict[str, Any]]:
+    ) -> tuple[NDArray[np.float64], dict[str, object]]:
         """Start uniformly across the limits, not at the goal (``options={"q": q}`` to choose)."""
         super().reset(seed=seed)
         if options and "q" in options:
@@ -116,7 +137,7 @@ class ArmReachEnv(gymnasium.Env):
             self.q = np.ascontiguousarray(self.task.random_start(self.np_random))
         return self.q.copy(), {}
 
-    def step(self, action: int) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
+    def step(self, action: int) -> tuple[NDArray[np.float64], float, bool, bool, dict[str, object]]:
         """Move one joint by one step; ``terminated`` at the goal."""
         reward, terminated = reach_step(self._params, self.q, int(action))
         return self.q.copy(), float(reward), bool(terminated), False, {}

@@ -34,7 +34,7 @@ import zipfile
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
 from pathlib import Path
-from typing import IO, Any
+from typing import IO, TypedDict
 
 import numpy as np
 from numpy.lib import format as npy_format
@@ -252,7 +252,7 @@ class PolicyFile:
     created: str = ""
     notes: str = ""
 
-    def header(self) -> dict[str, Any]:
+    def header(self) -> dict[str, object]:
         """The JSON header written to the file."""
         return {
             "format": FORMAT_NAME,
@@ -268,7 +268,15 @@ class PolicyFile:
         }
 
 
-def curve_header(mean_steps: np.ndarray, experiments: int) -> dict[str, Any]:
+class CurveHeader(TypedDict):
+    """A policy header's ``curve``: mean steps per episode (``None`` where no experiment ran
+    that episode) and how many experiments they average."""
+
+    mean_steps: list[float | None]
+    experiments: int
+
+
+def curve_header(mean_steps: np.ndarray, experiments: int) -> CurveHeader:
     """A policy header's ``curve``: the learning curve it came from, JSON-ready (NaN as null).
 
     Shared by the tabular and the tile-coded policy formats.
@@ -279,7 +287,7 @@ def curve_header(mean_steps: np.ndarray, experiments: int) -> dict[str, Any]:
     }
 
 
-def read_curve_header(curve: Any) -> tuple[np.ndarray, int]:
+def read_curve_header(curve: object) -> tuple[np.ndarray, int]:
     """The ``(mean_steps, experiments)`` of a policy header's ``curve`` (:func:`curve_header`).
 
     Raises:
@@ -388,7 +396,7 @@ def load_policy(path: str | Path) -> PolicyFile:
             )
         except JSONFileError as err:
             raise PolicyFileError(str(err)) from None
-        grid, config, mean_steps, experiments = _check_header(name, header)
+        header, grid, config, mean_steps, experiments = _check_header(name, header)
         q = archive.read("q", (grid.n_states, grid.n_actions), "fiu").astype(np.float64, copy=False)
         greedy = archive.read("greedy", (grid.n_states,), "iu").astype(np.int64, copy=False)
     if not np.all(np.isfinite(q)) or greedy.min() < 0 or greedy.max() >= grid.n_actions:
@@ -405,8 +413,10 @@ def load_policy(path: str | Path) -> PolicyFile:
     )
 
 
-def _check_header(name: str, header: Any) -> tuple[ArmGrid, DynaQConfig, np.ndarray, int]:
-    """The grid, settings, curve and experiment count of a policy's JSON header, all validated.
+def _check_header(
+    name: str, header: object
+) -> tuple[dict[str, object], ArmGrid, DynaQConfig, np.ndarray, int]:
+    """The header as a table, and its grid, settings, curve and experiment count, all validated.
 
     Raises:
         PolicyFileError: not a policy header, a newer version, or a damaged field.
@@ -430,7 +440,7 @@ def _check_header(name: str, header: Any) -> tuple[ArmGrid, DynaQConfig, np.ndar
         raise PolicyFileError(
             f"{name} has a damaged header ({err}); export the policy again."
         ) from None
-    return grid, config, mean_steps, experiments
+    return header, grid, config, mean_steps, experiments
 
 
 def greedy_path(

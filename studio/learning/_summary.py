@@ -7,7 +7,7 @@ planner, how many episodes its curve holds) is computed here, next to the format
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TypedDict
 
 import numpy as np
 
@@ -39,7 +39,21 @@ def has_default_goal(grid: ArmGrid) -> bool:
     return tuple(grid.goal) == tuple(default.goal)
 
 
-def policy_summary(policy: PolicyFile | TilePolicyFile) -> dict[str, Any]:
+class PolicySummary(TypedDict):
+    """A policy file's listing facts (see :func:`policy_summary`)."""
+
+    task: dict[str, object]
+    grid: dict[str, object]
+    joints: int
+    goal_deg: list[float]
+    planning: str
+    episodes: int
+    experiments: int
+    created: str
+    notes: str
+
+
+def policy_summary(policy: PolicyFile | TilePolicyFile) -> PolicySummary:
     """JSON-ready facts about a policy file of either kind for listings (the page, scripts).
 
     Returns:
@@ -52,6 +66,7 @@ def policy_summary(policy: PolicyFile | TilePolicyFile) -> dict[str, Any]:
         it was trained with), ``episodes`` (length of its learning curve), ``experiments`` (how
         many the curve averages), ``created`` and ``notes``.
     """
+    task: dict[str, object]
     if isinstance(policy, TilePolicyFile):
         reach = policy.task
         if reach is None:
@@ -59,7 +74,7 @@ def policy_summary(policy: PolicyFile | TilePolicyFile) -> dict[str, Any]:
         else:
             task, joints = task_spec(reach, policy.coder.coding), reach.joints
             goal = [round(float(x), GOAL_DECIMALS) for x in np.degrees(reach.goal[:joints])]
-        grid: dict[str, Any] = {}
+        grid: dict[str, object] = {}
     else:
         task, grid, joints = task_spec(policy.grid), policy.grid.to_dict(), policy.grid.joints
         goal = goal_degrees(policy.grid)

@@ -21,6 +21,7 @@ from studio.capture import (
     ObservationWriter,
     PlaybackSource,
     RecordingError,
+    RecordingWriter,
     describe,
     extract_demonstration,
     hand_pose,
@@ -167,6 +168,15 @@ def test_the_tape_reader_refuses_a_pose_file_in_one_sentence(tmp_path: Path) -> 
         ObservationWriter(tmp_path / "c.pose.csv", "pose").write(
             hand_pose(0, 0, [0, 0, 0], [1, 0, 0, 0])
         )
+
+
+def test_the_tape_writer_refuses_another_observation_in_one_sentence(tmp_path: Path) -> None:
+    """It used to fail with an AttributeError (a hand pose has no bend) instead of a sentence."""
+    with (
+        RecordingWriter(tmp_path / "t.tape.csv", 16) as out,
+        pytest.raises(RecordingError, match="records tape frames, not HandPose"),
+    ):
+        out.write(hand_pose(0, 0, [0, 0, 0], [1, 0, 0, 0]))
 
 
 def test_camera_source_checks_counts_and_refuses_floods(monkeypatch: pytest.MonkeyPatch) -> None:

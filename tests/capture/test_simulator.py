@@ -153,3 +153,16 @@ def test_goal_configuration_is_in_the_goal_bin_and_mirrors_off_the_arm_limits(go
     arm = retargeter.arm
     assert np.all(q_human >= arm.lower + GOAL_MARGIN_RAD - 1e-9)
     assert np.all(q_human <= arm.upper - GOAL_MARGIN_RAD + 1e-9)
+
+
+def test_a_given_retargeter_and_its_arm_are_the_ones_the_simulated_operator_uses():
+    """``simulate(retargeter=...)`` used to hand the retargeter over as the operator's arm."""
+    from studio.kinematics import HumanArm, Retargeter, tape_from_arm
+
+    retargeter = Retargeter("joint", mirror=True, arm=HumanArm("left"))
+    sim = simulate(0.5, seed=3, retargeter=retargeter)
+    bend, _ = tape_from_arm(retargeter.arm, sim.q_human, sim.config)
+    measured = np.stack([f.bend for f in sim.frames])
+    assert np.abs(measured - bend).max() < 6 * OperatorConfig().noise_rad
+    motion = SimulatorSource(seed=3, retargeter=retargeter)._sim.motion
+    assert motion.retargeter is retargeter and motion.arm is retargeter.arm
