@@ -34,6 +34,14 @@ from ._puma import LinkVisual as LinkVisual
 from ._puma import Puma560 as Puma560
 from ._retarget import RetargetConfig as RetargetConfig
 from ._retarget import Retargeter as Retargeter
+from ._robots import ROBOT_SPECS as ROBOT_SPECS
+from ._robots import Collision as Collision
+from ._robots import RobotArm as RobotArm
+from ._robots import RobotIK as RobotIK
+from ._robots import RobotSpec as RobotSpec
+from ._robots import load_robot as load_robot
+from ._robots import robot_names as robot_names
+from ._robots import robot_spec as robot_spec
 from ._synthetic import BodyShape as BodyShape
 from ._synthetic import arm_motion as arm_motion
 from ._synthetic import landmarks_from_arm as landmarks_from_arm

@@ -18,8 +18,6 @@ arm in the mirror image (through the sagittal plane, y -> -y) of the right arm's
 
 from __future__ import annotations
 
-import importlib.metadata
-import sysconfig
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Literal
@@ -29,11 +27,10 @@ import pinocchio as pin
 
 from ._checks import check_side, positive_number, real_array
 from ._errors import KinematicsError
+from ._robots import robots_folder
 
-URDF_RELATIVE = Path(
-    "cmeel.prefix/share/example-robot-data/robots/human_description/robots/human.urdf"
-)
-"""Where the ``example-robot-data`` wheel installs ``human.urdf``, relative to site-packages."""
+URDF_IN_ROBOTS = Path("human_description/robots/human.urdf")
+"""Where ``human.urdf`` lies in example-robot-data's robots folder (see ``robots_folder``)."""
 
 ARM_JOINTS = ("shoulder_Z", "shoulder_X", "shoulder_Y", "elbow_Z", "elbow_Y", "wrist_Z", "wrist_X")
 """The seven arm joints kept from ``human.urdf`` (prefixed ``right_`` or ``left_``)."""
@@ -54,21 +51,13 @@ def find_human_urdf() -> Path:
     Raises:
         KinematicsError: the package is not installed.
     """
-    candidates: list[Path] = []
-    try:
-        dist = importlib.metadata.distribution("example-robot-data")
-        candidates.append(Path(str(dist.locate_file(URDF_RELATIVE))))
-    except importlib.metadata.PackageNotFoundError:
-        pass
-    for key in ("purelib", "platlib"):
-        candidates.append(Path(sysconfig.get_paths()[key]) / URDF_RELATIVE)
-    for path in candidates:
-        if path.is_file():
-            return path
-    raise KinematicsError(
-        "The human arm model human.urdf was not found; install it with "
-        "`pip install example-robot-data`."
-    )
+    path = robots_folder() / URDF_IN_ROBOTS
+    if not path.is_file():
+        raise KinematicsError(
+            "The human arm model human.urdf was not found; install it with "
+            "`pip install example-robot-data`."
+        )
+    return path
 
 
 def _as_q(value: object, size: int, what: str) -> np.ndarray:

@@ -11,7 +11,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from studio.kinematics import ArmPose, HumanArm, KinematicsError, _human, mirror_human_q
+from studio.kinematics import ArmPose, HumanArm, KinematicsError, _human, _robots, mirror_human_q
 
 RIGHT = HumanArm("right")
 LEFT = HumanArm("left")
@@ -163,9 +163,9 @@ def test_missing_example_robot_data_names_the_package(monkeypatch, tmp_path):
     def missing(name):
         raise importlib.metadata.PackageNotFoundError(name)
 
-    monkeypatch.setattr(_human.importlib.metadata, "distribution", missing)
+    monkeypatch.setattr(_robots.importlib.metadata, "distribution", missing)
     monkeypatch.setattr(
-        _human.sysconfig, "get_paths", lambda: {"purelib": str(tmp_path), "platlib": str(tmp_path)}
+        _robots.sysconfig, "get_paths", lambda: {"purelib": str(tmp_path), "platlib": str(tmp_path)}
     )
     with pytest.raises(KinematicsError, match="example-robot-data"):
         HumanArm()

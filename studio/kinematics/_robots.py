@@ -1,0 +1,626 @@
+"""Today's arms from example-robot-data: one model per robot, with limits, IK and self-collision.
+
+The studio teaches the Puma560 (the paper's robot, built from its DH table in :mod:`._puma`) and
+the arms that ``example-robot-data`` ships with a URDF and meshes: the Franka Panda, the UR3, UR5
+and UR10, the SO-100 and SO-101 of the LeRobot community, the xArm7, the Unitree Z1 and the
+Kinova Jaco (j2s6s200). :func:`load_robot` gives a :class:`RobotArm` for any of them:
+
+- the arm's joints only (grippers and fingers locked at their lower limit), with the URDF's
+  position and velocity limits; a URDF ``continuous`` joint gets the limits +-2 pi, so that every
+  joint angle is one number;
+- the tool pose (:meth:`RobotArm.forward`) and a damped-least-squares IK within the limits with a
+  null-space task that keeps the elbow near a wanted point (:meth:`RobotArm.inverse`);
+- self-collision distances on the URDF's collision geometry with Pinocchio and coal
+  (:meth:`RobotArm.self_collisions`), adjacent links and the SRDF's disabled pairs excluded.
+
+URDFs give no acceleration limits; :attr:`RobotSpec.acceleration` holds the makers' figures where
+published (Panda) and otherwise twice the velocity limit per second, a conservative rule.
+"""
+
+from __future__ import annotations
+
+import functools
+import importlib.metadata
+import math
+import re
+import sysconfig
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+
+from ._checks import real_array
+from ._errors import KinematicsError
+
+ROBOTS_RELATIVE = Path("cmeel.prefix/share/example-robot-data/robots")
+"""Where the ``example-robot-data`` wheel installs its robots, relative to site-packages."""
+
+
+@dataclass(frozen=True)
+class RobotSpec:
+    """One offered robot: where its files are and which of its joints form the arm.
+
+    Attributes:
+        name: the name users type (``--robot panda``).
+        title: the name people read.
+        urdf: the URDF, relative to the robots folder (empty for the Puma560, built from DH).
+        srdf: the SRDF whose disabled collision pairs are honoured (empty: none).
+        tool: the frame whose pose is the tool's.
+        arm_joints: how many of the URDF's first joints form the arm (the rest are locked).
+        orientation: whether retargeting asks for the tool's orientation too (an arm with fewer
+            than six joints cannot reach every orientation, so it follows the position only).
+        acceleration: joint acceleration limits (rad/s^2), or empty for twice the velocity limit.
+        elbow: the joint (1-based) whose origin is the arm's elbow, for the null-space task.
+    """
+
+    name: str
+    title: str
+    urdf: str
+    srdf: str
+    tool: str
+    arm_joints: int
+    orientation: bool = True
+    acceleration: tuple[float, ...] = field(default=())
+    elbow: int = 3
+
+
+ROBOT_SPECS: dict[str, RobotSpec] = {
+    spec.name: spec
+    for spec in (
+        RobotSpec("puma560", "Puma560 (the paper's robot)", "", "", "tool", 6),
+        RobotSpec(
+            "panda",
+            "Franka Emika Panda",
+            "panda_description/urdf/panda.urdf",
+            "panda_description/srdf/panda.srdf",
+            "panda_hand_tcp",
+            7,
+            # Franka's datasheet (docs.franka.de, "Limits for Panda").
+            acceleration=(15.0, 7.5, 10.0, 12.5, 15.0, 20.0, 20.0),
+            elbow=4,
+        ),
+        RobotSpec(
+            "ur3",
+            "Universal Robots UR3",
+            "ur_description/urdf/ur3_robot.urdf",
+            "ur_description/srdf/ur5.srdf",
+            "tool0",
+            6,
+        ),
+        RobotSpec(
+            "ur5",
+            "Universal Robots UR5",
+            "ur_description/urdf/ur5_robot.urdf",
+            "ur_description/srdf/ur5.srdf",
+            "tool0",
+            6,
+        ),
+        RobotSpec(
+            "ur10",
+            "Universal Robots UR10",
+            "ur_description/urdf/ur10_robot.urdf",
+            "ur_description/srdf/ur5.srdf",
+            "tool0",
+            6,
+        ),
+        RobotSpec(
+            "so100",
+            "SO-100 (LeRobot)",
+            "so_arm_description/urdf/so100.urdf",
+            "",
+            "wrist",
+            5,
+            orientation=False,
+        ),
+        RobotSpec(
+            "so101",
+            "SO-101 (LeRobot)",
+            "so_arm_description/urdf/so101.urdf",
+            "",
+            "gripper_frame_link",
+            5,
+            orientation=False,
+        ),
+        RobotSpec(
+            "xarm7",
+            "UFactory xArm7",
+            "xarm_description/urdf/xarm7.urdf",
+            "xarm_description/srdf/xarm7.srdf",
+            "link_eef",
+            7,
+            elbow=4,
+        ),
+        RobotSpec(
+            "z1",
+            "Unitree Z1",
+            "z1_description/urdf/z1.urdf",
+            "",
+            "gripperStator",
+            6,
+        ),
+        RobotSpec(
+            "kinova",
+            "Kinova Jaco 2 (j2s6s200)",
+            "kinova_description/robots/kinova.urdf",
+            "kinova_description/srdf/kinova.srdf",
+            "j2s6s200_end_effector",
+            6,
+        ),
+    )
+}
+"""Every offered robot by name; the Puma560 first (the default, the paper's)."""
+
+DEFAULT_ROBOT = "puma560"
+
+PUMA_VELOCITY = 1.0
+"""Velocity limit of every Puma560 joint (rad/s). The DH model carries none; 1 rad/s is a
+conservative figure for an export meant for a real arm."""
+
+
+def robot_names() -> tuple[str, ...]:
+    """The names of the offered robots, the default first."""
+    return tuple(ROBOT_SPECS)
+
+
+def robot_spec(name: object) -> RobotSpec:
+    """The spec of robot ``name``, or a KinematicsError listing the offered names."""
+    spec = ROBOT_SPECS.get(name) if isinstance(name, str) else None
+    if spec is None:
+        raise KinematicsError(
+            f"Unknown robot {name!r}; use one of {', '.join(robot_names())} (`studio robots` "
+            "lists them with their joints)."
+        )
+    return spec
+
+
+def robots_folder() -> Path:
+    """The folder of example-robot-data's robots, or a KinematicsError saying how to install it."""
+    candidates: list[Path] = []
+    try:
+        dist = importlib.metadata.distribution("example-robot-data")
+        candidates.append(Path(str(dist.locate_file(ROBOTS_RELATIVE))))
+    except importlib.metadata.PackageNotFoundError:
+        pass
+    for key in ("purelib", "platlib"):
+        candidates.append(Path(sysconfig.get_paths()[key]) / ROBOTS_RELATIVE)
+    for path in candidates:
+        if path.is_dir():
+            return path
+    raise KinematicsError(
+        "The robot models of example-robot-data were not found; install them with "
+        "`pip install example-robot-data`."
+    )
+
+
+_CONTINUOUS = re.compile(r'(<joint\b[^>]*\btype=")continuous(")')
+
+
+def _bounded_urdf(text: str) -> str:
+    """``text`` with every ``continuous`` joint made ``revolute`` with limits of +-2 pi.
+
+    Pinocchio gives a continuous joint two coordinates (cos, sin); one angle per joint is what
+    limits, trajectories and exports speak, and +-2 pi is a full turn each way.
+    """
+
+    def revolute(match: re.Match[str]) -> str:
+        return f"{match.group(1)}revolute{match.group(2)}"
+
+    text = _CONTINUOUS.sub(revolute, text)
+    links = set(re.findall(r'<link\s+name="([^"]+)"', text))
+    for name in set(re.findall(r'<joint\s+name="([^"]+)"', text)) & links:
+        # A joint named like a link (SO-100's "gripper") makes Pinocchio's frame lookups ambiguous.
+        text = text.replace(f'<joint name="{name}"', f'<joint name="{name}_joint"')
+
+    def add_limit(joint: re.Match[str]) -> str:
+        body = joint.group(0)
+        if 'type="revolute"' not in body:
+            return body
+        limit = re.search(r"<limit\b[^>]*/>", body)
+        bounds = f'lower="{-2 * math.pi:.6f}" upper="{2 * math.pi:.6f}"'
+        if limit is None:
+            return body.replace(
+                "</joint>", f'<limit {bounds} effort="100" velocity="1.0"/></joint>'
+            )
+        if "lower=" in limit.group(0):
+            return body
+        return body.replace(limit.group(0), limit.group(0).replace("<limit", f"<limit {bounds}"))
+
+    return re.sub(r"<joint\b.*?</joint>", add_limit, text, flags=re.S)
+
+
+@dataclass(frozen=True)
+class RobotIK:
+    """The outcome of :meth:`RobotArm.inverse`.
+
+    Attributes:
+        q: joint angles (rad), always within the limits: the solution, or the closest found.
+        success: whether the tool reached the target within the tolerances.
+        position_error: tool position error (m).
+        rotation_error: tool rotation error (rad; 0 when only the position was asked).
+        iterations: iterations used.
+    """
+
+    q: np.ndarray
+    success: bool
+    position_error: float
+    rotation_error: float
+    iterations: int
+
+
+@dataclass(frozen=True)
+class Collision:
+    """Two links closer than the margin: ``distance`` is negative when they overlap (m)."""
+
+    link_a: str
+    link_b: str
+    distance: float
+
+
+class RobotArm:
+    """One robot's arm: Pinocchio model of its arm joints, limits, IK and self-collision.
+
+    Build it with :func:`load_robot` (cached per name). Not thread-safe: one per thread.
+
+    Attributes:
+        spec: the :class:`RobotSpec`.
+        name: ``spec.name``.
+        model, data: the Pinocchio model of the arm joints and its scratch data.
+        visual_model, collision_model: geometry (``collision_model`` may be empty: the Puma560's
+            DH model has no collision geometry).
+        joint_names: the URDF's names of the arm joints.
+        nq: number of arm joints.
+        lower, upper: position limits (rad).
+        velocity: velocity limits (rad/s).
+        acceleration: acceleration limits (rad/s^2).
+        home: a pose inside the limits the arm starts from (the middle of each joint's range,
+            or 0 where 0 is inside it).
+        shoulder: the origin of the second joint at ``home`` (m, base frame): the point the
+            operator's shoulder is mapped to.
+        reach: the largest distance from ``shoulder`` to the tool over the limits (sampled, m).
+        urdf_text: the URDF the model was built from (for export).
+    """
+
+    def __init__(
+        self,
+        spec: RobotSpec,
+        model: pin.Model,
+        visual_model: pin.GeometryModel,
+        collision_model: pin.GeometryModel,
+        urdf_text: str,
+        srdf: Path | None = None,
+    ) -> None:
+        self.spec = spec
+        self.name = spec.name
+        self.model = model
+        self.data = model.createData()
+        self.visual_model = visual_model
+        self.collision_model = collision_model
+        self.urdf_text = urdf_text
+        self.nq = model.nq
+        self.joint_names = tuple(model.names[i] for i in range(1, model.njoints))
+        self.lower = np.array(model.lowerPositionLimit, dtype=float)
+        self.upper = np.array(model.upperPositionLimit, dtype=float)
+        self.velocity = np.array(model.velocityLimit, dtype=float)
+        if spec.acceleration:
+            self.acceleration = np.array(spec.acceleration, dtype=float)
+        else:
+            self.acceleration = 2.0 * self.velocity
+        for array in (self.lower, self.upper, self.velocity, self.acceleration):
+            array.setflags(write=False)
+        self._tool = _frame_id(model, spec)
+        self.home = _home(self.joint_names, self.lower, self.upper, srdf)
+        self.home.setflags(write=False)
+        pin.forwardKinematics(model, self.data, self.home)
+        self._elbow_joint = min(spec.elbow, model.njoints - 1)
+        self.shoulder = np.array(self.data.oMi[min(2, model.njoints - 1)].translation)
+        self.reach = self._sampled_reach()
+        self._collision_data: pin.GeometryData | None = None
+        if len(collision_model.geometryObjects):
+            self._set_collision_pairs(srdf)
+
+    # ------------------------------------------------------------------------------ kinematics
+
+    def check_q(self, q: object, what: str = "q") -> np.ndarray:
+        """``q`` as finite angles of shape (nq,), or a KinematicsError naming the robot."""
+        arr = real_array(q, what, f"pass {self.nq} angles in radians")
+        if arr.shape != (self.nq,):
+            raise KinematicsError(
+                f"{what} must have {self.nq} angles for the {self.spec.title}; got shape "
+                f"{arr.shape}."
+            )
+        if not np.all(np.isfinite(arr)):
+            raise KinematicsError(f"{what} contains NaN or infinite angles; pass finite radians.")
+        return arr
+
+    def forward(self, q: object) -> np.ndarray:
+        """The tool pose in the base frame (4x4) at ``q``."""
+        arr = self.check_q(q)
+        pin.framesForwardKinematics(self.model, self.data, arr)
+        return self.data.oMf[self._tool].homogeneous.copy()
+
+    def joint_positions(self, q: object) -> np.ndarray:
+        """Each joint's origin in the base frame at ``q``, shape (nq, 3) (m)."""
+        arr = self.check_q(q)
+        pin.forwardKinematics(self.model, self.data, arr)
+        return np.array([self.data.oMi[i].translation for i in range(1, self.model.njoints)])
+
+    def elbow(self, q: np.ndarray) -> np.ndarray:
+        """The elbow's position at ``q`` (the third joint's origin; m)."""
+        pin.forwardKinematics(self.model, self.data, q)
+        return np.array(self.data.oMi[self._elbow_joint].translation)
+
+    def _sampled_reach(self, samples: int = 512) -> float:
+        rng = np.random.default_rng(0)
+        best = 0.0
+        for _ in range(samples):
+            q = rng.uniform(self.lower, self.upper)
+            pin.framesForwardKinematics(self.model, self.data, q)
+            best = max(
+                best, float(np.linalg.norm(self.data.oMf[self._tool].translation - self.shoulder))
+            )
+        return best
+
+    def inverse(
+        self,
+        oMdes: object,
+        q0: object | None = None,
+        *,
+        position_only: bool | None = None,
+        elbow: object | None = None,
+        iterations: int = 60,
+        position_tolerance: float = 1e-3,
+        rotation_tolerance: float = math.radians(1.0),
+        damping: float = 1e-2,
+        max_step: float = 0.2,
+    ) -> RobotIK:
+        """Joint angles that put the tool at ``oMdes``, by damped least squares within the limits.
+
+        Each iteration takes ``dq = J^T (J J^T + lambda^2 I)^-1 e`` and, for arms with joints to
+        spare, a null-space step moving the elbow towards ``elbow``; the result is projected
+        onto the limits, so every returned ``q`` is within them.
+
+        Args:
+            oMdes: the tool's target pose (4x4) in the base frame, or its position (3,).
+            q0: where to start (the previous frame's answer keeps motion continuous); default
+                :attr:`home`.
+            position_only: match the position only (default: when the spec says so or the
+                target is a position).
+            elbow: where the elbow should stay (3,), used in the null space only.
+            iterations, position_tolerance, rotation_tolerance, damping, max_step: the solver's
+                settings (max_step in rad per iteration, infinity norm).
+
+        Returns:
+            A :class:`RobotIK`.
+        """
+        target = real_array(oMdes, "oMdes", "pass a 4x4 pose or a 3-vector position")
+        if target.shape == (3,):
+            target_p, target_R, pos_only = target, np.eye(3), True
+        elif target.shape == (4, 4) and np.all(np.isfinite(target)):
+            target_p, target_R = target[:3, 3], target[:3, :3]
+            pos_only = (not self.spec.orientation) if position_only is None else position_only
+        else:
+            raise KinematicsError(
+                f"oMdes must be a 4x4 pose or a 3-vector of finite numbers; got shape {target.shape}."
+            )
+        if position_only:
+            pos_only = True
+        q = np.clip(self.home if q0 is None else self.check_q(q0, "q0"), self.lower, self.upper)
+        elbow_target = None if elbow is None else real_array(elbow, "elbow").reshape(3)
+        model, data, tool = self.model, self.data, self._tool
+        rows = 3 if pos_only else 6
+        damp = np.eye(rows) * damping**2
+        e = np.empty(rows)
+        pos_err = rot_err = math.inf
+        it = 0
+        for it in range(iterations + 1):
+            pin.forwardKinematics(model, data, q)
+            oMtool = pin.updateFramePlacement(model, data, tool)
+            e[:3] = target_p - oMtool.translation
+            pos_err = float(np.linalg.norm(e[:3]))
+            if pos_only:
+                rot_err = 0.0
+            else:
+                e[3:] = pin.log3(target_R @ oMtool.rotation.T)
+                rot_err = float(np.linalg.norm(e[3:]))
+            reached = pos_err <= position_tolerance and rot_err <= rotation_tolerance
+            if it == iterations or (reached and elbow_target is None):
+                break
+            pin.computeJointJacobians(model, data, q)
+            J = pin.getFrameJacobian(model, data, tool, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)[
+                :rows
+            ]
+            JJt = J @ J.T + damp
+            dq = J.T @ np.linalg.solve(JJt, e)
+            if elbow_target is not None and self.nq > rows:
+                Je = pin.getJointJacobian(
+                    model, data, self._elbow_joint, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+                )[:3]
+                pull = Je.T @ (elbow_target - data.oMi[self._elbow_joint].translation)
+                null = np.eye(self.nq) - J.T @ np.linalg.solve(JJt, J)
+                secondary = 0.5 * null @ pull
+                if reached and float(np.abs(secondary).max()) < 1e-4:
+                    break  # the elbow is as near as the tool lets it be
+                dq += secondary
+            biggest = float(np.abs(dq).max())
+            if biggest > max_step:
+                dq *= max_step / biggest
+            q = np.minimum(np.maximum(q + dq, self.lower), self.upper)
+        success = pos_err <= position_tolerance and rot_err <= rotation_tolerance
+        return RobotIK(q.copy(), bool(success), pos_err, rot_err, it)
+
+    # ------------------------------------------------------------------------- self-collision
+
+    def _set_collision_pairs(self, srdf: Path | None) -> None:
+        geom = self.collision_model
+        geom.addAllCollisionPairs()
+        if srdf is not None and srdf.is_file():
+            pin.removeCollisionPairs(self.model, geom, str(srdf))
+        parents = self.model.parents
+        keep = []
+        for pair in geom.collisionPairs:
+            a = geom.geometryObjects[pair.first].parentJoint
+            b = geom.geometryObjects[pair.second].parentJoint
+            if a == b or parents[a] == b or parents[b] == a:
+                continue  # the same link, or adjacent links: they touch by design
+            keep.append(pair)
+        geom.removeAllCollisionPairs()
+        for pair in keep:
+            geom.addCollisionPair(pair)
+        self._collision_data = pin.GeometryData(geom)
+        if srdf is None:
+            # No SRDF: as MoveIt's setup does, pairs already touching at home are taken to touch
+            # by design (meshes drawn overlapping at a folded rest pose).
+            touching = {(c.link_a, c.link_b) for c in self.self_collisions(self.home)}
+            for k in reversed(range(len(geom.collisionPairs))):
+                pair = geom.collisionPairs[k]
+                names = (
+                    _link_of(geom.geometryObjects[pair.first].name),
+                    _link_of(geom.geometryObjects[pair.second].name),
+                )
+                if names in touching:
+                    geom.removeCollisionPair(pair)
+            self._collision_data = pin.GeometryData(geom)
+
+    def self_collisions(self, q: object, margin: float = 0.0) -> list[Collision]:
+        """The link pairs closer than ``margin`` at ``q`` (overlaps have negative distances).
+
+        An arm without collision geometry (the Puma560's DH model) reports none.
+        """
+        arr = self.check_q(q)
+        if self._collision_data is None:
+            return []
+        geom, gdata = self.collision_model, self._collision_data
+        pin.computeDistances(self.model, self.data, geom, gdata, arr)
+        found = []
+        for k, pair in enumerate(geom.collisionPairs):
+            distance = float(gdata.distanceResults[k].min_distance)
+            if distance < margin:
+                a = geom.geometryObjects[pair.first].name
+                b = geom.geometryObjects[pair.second].name
+                found.append(Collision(_link_of(a), _link_of(b), distance))
+        return sorted(found, key=lambda c: c.distance)
+
+    @property
+    def checks_collisions(self) -> bool:
+        """Whether :meth:`self_collisions` has geometry to check."""
+        return self._collision_data is not None
+
+
+def _convex(geom: pin.GeometryModel) -> None:
+    """Replace each collision mesh by its convex hull.
+
+    Distances between hulls cost a fraction of mesh-to-mesh ones (a 5-joint SO-101 check drops
+    from about a second to milliseconds), and a hull contains its mesh, so a clearance found on
+    hulls holds for the meshes: the check errs on the safe side.
+    """
+    for obj in geom.geometryObjects:
+        shape = obj.geometry
+        if hasattr(shape, "buildConvexRepresentation"):
+            shape.buildConvexRepresentation(False)
+            obj.geometry = shape.convex
+
+
+def _home(
+    names: tuple[str, ...], lower: np.ndarray, upper: np.ndarray, srdf: Path | None
+) -> np.ndarray:
+    """The SRDF's ``home`` or ``default`` state, else 0 where allowed and mid-range elsewhere."""
+    zero_inside = (lower <= 0.0) & (upper >= 0.0)
+    home = np.where(zero_inside, 0.0, 0.5 * (lower + upper))
+    if srdf is not None and srdf.is_file():
+        text = srdf.read_text()
+        for state in ("home", "default"):
+            block = re.search(rf'<group_state\s+name="{state}".*?</group_state>', text, re.S)
+            if block is None:
+                continue
+            values = dict(re.findall(r'<joint\s+name="([^"]+)"\s+value="([^"]+)"', block.group(0)))
+            for i, name in enumerate(names):
+                if name in values:
+                    home[i] = float(values[name])
+            break
+    return np.clip(home, lower, upper)
+
+
+def _frame_id(model: pin.Model, spec: RobotSpec) -> int:
+    """The tool frame's id (a link's frame when a joint has the same name)."""
+    matches = [i for i, frame in enumerate(model.frames) if frame.name == spec.tool]
+    if not matches:
+        raise KinematicsError(
+            f"The {spec.title} model has no frame {spec.tool!r}; its URDF changed: report it."
+        )
+    bodies = [i for i in matches if model.frames[i].type == pin.FrameType.BODY]
+    return (bodies or matches)[0]
+
+
+def _link_of(geometry_name: str) -> str:
+    """A geometry object's link (Pinocchio names them ``<link>_<index>``)."""
+    head, _, tail = geometry_name.rpartition("_")
+    return head if head and tail.isdigit() else geometry_name
+
+
+def _reduce(
+    model: pin.Model, geoms: list[pin.GeometryModel], keep: int
+) -> tuple[pin.Model, list[pin.GeometryModel]]:
+    """The model with only its first ``keep`` joints free; the rest locked at a valid angle."""
+    locked = list(range(keep + 1, model.njoints))
+    if not locked:
+        return model, geoms
+    q_ref = np.clip(np.zeros(model.nq), model.lowerPositionLimit, model.upperPositionLimit)
+    reduced, reduced_geoms = pin.buildReducedModel(model, geoms, locked, q_ref)
+    return reduced, list(reduced_geoms)
+
+
+@functools.cache
+def load_robot(name: str, geometry: bool = True) -> RobotArm:
+    """The :class:`RobotArm` for ``name``, loaded once per process.
+
+    Args:
+        name: one of :func:`robot_names`.
+        geometry: load the meshes too (a second or more per robot; needed for drawing and for
+            :meth:`RobotArm.self_collisions`). Without them the model is ready in milliseconds,
+            enough for limits, FK and IK.
+
+    Raises:
+        KinematicsError: an unknown name, or a model whose files are missing or unreadable.
+    """
+    spec = robot_spec(name)
+    if spec.name == "puma560":
+        return _puma_arm(spec)
+    root = robots_folder()
+    urdf_path = root / spec.urdf
+    try:
+        text = _bounded_urdf(urdf_path.read_text())
+    except OSError as err:
+        raise KinematicsError(
+            f"The {spec.title} URDF {urdf_path} cannot be read ({err.strerror}); reinstall "
+            "example-robot-data."
+        ) from None
+    package_dirs = [str(root.parent.parent)]
+    try:
+        model = pin.buildModelFromXML(text)
+        if geometry:
+            geoms = [
+                pin.buildGeomFromUrdfString(model, text, kind, None, package_dirs)
+                for kind in (pin.GeometryType.VISUAL, pin.GeometryType.COLLISION)
+            ]
+        else:
+            geoms = [pin.GeometryModel(), pin.GeometryModel()]
+    except (RuntimeError, ValueError) as err:
+        raise KinematicsError(
+            f"The {spec.title} model cannot be built ({err}); its URDF or meshes are missing: "
+            "reinstall example-robot-data."
+        ) from None
+    model, (visual, collision) = _reduce(model, geoms, spec.arm_joints)
+    _convex(collision)
+    srdf = root / spec.srdf if spec.srdf else None
+    return RobotArm(spec, model, visual, collision, text, srdf)
+
+
+def _puma_arm(spec: RobotSpec) -> RobotArm:
+    from ._puma import Puma560
+
+    puma = Puma560()
+    empty = pin.GeometryModel()
+    model = puma.model.copy()
+    model.velocityLimit = np.full(6, PUMA_VELOCITY)
+    return RobotArm(spec, model, empty, pin.GeometryModel(), puma.urdf())

@@ -1,0 +1,109 @@
+"""Today's arms: every offered robot loads with its joints and limits, reaches by IK, and finds
+its own self-collisions; ``studio robots`` lists them."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from studio.kinematics import KinematicsError, load_robot, robot_names, robot_spec
+
+OFFERED = ("puma560", "panda", "ur3", "ur5", "ur10", "so100", "so101", "xarm7", "z1", "kinova")
+
+
+def test_the_puma_comes_first_and_every_arm_the_issue_names_is_offered():
+    assert robot_names()[0] == "puma560"
+    assert set(OFFERED) <= set(robot_names())
+
+
+def test_an_unknown_robot_is_refused_with_the_names_that_exist():
+    with pytest.raises(KinematicsError, match=r"Unknown robot 'pr2'; use one of puma560, panda"):
+        robot_spec("pr2")
+
+
+@pytest.mark.parametrize("name", OFFERED)
+def test_each_robot_has_finite_limits_inside_which_its_home_lies(name):
+    arm = load_robot(name, geometry=False)
+    assert arm.nq == len(arm.joint_names) >= 5
+    assert np.all(np.isfinite(arm.lower)) and np.all(np.isfinite(arm.upper))
+    assert np.all(arm.lower < arm.upper)
+    assert np.all((arm.home >= arm.lower) & (arm.home <= arm.upper))
+    assert np.all(arm.velocity > 0) and np.all(arm.acceleration > 0)
+    assert arm.reach > 0.2
+
+
+def test_continuous_joints_get_one_angle_each_with_a_full_turn_either_way():
+    arm = load_robot("kinova", geometry=False)
+    assert arm.nq == arm.model.nv == 6
+    assert arm.upper[0] == pytest.approx(2 * math.pi, abs=1e-5)
+
+
+def test_locked_grippers_are_not_arm_joints():
+    assert "panda_finger_joint1" not in load_robot("panda", geometry=False).joint_names
+    assert load_robot("so100", geometry=False).nq == 5
+
+
+@pytest.mark.parametrize("name", OFFERED)
+def test_ik_reaches_poses_the_arm_can_reach_within_1cm_and_5deg(name):
+    arm = load_robot(name, geometry=False)
+    rng = np.random.default_rng(7)
+    reached = 0
+    for _ in range(40):
+        q_true = rng.uniform(arm.lower, arm.upper)
+        target = arm.forward(q_true)
+        start = np.clip(q_true + rng.normal(0.0, 0.15, arm.nq), arm.lower, arm.upper)
+        result = arm.inverse(target, start)
+        assert np.all((result.q >= arm.lower) & (result.q <= arm.upper))
+        got = arm.forward(result.q)
+        ok = np.linalg.norm(got[:3, 3] - target[:3, 3]) < 0.01
+        if arm.spec.orientation:
+            cos = (np.trace(got[:3, :3].T @ target[:3, :3]) - 1) / 2
+            ok = ok and math.degrees(math.acos(np.clip(cos, -1, 1))) < 5
+        reached += ok
+    assert reached >= 38
+
+
+def test_the_null_space_moves_a_redundant_arms_elbow_without_moving_its_tool():
+    arm = load_robot("panda", geometry=False)
+    target = arm.forward(arm.home)
+    elbow_home = arm.elbow(arm.home.copy())
+    wanted = elbow_home + np.array([0.0, 0.15, 0.0])
+    result = arm.inverse(target, arm.home, elbow=wanted, iterations=200)
+    assert result.success
+    assert np.linalg.norm(arm.elbow(result.q) - wanted) < np.linalg.norm(elbow_home - wanted) - 0.03
+
+
+@pytest.mark.parametrize("name", ["panda", "ur5", "so100", "z1"])
+def test_home_is_free_and_a_folded_pose_is_found_in_collision_naming_the_links(name):
+    arm = load_robot(name)
+    assert arm.checks_collisions
+    assert arm.self_collisions(arm.home) == []
+    rng = np.random.default_rng(3)
+    for _ in range(400):
+        q = rng.uniform(arm.lower, arm.upper)
+        found = arm.self_collisions(q)
+        if found:
+            break
+    else:
+        pytest.fail(f"no self-collision found for {name} in 400 random poses")
+    worst = found[0]
+    assert worst.distance < 0 and worst.link_a != worst.link_b
+    link_names = {arm.model.frames[i].name for i in range(len(arm.model.frames))}
+    assert {worst.link_a, worst.link_b} <= link_names
+
+
+def test_studio_robots_lists_every_robot_with_joints_and_limits(capsys):
+    from studio.cli import main
+
+    assert main(["robots", "--json"]) == 0
+    robots = json.loads(capsys.readouterr().out)
+    assert [r["name"] for r in robots][0] == "puma560"
+    panda = next(r for r in robots if r["name"] == "panda")
+    assert [j["name"] for j in panda["joints"]][:2] == ["panda_joint1", "panda_joint2"]
+    assert panda["joints"][3]["upper_deg"] == pytest.approx(-4.0, abs=0.1)
+    assert main(["robots"]) == 0
+    text = capsys.readouterr().out
+    assert "puma560: Puma560" in text and "(default)" in text and "shoulder_pan_joint" in text
