@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 import pytest
 
-from studio.learning import curve_statistics, downsample_curve
+from studio.learning import FIGURE_POINTS, curve_statistics, downsample_curve
 from studio.web._app import STATIC_DIR
 
 ORIGIN = "http://page.test"
@@ -22,11 +22,12 @@ ORIGIN = "http://page.test"
 BROWSER_RULE = """async ([curve, points]) => {
     const { curveAxis, bucketCurve } = await import("/static/curves.js");
     const line = { curve, length: curve.episodes.length };
-    const { x, bucketOf } = curveAxis([line], "episode", points);
+    const { x, bucketOf } = curveAxis([line], "episode", points ?? undefined);
     const s = bucketCurve(line, x.length, bucketOf);
     return { episodes: x, mean: s.mean, std: s.std, min: s.min, max: s.max, count: s.count };
 }"""
-"""The chart's episode axis on one run, as ``chartData`` computes it, before it draws."""
+"""The chart's episode axis on one run, as ``chartData`` computes it, before it draws (points
+null: the chart's own number of points)."""
 
 
 @pytest.fixture
@@ -67,16 +68,16 @@ def stopped_run(experiments: int, episodes: int, seed: int) -> dict[str, list]:
 
 @pytest.mark.parametrize(
     ("episodes", "points"),
-    [(2500, 600), (1234, 100), (50, 600), (601, 600)],
-    ids=["5-episode buckets", "a partial last bucket", "short: as is", "just over"],
+    [(2500, 600), (1234, 100), (50, 600), (601, 600), (FIGURE_POINTS * 3 + 1, None)],
+    ids=["5-episode buckets", "a partial last bucket", "short: as is", "just over", "defaults"],
 )
 def test_the_chart_averages_a_long_curve_by_the_servers_rule(
-    rule_page: Any, episodes: int, points: int
+    rule_page: Any, episodes: int, points: int | None
 ) -> None:
     curve = stopped_run(4, episodes, seed=episodes)
-    server = downsample_curve(curve, points)
+    server = downsample_curve(curve) if points is None else downsample_curve(curve, points)
     page = rule_page.evaluate(BROWSER_RULE, [curve, points])
-    assert len(page["episodes"]) == len(server["episodes"]) <= points
+    assert len(page["episodes"]) == len(server["episodes"]) <= (points or FIGURE_POINTS)
     np.testing.assert_allclose(page["episodes"], server["episodes"], rtol=0, atol=1e-9)
     for key in ("mean", "std"):  # the server rounds these to 3 decimals
         np.testing.assert_allclose(page[key], server[key], rtol=0, atol=6e-4, err_msg=key)
