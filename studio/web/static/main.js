@@ -15,7 +15,7 @@ import { $, setProp, setText, showError } from "./dom.js";
 import { CURVE_FPS, connectEvents, events, renderLive } from "./events.js";
 import { exportFile, loadPolicies, uploadPolicy, watch } from "./policies.js";
 import { dismissCaptureFailure, loadRecordings, renderCaptureButton, saveRecordingEdit, toggleCapture, uploadRecording } from "./recordings.js";
-import { loadRuns } from "./runs.js";
+import { loadRuns, renderRuns } from "./runs.js";
 import { SOFTWARE_RENDERERS, SOFTWARE_SCENE_DPR, loadConfig, softwareWebGL } from "./scene.js";
 import { applySource, playback, renderSource, setRetarget, simulatorReach, syncKindOptions } from "./sources.js";
 import { S, markCurvesDirty } from "./state.js";
@@ -110,7 +110,8 @@ async function main() {
 // camera.js (a module loaded after this one) and the browser tests reach these by name, as they
 // did when the page was one classic script.
 Object.assign(window, { $, api, showError, setText, setProp });
-Object.assign(window, { plottedRuns, chartData, fewerFrom, softwareWebGL, SOFTWARE_SCENE_DPR, SOFTWARE_RENDERERS });
+Object.assign(window, { plottedRuns, chartData, fewerFrom, loadRuns, renderRuns });
+Object.assign(window, { softwareWebGL, SOFTWARE_SCENE_DPR, SOFTWARE_RENDERERS });
 Object.defineProperty(window, "events", { get: () => events }); // the live EventSource
 
 main();
