@@ -34,6 +34,10 @@ from ._puma import LinkVisual as LinkVisual
 from ._puma import Puma560 as Puma560
 from ._retarget import RetargetConfig as RetargetConfig
 from ._retarget import Retargeter as Retargeter
+from ._sleeve import SLEEVE_LIFT_M as SLEEVE_LIFT_M
+from ._sleeve import PosedBody as PosedBody
+from ._sleeve import pose_body as pose_body
+from ._sleeve import tape_on_sleeve as tape_on_sleeve
 from ._synthetic import BodyShape as BodyShape
 from ._synthetic import arm_motion as arm_motion
 from ._synthetic import landmarks_from_arm as landmarks_from_arm
