@@ -4,9 +4,8 @@ from __future__ import annotations
 
 import os
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from pathlib import Path
-from typing import Any
 
 from studio import StudioError
 
@@ -63,26 +62,8 @@ def capture(
     """
     check_seconds(seconds)
     check_seconds(give_up_seconds, "the wait for frames")
-    config = getattr(source, "config", None)
-    regions = int(getattr(config, "regions", DEFAULT_REGIONS) or DEFAULT_REGIONS)
     rate = float(getattr(source, "rate_hz", DEFAULT_RATE_HZ) or DEFAULT_RATE_HZ)
-    kind = getattr(source, "observation_kind", "tape")
-    writer: AppendWriter
-    if kind == "tape":
-        writer = RecordingWriter(
-            out,
-            regions,
-            config=config,
-            operator=operator,
-            notes=notes,
-            rate_hz=rate,
-            source=source_name or source.kind,
-        )
-    else:  # a pose or hand recording played back (or any fed source): the same kind again
-        side = str(getattr(source, "side", "right"))
-        writer = ObservationWriter(
-            out, kind, side=side, operator=operator, notes=notes, source=source_name or source.kind
-        )
+    writer = _writer_for(source, out, rate, operator, notes, source_name or source.kind)
     first_t: float | None = None
     failed = False
 
@@ -136,7 +117,36 @@ def capture(
     return writer.path
 
 
-def describe(summary: dict[str, Any]) -> str:
+def _writer_for(
+    source: ThreadedSource,
+    out: str | os.PathLike[str],
+    rate: float,
+    operator: str,
+    notes: str,
+    source_name: str,
+) -> AppendWriter:
+    """A new recording of ``source``'s observation kind at ``out``: a tape's with its config and
+    regions, or a pose or hand recording (played back, or any fed source) of the same kind."""
+    kind = getattr(source, "observation_kind", "tape")
+    if kind == "tape":
+        config = getattr(source, "config", None)
+        regions = int(getattr(config, "regions", DEFAULT_REGIONS) or DEFAULT_REGIONS)
+        return RecordingWriter(
+            out,
+            regions,
+            config=config,
+            operator=operator,
+            notes=notes,
+            rate_hz=rate,
+            source=source_name,
+        )
+    side = str(getattr(source, "side", "right"))
+    return ObservationWriter(
+        out, kind, side=side, operator=operator, notes=notes, source=source_name
+    )
+
+
+def describe(summary: Mapping[str, object]) -> str:
     """A few human lines about a recording summary (for ``studio info``)."""
     lines = [
         f"{summary['path']}",
@@ -156,7 +166,7 @@ def describe(summary: dict[str, Any]) -> str:
     return "\n".join(lines)
 
 
-def _what(summary: dict[str, Any]) -> str:
+def _what(summary: Mapping[str, object]) -> str:
     """What each frame holds, by the recording's kind."""
     kind = summary.get("kind", "tape")
     if kind == "pose":
@@ -166,7 +176,7 @@ def _what(summary: dict[str, Any]) -> str:
     return f"{summary['regions']} regions"
 
 
-def _recovered_text(summary: dict[str, Any]) -> str:
+def _recovered_text(summary: Mapping[str, object]) -> str:
     if summary.get("live"):
         return "no (still being recorded: the frames flushed so far are shown)"
     if summary["recovered"]:

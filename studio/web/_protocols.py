@@ -8,7 +8,7 @@ the simulator's reach, a fed source's ``submit``), by the small protocols below.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import NamedTuple, Protocol
 
@@ -32,8 +32,9 @@ class LivePose(NamedTuple):
     tape: np.ndarray | None = None
 
 
-HandMoved = Callable[[np.ndarray, np.ndarray], object]
-"""What dragging the hand guide's handle calls with the hand's position and orientation."""
+HandMoved = Callable[[np.ndarray, np.ndarray], Mapping[str, object]]
+"""Called with a hand position (3,) and orientation wxyz (4,) in the arm frame when the hand
+guide's handle is dragged; returns the ``HandPublic`` fields (``q_human``, ``reached``, ...)."""
 
 
 class LiveScene(Protocol):

@@ -196,13 +196,13 @@ class StoredFile(Generic[T]):
     error: str | None = None
 
 
-class _FileCache:
+class _FileCache(Generic[T]):
     """What a reader made of each file, its value or its refusal, read again only when the
     file's size or mtime changes (so a damaged file is not parsed again at every listing)."""
 
     def __init__(self) -> None:
         self._lock = threading.Lock()
-        self._entries: dict[Path, tuple[tuple[int, int], object, StudioError | None]] = {}
+        self._entries: dict[Path, tuple[tuple[int, int], T | StudioError]] = {}
 
     def get(self, path: Path, load: Callable[[Path], T]) -> T:
         stat = path.stat()
@@ -210,17 +210,17 @@ class _FileCache:
         with self._lock:
             hit = self._entries.get(path)
         if hit is None or hit[0] != key:
-            value, error = None, None
+            read: T | StudioError
             try:
-                value = load(path)
+                read = load(path)
             except StudioError as err:
-                error = err
-            hit = (key, value, error)
+                read = err
+            hit = (key, read)
             with self._lock:
                 self._entries[path] = hit
-        if hit[2] is not None:
-            raise hit[2]
-        return hit[1]  # type: ignore[return-value]  # what ``load`` gave for this path
+        if isinstance(hit[1], StudioError):
+            raise hit[1]
+        return hit[1]
 
     def forget_missing(self) -> None:
         """Drop the entries of files that no longer exist (deleted or renamed)."""
@@ -277,7 +277,7 @@ class FolderStore(Generic[T]):
         self.sample_fix = sample_fix
         self._load = load
         self._remove = remove
-        self._cache = _FileCache()
+        self._cache: _FileCache[T] = _FileCache()
         self._claim_lock = threading.Lock()  # choosing a free name and taking it are one step
         self.on_change = on_change
         self._in_use = in_use
