@@ -2,8 +2,8 @@
 
 The live pipeline, the studio's state and the routers hold the scene and the capture writer by
 these protocols, so a test can hand in a recording fake and the studio runs headless with none.
-Sources are held by :class:`studio.capture.FrameSource` and, for a kind's own calls (playback,
-the simulator's reach, a fed source's ``submit``), by the small protocols below.
+Sources are held by :class:`studio.capture.FrameSource`; a kind's own calls (playback, the
+simulator's reach, a fed source's ``submit``) are made after an ``isinstance`` check.
 """
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ from typing import NamedTuple, Protocol
 
 import numpy as np
 
-from studio.capture import FrameSource, HandPose, LandmarkFrame, Observation
+from studio.capture import Observation
 
 
 class LivePose(NamedTuple):
@@ -91,52 +91,3 @@ class CaptureWriter(Protocol):
 
     def close(self) -> None:
         """Finish the file cleanly."""
-
-
-class Playback(FrameSource, Protocol):
-    """A recording played back (:class:`studio.capture.PlaybackSource`)."""
-
-    speed: float | None
-    loop: bool
-
-    @property
-    def running(self) -> bool:
-        """Whether the producer runs."""
-
-    @property
-    def paused(self) -> bool:
-        """Whether playback is paused."""
-
-    @property
-    def position(self) -> float:
-        """Seconds from the recording's start."""
-
-    @property
-    def duration(self) -> float:
-        """The recording's length (s)."""
-
-    def pause(self) -> None:
-        """Pause."""
-
-    def resume(self) -> None:
-        """Play on."""
-
-    def seek(self, t: float) -> None:
-        """Jump to ``t`` s."""
-
-
-class Reacher(FrameSource, Protocol):
-    """The simulator's operator (:class:`studio.capture.SimulatorSource`)."""
-
-    def reach(self, q_robot_goal: np.ndarray) -> None:
-        """Reach the pose mirroring onto ``q_robot_goal``."""
-
-    def wander(self) -> None:
-        """Reach random poses again."""
-
-
-class Fed(FrameSource, Protocol):
-    """A source the page feeds (:class:`studio.capture.CameraSource`, ``HandSource``)."""
-
-    def submit(self, *args: object, **kwargs: object) -> LandmarkFrame | HandPose:
-        """Check and count one observation handed in."""
