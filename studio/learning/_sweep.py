@@ -59,8 +59,10 @@ from .._files import atomic_write_text, now_iso
 from .._numbers import is_int, is_number
 from ._arm import ArmGrid
 from ._config import DynaQConfig
+from ._curves import curve_statistics
 from ._dynaq import LiveProgress
 from ._errors import ConfigError, LearningError
+from ._owner import pid_alive, this_host
 from ._reach import ArmReach
 from ._reproduce import (
     CONVERGENCE_FACTOR,
@@ -68,15 +70,8 @@ from ._reproduce import (
     episodes_to_converge,
     generate_demonstrations,
 )
-from ._runs import (
-    TASK_ARM_GRID,
-    TASK_ARM_REACH,
-    RunFolder,
-    RunRecord,
-    curve_statistics,
-    pid_alive,
-    this_host,
-)
+from ._run_record import TASK_ARM_GRID, TASK_ARM_REACH, RunRecord
+from ._runs import RunFolder
 
 SWEEP_FORMAT = "teach-studio-sweep"
 """The ``format`` field of ``sweep.json``."""
