@@ -22,6 +22,7 @@ from typing import Final, cast
 
 import numpy as np
 
+from .._numbers import is_int
 from ._arm import ArmGrid
 from ._config import DEFAULT_EPISODES, DEFAULT_EXPERIMENTS, DEFAULT_SEED, DynaQConfig
 from ._errors import ConfigError, LearningError
@@ -227,9 +228,17 @@ def _grid_paths(
                 )
             )
         paths.append(list(path))
-    if request.generated:
+    count = request.generated
+    if not is_int(count) or count < 0:
+        problems.append(
+            (
+                "demonstrations",
+                f"demonstrations is {count!r}; give how many generated demonstrations to replay (0 or more).",
+            )
+        )
+    elif count and not problems:  # (a refused request: nothing to generate them for)
         rng = np.random.default_rng([request.seed, GENERATED_DEMO_STREAM])  # type: ignore[list-item]
-        paths += generate_demonstrations(grid, request.generated, rng)
+        paths += generate_demonstrations(grid, count, rng)
     return paths
 
 
