@@ -24,6 +24,7 @@ import sys
 import time
 from datetime import datetime
 from pathlib import Path
+from typing import cast
 
 from .._numbers import is_int
 from ._errors import LearningError
@@ -150,19 +151,20 @@ def pid_alive(pid: object, host: object = None, started: object = None) -> bool:
     ``started`` is when the record says its process started the work (ISO 8601): a live process
     with that pid that started later reused the pid after the recorded one ended.
     """
-    if not is_int(pid) or pid <= 0:  # type: ignore[operator]
+    if not is_int(pid) or cast(int, pid) <= 0:
         return False
+    pid = int(cast(int, pid))
     if not on_this_host(host):
         return True
     if pid == os.getpid():  # this process's only trainer, the page's queue, never reloads its own
         return False
     try:
-        os.kill(int(pid), 0)  # type: ignore[arg-type]
+        os.kill(pid, 0)
     except ProcessLookupError:
         return False
     except PermissionError:
         pass
-    return not _started_after(int(pid), started)  # type: ignore[arg-type]
+    return not _started_after(pid, started)
 
 
 PID_CLOCK_SLACK_SECONDS = 2.0

@@ -175,7 +175,7 @@ def _grid(request: RunRequest, problems: list[tuple[str, str]]) -> ArmGrid | Non
     problems added to ``problems``."""
     spec = dict(request.grid)
     if spec.get("goal") is not None:
-        spec["goal"] = tuple(spec["goal"])  # type: ignore[call-overload]
+        spec["goal"] = tuple(cast(Sequence[int], spec["goal"]))
     try:
         if request.goal_deg is None:
             return ArmGrid(**spec)  # type: ignore[arg-type]
@@ -191,7 +191,7 @@ def _grid(request: RunRequest, problems: list[tuple[str, str]]) -> ArmGrid | Non
                 )
             )
             return None
-        return grid_for_goal(request.goal_deg, spec.get("bins", ArmGrid.bins))  # type: ignore[arg-type]
+        return grid_for_goal(request.goal_deg, cast(int, spec.get("bins", ArmGrid.bins)))
     except ConfigError as err:
         problems += list(err.by_field.items())
     except TypeError as err:
@@ -237,9 +237,15 @@ def _grid_paths(
             )
         )
     elif count and not problems:  # (a refused request: nothing to generate them for)
-        rng = np.random.default_rng([request.seed, GENERATED_DEMO_STREAM])  # type: ignore[list-item]
+        rng = np.random.default_rng([cast(int, request.seed), GENERATED_DEMO_STREAM])
         paths += generate_demonstrations(grid, count, rng)
     return paths
+
+
+def _budget(request: RunRequest) -> tuple[int, int, int]:
+    """The request's experiments, episodes and seed, once :func:`run_problems` found them whole
+    numbers (the record checks them again)."""
+    return cast(tuple[int, int, int], (request.experiments, request.episodes, request.seed))
 
 
 def _grid_record(
@@ -256,9 +262,7 @@ def _grid_record(
     return RunRecord.for_arm_grid(
         grid,
         config,
-        request.experiments,  # type: ignore[arg-type]
-        request.episodes,  # type: ignore[arg-type]
-        request.seed,  # type: ignore[arg-type]
+        *_budget(request),
         paths,
         name=request.name,
         origin=request.origin,
@@ -319,9 +323,7 @@ def _reach_record(
             task,
             coding,
             config,
-            request.experiments,  # type: ignore[arg-type]
-            request.episodes,  # type: ignore[arg-type]
-            request.seed,  # type: ignore[arg-type]
+            *_budget(request),
             [p[:, : task.joints] for p in paths],
             name=request.name,
             origin=request.origin,

@@ -53,6 +53,7 @@ import sys
 from collections.abc import Callable
 from datetime import UTC, datetime
 from pathlib import Path
+from typing import cast
 
 import numpy as np
 
@@ -347,7 +348,7 @@ class RunFolder:
         self.cpu_seconds = float(cpu) if isinstance(cpu, int | float) and np.isfinite(cpu) else 0.0
         self.error = _text(status.get("error"))
         pid = status.get("pid")
-        self.pid = int(pid) if is_int(pid) else None  # type: ignore[call-overload]
+        self.pid = int(cast(int, pid)) if is_int(pid) else None
         host = status.get("host")
         self.host = host if isinstance(host, dict) else None
         alive = owner if owner is not None else pid_alive(self.pid, self.host, self.started)
