@@ -1,8 +1,11 @@
-"""Training runs on disk: one folder layout, one curve statistic set, one CSV layout, one figure.
+"""Training runs on disk: one folder layout, its status, its curve and its policy files.
 
 Whatever starts a run (``studio train``, ``studio reproduce``, a sweep, the page's run queue), it
 goes through :class:`RunFolder`, so every run folder reads back with :meth:`RunFolder.load` and
-the page lists, plots, watches and exports it.
+the page lists, plots, watches and exports it. What a run trains is its :class:`RunRecord`
+(``_run_record.py``, built by ``resolve_run`` in ``_run_request.py``); its statistics and
+``curves.csv`` layout are ``_curves.py``'s; the learner's thread is ``_run_train.py``'s; who owns
+a live run is ``_owner.py``'s.
 
 A run folder ``<parent>/<id>/`` holds:
 
@@ -33,7 +36,7 @@ and renamed there, so a full disk leaves no half-made run behind (:class:`Learni
 
 Use::
 
-    record = RunRecord.for_arm_grid(ArmGrid(), DynaQConfig(), 20, 100, seed=0, origin="cli")
+    record = resolve_run(RunRequest(experiments=20, episodes=100, seed=0))
     run = RunFolder.create(Path("runs"), record)   # runs/<time>-full-<hex>/
     result = run.train(workers=None)               # checkpoints, then policy + status
     again = RunFolder.load(run.path)
