@@ -29,7 +29,7 @@ import numpy as np
 from ._config import DynaQConfig
 from ._dynaq import LiveProgress, _run_experiment, run_experiments
 from ._mdp import TabularMDP
-from ._runs import TASK_ARM_GRID, TASK_ARM_REACH, TASK_KINDS
+from ._run_record import TASK_ARM_GRID, TASK_ARM_REACH, TASK_KINDS
 
 log = logging.getLogger(__name__)
 

@@ -38,9 +38,11 @@ from studio import StudioError, read_json
 
 from ._arm import ArmGrid
 from ._config import DEFAULT_EPISODES, DEFAULT_EXPERIMENTS, DEFAULT_SEED, DynaQConfig, check_budget
+from ._curves import curve_statistics, write_curves_csv
 from ._dynaq import ExperimentResult, LiveProgress, warm_up
 from ._errors import LearningError
-from ._runs import CONFIG_FILE, RunFolder, RunRecord, curve_statistics, write_curves_csv
+from ._run_record import RunRecord
+from ._runs import CONFIG_FILE, RunFolder
 
 DEMONSTRATIONS = 20
 """Demonstrated trajectories replayed by the supervised agents (paper: 20)."""

@@ -14,7 +14,7 @@ import numpy as np
 from ._arm import ArmGrid
 from ._linear_policy import TilePolicyFile
 from ._policy import PolicyFile
-from ._runs import task_spec
+from ._run_record import task_spec
 
 POLICY_SUFFIX = ".policy.npz"
 """The file suffix of policy files (the format is in :mod:`._policy`)."""

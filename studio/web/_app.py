@@ -33,6 +33,7 @@ from ._errors import (
 )
 from ._guard import GuardMiddleware, SiteRule
 from ._protocols import Scene
+from ._schemas import RUN_TASK_TAGS
 from ._settings import Settings, get_settings
 from ._state import Studio
 from .routers import (
@@ -191,7 +192,7 @@ def validation_sentence(errors: Sequence[Mapping[str, object]]) -> str:
     first = errors[0]
     where = first.get("loc", ())
     parts = where if isinstance(where, (list, tuple)) else ()
-    loc = [str(p) for p in parts if p not in ("body", "query", "path")]
+    loc = [str(p) for p in parts if p not in ("body", "query", "path", *RUN_TASK_TAGS)]
     field = ".".join(loc) or "the request body"
     message = str(first.get("msg", "is invalid")).rstrip(".")
     given = first.get("input")
@@ -200,7 +201,7 @@ def validation_sentence(errors: Sequence[Mapping[str, object]]) -> str:
         return f"{field} is missing; add it to the request."
     if kind == "extra_forbidden":
         return f"{field} is not a known field; remove it or check its spelling."
-    if kind in ("json_invalid", "model_attributes_type", "dict_type"):
+    if kind in ("json_invalid", "model_attributes_type", "dict_type", "model_type"):
         return f"The request body is not a JSON object ({message}); send a JSON object."
     shown = repr(given) if given is not None and len(repr(given)) <= 60 else "the value given"
     return f"{field} is {shown}: {message[0].lower()}{message[1:]}; fix {field} and try again."
