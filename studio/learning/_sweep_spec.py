@@ -33,7 +33,7 @@ from ._errors import ConfigError, LearningError
 from ._reach import ArmReach
 from ._reproduce import CONVERGENCE_FACTOR
 from ._run_record import TASK_ARM_GRID, TASK_ARM_REACH, RunRecord
-from ._run_request import CODING_SETTINGS, GENERATED_DEMO_STREAM, RunRequest, resolve_run
+from ._run_request import CODING_SETTINGS, RunRequest, resolve_run
 
 SWEEP_ID = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]{0,63}$")
 """A sweep id: a folder name, unique per data folder."""
@@ -299,7 +299,6 @@ def resolve_trial(
     experiments: int,
     episodes: int,
     seed: int,
-    demonstrations: np.random.Generator | None,
     *,
     name: str = "",
     group: str | None = None,
@@ -308,15 +307,12 @@ def resolve_trial(
     together), budget and seed, resolved by the code that owns each setting. This is the one
     place a sweep turns settings into a run.
 
-    Args:
-        demonstrations: draws the grid's generated demonstrations; None checks only (the goal
-            state stands in for each path, since only their count is checked).
+    The grid's generated demonstrations (``settings["demonstrations"]``) are drawn from the
+    trial's seed, as ``studio train --generated-demos N`` draws them.
 
     Raises:
         ConfigError, LearningError: a setting its owner refuses.
     """
-    count = settings.get("demonstrations", 0)
-    checking = demonstrations is None and is_int(count) and count > 0
     request = RunRequest(
         task=task,
         config=_pick(settings, CONFIG_FIELDS),
@@ -325,8 +321,7 @@ def resolve_trial(
         experiments=experiments,
         episodes=episodes,
         seed=seed,
-        # checking only: one generated path stands in for the count (its own checks still run)
-        generated=1 if checking else count,
+        generated=settings.get("demonstrations", 0),
         name=name,
         origin="sweep",
         group=group,
@@ -347,7 +342,6 @@ def trial_record(spec: SweepSpec, trial: Trial) -> RunRecord:
         spec.experiments,
         spec.episodes,
         trial.seed,
-        np.random.default_rng([trial.seed, GENERATED_DEMO_STREAM]),
         name=f"{spec.name}: {trial.label()}",
         group=spec.name,
     )
@@ -364,7 +358,7 @@ def _check(
     """Resolve the run record a trial with these settings would build, turning a refusal into a
     SweepError naming ``where``."""
     try:
-        resolve_trial(task, settings, experiments, episodes, seed, demonstrations=None)
+        resolve_trial(task, settings, experiments, episodes, seed)
     except ConfigError as err:
         raise SweepError(f"{where}: {err.problems[0]}") from None
     except LearningError as err:
