@@ -25,13 +25,11 @@ from ._config import MAX_EXPERIMENTS as MAX_EXPERIMENTS
 from ._config import PLANNERS as PLANNERS
 from ._config import DynaQConfig as DynaQConfig
 from ._config import check_budget as check_budget
-from ._dynaq import ExperimentResult as ExperimentResult
-from ._dynaq import LiveProgress as LiveProgress
-from ._dynaq import run_experiments as run_experiments
 from ._dynaq import warm_up as warm_up
 from ._errors import ConfigError as ConfigError
 from ._errors import LearningError as LearningError
 from ._errors import PolicyFileError as PolicyFileError
+from ._experiments import run_experiments as run_experiments
 from ._goal import DEFAULT_GOAL_JOINTS_DEG as DEFAULT_GOAL_JOINTS_DEG
 from ._goal import GOAL_JOINTS as GOAL_JOINTS
 from ._goal import check_goal_deg as check_goal_deg
@@ -42,6 +40,8 @@ from ._gym import ARM_REACH_ID as ARM_REACH_ID
 from ._gym import ArmGridEnv as ArmGridEnv
 from ._gym import ArmReachEnv as ArmReachEnv
 from ._gym import register as register_environments
+from ._learner import ExperimentResult as ExperimentResult
+from ._learner import LiveProgress as LiveProgress
 from ._linear import LinearResult as LinearResult
 from ._linear import greedy_rollout as greedy_rollout
 from ._linear import greedy_success as greedy_success

@@ -100,7 +100,7 @@ def measure(
     run: Callable[..., Any] | None = None,
 ) -> dict[str, Any]:
     """Learn the J-joint task for each budget and judge the greedy policies (see the module)."""
-    from ._dynaq import run_experiments
+    from ._experiments import run_experiments
 
     run = run or run_experiments
     task = ArmReach(joints=joints)

@@ -69,8 +69,9 @@ from .._files import atomic_write_text, now_iso
 from .._numbers import is_int
 from ._arm import ArmGrid
 from ._config import DEFAULT_SEED, MAX_STEPS_PER_EPISODE, DynaQConfig, check_budget
-from ._dynaq import ExperimentResult, LiveProgress, run_experiments
 from ._errors import ConfigError, LearningError
+from ._experiments import run_experiments
+from ._learner import ExperimentResult, LiveProgress
 from ._owner import OWNER_FILE, OwnerLock, owner_alive, process_started
 from ._policy import save_policy
 from ._reach import ArmReach

@@ -298,7 +298,7 @@ _MASK = (1 << 64) - 1
 
 def _python_dyna_q(mdp, config, episodes, seed, demos):
     """The kernel's algorithm in plain Python, drawing the same random numbers in the same order."""
-    from studio.learning._dynaq import experiment_seed
+    from studio.learning._learner import experiment_seed
 
     state = int(experiment_seed(seed, 0))
 

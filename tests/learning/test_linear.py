@@ -19,8 +19,8 @@ from studio.learning import (
     TileCoding,
     run_experiments,
 )
-from studio.learning._dynaq import experiment_seed
-from studio.learning._linear import _MOUNTAIN_CAR_PARAMS, mountain_car_step, reset_seed
+from studio.learning._learner import experiment_seed
+from studio.learning._linear_env import _MOUNTAIN_CAR_PARAMS, mountain_car_step, reset_seed
 
 REFERENCE = Path(__file__).resolve().parents[2] / "benchmarks" / "tiles_reference.py"
 MOUNTAIN_CAR = dict(alpha=0.5, gamma=1.0, epsilon=0.0)  # Sutton & Barto, section 10.1
