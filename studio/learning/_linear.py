@@ -34,7 +34,7 @@ priority comes up.
 Where the dynamics run. For our arm task (``TeachStudio/ArmReach-v0``) and Gymnasium's
 ``MountainCar-v0`` the whole experiment runs in one compiled kernel (:func:`_run_compiled`) that
 steps a numba twin of the environment's dynamics (:mod:`._linear_env`, which makes, checks and
-recognises the environments). Any other environment with a Box observation and Discrete actions
+recognises the environments). Every other environment with a Box observation and Discrete actions
 runs a Python loop calling ``env.step`` and the same compiled learning step (:func:`_learn`), so
 both paths give the same result bit for bit on the same task. Start states come from
 ``env.reset`` in both paths (seeded per experiment), so they agree too.
