@@ -33,13 +33,11 @@ from ._curves import curve_statistics as curve_statistics
 from ._curves import curves_csv as curves_csv
 from ._curves import downsample_curve as downsample_curve
 from ._curves import write_curves_csv as write_curves_csv
-from ._dynaq import ExperimentResult as ExperimentResult
-from ._dynaq import LiveProgress as LiveProgress
-from ._dynaq import run_experiments as run_experiments
 from ._dynaq import warm_up as warm_up
 from ._errors import ConfigError as ConfigError
 from ._errors import LearningError as LearningError
 from ._errors import PolicyFileError as PolicyFileError
+from ._experiments import run_experiments as run_experiments
 from ._goal import DEFAULT_GOAL_JOINTS_DEG as DEFAULT_GOAL_JOINTS_DEG
 from ._goal import GOAL_JOINTS as GOAL_JOINTS
 from ._goal import check_goal_deg as check_goal_deg
@@ -50,6 +48,8 @@ from ._gym import ARM_REACH_ID as ARM_REACH_ID
 from ._gym import ArmGridEnv as ArmGridEnv
 from ._gym import ArmReachEnv as ArmReachEnv
 from ._gym import register as register_environments
+from ._learner import ExperimentResult as ExperimentResult
+from ._learner import LiveProgress as LiveProgress
 from ._linear import LinearResult as LinearResult
 from ._linear import greedy_rollout as greedy_rollout
 from ._linear import greedy_success as greedy_success

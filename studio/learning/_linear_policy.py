@@ -36,7 +36,6 @@ import json
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
@@ -99,7 +98,7 @@ class TilePolicyFile:
         """Actions of the environment."""
         return int(self.weights.shape[1])
 
-    def header(self) -> dict[str, Any]:
+    def header(self) -> dict[str, object]:
         """The JSON header written to the file."""
         coder = self.coder
         return {
@@ -213,7 +212,7 @@ def load_tile_policy(path: str | Path) -> TilePolicyFile:
     )
 
 
-def _read_header(archive: BoundedNpz, name: str) -> Any:
+def _read_header(archive: BoundedNpz, name: str) -> object:
     if "header" not in archive.files:
         raise PolicyFileError(
             f"{name} lacks its header; it is not a Teach Studio policy file, export one again."
@@ -228,7 +227,7 @@ def _read_header(archive: BoundedNpz, name: str) -> Any:
         raise PolicyFileError(str(err)) from None
 
 
-def _check_header(name: str, header: Any) -> tuple[TileCoder, DynaQConfig, ArmReach | None, int]:
+def _check_header(name: str, header: object) -> tuple[TileCoder, DynaQConfig, ArmReach | None, int]:
     if not isinstance(header, dict) or header.get("format") != FORMAT_NAME:
         raise PolicyFileError(
             f"{name} is not a tile-coded Teach Studio policy file; export the policy again."

@@ -16,8 +16,9 @@ from collections.abc import Callable
 
 import numpy as np
 
-from ._dynaq import ExperimentResult, LiveProgress, run_experiments
 from ._errors import LearningError
+from ._experiments import run_experiments
+from ._learner import ExperimentResult, LiveProgress
 from ._prepare import prepare_learner
 from ._run_record import TASK_ARM_REACH, RunRecord
 

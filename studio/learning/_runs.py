@@ -66,8 +66,8 @@ from .._files import atomic_write_text, now_iso
 from .._numbers import is_int
 from ._config import MAX_STEPS_PER_EPISODE, check_budget
 from ._curves import curve_statistics, curves_csv
-from ._dynaq import ExperimentResult, LiveProgress
 from ._errors import ConfigError, LearningError
+from ._learner import ExperimentResult, LiveProgress
 from ._owner import OWNER_FILE, OwnerLock, owner_alive, pid_alive, this_host
 from ._policy import save_policy
 from ._run_record import TASK_ARM_REACH, RunRecord
