@@ -56,6 +56,11 @@ class SceneLayout:
         operator_position: floor point (x, y) under the middle of the operator's body (m).
         operator_yaw: the operator's heading about +Z (rad); pi faces the robot at the origin.
         rate_hz: most scene pushes per second (latest values win in between).
+        slow_live_s: a live stream whose poses come this far apart or more (pose estimation
+            without a GPU) is slow: viser's page redraws for a quarter of a second after each
+            push, so each of its poses would cost the browser a burst of redraws in the very
+            process that runs the pose model, slowing it by a third.
+        slow_live_rate_hz: most pushes per second of a slow live stream (latest wins).
         floor_half_size: the floor plate reaches this far from its centre (m).
         floor_cell: spacing of the floor's grid lines (m).
         playback_hold_s: how long the robot keeps the last pose of a finished playback before
@@ -74,6 +79,8 @@ class SceneLayout:
     operator_position: tuple[float, float] = (1.75, 0.0)
     operator_yaw: float = float(np.pi)
     rate_hz: float = 60.0
+    slow_live_s: float = 0.2
+    slow_live_rate_hz: float = 1.0
     floor_half_size: float = 1.6
     floor_cell: float = 0.25
     playback_hold_s: float = 5.0
@@ -283,6 +290,8 @@ class StudioScene:
         self._lock = threading.Lock()
         self._live: tuple[np.ndarray, np.ndarray, np.ndarray | None] | None = None
         self._live_version = 0
+        self._live_at = -np.inf  # when the latest live pose came, and the gap before it
+        self._live_gap = np.inf
         self._playback: Playback | None = None
         # Published by the loop (under _lock) for readers.
         self._q_robot_shown = np.array(self.robot.qz, dtype=float)
@@ -596,7 +605,15 @@ class StudioScene:
     def _tick(self, now: float, shown: _Shown) -> None:
         with self._lock:
             live, version, playback = self._live, self._live_version, self._playback
-            operator = self._operator
+            operator, slow = self._operator, self._live_gap >= self.layout.slow_live_s
+        if (
+            slow
+            and now - shown.live_at < 1.0 / self.layout.slow_live_rate_hz
+            and playback is None
+            and shown.playback is None
+            and operator.version == shown.operator_version
+        ):
+            return  # a slow stream's newer pose waits for its turn (latest wins)
         pose = pose_at(
             now, None if live is None else live[1], playback, self.layout.playback_hold_s
         )
@@ -632,6 +649,8 @@ class StudioScene:
         # Send now rather than at viser's next message window (up to 1/60 s later): the pose
         # is what the operator is waiting to see.
         self.server.flush()
+        if new_live:
+            shown.live_at = now
         shown.live_version = version
         shown.operator_version = operator.version
         shown.playback = playback
@@ -671,9 +690,11 @@ class StudioScene:
             np.array(q_robot, dtype=float),
             None if tape_positions is None else np.array(tape_positions, dtype=float),
         )
+        now = time.perf_counter()
         with self._lock:
             self._live = value
             self._live_version += 1
+            self._live_gap, self._live_at = now - self._live_at, now
         self._wake.set()
 
     def set_side(self, side: str) -> None:
@@ -879,6 +900,7 @@ class _Shown:
     """What the scene thread pushed last (its own bookkeeping; no other thread touches it)."""
 
     live_version: int = 0
+    live_at: float = -np.inf
     operator_version: int = 0
     q_robot: np.ndarray | None = None
     playback: Playback | None = None
