@@ -56,10 +56,10 @@ class SceneLayout:
         operator_position: floor point (x, y) under the middle of the operator's body (m).
         operator_yaw: the operator's heading about +Z (rad); pi faces the robot at the origin.
         rate_hz: most scene pushes per second (latest values win in between).
-        slow_live_s: a live stream whose poses come this far apart or more (pose estimation
-            without a GPU) is slow: viser's page redraws for a quarter of a second after each
-            push, so each of its poses would cost the browser a burst of redraws in the very
-            process that runs the pose model, slowing it by a third.
+        slow_live_s: a live stream whose poses come this far apart or more on average (pose
+            estimation without a GPU) is slow: viser's page redraws for a quarter of a second
+            after each push, so each of its poses would cost the browser a burst of redraws in
+            the very process that runs the pose model, slowing it by a third.
         slow_live_rate_hz: most pushes per second of a slow live stream (latest wins).
         floor_half_size: the floor plate reaches this far from its centre (m).
         floor_cell: spacing of the floor's grid lines (m).
@@ -290,8 +290,8 @@ class StudioScene:
         self._lock = threading.Lock()
         self._live: tuple[np.ndarray, np.ndarray, np.ndarray | None] | None = None
         self._live_version = 0
-        self._live_at = -np.inf  # when the latest live pose came, and the gap before it
-        self._live_gap = np.inf
+        self._live_at = -np.inf  # when the latest live pose came
+        self._live_gap = np.inf  # the gap between live poses, smoothed (s)
         self._playback: Playback | None = None
         # Published by the loop (under _lock) for readers.
         self._q_robot_shown = np.array(self.robot.qz, dtype=float)
@@ -694,7 +694,9 @@ class StudioScene:
         with self._lock:
             self._live = value
             self._live_version += 1
-            self._live_gap, self._live_at = now - self._live_at, now
+            gap = min(now - self._live_at, 1.0)  # a pause counts as one slow gap, not more
+            smooth = self._live_gap + 0.25 * (gap - self._live_gap)
+            self._live_gap, self._live_at = smooth if np.isfinite(smooth) else gap, now
         self._wake.set()
 
     def set_side(self, side: str) -> None:

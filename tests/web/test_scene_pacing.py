@@ -33,14 +33,16 @@ def scene():
     server.stop()
 
 
-def _stream(scene: StudioScene, count: int, gap_s: float) -> tuple[int, float, np.ndarray]:
-    """Send ``count`` distinct live poses ``gap_s`` apart; the pushes made meanwhile, the time
-    it took and the last robot pose sent."""
+def _stream(
+    scene: StudioScene, count: int, gap_s: float, jitter_s: float = 0.0
+) -> tuple[int, float, np.ndarray]:
+    """Send ``count`` distinct live poses ``gap_s`` apart on average (``gap_s`` -+ ``jitter_s``
+    in turn); the pushes made meanwhile, the time it took and the last robot pose sent."""
     start, t0 = scene.pushes, time.perf_counter()
     for i in range(count):
         q_robot = np.full(6, 1e-3 * (i + 1) + 0.1 * gap_s)
         scene.update_live(np.zeros(7), q_robot, None)
-        time.sleep(gap_s)
+        time.sleep(gap_s + (jitter_s if i % 2 else -jitter_s))
     return scene.pushes - start, time.perf_counter() - t0, q_robot
 
 
@@ -48,6 +50,14 @@ def test_a_slow_stream_reaches_the_scene_at_its_rate_and_latest_wins(scene):
     pushed, took, last = _stream(scene, count=25, gap_s=0.06)
     allowed = took * SLOW["slow_live_rate_hz"] + 1
     assert 1 <= pushed <= allowed, f"{pushed} pushes of 25 poses in {took:.2f} s"
+    assert wait_for(lambda: np.allclose(scene.current_q_robot(), last))
+
+
+def test_a_slow_stream_with_jitter_is_still_slow(scene):
+    """Poses 0.01 and 0.11 s apart in turn (a loaded machine): slow on average, so paced."""
+    pushed, took, last = _stream(scene, count=30, gap_s=0.06, jitter_s=0.05)
+    allowed = took * SLOW["slow_live_rate_hz"] + 1
+    assert 1 <= pushed <= allowed, f"{pushed} pushes of 30 poses in {took:.2f} s"
     assert wait_for(lambda: np.allclose(scene.current_q_robot(), last))
 
 
