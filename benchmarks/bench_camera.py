@@ -22,6 +22,11 @@ index.
    after a result), so without a GPU the answer comes later than the scene.
 3. The API while it runs: ``GET /api/source`` and ``GET /api/runs`` latencies, p50 and p99 (goal:
    p99 < 250 ms).
+4. The scene's pushes for a camera at the bare package's rate on an idle machine without a GPU
+   (3.5 frames/s, lite), landmarks of a known arm motion posted straight to the studio (no
+   browser, so the figure does not depend on the machine's load): how many robot poses a second
+   reach a viser client. viser's page redraws for a quarter of a second after each, in the
+   browser's software-GL process that also runs the pose model.
 
 On a 2-core machine without a GPU the model runs at a few frames a second and figures swing with
 other work on the machine: read the ratios of neighbouring windows, and rerun.
@@ -243,6 +248,32 @@ def scene_latencies(
     return out, missed
 
 
+VISER_SETTLE_S = 0.25
+"""How long viser's page (1.1) keeps redrawing after each update it receives (RENDER_SETTLE_MS)."""
+FED_RATE_HZ = 3.5
+"""The lite model's rate in a bare page on an idle 2-core machine with software WebGL."""
+
+
+def fed_scene_rate(base: str, scene: SceneWatch, seconds: float) -> tuple[float, float]:
+    """Post landmarks at :data:`FED_RATE_HZ` for ``seconds``; (frames, scene pushes) per second."""
+    from studio.kinematics import HumanArm, arm_motion, landmarks_from_arm
+
+    arm = HumanArm("right")
+    http("PUT", base + "/api/source", {"kind": "camera", "side": "right"})
+    before, sent = len(scene.arrivals), 0
+    t0 = time.perf_counter()
+    while (elapsed := time.perf_counter() - t0) < seconds:
+        world, image = landmarks_from_arm(arm_motion(elapsed, arm), arm)
+        body = {"t": elapsed, "world": world.tolist(), "image": image.tolist()}
+        http("POST", base + "/api/source/landmarks", {**body, "width": 640, "height": 480})
+        sent += 1
+        time.sleep(max(0.0, t0 + sent / FED_RATE_HZ - time.perf_counter()))
+    took = time.perf_counter() - t0
+    time.sleep(1.5)  # the last pose's push
+    http("PUT", base + "/api/source", IDLE_SOURCE)
+    return sent / took, (len(scene.arrivals) - before) / took
+
+
 def bare_window(bare: Any, frames: int, timeout_s: float) -> float:
     return window(
         bare,
@@ -260,6 +291,7 @@ def main() -> int:
     parser.add_argument("--pairs", type=int, default=2, help="bare/studio window pairs per model")
     parser.add_argument("--models", default="lite,full", help="models to time, comma-separated")
     parser.add_argument("--timeout", type=float, default=600.0, help="seconds a window may take")
+    parser.add_argument("--fed", type=float, default=20.0, help="seconds of posted landmarks")
     args = parser.parse_args()
 
     from playwright.sync_api import sync_playwright
@@ -276,6 +308,7 @@ def main() -> int:
         "--use-fake-device-for-media-stream",
         f"--use-file-for-fake-video-capture={clip}",
     ]
+    fed = fed_scene_rate(base, scene, args.fed)
     results: dict[str, dict[str, list[float]]] = {}
     latency: dict[str, list[float]] = {"landmarks": [], "scene": [], "answer": []}
     missed = 0
@@ -300,7 +333,7 @@ def main() -> int:
             page.select_option("[data-testid='source-kind']", "camera")  # shows its controls
             http("PUT", base + "/api/source", IDLE_SOURCE)
             probe.on.set()  # the API is probed beside both sides alike
-            for model in args.models.split(","):
+            for model in [m for m in args.models.split(",") if m]:
                 results[model] = {"bare": [], "studio": []}
                 bare.evaluate(f"() => setModel('{model}')")
                 page.select_option("[data-testid='camera-model']", model)
@@ -376,6 +409,11 @@ def main() -> int:
     print(
         f"  the still studio sent its scene {idle_n} message batches in {idle_s:.0f} s "
         "(the bare windows; viser's page itself redraws once a second when idle)"
+    )
+    print(
+        f"\nScene pushes for a camera at {fed[0]:.1f} frames/s (landmarks posted, no browser): "
+        f"{fed[1]:.1f} robot poses/s reach the scene; viser's page redraws about "
+        f"{min(1.0, fed[1] * VISER_SETTLE_S):.0%} of the time for them"
     )
     api_ms = [v * 1000 for v in probe.latencies]
     p99 = pct(api_ms, 99)
