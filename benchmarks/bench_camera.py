@@ -260,14 +260,18 @@ def fed_scene_rate(base: str, scene: SceneWatch, seconds: float) -> tuple[float,
 
     arm = HumanArm("right")
     http("PUT", base + "/api/source", {"kind": "camera", "side": "right"})
+    time.sleep(1.0)  # the previous source's last pushes (the simulator streams at start)
     before, sent = len(scene.arrivals), 0
-    t0 = time.perf_counter()
+    t0 = due = time.perf_counter()
     while (elapsed := time.perf_counter() - t0) < seconds:
         world, image = landmarks_from_arm(arm_motion(elapsed, arm), arm)
         body = {"t": elapsed, "world": world.tolist(), "image": image.tolist()}
         http("POST", base + "/api/source/landmarks", {**body, "width": 640, "height": 480})
         sent += 1
-        time.sleep(max(0.0, t0 + sent / FED_RATE_HZ - time.perf_counter()))
+        # The next frame a period later, never sooner: a late one is not caught up in a burst
+        # (the page sends the newest frame only).
+        due = max(due + 1 / FED_RATE_HZ, time.perf_counter())
+        time.sleep(max(0.0, due - time.perf_counter()))
     took = time.perf_counter() - t0
     time.sleep(1.5)  # the last pose's push
     http("PUT", base + "/api/source", IDLE_SOURCE)
