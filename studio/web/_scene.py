@@ -148,6 +148,8 @@ class StudioScene:
         self._lock = threading.Lock()
         self._live: _Live | None = None
         self._live_version = 0
+        self._live_at = -np.inf  # when the latest live pose came
+        self._live_gap = np.inf  # the gap between live poses, smoothed (s)
         self._playback: Playback | None = None
         # Published by the loop (under _lock) for readers.
         self._q_robot_shown = np.array(self.robot.qz, dtype=float)
@@ -430,7 +432,15 @@ class StudioScene:
     def _tick(self, now: float, shown: _Shown) -> None:
         with self._lock:
             live, version, playback = self._live, self._live_version, self._playback
-            operator = self._operator
+            operator, slow = self._operator, self._live_gap >= self.layout.slow_live_s
+        if (
+            slow
+            and now - shown.live_at < 1.0 / self.layout.slow_live_rate_hz
+            and playback is None
+            and shown.playback is None
+            and operator.version == shown.operator_version
+        ):
+            return  # a slow stream's newer pose waits for its turn (latest wins)
         if live is not None and live.version != operator.version:
             live = None  # posed for the arm taped before a switch
         pose = pose_at(
@@ -468,6 +478,8 @@ class StudioScene:
         # Send now rather than at viser's next message window (up to 1/60 s later): the pose
         # is what the operator is waiting to see.
         self.server.flush()
+        if new_live:
+            shown.live_at = now
         shown.live_version = version
         shown.operator_version = operator.version
         shown.playback = playback
@@ -501,12 +513,16 @@ class StudioScene:
             np.array(pose.q_robot, dtype=float),
             None if pose.tape is None else np.array(pose.tape, dtype=float),
         )
+        now = time.perf_counter()
         with self._lock:
             operator = self._operator
         posed = pose_body(operator.body, pose.q_human, pose.tape, self.layout.tape_lift_m)
         with self._lock:
             self._live = _Live(pose, posed, operator.version)
             self._live_version += 1
+            gap = min(now - self._live_at, 1.0)  # a pause counts as one slow gap, not more
+            smooth = self._live_gap + 0.25 * (gap - self._live_gap)
+            self._live_gap, self._live_at = smooth if np.isfinite(smooth) else gap, now
         self._wake.set()
 
     def update_live(
@@ -718,6 +734,7 @@ class _Shown:
     """What the scene thread pushed last (its own bookkeeping; no other thread touches it)."""
 
     live_version: int = 0
+    live_at: float = -np.inf
     operator_version: int = 0
     q_robot: np.ndarray | None = None
     playback: Playback | None = None

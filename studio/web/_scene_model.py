@@ -24,6 +24,11 @@ class SceneLayout:
         operator_position: floor point (x, y) under the middle of the operator's body (m).
         operator_yaw: the operator's heading about +Z (rad); pi faces the robot at the origin.
         rate_hz: most scene pushes per second (latest values win in between).
+        slow_live_s: a live stream whose poses come this far apart or more on average (pose
+            estimation without a GPU) is slow: viser's page redraws for a quarter of a second
+            after each push, so each of its poses would cost the browser a burst of redraws in
+            the very process that runs the pose model, slowing it by a third.
+        slow_live_rate_hz: most pushes per second of a slow live stream (latest wins).
         floor_half_size: the floor plate reaches this far from its centre (m).
         floor_cell: spacing of the floor's grid lines (m).
         playback_hold_s: how long the robot keeps the last pose of a finished playback before
@@ -42,6 +47,8 @@ class SceneLayout:
     operator_position: tuple[float, float] = (1.75, 0.0)
     operator_yaw: float = float(np.pi)
     rate_hz: float = 60.0
+    slow_live_s: float = 0.2
+    slow_live_rate_hz: float = 1.0
     floor_half_size: float = 1.6
     floor_cell: float = 0.25
     playback_hold_s: float = 5.0
