@@ -149,7 +149,7 @@ def ldlj(times: np.ndarray, q: np.ndarray) -> float:
     q = np.asarray(q, dtype=np.float64)
     q = q[:, None] if q.ndim == 1 else q
     t = _times(times, q.shape[0])
-    if q.shape[0] < 4:
+    if q.shape[0] < 4 or not np.any(np.diff(q, axis=0)):
         return math.nan
     velocity = np.gradient(q, t, axis=0)
     v_peak = float(np.linalg.norm(velocity, axis=1).max())
