@@ -83,6 +83,7 @@ from ._policy import load_policy as load_policy
 from ._policy import rollout as rollout
 from ._policy import save_policy as save_policy
 from ._policy import save_trajectory_csv as save_trajectory_csv
+from ._policy_likeness import policy_likeness_card as policy_likeness_card
 from ._prepare import PREPARE_SECONDS as PREPARE_SECONDS
 from ._prepare import learner_ready as learner_ready
 from ._prepare import prepare_in_background as prepare_in_background

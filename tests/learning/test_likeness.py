@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -181,3 +182,39 @@ def test_bad_input_gets_one_sentence():
     bad[3, 1] = np.nan
     with pytest.raises(LearningError, match="finite"):
         dtw_distance(bad, q)
+
+
+def test_every_policy_kind_gets_a_card_from_the_demonstrations_start(tmp_path):
+    from studio.capture import load_demonstration
+    from studio.learning import (
+        ArmReach,
+        DynaQConfig,
+        TilePolicyFile,
+        fit_dmp_policy,
+        load_policy,
+        policy_likeness_card,
+        save_policy,
+    )
+    from studio.samples import __file__ as samples
+
+    demo = load_demonstration(Path(samples).parent / "sample-reach-2.demo.json")
+    grid = demo.arm_grid()
+    q_table = np.zeros((grid.n_states, grid.n_actions))
+    save_policy(tmp_path / "grid.policy.npz", grid, q_table, DynaQConfig())
+    task = ArmReach(joints=3)
+    coding = task.features(tilings=2, tiles=4)
+    coder = coding.bind(task.lower, task.upper)
+    tile = TilePolicyFile(
+        coder=coder, weights=np.zeros((coder.size, task.n_actions)), config=DynaQConfig(), task=task
+    )
+    dmp = fit_dmp_policy(demo.times, demo.q_robot, learned_joints=3)
+    for policy in (load_policy(tmp_path / "grid.policy.npz"), tile, dmp):
+        card = policy_likeness_card(policy, demo.times, demo.q_robot)
+        assert len(card.policy.joint_shares) == 3 == len(card.demonstration.joint_shares)
+        assert card.demonstration.duration_s == pytest.approx(demo.times[-1] - demo.times[0])
+        assert math.isfinite(card.dtw_rad) and math.isfinite(card.frechet_m)
+    # the primitive is far more like its demonstration than an untrained tile policy
+    assert policy_likeness_card(dmp, demo.times, demo.q_robot).dtw_rad < 0.02
+    assert policy_likeness_card(tile, demo.times, demo.q_robot).dtw_rad > 0.1
+    with pytest.raises(LearningError, match=r"\(N, 6\)"):
+        policy_likeness_card(dmp, demo.times, demo.q_robot[:, :3])
