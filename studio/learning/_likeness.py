@@ -45,30 +45,34 @@ ToolPositions = Callable[[np.ndarray], np.ndarray]
 
 @njit(cache=True, nogil=True)
 def _dtw(a: np.ndarray, b: np.ndarray) -> tuple[float, int]:  # pragma: no cover - numba
-    """Total cost of the optimal warping and the number of pairs on it."""
+    """Total cost of the optimal warping and the number of pairs on it (two rows of memory)."""
     n, m = a.shape[0], b.shape[0]
-    cost = np.full((n + 1, m + 1), np.inf)
-    length = np.zeros((n + 1, m + 1), np.int64)
-    cost[0, 0] = 0.0
+    cost, prev_cost = np.full(m + 1, np.inf), np.full(m + 1, np.inf)
+    length, prev_length = np.zeros(m + 1, np.int64), np.zeros(m + 1, np.int64)
+    prev_cost[0] = 0.0
     for i in range(1, n + 1):
+        cost[0] = np.inf
         for j in range(1, m + 1):
             d = 0.0
             for k in range(a.shape[1]):
                 d += (a[i - 1, k] - b[j - 1, k]) ** 2
-            best, steps = cost[i - 1, j - 1], length[i - 1, j - 1]
-            if cost[i - 1, j] < best:
-                best, steps = cost[i - 1, j], length[i - 1, j]
-            if cost[i, j - 1] < best:
-                best, steps = cost[i, j - 1], length[i, j - 1]
-            cost[i, j] = best + math.sqrt(d)
-            length[i, j] = steps + 1
-    return cost[n, m], length[n, m]
+            best, steps = prev_cost[j - 1], prev_length[j - 1]
+            if prev_cost[j] < best:
+                best, steps = prev_cost[j], prev_length[j]
+            if cost[j - 1] < best:
+                best, steps = cost[j - 1], length[j - 1]
+            cost[j] = best + math.sqrt(d)
+            length[j] = steps + 1
+        cost, prev_cost = prev_cost, cost
+        length, prev_length = prev_length, length
+    return prev_cost[m], prev_length[m]
 
 
 @njit(cache=True, nogil=True)
 def _frechet(a: np.ndarray, b: np.ndarray) -> float:  # pragma: no cover - numba
+    """Eiter & Mannila's coupling recursion, two rows of memory."""
     n, m = a.shape[0], b.shape[0]
-    ca = np.empty((n, m))
+    row, prev = np.empty(m), np.empty(m)
     for i in range(n):
         for j in range(m):
             d = 0.0
@@ -76,14 +80,15 @@ def _frechet(a: np.ndarray, b: np.ndarray) -> float:  # pragma: no cover - numba
                 d += (a[i, k] - b[j, k]) ** 2
             d = math.sqrt(d)
             if i == 0 and j == 0:
-                ca[i, j] = d
+                row[j] = d
             elif i == 0:
-                ca[i, j] = max(ca[i, j - 1], d)
+                row[j] = max(row[j - 1], d)
             elif j == 0:
-                ca[i, j] = max(ca[i - 1, j], d)
+                row[j] = max(prev[j], d)
             else:
-                ca[i, j] = max(min(ca[i - 1, j], ca[i - 1, j - 1], ca[i, j - 1]), d)
-    return ca[n - 1, m - 1]
+                row[j] = max(min(prev[j], prev[j - 1], row[j - 1]), d)
+        row, prev = prev, row
+    return prev[m - 1]
 
 
 def _paths(a: np.ndarray, b: np.ndarray, what: str) -> tuple[np.ndarray, np.ndarray]:

@@ -93,6 +93,29 @@ def test_frechet_bounds_dtw_and_endpoints(n, m, seed):
     assert frechet_distance(b, a) == pytest.approx(d)
 
 
+def reference_dtw(a: np.ndarray, b: np.ndarray) -> float:
+    """Every monotone alignment's total and length by plain recursion over the full table."""
+    n, m = len(a), len(b)
+    best: dict[tuple[int, int], tuple[float, int]] = {(0, 0): (np.linalg.norm(a[0] - b[0]), 1)}
+    for i in range(n):
+        for j in range(m):
+            if (i, j) == (0, 0):
+                continue
+            before = [best[p] for p in ((i - 1, j - 1), (i - 1, j), (i, j - 1)) if min(p) >= 0]
+            total, steps = min(before, key=lambda x: x[0])
+            best[i, j] = (total + np.linalg.norm(a[i] - b[j]), steps + 1)
+    total, steps = best[n - 1, m - 1]
+    return total / steps
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.integers(1, 9), st.integers(1, 9), st.integers(0, 10_000))
+def test_dtw_matches_the_full_table_recursion(n, m, seed):
+    rng = np.random.default_rng(seed)
+    a, b = rng.normal(size=(n, 2)), rng.normal(size=(m, 2))
+    assert dtw_distance(a, b) == pytest.approx(reference_dtw(a, b))
+
+
 def test_js_divergence_exact_small_cases():
     assert js_divergence([1, 0], [0, 1]) == pytest.approx(1.0)
     assert js_divergence([0.3, 0.7], [0.3, 0.7]) == 0.0
