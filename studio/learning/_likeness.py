@@ -10,7 +10,8 @@ it, each computed for the policy and, beside it, for the demonstration itself:
 - **Discrete Fréchet distance** of the tool paths (m; Eiter & Mannila 1994): the shortest leash
   that lets a walker on each path reach its end, neither going back.
 - **LDLJ**, the log dimensionless jerk (Balasubramanian, Melendez-Calderon, Roby-Brami & Burdet,
-  J NeuroEng Rehabil 2015), on the *joint-space speed* ``|dq/dt|``:
+  J NeuroEng Rehabil 2015), in its velocity form, on the *joint-space* velocity ``dq/dt``
+  (``v_peak`` the peak of its norm; the paper's vector form, with joints in place of the hand):
   ``-ln((t2 - t1)^3 / v_peak^2 * integral |d^3 q / dt^3|^2 dt)``. Higher (less negative) is
   smoother; it does not depend on the motion's amplitude or duration.
 - **Joint shares**: each joint's travel ``sum |dq_j|`` over the total, compared with the
@@ -142,7 +143,7 @@ def _times(times: np.ndarray, n: int) -> np.ndarray:
 
 
 def ldlj(times: np.ndarray, q: np.ndarray) -> float:
-    """Log dimensionless jerk of the joint-space speed (Balasubramanian et al. 2015).
+    """Log dimensionless jerk of the joint-space velocity (Balasubramanian et al. 2015).
 
     ``-ln((t2 - t1)^3 / v_peak^2 * integral |q'''(t)|^2 dt)``, with derivatives taken by
     second-order finite differences on the sample times.
@@ -224,7 +225,7 @@ class MotionFigures:
     """One motion's own figures: the columns of a :class:`LikenessCard`.
 
     Attributes:
-        ldlj: log dimensionless jerk of the joint-space speed (higher is smoother).
+        ldlj: log dimensionless jerk of the joint-space velocity (higher is smoother).
         joint_shares: each joint's share of the total joint travel.
         together: share of the moving time in which two or more joints move.
         duration_s: seconds from the first sample to the last.
