@@ -13,11 +13,14 @@ from studio.learning import (
     ROLLOUT_SECONDS_PER_STEP,
     TILE_ROLLOUT_MAX_STEPS,
     TILE_ROLLOUT_SECONDS_PER_STEP,
+    DmpPolicyFile,
     LearningError,
     TilePolicyFile,
+    dmp_likeness_card,
     greedy_path,
     load_any_policy,
     rollout,
+    rollout_dmp_policy,
     rollout_tile_policy,
     save_trajectory_csv,
 )
@@ -110,10 +113,40 @@ def _run_tile(args: argparse.Namespace, policy: TilePolicyFile) -> int:
     return 0
 
 
+def _run_dmp(args: argparse.Namespace, policy: DmpPolicyFile) -> int:
+    """Roll a movement primitive out from --start-deg (default: its demonstration's start) and
+    print its likeness card (from the demonstration's start) beside the demonstration's."""
+    if args.start_state is not None:
+        raise LearningError(
+            "--start-state numbers grid states; a movement primitive starts from --start-deg angles."
+        )
+    start = (
+        None
+        if args.start_deg is None
+        else np.radians(_start_degrees(args.start_deg, len(policy.goal)))
+    )
+    times, q, reached = rollout_dmp_policy(policy, start, rate_hz=args.rate)
+    out = _out_path(args)
+    try:
+        save_trajectory_csv(out, times, q)
+    except OSError as err:
+        raise LearningError(f"Cannot write {out} ({err.strerror}); choose another --out.") from None
+    print(
+        f"the movement primitive {'reaches the goal' if reached else 'does NOT reach the goal'} in {times[-1]:.2f} s; "
+        f"wrote {len(times)} samples at {args.rate:g} Hz to {out}"
+    )
+    print(
+        f"likeness to its demonstration, from the demonstration's start:\n{dmp_likeness_card(policy, args.rate).text()}"
+    )
+    return 0
+
+
 def run(args: argparse.Namespace) -> int:
     policy = load_any_policy(args.policy)
     if isinstance(policy, TilePolicyFile):
         return _run_tile(args, policy)
+    if isinstance(policy, DmpPolicyFile):
+        return _run_dmp(args, policy)
     if args.max_steps is None:
         args.max_steps = ROLLOUT_MAX_STEPS
     if args.seconds_per_step is None:

@@ -42,6 +42,8 @@ import numpy as np
 from studio import JSONFileError, loads_json
 
 from ._config import DynaQConfig
+from ._dmp_policy import FORMAT_NAME as DMP_FORMAT_NAME
+from ._dmp_policy import DmpPolicyFile, load_dmp_policy
 from ._errors import LearningError, PolicyFileError
 from ._linear import LinearResult, greedy_rollout
 from ._policy import (
@@ -261,8 +263,9 @@ def _check_header(name: str, header: object) -> tuple[TileCoder, DynaQConfig, Ar
     return coder, config, task, n_actions
 
 
-def load_any_policy(path: str | Path) -> PolicyFile | TilePolicyFile:
-    """Read a policy file of either kind: tabular (:func:`load_policy`) or tile-coded.
+def load_any_policy(path: str | Path) -> PolicyFile | TilePolicyFile | DmpPolicyFile:
+    """Read a policy file of any kind: tabular (:func:`load_policy`), tile-coded, or a
+    movement primitive (:func:`load_dmp_policy`).
 
     Raises:
         PolicyFileError: as the two readers do.
@@ -279,6 +282,8 @@ def load_any_policy(path: str | Path) -> PolicyFile | TilePolicyFile:
         return load_tile_policy(path)
     if kind == TABULAR_FORMAT_NAME:
         return load_policy(path)
+    if kind == DMP_FORMAT_NAME:
+        return load_dmp_policy(path)
     raise PolicyFileError(
         f"{path.name} is not a Teach Studio policy file; export the policy again."
     )
