@@ -89,6 +89,10 @@ class RetargetConfig:
         max_joint_step: largest change of any joint of such a robot from one frame to the next
             (rad): a target that moves the IK's answer further (a wrist flip, a jump back into
             reach) is followed over several frames, never in one.
+        clearance: such a robot's links keep at least this distance from each other (m); a
+            pose closer than that is not taken (the last one is held). Convex-hull distances
+            near contact vary by about a millimetre between evaluations, so the margin keeps
+            every pose taken clear of contact for any later check.
     """
 
     reach_fraction: float = 0.95
@@ -96,6 +100,7 @@ class RetargetConfig:
     floor_height: float = 0.05
     floor_softness: float = 0.05
     max_joint_step: float = math.radians(4.5)
+    clearance: float = 0.005
 
     def __post_init__(self) -> None:
         positive_number(self.reach_fraction, "RetargetConfig.reach_fraction")
@@ -103,6 +108,7 @@ class RetargetConfig:
         positive_number(self.floor_height, "RetargetConfig.floor_height")
         positive_number(self.floor_softness, "RetargetConfig.floor_softness")
         positive_number(self.max_joint_step, "RetargetConfig.max_joint_step")
+        positive_number(self.clearance, "RetargetConfig.clearance")
 
 
 def _soft_floor(z: float, floor: float, width: float) -> float:
@@ -278,7 +284,7 @@ class Retargeter:
             if self._q_prev is not None:
                 step = self.config.max_joint_step
                 q = self._q_prev + np.clip(q - self._q_prev, -step, step)
-            if robot.checks_collisions and robot.self_collisions(q):
+            if robot.checks_collisions and robot.self_collisions(q, self.config.clearance):
                 # hold the last pose free of self-collision (the robot's home before the first)
                 q = robot.home if self._q_prev is None else self._q_prev
         self._q_prev = q.copy()

@@ -495,7 +495,10 @@ class RobotArm:
         arr = self.check_q(q)
         if self._collision_data is None:
             return []
-        geom, gdata = self.collision_model, self._collision_data
+        # Fresh scratch data for every query: coal warm-starts each pair's GJK from its previous
+        # answer, and near contact that made the same pose read clear once and touching the next.
+        geom = self.collision_model
+        gdata = pin.GeometryData(geom)
         pin.computeDistances(self.model, self.data, geom, gdata, arr)
         found = []
         for k, pair in enumerate(geom.collisionPairs):
