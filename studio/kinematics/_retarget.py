@@ -27,9 +27,14 @@ already describe the mirror image). Humeral rotation (shoulder_Y) has no Puma co
 dropped; :meth:`Retargeter.human_from_robot` sets it to zero.
 
 *cartesian* - the hand-centre pose relative to the shoulder is mirrored, scaled by the ratio of
-the robot's reach to the arm's (times ``reach_fraction``), placed at the Puma's shoulder and
-solved by :meth:`Puma560.inverse`, warm-started from the previous solution; when the full pose is
-out of reach of the Puma's wrist, the position alone is solved.
+the robot's reach to the arm's (times ``reach_fraction``), placed at the robot's shoulder and
+solved by the robot's IK, warm-started from the previous solution; when the full pose is out of
+reach of the wrist, the position alone is solved.
+
+Any robot of :func:`load_robot` (a :class:`RobotArm`) is driven in cartesian mode, the only one
+that means something for an arm whose joints are not the human arm's; on a redundant arm (Panda,
+xArm7) the IK's null-space task keeps the robot's elbow at the operator's elbow, mirrored and
+scaled like the hand. Joint mode is the Puma560's alone.
 """
 
 from __future__ import annotations
@@ -44,6 +49,7 @@ from ._checks import instance_of, positive_number, whole_number
 from ._errors import KinematicsError
 from ._human import SAGITTAL_MIRROR, HumanArm, _as_q
 from ._puma import IKConfig, IKResult, Puma560
+from ._robots import RobotArm, RobotIK
 
 Mode = Literal["joint", "cartesian"]
 
@@ -75,46 +81,76 @@ class RetargetConfig:
     Attributes:
         reach_fraction: the arm's full reach maps to this fraction of the robot's, keeping
             cartesian targets off the Puma's outstretched singularity.
-        ik_iterations: Puma IK iterations per attempt on the live path (warm starts need few).
+        ik_iterations: IK iterations per attempt on the live path (warm starts need few).
+        floor_height: a robot of :func:`load_robot` stands on a table: hand targets are kept
+            this far above its base plane (m), ...
+        floor_softness: ... by a soft floor of this width (m), so a hand lowered below it
+            slides along the table instead of stopping dead.
+        max_joint_step: largest change of any joint of such a robot from one frame to the next
+            (rad): a target that moves the IK's answer further (a wrist flip, a jump back into
+            reach) is followed over several frames, never in one.
+        clearance: such a robot's links keep at least this distance from each other (m); a
+            pose closer than that is not taken (the last one is held). Convex-hull distances
+            near contact vary by about a millimetre between evaluations, so the margin keeps
+            every pose taken clear of contact for any later check.
     """
 
     reach_fraction: float = 0.95
     ik_iterations: int = 20
+    floor_height: float = 0.05
+    floor_softness: float = 0.05
+    max_joint_step: float = math.radians(4.5)
+    clearance: float = 0.005
 
     def __post_init__(self) -> None:
         positive_number(self.reach_fraction, "RetargetConfig.reach_fraction")
         whole_number(self.ik_iterations, "RetargetConfig.ik_iterations", 1)
+        positive_number(self.floor_height, "RetargetConfig.floor_height")
+        positive_number(self.floor_softness, "RetargetConfig.floor_softness")
+        positive_number(self.max_joint_step, "RetargetConfig.max_joint_step")
+        positive_number(self.clearance, "RetargetConfig.clearance")
+
+
+def _soft_floor(z: float, floor: float, width: float) -> float:
+    """``z`` kept above ``floor`` smoothly: a softplus of width ``width`` (equal to ``z`` well above)."""
+    x = (z - floor) / width
+    return floor + width * (x + math.log1p(math.exp(-x)) if x > 0 else math.log1p(math.exp(x)))
 
 
 class Retargeter:
     """Human arm angles to Puma560 angles, in joint or cartesian mode.
 
     Args:
-        mode: ``"joint"`` or ``"cartesian"``; switchable later through ``.mode``.
+        mode: ``"joint"`` or ``"cartesian"``; switchable later through ``.mode``. Default:
+            joint for the Puma560, cartesian for any other robot.
         mirror: mirror the operator (the paper's choice).
-        robot: the Puma560 (default: one whose IK is capped at ``ik_iterations``).
+        robot: the Puma560 (default: one whose IK is capped at ``ik_iterations``), or any
+            :class:`RobotArm` (then the mode must be cartesian, the default for it).
         arm: the operator's arm (default: the right arm of default size).
         config: defaults.
     """
 
     def __init__(
         self,
-        mode: Mode = "joint",
+        mode: Mode | None = None,
         mirror: bool = True,
-        robot: Puma560 | None = None,
+        robot: Puma560 | RobotArm | None = None,
         arm: HumanArm | None = None,
         config: RetargetConfig | None = None,
     ) -> None:
-        instance_of(robot, Puma560, "Retargeter's robot", optional=True)
+        if robot is not None and not isinstance(robot, Puma560 | RobotArm):
+            raise KinematicsError(
+                f"Retargeter's robot must be a Puma560 or a RobotArm; got {type(robot).__name__}."
+            )
         instance_of(arm, HumanArm, "Retargeter's arm", optional=True)
         instance_of(config, RetargetConfig, "Retargeter's config", optional=True)
         self.config = config or RetargetConfig()
         self.robot = robot or Puma560(ik=IKConfig(max_iterations=self.config.ik_iterations))
         self.arm = arm or HumanArm()
         self.mirror = bool(mirror)
-        self.mode = mode
+        self.mode = mode or ("joint" if isinstance(self.robot, Puma560) else "cartesian")
         self._q_prev: np.ndarray | None = None
-        self.last_ik: IKResult | None = None
+        self.last_ik: IKResult | RobotIK | None = None
         """The last cartesian-mode IK result (``success``, ``error``, ``message``): an
         unreachable hand pose is reported here, while ``robot_from_human`` returns the closest
         configuration within the limits."""
@@ -130,6 +166,11 @@ class Retargeter:
     def mode(self, value: Mode) -> None:
         if value not in ("joint", "cartesian"):  # a caller without a type checker
             raise KinematicsError(f'Retarget mode must be "joint" or "cartesian"; got {value!r}.')
+        if value == "joint" and not isinstance(self.robot, Puma560):
+            raise KinematicsError(
+                f"Joint mode maps the human arm onto the Puma560's joints; the "
+                f"{self.robot.spec.title} follows the hand in cartesian mode: choose cartesian."
+            )
         self._mode = value
 
     @property
@@ -175,8 +216,36 @@ class Retargeter:
         )
         return np.minimum(np.maximum(q_robot, self.robot.lower), self.robot.upper)
 
+    def _shoulder(self) -> np.ndarray:
+        """Where the operator's shoulder is placed in the robot's base frame.
+
+        The Puma560's shoulder; for a robot on a table, its shoulder raised to at least half its
+        reach above the table, so the operator's hand at shoulder height (a reach forward) lands
+        mid-workspace and a lowered hand near the table, not under it.
+        """
+        robot = self.robot
+        if isinstance(robot, Puma560):
+            return np.array([0.0, 0.0, robot.dh[0].d])
+        lifted = robot.shoulder.copy()
+        lifted[2] = max(lifted[2], 0.5 * robot.reach)
+        return lifted
+
+    def _scale(self) -> float:
+        arm = self.arm
+        human_reach = arm.upper_arm_length + arm.forearm_length + arm.hand_length
+        return self.config.reach_fraction * self.robot.reach / human_reach
+
+    def _mirrored(self, p: np.ndarray) -> np.ndarray:
+        return SAGITTAL_MIRROR @ p if self._mirror else p
+
+    def elbow_target(self, q_human: object) -> np.ndarray:
+        """Where the robot's elbow should be (m, robot base frame): the operator's, mirrored and
+        scaled like the hand."""
+        elbow = self.arm.forward(q_human).elbow[:3, 3]
+        return self._shoulder() + self._scale() * self._mirrored(elbow)
+
     def hand_target(self, q_human: object) -> np.ndarray:
-        """The Puma tool pose (4x4, robot base frame) that cartesian mode aims at.
+        """The robot tool pose (4x4, robot base frame) that cartesian mode aims at.
 
         Args:
             q_human: arm angles (rad), shape (7,).
@@ -186,28 +255,51 @@ class Retargeter:
             shoulder, with the tool's approach axis along the fingers.
         """
         pose = self.arm.forward(q_human).hand
-        p, R = pose[:3, 3], pose[:3, :3]
+        p, R = self._mirrored(pose[:3, 3]), pose[:3, :3]
         if self._mirror:
-            p = SAGITTAL_MIRROR @ p
             R = SAGITTAL_MIRROR @ R @ URDF_LATERAL_MIRROR
-        arm = self.arm
-        human_reach = arm.upper_arm_length + arm.forearm_length + arm.hand_length
-        scale = self.config.reach_fraction * self.robot.reach / human_reach
         oMdes = np.eye(4)
         oMdes[:3, :3] = R @ HAND_TO_TOOL
-        oMdes[:3, 3] = np.array([0.0, 0.0, self.robot.dh[0].d]) + scale * p
+        oMdes[:3, 3] = self._shoulder() + self._scale() * p
+        if isinstance(self.robot, RobotArm):
+            oMdes[2, 3] = _soft_floor(
+                float(oMdes[2, 3]), self.config.floor_height, self.config.floor_softness
+            )
         return oMdes
 
     def _cartesian(self, q_human: np.ndarray) -> np.ndarray:
         oMdes = self.hand_target(q_human)
-        result = self.robot.inverse(oMdes, q0=self._q_prev)
-        if not result.success:
-            position = self.robot.inverse(oMdes[:3, 3], q0=result.q, position_only=True)
-            if position.success or position.error < result.error:
-                result = position
-        self._q_prev = result.q.copy()
-        self.last_ik = result
-        return result.q.copy()
+        robot = self.robot
+        if isinstance(robot, RobotArm):
+            found: IKResult | RobotIK = self._solve_arm(robot, oMdes, q_human)
+        else:
+            found = robot.inverse(oMdes, q0=self._q_prev)
+            if not found.success:
+                position = robot.inverse(oMdes[:3, 3], q0=found.q, position_only=True)
+                if position.success or position.error < found.error:
+                    found = position
+        self.last_ik = found
+        q = found.q
+        if isinstance(robot, RobotArm):
+            if self._q_prev is not None:
+                step = self.config.max_joint_step
+                q = self._q_prev + np.clip(q - self._q_prev, -step, step)
+            if robot.checks_collisions and robot.self_collisions(q, self.config.clearance):
+                # hold the last pose free of self-collision (the robot's home before the first)
+                q = robot.home if self._q_prev is None else self._q_prev
+        self._q_prev = q.copy()
+        return q.copy()
+
+    def _solve_arm(self, robot: RobotArm, oMdes: np.ndarray, q_human: np.ndarray) -> RobotIK:
+        """The arm's IK for one frame: the pose, else the position; one elbow step a frame."""
+        elbow = self.elbow_target(q_human) if robot.nq > 6 else None
+        settings = {"elbow": elbow, "iterations": self.config.ik_iterations, "elbow_iterations": 1}
+        found = robot.inverse(oMdes, q0=self._q_prev, **settings)
+        if not found.success and robot.spec.orientation:
+            position = robot.inverse(oMdes[:3, 3], q0=found.q, **settings)
+            if position.success or position.position_error < found.position_error:
+                found = position
+        return found
 
     def human_from_robot(self, q_robot: object) -> np.ndarray:
         """Operator arm angles that joint mode maps onto ``q_robot``: its inverse.

@@ -369,6 +369,7 @@ class RobotArm:
         position_only: bool | None = None,
         elbow: object | None = None,
         iterations: int = 60,
+        elbow_iterations: int = 200,
         position_tolerance: float = 1e-3,
         rotation_tolerance: float = math.radians(1.0),
         damping: float = 1e-2,
@@ -387,6 +388,8 @@ class RobotArm:
             position_only: match the position only (default: when the spec says so or the
                 target is a position).
             elbow: where the elbow should stay (3,), used in the null space only.
+            elbow_iterations: null-space steps allowed once the tool is on target (a live
+                caller takes one per frame and lets the elbow settle over frames).
             iterations, position_tolerance, rotation_tolerance, damping, max_step: the solver's
                 settings (max_step in rad per iteration, infinity norm).
 
@@ -409,6 +412,7 @@ class RobotArm:
         elbow_target = None if elbow is None else real_array(elbow, "elbow").reshape(3)
         model, data, tool = self.model, self.data, self._tool
         rows = 3 if pos_only else 6
+        elbow_steps = elbow_iterations
         damp = np.eye(rows) * damping**2
         e = np.empty(rows)
         pos_err = rot_err = math.inf
@@ -439,8 +443,9 @@ class RobotArm:
                 pull = Je.T @ (elbow_target - data.oMi[self._elbow_joint].translation)
                 null = np.eye(self.nq) - J.T @ np.linalg.solve(JJt, J)
                 secondary = 0.5 * null @ pull
-                if reached and float(np.abs(secondary).max()) < 1e-4:
-                    break  # the elbow is as near as the tool lets it be
+                if reached and (elbow_steps <= 0 or float(np.abs(secondary).max()) < 1e-4):
+                    break  # the elbow is as near as the tool lets it be, or left to next time
+                elbow_steps -= reached
                 dq += secondary
             biggest = float(np.abs(dq).max())
             if biggest > max_step:
@@ -490,7 +495,10 @@ class RobotArm:
         arr = self.check_q(q)
         if self._collision_data is None:
             return []
-        geom, gdata = self.collision_model, self._collision_data
+        # Fresh scratch data for every query: coal warm-starts each pair's GJK from its previous
+        # answer, and near contact that made the same pose read clear once and touching the next.
+        geom = self.collision_model
+        gdata = pin.GeometryData(geom)
         pin.computeDistances(self.model, self.data, geom, gdata, arr)
         found = []
         for k, pair in enumerate(geom.collisionPairs):

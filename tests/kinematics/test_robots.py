@@ -107,3 +107,87 @@ def test_studio_robots_lists_every_robot_with_joints_and_limits(capsys):
     assert main(["robots"]) == 0
     text = capsys.readouterr().out
     assert "puma560: Puma560" in text and "(default)" in text and "shoulder_pan_joint" in text
+
+
+# --------------------------------------------------------------------------- retargeting
+
+
+@pytest.fixture(scope="module")
+def motion():
+    from studio.kinematics import HumanArm, arm_motion
+
+    arm = HumanArm()
+    return arm_motion(np.arange(0.0, 8.0, 1 / 110), arm)
+
+
+@pytest.mark.parametrize("name", [n for n in OFFERED if n != "puma560"])
+def test_a_robot_follows_the_operator_within_limits_without_flips_or_self_collision(name, motion):
+    from studio.kinematics import Retargeter
+
+    arm = load_robot(name)
+    retargeter = Retargeter(robot=arm)
+    assert retargeter.mode == "cartesian"
+    q = np.array([retargeter.robot_from_human(q_human) for q_human in motion])
+    assert np.all((q >= arm.lower - 1e-12) & (q <= arm.upper + 1e-12))
+    jumps = np.degrees(np.abs(np.diff(q, axis=0))).max()
+    assert jumps <= 5.0
+    assert all(arm.self_collisions(pose) == [] for pose in q[::7])
+    # the hand's scaled path does leave the robot's base: the tool follows it much of the time
+    tool = np.array([arm.forward(pose)[:3, 3] for pose in q[::11]])
+    target = np.array([retargeter.hand_target(q_human)[:3, 3] for q_human in motion[::11]])
+    assert np.mean(np.linalg.norm(tool - target, axis=1) < 0.01) > 0.05
+
+
+@pytest.mark.parametrize("name", ["panda", "ur5", "xarm7", "kinova"])
+def test_on_a_reachable_smooth_path_the_tool_stays_within_1cm_and_5deg(name):
+    arm = load_robot(name, geometry=False)
+    t = np.linspace(0.0, 4.0, 440)[:, None]
+    centre = np.clip(arm.home, arm.lower + 0.4, arm.upper - 0.4)
+    path = centre + 0.35 * np.sin(2 * np.pi * t / np.linspace(2.0, 4.0, arm.nq))
+    q = path[0]
+    within = 0
+    for q_true in path:
+        target = arm.forward(q_true)
+        q = arm.inverse(target, q, iterations=20).q
+        got = arm.forward(q)
+        cos = (np.trace(got[:3, :3].T @ target[:3, :3]) - 1) / 2
+        rot = math.degrees(math.acos(np.clip(cos, -1, 1)))
+        within += np.linalg.norm(got[:3, 3] - target[:3, 3]) < 0.01 and rot < 5
+    assert within / len(path) >= 0.98
+
+
+def test_joint_mode_is_refused_for_a_robot_whose_joints_are_not_the_human_arms():
+    from studio.kinematics import Retargeter
+
+    with pytest.raises(KinematicsError, match="cartesian"):
+        Retargeter(mode="joint", robot=load_robot("ur5", geometry=False))
+
+
+def test_a_lowered_hand_is_kept_above_the_table_smoothly():
+    from studio.kinematics import HumanArm, Retargeter
+
+    retargeter = Retargeter(robot=load_robot("ur5", geometry=False))
+    hanging = np.zeros(7)  # the arm hangs: the scaled hand would be under the robot's base
+    z = retargeter.hand_target(hanging)[2, 3]
+    assert z >= retargeter.config.floor_height
+    raised = np.clip(
+        np.array([1.5, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]), HumanArm().lower, HumanArm().upper
+    )
+    high = retargeter.hand_target(raised)[2, 3]
+    assert high > 0.3 and high > z + 0.2
+
+
+def test_a_pose_near_contact_reads_the_same_every_time_it_is_checked():
+    arm = load_robot("kinova")
+    rng = np.random.default_rng(11)
+    poses = [rng.uniform(arm.lower, arm.upper) for _ in range(60)]
+    first = [
+        [(c.link_a, c.link_b, round(c.distance, 6)) for c in arm.self_collisions(q)] for q in poses
+    ]
+    for _ in range(2):
+        again = [
+            [(c.link_a, c.link_b, round(c.distance, 6)) for c in arm.self_collisions(q)]
+            for q in poses
+        ]
+        assert again == first
+    assert any(first)  # some of these poses do collide: the check is not vacuous
