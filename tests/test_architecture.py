@@ -16,6 +16,7 @@ PACKAGES = (
     "studio.learning",
     "studio.web",
     "studio.samples",
+    "studio.export",
 )
 OWNER = re.compile(r"`(studio\.[a-z]+)(?:\.([\w.]+))?`(?: \(([^)|]*)\))?")
 

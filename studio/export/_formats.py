@@ -1,6 +1,6 @@
 """The trajectory file formats: CSV with the URDF's joint names, and MCAP with ROS 2 messages.
 
-CSV: ``time,<joint names>``, one row per sample, seconds and radians. Findings of an unchecked
+CSV: ``time,<joint names>``, one row per sample, seconds (to the nanosecond) and radians. Findings of an unchecked
 export come first as ``#`` comment lines (``numpy.loadtxt`` and pandas' ``comment="#"`` skip them).
 
 MCAP (``mcap`` + ``mcap-ros2-support``, no ROS installation needed; opens in Foxglove and
@@ -97,7 +97,7 @@ def write_csv(
         delimiter=",",
         header=",".join(["time", *names]),
         comments="",
-        fmt="%.9g",
+        fmt=["%.9f"] + ["%.9g"] * q.shape[1],  # time to the nanosecond, as MCAP stamps it
     )
     data = buffer.getvalue().encode("utf-8")
     _write_or_refuse(path, lambda f: f.write(data), "CSV file")
