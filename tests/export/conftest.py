@@ -39,6 +39,4 @@ def smooth_arm(frames: int = 165, speed: float = 1.0) -> np.ndarray:
 @pytest.fixture(scope="session")
 def slow_recording(tmp_path_factory) -> Path:
     """1.5 s of a slow, smooth reach: within the Puma560's limits at the capture rate."""
-    return write_arm_recording(
-        tmp_path_factory.mktemp("rec") / "slow.tape.csv", smooth_arm(165)
-    )
+    return write_arm_recording(tmp_path_factory.mktemp("rec") / "slow.tape.csv", smooth_arm(165))
