@@ -10,8 +10,9 @@ waypoints (by arc length) starts and ends at rest.
 
 Why TOPP-RA rather than Ruckig: Ruckig's open-source edition plans from one state to one target
 and does not pass through intermediate waypoints, so a path of many waypoints would stop at each
-(measured on the sample demonstration: 120 s stopping at each of its 275 samples, against TOPP-RA
-following the same path without stops); TOPP-RA times a given path, which is this job.
+(``benchmarks/bench_export.py``: on the same thinned waypoints and limits, Ruckig stopping at
+each takes 1.05-1.16x TOPP-RA's duration on the sample demonstrations, whose jittery wrists
+nearly stop anyway, and 2.3x on a smooth arc); TOPP-RA times a given path, which is this job.
 """
 
 from __future__ import annotations
@@ -28,6 +29,10 @@ PATH_TOLERANCE_RAD = np.radians(0.5)
 LIMIT_FRACTION = 0.8
 """The share of each velocity and acceleration limit the timing uses by default: headroom for
 the controller's tracking and the spline's sampling, checked afterwards against the full limits."""
+GRID_PER_WAYPOINT = 20
+"""TOPP-RA grid points per waypoint: it bounds the limits at its grid points only, and 20 keeps
+the samples between them within the limits on the first pass for the sample demonstrations (8
+did not, and the retiming below then cost a quarter more time)."""
 RETIME_FACTOR = 0.8
 """TOPP-RA bounds the limits at its grid points only; when the sampled trajectory still exceeds
 a limit between them, the timing is run again with the limits scaled by this factor."""
@@ -131,7 +136,7 @@ def _toppra(
             ),
         ],
         path,
-        gridpoints=np.linspace(0.0, 1.0, max(200, 8 * len(q))),
+        gridpoints=np.linspace(0.0, 1.0, max(400, GRID_PER_WAYPOINT * len(q))),
         parametrizer="ParametrizeConstAccel",
     )
     trajectory = instance.compute_trajectory()
