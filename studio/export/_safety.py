@@ -176,8 +176,8 @@ def refuse(findings: list[Finding], source: str, robot: RobotArm) -> None:
     more = len(findings) - 1
     rest = f" (and {more} more finding{'s' if more > 1 else ''})" if more else ""
     raise SafetyError(
-        f"Refused: {source} for the {robot.spec.title}: {findings[0].sentence}{rest}; slow it "
-        "down or choose another segment, or pass --unchecked to write it anyway with the "
-        "findings stated in the file.",
+        f"Refused: {source} for the {robot.spec.title}: {findings[0].sentence}{rest}; export a "
+        "slower or other motion (a demonstration is timed within the limits) or for another "
+        "robot, or pass --unchecked to write it anyway with the findings stated in the file.",
         [f.sentence for f in findings],
     )

@@ -45,6 +45,8 @@ POLICY_ROBOT = "puma560"
 """The robot every policy file of this studio was learnt on (the files name no other yet)."""
 REACH_TOLERANCE_M = 0.01
 """A retargeted tool further than this from the operator's mapped hand is out of reach."""
+SETTLE_TRIES = 5
+"""IK passes on the first frame (each warm-started from the last) before the motion starts."""
 
 
 @dataclass(frozen=True)
@@ -143,6 +145,11 @@ def retarget(
     retargeter = Retargeter() if robot.name == POLICY_ROBOT else Retargeter(robot=robot)
     q = np.empty((len(q_human), robot.nq))
     findings: list[Finding] = []
+    for _ in range(SETTLE_TRIES if len(q_human) else 0):
+        # the first frame starts the IK cold: let it settle there as a live session would
+        retargeter.robot_from_human(q_human[0])
+        if not isinstance(retargeter.last_ik, RobotIK) or retargeter.last_ik.success:
+            break
     for i, q_h in enumerate(q_human):
         q[i] = retargeter.robot_from_human(q_h)
         ik = retargeter.last_ik
@@ -158,7 +165,7 @@ def retarget(
                     float(times[i]),
                     "reach",
                     robot.spec.tool,
-                    f"sample {i} (t = {times[i]:.3f} s): the hand's target is "
+                    f"frame {i} (t = {times[i]:.3f} s of the source): the hand's target is "
                     f"{ik.position_error * 100:.1f} cm out of the {robot.spec.title}'s reach "
                     f"(tolerance {REACH_TOLERANCE_M * 100:.0f} cm)",
                 )

@@ -5,8 +5,12 @@ here with TOPP-RA (``toppra``): the time-optimal timing along the path that keep
 velocity and acceleration within a fraction of the URDF's limits. The path is first cleared of
 repeated samples and thinned to the waypoints that matter (no sample of the original path is
 further than :data:`PATH_TOLERANCE_RAD` from the thinned one, joint by joint), so the capture
-noise of a demonstration does not force the arm to crawl; a clamped cubic spline through the
-waypoints (by arc length) starts and ends at rest.
+noise of a demonstration does not force the arm to crawl. The path through the waypoints (by
+arc length) is a cubic spline; where that overshoots a position limit (it did past the Panda's
+joint 6 on a sample demonstration), a shape-preserving cubic (PCHIP), which never goes beyond
+two consecutive waypoints, is used instead: slower to run (its second derivative jumps at the
+waypoints), but within the limits wherever the waypoints are. The timing starts and ends at
+rest.
 
 Why TOPP-RA rather than Ruckig: Ruckig's open-source edition plans from one state to one target
 and does not pass through intermediate waypoints, so a path of many waypoints would stop at each
@@ -126,6 +130,9 @@ def _toppra(
     s /= s[-1]
     toppra.setup_logging("WARNING")
     path = toppra.SplineInterpolator(s, q, bc_type="clamped")
+    dense = path(np.linspace(0.0, 1.0, max(400, GRID_PER_WAYPOINT * len(q))))
+    if (dense < robot.lower).any() or (dense > robot.upper).any():
+        path = _shape_preserving_path(s, q)
     velocity = fraction * robot.velocity
     acceleration = fraction * robot.acceleration
     instance = toppra.algorithm.TOPPRA(
@@ -150,3 +157,31 @@ def _toppra(
     # rate's grid, which players and LeRobot's timestamp checks expect
     times = np.arange(int(np.ceil(duration * rate_hz - 1e-9)) + 1) / rate_hz
     return times, np.asarray(trajectory(np.minimum(times, duration)), dtype=float)
+
+
+def _shape_preserving_path(s: np.ndarray, q: np.ndarray) -> object:  # a toppra path
+    """A TOPP-RA geometric path through ``q`` at ``s`` that stays between its waypoints."""
+    from scipy.interpolate import PchipInterpolator
+    from toppra.interpolator import AbstractGeometricPath
+
+    class ShapePreservingPath(AbstractGeometricPath):  # type: ignore[misc]
+        def __init__(self) -> None:
+            self.curves = [PchipInterpolator(s, q, axis=0)]
+            self.curves += [self.curves[0].derivative(1), self.curves[0].derivative(2)]
+
+        def __call__(self, path_positions: object, order: int = 0) -> np.ndarray:
+            return self.curves[order](path_positions)
+
+        @property
+        def dof(self) -> int:
+            return int(q.shape[1])
+
+        @property
+        def path_interval(self) -> np.ndarray:
+            return np.array([s[0], s[-1]])
+
+        @property
+        def waypoints(self) -> tuple[np.ndarray, np.ndarray]:
+            return s, q
+
+    return ShapePreservingPath()

@@ -115,7 +115,19 @@ def test_a_target_out_of_reach_is_refused_naming_the_sample(tmp_path):
     pose = np.random.default_rng(0).uniform(arm.lower, arm.upper, size=(5, 7))[4]
     rec = write_arm_recording(tmp_path / "far.tape.csv", np.repeat(pose[None], 12, axis=0))
     motion = recording_motion(rec, "so100")
-    with pytest.raises(SafetyError, match=r"sample \d+ \(t = [\d.]+ s\): the hand's target is "
+    with pytest.raises(SafetyError, match=r"frame \d+ \(t = [\d.]+ s of the source\): the hand's target is "
                        r"[\d.]+ cm out of the SO-100 \(LeRobot\)'s reach"):  # fmt: skip
         export_motion(motion, "csv", tmp_path / "far.csv")
     assert not (tmp_path / "far.csv").exists()
+
+
+def test_a_path_along_a_joint_limit_never_overshoots_it(tmp_path):
+    """Waypoints on a limit: a cubic spline through them bulges past it; the export must not."""
+    up = PUMA.upper[0]
+    q = np.zeros((5, 6))
+    q[:, 0] = [0.0, 0.8 * up, up, up, 0.2 * up]
+    q[:, 1] = [0.0, 0.1, 0.2, 0.3, 0.4]
+    motion = Motion("policy", "edge", PUMA, np.zeros(5), q, False, 50.0)
+    done = export_motion(motion, "csv", tmp_path / "edge.csv")
+    assert not done.findings and done.q[:, 0].max() <= up
+    _within_limits(PUMA, read_csv(tmp_path / "edge.csv")[1])
