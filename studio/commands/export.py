@@ -5,8 +5,8 @@
 self-collision) and writes it; the :mod:`studio.export` package does all three. ``SOURCE`` is a
 path, or a name in the data folder or among the shipped samples (``sample-reach-1``).
 
-``studio export POLICY`` alone (no ``--format`` nor ``--robot``) writes the policy's greedy
-rollout at its own pace as before: ``time,q1..q6`` CSV, not checked.
+``studio export POLICY`` alone (no ``--format``, ``--robot`` nor ``--unchecked``) writes the
+policy's greedy rollout at its own pace as before: ``time,q1..q6`` CSV, not checked.
 """
 
 from __future__ import annotations
@@ -237,7 +237,8 @@ def _motion(args: argparse.Namespace, source: Path, robot: str) -> tuple[Motion,
 
 
 def run(args: argparse.Namespace) -> int:
-    if args.format is None and args.robot is None and str(args.policy).endswith(".npz"):
+    legacy = args.format is None and args.robot is None and not args.unchecked
+    if legacy and str(args.policy).endswith(".npz"):
         return _run_legacy(args, load_any_policy(args.policy))
     source = find_source(args.policy, args.data_dir)
     fmt = args.format or "csv"

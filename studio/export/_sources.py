@@ -103,7 +103,10 @@ def find_source(given: str | Path, data_dir: str | Path = ".") -> Path:
     given = Path(given)
     if given.exists() or len(given.parts) != 1:
         if not given.is_file():
-            raise ExportError(f"There is no file {given}; check the path.")
+            what = "is a folder, not a file" if given.is_dir() else "does not exist"
+            raise ExportError(
+                f"{given} {what}; give the path of a policy, demonstration or recording file."
+            )
         return given
     root = Path(data_dir)
     endings = (DEMO_SUFFIX, *RECORDING_SUFFIXES)
