@@ -1,32 +1,44 @@
 """The camera teacher's speed in a real browser, each figure against a baseline in the same run.
 
-Chromium's fake camera plays a clip made here (``tests/e2e/camera_clips.py``: a photograph, or a
-drawn figure raising its arm), every frame stamped with its index.
+Chromium's fake camera plays a clip made here (``tests/e2e/camera_clips.py``: a drawn figure
+raising and lowering its arm, so that every frame's pose differs), every frame stamped with its
+index.
 
 1. Inference frame rate: the bare package (a minimal page that loads only the vendored
-   ``pose.js`` from the studio and runs the same camera loop) against
-   the studio page with the camera as its source (drawing, sending landmarks, the 3D scene), in
-   alternating windows of the same run, for the lite and the full model. Goal: the studio slows
-   inference by at most 10%.
-2. Camera-to-studio latency while the studio page runs: from the picture's capture time (the
+   ``pose.js`` from the studio and runs the same camera loop: each frame copied into a canvas,
+   its stamp read, the copy given to the model) against the studio page with the camera as its
+   source (drawing, sending landmarks, the 3D scene), in alternating windows of the same run,
+   for the lite and the full model. Both sides run beside the same studio server with the same
+   API probe: they differ by the studio page alone. Goal: the studio slows inference by at most
+   10%.
+2. Camera-to-scene latency while the studio page runs: from the picture's capture time (the
    video frame's ``captureTime``, else when the page took it) to the landmarks (the model's
-   result) and to the answer of ``POST /api/source/landmarks``, which the studio sends after it
-   has fitted the arm and retargeted the robot (``q_robot``, then in ``GET /api/source`` and the
-   scene); p50 and p99. The page hears that answer only when its main thread is free, and the
-   next inference starts right after a result, so without a GPU the second figure is an upper
-   bound: the studio's own share is the API's latency below.
+   result), to the scene, and to the page hearing the answer of ``POST /api/source/landmarks``;
+   p50 and p99. "Scene" is when the frame's robot pose reaches a viser client: the benchmark
+   listens to the scene's websocket like the page's 3D view does, and matches each frame's
+   ``q_robot`` (in the answer) to the robot pose the scene sends. Frames whose pose the scene
+   never sent (superseded by a newer one before its push, or unchanged) are counted apart. The
+   page hears the answer only when its main thread is free (the next inference starts right
+   after a result), so without a GPU the answer comes later than the scene.
 3. The API while it runs: ``GET /api/source`` and ``GET /api/runs`` latencies, p50 and p99 (goal:
    p99 < 250 ms).
+4. The scene's pushes for a camera at the bare package's rate on an idle machine without a GPU
+   (3.5 frames/s, lite), landmarks of a known arm motion posted straight to the studio (no
+   browser, so the figure does not depend on the machine's load): how many robot poses a second
+   reach a viser client. viser's page redraws for a quarter of a second after each, in the
+   browser's software-GL process that also runs the pose model.
 
 On a 2-core machine without a GPU the model runs at a few frames a second and figures swing with
 other work on the machine: read the ratios of neighbouring windows, and rerun.
 
-Run: ``python benchmarks/bench_camera.py`` (two to five minutes; needs /usr/bin/chromium).
+Run: ``python benchmarks/bench_camera.py`` (two to five minutes on an idle machine, far longer on
+a busy one; ``--models lite`` for half; needs /usr/bin/chromium).
 """
 
 from __future__ import annotations
 
 import argparse
+import asyncio
 import statistics
 import sys
 import tempfile
@@ -42,7 +54,7 @@ from bench_web import CHROMIUM, FLAGS, http, start_studio
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
-from tests.e2e.camera_clips import COLLECT_FRAMES_JS, astronaut_clip  # noqa: E402
+from tests.e2e.camera_clips import COLLECT_FRAMES_JS, READ_STAMP_JS, figure_clip  # noqa: E402
 
 BARE_PATH = "/bench-bare-blazepose"
 """Where the browser is handed the bare page, on the studio's own origin (so the vendored files
@@ -55,13 +67,29 @@ IDLE_SOURCE = {"kind": "hand", "side": "right"}
 so the bare package's windows run beside a still studio page."""
 WARMUP_FRAMES = 3
 """Frames dropped after each (re)start: the first inferences compile shaders and warm caches."""
+ROBOT_NODE = "/robot/link6"
+"""The scene node of the robot's last link: its position tells which robot pose the scene shows."""
+SAME_POSITION_M = 1e-7
+"""A scene position this near a frame's (the same arithmetic on the same joints) is that frame's."""
 
-BARE_HTML = """<!doctype html><html><head><meta charset="utf-8"><title>bare BlazePose</title></head>
+BARE_HTML = (
+    """<!doctype html><html><head><meta charset="utf-8"><title>bare BlazePose</title></head>
 <body><video id="v" playsinline muted style="position:absolute;width:1px;height:1px;opacity:0"></video>
 <script src="/static/vendor/mediapipe-pose/pose.js"></script>
 <script>
-// The vendored package alone, with the studio page's loop: one frame at a time, a yield between.
+// The vendored package alone, with the studio page's loop: one frame at a time, a yield between,
+// each frame copied into a canvas (camera.js's grab) whose stamp is read before the model sees it.
 const MODELS = { lite: 0, full: 1 };
+const readStamp = """
+    + READ_STAMP_JS
+    + """;
+const grabbed = document.createElement("canvas");
+function grab() {
+  if (grabbed.width !== video.videoWidth) grabbed.width = video.videoWidth;
+  if (grabbed.height !== video.videoHeight) grabbed.height = video.videoHeight;
+  grabbed.getContext("2d").drawImage(video, 0, 0);
+  return grabbed;
+}
 window.bench = { times: [], running: false, model: null, ready: false };
 const video = document.getElementById("v");
 const pose = new Pose({ locateFile: (f) => `/static/vendor/mediapipe-pose/${f}` });
@@ -83,7 +111,10 @@ async function setModel(model) {
 async function loop() {
   while (true) {
     await nextFrame();
-    if (window.bench.running && video.readyState >= 2) await pose.send({ image: video });
+    if (!window.bench.running || video.readyState < 2 || !video.videoWidth) continue;
+    const frame = grab();
+    window.bench.tag = readStamp(frame);
+    await pose.send({ image: frame });
   }
 }
 (async () => {
@@ -94,6 +125,7 @@ async function loop() {
   loop();
 })();
 </script></body></html>"""
+)
 
 
 def rate(times: list[float]) -> float:
@@ -113,7 +145,8 @@ class ApiProbe:
 
     def __init__(self, base: str, period_s: float = 0.2) -> None:
         self.base, self.period_s = base, period_s
-        self.latencies: list[float] = []
+        self.latencies: list[float] = []  # while the studio page's camera runs
+        self.side = "bare"  # which side runs now; the API's figure is the studio's
         self.on = threading.Event()
         self.stop = threading.Event()
         self.thread = threading.Thread(target=self._run, daemon=True)
@@ -127,9 +160,59 @@ class ApiProbe:
                 t0 = time.perf_counter()
                 with urllib.request.urlopen(self.base + paths[i % 2], timeout=30) as r:
                     r.read()
-                self.latencies.append(time.perf_counter() - t0)
+                if self.side == "studio":
+                    self.latencies.append(time.perf_counter() - t0)
                 i += 1
             time.sleep(self.period_s)
+
+
+class SceneWatch:
+    """A viser client of the studio's scene, in a thread: when each robot pose reaches it.
+
+    It connects to the scene's websocket as the page's 3D view does and decodes viser's wire
+    format (two little-endian sizes, zstd-compressed msgpack, then binary buffers), keeping the
+    arrival time (``time.time()``) of every position sent for :data:`ROBOT_NODE`.
+    """
+
+    def __init__(self, url: str) -> None:
+        self.url = url.replace("http://", "ws://", 1).split("?")[0].split("#")[0]
+        self.arrivals: list[tuple[float, np.ndarray]] = []
+        self.batches: list[float] = []  # arrival time of every message batch
+        self.connected = threading.Event()
+        self.thread = threading.Thread(target=lambda: asyncio.run(self._run()), daemon=True)
+        self.thread.start()
+        if not self.connected.wait(60):
+            raise SystemExit(f"could not connect to the scene at {self.url}")
+
+    async def _run(self) -> None:
+        import msgspec
+        import viser
+        import websockets
+        import zstandard
+
+        unzip = zstandard.ZstdDecompressor()
+        async with websockets.connect(
+            self.url, subprotocols=[f"viser-v{viser.__version__}"], max_size=None
+        ) as ws:
+            self.connected.set()
+            try:
+                async for raw in ws:
+                    now = time.time()
+                    self.batches.append(now)
+                    size, packed = (int.from_bytes(raw[k : k + 8], "little") for k in (0, 8))
+                    inner = unzip.decompress(raw[16 : 16 + packed], max_output_size=size)
+                    for m in msgspec.msgpack.decode(inner)["messages"]:
+                        if m.get("type") == "SetPositionMessage" and m.get("name") == ROBOT_NODE:
+                            self.arrivals.append((now, np.asarray(m["position"], float)))
+            except websockets.ConnectionClosed:
+                pass  # the studio stopped at the end of the run
+
+    def arrival(self, position: np.ndarray, after: float) -> float | None:
+        """When ``position`` first reached the scene at or after ``after`` (None: never)."""
+        for t, p in list(self.arrivals):
+            if t >= after and np.max(np.abs(p - position)) <= SAME_POSITION_M:
+                return t
+        return None
 
 
 def window(
@@ -144,28 +227,96 @@ def window(
     return rate(times)
 
 
+def scene_latencies(
+    frames: list[dict[str, Any]], origin_s: float, scene: SceneWatch
+) -> tuple[list[float], int]:
+    """Capture-to-scene latencies (ms) of the answered frames, and how many never reached it."""
+    from studio.kinematics import Puma560
+
+    robot = Puma560()
+    out, missed = [], 0
+    for f in frames:
+        q = (f.get("answer") or {}).get("q_robot")
+        if q is None:
+            continue
+        position = robot.joint_frames(np.asarray(q, float))[6][:3, 3]
+        arrived = scene.arrival(position, after=origin_s + f["tResult"])
+        if arrived is None:
+            missed += 1
+        else:
+            out.append((arrived - origin_s - f["body"]["t"]) * 1000)
+    return out, missed
+
+
+VISER_SETTLE_S = 0.25
+"""How long viser's page (1.1) keeps redrawing after each update it receives (RENDER_SETTLE_MS)."""
+FED_RATE_HZ = 3.5
+"""The lite model's rate in a bare page on an idle 2-core machine with software WebGL."""
+
+
+def fed_scene_rate(base: str, scene: SceneWatch, seconds: float) -> tuple[float, float]:
+    """Post landmarks at :data:`FED_RATE_HZ` for ``seconds``; (frames, scene pushes) per second."""
+    from studio.kinematics import HumanArm, arm_motion, landmarks_from_arm
+
+    arm = HumanArm("right")
+    http("PUT", base + "/api/source", {"kind": "camera", "side": "right"})
+    time.sleep(1.0)  # the previous source's last pushes (the simulator streams at start)
+    before, sent = len(scene.arrivals), 0
+    t0 = due = time.perf_counter()
+    while (elapsed := time.perf_counter() - t0) < seconds:
+        world, image = landmarks_from_arm(arm_motion(elapsed, arm), arm)
+        body = {"t": elapsed, "world": world.tolist(), "image": image.tolist()}
+        http("POST", base + "/api/source/landmarks", {**body, "width": 640, "height": 480})
+        sent += 1
+        # The next frame a period later, never sooner: a late one is not caught up in a burst
+        # (the page sends the newest frame only).
+        due = max(due + 1 / FED_RATE_HZ, time.perf_counter())
+        time.sleep(max(0.0, due - time.perf_counter()))
+    took = time.perf_counter() - t0
+    time.sleep(1.5)  # the last pose's push
+    http("PUT", base + "/api/source", IDLE_SOURCE)
+    return sent / took, (len(scene.arrivals) - before) / took
+
+
+def bare_window(bare: Any, frames: int, timeout_s: float) -> float:
+    return window(
+        bare,
+        "() => { window.bench.times = []; window.bench.running = true; }",
+        "() => { window.bench.running = false; }",
+        "window.bench.times",
+        frames,
+        timeout_s,
+    )
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--frames", type=int, default=15, help="frames per measuring window")
     parser.add_argument("--pairs", type=int, default=2, help="bare/studio window pairs per model")
+    parser.add_argument("--models", default="lite,full", help="models to time, comma-separated")
     parser.add_argument("--timeout", type=float, default=600.0, help="seconds a window may take")
+    parser.add_argument("--fed", type=float, default=20.0, help="seconds of posted landmarks")
     args = parser.parse_args()
 
     from playwright.sync_api import sync_playwright
 
     tmp = Path(tempfile.mkdtemp(prefix="bench-camera-"))
-    clip = astronaut_clip(tmp / "astronaut.y4m")
+    clip = figure_clip(tmp / "figure.y4m")
     (tmp / "data").mkdir()
     studio, base = start_studio(tmp / "data")
     probe = ApiProbe(base)
+    scene = SceneWatch(http("GET", base + "/api/config")["viser_url"])
     flags = [
         *FLAGS,
         "--use-fake-ui-for-media-stream",
         "--use-fake-device-for-media-stream",
         f"--use-file-for-fake-video-capture={clip}",
     ]
+    fed = fed_scene_rate(base, scene, args.fed)
     results: dict[str, dict[str, list[float]]] = {}
-    latency: dict[str, list[float]] = {"landmarks": [], "q_robot": []}
+    latency: dict[str, list[float]] = {"landmarks": [], "scene": [], "answer": []}
+    missed = 0
+    idle: list[tuple[float, float]] = []  # (start, end) of the bare windows: the studio is still
     try:
         with sync_playwright() as p:
             browser = p.chromium.launch(executable_path=CHROMIUM, args=flags, headless=True)
@@ -182,27 +333,24 @@ def main() -> int:
             page.goto(base + "/")
             page.wait_for_selector("body[data-ready='1']", timeout=120_000)
             page.evaluate(COLLECT_FRAMES_JS)
+            origin_s = page.evaluate("() => performance.timeOrigin") / 1000
             page.select_option("[data-testid='source-kind']", "camera")  # shows its controls
             http("PUT", base + "/api/source", IDLE_SOURCE)
-            for model in ("lite", "full"):
+            probe.on.set()  # the API is probed beside both sides alike
+            for model in [m for m in args.models.split(",") if m]:
                 results[model] = {"bare": [], "studio": []}
                 bare.evaluate(f"() => setModel('{model}')")
                 page.select_option("[data-testid='camera-model']", model)
                 for pair in range(args.pairs):
                     order = ("bare", "studio") if pair % 2 == 0 else ("studio", "bare")
                     for side in order:
+                        probe.side = side
                         if side == "bare":
-                            fps = window(
-                                bare,
-                                "() => { window.bench.times = []; window.bench.running = true; }",
-                                "() => { window.bench.running = false; }",
-                                "window.bench.times",
-                                args.frames,
-                                args.timeout,
-                            )
+                            t0 = time.time()
+                            fps = bare_window(bare, args.frames, args.timeout)
+                            idle.append((t0, time.time()))
                         else:
                             page.evaluate("() => { window.__frames = []; }")
-                            probe.on.set()
                             http("PUT", base + "/api/source", {"kind": "camera", "side": "right"})
                             fps = window(
                                 page,
@@ -213,16 +361,18 @@ def main() -> int:
                                 args.timeout,
                             )
                             http("PUT", base + "/api/source", IDLE_SOURCE)
-                            probe.on.clear()
                             frames = page.evaluate("() => window.__frames")[WARMUP_FRAMES:]
                             latency["landmarks"] += [
                                 (f["tResult"] - f["body"]["t"]) * 1000 for f in frames
                             ]
-                            latency["q_robot"] += [
+                            latency["answer"] += [
                                 (f["tAnswered"] - f["body"]["t"]) * 1000
                                 for f in frames
                                 if f["answer"]
                             ]
+                            to_scene, lost = scene_latencies(frames, origin_s, scene)
+                            latency["scene"] += to_scene
+                            missed += lost
                             page.wait_for_function("() => !window.studio.camera.running")
                         results[model][side].append(fps)
                         print(f"{model:4s} {side:6s} {fps:5.2f} frames/s", flush=True)
@@ -237,20 +387,38 @@ def main() -> int:
         b, s = statistics.median(sides["bare"]), statistics.median(sides["studio"])
         slowdown = 1 - s / b
         verdict = "meets" if slowdown <= SLOWDOWN_GOAL else "misses"
+        ratios = [st / ba for ba, st in zip(sides["bare"], sides["studio"], strict=True)]
         print(
             f"  {model}: bare package {b:.2f} frames/s, studio page {s:.2f} frames/s: "
-            f"the studio slows inference by {slowdown:+.0%} ({verdict} the goal <= {SLOWDOWN_GOAL:.0%})"
+            f"the studio slows inference by {slowdown:+.0%} ({verdict} the goal <= {SLOWDOWN_GOAL:.0%}); "
+            f"studio/bare per pair {', '.join(f'{r:.2f}' for r in ratios)}"
         )
     if "lite" in results and "full" in results:
         lite = statistics.median(results["lite"]["studio"])
         full = statistics.median(results["full"]["studio"])
         print(f"  lite / full in the studio page: {lite / full:.2f}x")
-    print("\nCamera-to-studio latency while the studio page runs (ms; the answer is heard late")
-    print("when the page's main thread is busy with the next inference, an upper bound):")
+    print("\nCamera-to-scene latency while the studio page runs (ms, from the picture's capture):")
+    names = {
+        "landmarks": "landmarks (the model's result)",
+        "scene": "scene (the robot pose reaches a viser client)",
+        "answer": "the page hears the studio's answer (late when inference runs)",
+    }
     for name, values in latency.items():
         print(
-            f"  capture -> {name:9s} p50 {pct(values, 50):7.0f}   p99 {pct(values, 99):7.0f}   (n={len(values)})"
+            f"  p50 {pct(values, 50):7.0f}   p99 {pct(values, 99):7.0f}   (n={len(values):3d})  {names[name]}"
         )
+    print(f"  frames whose pose the scene never sent (superseded or unchanged): {missed}")
+    idle_s = sum(b - a for a, b in idle)
+    idle_n = sum(a <= t <= b for t in scene.batches for a, b in idle)
+    print(
+        f"  the still studio sent its scene {idle_n} message batches in {idle_s:.0f} s "
+        "(the bare windows; viser's page itself redraws once a second when idle)"
+    )
+    print(
+        f"\nScene pushes for a camera at {fed[0]:.1f} frames/s (landmarks posted, no browser): "
+        f"{fed[1]:.1f} robot poses/s reach the scene; viser's page redraws about "
+        f"{min(1.0, fed[1] * VISER_SETTLE_S):.0%} of the time for them"
+    )
     api_ms = [v * 1000 for v in probe.latencies]
     p99 = pct(api_ms, 99)
     print(

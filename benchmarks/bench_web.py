@@ -400,7 +400,7 @@ def measure_with_page(
 
 
 SOFTWARE_DPR_QUERY = "fixedDpr=0.5"
-"""How the page loads the scene in a browser without a GPU (app.js, SOFTWARE_SCENE_DPR)."""
+"""How the page loads the scene in a browser without a GPU (scene.js, SOFTWARE_SCENE_DPR)."""
 IDLE_SLOWDOWN_GOAL = 1.18
 """Training with the page open on a still scene, against no page (issue 10 keeps it within 1.18x)."""
 SCENE_CPU_S = 5.0

@@ -62,26 +62,8 @@ def capture(
     """
     check_seconds(seconds)
     check_seconds(give_up_seconds, "the wait for frames")
-    config = getattr(source, "config", None)
-    regions = int(getattr(config, "regions", DEFAULT_REGIONS) or DEFAULT_REGIONS)
     rate = float(getattr(source, "rate_hz", DEFAULT_RATE_HZ) or DEFAULT_RATE_HZ)
-    kind = getattr(source, "observation_kind", "tape")
-    writer: AppendWriter
-    if kind == "tape":
-        writer = RecordingWriter(
-            out,
-            regions,
-            config=config,
-            operator=operator,
-            notes=notes,
-            rate_hz=rate,
-            source=source_name or source.kind,
-        )
-    else:  # a pose or hand recording played back (or any fed source): the same kind again
-        side = str(getattr(source, "side", "right"))
-        writer = ObservationWriter(
-            out, kind, side=side, operator=operator, notes=notes, source=source_name or source.kind
-        )
+    writer = _writer_for(source, out, rate, operator, notes, source_name or source.kind)
     first_t: float | None = None
     failed = False
 
@@ -133,6 +115,35 @@ def capture(
         if failed and writer.frames == 0:  # a capture that got no frame leaves no empty file
             writer.path.unlink(missing_ok=True)
     return writer.path
+
+
+def _writer_for(
+    source: ThreadedSource,
+    out: str | os.PathLike[str],
+    rate: float,
+    operator: str,
+    notes: str,
+    source_name: str,
+) -> AppendWriter:
+    """A new recording of ``source``'s observation kind at ``out``: a tape's with its config and
+    regions, or a pose or hand recording (played back, or any fed source) of the same kind."""
+    kind = getattr(source, "observation_kind", "tape")
+    if kind == "tape":
+        config = getattr(source, "config", None)
+        regions = int(getattr(config, "regions", DEFAULT_REGIONS) or DEFAULT_REGIONS)
+        return RecordingWriter(
+            out,
+            regions,
+            config=config,
+            operator=operator,
+            notes=notes,
+            rate_hz=rate,
+            source=source_name,
+        )
+    side = str(getattr(source, "side", "right"))
+    return ObservationWriter(
+        out, kind, side=side, operator=operator, notes=notes, source=source_name
+    )
 
 
 def describe(summary: RecordingSummary) -> str:

@@ -1,8 +1,9 @@
-"""Build a source from a short text spec, as the CLI and the web page name them.
+"""Build a source from a short text spec: the one factory of sources, for the CLI and the page.
 
 Specs: ``simulator`` (or ``simulator:SEED``), a recording path (``*.tape.csv``, played back),
 ``udp`` / ``udp:PORT`` / ``udp:HOST:PORT`` (a :class:`NetworkSource`), ``serial:PORT`` (a
-:class:`SerialSource`, with ``calibration``).
+:class:`SerialSource`, with ``calibration``), and for a caller that feeds them (the studio's
+page) ``camera[:SIDE]`` and ``hand[:SIDE]`` (a :class:`CameraSource`, a :class:`HandSource`).
 """
 
 from __future__ import annotations
@@ -10,7 +11,6 @@ from __future__ import annotations
 import math
 import os
 from pathlib import Path
-from typing import Any
 
 from ._errors import CaptureError
 from ._source import ThreadedSource
@@ -20,6 +20,8 @@ SOURCE_SPECS = (
     "simulator[:SEED] | FILE.tape.csv|.pose.csv|.hand.csv | udp[:[HOST:]PORT] | serial:PORT"
 )
 """What :func:`source_from_spec` accepts (for help texts)."""
+FED_KINDS = ("camera", "hand")
+"""Sources whose observations are handed in by calls (the page's camera and hand guide)."""
 MAX_PORT = 65535
 """The largest UDP port number."""
 
@@ -31,7 +33,8 @@ def source_from_spec(
     speed: float | None = 1.0,
     loop: bool = False,
     calibration: str | os.PathLike[str] | None = None,
-    **kwargs: Any,
+    token: str | None = None,
+    fed: bool = False,
 ) -> ThreadedSource:
     """The source a spec names (not started).
 
@@ -41,16 +44,26 @@ def source_from_spec(
         speed: playback speed (``None``: as fast as possible).
         loop: playback loops.
         calibration: serial calibration file.
-        kwargs: passed to the source's constructor.
+        token: the network bridge's token: only frames signed with it are taken.
+        fed: the caller hands observations in (``camera``, ``hand``); a command line cannot.
 
     Raises:
-        CaptureError: an unknown spec (the message lists the valid ones).
+        CaptureError: an unknown spec (the message lists the valid ones), a fed source for a
+            caller that cannot feed it, a bad side.
     """
     kind, _, rest = spec.partition(":")
     if kind == "simulator":
         from ._simulator import SimulatorSource
 
-        return SimulatorSource(seed=int(rest) if rest else seed, **kwargs)
+        return SimulatorSource(seed=int(rest) if rest else seed)
+    if kind in FED_KINDS:
+        if not fed:
+            raise CaptureError(
+                f"The {kind} source is fed by the studio's page; choose it there, or give one of {SOURCE_SPECS}."
+            )
+        from ._push_sources import CameraSource, HandSource
+
+        return (CameraSource if kind == "camera" else HandSource)(rest or "right")
     if kind == "udp":
         host, port = "127.0.0.1", DEFAULT_PORT
         if rest:
@@ -66,17 +79,17 @@ def source_from_spec(
                 )
         from ._network import NetworkSource
 
-        return NetworkSource(host, port, **kwargs)
+        return NetworkSource(host, port, token=token)
     if kind == "serial":
         if not rest:
             raise CaptureError("'serial' needs a port; write serial:/dev/ttyUSB0.")
         from ._serial import SerialSource
 
-        return SerialSource(rest, calibration=calibration, **kwargs)
+        return SerialSource(rest, calibration=calibration)
     if Path(spec).is_file():
         from ._playback import PlaybackSource
 
-        return PlaybackSource(spec, speed=speed, loop=loop, **kwargs)
+        return PlaybackSource(spec, speed=speed, loop=loop)
     raise CaptureError(
         f"'{spec}' is neither a source nor an existing recording; give one of {SOURCE_SPECS}."
     )

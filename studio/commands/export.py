@@ -38,12 +38,15 @@ from studio.learning import (
     ROLLOUT_SECONDS_PER_STEP,
     TILE_ROLLOUT_MAX_STEPS,
     TILE_ROLLOUT_SECONDS_PER_STEP,
+    DmpPolicyFile,
     LearningError,
     PolicyFile,
     TilePolicyFile,
+    dmp_likeness_card,
     greedy_path,
     load_any_policy,
     rollout,
+    rollout_dmp_policy,
     rollout_tile_policy,
     save_trajectory_csv,
 )
@@ -166,6 +169,27 @@ def _rollout_tile(
     )
 
 
+def _rollout_dmp(
+    args: argparse.Namespace, policy: DmpPolicyFile
+) -> tuple[np.ndarray, np.ndarray, str]:
+    """A movement primitive's rollout from --start-deg (default: its demonstration's start)."""
+    if args.start_state is not None:
+        raise LearningError(
+            "--start-state numbers grid states; a movement primitive starts from --start-deg angles."
+        )
+    start = (
+        None
+        if args.start_deg is None
+        else np.radians(_start_degrees(args.start_deg, len(policy.goal)))
+    )
+    times, q, reached = rollout_dmp_policy(policy, start, rate_hz=args.rate)
+    return (
+        times,
+        q,
+        f"the movement primitive {'reaches the goal' if reached else 'does NOT reach the goal'}",
+    )
+
+
 def _rollout_grid(
     args: argparse.Namespace, policy: PolicyFile, seconds_per_step: float | None
 ) -> tuple[np.ndarray, np.ndarray, str]:
@@ -196,14 +220,20 @@ def _rollout_grid(
 
 
 def _rollout(
-    args: argparse.Namespace, policy: PolicyFile | TilePolicyFile, seconds_per_step: float | None
+    args: argparse.Namespace,
+    policy: PolicyFile | TilePolicyFile | DmpPolicyFile,
+    seconds_per_step: float | None,
 ) -> tuple[np.ndarray, np.ndarray, str]:
     if isinstance(policy, TilePolicyFile):
         return _rollout_tile(args, policy, seconds_per_step)
+    if isinstance(policy, DmpPolicyFile):
+        return _rollout_dmp(args, policy)
     return _rollout_grid(args, policy, seconds_per_step)
 
 
-def _run_legacy(args: argparse.Namespace, policy: PolicyFile | TilePolicyFile) -> int:
+def _run_legacy(
+    args: argparse.Namespace, policy: PolicyFile | TilePolicyFile | DmpPolicyFile
+) -> int:
     """``studio export POLICY``: the rollout at the policy's own pace, as CSV ``time,q1..q6``."""
     times, q, summary = _rollout(args, policy, args.seconds_per_step)
     out = _out_path(args)
@@ -211,13 +241,17 @@ def _run_legacy(args: argparse.Namespace, policy: PolicyFile | TilePolicyFile) -
         save_trajectory_csv(out, times, q)
     except OSError as err:
         raise LearningError(f"Cannot write {out} ({err.strerror}); choose another --out.") from None
-    if isinstance(policy, TilePolicyFile):
+    if isinstance(policy, PolicyFile):
         print(
-            f"{summary} in {times[-1]:.2f} s; wrote {len(times)} samples at {args.rate:g} Hz to {out}"
+            f"{summary}; wrote {len(times)} samples ({times[-1]:.2f} s at {args.rate:g} Hz) to {out}"
         )
     else:
         print(
-            f"{summary}; wrote {len(times)} samples ({times[-1]:.2f} s at {args.rate:g} Hz) to {out}"
+            f"{summary} in {times[-1]:.2f} s; wrote {len(times)} samples at {args.rate:g} Hz to {out}"
+        )
+    if isinstance(policy, DmpPolicyFile):
+        print(
+            f"likeness to its demonstration, from the demonstration's start:\n{dmp_likeness_card(policy, args.rate).text()}"
         )
     return 0
 

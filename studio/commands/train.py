@@ -27,11 +27,9 @@ from __future__ import annotations
 
 import argparse
 import time
-from dataclasses import dataclass
+from collections.abc import Callable
 from pathlib import Path
-from typing import Any
-
-import numpy as np
+from typing import cast
 
 from studio import StudioError, read_json
 from studio.capture import DEMO_FORMAT, DEMO_SUFFIX, load_demonstration
@@ -44,17 +42,14 @@ from studio.learning import (
     REACH_DEFAULTS,
     TASK_KINDS,
     ArmGrid,
-    ConfigError,
+    DemonstrationPath,
     DynaQConfig,
     LearningError,
     LiveProgress,
     RunFolder,
     RunRecord,
-    arm_reach_record,
-    generate_demonstrations,
-    grid_for_goal,
-    raise_problems,
-    run_problems,
+    RunRequest,
+    resolve_run,
 )
 from studio.samples import SAMPLES_DIR
 
@@ -145,7 +140,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--no-progress", action="store_true", help="hide the progress bar")
 
 
-def _read_json(path: Path, what: str) -> Any:
+def _read_json(path: Path, what: str) -> object:
     """A JSON file the user names, read bounded (size, nesting depth, regular files only)."""
     if not path.exists():
         raise LearningError(f"The {what} file {path} does not exist; check the path.")
@@ -178,15 +173,8 @@ def demonstration_file(given: Path) -> Path:
     )
 
 
-def _demos_from(data: Any, source: Path, grid: ArmGrid) -> list[list[int]]:
-    """The grid paths of ``--demos`` (or a config's ``demonstrations``) on the run's grid.
-
-    A cut demonstration (``*.demo.json``) is replayed along the path the page replays: its joint
-    trajectory through :meth:`ArmGrid.path_from_joints` on this run's grid, never the file's
-    stored ``grid_path`` (written by older code, or edited by hand).
-    """
-    if isinstance(data, dict) and data.get("format") == DEMO_FORMAT:
-        return [_demonstration_path(source, grid)]
+def _grid_paths(data: object, source: Path) -> list[list[int]]:
+    """The grid state paths of a JSON file (``--demos``, or a config's ``demonstrations``)."""
     if isinstance(data, dict) and "demonstrations" in data:
         data = data["demonstrations"]
     if not isinstance(data, list) or not all(isinstance(d, list) for d in data):
@@ -196,22 +184,14 @@ def _demos_from(data: Any, source: Path, grid: ArmGrid) -> list[list[int]]:
     return data
 
 
-def _demonstration_path(source: Path, grid: ArmGrid) -> list[int]:
-    """A ``*.demo.json``'s grid path on ``grid``, refused when it does not reach the goal."""
-    demo = load_demonstration(source)
-    try:
-        path = grid.path_from_joints(demo.q_robot, stop_at_goal=True)
-    except LearningError as err:
-        raise LearningError(f"The demonstration {source} has no usable trajectory: {err}") from None
-    if path[-1] != grid.goal_state:
-        end = np.degrees(demo.q_robot[-1, :3])
-        raise LearningError(
-            f"The demonstration {source} ends at joints ({end[0]:.0f}, {end[1]:.0f}, {end[2]:.0f}) degrees, not in this run's goal bins {tuple(grid.goal)}; give another demonstration or set --goal-deg where it ends."
-        )
-    return list(path)
+def _recorded(source: Path) -> DemonstrationPath:
+    """A cut demonstration (``*.demo.json``): its joint trajectory, which the run replays along
+    the path the page replays, never the file's stored ``grid_path`` (written by older code, or
+    edited by hand)."""
+    return DemonstrationPath(f"The demonstration {source}", load_demonstration(source).q_robot)
 
 
-def _numbers(text: str, flag: str, kind: type, example: str) -> list[Any]:
+def _numbers(text: str, flag: str, kind: Callable[[str], float], example: str) -> list[float]:
     try:
         return [kind(v) for v in text.split(",")]
     except ValueError:
@@ -220,22 +200,9 @@ def _numbers(text: str, flag: str, kind: type, example: str) -> list[Any]:
         ) from None
 
 
-@dataclass(frozen=True)
-class TrainSettings:
-    """What ``studio train`` will run: flags over the config file over the learning defaults.
-
-    ``reach`` is the checked record of a ``--task arm-reach`` run (``grid`` is None then)."""
-
-    grid: ArmGrid | None
-    config: DynaQConfig
-    experiments: int
-    episodes: int
-    seed: int
-    demonstrations: list
-    reach: RunRecord | None = None
-
-
-def _spec_of(args: argparse.Namespace) -> dict[str, Any]:
+def _spec_of(args: argparse.Namespace) -> dict[str, object]:
+    """The ``--config`` file's settings: a run's own ``config.json`` (to repeat an arm-grid run)
+    or an object with ``grid``, ``config``, ``experiments`` ... (see the module docstring)."""
     if args.config is None:
         return {}
     spec = _read_json(args.config, "config")
@@ -250,8 +217,8 @@ def _spec_of(args: argparse.Namespace) -> dict[str, Any]:
                 f"The config file {args.config} is a {record.kind} run; --config repeats {TASK_KINDS[0]} runs, so give --task {record.kind} with its flags instead."
             )
         spec = {
-            "grid": {k: v for k, v in record.task.items() if k != "kind"},
-            "config": record.config,
+            "grid": record.arm_grid().to_dict(),
+            "config": record.config.to_dict(),
             "experiments": record.experiments,
             "episodes": record.episodes,
             "seed": record.seed,
@@ -260,14 +227,34 @@ def _spec_of(args: argparse.Namespace) -> dict[str, Any]:
     return spec
 
 
-def resolve(args: argparse.Namespace) -> TrainSettings:
-    """The run's settings, every bad one reported at once.
+def _picked(args: argparse.Namespace, spec: dict[str, object]) -> dict[str, object]:
+    """The budget and the seed: each flag, else the config file's value, else the default."""
+    out: dict[str, object] = {}
+    for key, default in (
+        ("experiments", DEFAULT_EXPERIMENTS),
+        ("episodes", DEFAULT_EPISODES),
+        ("seed", DEFAULT_SEED),
+    ):
+        value = getattr(args, key)
+        value = spec.get(key) if value is None else value
+        out[key] = default if value is None else value
+    return out
+
+
+def _dynaq_flags(args: argparse.Namespace) -> dict[str, object]:
+    """The Dyna-Q settings given as flags."""
+    keys = ("planning", "planning_steps", "alpha", "gamma", "epsilon")
+    return {key: getattr(args, key) for key in keys if getattr(args, key) is not None}
+
+
+def run_request(args: argparse.Namespace) -> RunRequest:
+    """The run the flags (over the config file, over the learning defaults) ask for.
 
     Raises:
-        LearningError: a bad file or flag (a :class:`ConfigError` lists every bad field).
+        LearningError: a file that cannot be read (bad settings are the resolver's to report).
     """
     if getattr(args, "task", TASK_KINDS[0]) != TASK_KINDS[0]:
-        return _resolve_reach(args)
+        return _reach_request(args)
     problems = [
         (
             flag,
@@ -277,71 +264,42 @@ def resolve(args: argparse.Namespace) -> TrainSettings:
         if flag != "joints" and getattr(args, flag, None) is not None
     ]
     spec = _spec_of(args)
-    grid_spec = dict(spec.get("grid", {}))
-    for key in ("joints", "bins"):
-        if getattr(args, key) is not None:
-            grid_spec[key] = getattr(args, key)
+    grid = dict(cast(dict, spec.get("grid", {})))
+    grid.update({k: getattr(args, k) for k in ("joints", "bins") if getattr(args, k) is not None})
     if args.goal is not None:
-        grid_spec["goal"] = _numbers(args.goal, "--goal", int, "5,6,2")
-    if grid_spec.get("goal") is not None:
-        grid_spec["goal"] = tuple(grid_spec["goal"])
-    grid: ArmGrid | None = None
-    try:
-        if args.goal_deg is not None:
-            extra = set(grid_spec) - {"bins", "joints", "goal"}
-            if extra or grid_spec.get("joints", 3) != 3:
-                raise LearningError(
-                    "--goal-deg sets a goal on the paper's 3-joint grid; give --goal bins for another grid."
-                )
-            degrees = _numbers(args.goal_deg, "--goal-deg", float, "0,45,-90")
-            grid = grid_for_goal(degrees, grid_spec.get("bins", ArmGrid.bins))
-        else:
-            grid = ArmGrid(**grid_spec)
-    except ConfigError as err:
-        problems += list(err.by_field.items())
-    except TypeError as err:
-        problems.append(
-            (
-                "grid",
-                f"The grid settings are wrong ({err}); use joints, bins, low_deg, high_deg and goal.",
-            )
-        )
-    except LearningError as err:
-        problems.append(("grid", str(err)))
-    config_spec = dict(spec.get("config", {}))
-    for key in ("planning", "planning_steps", "alpha", "gamma", "epsilon"):
-        if getattr(args, key) is not None:
-            config_spec[key] = getattr(args, key)
-    config: DynaQConfig | None = None
-    try:
-        config = DynaQConfig.from_dict(config_spec)
-    except ConfigError as err:
-        problems += list(err.by_field.items())
-    experiments = args.experiments if args.experiments is not None else spec.get("experiments")
-    episodes = args.episodes if args.episodes is not None else spec.get("episodes")
-    seed = args.seed if args.seed is not None else spec.get("seed")
-    experiments = DEFAULT_EXPERIMENTS if experiments is None else experiments
-    episodes = DEFAULT_EPISODES if episodes is None else episodes
-    seed = DEFAULT_SEED if seed is None else seed
-    problems += run_problems(experiments, episodes, seed, args.name or "", grid)
-    raise_problems(problems)
-    assert grid is not None and config is not None
-    demos = (
-        _demos_from(spec["demonstrations"], args.config, grid) if "demonstrations" in spec else []
-    )
+        grid["goal"] = [int(g) for g in _numbers(args.goal, "--goal", int, "5,6,2")]
+    grid_paths: list[list[int]] = []
+    if "demonstrations" in spec:
+        grid_paths = _grid_paths(spec["demonstrations"], args.config)
+    recorded: list[DemonstrationPath] = []
     if args.demos is not None:
         demo_file = demonstration_file(args.demos)
-        demos = _demos_from(_read_json(demo_file, "demonstrations"), demo_file, grid)
+        data = _read_json(demo_file, "demonstrations")
+        if isinstance(data, dict) and data.get("format") == DEMO_FORMAT:
+            grid_paths, recorded = [], [_recorded(demo_file)]
+        else:
+            grid_paths = _grid_paths(data, demo_file)
     if args.generated_demos:
-        demos = generate_demonstrations(
-            grid, args.generated_demos, np.random.default_rng([seed, 1])
-        )
-    return TrainSettings(grid, config, experiments, episodes, seed, demos)
+        grid_paths, recorded = [], []
+    goal_deg = None
+    if args.goal_deg is not None:
+        goal_deg = _numbers(args.goal_deg, "--goal-deg", float, "0,45,-90")
+    return RunRequest(
+        config={**cast(dict, spec.get("config", {})), **_dynaq_flags(args)},
+        grid=grid,
+        goal_deg=goal_deg,
+        **_picked(args, spec),  # type: ignore[arg-type]
+        demonstrations=recorded,
+        grid_paths=grid_paths,
+        generated=args.generated_demos or 0,
+        name=args.name or "",
+        origin="cli",
+        problems=problems,
+    )
 
 
-def _resolve_reach(args: argparse.Namespace) -> TrainSettings:
-    """:func:`resolve` for ``--task arm-reach``: the page's continuous-task settings and checks
-    (:func:`studio.learning.arm_reach_record`), with the learning package's defaults."""
+def _reach_request(args: argparse.Namespace) -> RunRequest:
+    """:func:`run_request` for ``--task arm-reach``: the page's continuous-task settings."""
     problems = [
         (flag, f"--{flag.replace('_', '-')} {why}; leave it out with --task {args.task}.")
         for flag, why in (
@@ -352,21 +310,10 @@ def _resolve_reach(args: argparse.Namespace) -> TrainSettings:
         )
         if getattr(args, flag) is not None
     ]
-    config: DynaQConfig | None = None
-    try:
-        config = DynaQConfig.from_dict(
-            {
-                key: getattr(args, key)
-                for key in ("planning", "planning_steps", "alpha", "gamma", "epsilon")
-                if getattr(args, key) is not None
-            }
-        )
-    except ConfigError as err:
-        problems += list(err.by_field.items())
-    goal_deg = DEFAULT_GOAL_JOINTS_DEG
+    goal_deg = list(DEFAULT_GOAL_JOINTS_DEG)
     if args.goal_deg is not None:
         goal_deg = _numbers(args.goal_deg, "--goal-deg", float, "0,45,-90")
-    demos = []
+    recorded = []
     if args.demos is not None:
         demo_file = demonstration_file(args.demos)
         data = _read_json(demo_file, "demonstrations")
@@ -374,50 +321,38 @@ def _resolve_reach(args: argparse.Namespace) -> TrainSettings:
             raise LearningError(
                 f"{demo_file} is not a cut demonstration; the continuous task replays a *.demo.json (its joint path)."
             )
-        demos = [load_demonstration(demo_file).q_robot]
-    settings = {
-        key: default if getattr(args, key) is None else getattr(args, key)
-        for key, default in REACH_DEFAULTS.items()
-    }
-    picked = {
-        "experiments": DEFAULT_EXPERIMENTS if args.experiments is None else args.experiments,
-        "episodes": DEFAULT_EPISODES if args.episodes is None else args.episodes,
-        "seed": DEFAULT_SEED if args.seed is None else args.seed,
-    }
-    record = arm_reach_record(
-        config,
-        **settings,
+        recorded = [_recorded(demo_file)]
+    return RunRequest(
+        task=args.task,
+        config=_dynaq_flags(args),
+        reach={k: getattr(args, k) for k in REACH_DEFAULTS if getattr(args, k) is not None},
         goal_deg=goal_deg,
-        **picked,
-        demonstrations=demos,
+        **_picked(args, {}),  # type: ignore[arg-type]
+        demonstrations=recorded,
         name=args.name or "",
         origin="cli",
         problems=problems,
     )
-    assert config is not None
-    return TrainSettings(
-        None, config, record.experiments, record.episodes, record.seed, demos, reach=record
-    )
+
+
+def resolve(args: argparse.Namespace) -> RunRecord:
+    """The run's checked record (:func:`studio.learning.resolve_run`), every bad setting
+    reported at once.
+
+    Raises:
+        LearningError: a bad file or flag (a :class:`ConfigError` lists every bad field).
+    """
+    return resolve_run(run_request(args))
 
 
 def run(args: argparse.Namespace) -> int:
     """Train into a new run folder; Ctrl-C stops at the next episode and keeps what was learnt."""
-    settings = resolve(args)
-    record = settings.reach or RunRecord.for_arm_grid(
-        settings.grid,  # type: ignore[arg-type]
-        settings.config,
-        settings.experiments,
-        settings.episodes,
-        settings.seed,
-        settings.demonstrations,
-        name=args.name or "",
-        origin="cli",
-    )
+    record = resolve(args)
     if args.out is None:
         folder = RunFolder.create(Path("runs"), record, status="running")
     else:
         folder = RunFolder.create(args.out.parent, record, name=args.out.name, status="running")
-    live = LiveProgress(settings.experiments, settings.episodes)
+    live = LiveProgress(record.experiments, record.episodes)
     bar = None
     if not args.no_progress:
         from tqdm import tqdm
@@ -453,9 +388,9 @@ def run(args: argparse.Namespace) -> int:
     wall = time.perf_counter() - start
     mean = result.mean_steps()
     print(
-        f"Trained {settings.experiments} x {settings.episodes} episodes ({settings.config.planning} planning) in {wall:.2f} s "
+        f"Trained {record.experiments} x {record.episodes} episodes ({record.config.planning} planning) in {wall:.2f} s "
         f"({result.cpu_seconds.sum():.2f} CPU s): mean steps {mean[0]:.0f} in episode 1, "
-        f"{mean[-1]:.1f} in episode {settings.episodes}."
+        f"{mean[-1]:.1f} in episode {record.episodes}."
     )
     print(
         f"Wrote config.json, status.json, steps.csv, curves.csv and policy.policy.npz to {folder.path}/"

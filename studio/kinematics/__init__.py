@@ -42,6 +42,10 @@ from ._robots import RobotSpec as RobotSpec
 from ._robots import load_robot as load_robot
 from ._robots import robot_names as robot_names
 from ._robots import robot_spec as robot_spec
+from ._sleeve import SLEEVE_LIFT_M as SLEEVE_LIFT_M
+from ._sleeve import PosedBody as PosedBody
+from ._sleeve import pose_body as pose_body
+from ._sleeve import tape_on_sleeve as tape_on_sleeve
 from ._synthetic import BodyShape as BodyShape
 from ._synthetic import arm_motion as arm_motion
 from ._synthetic import landmarks_from_arm as landmarks_from_arm

@@ -22,14 +22,14 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import Any
+from typing import TypedDict
 
 import gymnasium
 import numpy as np
 
 from ._config import DynaQConfig
 from ._gym import ARM_REACH_ID
-from ._linear import greedy_success
+from ._linear import LinearResult, greedy_success
 from ._reach import DEFAULT_MAX_EPISODE_STEPS, ArmReach
 
 BEYOND_JOINTS = (3, 4, 5, 6)
@@ -48,6 +48,25 @@ BEYOND_SUCCESS = 0.95
 """The issue's goal: the greedy policy reaches the goal from this share of random starts."""
 PAPER_BINS = 11
 """The paper's bins per joint."""
+
+
+class Budget(TypedDict):
+    """One episode budget's measurement for a joint count."""
+
+    episodes: int
+    cpu_seconds: float
+    success: list[float]  # per experiment: the greedy policy's share of starts reaching the goal
+    first_own_success: list[list[int] | None]
+
+
+class JointsRow(TypedDict):
+    """What :func:`measure` found for one joint count (one row of the report)."""
+
+    joints: int
+    memory: dict[str, float]
+    budgets: list[Budget]
+    time_to_goal: float | None
+    first_own_success_without_demos: list[list[int] | None]
 
 
 def demonstration_paths(task: ArmReach, count: int, rng: np.random.Generator) -> list[np.ndarray]:
@@ -97,10 +116,10 @@ def measure(
     episodes: Sequence[int] = BEYOND_EPISODES,
     experiments: int = BEYOND_EXPERIMENTS,
     workers: int | None = None,
-    run: Callable[..., Any] | None = None,
-) -> dict[str, Any]:
+    run: Callable[..., LinearResult] | None = None,
+) -> JointsRow:
     """Learn the J-joint task for each budget and judge the greedy policies (see the module)."""
-    from ._dynaq import run_experiments
+    from ._experiments import run_experiments
 
     run = run or run_experiments
     task = ArmReach(joints=joints)
@@ -110,7 +129,7 @@ def measure(
     config = DynaQConfig(planning="zero")
     cap = DEFAULT_MAX_EPISODE_STEPS
     make = lambda: gymnasium.make(ARM_REACH_ID, joints=joints)  # noqa: E731
-    budgets = []
+    budgets: list[Budget] = []
     for n in episodes:
         result = run(make, config, experiments, n, seed, demos, task.features(), workers=workers)
         success = [
@@ -158,7 +177,7 @@ def _firsts(values: Sequence[list[int] | None]) -> str:
     return ", ".join("never" if v is None else f"{v[0]}: {v[1]}" for v in values)
 
 
-def report_section(rows: Sequence[dict[str, Any]]) -> str:
+def report_section(rows: Sequence[JointsRow]) -> str:
     """The REPORT.md section of :func:`beyond_the_paper`'s measurements."""
     lines = [
         "\n## Beyond the paper: continuous joints with tile coding (the curse of dimensionality, measured)\n",
@@ -197,7 +216,7 @@ def report_section(rows: Sequence[dict[str, Any]]) -> str:
     return "\n".join(lines) + "\n"
 
 
-def figure(rows: Sequence[dict[str, Any]], out_dir: Path) -> list[Path]:
+def figure(rows: Sequence[JointsRow], out_dir: Path) -> list[Path]:
     """``beyond.png``/``.svg``: greedy success against CPU seconds per joint count, and memory."""
     from matplotlib.figure import Figure
 
@@ -250,7 +269,7 @@ def beyond_the_paper(
     episodes: Sequence[int] = BEYOND_EPISODES,
     experiments: int = BEYOND_EXPERIMENTS,
     workers: int | None = None,
-) -> tuple[str, list[Path], list[dict[str, Any]]]:
+) -> tuple[str, list[Path], list[JointsRow]]:
     """Measure every joint count; returns the REPORT.md section, the figure files and the rows.
 
     A one-episode run first loads (or compiles) the kernels, so no budget's CPU time counts it.

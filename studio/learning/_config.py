@@ -12,7 +12,6 @@ episodes) before any work starts.
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass, fields
-from typing import Any
 
 import numpy as np
 
@@ -81,12 +80,12 @@ class DynaQConfig:
             if isinstance(value, np.integer | np.floating):
                 object.__setattr__(self, f.name, value.item())
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, object]:
         """The settings as a JSON-ready dict (the inverse of :meth:`from_dict`)."""
         return asdict(self)
 
     @classmethod
-    def from_dict(cls, data: dict[str, Any]) -> DynaQConfig:
+    def from_dict(cls, data: object) -> DynaQConfig:
         """Settings from a dict such as a JSON body or a policy header; unknown keys are refused."""
         if not isinstance(data, dict):
             raise ConfigError(

@@ -2,15 +2,19 @@
 
 Reads top to bottom like the paper's algorithm box:
 
-1. a tiny deterministic random number generator (splitmix64) so every experiment is reproducible
-   bit for bit, whichever thread runs it;
-2. small pure step functions: the Q-learning update of Eq. 1 (keeping each state's greedy value
-   cached), the greedy choice with ties broken at random, a max-heap for prioritized sweeping;
-3. :func:`_run_experiment`, one experiment of ``episodes`` episodes: act, learn, update the model,
+1. small pure step functions: the Q-learning update of Eq. 1 (keeping each state's greedy value
+   cached), the greedy choice with ties broken at random, the queueing of prioritized sweeping;
+2. :func:`_run_experiment`, one experiment of ``episodes`` episodes: act, learn, update the model,
    plan; it writes each episode's step count as soon as the episode ends (live curves) and stops
    at an episode boundary when asked;
-4. :func:`run_experiments`, which validates the input, turns demonstrations into action lists and
-   spreads experiments over a thread pool (the kernels release the GIL).
+3. :func:`run_tabular_experiments`, which validates the input, turns demonstrations into action
+   lists and spreads experiments over a thread pool (the kernels release the GIL).
+   :func:`studio.learning.run_experiments` (:mod:`._experiments`) calls it for a
+   :class:`TabularMDP`.
+
+The random numbers (splitmix64, one generator per experiment), the priority queue and the run
+around the kernels (:class:`LiveProgress`, :class:`ExperimentResult`) are the linear learner's
+too: they live in :mod:`._learner`.
 
 Planners (``DynaQConfig.planning``):
 
@@ -31,68 +35,57 @@ The model is deterministic, as the MDP is: ``Model(s, a)`` stores the observed n
 
 Speed: the step functions are inlined into the kernel (numba ``inline="always"``). A numba call that
 passes arrays updates their reference counts atomically on the way in and out, which cost more than
-the step itself; inlined, a planning update is ~10 ns and a real step a few tens of ns.
+the step itself; inlined, a planning update is ~10 ns and a real step a few tens of ns. The kernel
+takes its arguments in named tuples (:data:`Dynamics`, :data:`Learning`, :data:`Demonstrations`),
+as the linear learner's does.
+
+Caching caveat: numba's disk cache of the kernel is keyed on this file alone, yet it compiles in
+the helpers of ``_learner.py``; after editing that file, touch this one (or delete
+``__pycache__/_dynaq*.nb*``) so the kernel recompiles.
 """
 
 from __future__ import annotations
 
-import os
-import sys
-import threading
 import time
-from collections.abc import Callable, Iterator, Sequence
+from collections import namedtuple
+from collections.abc import Sequence
 from concurrent.futures import ThreadPoolExecutor
-from contextlib import contextmanager, suppress
-from dataclasses import dataclass, replace
-from typing import Any, TypeVar
+from dataclasses import replace
 
 import numpy as np
 from numba import njit
 
-from ._config import PLANNERS, DynaQConfig, check_budget
+from ._config import DynaQConfig
 from ._errors import LearningError
+from ._learner import (
+    GOLDEN,
+    PLANNER_CODE,
+    PRIORITIZED,
+    ExperimentResult,
+    LiveProgress,
+    below,
+    check_run_arguments,
+    experiment_seed,
+    heap_pop,
+    heap_push,
+    lower_thread_priority,
+    mix,
+    plan_budget,
+    result_so_far,
+    unit,
+)
 from ._mdp import TabularMDP
-from ._tiles import TileCoding
 
-R = TypeVar("R", bound="ExperimentResult")
+Dynamics = namedtuple("Dynamics", "next_state reward terminal start_states")
+"""The task as the kernel reads it: a :class:`TabularMDP`'s arrays (see there)."""
 
-_PLANNER_CODE = {name: code for code, name in enumerate(PLANNERS)}
-MAX_NICENESS = 19
-"""The lowest CPU priority Linux gives a thread."""
-_ZERO, _FULL, _SOFT, _PRIORITIZED = (_PLANNER_CODE[name] for name in PLANNERS)
+Learning = namedtuple("Learning", "alpha gamma epsilon planner planning_steps max_steps threshold")
+"""A :class:`DynaQConfig` as plain numbers: its planner by code (:data:`PLANNER_CODE`), its
+episode cap as ``max_steps`` and its ``priority_threshold`` as ``threshold``."""
 
-_GOLDEN = np.uint64(0x9E3779B97F4A7C15)
-_MIX1 = np.uint64(0xBF58476D1CE4E5B9)
-_MIX2 = np.uint64(0x94D049BB133111EB)
-_U11 = np.uint64(11)
-_U27 = np.uint64(27)
-_U30 = np.uint64(30)
-_U31 = np.uint64(31)
-_U32 = np.uint64(32)
-_INV_2_53 = 1.0 / 9007199254740992.0
-
-# --------------------------------------------------------------------------- random numbers
-
-
-@njit(nogil=True, cache=True, inline="always")
-def _mix(z: np.uint64) -> np.uint64:
-    """splitmix64's output function: a well-mixed 64-bit word from the generator's counter."""
-    z = (z ^ (z >> _U30)) * _MIX1
-    z = (z ^ (z >> _U27)) * _MIX2
-    return z ^ (z >> _U31)
-
-
-@njit(nogil=True, cache=True, inline="always")
-def _below(z: np.uint64, n: int) -> int:
-    """An integer in [0, n) from a random word (Lemire's multiply-shift on the top 32 bits)."""
-    return np.int64(((z >> _U32) * np.uint64(n)) >> _U32)
-
-
-@njit(nogil=True, cache=True, inline="always")
-def _unit(z: np.uint64) -> float:
-    """A float in [0, 1) from a random word."""
-    return np.float64(z >> _U11) * _INV_2_53
-
+Demonstrations = namedtuple("Demonstrations", "actions offsets starts")
+"""Demonstrations replayed as the first episodes: every action back to back (int64), where each
+demonstration's actions begin (int64, ``n + 1``) and its first state (int64, ``n``)."""
 
 # --------------------------------------------------------------------------- step functions
 
@@ -145,8 +138,8 @@ def _greedy_with_ties(q, row, best, ties, n_actions, rng):
     if ties == 1:
         k = 0
     else:
-        rng += _GOLDEN
-        k = _below(_mix(rng), ties)
+        rng += GOLDEN
+        k = below(mix(rng), ties)
         if ties == n_actions:
             return k, rng
     pick = 0
@@ -160,63 +153,11 @@ def _greedy_with_ties(q, row, best, ties, n_actions, rng):
 
 
 @njit(nogil=True, cache=True, inline="always")
-def _heap_push(heap_idx, heap_pri, pos, size, idx, priority):
-    """Queue ``idx`` with ``priority`` (or raise its priority if queued lower); returns the size."""
-    i = pos[idx]
-    if i < 0:
-        i = size
-        size += 1
-    elif heap_pri[i] >= priority:
-        return size
-    while i > 0:  # sift up
-        parent = (i - 1) >> 1
-        if heap_pri[parent] >= priority:
-            break
-        heap_idx[i] = heap_idx[parent]
-        heap_pri[i] = heap_pri[parent]
-        pos[heap_idx[i]] = i
-        i = parent
-    heap_idx[i] = idx
-    heap_pri[i] = priority
-    pos[idx] = i
-    return size
-
-
-@njit(nogil=True, cache=True, inline="always")
-def _heap_pop(heap_idx, heap_pri, pos, size):
-    """Remove the highest-priority entry; returns (idx, new size)."""
-    top = heap_idx[0]
-    pos[top] = -1
-    size -= 1
-    if size == 0:
-        return top, size
-    idx = heap_idx[size]
-    priority = heap_pri[size]
-    i = 0
-    while True:  # sift down
-        child = 2 * i + 1
-        if child >= size:
-            break
-        if child + 1 < size and heap_pri[child + 1] > heap_pri[child]:
-            child += 1
-        if heap_pri[child] <= priority:
-            break
-        heap_idx[i] = heap_idx[child]
-        heap_pri[i] = heap_pri[child]
-        pos[heap_idx[i]] = i
-        i = child
-    heap_idx[i] = idx
-    heap_pri[i] = priority
-    pos[idx] = i
-    return top, size
-
-
-@njit(nogil=True, cache=True, inline="always")
 def _queue_pair(q, v, idx, s_next, r, gamma, threshold, heap_idx, heap_pri, pos, size):
     """Queue (s, a) (flat index ``idx``) with its remaining error if it exceeds the threshold."""
     priority = abs(r + gamma * v[s_next] - q[idx])
     if priority > threshold:
-        size = _heap_push(heap_idx, heap_pri, pos, size, idx, priority)
+        size = heap_push(heap_idx, heap_pri, pos, size, idx, priority)
     return size
 
 
@@ -230,7 +171,7 @@ def _queue_predecessors(
     while p >= 0:
         priority = abs(model_reward[p] + gamma * v[s] - q[p])
         if priority > threshold:
-            size = _heap_push(heap_idx, heap_pri, pos, size, p, priority)
+            size = heap_push(heap_idx, heap_pri, pos, size, p, priority)
         p = pred_link[p]
     return size
 
@@ -239,20 +180,22 @@ def _queue_predecessors(
 
 
 @njit(nogil=True, cache=True)
-def _run_experiment(
-    next_state, reward, terminal, start_states,
-    alpha, gamma, epsilon, planner, planning_steps, max_steps, threshold,
-    demo_actions, demo_offsets, demo_starts,
-    seed, stop, steps_out, updates_out, q,
-):  # fmt: skip
+def _run_experiment(task, learning, demos, seed, stop, steps_out, updates_out, q):
     """One Dyna-Q experiment; fills ``steps_out``/``updates_out``/``q`` and returns episodes done.
 
-    All arrays are C-contiguous: ``next_state`` int64 (S, A), ``reward`` float64 (S, A),
-    ``terminal`` bool (S,), ``start_states`` int64, ``demo_actions`` int64 (all demonstrations'
-    actions back to back), ``demo_offsets`` int64 (n_demos + 1), ``demo_starts`` int64 (n_demos,),
-    ``stop`` int64 (1,) (non-zero: stop at the next episode boundary), ``steps_out`` and
-    ``updates_out`` int64 (episodes,), ``q`` float64 (S, A), zero on entry.
+    ``task`` is a :data:`Dynamics`, ``learning`` a :data:`Learning`, ``demos`` a
+    :data:`Demonstrations`; ``seed`` the experiment's generator state (uint64). Every array is
+    C-contiguous: ``stop`` int64 (1,) (non-zero: stop at the next episode boundary),
+    ``steps_out`` and ``updates_out`` int64 (episodes,), ``q`` float64 (S, A), zero on entry.
+
+    One function of about 130 lines, on purpose: with its action choice, its model update and its
+    planning loops moved into inlined helpers, a real step took about twice as long (CPU per
+    zero-planning experiment on the arm grid 1.4 -> 3.0 ms; most likely the reference counting of
+    the arrays handed to a helper that holds a loop, which numba does not prune).
     """
+    next_state, reward, terminal, start_states = task
+    alpha, gamma, epsilon, planner, planning_steps, max_steps, threshold = learning
+    demo_actions, demo_offsets, demo_starts = demos
     n_states, n_actions = next_state.shape
     n_pairs = n_states * n_actions
     episodes = steps_out.shape[0]
@@ -268,7 +211,7 @@ def _run_experiment(
     # indices below 2**53) so that one 32-byte row, one cache line, holds all a uniform draw needs
     visited = np.empty((n_pairs, 4), np.float64)
     n_visited = 0
-    prioritized = planner == _PRIORITIZED
+    prioritized = planner == PRIORITIZED
     queue_len = n_pairs if prioritized else 0
     model_next = np.empty(queue_len, np.int64)  # the model by flat (s, a), for the sweeps
     model_reward = np.empty(queue_len, np.float64)
@@ -284,20 +227,15 @@ def _run_experiment(
     for episode in range(episodes):
         if stop[0] != 0:
             break
-        if planner == _ZERO:
-            n_plan = 0
-        elif planner == _SOFT:
-            n_plan = max(planning_steps - episode, 0)
-        else:
-            n_plan = planning_steps
+        n_plan = plan_budget(planner, planning_steps, episode)
         demo = episode < n_demos
         if demo:
             s = demo_starts[episode]
             first_action = demo_offsets[episode]
             limit = demo_offsets[episode + 1] - first_action
         else:
-            rng += _GOLDEN
-            s = start_states[_below(_mix(rng), start_states.shape[0])]
+            rng += GOLDEN
+            s = start_states[below(mix(rng), start_states.shape[0])]
             first_action = 0
             limit = max_steps
         steps = 0
@@ -307,10 +245,10 @@ def _run_experiment(
             if demo:
                 a = demo_actions[first_action + steps]
             else:
-                rng += _GOLDEN
-                if _unit(_mix(rng)) < epsilon:
-                    rng += _GOLDEN
-                    a = _below(_mix(rng), n_actions)
+                rng += GOLDEN
+                if unit(mix(rng)) < epsilon:
+                    rng += GOLDEN
+                    a = below(mix(rng), n_actions)
                 else:
                     a, rng = _greedy_with_ties(qf, s * n_actions, v[s], n_max[s], n_actions, rng)
             idx = s * n_actions + a
@@ -344,7 +282,7 @@ def _run_experiment(
                 for _ in range(n_plan):
                     if heap_size == 0:
                         break
-                    p, heap_size = _heap_pop(heap_idx, heap_pri, pos, heap_size)
+                    p, heap_size = heap_pop(heap_idx, heap_pri, pos, heap_size)
                     ps = p // n_actions
                     _q_update(
                         qf, v, n_max, p, ps, model_next[p], model_reward[p], alpha, gamma, n_actions
@@ -360,8 +298,8 @@ def _run_experiment(
                     )  # fmt: skip
             else:
                 for _ in range(n_plan):
-                    rng += _GOLDEN
-                    k = _below(_mix(rng), n_visited)
+                    rng += GOLDEN
+                    k = below(mix(rng), n_visited)
                     _q_update(
                         qf, v, n_max, np.int64(visited[k, 0]), np.int64(visited[k, 1]),
                         np.int64(visited[k, 2]), visited[k, 3], alpha, gamma, n_actions,
@@ -375,187 +313,12 @@ def _run_experiment(
     return done
 
 
-# --------------------------------------------------------------------------- the public API
-
-
-class LiveProgress:
-    """Shared, lock-free progress of a running :func:`run_experiments` call.
-
-    The kernels write ``steps[e, k]`` (and ``updates[e, k]``) the moment episode ``k`` of
-    experiment ``e`` ends; entries still -1 are not done yet. A web page polls these arrays from
-    another thread to draw live curves, and calls :meth:`stop` to end the run at the next episode
-    boundary.
-
-    The learner also sets :attr:`snapshot` once its tables exist: the result so far, whose Q
-    tables (or weights) are the very arrays the kernels update in place, so a checkpoint can save
-    the policy learnt so far without stopping them (or copying every table).
-
-    Args:
-        experiments: number of experiments of the run this object will follow.
-        episodes: episodes per experiment.
-        niceness: how much lower the CPU priority of the threads running the kernels is
-            (Linux ``nice``; 0 leaves it). A studio serving a page trains at a lower priority,
-            so that a heavy run takes only the CPU its API, live pipeline and scene leave.
-    """
-
-    def __init__(self, experiments: int, episodes: int, niceness: int = 0) -> None:
-        self.steps = np.full((experiments, episodes), -1, np.int64)
-        self.updates = np.full((experiments, episodes), -1, np.int64)
-        self.niceness = niceness
-        self.note: str | None = None
-        """A sentence on what the run does before its first episode (preparing the learner), or
-        None once it learns."""
-        self._stop = np.zeros(1, np.int64)
-        self.snapshot: Callable[[], ExperimentResult] | None = None
-        self._cpu_lock = threading.Lock()
-        self._cpu_done = 0.0
-        self._cpu_running: dict[int, float] = {}  # thread ident -> its CPU clock at start
-
-    @contextmanager
-    def counting_cpu(self) -> Iterator[list[float]]:
-        """Count the calling thread's CPU time as this run's while the block runs (the kernels'
-        threads wrap each experiment in it), so :attr:`cpu_seconds` grows live.
-
-        Yields a one-element list that holds the block's CPU seconds once it ends.
-        """
-        ident = threading.get_ident()
-        spent = [0.0]
-        start = time.thread_time()
-        with self._cpu_lock:
-            self._cpu_running[ident] = start
-        try:
-            yield spent
-        finally:
-            spent[0] = time.thread_time() - start
-            with self._cpu_lock:
-                del self._cpu_running[ident]
-                self._cpu_done += spent[0]
-
-    @property
-    def cpu_seconds(self) -> float:
-        """CPU seconds the run's experiments have used so far, the ones still running included."""
-        with self._cpu_lock:  # a thread leaves _cpu_running under this lock before it ends
-            total = self._cpu_done
-            for ident, start in self._cpu_running.items():
-                with suppress(OSError, AttributeError, OverflowError):  # no per-thread clocks
-                    total += time.clock_gettime(time.pthread_getcpuclockid(ident)) - start
-        return total
-
-    def stop(self) -> None:
-        """Ask every experiment to stop at its next episode boundary."""
-        self._stop[0] = 1
-
-    @property
-    def stopped(self) -> bool:
-        """Whether :meth:`stop` was called."""
-        return bool(self._stop[0])
-
-    @property
-    def completed(self) -> int:
-        """Episodes finished so far, over all experiments."""
-        return int(np.count_nonzero(self.steps >= 0))
-
-    @property
-    def total(self) -> int:
-        """Episodes the run will do if not stopped."""
-        return int(self.steps.size)
-
-
-def result_so_far(
-    kind: type[R],
-    live: LiveProgress,
-    cpu_seconds: np.ndarray,
-    q: np.ndarray,
-    config: DynaQConfig,
-    seed: int,
-    **extra: Any,
-) -> R:
-    """A learner's result as it stands: the progress so far, and ``q``, the tables the kernels
-    are updating in place (not copied); ``stopped`` while episodes remain. Every learner builds
-    its result, final or partial (:attr:`LiveProgress.snapshot`), through this."""
-    return kind(
-        steps=live.steps.copy(),
-        updates=live.updates.copy(),
-        cpu_seconds=cpu_seconds.copy(),
-        q=q,
-        config=config,
-        seed=seed,
-        stopped=bool(np.any(live.steps < 0)),
-        **extra,
-    )
-
-
-def lower_thread_priority(niceness: int) -> None:
-    """Run the calling thread ``niceness`` below the process's CPU priority (Linux, per thread).
-
-    Only the threads that run the kernels call it: they hold no GIL while they compute, so
-    the process's Python threads (a web server's) never wait for a low-priority thread holding
-    it. Idempotent; a no-op for ``niceness <= 0`` and where threads have no priority of their own.
-    """
-    if niceness <= 0 or not hasattr(os, "setpriority") or sys.platform != "linux":
-        return
-    try:
-        target = min(os.getpriority(os.PRIO_PROCESS, os.getpid()) + niceness, MAX_NICENESS)
-        tid = threading.get_native_id()
-        if os.getpriority(os.PRIO_PROCESS, tid) < target:
-            os.setpriority(os.PRIO_PROCESS, tid, target)
-    except OSError:  # never a reason not to train
-        return
-
-
-@dataclass(frozen=True, eq=False)
-class ExperimentResult:
-    """What :func:`run_experiments` returns.
-
-    Attributes:
-        steps: int ``(experiments, episodes)``: real steps per episode; -1 where the run was
-            stopped before the episode ended.
-        updates: int ``(experiments, episodes)``: Q updates per episode (real plus planning), -1
-            where not done.
-        cpu_seconds: float ``(experiments,)``: CPU time of each experiment's thread.
-        q: float ``(experiments, S, A)``: the final Q tables.
-        config: the settings used.
-        seed: the seed used.
-        stopped: whether the run was stopped early.
-    """
-
-    steps: np.ndarray
-    updates: np.ndarray
-    cpu_seconds: np.ndarray
-    q: np.ndarray
-    config: DynaQConfig
-    seed: int
-    stopped: bool
-
-    @property
-    def completed(self) -> np.ndarray:
-        """bool ``(experiments, episodes)``: which episodes finished."""
-        return self.steps >= 0
-
-    def mean_steps(self) -> np.ndarray:
-        """Mean steps per episode over the experiments that finished it (NaN where none did)."""
-        done = self.completed
-        total = np.where(done, self.steps, 0).sum(axis=0).astype(np.float64)
-        count = done.sum(axis=0)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            return np.where(count > 0, total / np.maximum(count, 1), np.nan)
-
-    def best_experiment(self, tail: float = 0.25) -> int:
-        """Index of the experiment with the fewest mean steps over its last ``tail`` of episodes."""
-        scores = []
-        for row in self.steps:
-            done = row[row >= 0]
-            if done.size == 0:
-                scores.append(np.inf)
-                continue
-            k = max(1, int(np.ceil(done.size * tail)))
-            scores.append(float(done[-k:].mean()))
-        return int(np.argmin(scores))
+# --------------------------------------------------------------------------- the tabular learner
 
 
 def demonstration_actions(
-    mdp: TabularMDP, demonstrations: Sequence[Sequence[int]]
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    mdp: TabularMDP, demonstrations: Sequence[Sequence[int] | np.ndarray]
+) -> Demonstrations:
     """Turn state sequences into the actions that connect them.
 
     Args:
@@ -612,16 +375,11 @@ def demonstration_actions(
         offsets.append(offsets[-1] + path.size - 1)
         starts.append(path[0])
     flat = np.concatenate(actions) if actions else np.zeros(0, np.int64)
-    return (
+    return Demonstrations(
         np.ascontiguousarray(flat, dtype=np.int64),
         np.asarray(offsets, dtype=np.int64),
         np.asarray(starts, dtype=np.int64),
     )
-
-
-def experiment_seed(seed: int, experiment: int) -> np.uint64:
-    """The generator seed of one experiment, derived from the run seed and its index."""
-    return np.uint64(np.random.SeedSequence([seed, experiment]).generate_state(1, np.uint64)[0])
 
 
 def warm_up() -> float:
@@ -635,120 +393,46 @@ def warm_up() -> float:
         np.array([[1], [1]]), np.array([[1.0], [0.0]]), np.array([False, True]), np.array([0])
     )
     for planning in ("full", "prioritized"):
-        run_experiments(corridor, DynaQConfig(planning=planning, planning_steps=1), 1, 1, 0)
+        run_tabular_experiments(corridor, DynaQConfig(planning=planning, planning_steps=1), 1, 1, 0)
     return time.perf_counter() - start
 
 
-def check_run_arguments(
-    config: object,
-    experiments: object,
-    episodes: object,
-    seed: object,
-    workers: object,
-    live: object,
-    n_states: int = 1,
-    n_actions: int = 1,
-) -> tuple[int, int, LiveProgress]:
-    """Check the arguments every learner's ``run_experiments`` shares, before any work starts.
-
-    Returns:
-        ``(seed, workers, live)``: the seed as a plain int, the thread count (``None``: one per
-        core), and the progress to fill (a new one when ``live`` is None).
-
-    Raises:
-        ConfigError, LearningError: one sentence naming the bad argument and the fix.
-    """
-    if not isinstance(config, DynaQConfig):
-        raise LearningError(f"config is a {type(config).__name__}; give a DynaQConfig.")
-    check_budget(experiments, episodes, n_states, n_actions)
-    if not isinstance(seed, int | np.integer) or isinstance(seed, bool) or not 0 <= seed < 2**63:
-        raise LearningError(f"seed is {seed!r}; give a whole number from 0 to 2**63 - 1.")
-    if workers is None:
-        workers = os.cpu_count() or 1
-    if not isinstance(workers, int) or isinstance(workers, bool) or workers < 1:
-        raise LearningError(f"workers is {workers!r}; give a whole number of threads, at least 1.")
-    if live is None:
-        live = LiveProgress(experiments, episodes)  # type: ignore[arg-type]
-    elif not isinstance(live, LiveProgress) or live.steps.shape != (experiments, episodes):
-        raise LearningError(
-            f"live follows a run of shape {getattr(getattr(live, 'steps', None), 'shape', None)}; create LiveProgress({experiments}, {episodes}) for this run."
-        )
-    if live.completed:
-        raise LearningError(
-            "live already holds a finished run; create a new LiveProgress for each run."
-        )
-    return int(seed), workers, live
-
-
-def run_experiments(
+def run_tabular_experiments(
     mdp: TabularMDP,
     config: DynaQConfig,
     experiments: int,
     episodes: int,
     seed: int,
-    demonstrations: Sequence[Sequence[int]] | None = None,
-    features: TileCoding | None = None,
+    demonstrations: Sequence[Sequence[int] | np.ndarray] | None = None,
     *,
     workers: int | None = None,
     live: LiveProgress | None = None,
 ) -> ExperimentResult:
-    """Run ``experiments`` independent Dyna-Q learners for ``episodes`` episodes each.
-
-    Experiment ``e`` draws its random numbers from a generator seeded by ``(seed, e)``, so the
-    result is identical bit for bit for a given seed whatever ``workers`` is. Experiments run on a
-    pool of ``workers`` threads; the compiled kernels release the GIL.
-
-    Args:
-        mdp: the task.
-        config: learning settings.
-        experiments: independent repetitions to average over (the paper used 20).
-        episodes: episodes per experiment.
-        seed: a non-negative integer.
-        demonstrations: state sequences replayed as the first ``len(demonstrations)`` episodes
-            (the agent takes the demonstrated actions, learning and planning as usual).
-        workers: threads to use (default: one per CPU core).
-        live: progress arrays to fill while running, and the stop flag to obey.
-        features: for a Gymnasium environment (a registered id or a zero-argument callable
-            returning one, Box observations, Discrete actions) in place of ``mdp``: the tile
-            coding of linear Dyna-Q (see :mod:`._linear`, which then runs the experiments and
-            returns a :class:`LinearResult` with the learned weights).
-
-    Returns:
-        The step and update counts per episode, CPU seconds per experiment and the final Q tables.
-
-    Raises:
-        LearningError: for a bad argument, a bad demonstration or a run over the limits.
-    """
-    if not isinstance(mdp, TabularMDP) and (isinstance(mdp, str) or callable(mdp)):
-        from ._linear import run_linear_experiments  # imports this module: import it late
-
-        return run_linear_experiments(
-            mdp, config, experiments, episodes, seed, demonstrations, features,
-            workers=workers, live=live,
-        )  # fmt: skip
-    if not isinstance(mdp, TabularMDP):
-        raise LearningError(
-            f"mdp is a {type(mdp).__name__}; give a TabularMDP (for example ArmGrid().mdp()), a Gymnasium environment id or a zero-argument callable returning an environment."
-        )
+    """Tabular Dyna-Q on ``mdp`` (:func:`studio.learning.run_experiments` for a
+    :class:`TabularMDP`, whose arguments it takes; ``demonstrations`` are state sequences)."""
     seed, workers, live = check_run_arguments(
         config, experiments, episodes, seed, workers, live, mdp.n_states, mdp.n_actions
     )
-    demo_actions, demo_offsets, demo_starts = demonstration_actions(mdp, demonstrations or [])
-
+    demos = demonstration_actions(mdp, demonstrations or [])
+    task = Dynamics(mdp.next_state, mdp.reward, mdp.terminal, mdp.start_states)
+    learning = Learning(
+        float(config.alpha),
+        float(config.gamma),
+        float(config.epsilon),
+        PLANNER_CODE[config.planning],
+        int(config.planning_steps),
+        int(config.max_steps_per_episode),
+        float(config.priority_threshold),
+    )
     q = np.zeros((experiments, mdp.n_states, mdp.n_actions), np.float64)
     cpu_seconds = np.zeros(experiments, np.float64)
-    planner = _PLANNER_CODE[config.planning]
 
     def one(e: int) -> None:
         lower_thread_priority(live.niceness)
         with live.counting_cpu() as spent:
             _run_experiment(
-                mdp.next_state, mdp.reward, mdp.terminal, mdp.start_states,
-                float(config.alpha), float(config.gamma), float(config.epsilon), planner,
-                int(config.planning_steps), int(config.max_steps_per_episode),
-                float(config.priority_threshold),
-                demo_actions, demo_offsets, demo_starts,
-                experiment_seed(seed, e), live._stop, live.steps[e], live.updates[e], q[e],
+                task, learning, demos, experiment_seed(seed, e), live._stop, live.steps[e],
+                live.updates[e], q[e],
             )  # fmt: skip
         cpu_seconds[e] = spent[0]
 

@@ -33,69 +33,71 @@ priority comes up.
 
 Where the dynamics run. For our arm task (``TeachStudio/ArmReach-v0``) and Gymnasium's
 ``MountainCar-v0`` the whole experiment runs in one compiled kernel (:func:`_run_compiled`) that
-steps a numba twin of the environment's dynamics (the arm's are defined once in :mod:`._reach`;
-Mountain Car's twin is tested equal to Gymnasium's ``step``). Any other environment with a Box
-observation and Discrete actions runs a Python loop calling ``env.step`` and the same compiled
-learning step (:func:`_learn`), so both paths give the same result bit for bit on the same task.
-Start states come from ``env.reset`` in both paths (seeded per experiment), so they agree too.
+steps a numba twin of the environment's dynamics (:mod:`._linear_env`, which makes, checks and
+recognises the environments). Every other environment with a Box observation and Discrete actions
+runs a Python loop calling ``env.step`` and the same compiled learning step (:func:`_learn`), so
+both paths give the same result bit for bit on the same task. Start states come from
+``env.reset`` in both paths (seeded per experiment), so they agree too.
 
-Random numbers: splitmix64 inside the kernels, as in the tabular learner, seeded per experiment
-by ``(seed, experiment)``; the environment's resets by ``seed`` and the experiment index.
+Random numbers: splitmix64 inside the kernels, as in the tabular learner (both take it, the
+priority heap and the run around the kernels from :mod:`._learner`), seeded per experiment by
+``(seed, experiment)``; the environment's resets by ``seed`` and the experiment index.
 
 Caching caveat: numba's disk cache of these kernels is keyed on this file alone, yet they compile
-in the dynamics of ``_reach.py`` and the features of ``_tiles.py``; after editing either, touch
-this file (or delete ``__pycache__/_linear*.nb*``) so the kernels recompile.
+in the dynamics of ``_reach.py`` and ``_linear_env.py``, the features of ``_tiles.py`` and the
+helpers of ``_learner.py``; after editing one of those, touch this file (or delete
+``__pycache__/_linear*.nb*``) so the kernels recompile.
 """
 
 from __future__ import annotations
 
-import math
 from collections import namedtuple
 from collections.abc import Callable, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, replace
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numba import njit
 
-from ._config import MAX_Q_ENTRIES, PLANNERS, DynaQConfig
-from ._dynaq import (
-    _GOLDEN,
+from ._config import MAX_Q_ENTRIES, DynaQConfig
+from ._errors import LearningError
+from ._learner import (
+    GOLDEN,
+    PLANNER_CODE,
+    PRIORITIZED,
+    ZERO,
     ExperimentResult,
     LiveProgress,
-    _below,
-    _heap_pop,
-    _heap_push,
-    _mix,
-    _unit,
+    below,
     check_run_arguments,
     experiment_seed,
+    heap_pop,
+    heap_push,
     lower_thread_priority,
+    mix,
+    plan_budget,
     result_so_far,
+    unit,
 )
-from ._errors import LearningError
-from ._reach import ArmReach, reach_step
+from ._linear_env import (
+    TASK_REACH,
+    env_demonstrations,
+    inspect_env,
+    make_env,
+    observe,
+    reset_seed,
+    reset_states,
+    task_step,
+)
+from ._reach import ArmReach
 from ._tiles import TileCoder, TileCoding, active_features
+
+if TYPE_CHECKING:
+    import gymnasium
 
 DEFAULT_MODEL_CAPACITY = 1 << 18
 """Transitions the sample model keeps (a ring; about 100 bytes each for a 6-D observation)."""
-
-_PLANNER_CODE = {name: code for code, name in enumerate(PLANNERS)}
-_ZERO, _FULL, _SOFT, _PRIORITIZED = (_PLANNER_CODE[name] for name in PLANNERS)
-
-_TASK_REACH = 0
-_TASK_MOUNTAIN_CAR = 1
-# Mountain Car's parameter layout (gymnasium's attribute names)
-_MOUNTAIN_CAR_PARAMS = (
-    "force",
-    "gravity",
-    "max_speed",
-    "min_position",
-    "max_position",
-    "goal_position",
-    "goal_velocity",
-)
 
 Agent = namedtuple(
     "Agent",
@@ -115,31 +117,6 @@ Episodes = namedtuple(
 """What the compiled kernel plays: start states ``(episodes, state_dim)``, demonstrations
 (starts ``(n, state_dim)``, actions back to back, offsets ``(n + 1,)``), the step cap, the
 planning budget and epsilon."""
-
-
-# --------------------------------------------------------------------------- Mountain Car twin
-
-
-@njit(nogil=True, cache=True)
-def mountain_car_step(params, state, action):
-    """Gymnasium's ``MountainCarEnv.step`` on ``state = [position, velocity]`` (in place).
-
-    Returns ``(reward, terminated)``. The same float64 operations in the same order as Gymnasium
-    1.x, so the result is equal bit for bit (a test steps both side by side).
-    """
-    force, gravity, max_speed = params[0], params[1], params[2]
-    min_position, max_position = params[3], params[4]
-    position = state[0]
-    velocity = state[1]
-    velocity += (action - 1) * force + math.cos(3 * position) * (-gravity)
-    velocity = min(max(velocity, -max_speed), max_speed)
-    position += velocity
-    position = min(max(position, min_position), max_position)
-    if position == min_position and velocity < 0:
-        velocity = 0.0
-    state[0] = position
-    state[1] = velocity
-    return -1.0, position >= params[5] and velocity >= params[6]
 
 
 # --------------------------------------------------------------------------- learning steps
@@ -174,10 +151,10 @@ def _choose(q, epsilon, rng):
     action or, when several actions tie for the best, one to pick among them.
     """
     n_actions = q.shape[0]
-    rng += _GOLDEN
-    if _unit(_mix(rng)) < epsilon:
-        rng += _GOLDEN
-        return _below(_mix(rng), n_actions), rng
+    rng += GOLDEN
+    if unit(mix(rng)) < epsilon:
+        rng += GOLDEN
+        return below(mix(rng), n_actions), rng
     best = _max(q)
     ties = 0
     for a in range(n_actions):
@@ -185,8 +162,8 @@ def _choose(q, epsilon, rng):
             ties += 1
     k = 0
     if ties > 1:
-        rng += _GOLDEN
-        k = _below(_mix(rng), ties)
+        rng += GOLDEN
+        k = below(mix(rng), ties)
     count = 0
     for a in range(n_actions):
         if q[a] == best:
@@ -248,7 +225,7 @@ def _queue(agent, slot):
     """Queue ``slot`` with its current error when that exceeds the threshold."""
     priority = _error(agent, slot)
     if priority > agent.threshold:
-        agent.counters[_HEAP] = _heap_push(
+        agent.counters[_HEAP] = heap_push(
             agent.heap_idx, agent.heap_pri, agent.heap_pos, agent.counters[_HEAP], slot, priority
         )
 
@@ -295,13 +272,13 @@ def _learn(agent, obs, feats_s, action, reward, terminal, obs_next, follows, n_p
     if agent.model_stamp.shape[0] == 0:
         return rng, updates
     slot = _store(agent, obs, action, reward, terminal, obs_next, follows)
-    if agent.planner == _PRIORITIZED:
+    if agent.planner == PRIORITIZED:
         _queue(agent, slot)
         _queue_predecessor(agent, slot)
         for _ in range(n_plan):
             if agent.counters[_HEAP] == 0:
                 break
-            p, agent.counters[_HEAP] = _heap_pop(
+            p, agent.counters[_HEAP] = heap_pop(
                 agent.heap_idx, agent.heap_pri, agent.heap_pos, agent.counters[_HEAP]
             )
             _replay(agent, p)
@@ -311,8 +288,8 @@ def _learn(agent, obs, feats_s, action, reward, terminal, obs_next, follows, n_p
     else:
         stored = agent.counters[_STORED]
         for _ in range(n_plan):
-            rng += _GOLDEN
-            _replay(agent, _below(_mix(rng), stored))
+            rng += GOLDEN
+            _replay(agent, below(mix(rng), stored))
         updates += n_plan
     return rng, updates
 
@@ -324,34 +301,7 @@ def _act(agent, feats, epsilon, rng):
     return _choose(agent.qvals, epsilon, rng)
 
 
-@njit(nogil=True, cache=True, inline="always")
-def _plan_budget(planner, planning_steps, episode):
-    if planner == _ZERO:
-        return 0
-    if planner == _SOFT:
-        return max(planning_steps - episode, 0)
-    return planning_steps
-
-
 # --------------------------------------------------------------------------- compiled tasks
-
-
-@njit(nogil=True, cache=True, inline="always")
-def _task_step(task, params, state, action):
-    if task == _TASK_REACH:
-        return reach_step(params, state, action)
-    return mountain_car_step(params, state, action)
-
-
-@njit(nogil=True, cache=True, inline="always")
-def _observe(task, state, obs):
-    """The observation the learner sees: the state (Mountain Car rounds it to float32)."""
-    if task == _TASK_MOUNTAIN_CAR:
-        for d in range(state.shape[0]):
-            obs[d] = np.float64(np.float32(state[d]))
-    else:
-        for d in range(state.shape[0]):
-            obs[d] = state[d]
 
 
 @njit(nogil=True, cache=True)
@@ -369,7 +319,7 @@ def _run_compiled(task, params, agent, plays, seed, stop, steps_out, updates_out
     for episode in range(episodes):
         if stop[0] != 0:
             break
-        n_plan = _plan_budget(agent.planner, plays.planning_steps, episode)
+        n_plan = plan_budget(agent.planner, plays.planning_steps, episode)
         demo = episode < n_demos
         if demo:
             state[:] = plays.demo_starts[episode]
@@ -379,7 +329,7 @@ def _run_compiled(task, params, agent, plays, seed, stop, steps_out, updates_out
             state[:] = plays.starts[episode]
             first = 0
             limit = plays.max_steps
-        _observe(task, state, obs)
+        observe(task, state, obs)
         active_features(agent.spec, obs, feats)
         steps = 0
         updates = 0
@@ -388,8 +338,8 @@ def _run_compiled(task, params, agent, plays, seed, stop, steps_out, updates_out
                 action = plays.demo_actions[first + steps]
             else:
                 action, rng = _act(agent, feats, plays.epsilon, rng)
-            reward, terminal = _task_step(task, params, state, action)
-            _observe(task, state, obs_next)
+            reward, terminal = task_step(task, params, state, action)
+            observe(task, state, obs_next)
             rng, n = _learn(
                 agent, obs, feats, action, reward, terminal, obs_next, steps > 0, n_plan, rng
             )
@@ -419,14 +369,14 @@ def _greedy_episode(task, params, spec, w, state, max_steps, path):
     q = np.empty(n_actions)
     path[0] = state
     for steps in range(max_steps):
-        _observe(task, state, obs)
+        observe(task, state, obs)
         active_features(spec, obs, feats)
         _q_values(w, feats, q)
         best = 0
         for a in range(1, n_actions):
             if q[a] > q[best]:
                 best = a
-        _, terminal = _task_step(task, params, state, best)
+        _, terminal = task_step(task, params, state, best)
         if steps + 1 < path.shape[0]:
             path[steps + 1] = state
         if terminal:
@@ -447,9 +397,9 @@ def _new_agent(
 ) -> Agent:
     """Zero weights (``weights``, a zeroed ``(size, actions)`` table to learn into, when given),
     an empty model (none at all for zero planning) and scratch arrays."""
-    planner = _PLANNER_CODE[config.planning]
-    cap = 0 if planner == _ZERO or config.planning_steps == 0 else capacity
-    queue = cap if planner == _PRIORITIZED else 0
+    planner = PLANNER_CODE[config.planning]
+    cap = 0 if planner == ZERO or config.planning_steps == 0 else capacity
+    queue = cap if planner == PRIORITIZED else 0
     return Agent(
         np.zeros((coder.size, n_actions), np.float64) if weights is None else weights,
         coder.spec,
@@ -474,109 +424,6 @@ def _new_agent(
         np.zeros(coder.n_active, np.int64),
         np.zeros(n_actions, np.float64),
     )
-
-
-@dataclass(frozen=True)
-class _Task:
-    """What a run knows about its environment after inspecting it."""
-
-    code: int | None  # compiled task code, or None for the Python loop
-    params: np.ndarray
-    low: np.ndarray
-    high: np.ndarray
-    n_actions: int
-    max_steps: int
-    reach: ArmReach | None
-    env_id: str | None
-
-
-_PASS_THROUGH_WRAPPERS = ("TimeLimit", "OrderEnforcing", "PassiveEnvChecker")
-"""Gymnasium wrappers that change neither observations, actions nor rewards."""
-
-
-def _make_env(env: object, index: int) -> Any:
-    """A fresh environment from an id or a zero-argument callable."""
-    import gymnasium
-
-    try:
-        made = gymnasium.make(env) if isinstance(env, str) else env()  # type: ignore[operator]
-    except gymnasium.error.Error as err:
-        raise LearningError(
-            f"Gymnasium cannot make {env!r} ({err}); give a registered environment id."
-        ) from None
-    if not isinstance(made, gymnasium.Env):
-        raise LearningError(
-            f"The environment factory returned a {type(made).__name__}; return a gymnasium.Env."
-        )
-    return made
-
-
-def _inspect(env: Any, config: DynaQConfig) -> _Task:
-    """Check the spaces and find a compiled twin of the dynamics, if there is one."""
-    from gymnasium import spaces
-    from gymnasium.envs.classic_control.mountain_car import MountainCarEnv
-
-    from ._gym import ArmReachEnv
-
-    name = getattr(getattr(env, "spec", None), "id", None) or type(env.unwrapped).__name__
-    if not isinstance(env.action_space, spaces.Discrete):
-        raise LearningError(
-            f"{name} has a {type(env.action_space).__name__} action space; this learner needs Discrete actions (discretise the actions, for example with a wrapper)."
-        )
-    if not isinstance(env.observation_space, spaces.Box) or len(env.observation_space.shape) != 1:
-        raise LearningError(
-            f"{name} has a {env.observation_space} observation space; tile coding needs a one-dimensional Box."
-        )
-    if int(env.action_space.start) != 0:
-        raise LearningError(
-            f"{name}'s actions start at {int(env.action_space.start)}; give a Discrete space starting at 0."
-        )
-    max_steps = int(config.max_steps_per_episode)
-    plain = True
-    layer = env
-    while hasattr(layer, "env"):
-        if type(layer).__name__ not in _PASS_THROUGH_WRAPPERS:
-            plain = False
-        if type(layer).__name__ == "TimeLimit":
-            max_steps = min(max_steps, int(layer._max_episode_steps))
-        layer = layer.env
-    raw = env.unwrapped
-    space = env.observation_space
-    code: int | None = None
-    params = np.zeros(0)
-    reach = None
-    if plain and type(raw) is ArmReachEnv:
-        code, reach = _TASK_REACH, raw.task
-        params = reach.params
-    elif plain and type(raw) is MountainCarEnv:
-        code = _TASK_MOUNTAIN_CAR
-        params = np.array([float(getattr(raw, p)) for p in _MOUNTAIN_CAR_PARAMS])
-    spec_id = getattr(getattr(env, "spec", None), "id", None)
-    return _Task(
-        code,
-        params,
-        np.asarray(space.low, np.float64),
-        np.asarray(space.high, np.float64),
-        int(env.action_space.n),
-        max_steps,
-        reach,
-        spec_id,
-    )
-
-
-def _internal_state(env: Any, task: _Task, obs: np.ndarray) -> np.ndarray:
-    """The state a compiled twin steps from, right after ``env.reset``."""
-    raw = env.unwrapped
-    if task.code == _TASK_MOUNTAIN_CAR:
-        return np.asarray(raw.state, dtype=np.float64).copy()
-    if task.code == _TASK_REACH:
-        return np.asarray(raw.q, dtype=np.float64).copy()
-    return np.asarray(obs, dtype=np.float64)
-
-
-def reset_seed(seed: int, experiment: int) -> int:
-    """The seed of an experiment's first ``env.reset`` (later resets continue its generator)."""
-    return int(np.random.SeedSequence([seed, experiment, 1]).generate_state(1, np.uint32)[0])
 
 
 @dataclass(frozen=True, eq=False)
@@ -606,40 +453,13 @@ class LinearResult(ExperimentResult):
         return self.weights[experiment][feats].sum(axis=-2)
 
 
-def _demonstrations(
-    demonstrations: Sequence[Any], task: _Task, dims: int
-) -> tuple[list[np.ndarray | None], list[np.ndarray]]:
-    """Per demonstration: its start state (None: from ``env.reset``) and its actions."""
-    starts: list[np.ndarray | None] = []
-    actions: list[np.ndarray] = []
-    for i, demo in enumerate(demonstrations):
-        arr = np.asarray(demo)
-        if arr.ndim == 2 and task.reach is not None:
-            start, acts = task.reach.demonstration_actions(arr, i)
-            starts.append(start)
-            actions.append(acts)
-            continue
-        if arr.ndim != 1 or arr.size == 0 or not np.issubdtype(arr.dtype, np.integer):
-            what = "a joint path (N, joints) in radians or " if task.reach is not None else ""
-            raise LearningError(
-                f"Demonstration {i} has shape {arr.shape} and type {arr.dtype}; give {what}a non-empty sequence of action numbers."
-            )
-        if arr.min() < 0 or arr.max() >= task.n_actions:
-            raise LearningError(
-                f"Demonstration {i} holds action {int(arr.max() if arr.max() >= task.n_actions else arr.min())}, outside [0, {task.n_actions - 1}]; give actions of this environment."
-            )
-        starts.append(None)
-        actions.append(arr.astype(np.int64))
-    return starts, actions
-
-
 def run_linear_experiments(
-    env: str | Callable[[], Any],
+    env: str | Callable[[], gymnasium.Env],
     config: DynaQConfig,
     experiments: int,
     episodes: int,
     seed: int,
-    demonstrations: Sequence[Any] | None,
+    demonstrations: Sequence[Sequence[int] | np.ndarray] | None,
     features: TileCoding | None,
     *,
     workers: int | None = None,
@@ -676,15 +496,15 @@ def run_linear_experiments(
             f"env is a {type(env).__name__}; give a TabularMDP, a Gymnasium id or a zero-argument callable returning an environment."
         )
     seed, workers, live = check_run_arguments(config, experiments, episodes, seed, workers, live)
-    envs = [_make_env(env, e) for e in range(experiments)]
+    envs = [make_env(env, e) for e in range(experiments)]
     try:
-        task = _inspect(envs[0], config)
+        task = inspect_env(envs[0], config)
         coder = features.bind(task.low, task.high)
         problem = weight_problem(experiments, coder, task.n_actions)
         if problem:
             raise LearningError(problem)
         dims = int(task.low.shape[0])
-        demo_starts, demo_actions = _demonstrations(demonstrations or [], task, dims)
+        demo_starts, demo_actions = env_demonstrations(demonstrations or [], task)
         weights = np.zeros((experiments, coder.size, task.n_actions), np.float64)
         agents = [  # each learns into its row of ``weights``, which checkpoints read as it learns
             _new_agent(coder, task.n_actions, dims, config, model_capacity, weights[e])
@@ -730,18 +550,9 @@ def weight_problem(experiments: int, coder: TileCoder, n_actions: int) -> str | 
     return f"{experiments} weight tables of {coder.size:,} rows x {n_actions} actions need {entries * 8 / 1e9:.1f} GB; give TileCoding a smaller size or run fewer experiments (at most {MAX_Q_ENTRIES:,} weights in all)."
 
 
-def _reset_states(env: Any, task: _Task, seed: int, e: int, episodes: int) -> np.ndarray:
-    """Every episode's start state, from the environment's own ``reset`` (seeded once)."""
-    states = []
-    for k in range(episodes):
-        obs, _ = env.reset(seed=reset_seed(seed, e) if k == 0 else None)
-        states.append(_internal_state(env, task, obs))
-    return np.ascontiguousarray(np.array(states, dtype=np.float64))
-
-
 def _compiled_experiment(env, task, agent, config, seed, e, demo_starts, demo_actions, live):
     episodes = live.steps.shape[1]
-    starts = _reset_states(env, task, seed, e, episodes)
+    starts = reset_states(env, task, seed, e, episodes)
     dims = starts.shape[1]
     if any(s is None for s in demo_starts):
         raise LearningError(
@@ -776,7 +587,7 @@ def _python_experiment(env, task, agent, config, seed, e, demo_starts, demo_acti
     for episode in range(episodes):
         if live.stopped:
             break
-        n_plan = _plan_budget_py(planner, int(config.planning_steps), episode)
+        n_plan = plan_budget.py_func(planner, int(config.planning_steps), episode)
         obs, _ = env.reset(seed=reset_seed(seed, e) if episode == 0 else None)
         demo = episode < len(demo_actions)
         if demo and demo_starts[episode] is not None:
@@ -808,14 +619,6 @@ def _python_experiment(env, task, agent, config, seed, e, demo_starts, demo_acti
         live.updates[e, episode] = updates
 
 
-def _plan_budget_py(planner: int, planning_steps: int, episode: int) -> int:
-    if planner == _ZERO:
-        return 0
-    if planner == _SOFT:
-        return max(planning_steps - episode, 0)
-    return planning_steps
-
-
 def greedy_rollout(
     task: ArmReach, coder: TileCoder, weights: np.ndarray, start: np.ndarray, max_steps: int
 ) -> tuple[np.ndarray, bool]:
@@ -826,7 +629,7 @@ def greedy_rollout(
     state = np.array(start, dtype=np.float64)
     path = np.empty((max_steps + 1, task.joints))
     steps = _greedy_episode(
-        np.int64(_TASK_REACH), task.params, coder.spec,
+        np.int64(TASK_REACH), task.params, coder.spec,
         np.ascontiguousarray(weights, np.float64), state, np.int64(max_steps), path,
     )  # fmt: skip
     reached = steps >= 0
@@ -855,4 +658,4 @@ def _success_many(params, spec, w, starts, max_steps, out):
     path = np.empty((1, starts.shape[1]))
     for i in range(starts.shape[0]):
         state = starts[i].copy()
-        out[i] = _greedy_episode(_TASK_REACH, params, spec, w, state, max_steps, path) >= 0
+        out[i] = _greedy_episode(TASK_REACH, params, spec, w, state, max_steps, path) >= 0

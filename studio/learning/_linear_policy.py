@@ -36,13 +36,14 @@ import json
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
 from studio import JSONFileError, loads_json
 
 from ._config import DynaQConfig
+from ._dmp_policy import FORMAT_NAME as DMP_FORMAT_NAME
+from ._dmp_policy import DmpPolicyFile, load_dmp_policy
 from ._errors import LearningError, PolicyFileError
 from ._linear import LinearResult, greedy_rollout
 from ._policy import (
@@ -99,7 +100,7 @@ class TilePolicyFile:
         """Actions of the environment."""
         return int(self.weights.shape[1])
 
-    def header(self) -> dict[str, Any]:
+    def header(self) -> dict[str, object]:
         """The JSON header written to the file."""
         coder = self.coder
         return {
@@ -213,7 +214,7 @@ def load_tile_policy(path: str | Path) -> TilePolicyFile:
     )
 
 
-def _read_header(archive: BoundedNpz, name: str) -> Any:
+def _read_header(archive: BoundedNpz, name: str) -> object:
     if "header" not in archive.files:
         raise PolicyFileError(
             f"{name} lacks its header; it is not a Teach Studio policy file, export one again."
@@ -228,7 +229,7 @@ def _read_header(archive: BoundedNpz, name: str) -> Any:
         raise PolicyFileError(str(err)) from None
 
 
-def _check_header(name: str, header: Any) -> tuple[TileCoder, DynaQConfig, ArmReach | None, int]:
+def _check_header(name: str, header: object) -> tuple[TileCoder, DynaQConfig, ArmReach | None, int]:
     if not isinstance(header, dict) or header.get("format") != FORMAT_NAME:
         raise PolicyFileError(
             f"{name} is not a tile-coded Teach Studio policy file; export the policy again."
@@ -262,8 +263,9 @@ def _check_header(name: str, header: Any) -> tuple[TileCoder, DynaQConfig, ArmRe
     return coder, config, task, n_actions
 
 
-def load_any_policy(path: str | Path) -> PolicyFile | TilePolicyFile:
-    """Read a policy file of either kind: tabular (:func:`load_policy`) or tile-coded.
+def load_any_policy(path: str | Path) -> PolicyFile | TilePolicyFile | DmpPolicyFile:
+    """Read a policy file of any kind: tabular (:func:`load_policy`), tile-coded, or a
+    movement primitive (:func:`load_dmp_policy`).
 
     Raises:
         PolicyFileError: as the two readers do.
@@ -280,6 +282,8 @@ def load_any_policy(path: str | Path) -> PolicyFile | TilePolicyFile:
         return load_tile_policy(path)
     if kind == TABULAR_FORMAT_NAME:
         return load_policy(path)
+    if kind == DMP_FORMAT_NAME:
+        return load_dmp_policy(path)
     raise PolicyFileError(
         f"{path.name} is not a Teach Studio policy file; export the policy again."
     )

@@ -19,7 +19,7 @@ import threading
 
 import numpy as np
 
-from ._runs import STATISTICS, curve_statistics
+from ._curves import STATISTICS, curve_statistics
 
 SPAN_GAP = 64
 """Changed episodes closer than this are sent as one span (fewer, slightly longer pieces)."""

@@ -9,7 +9,8 @@ crash, a reboot), so any other process, a second studio on the same data folder 
 liveness from the lock and never has to guess, or rewrite the status.
 
 Run folders written before owners locked have no ``owner.lock``; they are judged by their pid,
-checked against the process's start time (:func:`process_started`), on their own host.
+checked against the process's start time (:func:`process_started`), on their own host
+(:func:`pid_alive`, :func:`this_host`).
 """
 
 from __future__ import annotations
@@ -17,10 +18,15 @@ from __future__ import annotations
 import contextlib
 import fcntl
 import os
+import socket
 import stat
+import sys
 import time
+from datetime import datetime
 from pathlib import Path
+from typing import cast
 
+from .._numbers import is_int
 from ._errors import LearningError
 
 OWNER_FILE = "owner.lock"
@@ -115,3 +121,64 @@ def process_started(pid: int) -> float | None:
     except (OSError, ValueError, IndexError, StopIteration):
         return None
     return boot + ticks / os.sysconf("SC_CLK_TCK")
+
+
+def this_host() -> dict[str, str | None]:
+    """Where this process runs, recorded beside every ``pid`` a run or a sweep writes (a pid names
+    a process only on its own host): ``hostname``, and ``node``, the Ray node id when this process
+    is part of a Ray cluster (a sweep's driver or worker), else None. Ray is never imported here."""
+    ray = sys.modules.get("ray")
+    node = None
+    if ray is not None and ray.is_initialized():
+        node = ray.get_runtime_context().get_node_id()
+    return {"hostname": socket.gethostname(), "node": node}
+
+
+def on_this_host(host: object) -> bool:
+    """Whether a record's ``host`` (:func:`this_host`) is this machine; a record without one (older
+    runs, written before hosts were recorded) counts as this machine's."""
+    hostname = host.get("hostname") if isinstance(host, dict) else None
+    return not isinstance(hostname, str) or hostname == socket.gethostname()
+
+
+def pid_alive(pid: object, host: object = None, started: object = None) -> bool:
+    """Whether ``pid`` is a live process other than this one: a run or sweep whose status says
+    it is training but whose process is gone (a crash, ``kill -9``) reads as stopped.
+
+    ``host`` is the record's :func:`this_host`. A pid recorded on another host (a sweep's trial
+    on another node of a cluster, seen through shared storage) names no process here, so this
+    host cannot judge it: it counts as alive (its driver records a trial whose worker died).
+    ``started`` is when the record says its process started the work (ISO 8601): a live process
+    with that pid that started later reused the pid after the recorded one ended.
+    """
+    if not is_int(pid) or cast(int, pid) <= 0:
+        return False
+    pid = int(cast(int, pid))
+    if not on_this_host(host):
+        return True
+    if pid == os.getpid():  # this process's only trainer, the page's queue, never reloads its own
+        return False
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        pass
+    return not _started_after(pid, started)
+
+
+PID_CLOCK_SLACK_SECONDS = 2.0
+"""How much later than a record's ``started`` (kept to the second) its process may seem to have
+started before the pid counts as reused."""
+
+
+def _started_after(pid: int, started: object) -> bool:
+    """Whether process ``pid`` started after the ISO time ``started`` (unknown: False)."""
+    if not isinstance(started, str):
+        return False
+    try:
+        when = datetime.fromisoformat(started).timestamp()
+    except ValueError:
+        return False
+    began = process_started(pid)
+    return began is not None and began > when + PID_CLOCK_SLACK_SECONDS

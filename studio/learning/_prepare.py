@@ -27,9 +27,11 @@ import time
 import numpy as np
 
 from ._config import DynaQConfig
-from ._dynaq import LiveProgress, _run_experiment, run_experiments
+from ._dynaq import _run_experiment
+from ._experiments import run_experiments
+from ._learner import LiveProgress
 from ._mdp import TabularMDP
-from ._runs import TASK_ARM_GRID, TASK_ARM_REACH, TASK_KINDS
+from ._run_record import TASK_ARM_GRID, TASK_ARM_REACH, TASK_KINDS
 
 log = logging.getLogger(__name__)
 

@@ -39,7 +39,7 @@ from numba import njit
 from studio.kinematics import Puma560
 
 from ._arm import DEFAULT_GOAL_DEG, GOAL_REWARD, STEP_REWARD
-from ._errors import LearningError
+from ._errors import ConfigError, LearningError
 from ._tiles import TileCoding
 
 ROBOT_JOINTS = 6
@@ -136,8 +136,11 @@ class ArmReach:
             or isinstance(self.joints, bool)
             or not MIN_JOINTS <= self.joints <= ROBOT_JOINTS
         ):
-            raise LearningError(
-                f"joints is {self.joints!r}; give {MIN_JOINTS} to {ROBOT_JOINTS} (joints 1..J of the arm)."
+            raise ConfigError(
+                [
+                    f"joints is {self.joints!r}; give {MIN_JOINTS} to {ROBOT_JOINTS} (joints 1..J of the arm)."
+                ],
+                ["joints"],
             )
         object.__setattr__(self, "joints", int(self.joints))
         for name, low, high in (
@@ -153,7 +156,9 @@ class ArmReach:
                 or not math.isfinite(value)
                 or not low <= value <= high
             ):
-                raise LearningError(f"{name} is {value!r}; give a number from {low} to {high}.")
+                raise ConfigError(
+                    [f"{name} is {value!r}; give a number from {low} to {high}."], [name]
+                )
             object.__setattr__(self, name, float(value))
         lower, upper = _limits()
         if self.goal is None:
@@ -161,8 +166,11 @@ class ArmReach:
         else:
             g = np.asarray(self.goal, dtype=np.float64).reshape(-1)
             if g.shape not in ((self.joints,), (ROBOT_JOINTS,)) or not np.all(np.isfinite(g)):
-                raise LearningError(
-                    f"goal is {self.goal!r}; give {self.joints} or {ROBOT_JOINTS} finite joint angles in radians."
+                raise ConfigError(
+                    [
+                        f"goal is {self.goal!r}; give {self.joints} or {ROBOT_JOINTS} finite joint angles in radians."
+                    ],
+                    ["goal"],
                 )
             goal = np.radians(DEFAULT_GOAL_DEG).copy()
             goal[: g.shape[0]] = g
@@ -171,8 +179,11 @@ class ArmReach:
         )
         if outside.size:
             j = int(outside[0])
-            raise LearningError(
-                f"The goal's joint {j + 1} is {np.degrees(goal[j]):.1f} deg, outside its limits [{np.degrees(lower[j]):.0f}, {np.degrees(upper[j]):.0f}]; give a goal inside the limits."
+            raise ConfigError(
+                [
+                    f"The goal's joint {j + 1} is {np.degrees(goal[j]):.1f} deg, outside its limits [{np.degrees(lower[j]):.0f}, {np.degrees(upper[j]):.0f}]; give a goal inside the limits."
+                ],
+                ["goal"],
             )
         object.__setattr__(self, "goal", tuple(float(x) for x in np.clip(goal, lower, upper)))
 

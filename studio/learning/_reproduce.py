@@ -28,9 +28,10 @@ from __future__ import annotations
 import csv
 import shutil
 import time
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -38,9 +39,16 @@ from studio import StudioError, read_json
 
 from ._arm import ArmGrid
 from ._config import DEFAULT_EPISODES, DEFAULT_EXPERIMENTS, DEFAULT_SEED, DynaQConfig, check_budget
-from ._dynaq import ExperimentResult, LiveProgress, warm_up
+from ._curves import curve_statistics, write_curves_csv
+from ._dynaq import warm_up
 from ._errors import LearningError
-from ._runs import CONFIG_FILE, RunFolder, RunRecord, curve_statistics, write_curves_csv
+from ._learner import ExperimentResult, LiveProgress
+from ._run_record import RunRecord
+from ._runs import CONFIG_FILE, RunFolder
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from tqdm import tqdm
 
 DEMONSTRATIONS = 20
 """Demonstrated trajectories replayed by the supervised agents (paper: 20)."""
@@ -176,7 +184,7 @@ def _write_timing(path: Path, results: dict[str, ExperimentResult], wall: dict[s
             )
 
 
-def _curve(ax: Any, x: np.ndarray, steps: np.ndarray, **style: Any) -> None:
+def _curve(ax: Axes, x: np.ndarray, steps: np.ndarray, **style: str) -> None:
     """Mean steps per episode, with a band of one standard error either side."""
     mean = steps.mean(axis=0)
     se = _standard_error(steps.astype(np.float64))
@@ -260,35 +268,36 @@ def _fmt_episode(k: int | None, episodes: int) -> str:
     return f"episode {k}" if k is not None else f"not within {episodes} episodes"
 
 
-def judge_claims(results: dict[str, ExperimentResult], grid: ArmGrid, demos: int) -> list[Claim]:
-    """Compare our curves and times with the paper's claims (Section V)."""
-    mean = {name: r.steps.mean(axis=0) for name, r in results.items()}
-    cpu = {name: float(r.cpu_seconds.sum()) for name, r in results.items()}
-    updates = {name: int(r.updates.sum()) for name, r in results.items()}
-    episodes = next(iter(results.values())).steps.shape[1]
-    level = CONVERGENCE_FACTOR * grid.mean_shortest_steps()
-    claims = []
+PLANNERS_SHORT = ("ZPL", "FPL", "SPL")
+"""The paper's three planners by their short names (zero, full, soft)."""
 
-    first = {p: mean[f"US-{p}"][0] for p in ("ZPL", "FPL", "SPL")}
+
+def _claim_first_episode(
+    results: dict[str, ExperimentResult], mean: dict[str, np.ndarray]
+) -> Claim:
+    first = {p: mean[f"US-{p}"][0] for p in PLANNERS_SHORT}
     first_se = {p: _standard_error(results[f"US-{p}"].steps[:, :1])[0] for p in first}
-    claims.append(
-        Claim(
-            f"An unsupervised agent needs thousands of steps in its first episode (paper: about {PAPER_FIRST_EPISODE_STEPS}).",
-            "Mean first-episode steps ± standard error: "
-            + ", ".join(f"US-{p} {_pm(v, first_se[p])}" for p, v in first.items())
-            + ". A first episode is a search for a goal not yet seen; its length spreads about as "
-            "widely as its mean, so 20 experiments pin the mean down to about ± 20 %, and it "
-            "depends on where the goal lies (goals near the ends of the joint ranges take longer "
-            "to find; the paper shows its goal only as a picture). Counted as reproduced when "
-            "every mean is at least 1000.",
-            bool(min(first.values()) >= 1000),
-        )
+    return Claim(
+        f"An unsupervised agent needs thousands of steps in its first episode (paper: about {PAPER_FIRST_EPISODE_STEPS}).",
+        "Mean first-episode steps ± standard error: "
+        + ", ".join(f"US-{p} {_pm(v, first_se[p])}" for p, v in first.items())
+        + ". A first episode is a search for a goal not yet seen; its length spreads about as "
+        "widely as its mean, so 20 experiments pin the mean down to about ± 20 %, and it "
+        "depends on where the goal lies (goals near the ends of the joint ranges take longer "
+        "to find; the paper shows its goal only as a picture). Counted as reproduced when "
+        "every mean is at least 1000.",
+        bool(min(first.values()) >= 1000),
     )
 
+
+def _claim_planners_converge(
+    mean: dict[str, np.ndarray], grid: ArmGrid, demos: int, episodes: int
+) -> Claim:
+    level = CONVERGENCE_FACTOR * grid.mean_shortest_steps()
     conv = {}
     for prefix in ("US", "SV"):
         start = demos if prefix == "SV" else 0
-        for p in ("ZPL", "FPL", "SPL"):
+        for p in PLANNERS_SHORT:
             conv[f"{prefix}-{p}"] = episodes_to_converge(mean[f"{prefix}-{p}"], level, start)
 
     def earlier(a: int | None, b: int | None) -> bool:
@@ -299,123 +308,127 @@ def judge_claims(results: dict[str, ExperimentResult], grid: ArmGrid, demos: int
         for prefix in ("US", "SV")
         for p in ("FPL", "SPL")
     )
-    claims.append(
-        Claim(
-            "Planning agents converge in far fewer episodes than zero-planning agents.",
-            f"Episodes until the {CONVERGENCE_WINDOW}-episode mean falls to {level:.0f} steps "
-            f"({CONVERGENCE_FACTOR:g} x the mean shortest path of {grid.mean_shortest_steps():.2f}): "
-            + ", ".join(f"{name} {_fmt_episode(k, episodes)}" for name, k in conv.items())
-            + ". Counted as reproduced when each planner needs at most half the episodes of zero planning.",
-            planners_win,
-        )
+    return Claim(
+        "Planning agents converge in far fewer episodes than zero-planning agents.",
+        f"Episodes until the {CONVERGENCE_WINDOW}-episode mean falls to {level:.0f} steps "
+        f"({CONVERGENCE_FACTOR:g} x the mean shortest path of {grid.mean_shortest_steps():.2f}): "
+        + ", ".join(f"{name} {_fmt_episode(k, episodes)}" for name, k in conv.items())
+        + ". Counted as reproduced when each planner needs at most half the episodes of zero planning.",
+        planners_win,
     )
 
-    demo_peak = max(float(mean[f"SV-{p}"][:demos].max()) for p in ("ZPL", "FPL", "SPL"))
-    us_first = min(first.values())
-    claims.append(
-        Claim(
-            "Supervision removes the long first episodes.",
-            f"Longest mean episode while replaying the {demos} demonstrations: {demo_peak:.1f} steps, "
-            f"against {us_first:.0f} in the unsupervised first episode.",
-            bool(demo_peak < 0.1 * us_first),
-        )
+
+def _claim_supervision(mean: dict[str, np.ndarray], demos: int) -> Claim:
+    demo_peak = max(float(mean[f"SV-{p}"][:demos].max()) for p in PLANNERS_SHORT)
+    us_first = min(mean[f"US-{p}"][0] for p in PLANNERS_SHORT)
+    return Claim(
+        "Supervision removes the long first episodes.",
+        f"Longest mean episode while replaying the {demos} demonstrations: {demo_peak:.1f} steps, "
+        f"against {us_first:.0f} in the unsupervised first episode.",
+        bool(demo_peak < 0.1 * us_first),
     )
 
+
+def _claim_release(
+    results: dict[str, ExperimentResult], mean: dict[str, np.ndarray], demos: int
+) -> Claim:
+    jump = {p: float(mean[f"SV-{p}"][demos]) for p in PLANNERS_SHORT}
+    jump_se = {p: _standard_error(results[f"SV-{p}"].steps[:, demos : demos + 1])[0] for p in jump}
+    return Claim(
+        "On release the supervised zero-planning agent jumps to about 200 steps per episode, the planning agents to about 40.",
+        f"Mean steps ± standard error in episode {demos + 1}, the first after release: "
+        + ", ".join(
+            f"SV-{p} {_pm(v, jump_se[p])} (paper ~{PAPER_RELEASE_STEPS[p]})"
+            for p, v in jump.items()
+        )
+        + ". Counted as reproduced when zero planning jumps at least twice as high as both planners.",
+        bool(jump["ZPL"] >= 2 * max(jump["FPL"], jump["SPL"])),
+    )
+
+
+def _claim_unsupervised_better(results: dict[str, ExperimentResult], demos: int) -> Claim:
+    window = slice(demos, 35)
+    sv_runs = results["SV-FPL"].steps[:, window].mean(axis=1)  # one value per experiment
+    us_runs = results["US-FPL"].steps[:, window].mean(axis=1)
+    sv, us = float(sv_runs.mean()), float(us_runs.mean())
+    sv_se = float(_standard_error(sv_runs))
+    us_se = float(_standard_error(us_runs))
+    diff_se = float(np.hypot(sv_se, us_se))
+    if not np.isfinite(diff_se):
+        noise = ""
+    elif sv - us > 2 * diff_se:
+        noise = " The difference is more than twice its standard error."
+    else:
+        noise = (
+            " The difference is within twice its standard error: the direction matches the "
+            "paper, but this many experiments cannot tell the two apart."
+        )
+    return Claim(
+        "Between the 20th and 35th episode the unsupervised agent performs a little better than the supervised one (Fig. 8).",
+        f"Mean steps over episodes {demos + 1}-35 with full planning: supervised {_pm(sv, sv_se, 1)}, "
+        f"unsupervised {_pm(us, us_se, 1)}; difference {_pm(sv - us, diff_se, 1)}." + noise,
+        bool(us < sv),
+    )
+
+
+def _ratios(values: Mapping[str, float], top: str, bottom: str, floor: float) -> dict[str, float]:
+    """``top`` over ``bottom`` (planners' short names) for SV and US, the divisor at least ``floor``."""
+    return {p: values[f"{p}-{top}"] / max(values[f"{p}-{bottom}"], floor) for p in ("SV", "US")}
+
+
+def _claim_full_cost(cpu: dict[str, float], updates: dict[str, int]) -> Claim:
+    ratios = _ratios(cpu, "FPL", "ZPL", 1e-12)
+    upd = _ratios(updates, "FPL", "ZPL", 1)
+    paper = _ratios(PAPER_MATLAB_SECONDS, "FPL", "ZPL", 1e-12)
+    return Claim(
+        "Full planning costs about 50 times the CPU time of zero planning.",
+        "CPU full/zero: "
+        + ", ".join(f"{p} {ratios[p]:.1f}x (paper {paper[p]:.1f}x)" for p in ratios)
+        + "; Q updates full/zero: "
+        + ", ".join(f"{p} {upd[p]:.1f}x" for p in upd)
+        + f". Counted as reproduced when both ratios, of CPU and of Q updates, lie between "
+        f"{FULL_ZERO_RANGE[0]:g}x and {FULL_ZERO_RANGE[1]:g}x (CPU times of hundredths of a "
+        "second vary by about 10 % between runs on a busy machine; update counts are exact). "
+        f"The work itself grows only {min(upd.values()):.0f}-{max(upd.values()):.0f}x, so the "
+        "paper's 50x also reflects Matlab's costly planning loop; in our kernel a planning "
+        "update costs a fraction of a real step (action choice, model bookkeeping).",
+        all(_within(r, FULL_ZERO_RANGE) for r in (*ratios.values(), *upd.values())),
+    )
+
+
+def _claim_soft_cost(cpu: dict[str, float], updates: dict[str, int]) -> Claim:
+    soft = _ratios(cpu, "SPL", "FPL", 1e-12)
+    soft_updates = _ratios(updates, "SPL", "FPL", 1)
+    paper_soft = _ratios(PAPER_MATLAB_SECONDS, "SPL", "FPL", 1e-12)
+    return Claim(
+        "Soft planning costs about a third to half of full planning.",
+        "CPU soft/full: "
+        + ", ".join(f"{p} {soft[p]:.2f} (paper {paper_soft[p]:.2f})" for p in soft)
+        + "; Q updates soft/full: "
+        + ", ".join(f"{p} {soft_updates[p]:.2f}" for p in soft_updates)
+        + f". Counted as reproduced when both ratios, of CPU and of Q updates, lie between "
+        f"{SOFT_FULL_RANGE[0]:g} and {SOFT_FULL_RANGE[1]:g}. Most planning happens in the long "
+        "early episodes, where soft still plans almost as much as full.",
+        all(_within(r, SOFT_FULL_RANGE) for r in (*soft.values(), *soft_updates.values())),
+    )
+
+
+def judge_claims(results: dict[str, ExperimentResult], grid: ArmGrid, demos: int) -> list[Claim]:
+    """Compare our curves and times with the paper's claims (Section V), one claim each."""
+    mean = {name: r.steps.mean(axis=0) for name, r in results.items()}
+    cpu = {name: float(r.cpu_seconds.sum()) for name, r in results.items()}
+    updates = {name: int(r.updates.sum()) for name, r in results.items()}
+    episodes = next(iter(results.values())).steps.shape[1]
+    claims = [
+        _claim_first_episode(results, mean),
+        _claim_planners_converge(mean, grid, demos, episodes),
+        _claim_supervision(mean, demos),
+    ]
     if episodes > demos:
-        jump = {p: float(mean[f"SV-{p}"][demos]) for p in ("ZPL", "FPL", "SPL")}
-        jump_se = {
-            p: _standard_error(results[f"SV-{p}"].steps[:, demos : demos + 1])[0] for p in jump
-        }
-        claims.append(
-            Claim(
-                "On release the supervised zero-planning agent jumps to about 200 steps per episode, the planning agents to about 40.",
-                f"Mean steps ± standard error in episode {demos + 1}, the first after release: "
-                + ", ".join(
-                    f"SV-{p} {_pm(v, jump_se[p])} (paper ~{PAPER_RELEASE_STEPS[p]})"
-                    for p, v in jump.items()
-                )
-                + ". Counted as reproduced when zero planning jumps at least twice as high as both planners.",
-                bool(jump["ZPL"] >= 2 * max(jump["FPL"], jump["SPL"])),
-            )
-        )
+        claims.append(_claim_release(results, mean, demos))
     if episodes >= 35 and demos < 35:
-        window = slice(demos, 35)
-        sv_runs = results["SV-FPL"].steps[:, window].mean(axis=1)  # one value per experiment
-        us_runs = results["US-FPL"].steps[:, window].mean(axis=1)
-        sv, us = float(sv_runs.mean()), float(us_runs.mean())
-        sv_se = float(_standard_error(sv_runs))
-        us_se = float(_standard_error(us_runs))
-        diff_se = float(np.hypot(sv_se, us_se))
-        if not np.isfinite(diff_se):
-            noise = ""
-        elif sv - us > 2 * diff_se:
-            noise = " The difference is more than twice its standard error."
-        else:
-            noise = (
-                " The difference is within twice its standard error: the direction matches the "
-                "paper, but this many experiments cannot tell the two apart."
-            )
-        claims.append(
-            Claim(
-                "Between the 20th and 35th episode the unsupervised agent performs a little better than the supervised one (Fig. 8).",
-                f"Mean steps over episodes {demos + 1}-35 with full planning: supervised {_pm(sv, sv_se, 1)}, "
-                f"unsupervised {_pm(us, us_se, 1)}; difference {_pm(sv - us, diff_se, 1)}." + noise,
-                bool(us < sv),
-            )
-        )
-
-    ratios = {
-        prefix: cpu[f"{prefix}-FPL"] / max(cpu[f"{prefix}-ZPL"], 1e-12) for prefix in ("SV", "US")
-    }
-    upd = {
-        prefix: updates[f"{prefix}-FPL"] / max(updates[f"{prefix}-ZPL"], 1)
-        for prefix in ("SV", "US")
-    }
-    paper = {
-        prefix: PAPER_MATLAB_SECONDS[f"{prefix}-FPL"] / PAPER_MATLAB_SECONDS[f"{prefix}-ZPL"]
-        for prefix in ("SV", "US")
-    }
-    claims.append(
-        Claim(
-            "Full planning costs about 50 times the CPU time of zero planning.",
-            "CPU full/zero: "
-            + ", ".join(f"{p} {ratios[p]:.1f}x (paper {paper[p]:.1f}x)" for p in ratios)
-            + "; Q updates full/zero: "
-            + ", ".join(f"{p} {upd[p]:.1f}x" for p in upd)
-            + f". Counted as reproduced when both ratios, of CPU and of Q updates, lie between "
-            f"{FULL_ZERO_RANGE[0]:g}x and {FULL_ZERO_RANGE[1]:g}x (CPU times of hundredths of a "
-            "second vary by about 10 % between runs on a busy machine; update counts are exact). "
-            f"The work itself grows only {min(upd.values()):.0f}-{max(upd.values()):.0f}x, so the "
-            "paper's 50x also reflects Matlab's costly planning loop; in our kernel a planning "
-            "update costs a fraction of a real step (action choice, model bookkeeping).",
-            all(_within(r, FULL_ZERO_RANGE) for r in (*ratios.values(), *upd.values())),
-        )
-    )
-    soft = {
-        prefix: cpu[f"{prefix}-SPL"] / max(cpu[f"{prefix}-FPL"], 1e-12) for prefix in ("SV", "US")
-    }
-    soft_updates = {
-        prefix: updates[f"{prefix}-SPL"] / max(updates[f"{prefix}-FPL"], 1)
-        for prefix in ("SV", "US")
-    }
-    paper_soft = {
-        prefix: PAPER_MATLAB_SECONDS[f"{prefix}-SPL"] / PAPER_MATLAB_SECONDS[f"{prefix}-FPL"]
-        for prefix in ("SV", "US")
-    }
-    claims.append(
-        Claim(
-            "Soft planning costs about a third to half of full planning.",
-            "CPU soft/full: "
-            + ", ".join(f"{p} {soft[p]:.2f} (paper {paper_soft[p]:.2f})" for p in soft)
-            + "; Q updates soft/full: "
-            + ", ".join(f"{p} {soft_updates[p]:.2f}" for p in soft_updates)
-            + f". Counted as reproduced when both ratios, of CPU and of Q updates, lie between "
-            f"{SOFT_FULL_RANGE[0]:g} and {SOFT_FULL_RANGE[1]:g}. Most planning happens in the long "
-            "early episodes, where soft still plans almost as much as full.",
-            all(_within(r, SOFT_FULL_RANGE) for r in (*soft.values(), *soft_updates.values())),
-        )
-    )
-    return claims
+        claims.append(_claim_unsupervised_better(results, demos))
+    return [*claims, _claim_full_cost(cpu, updates), _claim_soft_cost(cpu, updates)]
 
 
 def _table(results: dict[str, ExperimentResult], wall: dict[str, float]) -> str:
@@ -563,52 +576,8 @@ def reproduce(
     demos = generate_demonstrations(grid, DEMONSTRATIONS, np.random.default_rng([seed, 1]))
     n_demos = min(DEMONSTRATIONS, episodes)
     warm_up()  # so the first configuration's CPU time is learning, not loading the kernels
-    bar = None
-    if progress:
-        from tqdm import tqdm
-
-        bar = tqdm(
-            total=(len(CONFIGURATIONS) + len(EXTENSIONS)) * experiments * episodes,
-            unit="episode",
-            desc="reproduce",
-        )
-    results: dict[str, ExperimentResult] = {}
-    wall: dict[str, float] = {}
-    try:
-        for name, (supervised, planning) in {**CONFIGURATIONS, **EXTENSIONS}.items():
-            if bar is not None:
-                bar.set_postfix_str(name)
-            record = RunRecord.for_arm_grid(
-                grid,
-                DynaQConfig(planning=planning),
-                experiments,
-                episodes,
-                seed,
-                demos[:n_demos] if supervised else [],
-                name=name,
-                origin="reproduce",
-                group=out.resolve().name,
-            )
-            _remove_earlier_run(out / name)
-            folder = RunFolder.create(out, record, name=name, status="running")
-            live = LiveProgress(experiments, episodes)
-            shown = [0]
-
-            def progress(live: LiveProgress, shown: list[int] = shown) -> None:
-                if bar is not None:
-                    bar.update(live.completed - shown[0])  # type: ignore[attr-defined]
-                    shown[0] = live.completed
-
-            start = time.perf_counter()
-            result = folder.train(live, workers=workers, on_checkpoint=progress)
-            wall[name] = time.perf_counter() - start
-            progress(live)
-            if result is None:
-                raise LearningError(folder.error or f"The {name} run in {folder.path} failed.")
-            results[name] = result
-    finally:
-        if bar is not None:
-            bar.close()
+    runs = _Runs(out, grid, demos[:n_demos], experiments, episodes, seed, workers)
+    results, wall = _run_configurations(runs, progress)
     extensions = {name: results.pop(name) for name in EXTENSIONS}
     claims = judge_claims(results, grid, n_demos)
     table = _table(results, wall)
@@ -630,3 +599,77 @@ def reproduce(
             stream.write(section)
         files += figures
     return ReproduceResult(out, results, wall, claims, table, files, extensions)
+
+
+@dataclass(frozen=True)
+class _Runs:
+    """What every configuration's run shares: where, on what, with which demonstrations."""
+
+    out: Path
+    grid: ArmGrid
+    demos: list[list[int]]
+    experiments: int
+    episodes: int
+    seed: int
+    workers: int | None
+
+
+def _run_configurations(
+    runs: _Runs, progress: bool
+) -> tuple[dict[str, ExperimentResult], dict[str, float]]:
+    """Train every configuration (and extension) as a run folder in ``runs.out``; returns the
+    results and wall seconds by name. ``progress``: a tqdm bar over all their episodes."""
+    bar = None
+    if progress:
+        from tqdm import tqdm
+
+        bar = tqdm(
+            total=(len(CONFIGURATIONS) + len(EXTENSIONS)) * runs.experiments * runs.episodes,
+            unit="episode",
+            desc="reproduce",
+        )
+    results: dict[str, ExperimentResult] = {}
+    wall: dict[str, float] = {}
+    try:
+        for name, (supervised, planning) in {**CONFIGURATIONS, **EXTENSIONS}.items():
+            if bar is not None:
+                bar.set_postfix_str(name)
+            results[name], wall[name] = _run_configuration(runs, name, supervised, planning, bar)
+    finally:
+        if bar is not None:
+            bar.close()
+    return results, wall
+
+
+def _run_configuration(
+    runs: _Runs, name: str, supervised: bool, planning: str, bar: tqdm | None
+) -> tuple[ExperimentResult, float]:
+    """One configuration's run folder, trained: its result and wall seconds."""
+    record = RunRecord.for_arm_grid(
+        runs.grid,
+        DynaQConfig(planning=planning),
+        runs.experiments,
+        runs.episodes,
+        runs.seed,
+        runs.demos if supervised else [],
+        name=name,
+        origin="reproduce",
+        group=runs.out.resolve().name,
+    )
+    _remove_earlier_run(runs.out / name)
+    folder = RunFolder.create(runs.out, record, name=name, status="running")
+    live = LiveProgress(runs.experiments, runs.episodes)
+    shown = [0]
+
+    def progress(live: LiveProgress) -> None:
+        if bar is not None:
+            bar.update(live.completed - shown[0])
+            shown[0] = live.completed
+
+    start = time.perf_counter()
+    result = folder.train(live, workers=runs.workers, on_checkpoint=progress)
+    wall = time.perf_counter() - start
+    progress(live)
+    if result is None:
+        raise LearningError(folder.error or f"The {name} run in {folder.path} failed.")
+    return result, wall

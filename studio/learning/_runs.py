@@ -1,8 +1,11 @@
-"""Training runs on disk: one folder layout, one curve statistic set, one CSV layout, one figure.
+"""Training runs on disk: one folder layout, its status, its curve and its policy files.
 
 Whatever starts a run (``studio train``, ``studio reproduce``, a sweep, the page's run queue), it
 goes through :class:`RunFolder`, so every run folder reads back with :meth:`RunFolder.load` and
-the page lists, plots, watches and exports it.
+the page lists, plots, watches and exports it. What a run trains is its :class:`RunRecord`
+(``_run_record.py``, built by ``resolve_run`` in ``_run_request.py``); its statistics and
+``curves.csv`` layout are ``_curves.py``'s; the learner's thread is ``_run_train.py``'s; who owns
+a live run is ``_owner.py``'s.
 
 A run folder ``<parent>/<id>/`` holds:
 
@@ -33,7 +36,7 @@ and renamed there, so a full disk leaves no half-made run behind (:class:`Learni
 
 Use::
 
-    record = RunRecord.for_arm_grid(ArmGrid(), DynaQConfig(), 20, 100, seed=0, origin="cli")
+    record = resolve_run(RunRequest(experiments=20, episodes=100, seed=0))
     run = RunFolder.create(Path("runs"), record)   # runs/<time>-full-<hex>/
     result = run.train(workers=None)               # checkpoints, then policy + status
     again = RunFolder.load(run.path)
@@ -43,23 +46,17 @@ Use::
 from __future__ import annotations
 
 import contextlib
-import csv
 import io
 import json
 import logging
 import os
 import secrets
 import shutil
-import socket
 import sys
-import threading
-import time
-import warnings
-from collections.abc import Callable, Iterable, Sequence
-from dataclasses import dataclass, field
+from collections.abc import Callable
 from datetime import UTC, datetime
 from pathlib import Path
-from typing import Any
+from typing import cast
 
 import numpy as np
 
@@ -67,663 +64,32 @@ from studio import StudioError, read_bytes_bounded, read_json
 
 from .._files import atomic_write_text, now_iso
 from .._numbers import is_int
-from ._arm import ArmGrid
-from ._config import DEFAULT_SEED, MAX_STEPS_PER_EPISODE, DynaQConfig, check_budget
-from ._dynaq import ExperimentResult, LiveProgress, run_experiments
+from ._config import MAX_STEPS_PER_EPISODE, check_budget
+from ._curves import curve_statistics, curves_csv
 from ._errors import ConfigError, LearningError
-from ._owner import OWNER_FILE, OwnerLock, owner_alive, process_started
+from ._learner import ExperimentResult, LiveProgress
+from ._owner import OWNER_FILE, OwnerLock, owner_alive, pid_alive, this_host
 from ._policy import save_policy
-from ._reach import ArmReach
-from ._tiles import TileCoding
+from ._run_record import TASK_ARM_REACH, RunRecord
+from ._run_train import TrainingThread, watch_training
 
 log = logging.getLogger(__name__)
 
-RUN_FORMAT = "teach-studio-run"
-"""The ``format`` field of a run's ``config.json``."""
-RUN_VERSION = 1
-"""The version of the run folder layout this code writes and reads."""
 CONFIG_FILE = "config.json"
 STATUS_FILE = "status.json"
 STEPS_FILE = "steps.csv"
 CURVES_FILE = "curves.csv"
 POLICY_FILE = "policy.policy.npz"
-CHECKPOINT_SECONDS = 1.0
-"""How often a training run's ``steps.csv`` is written to disk (at most this much is lost)."""
-CHECKPOINT_COST_FACTOR = 10.0
-"""A checkpoint waits at least this many times as long as the last one took to write, so a huge
-run (20 x 50,000 episodes) spends under a tenth of a core on checkpoints."""
-FIGURE_POINTS = 600
-"""A curve figure draws at most about this many points per line (longer runs are averaged)."""
-ORIGINS = ("cli", "page", "reproduce", "sweep")
-"""What made a run: ``studio train``, the page's run queue, ``studio reproduce``, a sweep."""
 STATUSES = ("queued", "running", "done", "stopped", "failed")
-TASK_ARM_GRID = "arm-grid"
-"""``task.kind`` of the paper's arm grid (``task`` also holds the :meth:`ArmGrid.to_dict` spec)."""
-TASK_ARM_REACH = "arm-reach"
-"""``task.kind`` of the continuous-joint task (``task`` also holds the :meth:`ArmReach.to_dict`
-fields and ``tile_coding``, the :meth:`TileCoding.to_dict` settings); its demonstrations are
-joint paths ``(N, joints)`` in radians."""
-TASK_KINDS = (TASK_ARM_GRID, TASK_ARM_REACH)
 MAX_STATUS_BYTES = 64 * 1024
 """Largest ``status.json`` read (the studio writes a few hundred bytes)."""
 STEPS_HEADER_BYTES = 1024
 """Room for ``steps.csv``'s comment line when bounding its size."""
 
-CURVE_COLUMNS = (
-    "episode",
-    "mean",
-    "std",
-    "median",
-    "p10",
-    "p90",
-    "min",
-    "max",
-    "experiments",
-)
-"""The one ``curves.csv`` layout: per episode (1-based), statistics of the real steps over the
-``experiments`` that finished it. ``studio reproduce`` puts a ``configuration`` column first."""
-STATISTICS = CURVE_COLUMNS[1:-1]
-
-
-# ----------------------------------------------------------------------------- statistics
-
-
-def curve_statistics(steps: np.ndarray, start: int = 0) -> dict[str, list]:
-    """Learning-curve statistics of an ``(experiments, episodes)`` steps array, -1 for not done.
-
-    Episodes run from index ``start`` up to the last one that any experiment finished. Each
-    statistic is over the experiments that finished that episode (``count``): mean, population
-    standard deviation, median, 10th and 90th percentiles, min and max. Experiments of a stopped
-    run end at different episodes, so ``count`` falls towards the end: a plot shows it rather than
-    pretend every point averages all experiments.
-
-    Returns:
-        ``{"episodes": [1-based], "mean", "std", "median", "p10", "p90", "min", "max", "count"}``,
-        lists of equal length.
-    """
-    steps = np.asarray(steps)
-    if steps.ndim != 2:
-        raise LearningError(
-            f"steps has shape {steps.shape}; give an (experiments, episodes) array."
-        )
-    count = (steps >= 0).sum(axis=0)
-    nonzero = np.flatnonzero(count)
-    last = int(nonzero[-1]) + 1 if nonzero.size else 0
-    start = max(0, min(int(start), last))
-    values = steps[:, start:last].astype(np.float64)
-    values[values < 0] = np.nan
-    out: dict[str, list] = {"episodes": list(range(start + 1, last + 1))}
-    if values.shape[1] == 0:
-        out.update({key: [] for key in STATISTICS})
-        out["count"] = []
-        return out
-    with np.errstate(invalid="ignore", divide="ignore"), warnings.catch_warnings():
-        warnings.simplefilter("ignore", RuntimeWarning)  # an episode nobody finished: 0, count 0
-        p10, median, p90 = _column_percentiles(values, count[start:last], (10, 50, 90))
-        stats = {
-            "mean": np.nanmean(values, axis=0),
-            "std": np.nanstd(values, axis=0),
-            "median": median,
-            "p10": p10,
-            "p90": p90,
-            "min": np.nanmin(values, axis=0),
-            "max": np.nanmax(values, axis=0),
-        }
-    for key in STATISTICS:
-        out[key] = np.round(np.nan_to_num(stats[key]), 3).tolist()
-    out["count"] = count[start:last].astype(np.int64).tolist()
-    return out
-
-
-def _column_percentiles(
-    values: np.ndarray, count: np.ndarray, percents: Sequence[float]
-) -> list[np.ndarray]:
-    """Per-column percentiles of the non-NaN values (numpy's default "linear" method), with
-    ``count`` >= 1 valid values per column: one sort instead of ``nanpercentile``'s per-column loop."""
-    ordered = np.sort(values, axis=0)  # NaN sorts last
-    columns = np.arange(values.shape[1])
-    out = []
-    for percent in percents:
-        position = np.maximum(count - 1, 0) * (percent / 100.0)
-        low = np.floor(position).astype(np.int64)
-        high = np.minimum(low + 1, np.maximum(count - 1, 0))
-        a, b = ordered[low, columns], ordered[high, columns]
-        out.append(a + (b - a) * (position - low))
-    return out
-
-
-def downsample_curve(curve: dict[str, list], points: int = FIGURE_POINTS) -> dict[str, list]:
-    """A curve averaged in equal buckets of episodes so that it has at most ``points`` points.
-
-    Each bucket's episode is its mean episode, its mean/std/median/percentiles are the means of
-    the bucket's values, ``min``/``max`` the bucket's extremes and ``count`` its smallest count (so
-    a point never claims more experiments than all of its episodes had). A curve with at most
-    ``points`` episodes is returned as is.
-    """
-    n = len(curve["episodes"])
-    if n <= points:
-        return curve
-    size = -(-n // points)
-    edges = np.arange(0, n, size)
-
-    def reduce(key: str, fn: Callable[..., np.ndarray]) -> list:
-        return fn(np.asarray(curve[key], dtype=np.float64), edges).tolist()
-
-    def mean_of(a: np.ndarray, e: np.ndarray) -> np.ndarray:
-        return np.add.reduceat(a, e) / np.diff(np.append(e, a.size))
-
-    out = {"episodes": reduce("episodes", mean_of)}
-    for key in ("mean", "std", "median", "p10", "p90"):
-        out[key] = np.round(reduce(key, mean_of), 3).tolist()
-    out["min"] = reduce("min", np.minimum.reduceat)
-    out["max"] = reduce("max", np.maximum.reduceat)
-    out["count"] = [int(c) for c in reduce("count", np.minimum.reduceat)]
-    return out
-
-
-def curves_csv(curve: dict[str, list], configuration: str | None = None) -> str:
-    """A curve as CSV text in the one layout :data:`CURVE_COLUMNS`.
-
-    Args:
-        curve: from :func:`curve_statistics`.
-        configuration: when given, a leading ``configuration`` column holding it on every row
-            (``studio reproduce`` writes several runs into one file this way).
-    """
-    out = io.StringIO()
-    write_curves_csv(out, [(configuration, curve)] if configuration else [(None, curve)])
-    return out.getvalue()
-
-
-def write_curves_csv(
-    stream: io.TextIOBase | Any, curves: Sequence[tuple[str | None, dict[str, list]]]
-) -> None:
-    """Write curves to an open text stream: a header, then one row per episode per curve.
-
-    A ``configuration`` column comes first when the curves are named (several runs in one file).
-    """
-    named = any(name is not None for name, _ in curves)
-    writer = csv.writer(stream, lineterminator="\n")
-    writer.writerow((["configuration"] if named else []) + list(CURVE_COLUMNS))
-    for name, curve in curves:
-        columns = [curve["episodes"], *(curve[k] for k in STATISTICS), curve["count"]]
-        for row in zip(*columns, strict=True):
-            values = [row[0], *(f"{v:.6g}" for v in row[1:-1]), row[-1]]
-            writer.writerow(([name] if named else []) + values)
-
-
-def curve_plot(
-    curves: Sequence[tuple[str, dict[str, list]]],
-    *,
-    log_steps: bool = False,
-    title: str = "",
-    points: int = FIGURE_POINTS,
-) -> Any:
-    """Learning curves as a matplotlib ``Figure``: per run its mean line and a 10-90 % band.
-
-    Long runs are averaged to about ``points`` points per line (:func:`downsample_curve`), so a
-    25,000-episode run draws as a line, not a solid block. Where fewer experiments than the run's
-    most finished an episode, the line turns dotted, so a band never silently stops averaging all
-    of them. Drawn on matplotlib's object API (no global state, safe in threads).
-    """
-    from matplotlib.figure import Figure
-
-    fig = Figure(figsize=(7, 4), dpi=120, layout="constrained")
-    ax = fig.add_subplot()
-    drawn = False
-    for label, full in curves:
-        curve = downsample_curve(full, points)
-        x = np.asarray(curve["episodes"], dtype=np.float64)
-        if not x.size:
-            continue
-        drawn = True
-        mean = np.asarray(curve["mean"])
-        count = np.asarray(curve["count"])
-        complete = count >= count.max()
-        (line,) = ax.plot(x, np.where(complete, mean, np.nan), lw=1.6, label=label)
-        if not complete.all():
-            fewer = ~complete
-            fewer[:-1] |= fewer[1:]  # start at the last complete point, so the two lines join
-            ax.plot(
-                x,
-                np.where(fewer, mean, np.nan),
-                lw=1.2,
-                ls=":",
-                color=line.get_color(),
-                label=f"{label} (fewer experiments)",
-            )
-        ax.fill_between(x, curve["p10"], curve["p90"], alpha=0.2, color=line.get_color())
-    if not drawn:
-        ax.text(
-            0.5, 0.5, "no finished episodes yet", ha="center", va="center", transform=ax.transAxes
-        )
-    else:
-        ax.legend(loc="upper right", fontsize="small")
-    if log_steps:
-        ax.set_yscale("log")
-    ax.set_xlabel("episode")
-    ax.set_ylabel("steps to the goal (line: mean, band: 10-90 %)")
-    ax.set_title(title)
-    ax.grid(alpha=0.3)
-    return fig
-
-
-def curve_figure(
-    curves: Sequence[tuple[str, dict[str, list]]],
-    fmt: str = "png",
-    *,
-    log_steps: bool = False,
-    title: str = "",
-    points: int = FIGURE_POINTS,
-) -> bytes:
-    """:func:`curve_plot` as PNG or SVG bytes (the page's "Plot PNG/SVG" downloads)."""
-    if fmt not in ("png", "svg"):
-        raise LearningError(f"The figure format {fmt!r} is not supported; use png or svg.")
-    fig = curve_plot(curves, log_steps=log_steps, title=title, points=points)
-    buffer = io.BytesIO()
-    fig.savefig(buffer, format=fmt)
-    return buffer.getvalue()
-
-
-# ----------------------------------------------------------------------------- config.json
-
-
-def task_spec(task: ArmGrid | ArmReach, coding: TileCoding | None = None) -> dict[str, Any]:
-    """A task as run records and policy listings write it: its kind and its settings.
-
-    ``{"kind": "arm-grid", **grid.to_dict()}``, or ``{"kind": "arm-reach", **task.to_dict(),
-    "tile_coding": coding.to_dict()}`` for the continuous task.
-    """
-    if isinstance(task, ArmGrid):
-        return {"kind": TASK_ARM_GRID, **task.to_dict()}
-    spec: dict[str, Any] = {"kind": TASK_ARM_REACH, **task.to_dict()}
-    if coding is not None:
-        spec["tile_coding"] = coding.to_dict()
-    return spec
-
-
-@dataclass(frozen=True)
-class RunRecord:
-    """A run's ``config.json``: what it trains and how, self-describing without the page.
-
-    Attributes:
-        task: what is learnt: ``{"kind": "arm-grid", joints, bins, low_deg, high_deg, goal}``
-            for the paper's grid (:meth:`ArmGrid.to_dict`); other kinds may add their own fields.
-        config: the :class:`DynaQConfig` fields.
-        experiments: independent experiments averaged.
-        episodes: episodes per experiment.
-        seed: the run's seed.
-        demonstrations: grid state paths replayed as the first episodes (so a run repeats without
-            the demonstration files).
-        name: a free label ("" for none).
-        origin: what made the run, one of :data:`ORIGINS`.
-        group: runs made together (a reproduce or a sweep) share it; None otherwise.
-        created: ISO 8601 UTC.
-        request: what the user asked for in the terms of the tool that made the run (the page's
-            form: ``goal_deg``, demonstration names); None when there is nothing beyond the above.
-    """
-
-    task: dict[str, Any]
-    config: dict[str, Any]
-    experiments: int
-    episodes: int
-    seed: int = DEFAULT_SEED
-    demonstrations: list[list[int]] = field(default_factory=list)
-    name: str = ""
-    origin: str = "cli"
-    group: str | None = None
-    created: str = ""
-    request: dict[str, Any] | None = None
-
-    @classmethod
-    def for_arm_grid(
-        cls,
-        grid: ArmGrid,
-        config: DynaQConfig,
-        experiments: int,
-        episodes: int,
-        seed: int = DEFAULT_SEED,
-        demonstrations: Sequence[Sequence[int]] = (),
-        *,
-        name: str = "",
-        origin: str = "cli",
-        group: str | None = None,
-        request: dict[str, Any] | None = None,
-    ) -> RunRecord:
-        """A checked record for the arm grid.
-
-        Raises:
-            ConfigError: one sentence per bad field (budget, seed, name, origin, demonstrations).
-        """
-        problems = run_problems(experiments, episodes, seed, name, grid)
-        paths = [[int(s) for s in path] for path in demonstrations]
-        return cls._checked(
-            problems,
-            task_spec(grid),
-            config,
-            experiments,
-            episodes,
-            seed,
-            paths,
-            name=name,
-            origin=origin,
-            group=group,
-            request=request,
-        )
-
-    @classmethod
-    def _checked(
-        cls,
-        problems: list[tuple[str, str]],
-        task: dict[str, Any],
-        config: DynaQConfig,
-        experiments: int,
-        episodes: int,
-        seed: int,
-        paths: list,
-        *,
-        name: str,
-        origin: str,
-        group: str | None,
-        request: dict[str, Any] | None,
-    ) -> RunRecord:
-        """The record, once the checks every task shares (origin, demonstrations against
-        episodes) join the task's own ``problems``; all of them raised at once."""
-        if origin not in ORIGINS:
-            problems.append(("origin", f"origin is {origin!r}; give one of {', '.join(ORIGINS)}."))
-        if is_int(episodes) and len(paths) > episodes:
-            problems.append(
-                (
-                    "demonstrations",
-                    f"The run replays {len(paths)} demonstrations but has only {episodes} episodes; give at least as many episodes as demonstrations.",
-                )
-            )
-        raise_problems(problems)
-        return cls(
-            task=task,
-            config=config.to_dict(),
-            experiments=int(experiments),
-            episodes=int(episodes),
-            seed=int(seed),
-            demonstrations=paths,
-            name=name,
-            origin=origin,
-            group=group,
-            created=now_iso(),
-            request=request,
-        )
-
-    @classmethod
-    def for_arm_reach(
-        cls,
-        task: ArmReach,
-        coding: TileCoding,
-        config: DynaQConfig,
-        experiments: int,
-        episodes: int,
-        seed: int = DEFAULT_SEED,
-        demonstrations: Sequence[np.ndarray] = (),
-        *,
-        name: str = "",
-        origin: str = "cli",
-        group: str | None = None,
-        request: dict[str, Any] | None = None,
-    ) -> RunRecord:
-        """A checked record for the continuous-joint task learnt with tile coding.
-
-        Raises:
-            ConfigError: one sentence per bad field (budget, seed, name, origin, weight table,
-                demonstrations, each naming the demonstration and the fix).
-        """
-        from ._linear import weight_problem  # imports the kernels: import when needed
-
-        problems = run_problems(experiments, episodes, seed, name)
-        try:
-            coder = coding.bind(task.lower, task.upper)
-            problem = is_int(experiments) and weight_problem(experiments, coder, task.n_actions)
-            if problem:
-                problems.append(("tiles", problem))
-        except LearningError as err:
-            problems.append(("tiles", str(err)))
-        paths = []
-        for i, path in enumerate(demonstrations):
-            try:
-                task.demonstration_actions(path, i)
-                paths.append(np.asarray(path, dtype=np.float64)[:, : task.joints].tolist())
-            except LearningError as err:
-                problems.append(("demonstrations", str(err)))
-        return cls._checked(
-            problems,
-            task_spec(task, coding),
-            config,
-            experiments,
-            episodes,
-            seed,
-            paths,
-            name=name,
-            origin=origin,
-            group=group,
-            request=request,
-        )
-
-    @property
-    def kind(self) -> str:
-        """The task's kind: ``"arm-grid"`` (the paper's task) or ``"arm-reach"`` (continuous)."""
-        return str(self.task.get("kind", TASK_ARM_GRID))
-
-    def arm_reach(self) -> ArmReach:
-        """The task as an :class:`ArmReach` (for kind ``"arm-reach"``)."""
-        if self.kind != TASK_ARM_REACH:
-            raise LearningError(
-                f"This run's task is {self.kind!r}, not the continuous arm task; open it with the tool that made it."
-            )
-        spec = {k: v for k, v in self.task.items() if k not in ("kind", "tile_coding")}
-        return ArmReach.from_dict(spec)
-
-    def tile_coding(self) -> TileCoding:
-        """The tile coding of an ``"arm-reach"`` run."""
-        self.arm_reach()
-        return TileCoding.from_dict(self.task["tile_coding"])
-
-    def arm_grid(self) -> ArmGrid:
-        """The task as an :class:`ArmGrid` (for kind ``"arm-grid"``)."""
-        if self.kind != TASK_ARM_GRID:
-            raise LearningError(
-                f"This run's task is {self.kind!r}, not the arm grid; open it with the tool that made it."
-            )
-        spec = {k: v for k, v in self.task.items() if k != "kind"}
-        if spec.get("goal") is not None:
-            spec["goal"] = tuple(spec["goal"])
-        return ArmGrid(**spec)
-
-    def dynaq_config(self) -> DynaQConfig:
-        """The Dyna-Q settings."""
-        return DynaQConfig.from_dict(self.config)
-
-    def label(self) -> str:
-        """The run's name, else its planner, size and demonstrations."""
-        if self.name:
-            return self.name
-        demos = len(self.demonstrations)
-        extra = f", {demos} demos" if demos else ""
-        return f"{self.config.get('planning', '?')} x{self.experiments}{extra}"
-
-    def to_dict(self) -> dict[str, Any]:
-        """The JSON object stored as ``config.json``."""
-        data = {
-            "format": RUN_FORMAT,
-            "version": RUN_VERSION,
-            "task": self.task,
-            "config": self.config,
-            "experiments": self.experiments,
-            "episodes": self.episodes,
-            "seed": self.seed,
-            "demonstrations": self.demonstrations,
-            "name": self.name,
-            "origin": self.origin,
-            "group": self.group,
-            "created": self.created,
-        }
-        if self.request is not None:
-            data["request"] = self.request
-        return data
-
-    @classmethod
-    def from_dict(cls, data: Any) -> RunRecord:
-        """A record from ``config.json``'s object; also reads the layouts written before version 1
-        (the page's ``{"request", "grid", ...}`` and ``studio train``'s ``{"grid", "config", ...}``).
-
-        Raises:
-            LearningError: not a run record, a newer version, or missing fields.
-        """
-        if not isinstance(data, dict):
-            raise LearningError("config.json holds no JSON object; it is not a run folder.")
-        version = data.get("version", 0)
-        if data.get("format", RUN_FORMAT) != RUN_FORMAT or not is_int(version):
-            raise LearningError(
-                f"config.json has format {data.get('format')!r}; it is not a {RUN_FORMAT} folder."
-            )
-        if version > RUN_VERSION:
-            raise LearningError(
-                f"This run folder has version {version}, newer than this studio's {RUN_VERSION}; update Teach Studio."
-            )
-        task = data.get("task")
-        if task is None and isinstance(data.get("grid"), dict):  # before version 1
-            task = {"kind": TASK_ARM_GRID, **data["grid"]}
-        request = data.get("request")
-        missing = [
-            key
-            for key, value in (
-                ("task", task),
-                ("config", data.get("config")),
-                ("experiments", data.get("experiments", _from(request, "experiments"))),
-                ("episodes", data.get("episodes", _from(request, "episodes"))),
-            )
-            if value is None
-        ]
-        if missing:
-            raise LearningError(
-                f"config.json lacks {', '.join(missing)}; it is not a complete run record."
-            )
-        return cls(
-            task=dict(task),
-            config=dict(data["config"]),
-            experiments=int(data.get("experiments", _from(request, "experiments"))),
-            episodes=int(data.get("episodes", _from(request, "episodes"))),
-            seed=int(data.get("seed", _from(request, "seed") or DEFAULT_SEED)),
-            demonstrations=[
-                [[float(x) for x in row] for row in p]
-                if task.get("kind") == TASK_ARM_REACH
-                else list(map(int, p))
-                for p in data.get("demonstrations") or []
-            ],
-            name=str(data.get("name") or _from(request, "name") or ""),
-            origin=str(data.get("origin") or ("page" if request is not None else "cli")),
-            group=data.get("group"),
-            created=str(data.get("created") or ""),
-            request=request if isinstance(request, dict) else None,
-        )
-
-
-def _from(request: Any, key: str) -> Any:
-    return request.get(key) if isinstance(request, dict) else None
-
 
 def _text(value: object) -> str | None:
     """A string field of ``status.json``, or None when missing or of another type (damaged)."""
     return value if isinstance(value, str) else None
-
-
-def run_problems(
-    experiments: object,
-    episodes: object,
-    seed: object,
-    name: object = "",
-    grid: ArmGrid | None = None,
-) -> list[tuple[str, str]]:
-    """``(field, sentence)`` for each bad run-level setting: budget, seed and name."""
-    problems: list[tuple[str, str]] = []
-    try:
-        if grid is None:
-            check_budget(experiments, episodes)
-        else:
-            check_budget(experiments, episodes, grid.n_states, grid.n_actions)
-    except ConfigError as err:
-        problems += list(err.by_field.items())
-    if not is_int(seed) or not 0 <= seed < 2**63:  # type: ignore[operator]
-        problems.append(("seed", f"seed is {seed!r}; give a whole number from 0 to 2**63 - 1."))
-    if not isinstance(name, str) or (name and (not name.strip() or len(name) > 100)):
-        problems.append(("name", "name must be 1 to 100 characters; give a shorter label or none."))
-    return problems
-
-
-def raise_problems(problems: Iterable[tuple[str, str]]) -> None:
-    """Raise one :class:`ConfigError` carrying every ``(field, sentence)`` problem, if any."""
-    problems = list(problems)
-    if problems:
-        raise ConfigError([text for _, text in problems], [name for name, _ in problems])
-
-
-# ----------------------------------------------------------------------------- the folder
-
-
-def this_host() -> dict[str, str | None]:
-    """Where this process runs, recorded beside every ``pid`` a run or a sweep writes (a pid names
-    a process only on its own host): ``hostname``, and ``node``, the Ray node id when this process
-    is part of a Ray cluster (a sweep's driver or worker), else None. Ray is never imported here."""
-    ray = sys.modules.get("ray")
-    node = None
-    if ray is not None and ray.is_initialized():
-        node = ray.get_runtime_context().get_node_id()
-    return {"hostname": socket.gethostname(), "node": node}
-
-
-def on_this_host(host: object) -> bool:
-    """Whether a record's ``host`` (:func:`this_host`) is this machine; a record without one (older
-    runs, written before hosts were recorded) counts as this machine's."""
-    hostname = host.get("hostname") if isinstance(host, dict) else None
-    return not isinstance(hostname, str) or hostname == socket.gethostname()
-
-
-def pid_alive(pid: object, host: object = None, started: object = None) -> bool:
-    """Whether ``pid`` is a live process other than this one: a run or sweep whose status says
-    it is training but whose process is gone (a crash, ``kill -9``) reads as stopped.
-
-    ``host`` is the record's :func:`this_host`. A pid recorded on another host (a sweep's trial
-    on another node of a cluster, seen through shared storage) names no process here, so this
-    host cannot judge it: it counts as alive (its driver records a trial whose worker died).
-    ``started`` is when the record says its process started the work (ISO 8601): a live process
-    with that pid that started later reused the pid after the recorded one ended.
-    """
-    if not is_int(pid) or pid <= 0:  # type: ignore[operator]
-        return False
-    if not on_this_host(host):
-        return True
-    if pid == os.getpid():  # this process's only trainer, the page's queue, never reloads its own
-        return False
-    try:
-        os.kill(int(pid), 0)  # type: ignore[arg-type]
-    except ProcessLookupError:
-        return False
-    except PermissionError:
-        pass
-    return not _started_after(int(pid), started)  # type: ignore[arg-type]
-
-
-PID_CLOCK_SLACK_SECONDS = 2.0
-"""How much later than a record's ``started`` (kept to the second) its process may seem to have
-started before the pid counts as reused."""
-
-
-def _started_after(pid: int, started: object) -> bool:
-    """Whether process ``pid`` started after the ISO time ``started`` (unknown: False)."""
-    if not isinstance(started, str):
-        return False
-    try:
-        when = datetime.fromisoformat(started).timestamp()
-    except ValueError:
-        return False
-    began = process_started(pid)
-    return began is not None and began > when + PID_CLOCK_SLACK_SECONDS
 
 
 def delete_run_folder(path: Path, owner: OwnerLock | None = None) -> None:
@@ -877,7 +243,7 @@ class RunFolder:
         except OSError as err:
             raise _disk_error(err, "the run folder", parent) from None
         stamp = datetime.now(UTC).strftime("%Y%m%d-%H%M%S")
-        planning = record.config.get("planning", "run")
+        planning = record.config.planning
         while True:
             final = parent / (name or f"{stamp}-{planning}-{secrets.token_hex(2)}")
             if final.exists() and (not final.is_dir() or any(final.iterdir())):
@@ -961,7 +327,7 @@ class RunFolder:
         """
         if owner == "probe":  # before the status: a lock let go means its final status is written
             owner = owner_alive(self.path)
-        status: dict[str, Any] = {}
+        status: dict[str, object] = {}
         if (self.path / STATUS_FILE).is_symlink():
             log.warning("run %s: %s is a link, ignored", self.id, STATUS_FILE)
         elif (self.path / STATUS_FILE).exists():
@@ -984,7 +350,8 @@ class RunFolder:
         cpu = status.get("cpu_seconds")
         self.cpu_seconds = float(cpu) if isinstance(cpu, int | float) and np.isfinite(cpu) else 0.0
         self.error = _text(status.get("error"))
-        self.pid = status.get("pid")
+        pid = status.get("pid")
+        self.pid = int(cast(int, pid)) if is_int(pid) else None
         host = status.get("host")
         self.host = host if isinstance(host, dict) else None
         alive = owner if owner is not None else pid_alive(self.pid, self.host, self.started)
@@ -1168,10 +535,11 @@ class RunFolder:
     ) -> ExperimentResult | None:
         """Train the run: checkpoint its curve while it learns, then save steps, policy, status.
 
-        The experiments run in a thread (the kernels release the GIL); this thread writes
-        ``steps.csv`` at most every :data:`CHECKPOINT_SECONDS` when the curve moved, and calls
-        ``on_checkpoint`` every ``poll_seconds`` (a progress bar). ``live.stop()`` (or Ctrl-C here)
-        ends the run at the next episode boundary; a run stopped before it started trains nothing.
+        The experiments run in a thread (:class:`TrainingThread`; the kernels release the GIL);
+        this thread writes ``steps.csv`` at most every :data:`CHECKPOINT_SECONDS` when the curve
+        moved, and calls ``on_checkpoint`` every ``poll_seconds`` (a progress bar).
+        ``live.stop()`` (or Ctrl-C here) ends the run at the next episode boundary; a run stopped
+        before it started trains nothing.
 
         Returns:
             The result, or None when the run failed (``status``/``error`` say why) or was stopped
@@ -1189,61 +557,17 @@ class RunFolder:
         self.save_status()
         if live.stopped:  # stopped before training started: nothing to run
             return self._finish(live, None, None)
-        box: dict[str, Any] = {}
-        ended = threading.Event()  # not Thread.join: a Ctrl-C inside join can end it too early
+        thread = TrainingThread(self.id, record, live, workers).start()
 
-        def target() -> None:
-            try:
-                from ._prepare import prepare_learner  # imports this module
+        def checkpoint() -> None:
+            self.save_steps(live.steps, curves=False)
+            self._checkpoint_policy(live)
 
-                prepare_learner(record.kind, live)  # the first run here compiles the kernels
-                if record.kind == TASK_ARM_REACH:
-                    box["result"] = _train_arm_reach(record, workers, live)
-                    return
-                box["result"] = run_experiments(
-                    record.arm_grid().mdp(),
-                    record.dynaq_config(),
-                    record.experiments,
-                    record.episodes,
-                    record.seed,
-                    record.demonstrations,
-                    workers=workers,
-                    live=live,
-                )
-            except BaseException as err:  # handed to the caller's thread
-                box["error"] = err
-            finally:
-                ended.set()
-
-        thread = threading.Thread(target=target, name=f"studio-train-{self.id}", daemon=True)
-        thread.start()
-        interrupted = False
-        saved, last, every = 0, time.monotonic(), CHECKPOINT_SECONDS
-        while not ended.is_set():
-            try:
-                ended.wait(poll_seconds)
-                if on_checkpoint is not None:
-                    on_checkpoint(live)
-                now = time.monotonic()
-                done = live.completed
-                if now - last >= every and done != saved and not ended.is_set():
-                    self.save_steps(live.steps, curves=False)
-                    self._checkpoint_policy(live)
-                    saved, last = done, time.monotonic()
-                    # a huge run's checkpoint costs: keep writing it under a tenth of the time
-                    every = max(CHECKPOINT_SECONDS, CHECKPOINT_COST_FACTOR * (last - now))
-            except KeyboardInterrupt:
-                interrupted = True
-                live.stop()
-            except LearningError as err:  # a full disk mid-run: stop, keep what is on disk
-                log.warning("run %s: %s", self.id, err)
-                live.stop()
-                box.setdefault("disk", err)
-        result = box.get("result")
-        self._finish(live, result, box.get("error") or box.get("disk"))
+        interrupted, disk = watch_training(thread, live, checkpoint, on_checkpoint, poll_seconds)
+        self._finish(live, thread.result, thread.error or disk)
         if interrupted:
             raise KeyboardInterrupt
-        return result
+        return thread.result
 
     def _checkpoint_policy(self, live: LiveProgress) -> None:
         """Save the policy learnt so far (the kernels' tables as they are now), so a process
@@ -1292,29 +616,6 @@ class RunFolder:
         with contextlib.suppress(LearningError):
             self.save_status()
         return result
-
-
-def _train_arm_reach(
-    record: RunRecord, workers: int | None, live: LiveProgress
-) -> ExperimentResult:
-    """Linear Dyna-Q on ``TeachStudio/ArmReach-v0`` as the record says."""
-    import gymnasium
-
-    from ._gym import ARM_REACH_ID
-
-    task = record.arm_reach()
-    spec = task.to_dict()
-    return run_experiments(
-        lambda: gymnasium.make(ARM_REACH_ID, **spec),
-        record.dynaq_config(),
-        record.experiments,
-        record.episodes,
-        record.seed,
-        [np.asarray(p, dtype=np.float64) for p in record.demonstrations],
-        record.tile_coding(),
-        workers=workers,
-        live=live,
-    )
 
 
 def find_runs(parent: Path) -> list[Path]:

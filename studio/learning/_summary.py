@@ -12,9 +12,10 @@ from typing import TypedDict
 import numpy as np
 
 from ._arm import ArmGrid
+from ._dmp_policy import DmpPolicyFile
 from ._linear_policy import TilePolicyFile
 from ._policy import PolicyFile
-from ._runs import task_spec
+from ._run_record import task_spec
 
 POLICY_SUFFIX = ".policy.npz"
 """The file suffix of policy files (the format is in :mod:`._policy`)."""
@@ -53,7 +54,7 @@ class PolicySummary(TypedDict):
     notes: str
 
 
-def policy_summary(policy: PolicyFile | TilePolicyFile) -> PolicySummary:
+def policy_summary(policy: PolicyFile | TilePolicyFile | DmpPolicyFile) -> PolicySummary:
     """JSON-ready facts about a policy file of either kind for listings (the page, scripts).
 
     Returns:
@@ -64,10 +65,14 @@ def policy_summary(policy: PolicyFile | TilePolicyFile) -> PolicySummary:
         ``goal_deg`` (the goal of those joints in degrees: the goal bin's centre, see
         :func:`goal_degrees`, or the continuous task's goal angles), ``planning`` (the planner
         it was trained with), ``episodes`` (length of its learning curve), ``experiments`` (how
-        many the curve averages), ``created`` and ``notes``.
+        many the curve averages), ``created`` and ``notes``. A movement primitive's task is
+        ``{"kind": "dmp", "basis": ...}`` and its planning ``"none"``.
     """
     task: dict[str, object]
-    if isinstance(policy, TilePolicyFile):
+    if isinstance(policy, DmpPolicyFile):
+        task, grid, joints = {"kind": "dmp", "basis": policy.primitive.basis}, {}, len(policy.goal)
+        goal = [round(float(x), GOAL_DECIMALS) for x in np.degrees(policy.goal)]
+    elif isinstance(policy, TilePolicyFile):
         reach = policy.task
         if reach is None:
             task, joints, goal = {"kind": policy.env_id or "gymnasium"}, 0, []
@@ -83,7 +88,7 @@ def policy_summary(policy: PolicyFile | TilePolicyFile) -> PolicySummary:
         "grid": grid,
         "joints": joints,
         "goal_deg": goal,
-        "planning": policy.config.planning,
+        "planning": "none" if isinstance(policy, DmpPolicyFile) else policy.config.planning,
         "episodes": int(len(policy.mean_steps)),
         "experiments": int(policy.experiments),
         "created": policy.created,

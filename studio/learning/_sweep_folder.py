@@ -30,7 +30,8 @@ from studio import StudioError, read_json
 
 from .._files import atomic_write_text, now_iso
 from ._errors import LearningError
-from ._runs import RunFolder, pid_alive, this_host
+from ._owner import pid_alive, this_host
+from ._runs import RunFolder
 from ._sweep_spec import Settings, SpecDict, SweepError, SweepSpec
 
 SWEEP_FORMAT = "teach-studio-sweep"

@@ -35,8 +35,10 @@ from studio import is_loopback
 
 from .._files import now_iso
 from .._numbers import is_int
-from ._dynaq import LiveProgress
-from ._runs import RunFolder, RunRecord, this_host
+from ._learner import LiveProgress
+from ._owner import this_host
+from ._run_record import RunRecord
+from ._runs import RunFolder
 from ._sweep_folder import (
     RAY_DIR,
     TrialEnd,

@@ -31,8 +31,9 @@ from ._arm import ArmGrid
 from ._config import DynaQConfig
 from ._errors import ConfigError, LearningError
 from ._reach import ArmReach
-from ._reproduce import CONVERGENCE_FACTOR, generate_demonstrations
-from ._runs import TASK_ARM_GRID, TASK_ARM_REACH, RunRecord
+from ._reproduce import CONVERGENCE_FACTOR
+from ._run_record import TASK_ARM_GRID, TASK_ARM_REACH, RunRecord
+from ._run_request import CODING_SETTINGS, RunRequest, resolve_run
 
 SWEEP_ID = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]{0,63}$")
 """A sweep id: a folder name, unique per data folder."""
@@ -43,9 +44,8 @@ continuous joints (tile-coded linear Dyna-Q)."""
 GRID_FIELDS = tuple(f.name for f in fields(ArmGrid))
 """Task settings of the arm grid: joints, bins, low_deg, high_deg, goal."""
 REACH_FIELDS = tuple(f.name for f in fields(ArmReach))
-"""Task settings of the continuous joints: joints, step_deg, goal, tolerances, shaping."""
-CODING_SETTINGS = ("tilings", "tiles", "size")
-"""The continuous task's tile coding (:meth:`ArmReach.features`, as the page and CLI build it)."""
+"""Task settings of the continuous joints: joints, step_deg, goal, tolerances, shaping (and the
+tile coding's ``CODING_SETTINGS``)."""
 CONFIG_FIELDS = tuple(f.name for f in fields(DynaQConfig))
 """Learning settings: every :class:`DynaQConfig` field."""
 RUN_SETTINGS = ("demonstrations",)
@@ -70,8 +70,6 @@ METRICS = {
 }
 """What a sweep can measure per trial; all are minimised."""
 DEFAULT_METRIC = "episodes_to_converge"
-DEMO_SEED_STREAM = 1
-"""Generated demonstrations draw from ``default_rng([seed, 1])``, as ``studio train`` does."""
 
 MAX_TRIALS = 100_000
 """Upper bound on the trials of one sweep."""
@@ -301,7 +299,6 @@ def resolve_trial(
     experiments: int,
     episodes: int,
     seed: int,
-    demonstrations: np.random.Generator | None,
     *,
     name: str = "",
     group: str | None = None,
@@ -310,55 +307,31 @@ def resolve_trial(
     together), budget and seed, resolved by the code that owns each setting. This is the one
     place a sweep turns settings into a run.
 
-    Args:
-        demonstrations: draws the grid's generated demonstrations; None checks only (the goal
-            state stands in for each path, since only their count is checked).
+    The grid's generated demonstrations (``settings["demonstrations"]``) are drawn from the
+    trial's seed, as ``studio train --generated-demos N`` draws them.
 
     Raises:
         ConfigError, LearningError: a setting its owner refuses.
     """
-    config = DynaQConfig.from_dict(_pick(settings, CONFIG_FIELDS))
-    if task == TASK_ARM_REACH:
-        reach = ArmReach.from_dict(_pick(settings, REACH_FIELDS))
-        coding = reach.features(**_pick(settings, CODING_SETTINGS))
-        return RunRecord.for_arm_reach(
-            reach,
-            coding,
-            config,
-            experiments,
-            episodes,
-            seed,
-            origin="sweep",
-            name=name,
-            group=group,
-        )
-    grid_spec = _pick(settings, GRID_FIELDS)
-    if isinstance(grid_spec.get("goal"), list):
-        grid_spec["goal"] = tuple(grid_spec["goal"])
-    grid = ArmGrid(**grid_spec)
-    paths = _demonstrations(grid, settings.get("demonstrations", 0), demonstrations)
-    return RunRecord.for_arm_grid(
-        grid, config, experiments, episodes, seed, paths, origin="sweep", name=name, group=group
+    request = RunRequest(
+        task=task,
+        config=_pick(settings, CONFIG_FIELDS),
+        grid=_pick(settings, GRID_FIELDS) if task == TASK_ARM_GRID else {},
+        reach=_pick(settings, (*REACH_FIELDS, *CODING_SETTINGS)) if task == TASK_ARM_REACH else {},
+        experiments=experiments,
+        episodes=episodes,
+        seed=seed,
+        generated=settings.get("demonstrations", 0),
+        name=name,
+        origin="sweep",
+        group=group,
     )
+    return resolve_run(request)
 
 
 def _pick(settings: Mapping[str, object], names: tuple[str, ...]) -> dict[str, object]:
     """The settings among ``names`` (those one owner checks)."""
     return {k: v for k, v in settings.items() if k in names}
-
-
-def _demonstrations(
-    grid: ArmGrid, count: object, rng: np.random.Generator | None
-) -> list[list[int]]:
-    """``count`` generated demonstrations of the grid (None: check only, the goal state standing
-    in for each path)."""
-    if not is_int(count) or count < 0:
-        raise LearningError(
-            f"demonstrations is {count!r}; give how many generated demonstrations to replay (0 or more)."
-        )
-    if rng is None:
-        return [[grid.goal_state]] * count
-    return generate_demonstrations(grid, count, rng) if count else []
 
 
 def trial_record(spec: SweepSpec, trial: Trial) -> RunRecord:
@@ -369,7 +342,6 @@ def trial_record(spec: SweepSpec, trial: Trial) -> RunRecord:
         spec.experiments,
         spec.episodes,
         trial.seed,
-        np.random.default_rng([trial.seed, DEMO_SEED_STREAM]),
         name=f"{spec.name}: {trial.label()}",
         group=spec.name,
     )
@@ -386,7 +358,7 @@ def _check(
     """Resolve the run record a trial with these settings would build, turning a refusal into a
     SweepError naming ``where``."""
     try:
-        resolve_trial(task, settings, experiments, episodes, seed, demonstrations=None)
+        resolve_trial(task, settings, experiments, episodes, seed)
     except ConfigError as err:
         raise SweepError(f"{where}: {err.problems[0]}") from None
     except LearningError as err:

@@ -19,9 +19,11 @@ from typing import TypeAlias, cast
 import numpy as np
 
 from .._numbers import is_number
+from ._curves import curve_statistics
 from ._errors import LearningError
 from ._reproduce import _standard_error, episodes_to_converge
-from ._runs import TASK_ARM_GRID, RunFolder, RunRecord, curve_statistics
+from ._run_record import TASK_ARM_GRID, RunRecord
+from ._runs import RunFolder
 from ._sweep_folder import (
     FIGURE_STEM,
     SUMMARY_FILE,

@@ -37,7 +37,7 @@ import numpy as np
 from numba import njit
 
 from .._numbers import is_int
-from ._errors import LearningError
+from ._errors import ConfigError, LearningError
 
 DEFAULT_TILINGS = 8
 """Offset tilings (Sutton & Barto's Mountain Car uses 8)."""
@@ -99,14 +99,20 @@ class TileCoding:
         for name, high in (("tilings", MAX_TILINGS), ("tiles", MAX_TILES)):
             value = getattr(self, name)
             if not is_int(value) or not 1 <= value <= high:
-                raise LearningError(
-                    f"{name} is {value!r}; give a whole number from 1 to {high:,} ({name} of zero would activate no feature)."
+                raise ConfigError(
+                    [
+                        f"{name} is {value!r}; give a whole number from 1 to {high:,} ({name} of zero would activate no feature)."
+                    ],
+                    [name],
                 )
             object.__setattr__(self, name, int(value))
         if self.size is not None:
             if not is_int(self.size) or not 1 <= self.size <= MAX_SIZE:
-                raise LearningError(
-                    f"size is {self.size!r}; give a whole number of weight rows from 1 to {MAX_SIZE:,}."
+                raise ConfigError(
+                    [
+                        f"size is {self.size!r}; give a whole number of weight rows from 1 to {MAX_SIZE:,}."
+                    ],
+                    ["size"],
                 )
             object.__setattr__(self, "size", int(self.size))
         for name in ("low", "high"):

@@ -9,10 +9,9 @@ from __future__ import annotations
 
 import logging
 import re
-from collections.abc import AsyncIterator
+from collections.abc import AsyncIterator, Mapping, Sequence
 from contextlib import asynccontextmanager
 from pathlib import Path
-from typing import Any
 
 from fastapi import FastAPI, Request
 from fastapi.exceptions import RequestValidationError
@@ -33,6 +32,8 @@ from ._errors import (
     os_error_answer,
 )
 from ._guard import GuardMiddleware, SiteRule
+from ._protocols import Scene
+from ._schemas import RUN_TASK_TAGS
 from ._settings import Settings, get_settings
 from ._state import Studio
 from .routers import (
@@ -56,7 +57,7 @@ MULTIPART_OVERHEAD_BYTES = 64 * 1024
 """Room for the multipart framing around an upload at the size limit."""
 
 
-def create_app(settings: Settings | None = None, scene: Any = None) -> FastAPI:
+def create_app(settings: Settings | None = None, scene: Scene | None = None) -> FastAPI:
     """The studio's web app.
 
     Args:
@@ -93,10 +94,50 @@ def create_app(settings: Settings | None = None, scene: Any = None) -> FastAPI:
     )
     app.add_middleware(TrustedHostMiddleware, allowed_hosts=settings.trusted_hosts())
 
+    answer_errors(app, settings)
+    for module in (
+        config,
+        sources,
+        capture,
+        recordings,
+        demonstrations,
+        runs,
+        sweeps,
+        policies,
+        watch,
+        events,
+    ):
+        app.include_router(module.router)
+
+    @app.get("/", include_in_schema=False)
+    def index() -> FileResponse:
+        page = STATIC_DIR / "index.html"
+        if not page.is_file():
+            raise NotFoundError(
+                f"The page is missing from {STATIC_DIR}; reinstall Teach Studio (the API still works at /docs)."
+            )
+        return FileResponse(page, headers={"Cache-Control": "no-cache"})
+
+    app.mount("/static", StaticFiles(directory=STATIC_DIR, check_dir=False), name="static")
+
+    def openapi() -> dict[str, object]:
+        if app.openapi_schema is None:  # built once, with the studio's real error shape
+            app.openapi_schema = document_errors(FastAPI.openapi(app))
+        return app.openapi_schema
+
+    app.openapi = openapi  # type: ignore[method-assign]
+    return app
+
+
+def answer_errors(app: FastAPI, settings: Settings) -> None:
+    """Answer every refusal as ``{"detail": sentence}``: a :class:`studio.StudioError` with its
+    status (422 for the algorithm packages'), a wrong method, a disk that refuses a write, a
+    malformed request."""
+
     @app.exception_handler(StudioError)
     async def studio_error(request: Request, err: StudioError) -> JSONResponse:
         status = err.status_code if isinstance(err, WebError) else 422
-        body: dict[str, Any] = {"detail": str(err)}
+        body: dict[str, object] = {"detail": str(err)}
         reason = getattr(err, "reason", None)
         if isinstance(reason, str):
             body["reason"] = reason  # e.g. a refused demonstration: "never_reaches_goal"
@@ -126,39 +167,6 @@ def create_app(settings: Settings | None = None, scene: Any = None) -> FastAPI:
     async def validation_error(request: Request, err: RequestValidationError) -> JSONResponse:
         return JSONResponse({"detail": validation_sentence(err.errors())}, status_code=422)
 
-    for module in (
-        config,
-        sources,
-        capture,
-        recordings,
-        demonstrations,
-        runs,
-        sweeps,
-        policies,
-        watch,
-        events,
-    ):
-        app.include_router(module.router)
-
-    @app.get("/", include_in_schema=False)
-    def index() -> FileResponse:
-        page = STATIC_DIR / "index.html"
-        if not page.is_file():
-            raise NotFoundError(
-                f"The page is missing from {STATIC_DIR}; reinstall Teach Studio (the API still works at /docs)."
-            )
-        return FileResponse(page, headers={"Cache-Control": "no-cache"})
-
-    app.mount("/static", StaticFiles(directory=STATIC_DIR, check_dir=False), name="static")
-
-    def openapi() -> dict[str, Any]:
-        if app.openapi_schema is None:  # built once, with the studio's real error shape
-            app.openapi_schema = document_errors(FastAPI.openapi(app))
-        return app.openapi_schema
-
-    app.openapi = openapi  # type: ignore[method-assign]
-    return app
-
 
 def allowed_methods(app: FastAPI, path: str) -> list[str]:
     """Every method the API documents at ``path`` (for a 405's ``Allow``).
@@ -177,12 +185,14 @@ def allowed_methods(app: FastAPI, path: str) -> list[str]:
     return sorted(methods)
 
 
-def validation_sentence(errors: list[dict[str, Any]]) -> str:
+def validation_sentence(errors: Sequence[Mapping[str, object]]) -> str:
     """One sentence for FastAPI's validation errors, naming the first bad field and the fix."""
     if not errors:
         return "The request is malformed; check its fields and try again."
     first = errors[0]
-    loc = [str(p) for p in first.get("loc", ()) if p not in ("body", "query", "path")]
+    where = first.get("loc", ())
+    parts = where if isinstance(where, (list, tuple)) else ()
+    loc = [str(p) for p in parts if p not in ("body", "query", "path", *RUN_TASK_TAGS)]
     field = ".".join(loc) or "the request body"
     message = str(first.get("msg", "is invalid")).rstrip(".")
     given = first.get("input")
@@ -191,7 +201,7 @@ def validation_sentence(errors: list[dict[str, Any]]) -> str:
         return f"{field} is missing; add it to the request."
     if kind == "extra_forbidden":
         return f"{field} is not a known field; remove it or check its spelling."
-    if kind in ("json_invalid", "model_attributes_type", "dict_type"):
+    if kind in ("json_invalid", "model_attributes_type", "dict_type", "model_type"):
         return f"The request body is not a JSON object ({message}); send a JSON object."
     shown = repr(given) if given is not None and len(repr(given)) <= 60 else "the value given"
     return f"{field} is {shown}: {message[0].lower()}{message[1:]}; fix {field} and try again."

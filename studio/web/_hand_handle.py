@@ -11,14 +11,15 @@ from __future__ import annotations
 import logging
 import threading
 import time
-from collections.abc import Callable
-from typing import Any
+from collections.abc import Callable, Mapping
 
 import numpy as np
 import viser
 import viser.transforms as vtf
 
 from studio import StudioError
+
+from ._protocols import HandMoved
 
 log = logging.getLogger(__name__)
 
@@ -31,9 +32,6 @@ MIN_INTERVAL_S = 1.0 / 60.0
 """Drag updates closer together than this are skipped (the release is always handed on), so a
 fast mouse stays well under the hand source's flood limit and the IK keeps up."""
 
-HandMoved = Callable[[np.ndarray, np.ndarray], Any]
-"""Called with a hand position (3,) and orientation wxyz (4,) in the arm frame; returns the
-``HandPublic`` fields (``q_human``, ``reached``, ...)."""
 HandOf = Callable[[np.ndarray], np.ndarray]
 """The hand's 4x4 pose in the arm frame for a ``q_human``."""
 
@@ -107,7 +105,7 @@ class HandHandle:
             self._handle = None
         self._on_move = None
 
-    def _dragged(self, event: Any) -> None:
+    def _dragged(self, event: viser.TransformControlsEvent) -> None:
         now = time.monotonic()
         if getattr(event, "phase", "update") == "update" and now - self._last_move < MIN_INTERVAL_S:
             return
@@ -118,7 +116,7 @@ class HandHandle:
         if getattr(event, "phase", "update") == "end" and reached is not None:
             self.snap(reached)
 
-    def snap(self, answer: dict[str, Any]) -> None:
+    def snap(self, answer: Mapping[str, object]) -> None:
         """Put the handle back on the hand when the arm stopped short of it (out of reach)."""
         with self._lock:
             handle, hand_of, worldMbase = self._handle, self._hand_of, self._worldMbase
@@ -128,7 +126,7 @@ class HandHandle:
         handle.position = worldMhand[:3, 3]
         handle.wxyz = vtf.SO3.from_matrix(worldMhand[:3, :3]).wxyz
 
-    def move(self, position: np.ndarray, wxyz: np.ndarray) -> dict[str, Any] | None:
+    def move(self, position: np.ndarray, wxyz: np.ndarray) -> Mapping[str, object] | None:
         """The handle was dragged to a world pose: hand it on in the arm frame.
 
         Returns what the hand guide reached, or None when the update was refused.
@@ -144,4 +142,4 @@ class HandHandle:
             log.debug("hand handle update refused: %s", err)
             return None
         self.moves += 1
-        return answer if isinstance(answer, dict) else None
+        return answer if isinstance(answer, Mapping) else None

@@ -7,7 +7,8 @@ landmarks' stream fitter, the hand guide's IK; warm-started observation to obser
 chain demonstration extraction uses. Sources fed by calls (the camera, the hand guide) hand each
 observation to :meth:`Pipeline.observe`, which fits and records it at once and says what the fit
 made of it.
-The newest pose goes to the scene with ``update_live`` (latest wins, never blocks). When the
+The newest pose goes to the scene as a :class:`LivePose` (``show_live``: latest wins, never
+blocks). When the
 kinematics fall behind the stream, only the newest frames of a batch are fitted: the recording
 still gets every frame, the scene the newest pose.
 
@@ -22,15 +23,13 @@ import dataclasses
 import logging
 import threading
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import Any, Protocol
 
 import numpy as np
 
 from studio import StudioError
 from studio.capture import (
-    AppendWriter,
     Fitted,
     FrameSource,
     Observation,
@@ -40,6 +39,7 @@ from studio.capture import (
 from studio.kinematics import TapeConfig
 
 from ._errors import ConflictError, storage_sentence
+from ._protocols import CaptureWriter, LivePose, LiveScene
 
 log = logging.getLogger(__name__)
 
@@ -52,27 +52,20 @@ IDLE_SLEEP_S = 0.05
 ROBOT_JOINTS = 6
 
 
-class LiveScene(Protocol):
-    """What the pipeline asks of the scene."""
-
-    def update_live(
-        self, q_human: np.ndarray, q_robot: np.ndarray, tape_positions: np.ndarray | None = None
-    ) -> None:
-        """Show the newest live pose."""
-
-    def set_side(self, side: str) -> None:
-        """Make ``side`` the operator's arm that follows the fit."""
-
-
 class Pipeline:
     """The live source, its kinematics, the capture writer, and live demonstration marking.
 
     Args:
         scene: the :class:`studio.web._scene.StudioScene` to feed, or None (headless, tests).
+        on_change: called with ``"recordings"`` whenever a capture adds or finishes a recording
+            (the studio's list versions, as the stores and the run queue announce theirs).
     """
 
-    def __init__(self, scene: LiveScene | None = None) -> None:
+    def __init__(
+        self, scene: LiveScene | None = None, on_change: Callable[[str], None] | None = None
+    ) -> None:
         self.scene = scene
+        self._on_change = on_change
         self._lock = threading.RLock()
         self._fit_lock = threading.Lock()  # one fit at a time (the thread, or a fed source's call)
         self._source: FrameSource | None = None
@@ -87,7 +80,7 @@ class Pipeline:
         self._residual: float | None = None
         self._last_t: float | None = None
         self._observable: np.ndarray | None = None  # what the camera's fit could see
-        self._writer: AppendWriter | None = None
+        self._writer: CaptureWriter | None = None
         self._capture_name: str | None = None
         self._capture_path: Path | None = None
         self._capture_frames = 0
@@ -163,7 +156,7 @@ class Pipeline:
             ConflictError: a capture is running (stop it before switching).
         """
         with self._lock:
-            self.set_source(None, kind)  # type: ignore[arg-type]
+            self.set_source(None, kind)
             self._start_error = message
 
     def clear_source(self) -> None:
@@ -180,7 +173,7 @@ class Pipeline:
                 log.exception("stopping the %s source failed", self._kind)
 
     @property
-    def source(self) -> Any:  # the concrete source: the state calls its kind's own methods
+    def source(self) -> FrameSource | None:
         """The current source object (None without one)."""
         return self._source
 
@@ -209,7 +202,7 @@ class Pipeline:
         """``"joint"`` or ``"cartesian"``: how the arm is mapped onto the robot now."""
         return self._mode
 
-    def status(self) -> dict[str, Any]:
+    def status(self) -> dict[str, object]:
         """The ``SourcePublic`` fields (without playback, which the state adds)."""
         with self._lock:
             source = self._source
@@ -273,7 +266,7 @@ class Pipeline:
 
     # ------------------------------------------------------------------ capture
 
-    def start_capture(self, writer: AppendWriter, name: str, path: Path) -> None:
+    def start_capture(self, writer: CaptureWriter, name: str, path: Path) -> None:
         """Send every raw frame to ``writer`` from now on.
 
         Raises:
@@ -291,6 +284,7 @@ class Pipeline:
             self._capture_error = None
             self._capture_t0 = None
             self._capture_last_t = None
+        self._changed()
 
     def stop_capture(self) -> tuple[str, Path]:
         """Close the capture file cleanly; returns its name and path.
@@ -309,17 +303,25 @@ class Pipeline:
     def flush_capture(self) -> None:
         """Write the capture's buffered frames to disk now (for cutting a demonstration)."""
         with self._lock:
-            if self._writer is not None and hasattr(self._writer, "flush"):
+            if self._writer is not None:
                 self._writer.flush()
 
     def _close_writer(self) -> None:
+        writer = self._writer
+        if writer is None:
+            return
         try:
-            self._writer.close()
+            writer.close()
         except Exception as err:  # the file's flushed frames are still there, marked recovered
             log.warning("closing the capture %s failed: %s", self._capture_name, err)
             self._capture_error = self._capture_failure(err)
         self._writer = None
         self._capture_name = None
+        self._changed()  # the recording is complete (or kept as far as it got)
+
+    def _changed(self) -> None:
+        if self._on_change is not None:
+            self._on_change("recordings")
 
     def _capture_failure(self, err: Exception) -> str:
         """One sentence for a capture the disk (or the writer) stopped, with the frames kept."""
@@ -337,7 +339,7 @@ class Pipeline:
         with self._lock:
             self._capture_error = None
 
-    def capture_status(self) -> dict[str, Any]:
+    def capture_status(self) -> dict[str, object]:
         """The ``CapturePublic`` fields."""
         with self._lock:
             active = self._writer is not None
@@ -399,7 +401,7 @@ class Pipeline:
             return None
         return f"{self._capture_rejected} frames of another tape width were left out of the recording; check that one tape sends."
 
-    def _record(self, frames: Sequence[Any]) -> None:
+    def _record(self, frames: Sequence[Observation]) -> None:
         """Append frames to the capture; a frame of another width than the recording's is left
         out and counted (one odd frame never ends a capture); a failed write ends it, with the
         reason kept in ``capture_status()["error"]`` until dismissed."""
@@ -446,7 +448,9 @@ class Pipeline:
             self._fitter = fitter
         return fitter
 
-    def _fit(self, source: FrameSource, observations: Sequence[Observation]) -> Fitted | None:
+    def _fit(
+        self, source: FrameSource | None, observations: Sequence[Observation]
+    ) -> Fitted | None:
         """Fit observations in order and show the newest pose; a failing fit is shown, not fatal."""
         try:
             with self._fit_lock:
@@ -463,7 +467,7 @@ class Pipeline:
                         self._kin_error = None
                         self._fit_warning = fitted.warning
             if self.scene is not None and fitted is not None:
-                self.scene.update_live(fitted.q_human, fitted.q_robot, fitted.tape_points)
+                self.scene.show_live(LivePose(fitted.q_human, fitted.q_robot, fitted.tape_points))
             return fitted
         except StudioError as err:
             with self._lock:

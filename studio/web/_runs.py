@@ -25,30 +25,26 @@ from datetime import UTC, datetime
 from pathlib import Path
 
 import numpy as np
+from pydantic import TypeAdapter
 
 from studio.learning import (
     DEFAULT_GOAL_JOINTS_DEG,
-    ArmGrid,
-    ConfigError,
-    DynaQConfig,
+    DemonstrationPath,
     LearningError,
     LiveCurve,
     LiveProgress,
     RunFolder,
     RunRecord,
-    arm_reach_record,
+    RunRequest,
     delete_run_folder,
     find_runs,
     goal_degrees,
-    goal_problems,
-    grid_for_goal,
-    raise_problems,
-    run_problems,
+    resolve_run,
 )
 
 from .._files import now_iso
 from ._errors import ConflictError, InvalidError, NotFoundError
-from ._schemas import RunCreate, RunPublic
+from ._schemas import GridRunCreate, RunCreate, RunPublic
 
 __all__ = ["Run", "RunQueue", "prepare_run"]
 
@@ -127,8 +123,7 @@ class Run:
     @property
     def demonstrations(self) -> list[str]:
         """Names of the demonstrations the page asked for (none for other origins)."""
-        request = self.folder.record.request or {}
-        return list(request.get("demonstrations") or [])
+        return list(self.folder.record.demonstration_names)
 
     def live_curve(self) -> LiveCurve:
         """The run's curve, brought up to date: while it trains at most every
@@ -221,7 +216,7 @@ class DamagedRun:
             id=self.id,
             name=self.id,
             status="damaged",
-            config=RunCreate(),
+            config=GridRunCreate(),
             created=created,
             started=None,
             finished=None,
@@ -264,57 +259,19 @@ def _status_mtime(path: Path) -> float:
         return 0.0
 
 
+RUN_CREATE: TypeAdapter[RunCreate] = TypeAdapter(RunCreate)
+
+
 def run_create_of(record: RunRecord) -> RunCreate:
-    """The page's form values of a run, whatever made it (the page keeps what the user typed)."""
-    if record.request is not None:
-        with contextlib.suppress(ValueError):
-            return RunCreate.model_validate(record.request)
-    config = record.config
-    grid_spec = record.task
-    goal_deg: list[float] = []
-    with contextlib.suppress(LearningError, TypeError, ValueError):
-        goal_deg = goal_degrees(record.arm_grid())
-    defaults = DynaQConfig()
-    reach: dict[str, object] = {}
-    with contextlib.suppress(LearningError, TypeError, ValueError, KeyError):
-        task, coding = record.arm_reach(), record.tile_coding()
-        reach = {
-            "task": "arm-reach",
-            "joints": task.joints,
-            "step_deg": task.step_deg,
-            "tilings": coding.tilings,
-            "tiles": coding.tiles,
-        }
-    return RunCreate(
-        **reach,  # type: ignore[arg-type]
-        name=record.name or None,
-        planning=config.get("planning", defaults.planning),
-        planning_steps=config.get("planning_steps", defaults.planning_steps),
-        epsilon=config.get("epsilon", defaults.epsilon),
-        alpha=config.get("alpha", defaults.alpha),
-        gamma=config.get("gamma", defaults.gamma),
-        episodes=record.episodes,
-        experiments=record.experiments,
-        bins=int(grid_spec.get("bins", ArmGrid.bins)),
-        goal_deg=goal_deg or list(DEFAULT_GOAL_JOINTS_DEG),
-        demonstrations=[],
-        seed=record.seed,
-    )
-
-
-def _dynaq_config(create: RunCreate, problems: list[tuple[str, str]]) -> DynaQConfig | None:
-    """The form's Dyna-Q settings, or None with their problems added to ``problems``."""
-    try:
-        return DynaQConfig(
-            alpha=create.alpha,
-            gamma=create.gamma,
-            epsilon=create.epsilon,
-            planning=create.planning,
-            planning_steps=create.planning_steps,
-        )
-    except ConfigError as err:
-        problems += list(err.by_field.items())
-        return None
+    """The page's form values of a run, whatever made it (:meth:`RunRecord.form`; a goal the
+    person did not type is shown as the grid's goal bin centre, else the default goal)."""
+    form = record.form()
+    if "goal_deg" not in form:
+        goal: list[float] = []
+        with contextlib.suppress(LearningError):
+            goal = goal_degrees(record.arm_grid())
+        form["goal_deg"] = goal or list(DEFAULT_GOAL_JOINTS_DEG)
+    return RUN_CREATE.validate_python(form)
 
 
 def prepare_run(create: RunCreate, demonstration_path: Callable[[str], np.ndarray]) -> RunRecord:
@@ -325,82 +282,17 @@ def prepare_run(create: RunCreate, demonstration_path: Callable[[str], np.ndarra
         demonstration_path: the Puma560 joint path (N, 6), radians, of a demonstration by name.
 
     Returns:
-        The run's record (grid, Dyna-Q settings, demonstrations' grid paths).
+        The run's record (:func:`studio.learning.resolve_run`).
 
     Raises:
         ConfigError: one sentence per bad field, keyed by field (answered as 422).
     """
-    if create.task == "arm-reach":
-        return _prepare_reach_run(create, demonstration_path)
-    problems: list[tuple[str, str]] = []
-    config = _dynaq_config(create, problems)
-    grid = None
-    goal = goal_problems(create.goal_deg)
-    if goal:
-        problems += [("goal_deg", text) for text in goal]
-    try:
-        grid = (
-            grid_for_goal(create.goal_deg, create.bins) if not goal else ArmGrid(bins=create.bins)
-        )
-    except ConfigError as err:
-        problems += list(err.by_field.items())
-    except LearningError as err:
-        problems.append(("bins", str(err)))
-    problems += run_problems(
-        create.experiments, create.episodes, create.seed, create.name or "", grid
-    )
-    paths: list[list[int]] = []
-    if grid is not None and not goal:
-        for name in create.demonstrations:
-            q_path = np.asarray(demonstration_path(name), dtype=np.float64)
-            path = grid.path_from_joints(q_path, stop_at_goal=True)
-            if path[-1] != grid.goal_state:
-                end = np.degrees(q_path[-1, :3])
-                problems.append(
-                    (
-                        "demonstrations",
-                        f"Demonstration {name!r} ends at joints ({end[0]:.0f}, {end[1]:.0f}, {end[2]:.0f}) degrees, not in the goal bin; choose demonstrations that reach this run's goal or set the goal where they end.",
-                    )
-                )
-            paths.append(list(path))
-    raise_problems(problems)
-    assert grid is not None and config is not None
-    return RunRecord.for_arm_grid(
-        grid,
-        config,
-        create.experiments,
-        create.episodes,
-        create.seed,
-        paths,
-        name=create.name or "",
-        origin="page",
-        request=create.model_dump(),
-    )
-
-
-def _prepare_reach_run(
-    create: RunCreate, demonstration_path: Callable[[str], np.ndarray]
-) -> RunRecord:
-    """:func:`prepare_run` for the continuous task (the learning package's
-    :func:`~studio.learning.arm_reach_record`, as ``studio train --task arm-reach`` does)."""
-    problems: list[tuple[str, str]] = []
-    config = _dynaq_config(create, problems)
-    return arm_reach_record(
-        config,
-        joints=create.joints,
-        step_deg=create.step_deg,
-        tilings=create.tilings,
-        tiles=create.tiles,
-        goal_deg=create.goal_deg,
-        experiments=create.experiments,
-        episodes=create.episodes,
-        seed=create.seed,
-        demonstrations=[demonstration_path(name) for name in create.demonstrations],
-        name=create.name or "",
-        origin="page",
-        request=create.model_dump(),
-        problems=problems,
-    )
+    demonstrations = [
+        DemonstrationPath(f"Demonstration {name!r}", demonstration_path(name), name)
+        for name in create.demonstrations
+    ]
+    request = RunRequest.from_form(create.model_dump(), demonstrations=demonstrations)
+    return resolve_run(request)
 
 
 class RunQueue:

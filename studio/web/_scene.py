@@ -11,11 +11,10 @@ not a source here, so no second arm follows anything). The taped arm is the curr
 taped there starts, and the tape is drawn along that arm's sleeve.
 
 The live pipeline runs at the tape's 110 Hz; a browser's websocket may be far slower. So
-:meth:`StudioScene.update_live` only stores the latest values (latest wins) and a scene thread
-pushes them to viser at a bounded rate, one batched message per update. What the robot shows at
-a given instant is the pure function :func:`pose_at` of the inputs (the live pose, the playback)
-and the clock, in one of three modes: ``live`` (following the tape), ``playback`` (performing a
-trajectory) and ``hold`` (keeping a finished playback's last pose a moment, then back to live).
+:meth:`StudioScene.show_live` only poses the operator for the newest :class:`LivePose` (once, in
+the kinematics package) and stores it (latest wins), and a scene thread pushes it to viser at a
+bounded rate, one batched message per update. What the robot shows at a given instant is the
+pure function :func:`pose_at` of the inputs and the clock (:mod:`._scene_model`).
 
 World frame: Z up, floor at z = 0, the Puma560's base at the origin facing +X; the operator
 stands on the +X side facing -X.
@@ -23,154 +22,37 @@ stands on the +X side facing -X.
 
 from __future__ import annotations
 
-import enum
 import logging
 import threading
 import time
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 import viser
 import viser.transforms as vtf
 
-from studio.kinematics import HumanArm, HumanBody, MeshConfig, MeshPart, Puma560, puma560_meshes
+from studio.kinematics import (
+    HumanArm,
+    HumanBody,
+    MeshPart,
+    PosedBody,
+    Puma560,
+    pose_body,
+    puma560_meshes,
+)
 
-from ._hand_handle import HandHandle, HandMoved
+from ._hand_handle import HandHandle
+from ._protocols import HandMoved, LivePose
+from ._scene_model import Mode, Playback, SceneLayout, pose_at
+from ._scene_model import camera_projection as camera_projection
 
 log = logging.getLogger(__name__)
 
-TAPE_LIFT_ROUNDS = 3
 SOFTWARE_WEBGL_NOTICE = "webgl-software-rendering"
 """The id of the notice viser's client raises by itself when WebGL is drawn in software
 (``client/src/BrowserWarning.tsx``). The studio's page says the same in its own words, beside the
 scene rather than over it, so every browser that connects gets this notice closed."""
-"""Rounds of pushing tape points off the arm's segments (see ``StudioScene.tape_on_sleeve``)."""
-
-
-@dataclass(frozen=True)
-class SceneLayout:
-    """Where things stand, how the camera looks at them and how fast the scene is refreshed.
-
-    Attributes:
-        operator_position: floor point (x, y) under the middle of the operator's body (m).
-        operator_yaw: the operator's heading about +Z (rad); pi faces the robot at the origin.
-        rate_hz: most scene pushes per second (latest values win in between).
-        floor_half_size: the floor plate reaches this far from its centre (m).
-        floor_cell: spacing of the floor's grid lines (m).
-        playback_hold_s: how long the robot keeps the last pose of a finished playback before
-            following the live pose again.
-        camera_position: default camera position (m): beside the pair, a little above.
-        camera_look_at: default camera target (m): between the two bodies.
-        camera_fov_deg: default vertical field of view (degrees).
-        ghost_opacity: opacity of the goal's ghost robot.
-        fill_light: intensity of the sky/ground fill light.
-        tape_lift_m: how far the tape is drawn from the upper arm's and the forearm's axis
-            (m): on the sleeve, where it is strapped, rather than hidden inside the mesh.
-        mesh: mesh simplification (see :class:`~studio.kinematics.MeshConfig`).
-        colors: named colours (0-255 rgb).
-    """
-
-    operator_position: tuple[float, float] = (1.75, 0.0)
-    operator_yaw: float = float(np.pi)
-    rate_hz: float = 60.0
-    floor_half_size: float = 1.6
-    floor_cell: float = 0.25
-    playback_hold_s: float = 5.0
-    camera_position: tuple[float, float, float] = (1.2, -3.9, 1.85)
-    camera_look_at: tuple[float, float, float] = (0.85, 0.0, 0.95)
-    camera_fov_deg: float = 50.0
-    ghost_opacity: float = 0.22
-    fill_light: float = 1.6
-    tape_lift_m: tuple[float, float] = (0.055, 0.045)
-    mesh: MeshConfig = field(default_factory=MeshConfig)
-    colors: dict[str, tuple[int, int, int]] = field(
-        default_factory=lambda: {
-            "tape": (20, 190, 120),
-            "goal": (230, 60, 60),
-            "path": (40, 120, 230),
-            "path_start": (40, 170, 90),
-            "trace": (240, 150, 20),
-            "floor": (236, 238, 241),
-            "floor_lines": (196, 200, 206),
-        }
-    )
-
-
-class Mode(enum.Enum):
-    """What the robot shows: the live pose, a playback, or a finished playback's last pose."""
-
-    LIVE = "live"
-    PLAYBACK = "playback"
-    HOLD = "hold"
-
-
-@dataclass(frozen=True, eq=False)
-class Playback:
-    """A trajectory being performed: sample times from 0 (s), joints, tool points, bin marks.
-
-    Attributes:
-        times: ``(N,)`` s, non-decreasing, from 0.
-        q: ``(N, 6)`` rad.
-        tool: ``(N, 3)`` world tool positions (m).
-        marks: sample indices where a grid bin is marked.
-        started: clock time (``time.perf_counter``) of sample 0.
-    """
-
-    times: np.ndarray
-    q: np.ndarray
-    tool: np.ndarray
-    marks: np.ndarray
-    started: float
-
-
-@dataclass(frozen=True)
-class ScenePose:
-    """What the robot shows at an instant.
-
-    Attributes:
-        mode: the mode in force.
-        q_robot: the robot joints (rad), or None when there is nothing to show yet.
-        trace_upto: the last playback sample the trace reaches (-1: no trace).
-    """
-
-    mode: Mode
-    q_robot: np.ndarray | None
-    trace_upto: int = -1
-
-
-def pose_at(
-    now: float,
-    live_q_robot: np.ndarray | None,
-    playback: Playback | None,
-    hold_s: float,
-) -> ScenePose:
-    """The robot pose at clock time ``now``: a pure function of the inputs.
-
-    Args:
-        now: clock time (s, same clock as ``playback.started``).
-        live_q_robot: the newest live robot joints, or None before the first live pose.
-        playback: the trajectory being performed, or None.
-        hold_s: how long a finished playback's last pose is held.
-
-    Returns:
-        ``playback`` (interpolated between samples) while the trajectory runs, ``hold`` (its
-        last pose) for ``hold_s`` after it ends, ``live`` otherwise.
-    """
-    if playback is not None:
-        times = playback.times
-        t = now - playback.started
-        end = float(times[-1])
-        if t < end:
-            k = int(np.searchsorted(times, t, side="right")) - 1
-            k = min(max(k, 0), len(times) - 2)
-            span = times[k + 1] - times[k]
-            w = 0.0 if span <= 0 else min(max((t - times[k]) / span, 0.0), 1.0)
-            q = (1 - w) * playback.q[k] + w * playback.q[k + 1]
-            return ScenePose(Mode.PLAYBACK, q, k)
-        if t < end + hold_s:
-            return ScenePose(Mode.HOLD, playback.q[-1], len(times) - 1)
-    return ScenePose(Mode.LIVE, live_q_robot, -1)
 
 
 def wxyz_of(rotations: np.ndarray) -> np.ndarray:
@@ -198,35 +80,6 @@ def _rgb255(rgb: Sequence[float]) -> tuple[int, int, int]:
     return r, g, b
 
 
-def camera_projection(
-    points: np.ndarray, layout: SceneLayout, aspect: float
-) -> tuple[np.ndarray, np.ndarray]:
-    """Where world points land on the default camera's image.
-
-    Args:
-        points: ``(N, 3)`` world points (m).
-        layout: gives the camera's position, target and vertical field of view (Z up).
-        aspect: image width / height.
-
-    Returns:
-        ``(ndc (N, 2), depth (N,))``: normalised image coordinates (inside the image when both
-        lie in [-1, 1]) and the distance in front of the camera (m; negative is behind).
-    """
-    eye = np.asarray(layout.camera_position, dtype=float)
-    forward = np.asarray(layout.camera_look_at, dtype=float) - eye
-    forward /= np.linalg.norm(forward)
-    right = np.cross(forward, [0.0, 0.0, 1.0])
-    right /= np.linalg.norm(right)
-    up = np.cross(right, forward)
-    d = np.atleast_2d(np.asarray(points, dtype=float)) - eye
-    depth = d @ forward
-    tan_half = np.tan(np.radians(layout.camera_fov_deg) / 2)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        x = (d @ right) / (depth * tan_half * aspect)
-        y = (d @ up) / (depth * tan_half)
-    return np.stack([x, y], axis=1), depth
-
-
 @dataclass(frozen=True, eq=False)
 class _Operator:
     """The operator as taped now: the body (taped arm) and where its arm base frame stands.
@@ -239,10 +92,22 @@ class _Operator:
         worldMbase: world pose of the taped arm's base frame (4x4).
         version: increases with each switch; the scene thread redraws the operator when it
             differs from the version it drew.
+        rest: the meshes posed at rest (the taped arm at neutral, no tape).
     """
 
     body: HumanBody
     worldMbase: np.ndarray
+    version: int
+    rest: PosedBody
+
+
+@dataclass(frozen=True, eq=False)
+class _Live:
+    """The newest live pose with the operator posed for it (once, by the caller of
+    :meth:`StudioScene.show_live`), for the operator of that ``version``."""
+
+    pose: LivePose
+    posed: PosedBody
     version: int
 
 
@@ -275,14 +140,16 @@ class StudioScene:
         self.robot = robot if robot is not None else Puma560()
         body = body if body is not None else HumanBody(side, self.layout.mesh)
         self._bodies = {body.side: body}  # one per taped arm, sharing the meshes
-        self._operator = _Operator(body, self._operator_placement(body), 0)
+        self._operator = self._operator_for(body, 0)
         self._switch_lock = threading.Lock()  # one set_side at a time
         self._robot_parts = puma560_meshes(self.layout.mesh)
 
         # Inputs, written by any thread under _lock; the loop reads a snapshot.
         self._lock = threading.Lock()
-        self._live: tuple[np.ndarray, np.ndarray, np.ndarray | None] | None = None
+        self._live: _Live | None = None
         self._live_version = 0
+        self._live_at = -np.inf  # when the latest live pose came
+        self._live_gap = np.inf  # the gap between live poses, smoothed (s)
         self._playback: Playback | None = None
         # Published by the loop (under _lock) for readers.
         self._q_robot_shown = np.array(self.robot.qz, dtype=float)
@@ -305,16 +172,19 @@ class StudioScene:
 
     # ------------------------------------------------------------------ building
 
-    def _operator_placement(self, body: HumanBody) -> np.ndarray:
-        """World pose of the taped arm's base frame: the body upright on the floor, facing -X.
+    def _operator_for(self, body: HumanBody, version: int) -> _Operator:
+        """The operator taped on ``body``'s arm, placed upright on the floor facing -X.
 
         The body's middle and feet are placed, not its shoulder, so the resting body stands on
         the same spot whichever arm is taped.
         """
         lay = self.layout
-        rest = body.poses(None)
+        rest = pose_body(body, None)
         pts = np.concatenate(
-            [p.vertices @ m[:3, :3].T + m[:3, 3] for p, m in zip(body.parts, rest, strict=True)]
+            [
+                p.vertices @ m[:3, :3].T + m[:3, 3]
+                for p, m in zip(body.parts, rest.parts, strict=True)
+            ]
         )
         centre = (pts.min(axis=0) + pts.max(axis=0)) / 2
         rotation = vtf.SO3.from_z_radians(lay.operator_yaw).as_matrix()
@@ -322,7 +192,7 @@ class StudioScene:
         out[:3, :3] = rotation
         target = np.array([lay.operator_position[0], lay.operator_position[1], 0.0])
         out[:3, 3] = target - rotation @ np.array([centre[0], centre[1], body.floor_z])
-        return out
+        return _Operator(body, out, version, rest)
 
     def _build(self) -> None:
         s = self.server.scene
@@ -434,7 +304,7 @@ class StudioScene:
     def _add_operator(self) -> list[viser.MeshHandle]:
         s = self.server.scene
         operator = self._operator
-        poses = _operator_poses(operator, None)
+        poses = operator.worldMbase @ operator.rest.parts
         handles = []
         for part, pose in zip(operator.body.parts, poses, strict=True):
             handles.append(
@@ -471,37 +341,10 @@ class StudioScene:
         return _to_world(operator, p)
 
     def tape_on_sleeve(self, tape: np.ndarray, q_human: np.ndarray) -> np.ndarray:
-        """Tape points (arm base frame) lifted off the taped arm's axis onto its surface.
-
-        The fit models the tape along the bones; drawn there it would hide inside the arm's
-        mesh. Each point closer to the upper arm's (forearm's) axis than ``tape_lift_m`` is
-        pushed out radially to that distance; points away from the arm (on the back) stay.
-        """
-        return self._on_sleeve(self.body, tape, q_human)
-
-    def _on_sleeve(self, body: HumanBody, tape: np.ndarray, q_human: np.ndarray) -> np.ndarray:
-        links = [f"{body.side}_{link}" for link in ("upperarm", "lowerarm", "hand")]
-        axis = body.link_poses(links, q_human)[:, :3, 3]
-        out = np.array(tape, dtype=float)
-        # Pushed off one segment, a point near the elbow may land inside the other: a few rounds
-        # settle it. All points at once: this runs for every live pose the scene shows.
-        for _ in range(TAPE_LIFT_ROUNDS):
-            for a, b, lift in zip(axis[:-1], axis[1:], self.layout.tape_lift_m, strict=True):
-                ab = b - a
-                t = np.clip((out - a) @ ab / (ab @ ab), 0.0, 1.0)
-                c = a + t[:, None] * ab
-                away = out - c
-                d = np.linalg.norm(away, axis=1)
-                inside = d < lift
-                if not inside.any():
-                    continue
-                on_axis = inside & (d <= 1e-9)
-                if on_axis.any():  # any direction across the axis
-                    across = np.cross(ab, np.eye(3)[int(np.argmin(np.abs(ab)))])
-                    away[on_axis] = across
-                    d[on_axis] = np.linalg.norm(across)
-                out[inside] = c[inside] + away[inside] / d[inside, None] * lift
-        return out
+        """Tape points (arm base frame) on the taped arm's sleeve at ``q_human``, as drawn
+        (:func:`studio.kinematics.pose_body`)."""
+        posed = pose_body(self.body, q_human, tape, self.layout.tape_lift_m)
+        return posed.tape if posed.tape is not None else np.array(tape, dtype=float)
 
     def tool_positions(self, q_robot: np.ndarray) -> np.ndarray:
         """World tool positions of joint configurations ``(N, 6)`` -> ``(N, 3)``."""
@@ -530,24 +373,17 @@ class StudioScene:
             h.position = pose[:3, 3]
             h.wxyz = wxyz
 
-    def _push_operator(
-        self,
-        operator: _Operator,
-        q_human: np.ndarray | None,
-        tape: np.ndarray | None,
-        whole: bool = False,
-    ) -> None:
-        """Pose the taped arm's meshes (every mesh when ``whole``: the taped arm changed, and
-        the tape goes until the new arm's first tape) and draw the tape on its sleeve."""
-        poses = _operator_poses(operator, q_human)
+    def _push_operator(self, operator: _Operator, posed: PosedBody, whole: bool = False) -> None:
+        """Place the taped arm's meshes (every mesh when ``whole``: the taped arm changed, and
+        the tape goes until the new arm's first tape) and the tape on its sleeve, as posed."""
+        poses = operator.worldMbase @ posed.parts
         moving = list(range(len(poses))) if whole else operator.body.moving
         quats = wxyz_of(poses[moving, :3, :3])
         for i, wxyz in zip(moving, quats, strict=True):
             self._operator_handles[i].position = poses[i, :3, 3]
             self._operator_handles[i].wxyz = wxyz
-        if q_human is not None and tape is not None and len(tape) >= 2:
-            sleeve = self._on_sleeve(operator.body, tape, q_human)
-            self._tape.points = _to_world(operator, sleeve).astype(np.float32)
+        if posed.tape is not None:
+            self._tape.points = _to_world(operator, posed.tape).astype(np.float32)
             if not self._tape.visible:
                 self._tape.visible = True
         elif whole and self._tape.visible:
@@ -596,9 +432,19 @@ class StudioScene:
     def _tick(self, now: float, shown: _Shown) -> None:
         with self._lock:
             live, version, playback = self._live, self._live_version, self._playback
-            operator = self._operator
+            operator, slow = self._operator, self._live_gap >= self.layout.slow_live_s
+        if (
+            slow
+            and now - shown.live_at < 1.0 / self.layout.slow_live_rate_hz
+            and playback is None
+            and shown.playback is None
+            and operator.version == shown.operator_version
+        ):
+            return  # a slow stream's newer pose waits for its turn (latest wins)
+        if live is not None and live.version != operator.version:
+            live = None  # posed for the arm taped before a switch
         pose = pose_at(
-            now, None if live is None else live[1], playback, self.layout.playback_hold_s
+            now, None if live is None else live.pose.q_robot, playback, self.layout.playback_hold_s
         )
         new_live = live is not None and version != shown.live_version
         operator_changed = operator.version != shown.operator_version
@@ -621,9 +467,9 @@ class StudioScene:
                 self._hide_trace()
                 shown.trace_upto = -1
             if new_live and live is not None:
-                self._push_operator(operator, live[0], live[2], whole=operator_changed)
+                self._push_operator(operator, live.posed, whole=operator_changed)
             elif operator_changed:
-                self._push_operator(operator, None, None, whole=True)
+                self._push_operator(operator, operator.rest, whole=True)
             if robot_changed and pose.q_robot is not None:
                 self._push_robot(self._robot_handles, pose.q_robot)
             if playback is not None and pose.trace_upto > shown.trace_upto:
@@ -632,6 +478,8 @@ class StudioScene:
         # Send now rather than at viser's next message window (up to 1/60 s later): the pose
         # is what the operator is waiting to see.
         self.server.flush()
+        if new_live:
+            shown.live_at = now
         shown.live_version = version
         shown.operator_version = operator.version
         shown.playback = playback
@@ -645,36 +493,43 @@ class StudioScene:
                 self._side_shown = operator.body.side
                 self._q_human_shown = np.zeros(len(self._q_human_shown))  # the new arm rests
             if new_live and live is not None:
-                self._q_human_shown = live[0].copy()
+                self._q_human_shown = live.pose.q_human.copy()
             self._shown_playback = playback
             self._shown_mode = pose.mode
         self.pushes += 1
 
     # ------------------------------------------------------------------ public API
 
-    def update_live(
-        self,
-        q_human: np.ndarray,
-        q_robot: np.ndarray,
-        tape_positions: np.ndarray | None = None,
-    ) -> None:
-        """Show the latest live pose (never blocks; the scene thread pushes the newest).
+    def show_live(self, pose: LivePose) -> None:
+        """Show the latest live pose (never waits for the browser; the scene thread pushes the
+        newest).
 
-        Args:
-            q_human: the fitted arm's joints (7,), rad.
-            q_robot: the retargeted Puma560 joints (6,), rad.
-            tape_positions: the reconstructed tape ``(regions + 1, 3)`` in the arm's base
-                frame, m, or None to leave the tape as drawn.
+        The operator is posed for it here, once (:func:`studio.kinematics.pose_body`: the meshes
+        and the tape on the sleeve), so the scene thread only places what it is given. A pose
+        without a tape leaves the tape as drawn.
         """
-        value = (
-            np.array(q_human, dtype=float),
-            np.array(q_robot, dtype=float),
-            None if tape_positions is None else np.array(tape_positions, dtype=float),
+        pose = LivePose(
+            np.array(pose.q_human, dtype=float),
+            np.array(pose.q_robot, dtype=float),
+            None if pose.tape is None else np.array(pose.tape, dtype=float),
         )
+        now = time.perf_counter()
         with self._lock:
-            self._live = value
+            operator = self._operator
+        posed = pose_body(operator.body, pose.q_human, pose.tape, self.layout.tape_lift_m)
+        with self._lock:
+            self._live = _Live(pose, posed, operator.version)
             self._live_version += 1
+            gap = min(now - self._live_at, 1.0)  # a pause counts as one slow gap, not more
+            smooth = self._live_gap + 0.25 * (gap - self._live_gap)
+            self._live_gap, self._live_at = smooth if np.isfinite(smooth) else gap, now
         self._wake.set()
+
+    def update_live(
+        self, q_human: np.ndarray, q_robot: np.ndarray, tape_positions: np.ndarray | None = None
+    ) -> None:
+        """:meth:`show_live` of ``LivePose(q_human, q_robot, tape_positions)``."""
+        self.show_live(LivePose(q_human, q_robot, tape_positions))
 
     def set_side(self, side: str) -> None:
         """Put the tape on the operator's ``side`` arm: it follows the fit, the other rests.
@@ -697,7 +552,7 @@ class StudioScene:
                 self._bodies[body.side] = body
             if body is current.body:
                 return
-            operator = _Operator(body, self._operator_placement(body), current.version + 1)
+            operator = self._operator_for(body, current.version + 1)
             with self._lock:
                 self._operator = operator
                 self._live = None
@@ -879,6 +734,7 @@ class _Shown:
     """What the scene thread pushed last (its own bookkeeping; no other thread touches it)."""
 
     live_version: int = 0
+    live_at: float = -np.inf
     operator_version: int = 0
     q_robot: np.ndarray | None = None
     playback: Playback | None = None

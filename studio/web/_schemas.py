@@ -8,9 +8,18 @@ whose one-sentence messages the API passes on as 422.
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import Annotated, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, StrictBool, StrictInt
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Discriminator,
+    Field,
+    StrictBool,
+    StrictInt,
+    Tag,
+    field_validator,
+)
 
 from studio.learning import (
     DEFAULT_EPISODES,
@@ -31,8 +40,6 @@ Side = Literal["right", "left"]
 DEFAULT_GOAL_DEG = DEFAULT_GOAL_JOINTS_DEG
 """The learning package's default goal for joints 1-3 (an arm reaching forward and down)."""
 _DYNAQ = DynaQConfig()
-TaskKind = Literal[TASK_KINDS]  # type: ignore[valid-type]
-"""What a run learns: the paper's grid (tabular) or continuous joints (tile coding)."""
 """The learning package's training defaults: ``RunCreate`` takes each of its defaults from here."""
 
 
@@ -54,7 +61,7 @@ class ConfigPublic(BaseModel):
     data_dir: str
     scene_instance: str | None = None
     """The id the scene at ``viser_url`` answers at ``/studio-instance`` (None: not checked)."""
-    training: RunCreate | None = Field(
+    training: RunDefaults | None = Field(
         None, description="the train form's defaults: the learning package's, served once"
     )
     planners: list[str] = Field(default_factory=list, description="the planning modes")
@@ -318,9 +325,10 @@ class MarkPublic(BaseModel):
 # ----------------------------------------------------------------------------- runs
 
 
-class RunCreate(_Body):
-    """A training run. Every default is the learning package's (``DynaQConfig``, ``ArmGrid``, the
-    run defaults), which also checks every value and reports all bad fields at once."""
+class _RunCreateBase(_Body):
+    """What every training run sets. Every default is the learning package's (``DynaQConfig``,
+    ``ArmGrid``, the run defaults), which also checks every value and reports all bad fields at
+    once."""
 
     name: str | None = None
     planning: PlanningName = _DYNAQ.planning  # type: ignore[assignment]
@@ -330,20 +338,67 @@ class RunCreate(_Body):
     gamma: float = _DYNAQ.gamma
     episodes: int = DEFAULT_EPISODES
     experiments: int = DEFAULT_EXPERIMENTS
-    bins: int = ArmGrid.bins
-    task: TaskKind = "arm-grid"
-    """``arm-grid``: the paper's grid, tabular; ``arm-reach``: continuous joints, tile coding."""
-    joints: int = REACH_DEFAULTS["joints"]
-    """Continuous task: joints 1..J learnt (3 to 6)."""
-    step_deg: float = REACH_DEFAULTS["step_deg"]
-    """Continuous task: joint increment per action, degrees."""
-    tilings: int = REACH_DEFAULTS["tilings"]
-    """Continuous task: offset tilings of each joint."""
-    tiles: int = REACH_DEFAULTS["tiles"]
-    """Continuous task: tiles per joint in each tiling."""
     goal_deg: list[float] = Field(default_factory=lambda: list(DEFAULT_GOAL_DEG))
+    """The goal as joint 1-3 angles, degrees (the continuous task's when it replays no
+    demonstration: then the first demonstration's end is its goal)."""
     demonstrations: list[str] = Field(default_factory=list)
     seed: int = DEFAULT_SEED
+
+
+class GridRunCreate(_RunCreateBase):
+    """A run on the paper's arm grid, tabular (``task`` may be left out)."""
+
+    task: Literal["arm-grid"] = "arm-grid"
+    bins: int = ArmGrid.bins
+    """Bins per joint."""
+
+    @field_validator("task", mode="before")
+    @classmethod
+    def _known_task(cls, task: object) -> object:
+        if task not in TASK_KINDS:
+            raise ValueError(f"Input should be {' or '.join(map(repr, TASK_KINDS))}")
+        return task
+
+
+class ReachRunCreate(_RunCreateBase):
+    """A run on the arm's continuous joints, learnt with tile coding."""
+
+    task: Literal["arm-reach"]
+    joints: int = REACH_DEFAULTS["joints"]
+    """Joints 1..J learnt (3 to 6)."""
+    step_deg: float = REACH_DEFAULTS["step_deg"]
+    """Joint increment per action, degrees."""
+    tilings: int = REACH_DEFAULTS["tilings"]
+    """Offset tilings of each joint."""
+    tiles: int = REACH_DEFAULTS["tiles"]
+    """Tiles per joint in each tiling."""
+    bins: int | None = None
+    """Not used by this task: the page's form sends its grid field along with every run."""
+
+
+def _task_of(body: object) -> str:
+    """The union member of a run body: its ``task``, the arm grid when it names none."""
+    task = body.get("task") if isinstance(body, dict) else getattr(body, "task", None)
+    return task if task in TASK_KINDS else TASK_KINDS[0]  # an unknown one is refused there
+
+
+RunCreate = Annotated[
+    Annotated[GridRunCreate, Tag(TASK_KINDS[0])] | Annotated[ReachRunCreate, Tag(TASK_KINDS[1])],
+    Discriminator(_task_of),
+]
+"""A training run, by what it learns (``task``): ``arm-grid``, the paper's grid, tabular (the
+default); ``arm-reach``, the arm's continuous joints with tile coding."""
+RUN_TASK_TAGS = TASK_KINDS
+"""The tags of :data:`RunCreate`'s members, which validation errors put in front of the field."""
+
+
+class RunDefaults(GridRunCreate):
+    """The train form's defaults (every task's fields, the learning package's defaults)."""
+
+    joints: int = REACH_DEFAULTS["joints"]
+    step_deg: float = REACH_DEFAULTS["step_deg"]
+    tilings: int = REACH_DEFAULTS["tilings"]
+    tiles: int = REACH_DEFAULTS["tiles"]
 
 
 class RunPublic(BaseModel):

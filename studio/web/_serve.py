@@ -21,7 +21,7 @@ import time
 import webbrowser
 from collections.abc import Callable, Iterable
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 from urllib.parse import urlsplit
 
 from studio import StudioError, is_loopback
@@ -31,9 +31,15 @@ from ._guard import SiteRule
 from ._settings import Settings
 
 if TYPE_CHECKING:
+    import uvicorn
     import viser
+    from websockets.asyncio.server import Server, ServerConnection
+    from websockets.http11 import Request, Response
 
     from ._scene import StudioScene
+
+    ProcessRequest = Callable[[ServerConnection, Request], Response | None]
+    """websockets' hook that may answer a handshake request itself."""
 
 log = logging.getLogger(__name__)
 
@@ -91,7 +97,7 @@ class SceneGuard(SiteRule):
 
     # ------------------------------------------------------------------ websockets hook
 
-    def wrap(self, process_request: Callable[..., Any] | None) -> Callable[..., Any]:
+    def wrap(self, process_request: ProcessRequest | None) -> ProcessRequest:
         """A websockets ``process_request`` that applies the rule, then calls the original."""
         from websockets.datastructures import Headers
         from websockets.http11 import Response
@@ -103,7 +109,7 @@ class SceneGuard(SiteRule):
             h["Cache-Control"] = "no-store"
             return Response(status, reason, h, body)
 
-        def guarded(connection: Any, request: Any) -> Any:
+        def guarded(connection: ServerConnection, request: Request) -> Response | None:
             headers = request.headers
             origin = headers.get("Origin")
             if not self.host_ok(headers.get("Host")):
@@ -161,7 +167,7 @@ class SceneGuard(SiteRule):
         server.request_share_url = refuse_call  # type: ignore[method-assign]
 
 
-def _websockets_server(server: viser.ViserServer) -> Any:
+def _websockets_server(server: viser.ViserServer) -> Server:
     """The ``websockets`` server object behind a running viser server.
 
     viser 1.1 keeps it only as a local of the coroutine that serves it (``serve_future`` in
@@ -173,7 +179,7 @@ def _websockets_server(server: viser.ViserServer) -> Any:
     if loop is None:
         raise ServeError("The scene server is not running; restart the studio.")
 
-    async def find() -> Any:
+    async def find() -> Server | None:
         for task in asyncio.all_tasks(loop):
             frame = getattr(task.get_coro(), "cr_frame", None)
             found = frame.f_locals.get("serve_future") if frame is not None else None
@@ -284,7 +290,7 @@ def prepare_data_dir(data_dir: Path) -> None:
         ) from None
 
 
-def _prepare_when_up(http: Any) -> None:
+def _prepare_when_up(http: uvicorn.Server) -> None:
     """Once the API answers, compile the learner's kernels in the background if they are not
     cached (a first run then loads them instead of compiling them); after, so that the compile
     never slows the start."""

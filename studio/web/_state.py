@@ -1,8 +1,9 @@
 """The studio's state: the stores, the live pipeline, the run queue, the scene and the watched rollouts.
 
 One :class:`Studio` per app, built when the app starts and closed when it stops. Routes reach it
-through the ``StudioDep`` dependency. List changes bump a version per list; the SSE stream
-compares versions, so a slow or vanished client never holds anything up.
+through the ``StudioDep`` dependency. Every list's owner announces its own changes through one
+``on_change`` callback (the stores, the pipeline's capture, the run queue), which bumps a version
+per list; the SSE stream compares versions, so a slow or vanished client never holds anything up.
 """
 
 from __future__ import annotations
@@ -10,18 +11,31 @@ from __future__ import annotations
 import logging
 import threading
 import uuid
+from collections.abc import Callable
 from datetime import UTC, datetime
 from pathlib import Path
-from typing import Any
+from typing import TypeVar
 
 import numpy as np
 
 from studio import StudioError, is_loopback
-from studio.capture import DEFAULT_PORT, being_recorded
-from studio.learning import GOAL_JOINTS, check_goal_deg
+from studio.capture import (
+    DEFAULT_PORT,
+    CameraSource,
+    Fitted,
+    FloodError,
+    HandPose,
+    HandSource,
+    LandmarkFrame,
+    PlaybackSource,
+    SimulatorSource,
+    source_from_spec,
+)
+from studio.learning import GOAL_JOINTS, PolicyFile, TilePolicyFile, check_goal_deg
 
 from ._errors import ConflictError, InvalidError, NotFoundError, TooManyRequestsError
 from ._pipeline import Pipeline
+from ._protocols import Scene
 from ._runs import RunQueue
 from ._settings import Settings
 from ._store import (
@@ -32,6 +46,8 @@ from ._store import (
 
 log = logging.getLogger(__name__)
 
+Fed = TypeVar("Fed", LandmarkFrame, HandPose)
+"""An observation a fed source (the camera, the hand guide) takes in."""
 LIST_NAMES = ("recordings", "demonstrations", "runs", "policies")
 ROLLOUTS_KEPT = 16
 """Policies whose last watched rollout stays downloadable (each at most a megabyte or two)."""
@@ -63,17 +79,20 @@ class Studio:
         scene: the viser scene to drive, or None (tests, headless).
     """
 
-    def __init__(self, settings: Settings, scene: Any = None) -> None:
+    def __init__(self, settings: Settings, scene: Scene | None = None) -> None:
         self.settings = settings
         for folder in (settings.recordings_dir, settings.runs_dir, settings.policies_dir):
             folder.mkdir(parents=True, exist_ok=True)
         self.changes = ListChanges()
-        self.recordings = recording_store(settings.recordings_dir)
-        self.policies = policy_store(settings.policies_dir)
-        self.demonstrations = demonstration_store(settings.recordings_dir)
-        self.runs = RunQueue(settings.runs_dir, self.changes.bump, settings.run_workers)
+        changed = self.changes.bump
         self.scene = scene
-        self.pipeline = Pipeline(scene)
+        self.pipeline = Pipeline(scene, on_change=changed)
+        self.runs = RunQueue(settings.runs_dir, changed, settings.run_workers)
+        self.recordings = recording_store(settings.recordings_dir, self.pipeline, changed)
+        self.policies = policy_store(settings.policies_dir, changed, self._policy_playing)
+        self.demonstrations = demonstration_store(
+            settings.recordings_dir, changed, self._demonstration_replayed
+        )
         self.watch_lock = threading.Lock()
         self.watching: str | None = None  # "policy:<name>" or "run:<id>" being played
         # the last rollout watched of each policy key: (times, q), the oldest watched first
@@ -119,10 +138,9 @@ class Studio:
             return
         path = Path(source)
         if path.is_file() and path.resolve().parent != self.settings.recordings_dir.resolve():
-            from studio.capture import PlaybackSource
-
             name = self.recordings.stem_of(path.name)
-            self.pipeline.set_source(PlaybackSource(path, loop=True), "recording", name)
+            playback = source_from_spec(str(path.resolve()), loop=True)
+            self.pipeline.set_source(playback, "recording", name)
             return
         name = self.recordings.stem_of(path.name) if path.is_file() else source
         self.set_source(kind="recording", recording=name, loop=True)
@@ -139,77 +157,69 @@ class Studio:
         seed: int | None = None,
         side: str | None = None,
     ) -> None:
-        """Build a source of ``kind`` and make it the live one."""
+        """Build a source of ``kind`` (with the capture package's one factory of sources) and
+        make it the live one."""
+        if self.scene is not None and kind not in ("camera", "hand"):
+            self.scene.show_hand_handle(None, None)
         if kind in ("camera", "hand"):
-            from studio.capture import CameraSource, HandSource
-
-            fed = CameraSource if kind == "camera" else HandSource
-            self.pipeline.set_source(fed(side or "right"), kind)
+            self.pipeline.set_source(source_from_spec(f"{kind}:{side or 'right'}", fed=True), kind)
             if kind == "hand" and self.scene is not None:
                 self.scene.show_hand_handle(self.pipeline.side(), self.hand_moved)
-            return
-        if self.scene is not None:
-            self.scene.show_hand_handle(None, None)
-        if kind == "simulator":
-            from studio.capture import SimulatorSource
-
-            source = SimulatorSource(seed=seed if seed is not None else 0)
-            self.pipeline.set_source(source, kind)
+        elif kind == "simulator":
+            self.pipeline.set_source(source_from_spec("simulator", seed=seed or 0), kind)
         elif kind == "recording":
             if recording is None:
                 raise InvalidError(
                     "recording is missing; give the name of a recording to play back."
                 )
-            from studio.capture import PlaybackSource
-
-            current = self.pipeline.source
-            if (
-                self.pipeline.kind == "recording"
-                and self.pipeline.recording == recording
-                and current is not None
-                and current.running
-            ):
-                # The recording already playing: change its speed and loop in place, so that
-                # ticking "loop" never restarts it from 0.
-                if speed is not None:
-                    current.speed = speed
-                if loop is not None:
-                    current.loop = loop
-                return
-            path = self.recordings.path(recording)
-            source = PlaybackSource(
-                path, speed=speed if speed is not None else 1.0, loop=True if loop is None else loop
-            )
-            self.pipeline.set_source(source, kind, recording)
+            if not self._replay_in_place(recording, speed, loop):
+                path = self.recordings.path(recording).resolve()
+                playback = source_from_spec(
+                    str(path), speed=1.0 if speed is None else speed, loop=loop is not False
+                )
+                self.pipeline.set_source(playback, kind, recording)
         elif kind == "network":
-            from studio.capture import NetworkSource
-
             # Loopback unless the user asked for another address (serve --bridge-host); beyond
             # loopback only frames signed with the studio's token are taken.
             host = self.settings.bridge_host
             token = None if is_loopback(host) else self.settings.token
-            source = NetworkSource(host, DEFAULT_PORT if port is None else port, token=token)
-            self.pipeline.set_source(source, kind)
+            spec = f"udp:{host}:{DEFAULT_PORT if port is None else port}"
+            self.pipeline.set_source(source_from_spec(spec, token=token), kind)
         elif kind == "serial":
             if not device:
                 raise InvalidError(
                     "device is missing; give the serial device of the tape, for example /dev/ttyUSB0."
                 )
-            from studio.capture import SerialSource
-
-            path = calibration.strip() if calibration else ""
             try:
-                source = SerialSource(device, calibration=path or None)
+                serial = source_from_spec(
+                    f"serial:{device}", calibration=(calibration or "").strip() or None
+                )
             except StudioError as err:
                 # pyserial missing, a missing or malformed calibration file: the switch happens
                 # as for a device that cannot open, with the serial source showing why.
                 self.pipeline.report_error(kind, str(err))
                 return
-            self.pipeline.set_source(source, kind)
+            self.pipeline.set_source(serial, kind)
         else:  # the schema allows only the kinds above
             raise InvalidError(
                 f"kind is {kind!r}; give simulator, recording, network, serial, camera or hand."
             )
+
+    def _replay_in_place(self, recording: str, speed: float | None, loop: bool | None) -> bool:
+        """Change the speed and loop of ``recording`` if it is the one playing (so that ticking
+        "loop" never restarts it from 0); whether it was."""
+        current = self.pipeline.source
+        if not (
+            isinstance(current, PlaybackSource)
+            and self.pipeline.recording == recording
+            and current.running
+        ):
+            return False
+        if speed is not None:
+            current.speed = speed
+        if loop is not None:
+            current.loop = loop
+        return True
 
     def simulator_reach(self, action: str, goal_deg: list[float]) -> None:
         """Make the simulator reach a robot goal (``goal_deg``, joints 1-3) or wander again.
@@ -219,7 +229,7 @@ class Studio:
             ConfigError: the goal is not 3 angles within the Puma560's limits.
         """
         source = self.pipeline.source
-        if self.pipeline.kind != "simulator" or source is None:
+        if self.pipeline.kind != "simulator" or not isinstance(source, SimulatorSource):
             raise ConflictError(
                 "The live source is not the simulator; switch the source to the simulator first."
             )
@@ -231,29 +241,35 @@ class Studio:
         if self.scene is not None:
             self.scene.set_goal(q)
 
-    def _observe_fed(self, kind: str, *args: Any, **kwargs: Any) -> tuple[Any, Any]:
-        """Hand one update to the fed source ``kind`` (camera or hand) and fit it; returns the
-        observation and the fit (None when the fit failed: the pipeline's status says why).
+    def _fed_source(self, kind: str) -> CameraSource | HandSource:
+        """The live fed source ``kind`` (camera or hand).
 
         Raises:
             ConflictError: the live source is not ``kind``.
-            TooManyRequestsError: a flood (the update is dropped).
         """
-        from studio.capture import FloodError
-
         source = self.pipeline.source
-        if self.pipeline.kind != kind or source is None:
+        fed = CameraSource if kind == "camera" else HandSource
+        if self.pipeline.kind != kind or not isinstance(source, fed):
             label = "camera" if kind == "camera" else "hand guide"
             raise ConflictError(
                 f"The live source is not the {label}; switch the source to {kind} first."
             )
+        return source
+
+    def _observe_fed(self, submit: Callable[[], Fed]) -> tuple[Fed, Fitted | None]:
+        """Hand one update to a fed source (``submit``) and fit it; returns the observation and
+        the fit (None when it failed: the pipeline's status says why).
+
+        Raises:
+            TooManyRequestsError: a flood (the update is dropped).
+        """
         try:
-            observation = source.submit(*args, **kwargs)
+            observation = submit()
         except FloodError as err:
             raise TooManyRequestsError(str(err)) from None
         return observation, self.pipeline.observe(observation)
 
-    def post_landmarks(self, frame: dict[str, Any]) -> dict[str, Any]:
+    def post_landmarks(self, frame: dict[str, object]) -> dict[str, object]:
         """Fit and record one frame of landmarks from the page (``LandmarksFrame``).
 
         Raises:
@@ -261,7 +277,8 @@ class Studio:
             TooManyRequestsError: a flood (the frame is dropped).
             CaptureError: NaN or wrong sizes (422).
         """
-        observation, fitted = self._observe_fed("camera", **frame)
+        camera = self._fed_source("camera")
+        observation, fitted = self._observe_fed(lambda: camera.submit(**frame))
         observable = None if fitted is None else fitted.observable
         warning = fitted.warning if fitted is not None else self.pipeline.status()["error"]
         return {
@@ -272,7 +289,7 @@ class Studio:
             "q_robot": None if fitted is None else [float(x) for x in fitted.q_robot],
         }
 
-    def hand_moved(self, position: Any, wxyz: Any = None) -> dict[str, Any]:
+    def hand_moved(self, position: object, wxyz: object = None) -> dict[str, object]:
         """Move the operator's hand to a pose (``HandTarget``): what dragging the scene's handle
         does. Returns the arm and robot reached (``HandPublic``).
 
@@ -281,7 +298,8 @@ class Studio:
             TooManyRequestsError: a flood (the update is dropped).
             CaptureError: NaN or wrong sizes (422).
         """
-        _, fitted = self._observe_fed("hand", position, wxyz)
+        hand = self._fed_source("hand")
+        _, fitted = self._observe_fed(lambda: hand.submit(position, wxyz))
         if fitted is None:
             raise InvalidError(
                 self.pipeline.status()["error"]
@@ -295,12 +313,12 @@ class Studio:
             "warning": fitted.warning,
         }
 
-    def source_public(self) -> dict[str, Any]:
+    def source_public(self) -> dict[str, object]:
         """``SourcePublic``: the pipeline status plus the playback state."""
         status = self.pipeline.status()
         status["playback"] = None
         source = self.pipeline.source
-        if self.pipeline.kind == "recording" and source is not None:
+        if self.pipeline.kind == "recording" and isinstance(source, PlaybackSource):
             status["playback"] = _playback_state(source)
         return status
 
@@ -311,7 +329,7 @@ class Studio:
             ConflictError: the live source is not a recording.
         """
         source = self.pipeline.source
-        if self.pipeline.kind != "recording" or source is None:
+        if self.pipeline.kind != "recording" or not isinstance(source, PlaybackSource):
             raise ConflictError(
                 "The live source is not a recording; switch the source to a recording first."
             )
@@ -358,16 +376,14 @@ class Studio:
             notes=notes or "",
             source=self.pipeline.source_label(),
         )
-        self.pipeline.start_capture(writer, final, path)
+        self.pipeline.start_capture(writer, final, path)  # which announces the new recording
         self.mark_t0 = None
-        self.changes.bump("recordings")
         return final
 
     def stop_capture(self) -> str:
         """Close the capture cleanly; returns the new recording's name."""
         name, _ = self.pipeline.stop_capture()
         self.mark_t0 = None
-        self.changes.bump("recordings")
         return name
 
     # ------------------------------------------------------------------ demonstrations
@@ -420,7 +436,6 @@ class Studio:
         tmp = self.settings.recordings_dir / f".cut-{uuid.uuid4().hex}.tmp"
         demo.save(tmp)  # then named without replacing a file that took the name meanwhile
         final = self.demonstrations.claim(tmp, final, exact=name is not None)
-        self.changes.bump("demonstrations")
         if self.scene is not None:
             self.scene.show_path(f"demo-{final}", np.asarray(demo.q_robot))
         return final
@@ -457,35 +472,41 @@ class Studio:
             self.scene.show_path(f"demo-{name}", q)
             self.scene.play_trajectory(np.asarray(demo.times, dtype=float), q)
 
+    def delete_demonstration(self, name: str) -> None:
+        """Delete a demonstration (409 for a sample, or while a queued or running run replays
+        it) and its path from the scene."""
+        self.demonstrations.delete(name)
+        if self.scene is not None:
+            self.scene.clear_path(f"demo-{name}")
+
     # ------------------------------------------------------------------ in-use checks
 
-    def recording_in_use(self, name: str) -> str | None:
-        """Why recording ``name`` cannot be deleted or renamed now, or None (a capture by
-        another studio on the same data folder counts: its writer's lock says so)."""
-        if self.pipeline.kind == "recording" and self.pipeline.recording == name:
-            return f"Recording {name!r} is the live source; switch the source to another one first."
-        if self.pipeline.capture_name == name:
-            return f"Recording {name!r} is being captured; stop the recording first."
-        if self.captured_elsewhere(name):
-            return f"Recording {name!r} is being captured by another studio or `studio record` on this data folder; stop that capture first."
-        return None
+    def _demonstration_replayed(self, name: str) -> str | None:
+        """Why demonstration ``name`` cannot be deleted now: a queued or running run replays it."""
+        run = self.runs.uses_demonstration(name)
+        if run is None:
+            return None
+        return f"Demonstration {name!r} is used by run {run.id}, which is {run.status}; stop that run first."
 
-    def captured_elsewhere(self, name: str) -> bool:
-        """Whether another process (a second studio, ``studio record``) is capturing ``name``."""
-        if self.pipeline.capture_name == name:
-            return False
-        try:
-            return being_recorded(self.recordings.path(name))
-        except StudioError:  # missing, a link, not a regular file: nobody writes it
-            return False
+    def _policy_playing(self, name: str) -> str | None:
+        """Why uploaded policy ``name`` cannot be deleted now: it plays in the scene."""
+        if self.policy_in_use(f"policy:{name}"):
+            return f"Policy {name!r} is playing in the scene; stop watching it first."
+        return None
 
     def policy_in_use(self, key: str) -> bool:
         """Whether the scene is playing this policy (``policy:<name>`` or ``run:<id>``)."""
-        return (
-            self.watching == key
-            and self.scene is not None
-            and bool(getattr(self.scene, "playing", False))
-        )
+        return self.watching == key and self.scene is not None and self.scene.playing
+
+    def delete_policy(self, name: str) -> None:
+        """Delete an uploaded policy (409 while it plays in the scene; a run's policy goes with
+        its run) and forget its rollout."""
+        if not self.policies.exists(name) and name in {r.id for r in self.runs.list()}:
+            raise ConflictError(
+                f"Policy {name!r} belongs to a run; delete the run to delete its policy."
+            )
+        self.policies.delete(name)
+        self.forget_rollout(f"policy:{name}")
 
     def policy_names(self) -> set[str]:
         """Names taken by uploaded policies and runs (a policy upload must not shadow them)."""
@@ -513,7 +534,9 @@ class Studio:
                 return r.policy_path, f"run:{policy}"
         return self.policies.path(policy), f"policy:{policy}"
 
-    def load_policy(self, run: str | None, policy: str | None) -> tuple[Any, str]:
+    def load_policy(
+        self, run: str | None, policy: str | None
+    ) -> tuple[PolicyFile | TilePolicyFile, str]:
         """Load the policy of a run or an uploaded policy, of either kind, through the policy
         store's one reader; returns it and its key (see :meth:`policy_file`)."""
         path, key = self.policy_file(run, policy)
@@ -545,7 +568,7 @@ class Studio:
             return (key, *self.rollouts[key])
 
 
-def _playback_state(source: Any) -> dict[str, Any] | None:
+def _playback_state(source: PlaybackSource) -> dict[str, object]:
     return {
         "playing": bool(source.running and not source.paused),
         "speed": None if source.speed is None else float(source.speed),

@@ -19,6 +19,11 @@ only regular files there), never read, served or changed, and deleting it remove
 The shipped samples (:data:`studio.samples.SAMPLES_DIR`) are offered by every data folder as a
 read-only group: names starting with ``sample-`` belong to it, can be played, trained on and
 copied, never changed or deleted.
+
+A store announces its own changes: every file it adds, changes or deletes calls its
+``on_change`` with the list's name (``"recordings"``, ...), as the run queue does for runs, and
+it refuses to delete a file its ``in_use`` names a reason for (a recording the live source
+plays, a demonstration a queued run replays, a policy playing in the scene).
 """
 
 from __future__ import annotations
@@ -32,7 +37,7 @@ import uuid
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Generic, TypeVar
+from typing import Generic, Protocol, TypeVar
 
 from fastapi import UploadFile
 
@@ -42,9 +47,12 @@ from studio.capture import (
     RECORDING_SUFFIX,
     RECORDING_SUFFIXES,
     Demonstration,
+    being_recorded,
     delete_recording,
     load_demonstration,
+    rename_recording,
     summarize_any_recording,
+    update_recording_meta,
 )
 from studio.learning import POLICY_SUFFIX, PolicyFile, TilePolicyFile, load_any_policy
 from studio.samples import SAMPLES_DIR
@@ -62,6 +70,12 @@ DEMONSTRATION_SUFFIX = DEMO_SUFFIX
 """Demonstrations lie next to their recordings: ``<name>.demo.json`` (the capture package's)."""
 
 T = TypeVar("T")
+OnChange = Callable[[str], None]
+"""Called with a list's name (``"recordings"``, ``"demonstrations"``, ...) when it changed."""
+InUse = Callable[[str], "str | None"]
+"""Why a file cannot be deleted or renamed now (one sentence with the fix), or None."""
+RecordingSummary = dict[str, object]
+"""A recording's listing facts, as :func:`studio.capture.summarize_any_recording` gives them."""
 
 
 def symlink_text(path: Path) -> str:
@@ -182,13 +196,13 @@ class StoredFile(Generic[T]):
     error: str | None = None
 
 
-class _FileCache:
+class _FileCache(Generic[T]):
     """What a reader made of each file, its value or its refusal, read again only when the
     file's size or mtime changes (so a damaged file is not parsed again at every listing)."""
 
     def __init__(self) -> None:
         self._lock = threading.Lock()
-        self._entries: dict[Path, tuple[tuple[int, int], Any, StudioError | None]] = {}
+        self._entries: dict[Path, tuple[tuple[int, int], T | StudioError]] = {}
 
     def get(self, path: Path, load: Callable[[Path], T]) -> T:
         stat = path.stat()
@@ -196,16 +210,16 @@ class _FileCache:
         with self._lock:
             hit = self._entries.get(path)
         if hit is None or hit[0] != key:
-            value, error = None, None
+            read: T | StudioError
             try:
-                value = load(path)
+                read = load(path)
             except StudioError as err:
-                error = err
-            hit = (key, value, error)
+                read = err
+            hit = (key, read)
             with self._lock:
                 self._entries[path] = hit
-        if hit[2] is not None:
-            raise hit[2]
+        if isinstance(hit[1], StudioError):
+            raise hit[1]
         return hit[1]
 
     def forget_missing(self) -> None:
@@ -235,6 +249,8 @@ class FolderStore(Generic[T]):
             :class:`studio.StudioError` to refuse.
         also: further suffixes of the same kind (recordings of landmarks and hand poses beside
             the tape's); a name is unique across all of them.
+        on_change: called with ``plural`` after each file added, changed or deleted.
+        in_use: why a file cannot be deleted now, or None (default: never in use).
     """
 
     def __init__(
@@ -249,6 +265,8 @@ class FolderStore(Generic[T]):
         sample_fix: str = "copy it to make your own",
         remove: Callable[[Path], None] = Path.unlink,
         also: tuple[str, ...] = (),
+        on_change: OnChange | None = None,
+        in_use: InUse | None = None,
     ) -> None:
         self.folder = folder
         self.suffix = suffix
@@ -259,8 +277,19 @@ class FolderStore(Generic[T]):
         self.sample_fix = sample_fix
         self._load = load
         self._remove = remove
-        self._cache = _FileCache()
+        self._cache: _FileCache[T] = _FileCache()
         self._claim_lock = threading.Lock()  # choosing a free name and taking it are one step
+        self.on_change = on_change
+        self._in_use = in_use
+
+    def changed(self, plural: str | None = None) -> None:
+        """Announce that the list ``plural`` (default: this store's) changed."""
+        if self.on_change is not None:
+            self.on_change(plural or self.plural)
+
+    def in_use(self, name: str) -> str | None:
+        """Why ``name`` cannot be deleted now (one sentence with the fix), or None."""
+        return self._in_use(name) if self._in_use is not None else None
 
     # ------------------------------------------------------------------ names and paths
 
@@ -418,15 +447,19 @@ class FolderStore(Generic[T]):
     # ------------------------------------------------------------------ changing
 
     def delete(self, name: str) -> None:
-        """Delete a user's file (404 if none, 409 for a sample); a symbolic link is removed
-        itself, never what it points to. The store's ``remove`` does the deleting (for
-        recordings it refuses a file a capture holds)."""
+        """Delete a user's file (404 if none, 409 for a sample or while :meth:`in_use` gives a
+        reason); a symbolic link is removed itself, never what it points to. The store's
+        ``remove`` does the deleting (for recordings it refuses a file a capture holds)."""
         self.check_deletable(name)
+        reason = self.in_use(name)
+        if reason:
+            raise ConflictError(reason)
         path = self._located(name)
         if path.is_symlink():
             path.unlink()
-            return
-        self._remove(path)
+        else:
+            self._remove(path)
+        self.changed()
 
     def adopt(
         self, tmp: Path, filename: str | None, taken: Callable[[str], bool] | None = None
@@ -491,6 +524,7 @@ class FolderStore(Generic[T]):
                     raise ConflictError(
                         f"A {self.what} named {final!r} already exists; choose another name."
                     )
+            self.changed()
             return final
         finally:
             tmp.unlink(missing_ok=True)
@@ -519,6 +553,7 @@ class FolderStore(Generic[T]):
                     if not (exact and taken(name)) and link_new(
                         tmp, self.folder / f"{name}{suffix or self.suffix}"
                     ):
+                        self.changed()
                         return name
                     if exact:
                         raise ConflictError(
@@ -528,27 +563,158 @@ class FolderStore(Generic[T]):
             tmp.unlink(missing_ok=True)
 
 
-def recording_store(folder: Path) -> FolderStore[dict[str, Any]]:
+class LiveRecordings(Protocol):
+    """What holds a recording in this studio (the live pipeline): the one its source plays and
+    the one its capture writes."""
+
+    @property
+    def recording(self) -> str | None:
+        """The recording the live source plays, or None."""
+
+    @property
+    def capture_name(self) -> str | None:
+        """The recording being captured, or None."""
+
+
+class RecordingStore(FolderStore[RecordingSummary]):
     """Recordings ``<folder>/<name>.tape.csv`` (and ``.pose.csv``, ``.hand.csv``), each cached as
-    the capture package's summary.
+    the capture package's summary, which knows which ones are in use and renames a recording
+    with the demonstrations cut from it.
 
     :func:`studio.capture.summarize_recording` streams the whole file (so damage shows) in one
     block of memory, however long the recording.
+
+    Args:
+        folder: the user's recordings (demonstrations lie beside them).
+        live: what this studio plays and captures (None: nothing).
+        on_change: called with ``"recordings"`` (and ``"demonstrations"`` when a rename changed
+            theirs).
     """
-    return FolderStore(
-        folder,
-        suffix=RECORDING_SUFFIX,
-        what="recording",
-        plural="recordings",
-        load=summarize_any_recording,
-        samples=SAMPLES_DIR,
-        sample_fix="copy it to your recordings to change it",
-        remove=delete_recording,
-        also=RECORDING_SUFFIXES,
-    )
+
+    def __init__(
+        self,
+        folder: Path,
+        live: LiveRecordings | None = None,
+        on_change: OnChange | None = None,
+    ) -> None:
+        super().__init__(
+            folder,
+            suffix=RECORDING_SUFFIX,
+            what="recording",
+            plural="recordings",
+            load=summarize_any_recording,
+            samples=SAMPLES_DIR,
+            sample_fix="copy it to your recordings to change it",
+            remove=delete_recording,
+            also=RECORDING_SUFFIXES,
+            on_change=on_change,
+        )
+        self.live = live
+
+    def _capturing(self) -> str | None:
+        return self.live.capture_name if self.live is not None else None
+
+    def in_use(self, name: str) -> str | None:
+        """Why this studio holds recording ``name`` (it is the live source, or being captured),
+        or None. A capture by another process is refused by its writer's lock when deleting
+        (:func:`studio.capture.delete_recording`), and by :meth:`busy` before a change."""
+        if self.live is not None and self.live.recording == name:
+            return f"Recording {name!r} is the live source; switch the source to another one first."
+        if self._capturing() == name:
+            return f"Recording {name!r} is being captured; stop the recording first."
+        return None
+
+    def busy(self, name: str) -> str | None:
+        """Why recording ``name`` cannot be renamed now, or None: :meth:`in_use`, or a capture
+        by another studio (or ``studio record``) on the same data folder."""
+        reason = self.in_use(name)
+        if reason is None and self.captured_elsewhere(name):
+            return f"Recording {name!r} is being captured by another studio or `studio record` on this data folder; stop that capture first."
+        return reason
+
+    def captured_elsewhere(self, name: str) -> bool:
+        """Whether another process (a second studio, ``studio record``) is capturing ``name``."""
+        if self._capturing() == name:
+            return False
+        try:
+            return being_recorded(self.path(name))
+        except StudioError:  # missing, a link, not a regular file: nobody writes it
+            return False
+
+    def copy(
+        self,
+        name: str,
+        new_name: str | None = None,
+        prepare: Callable[[Path, str], None] | None = None,
+    ) -> str:
+        """Copy ``name`` into the user's recordings, its header naming the copy (see
+        :meth:`FolderStore.copy`)."""
+
+        def retitle(tmp: Path, final: str) -> None:
+            update_recording_meta(tmp, name=final)
+            if prepare is not None:
+                prepare(tmp, final)
+
+        return super().copy(name, new_name, prepare=retitle)
+
+    def update(
+        self,
+        name: str,
+        new_name: str | None = None,
+        notes: str | None = None,
+        operator: str | None = None,
+    ) -> str:
+        """Rename ``name`` and/or set its operator and notes; returns its name afterwards.
+
+        The header is changed by an atomic replace, the frames are never touched; a rename also
+        updates the demonstrations cut from the recording.
+
+        Raises:
+            ConflictError: a sample, being captured (here or elsewhere), a rename while it is in
+                use, or the new name is taken.
+            NotFoundError: no such recording, or it was deleted meanwhile.
+            InvalidError: a bad new name.
+        """
+        path = self.writable_path(name)
+        if self._capturing() == name or self.captured_elsewhere(name):
+            raise ConflictError(
+                self.busy(name)
+                or f"Recording {name!r} is being captured; stop the recording first."
+            )
+        renaming = new_name is not None and new_name != name
+        if new_name is not None and renaming:
+            self.check_new_name(new_name)
+            reason = self.busy(name)
+            if reason:
+                raise ConflictError(reason)
+        changes = {k: v for k, v in (("notes", notes), ("operator", operator)) if v is not None}
+        try:
+            if changes:
+                update_recording_meta(path, **changes)
+            if new_name is not None and renaming:
+                rename_recording(path, new_name)
+                self.changed("demonstrations")  # their "recording" follows the rename
+        except (StudioError, FileNotFoundError):
+            if not path.exists():  # a DELETE won the race: say so, not "cannot open <path>"
+                raise NotFoundError(
+                    f"Recording {name!r} was deleted meanwhile; refresh the recordings list."
+                ) from None
+            raise
+        finally:
+            self.changed()
+        return new_name if new_name is not None and renaming else name
 
 
-def demonstration_store(folder: Path) -> FolderStore[Demonstration]:
+def recording_store(
+    folder: Path, live: LiveRecordings | None = None, on_change: OnChange | None = None
+) -> RecordingStore:
+    """The recordings in ``folder`` (see :class:`RecordingStore`)."""
+    return RecordingStore(folder, live, on_change)
+
+
+def demonstration_store(
+    folder: Path, on_change: OnChange | None = None, in_use: InUse | None = None
+) -> FolderStore[Demonstration]:
     """Demonstrations ``<folder>/<name>.demo.json``, next to the recordings they were cut from."""
     return FolderStore(
         folder,
@@ -558,12 +724,22 @@ def demonstration_store(folder: Path) -> FolderStore[Demonstration]:
         load=load_demonstration,
         samples=SAMPLES_DIR,
         sample_fix="cut your own from its recording instead",
+        on_change=on_change,
+        in_use=in_use,
     )
 
 
-def policy_store(folder: Path) -> FolderStore[PolicyFile | TilePolicyFile]:
+def policy_store(
+    folder: Path, on_change: OnChange | None = None, in_use: InUse | None = None
+) -> FolderStore[PolicyFile | TilePolicyFile]:
     """Policies ``<folder>/<name>.policy.npz`` of every kind the studio writes, tabular or
     tile-coded (runs keep theirs in their run folder; the store reads those too)."""
     return FolderStore(
-        folder, suffix=POLICY_SUFFIX, what="policy", plural="policies", load=load_any_policy
+        folder,
+        suffix=POLICY_SUFFIX,
+        what="policy",
+        plural="policies",
+        load=load_any_policy,
+        on_change=on_change,
+        in_use=in_use,
     )

@@ -193,9 +193,91 @@ def image_elbow_deg(image: np.ndarray, side: str = "right") -> float:
     return math.degrees(math.acos(max(-1.0, min(1.0, cos))))
 
 
+# ---------------------------------------------------------------------------- the studio's mannequin
+
+MANNEQUIN_ABDUCTION_DEG = (10.0, 80.0)
+"""The rendered right upper arm's lift sideways from hanging, over the motion."""
+MANNEQUIN_FLEXION_DEG = (10.0, 120.0)
+"""The rendered right elbow's flexion (0 straight) over the motion: interior angle 170 -> 60."""
+MANNEQUIN_CAMERA = {"distance_m": 3.2, "focal_px": 700.0, "centre": (0.0, 0.21, -0.5)}
+"""A pinhole camera in front of the body, looking at it, in the arm base frame (x forward, z up)."""
+
+
+def mannequin_q(index: int, frames: int) -> np.ndarray:
+    """The right arm's joints (HumanArm's order) in frame ``index``: abducted and bent in the
+    picture's plane (the humerus turned so the elbow bends sideways and up), a raise and lower."""
+    phase = (1 - math.cos(2 * math.pi * index / frames)) / 2
+    abduction = np.radians(np.interp(phase, [0, 1], MANNEQUIN_ABDUCTION_DEG))
+    flexion = np.radians(np.interp(phase, [0, 1], MANNEQUIN_FLEXION_DEG))
+    return np.array([0.0, abduction, -math.pi / 2, flexion, 0.0, 0.0, 0.0])
+
+
+class Mannequin:
+    """The studio's own human model (Gepetto's human meshes, :class:`~studio.kinematics.HumanBody`)
+    drawn with its right arm at a pose, by a painter's algorithm (triangles far to near)."""
+
+    def __init__(self) -> None:
+        from studio.kinematics import HumanBody
+
+        self.body = HumanBody("right")
+        names = [p.name for p in self.body.parts]
+        self.joints = {
+            side: [
+                names.index(f"{side}_{link}")
+                for link in ("upperarm/upperarm_mesh", "lowerarm/lowerarm_mesh", "hand/hand_mesh")
+            ]
+            for side in ("right", "left")
+        }
+
+    def project(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Pixel coordinates (N, 2) and depths (N,) of arm-base-frame points."""
+        cam = MANNEQUIN_CAMERA
+        rel = np.asarray(points, float) - np.asarray(cam["centre"])
+        depth = cam["distance_m"] - rel[:, 0]  # the camera stands on +x, looking at -x
+        # Image right is the body's +y (its left): a camera facing the person, not a mirror.
+        u = WIDTH / 2 + cam["focal_px"] * rel[:, 1] / depth
+        v = HEIGHT / 2 - cam["focal_px"] * rel[:, 2] / depth
+        return np.stack([u, v], axis=1), depth
+
+    def arm_pixels(self, q: np.ndarray, side: str = "right") -> np.ndarray:
+        """Shoulder, elbow and wrist of ``side`` in pixels (3, 2) with the right arm at ``q``."""
+        poses = self.body.poses(np.asarray(q, float))
+        return self.project(np.stack([poses[i][:3, 3] for i in self.joints[side]]))[0]
+
+    def render(self, q: np.ndarray) -> np.ndarray:
+        from PIL import Image, ImageDraw
+
+        light = np.array([0.6, -0.3, 0.75])
+        light /= np.linalg.norm(light)
+        tris, colours, depths = [], [], []
+        for part, pose in zip(self.body.parts, self.body.poses(np.asarray(q, float)), strict=True):
+            v = part.vertices.astype(float) @ pose[:3, :3].T + pose[:3, 3]
+            t = v[part.faces]
+            n = np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0])
+            n /= np.linalg.norm(n, axis=1, keepdims=True) + 1e-12
+            shade = 0.45 + 0.55 * np.abs(n @ light)
+            px, depth = self.project(t.reshape(-1, 3))
+            tris.append(px.reshape(-1, 3, 2))
+            depths.append(depth.reshape(-1, 3).mean(axis=1))
+            colours.append(np.clip(np.outer(shade, part.rgb) * 255, 0, 255).astype(np.uint8))
+        tri, colour, depth = np.concatenate(tris), np.concatenate(colours), np.concatenate(depths)
+        img = Image.new("RGB", (WIDTH, HEIGHT), (214, 222, 230))
+        draw = ImageDraw.Draw(img)
+        for k in np.argsort(-depth):  # far to near
+            draw.polygon([tuple(p) for p in tri[k]], fill=tuple(int(c) for c in colour[k]))
+        return np.asarray(img)
+
+
+def mannequin_clip(path: Path, frames: int = 40, fps: int = 10) -> Path:
+    """The studio's mannequin raising and bending its right arm once over ``frames`` (looped)."""
+    model = Mannequin()
+    return write_y4m(path, (model.render(mannequin_q(k, frames)) for k in range(frames)), fps)
+
+
 CLIPS: dict[str, Callable[[Path], Path]] = {
     "astronaut": astronaut_clip,
     "blank": blank_clip,
     "figure": figure_clip,
+    "mannequin": mannequin_clip,
 }
 """Clip makers by name, for the tests and the benchmark."""

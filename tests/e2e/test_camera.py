@@ -23,9 +23,15 @@ from tests.conftest import require
 from tests.e2e.camera_clips import (
     CLIPS,
     COLLECT_FRAMES_JS,
+    HEIGHT,
+    MANNEQUIN_FLEXION_DEG,
+    WIDTH,
+    Mannequin,
     figure_clip,
     figure_elbow_deg,
     image_elbow_deg,
+    mannequin_clip,
+    mannequin_q,
 )
 from tests.e2e.conftest import CHROMIUM, CHROMIUM_FLAGS, Studio, shot
 
@@ -37,7 +43,13 @@ FIGURE_FRAMES = 120
 """Frames of the drawn-figure clip (12 s at 10 frames/s, one raise and lower, looped)."""
 FIGURE_SAMPLES = 12
 """Estimated frames of the drawn figure compared with the drawing."""
+MANNEQUIN_FRAMES = 40
+"""Frames of the rendered-mannequin clip (4 s at 10 frames/s, one raise and lower, looped)."""
+MANNEQUIN_SAMPLES = 10
 ELBOW_MAE_DEG = 10.0
+ARM_PX = 40.0
+"""How near (pixels, median) the taped arm's landmarks must be to the rendered arm's joints: the
+two shoulders are 92 px apart in the mannequin clip, the elbows 100-150 px."""
 LOOPBACK = {"127.0.0.1", "localhost", "::1", "[::1]"}
 POSE_FILES = "/static/vendor/mediapipe-pose/"
 
@@ -59,7 +71,12 @@ def make_clip(clip_dir: Path) -> Callable[[str], Path]:
                 except ImportError:
                     require(False, "scikit-image is not installed (pip install -e .[test])")
             path = clip_dir / f"{name}.y4m"
-            made[name] = figure_clip(path, FIGURE_FRAMES) if name == "figure" else CLIPS[name](path)
+            if name == "figure":
+                made[name] = figure_clip(path, FIGURE_FRAMES)
+            elif name == "mannequin":
+                made[name] = mannequin_clip(path, MANNEQUIN_FRAMES)
+            else:
+                made[name] = CLIPS[name](path)
         return made[name]
 
     return make
@@ -138,6 +155,17 @@ def studio_elbow_deg(q_human: list[float]) -> float:
     return 180.0 - abs(math.degrees(q_human[3]))
 
 
+def elbow_maes(frames: list[dict[str, Any]], drawn: list[float]) -> tuple[float, float]:
+    """Mean absolute error (deg) against the drawn elbow of the studio's fit and of the image
+    landmarks alone."""
+    studio = [studio_elbow_deg(f["answer"]["q_human"]) for f in frames]
+    image = [image_elbow_deg(f["body"]["image"]) for f in frames]
+    return (
+        statistics.fmean(abs(a - b) for a, b in zip(studio, drawn, strict=True)),
+        statistics.fmean(abs(a - b) for a, b in zip(image, drawn, strict=True)),
+    )
+
+
 def test_a_photograph_is_seen_and_only_landmarks_reach_the_studio(
     open_camera: Callable[..., CameraPage], make_clip: Callable[[str], Path], studio_server: Studio
 ) -> None:
@@ -182,15 +210,50 @@ def test_the_studio_tracks_a_drawn_elbow(
         "f.tag !== null && f.answer && f.answer.person_detected && f.answer.q_human",
     )[2:]  # the first two settle the studio's filter
     drawn = [figure_elbow_deg(f["tag"], FIGURE_FRAMES) for f in frames]
-    studio = [studio_elbow_deg(f["answer"]["q_human"]) for f in frames]
-    image = [image_elbow_deg(f["body"]["image"]) for f in frames]
-    mae = statistics.fmean(abs(a - b) for a, b in zip(studio, drawn, strict=True))
-    mae_image = statistics.fmean(abs(a - b) for a, b in zip(image, drawn, strict=True))
+    mae, mae_image = elbow_maes(frames, drawn)
     print(
         f"elbow MAE over {len(frames)} frames: studio {mae:.1f} deg, "
         f"image landmarks alone {mae_image:.1f} deg (drawn {min(drawn):.0f}-{max(drawn):.0f} deg)"
     )
     assert max(drawn) - min(drawn) > 30, "the samples do not span the motion"
+    assert mae <= ELBOW_MAE_DEG
+
+
+def test_the_studios_mannequin_is_seen_with_its_sides_put_back(
+    open_camera: Callable[..., CameraPage], make_clip: Callable[[str], Path]
+) -> None:
+    """The studio's own human model, rendered, raising its right arm: BlazePose sees a person in
+    every frame but takes it for one seen from behind and swaps left and right. The page swaps
+    them back (the person faces the camera), so the taped right arm's landmarks are the rendered
+    right arm's, and the studio's elbow follows the rendered one."""
+    model = Mannequin()
+    cam = open_camera(make_clip("mannequin"))
+    cam.use_camera("right")
+    frames = cam.frames(MANNEQUIN_SAMPLES + 2, "f.tag !== null")[2:]  # two settle the filter
+    assert all(f["body"]["world"] is not None for f in frames), "a frame without a person"
+    assert all(f["answer"] and f["answer"]["person_detected"] for f in frames)
+    swapped = sum(bool(f["swapped"]) for f in frames)
+    near, far = [], []  # per frame: mean distance of the right-arm landmarks to each rendered arm
+    for f in frames:
+        q = mannequin_q(f["tag"], MANNEQUIN_FRAMES)
+        seen = [
+            [p[0] * WIDTH, p[1] * HEIGHT] for p in (f["body"]["image"][i] for i in (12, 14, 16))
+        ]
+        for side, out in (("right", near), ("left", far)):
+            truth = model.arm_pixels(q, side).tolist()
+            out.append(statistics.fmean(math.dist(a, b) for a, b in zip(seen, truth, strict=True)))
+    drawn = [180.0 - math.degrees(mannequin_q(f["tag"], MANNEQUIN_FRAMES)[3]) for f in frames]
+    mae, mae_image = elbow_maes(frames, drawn)
+    print(
+        f"mannequin: {swapped}/{len(frames)} frames swapped back; right-arm landmarks "
+        f"{statistics.median(near):.0f} px from the rendered right arm (median), "
+        f"{statistics.median(far):.0f} px from the left; elbow MAE studio {mae:.1f} deg, "
+        f"image landmarks {mae_image:.1f} deg (rendered {min(drawn):.0f}-{max(drawn):.0f} deg)"
+    )
+    assert swapped > 0, "BlazePose no longer swaps this mannequin: the test lost its subject"
+    assert all(n < f for n, f in zip(near, far, strict=True)), "the taped arm is the other arm"
+    assert statistics.median(near) < ARM_PX
+    assert max(drawn) - min(drawn) > (MANNEQUIN_FLEXION_DEG[1] - MANNEQUIN_FLEXION_DEG[0]) / 4
     assert mae <= ELBOW_MAE_DEG
 
 

@@ -28,7 +28,7 @@ from studio.learning import (
 )
 from studio.learning._reproduce import CONFIGURATIONS, EXTENSIONS, PAPER_MATLAB_SECONDS
 from studio.web import create_app
-from studio.web._schemas import RunCreate
+from studio.web._schemas import ReachRunCreate
 from tests.web.conftest import TINY_RUN, make_settings, wait_run
 
 
@@ -219,7 +219,7 @@ def _parse_train(argv: list[str]) -> argparse.Namespace:
 
 def test_the_train_commands_defaults_are_the_learning_packages() -> None:
     settings = train.resolve(_parse_train([]))
-    assert settings.config == DynaQConfig() and settings.grid == ArmGrid()
+    assert settings.config == DynaQConfig() and settings.task == ArmGrid()
     assert (settings.experiments, settings.episodes, settings.seed) == (
         DEFAULT_EXPERIMENTS,
         DEFAULT_EPISODES,
@@ -227,7 +227,7 @@ def test_the_train_commands_defaults_are_the_learning_packages() -> None:
     )
     assert settings.demonstrations == []
     flags = train.resolve(_parse_train(["--planning", "soft", "--bins", "7", "--seed", "4"]))
-    assert flags.config == DynaQConfig(planning="soft") and flags.grid == ArmGrid(bins=7)
+    assert flags.config == DynaQConfig(planning="soft") and flags.task == ArmGrid(bins=7)
     assert flags.seed == 4
 
 
@@ -248,7 +248,7 @@ def test_the_page_and_the_command_share_every_default(tmp_path) -> None:
     assert config.planning == "full"  # the paper's Dyna-Q: 100 planning updates per real step
     # the default goal's bins are the grid's default goal
     assert (
-        train.resolve(_parse_train(["--goal-deg", ",".join(map(str, form["goal_deg"]))])).grid
+        train.resolve(_parse_train(["--goal-deg", ",".join(map(str, form["goal_deg"]))])).task
         == grid
     )
 
@@ -344,11 +344,11 @@ def test_train_takes_the_continuous_defaults_and_checks_from_the_page(tmp_path) 
     settings = train.resolve(_parse_train(["--task", "arm-reach"]))
     with TestClient(create_app(make_settings(tmp_path))) as client:
         form = client.get("/api/config").json()["training"]
-    task = settings.reach.task
-    assert task["joints"] == form["joints"] and task["step_deg"] == form["step_deg"]
-    assert task["tile_coding"]["tiles"] == form["tiles"]
-    assert task["tile_coding"]["tilings"] == form["tilings"]
-    page = RunCreate(task="arm-reach")
+    task, coding = settings.arm_reach(), settings.tile_coding()
+    assert task.joints == form["joints"] and task.step_deg == form["step_deg"]
+    assert coding.tiles == form["tiles"]
+    assert coding.tilings == form["tilings"]
+    page = ReachRunCreate(task="arm-reach")
     keys = ("planning", "planning_steps", "alpha", "gamma", "epsilon")
     assert settings.config == DynaQConfig(**{key: getattr(page, key) for key in keys})
     assert (settings.experiments, settings.episodes) == (page.experiments, page.episodes)

@@ -18,7 +18,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-import studio.learning._runs as runs_module
+import studio.learning._run_record as runs_module
 from studio.learning import (
     CURVE_COLUMNS,
     ArmGrid,
@@ -34,7 +34,7 @@ from studio.learning import (
     find_runs,
     load_policy,
 )
-from studio.learning._runs import curve_plot
+from studio.learning._curves import curve_plot
 
 REPO = Path(__file__).resolve().parents[2]
 

@@ -20,7 +20,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from studio.learning import ArmGrid, DynaQConfig
-from studio.learning._runs import RunFolder, RunRecord, on_this_host, pid_alive, this_host
+from studio.learning._owner import on_this_host, pid_alive, this_host
+from studio.learning._runs import RunFolder, RunRecord
 from studio.learning._sweep_folder import prepare_folder as _prepare
 from studio.learning._sweep_list import load_sweep
 from studio.learning._sweep_spec import parse_sweep_spec

@@ -52,7 +52,7 @@ def test_nearby_observations_share_most_features(x, fraction):
     y = np.clip(x + np.array(fraction) * (HIGH - LOW), LOW, HIGH)
     a, b = coder.active(x), coder.active(y)
     du = np.abs(y - x) * 8 / (HIGH - LOW)
-    bound = sum(math.ceil(d * 8 - 1e-9) for d in du)
+    bound = sum(max(math.ceil(d * 8 - 1e-9), int(d > 0)) for d in du)  # any move may cross one
     assert int(np.sum(a != b)) <= bound
     assert np.array_equal(coder.active(x), a)  # the same observation, the same tiles
 

@@ -362,10 +362,10 @@ def test_csv_of_curve_is_parseable(client):
 
 
 def test_a_failing_run_shows_why_and_the_queue_goes_on(client, monkeypatch):
-    import studio.learning._runs
+    import studio.learning._run_train
     from studio.learning import LearningError
 
-    real = studio.learning._runs.run_experiments
+    real = studio.learning._run_train.run_experiments
     calls = []
 
     def flaky(*args, **kwargs):
@@ -376,7 +376,7 @@ def test_a_failing_run_shows_why_and_the_queue_goes_on(client, monkeypatch):
             raise RuntimeError("boom")
         return real(*args, **kwargs)
 
-    monkeypatch.setattr(studio.learning._runs, "run_experiments", flaky)
+    monkeypatch.setattr(studio.learning._run_train, "run_experiments", flaky)
     first = client.post("/api/runs", json=TINY_RUN).json()
     second = client.post("/api/runs", json=TINY_RUN).json()
     third = client.post("/api/runs", json=TINY_RUN).json()

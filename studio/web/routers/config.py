@@ -10,7 +10,7 @@ from studio.learning import PLANNERS
 from ... import __version__
 from .._deps import SettingsDep
 from .._scene import SceneLayout
-from .._schemas import ConfigPublic, RunCreate
+from .._schemas import ConfigPublic, RunDefaults
 
 router = APIRouter(prefix="/api/config", tags=["config"])
 
@@ -25,7 +25,7 @@ def read_config(settings: SettingsDep) -> ConfigPublic:
         upload_limit_bytes=settings.upload_limit_bytes,
         data_dir=str(settings.data_dir.resolve()),
         scene_instance=settings.scene_instance,
-        training=RunCreate(),
+        training=RunDefaults(),
         planners=list(PLANNERS),
         scene_colors=SceneLayout().colors,
     )

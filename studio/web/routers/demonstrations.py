@@ -13,7 +13,6 @@ from studio.capture import RECORDING_SUFFIX, RECORDING_SUFFIXES, Demonstration
 from studio.learning import goal_degrees, has_default_goal
 
 from .._deps import StudioDep
-from .._errors import ConflictError
 from .._schemas import (
     DemonstrationCreate,
     DemonstrationDetail,
@@ -129,14 +128,5 @@ def preview_demonstration(name: str, studio: StudioDep) -> Response:
 @router.delete("/{name}", status_code=204)
 def delete_demonstration(name: str, studio: StudioDep) -> Response:
     """Delete a demonstration (409 for a sample, or while a queued or running run replays it)."""
-    studio.demonstrations.check_deletable(name)
-    run = studio.runs.uses_demonstration(name)
-    if run is not None:
-        raise ConflictError(
-            f"Demonstration {name!r} is used by run {run.id}, which is {run.status}; stop that run first."
-        )
-    studio.demonstrations.delete(name)
-    if studio.scene is not None:
-        studio.scene.clear_path(f"demo-{name}")
-    studio.changes.bump("demonstrations")
+    studio.delete_demonstration(name)
     return Response(status_code=204)

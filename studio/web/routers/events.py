@@ -12,7 +12,6 @@ import asyncio
 import json
 import time
 from collections.abc import AsyncIterator
-from typing import Any
 
 from fastapi import APIRouter, Request
 from fastapi.responses import StreamingResponse
@@ -88,7 +87,7 @@ async def stream_events(
         await asyncio.sleep(max(0.0, TICK_S - (time.monotonic() - now)))
 
 
-def run_event(run: Run, seen: dict[str, int]) -> dict[str, Any]:
+def run_event(run: Run, seen: dict[str, int]) -> dict[str, object]:
     """A ``run`` event: the run, and its curve where it changed since this client's last event.
 
     A client's first event carries the whole curve (``curve``, ``from`` 0); later ones carry
@@ -98,7 +97,7 @@ def run_event(run: Run, seen: dict[str, int]) -> dict[str, Any]:
     experiments train at far-apart episodes (each running experiment makes one small piece).
     """
     with run.curve_held() as curve:
-        event: dict[str, Any] = {"run": run.model(curve).model_dump(mode="json")}
+        event: dict[str, object] = {"run": run.model(curve).model_dump(mode="json")}
         previous = seen.get(run.id)
         if previous is None:
             event.update({"curve": curve.curve(), "from": 0})
@@ -111,7 +110,7 @@ def run_event(run: Run, seen: dict[str, int]) -> dict[str, Any]:
     return event
 
 
-def _final_run(studio: Studio, run_id: str, seen: dict[str, int]) -> dict[str, Any] | None:
+def _final_run(studio: Studio, run_id: str, seen: dict[str, int]) -> dict[str, object] | None:
     """The last event of a run that stopped training since the previous tick."""
     try:
         run = studio.runs.get(run_id)

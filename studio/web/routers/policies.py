@@ -11,7 +11,6 @@ from starlette.concurrency import run_in_threadpool
 from studio.learning import POLICY_SUFFIX, PolicyFile, TilePolicyFile, policy_summary
 
 from .._deps import SettingsDep, StudioDep
-from .._errors import ConflictError
 from .._schemas import PolicyPublic
 from .._store import StoredFile, receive_upload
 from . import file_responses
@@ -67,7 +66,6 @@ async def upload_policy(
     def adopt() -> PolicyPublic:  # reading the file and the run folders: not on the loop
         taken = studio.policy_names()
         name = studio.policies.adopt(tmp, file.filename, lambda n: n in taken)
-        studio.changes.bump("policies")
         return policy_public(studio.policies.entry(name))
 
     return await run_in_threadpool(adopt)
@@ -90,14 +88,5 @@ def download_policy(name: str, studio: StudioDep) -> FileResponse:
 @router.delete("/{name}", status_code=204)
 def delete_policy(name: str, studio: StudioDep) -> Response:
     """Delete an uploaded policy (409 while it plays in the scene; a run's policy goes with its run)."""
-    if not studio.policies.exists(name) and name in {r.id for r in studio.runs.list()}:
-        raise ConflictError(
-            f"Policy {name!r} belongs to a run; delete the run to delete its policy."
-        )
-    studio.policies.check_deletable(name)
-    if studio.policy_in_use(f"policy:{name}"):
-        raise ConflictError(f"Policy {name!r} is playing in the scene; stop watching it first.")
-    studio.policies.delete(name)
-    studio.forget_rollout(f"policy:{name}")
-    studio.changes.bump("policies")
+    studio.delete_policy(name)
     return Response(status_code=204)

@@ -5,49 +5,44 @@ The shipped samples are listed first; they can be played, cut and copied, never 
 
 from __future__ import annotations
 
-from pathlib import Path
-from typing import Annotated, Any
+from typing import Annotated
 
 from fastapi import APIRouter, File, Response, UploadFile
 from fastapi.responses import StreamingResponse
 from starlette.concurrency import run_in_threadpool
 
-from studio.capture import (
-    RecordingError,
-    recording_bytes,
-    rename_recording,
-    update_recording_meta,
-)
+from studio.capture import RecordingError, recording_bytes
 
-from ..._errors import StudioError
 from .._deps import SettingsDep, StudioDep
 from .._errors import ConflictError, NotFoundError
 from .._schemas import RecordingCopy, RecordingPublic, RecordingUpdate
 from .._state import Studio
-from .._store import StoredFile, receive_upload
+from .._store import RecordingSummary, StoredFile, receive_upload
 from . import file_responses
 
 router = APIRouter(prefix="/api/recordings", tags=["recordings"])
 
 
-def recording_public(entry: StoredFile[dict[str, Any]]) -> RecordingPublic:
+def recording_public(entry: StoredFile[RecordingSummary]) -> RecordingPublic:
     """The list entry of one recording, from the capture package's summary of it."""
     summary = entry.value or {}
-    return RecordingPublic(
-        name=entry.name,
-        frames=summary.get("frames", 0),
-        duration=summary.get("duration", 0.0),
-        rate_hz=summary.get("rate_hz") or None,
-        created=summary.get("created") or "",
-        operator=summary.get("operator") or "",
-        notes=summary.get("notes") or "",
-        source=summary.get("source") or "",
-        recovered=summary.get("recovered", False),
-        size_bytes=entry.size_bytes,
-        sample=entry.sample,
-        error=entry.error,
-        kind=summary.get("kind", "tape"),
-        warnings=summary.get("warnings") or [],
+    return RecordingPublic.model_validate(
+        {
+            "name": entry.name,
+            "frames": summary.get("frames", 0),
+            "duration": summary.get("duration", 0.0),
+            "rate_hz": summary.get("rate_hz") or None,
+            "created": summary.get("created") or "",
+            "operator": summary.get("operator") or "",
+            "notes": summary.get("notes") or "",
+            "source": summary.get("source") or "",
+            "recovered": summary.get("recovered", False),
+            "size_bytes": entry.size_bytes,
+            "sample": entry.sample,
+            "error": entry.error,
+            "kind": summary.get("kind", "tape"),
+            "warnings": summary.get("warnings") or [],
+        }
     )
 
 
@@ -57,7 +52,7 @@ def read_public(studio: Studio, name: str) -> RecordingPublic:
     A file another process is capturing is shown as such, not read (it grows, and without its
     ``# end`` line a reader would call it recovered).
     """
-    if studio.captured_elsewhere(name):
+    if studio.recordings.captured_elsewhere(name):
         path = studio.recordings.path(name)
         return RecordingPublic(
             name=name,
@@ -106,9 +101,7 @@ async def upload_recording(
     tmp = await receive_upload(file, studio.recordings.folder, settings.upload_limit_bytes)
 
     def adopt() -> RecordingPublic:  # parsing a long recording takes seconds: not on the loop
-        name = studio.recordings.adopt(tmp, file.filename)
-        studio.changes.bump("recordings")
-        return read_public(studio, name)
+        return read_public(studio, studio.recordings.adopt(tmp, file.filename))
 
     return await run_in_threadpool(adopt)
 
@@ -144,13 +137,7 @@ def copy_recording(
     The copy is named ``body.name`` (409 if taken), else the original's name without
     ``sample-``, made free with ``-2``, ``-3``, ...
     """
-
-    def retitle(tmp: Path, final: str) -> None:
-        update_recording_meta(tmp, name=final)
-
-    new = studio.recordings.copy(name, body.name if body else None, prepare=retitle)
-    studio.changes.bump("recordings")
-    return read_public(studio, new)
+    return read_public(studio, studio.recordings.copy(name, body.name if body else None))
 
 
 @router.patch("/{name}")
@@ -160,49 +147,16 @@ def update_recording(name: str, body: RecordingUpdate, studio: StudioDep) -> Rec
     The header is changed by an atomic replace, the frames are never touched; a rename also
     updates the demonstrations cut from the recording. Samples are refused (409).
     """
-    path = studio.recordings.writable_path(name)
-    if studio.pipeline.capture_name == name or studio.captured_elsewhere(name):
-        raise ConflictError(
-            studio.recording_in_use(name)
-            or f"Recording {name!r} is being captured; stop the recording first."
-        )
-    renaming = body.name is not None and body.name != name
-    if renaming:
-        studio.recordings.check_new_name(body.name)
-        reason = studio.recording_in_use(name)
-        if reason:
-            raise ConflictError(reason)
-    changes = {
-        k: v for k, v in (("notes", body.notes), ("operator", body.operator)) if v is not None
-    }
-    try:
-        if changes:
-            update_recording_meta(path, **changes)
-        studio.changes.bump("recordings")
-        if renaming:
-            rename_recording(path, body.name)
-            studio.changes.bump("demonstrations")  # their "recording" follows the rename
-            return read_public(studio, body.name)
-    except (StudioError, FileNotFoundError):
-        if not path.exists():  # a DELETE won the race: say so, not "cannot open <path>"
-            raise NotFoundError(
-                f"Recording {name!r} was deleted meanwhile; refresh the recordings list."
-            ) from None
-        raise
-    return read_public(studio, name)
+    new = studio.recordings.update(name, body.name, notes=body.notes, operator=body.operator)
+    return read_public(studio, new)
 
 
 @router.delete("/{name}", status_code=204)
 def delete_recording(name: str, studio: StudioDep) -> Response:
     """Delete a recording (409 while it is the live source or being captured, here or by
     another studio on the same data folder, or a sample)."""
-    studio.recordings.check_deletable(name)
-    reason = studio.recording_in_use(name)
-    if reason:
-        raise ConflictError(reason)
     try:  # under the capture's lock: a capture that started meanwhile is refused too
         studio.recordings.delete(name)
     except RecordingError as err:
         raise ConflictError(str(err)) from None
-    studio.changes.bump("recordings")
     return Response(status_code=204)

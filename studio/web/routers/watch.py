@@ -9,10 +9,12 @@ import numpy as np
 from fastapi import APIRouter, Response
 
 from studio.learning import (
+    DmpPolicyFile,
     TilePolicyFile,
     greedy_path,
     greedy_rollout,
     rollout,
+    rollout_dmp_policy,
     rollout_tile_policy,
     save_trajectory_csv,
 )
@@ -41,6 +43,8 @@ def watch(body: WatchCreate, studio: StudioDep) -> WatchPublic:
     policy, key = studio.load_policy(body.run, body.policy)
     if isinstance(policy, TilePolicyFile):
         return _watch_tile_policy(body, studio, policy, key)
+    if isinstance(policy, DmpPolicyFile):
+        return _watch_dmp_policy(body, studio, policy, key)
     grid = policy.grid
     seed = start_seed(body)
     if body.start == "current":
@@ -117,6 +121,29 @@ def _watch_tile_policy(
         times=np.round(times, ROUND_DECIMALS).tolist(),
         q_robot=np.round(q, ROUND_DECIMALS).tolist(),
         reached_goal=bool(reached),
+    )
+
+
+def _watch_dmp_policy(
+    body: WatchCreate, studio: StudioDep, policy: DmpPolicyFile, key: str
+) -> WatchPublic:
+    """Play a movement primitive from its demonstration's start (or the current pose) to its goal."""
+    start = None
+    if body.start == "current":
+        scene = studio.scene
+        start = np.asarray(scene.current_q_robot() if scene else studio.pipeline.q_robot())
+    times, q, reached = rollout_dmp_policy(policy, start, ROLLOUT_RATE_HZ)
+    studio.keep_rollout(key, times, q)
+    if studio.scene is not None:
+        studio.scene.set_goal(policy.goal)
+        studio.scene.play_trajectory(times, q)
+    return WatchPublic(
+        steps=len(times) - 1,
+        seed=None,
+        states=[],
+        times=np.round(times, ROUND_DECIMALS).tolist(),
+        q_robot=np.round(q, ROUND_DECIMALS).tolist(),
+        reached_goal=reached,
     )
 
 

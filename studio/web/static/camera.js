@@ -8,7 +8,8 @@
  * `@mediapipe/pose`, loaded only then) on each new video frame, draws the picture small with the
  * skeleton over it, and sends each frame's 33 world and image landmarks to
  * POST /api/source/landmarks. No picture leaves the page. Frames are taken one at a time, with a
- * yield to the page between them: `pose.send()` called back to back blocks the page.
+ * yield to the page between them: `pose.send()` called back to back blocks the page. A person the
+ * model takes for one seen from behind has their left and right put back (see facesAway).
  */
 
 const VENDOR = "/static/vendor/mediapipe-pose";
@@ -19,6 +20,11 @@ const DEFAULT_MODEL = "lite";
 const CAMERA_SIZE = { width: 640, height: 480 }; // asked of the camera; BlazePose works on 256 px
 const ARM_LANDMARKS = { right: [12, 14, 16], left: [11, 13, 15] }; // shoulder, elbow, wrist
 const VISIBLE = 0.5; // a bone with a less visible end is not drawn
+// BlazePose's left/right landmark pairs (nose excepted: eyes, ears, mouth, shoulders, arms, hands, legs).
+const LEFT_RIGHT = [[1, 4], [2, 5], [3, 6], [7, 8], [9, 10], [11, 12], [13, 14], [15, 16], [17, 18], [19, 20], [21, 22], [23, 24], [25, 26], [27, 28], [29, 30], [31, 32]];
+// The right shoulder this far (a fraction of the shoulders-to-hips height) right of the left one in
+// the picture reads as a person seen from behind; nearer, the person may simply stand sideways.
+const TURNED_MARGIN = 0.25;
 // Human-arm joints in HumanArm's order (studio.kinematics ARM_JOINTS), as the page names them.
 const JOINT_LABELS = ["shoulder Z", "shoulder X", "shoulder Y", "elbow Z", "elbow Y", "wrist Z", "wrist X"];
 // The achieved frame rate is counted over the last FPS_FRAMES results within FPS_WINDOW_S: a few
@@ -47,6 +53,7 @@ const C = {
   answer: null, // the studio's last answer: {person_detected, observable, warning, ...}
   studioSide: null, // the teaching arm the studio last reported
   probe: null, // tests and benchmarks: a function(canvas) of the frame; its value travels with it
+  swapped: 0, // results whose left and right labels the page swapped back (see facesAway)
   grabbed: null, // the canvas each frame is copied into
 };
 S.camera = C;
@@ -237,6 +244,28 @@ async function loop() {
   }
 }
 
+/**
+ * Whether BlazePose labelled the person as seen from behind: their right shoulder on the
+ * picture's right (the camera's picture, not mirrored), clearly so for the body's height.
+ *
+ * The studio's contract is a person facing the camera, whose right is on the picture's left.
+ * BlazePose decides left from right by the body it believes it sees, and on some figures (the
+ * studio's own rendered mannequin, a face it cannot read) it takes the front for the back and
+ * swaps every left/right pair: the taped arm's landmarks would then be the other arm's.
+ */
+function facesAway(image, width, height) {
+  const [ls, rs, lh, rh] = [image[11], image[12], image[23], image[24]];
+  const torso = Math.hypot(((ls.x + rs.x - lh.x - rh.x) / 2) * width, ((ls.y + rs.y - lh.y - rh.y) / 2) * height);
+  return (rs.x - ls.x) * width > TURNED_MARGIN * torso;
+}
+
+/** The landmarks with every left/right pair exchanged. */
+function swapSides(points) {
+  const out = points.slice();
+  for (const [a, b] of LEFT_RIGHT) [out[a], out[b]] = [points[b], points[a]];
+  return out;
+}
+
 function onResults(results) {
   const frame = C.current;
   if (!frame || !C.running) return;
@@ -245,9 +274,16 @@ function onResults(results) {
   C.times.push(now);
   while (C.times.length > FPS_FRAMES || (C.times.length && C.times[0] < now - FPS_WINDOW_S)) C.times.shift();
   C.fps = C.times.length > 1 ? (C.times.length - 1) / (C.times[C.times.length - 1] - C.times[0]) : null;
-  const image = results.poseLandmarks || null;
-  const world = results.poseWorldLandmarks || null;
-  draw(results, $("source-side").value);
+  let image = results.poseLandmarks || null;
+  let world = results.poseWorldLandmarks || null;
+  // Seen "from behind": swap the labels back, so the taped arm is the person's taped arm.
+  const swapped = !!(image && world && facesAway(image, frame.width, frame.height));
+  if (swapped) {
+    image = swapSides(image);
+    world = swapSides(world);
+    C.swapped += 1;
+  }
+  draw(image, $("source-side").value);
   renderFps();
   send({
     t: frame.t,
@@ -257,7 +293,7 @@ function onResults(results) {
     height: frame.height,
     fps: C.fps,
     model: C.poseModel,
-  }, { tag: frame.tag, tResult: now });
+  }, { tag: frame.tag, tResult: now, swapped });
 }
 
 /* ------------------------------------------------------------------ to the studio */
@@ -286,12 +322,12 @@ async function post(body, info) {
   renderStatus();
   renderObservable(answer ? answer.observable : null);
   document.dispatchEvent(new CustomEvent("studio:landmarks", {
-    detail: { body, answer, tag: info.tag, tResult: info.tResult, tAnswered: performance.now() / 1000 },
+    detail: { body, answer, tag: info.tag, swapped: info.swapped, tResult: info.tResult, tAnswered: performance.now() / 1000 },
   }));
 }
 
 /* ------------------------------------------------------------------ drawing */
-function draw(results, side) {
+function draw(lm, side) {
   // The frame the model saw, from the page's own copy: drawing the model's WebGL output
   // (results.image) would read it back from the GPU, stalling it with software WebGL.
   const picture = C.grabbed;
@@ -303,7 +339,6 @@ function draw(results, side) {
   ctx.save();
   if ($("camera-mirror").checked) { ctx.translate(w, 0); ctx.scale(-1, 1); }
   ctx.drawImage(picture, 0, 0, w, h);
-  const lm = results.poseLandmarks;
   if (lm) {
     ctx.lineWidth = 2;
     ctx.strokeStyle = "rgba(255,255,255,0.85)";

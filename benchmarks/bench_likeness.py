@@ -1,0 +1,141 @@
+"""Likeness of the movement-primitive baseline to each shipped sample demonstration.
+
+Measures, in one run (``python benchmarks/bench_likeness.py``, about 10 s on one free core), for
+each ``studio/samples/sample-reach-*.demo.json``:
+
+1. The DMP (``fit_movement_primitive``, ``DMP_BASIS`` basis functions per joint) rolled out from
+   the demonstration's own start to its own end at its sample rate, against two baselines on the
+   same samples: straight-line joint interpolation over the same duration, and a minimum-jerk
+   straight line. Figures: joint-space DTW per sample on the demonstration's learned joints (its
+   grid's 3; goal <= 0.02 rad) and on all six, and the tool path's discrete Fréchet distance.
+   The wrist joints of the samples carry sample-to-sample jitter of up to 0.3 rad (fit noise near
+   the wrist singularity); the "jitter floor" column is the six-joint DTW of a 9-sample moving
+   average of the demonstration itself, which no smooth motion can beat.
+2. The likeness card of the DMP policy (``dmp_likeness_card``: 50 Hz, from the demonstration's
+   start), the demonstration's own values beside the policy's.
+3. New starts: 20 starts drawn around the demonstration's start (+-0.5 rad per joint), each
+   rolled to the demonstration's goal: how many arrive, their LDLJ and their duration.
+4. CPU time of one fit + rollout against the straight line's, interleaved, median of 5 (the
+   machine is shared: treat the times as rough).
+"""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+import numpy as np
+
+from studio.capture import load_demonstration
+from studio.learning import (
+    DMP_BASIS,
+    dmp_likeness_card,
+    dtw_distance,
+    fit_dmp_policy,
+    fit_movement_primitive,
+    frechet_distance,
+    ldlj,
+    puma_tool_positions,
+    roll_out_primitive,
+    rollout_dmp_policy,
+)
+
+SAMPLES = sorted((Path(__file__).resolve().parents[1] / "studio" / "samples").glob("*.demo.json"))
+GOAL_DTW_RAD = 0.02
+NEW_STARTS = 20
+START_SPREAD_RAD = 0.5
+REPEATS = 5
+
+
+def straight(times: np.ndarray, q: np.ndarray, min_jerk: bool) -> np.ndarray:
+    u = (times - times[0]) / (times[-1] - times[0])
+    if min_jerk:
+        u = u**3 * (10.0 - 15.0 * u + 6.0 * u**2)
+    return q[0] + u[:, None] * (q[-1] - q[0])
+
+
+def moving_average(q: np.ndarray, width: int = 9) -> np.ndarray:
+    padded = np.pad(q, ((width // 2, width // 2), (0, 0)), mode="edge")
+    kernel = np.ones(width) / width
+    return np.column_stack([np.convolve(c, kernel, mode="valid") for c in padded.T])
+
+
+def reproduction(path: Path) -> bool:
+    demo = load_demonstration(path)
+    times, q, k = demo.times, demo.q_robot, demo.grid["joints"]
+    rate = (len(times) - 1) / (times[-1] - times[0])
+    _, dmp = roll_out_primitive(fit_movement_primitive(times, q), rate_hz=rate)
+    tool = puma_tool_positions(q)
+    rows = {
+        "DMP": dmp,
+        "straight line": straight(times, q, False),
+        "min-jerk line": straight(times, q, True),
+    }
+    print(f"\n{path.name}: {len(times)} samples, {times[-1] - times[0]:.2f} s, {k} learned joints")
+    print(f"  {'':<16}{'DTW 3 joints':>14}{'DTW 6 joints':>14}{'Frechet (m)':>13}{'LDLJ':>8}")
+    for name, path_q in rows.items():
+        print(
+            f"  {name:<16}{dtw_distance(path_q[:, :k], q[:, :k]):>14.4f}"
+            f"{dtw_distance(path_q, q):>14.4f}"
+            f"{frechet_distance(puma_tool_positions(path_q), tool):>13.4f}"
+            f"{ldlj(np.arange(len(path_q)) / rate, path_q[:, :k]):>8.2f}"
+        )
+    floor = dtw_distance(moving_average(q), q)
+    print(f"  {'demonstration':<16}{0:>14.4f}{0:>14.4f}{0:>13.4f}{ldlj(times, q[:, :k]):>8.2f}")
+    print(f"  jitter floor (6 joints, a smoothed copy of the demonstration): {floor:.4f} rad")
+    ok = dtw_distance(dmp[:, :k], q[:, :k]) <= GOAL_DTW_RAD
+    print(
+        f"  goal: DMP DTW on the learned joints <= {GOAL_DTW_RAD} rad: {'met' if ok else 'MISSED'}"
+    )
+    return ok
+
+
+def card_and_new_starts(path: Path) -> None:
+    demo = load_demonstration(path)
+    policy = fit_dmp_policy(demo.times, demo.q_robot, learned_joints=demo.grid["joints"])
+    print(f"\n{path.name}: likeness card of the DMP policy (50 Hz, from the demonstration's start)")
+    print("  " + dmp_likeness_card(policy).text().replace("\n", "\n  "))
+    rng = np.random.default_rng(0)
+    reached, smooth, durations = 0, [], []
+    for _ in range(NEW_STARTS):
+        start = demo.q_robot[0] + rng.uniform(-START_SPREAD_RAD, START_SPREAD_RAD, 6)
+        times, q, ok = rollout_dmp_policy(policy, start)
+        reached += ok
+        smooth.append(ldlj(times, q[:, : policy.learned_joints]))
+        durations.append(times[-1])
+    print(
+        f"  from {NEW_STARTS} new starts: {reached}/{NEW_STARTS} reach the goal joints, "
+        f"LDLJ median {np.median(smooth):.2f}, duration median {np.median(durations):.2f} s"
+    )
+
+
+def timing(path: Path) -> None:
+    demo = load_demonstration(path)
+    dmp_s, line_s = [], []
+    for _ in range(REPEATS):
+        start = time.process_time()
+        roll_out_primitive(fit_movement_primitive(demo.times, demo.q_robot), rate_hz=50.0)
+        dmp_s.append(time.process_time() - start)
+        start = time.process_time()
+        straight(demo.times, demo.q_robot, True)
+        line_s.append(time.process_time() - start)
+    dmp, line = np.median(dmp_s), np.median(line_s)
+    print(
+        f"\nCPU per fit + rollout ({DMP_BASIS} basis functions, 6 joints): DMP {dmp * 1e3:.1f} ms, "
+        f"min-jerk line {line * 1e3:.3f} ms (ratio {dmp / max(line, 1e-9):.0f}x; shared machine, rough)"
+    )
+
+
+def main() -> None:
+    fit_movement_primitive(np.arange(3.0), np.zeros((3, 1)))  # compile nothing, warm numpy
+    dtw_distance(np.zeros((2, 1)), np.zeros((2, 1)))  # compile the numba kernels once
+    frechet_distance(np.zeros((2, 1)), np.zeros((2, 1)))
+    met = [reproduction(path) for path in SAMPLES]
+    for path in SAMPLES:
+        card_and_new_starts(path)
+    timing(SAMPLES[0])
+    print(f"\nreproduction goal met for {sum(met)}/{len(met)} sample demonstrations")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,252 @@
+"""Movement-primitive policy files: a DMP fitted to a demonstration, on disk and rolled out.
+
+Format ``teach-studio-dmp-policy``, version 1: a ``.policy.npz`` archive (no pickles) beside the
+tabular and tile-coded formats, holding
+
+- ``header``: a 0-d unicode array with a JSON object::
+
+      {"format": "teach-studio-dmp-policy", "version": 1,
+       "primitive": {"joints": 6, "basis": 50, "duration_s": 2.49, "alpha_z": 25.0,
+                     "alpha_x": 4.0, "start": [...6 rad...], "goal": [...6 rad...]},
+       "goal": [...6 rad...],          (where rollouts go; the demonstration's end by default)
+       "learned_joints": 3,            (the joints the likeness card compares)
+       "likeness": {...},              (LikenessCard.to_dict() from the demonstration's start)
+       "created": "...", "notes": ""}
+
+- ``weights``: float64 ``(joints, basis)``, the forcing terms (see :mod:`._dmp`);
+- ``demo_times``: float64 ``(N,)`` and ``demo_q``: float64 ``(N, 6)``, the demonstration it was
+  fitted to, so its likeness card can be computed from the file alone.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from datetime import UTC, datetime
+from pathlib import Path
+
+import numpy as np
+
+from studio import JSONFileError, loads_json
+
+from ._dmp import (
+    DMP_BASIS,
+    DMP_SETTLE_RAD,
+    MovementPrimitive,
+    fit_movement_primitive,
+    roll_out_primitive,
+)
+from ._errors import LearningError, PolicyFileError
+from ._likeness import LikenessCard, likeness_card, puma_tool_positions
+from ._policy import MAX_HEADER_CHARS, MAX_NPZ_BYTES, ROBOT_JOINTS, ROLLOUT_RATE_HZ, BoundedNpz
+
+FORMAT_NAME = "teach-studio-dmp-policy"
+FORMAT_VERSION = 1
+MAX_DEMO_SAMPLES = 1_000_000
+"""Most demonstration samples a DMP policy file may hold."""
+
+
+@dataclass(frozen=True, eq=False)
+class DmpPolicyFile:
+    """A movement-primitive baseline policy: a DMP and the demonstration it was fitted to.
+
+    Attributes:
+        primitive: the fitted DMP over the Puma560's six joints.
+        goal: where rollouts go ``(6,)`` (rad).
+        demo_times: the demonstration's sample times ``(N,)`` (s).
+        demo_q: the demonstration's joints ``(N, 6)`` (rad).
+        learned_joints: joints the likeness card compares (the demonstration's task joints).
+        created: ISO 8601 time of writing.
+        notes: free text.
+        mean_steps: empty (a primitive has no learning curve; kept so listings read all kinds alike).
+        experiments: 1.
+    """
+
+    primitive: MovementPrimitive
+    goal: np.ndarray
+    demo_times: np.ndarray
+    demo_q: np.ndarray
+    learned_joints: int = ROBOT_JOINTS
+    created: str = ""
+    notes: str = ""
+    mean_steps: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    experiments: int = 1
+
+    def header(self, likeness: LikenessCard | None = None) -> dict[str, object]:
+        """The JSON header written to the file."""
+        p = self.primitive
+        return {
+            "format": FORMAT_NAME,
+            "version": FORMAT_VERSION,
+            "primitive": {
+                "joints": p.joints,
+                "basis": p.basis,
+                "duration_s": p.duration_s,
+                "alpha_z": p.alpha_z,
+                "alpha_x": p.alpha_x,
+                "start": p.start.tolist(),
+                "goal": p.goal.tolist(),
+            },
+            "goal": self.goal.tolist(),
+            "learned_joints": self.learned_joints,
+            "likeness": None if likeness is None else likeness.to_dict(),
+            "created": self.created,
+            "notes": self.notes,
+        }
+
+
+def fit_dmp_policy(
+    times: np.ndarray,
+    q_robot: np.ndarray,
+    *,
+    goal: np.ndarray | None = None,
+    learned_joints: int = ROBOT_JOINTS,
+    basis: int = DMP_BASIS,
+    notes: str = "",
+) -> DmpPolicyFile:
+    """Fit the movement-primitive baseline to a demonstration's Puma560 joint path.
+
+    Args:
+        times: the demonstration's sample times ``(N,)`` (s).
+        q_robot: its joints ``(N, 6)`` (rad): a demonstration's ``q_robot``.
+        goal: where rollouts go (default: where the demonstration ends).
+        learned_joints: the joints its likeness card compares (a demonstration's grid joints).
+        basis: basis functions per joint.
+        notes: free text.
+
+    Raises:
+        LearningError: a path that is not ``(N, 6)`` finite angles, or a bad goal or count.
+    """
+    q = np.asarray(q_robot, dtype=np.float64)
+    if q.ndim != 2 or q.shape[1] != ROBOT_JOINTS:
+        raise LearningError(
+            f"The demonstration's joints have shape {q.shape}; give (N, {ROBOT_JOINTS}) Puma560 angles in radians."
+        )
+    if not isinstance(learned_joints, int) or not 1 <= learned_joints <= ROBOT_JOINTS:
+        raise LearningError(f"learned_joints is {learned_joints!r}; give 1 to {ROBOT_JOINTS}.")
+    primitive = fit_movement_primitive(times, q, basis)
+    target = primitive.goal if goal is None else np.asarray(goal, dtype=np.float64).reshape(-1)
+    if target.shape != (ROBOT_JOINTS,) or not np.all(np.isfinite(target)):
+        raise LearningError(f"The goal has {target.size} angles; give {ROBOT_JOINTS} in radians.")
+    return DmpPolicyFile(
+        primitive=primitive,
+        goal=target.copy(),
+        demo_times=np.asarray(times, dtype=np.float64).reshape(-1).copy(),
+        demo_q=q.copy(),
+        learned_joints=learned_joints,
+        created=datetime.now(UTC).isoformat(timespec="seconds"),
+        notes=notes,
+    )
+
+
+def rollout_dmp_policy(
+    policy: DmpPolicyFile, start_q: np.ndarray | None = None, rate_hz: float = ROLLOUT_RATE_HZ
+) -> tuple[np.ndarray, np.ndarray, bool]:
+    """The primitive from ``start_q`` (default: the demonstration's start) to the policy's goal.
+
+    Returns:
+        ``(times (N,), q (N, 6), reached)``: ``reached`` when every joint ends within
+        :data:`._dmp.DMP_SETTLE_RAD` of the goal.
+    """
+    times, q = roll_out_primitive(policy.primitive, start_q, policy.goal, rate_hz)
+    reached = bool(np.all(np.abs(q[-1] - policy.goal) <= DMP_SETTLE_RAD))
+    return times, q, reached
+
+
+def dmp_likeness_card(policy: DmpPolicyFile, rate_hz: float = ROLLOUT_RATE_HZ) -> LikenessCard:
+    """The likeness card of the primitive's rollout from the demonstration's own start."""
+    times, q, _ = rollout_dmp_policy(policy, policy.demo_q[0], rate_hz)
+    k = policy.learned_joints
+    return likeness_card(times, q, policy.demo_times, policy.demo_q, puma_tool_positions, joints=k)
+
+
+def save_dmp_policy(
+    path: str | Path, policy: DmpPolicyFile, *, compress: bool = True
+) -> LikenessCard:
+    """Write a DMP policy file (format above), its likeness card in the header; return the card."""
+    card = dmp_likeness_card(policy)
+    with Path(path).open("wb") as stream:
+        (np.savez_compressed if compress else np.savez)(
+            stream,
+            header=np.array(json.dumps(policy.header(card))),
+            weights=policy.primitive.weights,
+            demo_times=policy.demo_times,
+            demo_q=policy.demo_q,
+        )
+    return card
+
+
+def _vector(value: object, size: int, what: str) -> np.ndarray:
+    v = np.asarray(value, dtype=np.float64).reshape(-1)
+    if v.shape != (size,) or not np.all(np.isfinite(v)):
+        raise ValueError(f"its {what} is not {size} finite numbers")
+    return v
+
+
+def load_dmp_policy(path: str | Path) -> DmpPolicyFile:
+    """Read a DMP policy file, checking its format, version, header and shapes.
+
+    Raises:
+        PolicyFileError: missing, corrupt, not a DMP policy, or from a newer version.
+    """
+    path = Path(path)
+    name = path.name
+    if not path.is_file():
+        raise PolicyFileError(
+            f"Policy file {name} does not exist; give the path of a .policy.npz file."
+        )
+    with BoundedNpz(path, name, MAX_NPZ_BYTES) as archive:
+        try:
+            header = loads_json(
+                archive.read_text("header", MAX_HEADER_CHARS),
+                f"{name}'s header",
+                max_bytes=MAX_HEADER_CHARS,
+            )
+        except JSONFileError as err:
+            raise PolicyFileError(str(err)) from None
+        if not isinstance(header, dict) or header.get("format") != FORMAT_NAME:
+            raise PolicyFileError(f"{name} is not a DMP policy file; export the policy again.")
+        version = header.get("version")
+        if not isinstance(version, int) or isinstance(version, bool) or version > FORMAT_VERSION:
+            raise PolicyFileError(
+                f"{name} uses DMP policy format version {version!r}, not one this studio reads ({FORMAT_VERSION}); upgrade Teach Studio to read it."
+            )
+        try:
+            spec = header["primitive"]
+            joints, basis = int(spec["joints"]), int(spec["basis"])
+            if joints != ROBOT_JOINTS or basis < 2:
+                raise ValueError(f"it has {joints} joints and {basis} basis functions")
+            weights = archive.read("weights", (joints, basis), "f").astype(np.float64)
+            demo_times = archive.read("demo_times", None, "f").astype(np.float64)
+            demo_q = archive.read("demo_q", (demo_times.shape[0], joints), "f").astype(np.float64)
+            if demo_times.ndim != 1 or not 3 <= demo_times.shape[0] <= MAX_DEMO_SAMPLES:
+                raise ValueError("its demonstration is not 3 or more samples")
+            primitive = MovementPrimitive(
+                weights=weights,
+                start=_vector(spec["start"], joints, "start"),
+                goal=_vector(spec["goal"], joints, "demonstrated goal"),
+                duration_s=float(spec["duration_s"]),
+                alpha_z=float(spec["alpha_z"]),
+                alpha_x=float(spec["alpha_x"]),
+            )
+            goal = _vector(header["goal"], joints, "goal")
+            learned = header.get("learned_joints", joints)
+            if not isinstance(learned, int) or not 1 <= learned <= joints:
+                raise ValueError(f"learned_joints is {learned!r}")
+            if not (np.all(np.isfinite(weights)) and np.all(np.isfinite(demo_q))):
+                raise ValueError("it holds NaN values")
+            if not primitive.duration_s > 0:
+                raise ValueError("its duration is not positive")
+        except (KeyError, TypeError, ValueError, AttributeError, OverflowError) as err:
+            raise PolicyFileError(
+                f"{name} has a damaged header ({err}); export the policy again."
+            ) from None
+    return DmpPolicyFile(
+        primitive=primitive,
+        goal=goal,
+        demo_times=demo_times,
+        demo_q=demo_q,
+        learned_joints=learned,
+        created=str(header.get("created", "")),
+        notes=str(header.get("notes", "")),
+    )

@@ -1,0 +1,375 @@
+"""Likeness: how much a policy's motion looks like the demonstration it was taught from.
+
+The paper's claim is that a demonstration teaches the *character* of a motion: its smoothness,
+how the motion is spread over the joints, its execution time. These are the numbers that judge
+it, each computed for the policy and, beside it, for the demonstration itself:
+
+- **DTW** (dynamic time warping) in joint space, per sample: the mean Euclidean joint distance
+  (rad) between the two paths along the warping that minimises the total distance; the total is
+  divided by the number of aligned pairs, so a long rollout is not penalised for its length.
+- **Discrete Fréchet distance** of the tool paths (m; Eiter & Mannila 1994): the shortest leash
+  that lets a walker on each path reach its end, neither going back.
+- **LDLJ**, the log dimensionless jerk (Balasubramanian, Melendez-Calderon, Roby-Brami & Burdet,
+  J NeuroEng Rehabil 2015), in its velocity form, on the *joint-space* velocity ``dq/dt``
+  (``v_peak`` the peak of its norm; the paper's vector form, with joints in place of the hand):
+  ``-ln((t2 - t1)^3 / v_peak^2 * integral |d^3 q / dt^3|^2 dt)``. Higher (less negative) is
+  smoother; it does not depend on the motion's amplitude or duration.
+- **Joint shares**: each joint's travel ``sum |dq_j|`` over the total, compared with the
+  demonstration's by the Jensen-Shannon divergence (bits, 0 = same spread, 1 = disjoint).
+- **Moving together**: the share of the moving time (any joint faster than
+  :data:`MOVING_SPEED_FRACTION` of the path's fastest joint speed) in which two or more joints
+  move.
+- **Duration** (s).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import asdict, dataclass
+
+import numpy as np
+from numba import njit
+
+from studio.kinematics import Puma560
+
+from ._errors import LearningError
+
+MOVING_SPEED_FRACTION = 0.05
+"""A joint counts as moving when its speed exceeds this fraction of the path's peak joint speed
+(relative, so a slow and a fast motion are judged alike; 5% ignores sensor jitter and the slow
+tail of a settling arm)."""
+
+ToolPositions = Callable[[np.ndarray], np.ndarray]
+"""Joint angles ``(N, joints)`` to tool positions ``(N, 3)`` in metres (forward kinematics)."""
+
+
+@njit(cache=True, nogil=True)
+def _dtw(a: np.ndarray, b: np.ndarray) -> tuple[float, int]:  # pragma: no cover - numba
+    """Total cost of the optimal warping and the number of pairs on it (two rows of memory)."""
+    n, m = a.shape[0], b.shape[0]
+    cost, prev_cost = np.full(m + 1, np.inf), np.full(m + 1, np.inf)
+    length, prev_length = np.zeros(m + 1, np.int64), np.zeros(m + 1, np.int64)
+    prev_cost[0] = 0.0
+    for i in range(1, n + 1):
+        cost[0] = np.inf
+        for j in range(1, m + 1):
+            d = 0.0
+            for k in range(a.shape[1]):
+                d += (a[i - 1, k] - b[j - 1, k]) ** 2
+            best, steps = prev_cost[j - 1], prev_length[j - 1]
+            if prev_cost[j] < best:
+                best, steps = prev_cost[j], prev_length[j]
+            if cost[j - 1] < best:
+                best, steps = cost[j - 1], length[j - 1]
+            cost[j] = best + math.sqrt(d)
+            length[j] = steps + 1
+        cost, prev_cost = prev_cost, cost
+        length, prev_length = prev_length, length
+    return prev_cost[m], prev_length[m]
+
+
+@njit(cache=True, nogil=True)
+def _frechet(a: np.ndarray, b: np.ndarray) -> float:  # pragma: no cover - numba
+    """Eiter & Mannila's coupling recursion, two rows of memory."""
+    n, m = a.shape[0], b.shape[0]
+    row, prev = np.empty(m), np.empty(m)
+    for i in range(n):
+        for j in range(m):
+            d = 0.0
+            for k in range(a.shape[1]):
+                d += (a[i, k] - b[j, k]) ** 2
+            d = math.sqrt(d)
+            if i == 0 and j == 0:
+                row[j] = d
+            elif i == 0:
+                row[j] = max(row[j - 1], d)
+            elif j == 0:
+                row[j] = max(prev[j], d)
+            else:
+                row[j] = max(min(prev[j], prev[j - 1], row[j - 1]), d)
+        row, prev = prev, row
+    return prev[m - 1]
+
+
+def _paths(a: np.ndarray, b: np.ndarray, what: str) -> tuple[np.ndarray, np.ndarray]:
+    """Both paths as finite float ``(N, D)`` arrays of the same width, at least one sample each."""
+    out = []
+    for name, x in (("first", a), ("second", b)):
+        x = np.asarray(x, dtype=np.float64)
+        if x.ndim == 1:
+            x = x[:, None]
+        if x.ndim != 2 or x.shape[0] < 1 or not np.all(np.isfinite(x)):
+            raise LearningError(
+                f"The {name} {what} has shape {x.shape} or non-finite values; give an (N, D) array of finite numbers with N >= 1."
+            )
+        out.append(np.ascontiguousarray(x))
+    if out[0].shape[1] != out[1].shape[1]:
+        raise LearningError(
+            f"The {what}s have {out[0].shape[1]} and {out[1].shape[1]} columns; compare paths of the same joints."
+        )
+    return out[0], out[1]
+
+
+def dtw_distance(a: np.ndarray, b: np.ndarray) -> float:
+    """Dynamic-time-warping distance per aligned sample (units of the paths, e.g. rad).
+
+    Args:
+        a: path ``(N, D)`` (or ``(N,)``).
+        b: path ``(M, D)``.
+
+    Returns:
+        The smallest total Euclidean distance over monotone alignments of every sample of both
+        paths, divided by the number of aligned pairs.
+    """
+    a, b = _paths(a, b, "path")
+    total, pairs = _dtw(a, b)
+    return float(total / pairs)
+
+
+def frechet_distance(a: np.ndarray, b: np.ndarray) -> float:
+    """The discrete Fréchet distance between two polylines ``(N, D)`` and ``(M, D)``."""
+    a, b = _paths(a, b, "path")
+    return float(_frechet(a, b))
+
+
+def _times(times: np.ndarray, n: int) -> np.ndarray:
+    t = np.asarray(times, dtype=np.float64).reshape(-1)
+    if t.shape != (n,) or not np.all(np.isfinite(t)) or (n > 1 and np.any(np.diff(t) <= 0)):
+        raise LearningError(
+            f"The times have shape {t.shape} for {n} samples; give one increasing time per sample."
+        )
+    return t
+
+
+def ldlj(times: np.ndarray, q: np.ndarray) -> float:
+    """Log dimensionless jerk of the joint-space velocity (Balasubramanian et al. 2015).
+
+    ``-ln((t2 - t1)^3 / v_peak^2 * integral |q'''(t)|^2 dt)``, with derivatives taken by
+    second-order finite differences on the sample times.
+
+    Returns:
+        The LDLJ (higher is smoother; a minimum-jerk reach scores about -5.3), NaN for a path
+        that does not move or has fewer than 4 samples.
+    """
+    q = np.asarray(q, dtype=np.float64)
+    q = q[:, None] if q.ndim == 1 else q
+    t = _times(times, q.shape[0])
+    if q.shape[0] < 4 or not np.any(np.diff(q, axis=0)):
+        return math.nan
+    velocity = np.gradient(q, t, axis=0)
+    v_peak = float(np.linalg.norm(velocity, axis=1).max())
+    if v_peak <= 0.0:
+        return math.nan
+    jerk = np.gradient(np.gradient(velocity, t, axis=0), t, axis=0)
+    squared = (jerk**2).sum(axis=1)
+    integral = float(np.sum(0.5 * (squared[1:] + squared[:-1]) * np.diff(t)))
+    duration = t[-1] - t[0]
+    if integral <= 0.0:
+        return math.nan
+    return -math.log(duration**3 / v_peak**2 * integral)
+
+
+def joint_shares(q: np.ndarray) -> np.ndarray:
+    """Each joint's share of the total travel ``sum_t |dq_j|`` (sums to 1; zeros for no motion)."""
+    q = np.asarray(q, dtype=np.float64)
+    travel = np.abs(np.diff(q, axis=0)).sum(axis=0) if q.shape[0] > 1 else np.zeros(q.shape[1])
+    total = travel.sum()
+    return travel / total if total > 0 else np.zeros_like(travel)
+
+
+def js_divergence(p: np.ndarray, q: np.ndarray) -> float:
+    """Jensen-Shannon divergence in bits between two distributions (normalised first).
+
+    0 for the same distribution, 1 for disjoint ones; NaN when either is all zeros.
+    """
+    p = np.asarray(p, dtype=np.float64)
+    q = np.asarray(q, dtype=np.float64)
+    if p.shape != q.shape or np.any(p < 0) or np.any(q < 0):
+        raise LearningError(
+            f"The distributions have shapes {p.shape} and {q.shape}; give two of the same length with no negative entries."
+        )
+    if p.sum() <= 0 or q.sum() <= 0:
+        return math.nan
+    p, q = p / p.sum(), q / q.sum()
+    m = 0.5 * (p + q)
+
+    def kl(x: np.ndarray) -> float:
+        mask = x > 0
+        return float(np.sum(x[mask] * np.log2(x[mask] / m[mask])))
+
+    return max(0.0, 0.5 * kl(p) + 0.5 * kl(q))
+
+
+def moving_together(times: np.ndarray, q: np.ndarray) -> float:
+    """Share of the moving time in which two or more joints move (see the module docstring).
+
+    NaN for a path that does not move.
+    """
+    q = np.asarray(q, dtype=np.float64)
+    t = _times(times, q.shape[0])
+    if q.shape[0] < 2:
+        return math.nan
+    dt = np.diff(t)
+    speed = np.abs(np.diff(q, axis=0)) / dt[:, None]
+    peak = speed.max()
+    if peak <= 0:
+        return math.nan
+    moving = (speed > MOVING_SPEED_FRACTION * peak).sum(axis=1)
+    moving_time = dt[moving >= 1].sum()
+    return float(dt[moving >= 2].sum() / moving_time)
+
+
+@dataclass(frozen=True)
+class MotionFigures:
+    """One motion's own figures: the columns of a :class:`LikenessCard`.
+
+    Attributes:
+        ldlj: log dimensionless jerk of the joint-space velocity (higher is smoother).
+        joint_shares: each joint's share of the total joint travel.
+        together: share of the moving time in which two or more joints move.
+        duration_s: seconds from the first sample to the last.
+        joint_travel_rad: total joint travel ``sum |dq|`` (the scale DTW is read against).
+        tool_path_m: length of the tool path (the scale Fréchet is read against).
+    """
+
+    ldlj: float
+    joint_shares: tuple[float, ...]
+    together: float
+    duration_s: float
+    joint_travel_rad: float
+    tool_path_m: float
+
+
+def motion_figures(times: np.ndarray, q: np.ndarray, tool: np.ndarray) -> MotionFigures:
+    """The :class:`MotionFigures` of joint path ``q`` ``(N, J)`` at ``times`` with tool path
+    ``tool`` ``(N, 3)``."""
+    q = np.asarray(q, dtype=np.float64)
+    t = _times(times, q.shape[0])
+    tool = np.asarray(tool, dtype=np.float64)
+    return MotionFigures(
+        ldlj=ldlj(t, q),
+        joint_shares=tuple(float(x) for x in joint_shares(q)),
+        together=moving_together(t, q),
+        duration_s=float(t[-1] - t[0]),
+        joint_travel_rad=float(np.abs(np.diff(q, axis=0)).sum()),
+        tool_path_m=float(np.linalg.norm(np.diff(tool, axis=0), axis=1).sum()),
+    )
+
+
+def _number(x: float) -> float | None:
+    """A float for JSON (NaN, which JSON lacks, as null)."""
+    return None if not math.isfinite(x) else round(float(x), 6)
+
+
+@dataclass(frozen=True)
+class LikenessCard:
+    """A policy's motion compared with the demonstration it was taught from.
+
+    ``dtw_rad``, ``frechet_m`` and ``shares_js`` compare the two (the demonstration's own value
+    is 0 by definition; read them against ``demonstration.joint_travel_rad`` and
+    ``demonstration.tool_path_m``); ``policy`` and ``demonstration`` hold each motion's own
+    figures side by side.
+
+    Attributes:
+        dtw_rad: joint-space DTW distance per aligned sample (rad).
+        frechet_m: discrete Fréchet distance of the tool paths (m).
+        shares_js: Jensen-Shannon divergence of the joint shares (bits).
+        policy: the policy rollout's figures.
+        demonstration: the demonstration's figures.
+    """
+
+    dtw_rad: float
+    frechet_m: float
+    shares_js: float
+    policy: MotionFigures
+    demonstration: MotionFigures
+
+    def to_dict(self) -> dict[str, object]:
+        """JSON-ready (NaN as null), numbers to a micro-unit."""
+        data = asdict(self)
+        for key in ("dtw_rad", "frechet_m", "shares_js"):
+            data[key] = _number(data[key])
+        for side in ("policy", "demonstration"):
+            figures = data[side]
+            for key, value in figures.items():
+                figures[key] = (
+                    [_number(x) for x in value] if isinstance(value, tuple) else _number(value)
+                )
+        return data
+
+    def text(self) -> str:
+        """A short table for the terminal: each figure, the policy's value, the demonstration's."""
+        p, d = self.policy, self.demonstration
+
+        def f(x: float, digits: int) -> str:
+            return "n/a" if not math.isfinite(x) else f"{x:.{digits}f}"
+
+        def shares(m: MotionFigures) -> str:
+            return "/".join(f"{100 * s:.0f}" for s in m.joint_shares)
+
+        rows = [
+            ("", "policy", "demonstration"),
+            (
+                "DTW, joints (rad/sample)",
+                f(self.dtw_rad, 4),
+                f"0 (travel {d.joint_travel_rad:.2f} rad)",
+            ),
+            ("Frechet, tool (m)", f(self.frechet_m, 4), f"0 (path {d.tool_path_m:.3f} m)"),
+            ("smoothness LDLJ", f(p.ldlj, 2), f(d.ldlj, 2)),
+            ("joint shares (%)", shares(p), shares(d)),
+            ("  JS divergence (bits)", f(self.shares_js, 3), "0"),
+            ("joints together (%)", f(100 * p.together, 0), f(100 * d.together, 0)),
+            ("duration (s)", f(p.duration_s, 2), f(d.duration_s, 2)),
+        ]
+        return "\n".join(f"{a:<26}{b:>12}  {c}" for a, b, c in rows)
+
+
+def likeness_card(
+    policy_times: np.ndarray,
+    policy_q: np.ndarray,
+    demo_times: np.ndarray,
+    demo_q: np.ndarray,
+    tool_positions: ToolPositions,
+    joints: int | None = None,
+) -> LikenessCard:
+    """Compare a policy's joint trajectory with a demonstration's.
+
+    Args:
+        policy_times: the rollout's sample times ``(N,)`` (s).
+        policy_q: the rollout's joint angles ``(N, J)`` (rad), started from the demonstration's
+            start.
+        demo_times: the demonstration's sample times ``(M,)``.
+        demo_q: the demonstration's joint angles ``(M, J)``.
+        tool_positions: forward kinematics, ``(K, J)`` joints to ``(K, 3)`` tool positions (m);
+            for the Puma560 :func:`puma_tool_positions`.
+        joints: compare only the first ``joints`` columns (the joints a task learns; the tool
+            paths still come from all of them). Default: all.
+
+    Raises:
+        LearningError: shapes that do not match, non-finite values, or times that do not increase.
+    """
+    policy_q, demo_q = _paths(policy_q, demo_q, "joint path")
+    k = policy_q.shape[1] if joints is None else joints
+    if not isinstance(k, int) or not 1 <= k <= policy_q.shape[1]:
+        raise LearningError(f"joints is {joints!r}; give 1 to {policy_q.shape[1]}.")
+    policy_tool = np.asarray(tool_positions(policy_q), dtype=np.float64)
+    demo_tool = np.asarray(tool_positions(demo_q), dtype=np.float64)
+    policy = motion_figures(policy_times, policy_q[:, :k], policy_tool)
+    demonstration = motion_figures(demo_times, demo_q[:, :k], demo_tool)
+    return LikenessCard(
+        dtw_rad=dtw_distance(policy_q[:, :k], demo_q[:, :k]),
+        frechet_m=frechet_distance(policy_tool, demo_tool),
+        shares_js=js_divergence(
+            np.array(policy.joint_shares), np.array(demonstration.joint_shares)
+        ),
+        policy=policy,
+        demonstration=demonstration,
+    )
+
+
+def puma_tool_positions(q: np.ndarray) -> np.ndarray:
+    """The Puma560's tool positions ``(N, 3)`` (m) for joint angles ``(N, 6)`` (rad)."""
+    robot = Puma560()
+    q = np.asarray(q, dtype=np.float64)
+    return np.array([robot.forward(row)[:3, 3] for row in q]).reshape(-1, 3)

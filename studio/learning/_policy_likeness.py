@@ -1,0 +1,63 @@
+"""The likeness card of any policy kind, rolled out from a demonstration's own start.
+
+One place that knows how each kind rolls out from given joint angles (a grid policy from the bin
+they fall in, a tile-coded policy from the learned joints, a movement primitive from all six), so
+the page, ``studio export`` and run files score every policy the same way.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ._dmp_policy import DmpPolicyFile, rollout_dmp_policy
+from ._errors import LearningError
+from ._likeness import LikenessCard, likeness_card, puma_tool_positions
+from ._linear_policy import TilePolicyFile, rollout_tile_policy
+from ._policy import ROBOT_JOINTS, ROLLOUT_RATE_HZ, PolicyFile, rollout
+
+
+def policy_likeness_card(
+    policy: PolicyFile | TilePolicyFile | DmpPolicyFile,
+    demo_times: np.ndarray,
+    demo_q: np.ndarray,
+    rate_hz: float = ROLLOUT_RATE_HZ,
+) -> LikenessCard:
+    """Roll ``policy`` out from the demonstration's first sample and compare the two.
+
+    The card compares the joints the policy learns (a grid's or a task's joints; a movement
+    primitive's ``learned_joints``); the other joints are held where the rollout keeps them (a
+    grid policy: at the demonstration's start; a tile-coded policy: at the task's goal).
+
+    Args:
+        policy: a policy of any kind (:func:`load_any_policy`).
+        demo_times: the demonstration's sample times ``(N,)`` (s).
+        demo_q: its Puma560 joints ``(N, 6)`` (rad), for example a demonstration's ``q_robot``.
+        rate_hz: the rollout's sample rate.
+
+    Raises:
+        LearningError: a demonstration that is not ``(N, 6)`` finite angles, a start outside
+            the task's joint limits, or a tile-coded policy of another environment.
+    """
+    q_demo = np.asarray(demo_q, dtype=np.float64)
+    if q_demo.ndim != 2 or q_demo.shape[1] != ROBOT_JOINTS or q_demo.shape[0] < 1:
+        raise LearningError(
+            f"The demonstration's joints have shape {q_demo.shape}; give (N, {ROBOT_JOINTS}) Puma560 angles in radians."
+        )
+    if not np.all(np.isfinite(q_demo)):
+        raise LearningError("The demonstration holds NaN angles; re-record it.")
+    start = q_demo[0]
+    if isinstance(policy, DmpPolicyFile):
+        times, q, _ = rollout_dmp_policy(policy, start, rate_hz)
+        joints = policy.learned_joints
+    elif isinstance(policy, TilePolicyFile):
+        if policy.task is None:
+            raise LearningError(
+                f"This policy was trained on {policy.env_id or 'another environment'}, not the arm; only arm policies have a likeness card."
+            )
+        joints = policy.task.joints
+        times, q, _ = rollout_tile_policy(policy, start[:joints], rate_hz)
+    else:
+        grid = policy.grid
+        joints = grid.joints
+        times, q = rollout(policy, grid.state_of_angles(start[:joints]), rate_hz, hold=start)
+    return likeness_card(times, q, demo_times, q_demo, puma_tool_positions, joints=joints)

@@ -1,0 +1,143 @@
+"""Training a run: the learner in a thread of its own, watched by the caller's thread.
+
+The kernels release the GIL, so a run learns in a daemon thread (:class:`TrainingThread`) while
+the thread that started it (the page's queue worker, ``studio train``'s main thread) checkpoints
+the curve and the policy at most every :data:`CHECKPOINT_SECONDS` and reports progress
+(:func:`watch_training`); a Ctrl-C there stops the learner at the next episode boundary.
+:meth:`studio.learning.RunFolder.train` puts the two together with the run folder's files.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+import time
+from collections.abc import Callable
+
+import numpy as np
+
+from ._errors import LearningError
+from ._experiments import run_experiments
+from ._learner import ExperimentResult, LiveProgress
+from ._prepare import prepare_learner
+from ._run_record import TASK_ARM_REACH, RunRecord
+
+log = logging.getLogger(__name__)
+
+CHECKPOINT_SECONDS = 1.0
+"""How often a training run's ``steps.csv`` is written to disk (at most this much is lost)."""
+CHECKPOINT_COST_FACTOR = 10.0
+"""A checkpoint waits at least this many times as long as the last one took to write, so a huge
+run (20 x 50,000 episodes) spends under a tenth of a core on checkpoints."""
+
+
+def train_learner(
+    record: RunRecord, live: LiveProgress, workers: int | None = None
+) -> ExperimentResult:
+    """Run the record's experiments: Dyna-Q on the arm grid, or linear Dyna-Q with tile coding
+    on ``TeachStudio/ArmReach-v0``; the first run on a machine compiles the kernels first."""
+    prepare_learner(record.kind, live)
+    if record.kind == TASK_ARM_REACH:
+        import gymnasium
+
+        from ._gym import ARM_REACH_ID
+
+        spec = record.arm_reach().to_dict()
+        return run_experiments(
+            lambda: gymnasium.make(ARM_REACH_ID, **spec),
+            record.config,
+            record.experiments,
+            record.episodes,
+            record.seed,
+            [np.asarray(p, dtype=np.float64) for p in record.demonstrations],
+            record.tile_coding(),
+            workers=workers,
+            live=live,
+        )
+    return run_experiments(
+        record.arm_grid().mdp(),
+        record.config,
+        record.experiments,
+        record.episodes,
+        record.seed,
+        record.demonstrations,
+        workers=workers,
+        live=live,
+    )
+
+
+class TrainingThread:
+    """:func:`train_learner` in a daemon thread; its result, or the error it raised.
+
+    Attributes:
+        ended: set when the learner returned or raised (waited on, never ``join``: a Ctrl-C
+            inside ``join`` can end it too early).
+        result: what it learnt, once ended without an error.
+        error: what it raised, once ended with one.
+    """
+
+    def __init__(
+        self, run_id: str, record: RunRecord, live: LiveProgress, workers: int | None
+    ) -> None:
+        self.run_id = run_id
+        self.ended = threading.Event()
+        self.result: ExperimentResult | None = None
+        self.error: BaseException | None = None
+        self._args = (record, live, workers)
+        self._thread = threading.Thread(
+            target=self._run, name=f"studio-train-{run_id}", daemon=True
+        )
+
+    def start(self) -> TrainingThread:
+        """Start learning; returns itself."""
+        self._thread.start()
+        return self
+
+    def _run(self) -> None:
+        try:
+            self.result = train_learner(*self._args)
+        except BaseException as err:  # handed to the caller's thread
+            self.error = err
+        finally:
+            self.ended.set()
+
+
+def watch_training(
+    thread: TrainingThread,
+    live: LiveProgress,
+    checkpoint: Callable[[], None],
+    on_checkpoint: Callable[[LiveProgress], None] | None = None,
+    poll_seconds: float = 0.05,
+) -> tuple[bool, LearningError | None]:
+    """Wait for ``thread`` to end, calling ``checkpoint`` when the curve moved and at most every
+    :data:`CHECKPOINT_SECONDS` (less often when one takes over a tenth of that), and
+    ``on_checkpoint`` every ``poll_seconds``.
+
+    A Ctrl-C, or a :class:`LearningError` from ``checkpoint`` (a full disk), stops the learner
+    at its next episode boundary and waits for it.
+
+    Returns:
+        Whether it was interrupted (Ctrl-C), and the checkpoint's error, if any.
+    """
+    interrupted, disk = False, None
+    saved, last, every = 0, time.monotonic(), CHECKPOINT_SECONDS
+    while not thread.ended.is_set():
+        try:
+            thread.ended.wait(poll_seconds)
+            if on_checkpoint is not None:
+                on_checkpoint(live)
+            now = time.monotonic()
+            done = live.completed
+            if now - last >= every and done != saved and not thread.ended.is_set():
+                checkpoint()
+                saved, last = done, time.monotonic()
+                # a huge run's checkpoint costs: keep writing it under a tenth of the time
+                every = max(CHECKPOINT_SECONDS, CHECKPOINT_COST_FACTOR * (last - now))
+        except KeyboardInterrupt:
+            interrupted = True
+            live.stop()
+        except LearningError as err:  # a full disk mid-run: stop, keep what is on disk
+            log.warning("run %s: %s", thread.run_id, err)
+            live.stop()
+            disk = disk or err
+    return interrupted, disk

@@ -1,0 +1,93 @@
+"""What the web layer's parts ask of each other: the live pose, the scene, the capture writer.
+
+The live pipeline, the studio's state and the routers hold the scene and the capture writer by
+these protocols, so a test can hand in a recording fake and the studio runs headless with none.
+Sources are held by :class:`studio.capture.FrameSource`; a kind's own calls (playback, the
+simulator's reach, a fed source's ``submit``) are made after an ``isinstance`` check.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping, Sequence
+from pathlib import Path
+from typing import NamedTuple, Protocol
+
+import numpy as np
+
+from studio.capture import Observation
+
+
+class LivePose(NamedTuple):
+    """The newest fitted pose, as the pipeline hands it to the scene.
+
+    Attributes:
+        q_human: the fitted arm's joints ``(7,)`` (rad).
+        q_robot: the retargeted Puma560 joints ``(6,)`` (rad).
+        tape: the reconstructed tape ``(regions + 1, 3)`` in the arm's base frame (m), or None
+            (no tape: a camera or the hand guide teaches).
+    """
+
+    q_human: np.ndarray
+    q_robot: np.ndarray
+    tape: np.ndarray | None = None
+
+
+HandMoved = Callable[[np.ndarray, np.ndarray], Mapping[str, object]]
+"""Called with a hand position (3,) and orientation wxyz (4,) in the arm frame when the hand
+guide's handle is dragged; returns the ``HandPublic`` fields (``q_human``, ``reached``, ...)."""
+
+
+class LiveScene(Protocol):
+    """What the live pipeline asks of the scene."""
+
+    def show_live(self, pose: LivePose) -> None:
+        """Show the newest live pose (latest wins, never blocks)."""
+
+    def set_side(self, side: str) -> None:
+        """Make ``side`` the operator's arm that follows the fit."""
+
+
+class Scene(LiveScene, Protocol):
+    """What the studio and its routers ask of the scene (:class:`~._scene.StudioScene`)."""
+
+    @property
+    def playing(self) -> bool:
+        """Whether a playback runs."""
+
+    def set_goal(self, q_robot_goal: np.ndarray | None) -> None:
+        """Show the goal's ghost robot (None hides it)."""
+
+    def show_path(self, name: str, q_robot_path: np.ndarray) -> None:
+        """Draw the tool path of a robot joint path."""
+
+    def clear_path(self, name: str | None = None) -> None:
+        """Remove a path (every path when None)."""
+
+    def play_trajectory(
+        self, times: np.ndarray, q_robot: np.ndarray, states: Sequence[int] | None = None
+    ) -> None:
+        """Animate the robot along a trajectory."""
+
+    def stop_playback(self) -> None:
+        """Stop a playback."""
+
+    def current_q_robot(self) -> np.ndarray:
+        """The robot joints shown now."""
+
+    def show_hand_handle(self, side: str | None, on_move: HandMoved | None) -> None:
+        """Show the hand guide's handle on ``side``'s hand (None hides it)."""
+
+
+class CaptureWriter(Protocol):
+    """What the pipeline asks of a recording's writer (:class:`studio.capture.AppendWriter`)."""
+
+    path: Path
+
+    def write_many(self, frames: Sequence[Observation]) -> None:
+        """Append observations."""
+
+    def flush(self) -> None:
+        """Make the written observations durable now."""
+
+    def close(self) -> None:
+        """Finish the file cleanly."""

@@ -1,0 +1,234 @@
+/* Teach Studio page: the learning-curve chart, and each run's colour and label as the lists show them.
+ *
+ * uPlot (vendored from npm, see static/vendor/README.md) draws on a canvas: a redraw with new data
+ * takes about a millisecond, so live curves at CURVE_FPS never compete with training for the CPU.
+ */
+
+import { bucketCurve, curveAxis } from "./curves.js";
+import { $, setProp, setText } from "./dom.js";
+import { S } from "./state.js";
+
+const PALETTE = ["#2a62b8", "#d9822b", "#23874b", "#b83280", "#6b4fbb", "#0f8b8d", "#a0522d", "#7a7a7a"];
+
+export function runColor(id) {
+  const i = S.runs.length - 1 - S.runs.findIndex((r) => r.id === id);
+  return PALETTE[((i % PALETTE.length) + PALETTE.length) % PALETTE.length];
+}
+
+/** What a run learns, in words: the paper's grid (tabular) or continuous joints (tile coding).
+ * A run made before the continuous task existed has no task in its config: it is a grid run. */
+function runTask(r) {
+  const c = r.config || {};
+  return c.task === "arm-reach" ? `continuous, ${c.joints} joints` : "grid";
+}
+
+export function runLabel(r) {
+  const c = r.config || {};
+  const name = r.name || r.id;
+  const demos = (c.demonstrations || []).length;
+  const planning = c.planning && !name.includes(c.planning) ? ` · ${c.planning}` : "";
+  return `${name} · ${runTask(r)}${planning}${demos && !/demo/.test(name) ? ` +${demos} demo` : ""}`;
+}
+
+/** The runs to plot, oldest first (so colours and legend order stay put as runs are added). */
+export function plottedRuns() {
+  return [...S.runs].reverse().filter((r) => {
+    const c = S.curves.get(r.id);
+    return S.shown.has(r.id) && c && c.episodes.length > 0;
+  });
+}
+
+/** Episodes per experiment of a run (its fraction-of-run axis divides by this). */
+function runLength(r) {
+  const c = S.curves.get(r.id);
+  const planned = r.config && r.config.episodes;
+  return Math.max(1, planned || (c.episodes.length ? c.episodes[c.episodes.length - 1] : 1));
+}
+
+/**
+ * The chart's columns: the x axis, then per run its mean and, with a band, its low and high
+ * edges. Missing episodes are null (a gap); on a log axis nothing below one step is drawn. Also
+ * per run the fewest experiments any point of a bucket averages (``counts``) and the run's most
+ * (``full``), so the legend and a marker say where the band stops averaging every experiment.
+ */
+export function chartData(runs, band, log, xMode = "episode") {
+  const lines = runs.map((r) => ({ curve: S.curves.get(r.id), length: runLength(r) }));
+  const { x, bucketOf } = curveAxis(lines, xMode);
+  const n = x.length;
+  const cols = [x];
+  const counts = [];
+  const full = [];
+  const floor = (v) => (log && v < 1 ? null : v);
+  runs.forEach((r, i) => {
+    const s = bucketCurve(lines[i], n, bucketOf);
+    const mean = new Array(n).fill(null); const low = new Array(n).fill(null); const high = new Array(n).fill(null);
+    for (let b = 0; b < n; b++) {
+      if (s.mean[b] === null) continue;
+      const m = s.mean[b];
+      mean[b] = floor(m);
+      if (band === "minmax") {
+        low[b] = floor(s.min[b]); high[b] = floor(s.max[b]);
+      } else {
+        low[b] = floor(Math.max(m - s.std[b], log ? Math.max(s.min[b], 1) : 0)); high[b] = floor(m + s.std[b]);
+      }
+    }
+    cols.push(mean);
+    if (band !== "none") cols.push(low, high);
+    counts.push(s.count);
+    full.push(s.most || (r.config && r.config.experiments) || 0);
+  });
+  cols.counts = counts;
+  cols.full = full;
+  return cols;
+}
+
+/** Where each run's points stop averaging all its experiments: the first such x, or null. */
+export function fewerFrom(data, i) {
+  const counts = data.counts[i];
+  for (let b = 0; b < counts.length; b++) {
+    if (counts[b] !== null && counts[b] < data.full[i]) return data[0][b];
+  }
+  return null;
+}
+
+function hexAlpha(hex, a) {
+  const n = parseInt(hex.slice(1), 16);
+  return `rgba(${(n >> 16) & 255},${(n >> 8) & 255},${n & 255},${a})`;
+}
+
+/** uPlot options for these runs: a mean line per run and, with a band, two unlabelled edges filled;
+ * a dashed marker where a run's points start averaging fewer experiments than it has. */
+function chartOptions(runs, band, log, width, height, xMode = "episode") {
+  const xLabel = xMode === "fraction" ? "fraction of run" : "episode";
+  const series = [{ label: xLabel, value: (u, v) => (v == null ? "–" : xMode === "fraction" ? v.toFixed(3) : String(v)) }];
+  const bands = [];
+  runs.forEach((r, i) => {
+    const color = runColor(r.id);
+    const meanIdx = series.length;
+    series.push({
+      label: runLabel(r), stroke: color, width: 1.8, spanGaps: false,
+      value: (u, v, si, di) => {
+        if (v == null) return "–";
+        const n = di == null || !u.data.counts ? null : u.data.counts[i][di];
+        const of = u.data.full ? u.data.full[i] : null;
+        return `${v.toFixed(1)} steps${n != null && of ? ` · ${n} of ${of} exp.` : ""}`;
+      },
+    });
+    if (band !== "none") {
+      for (const edge of ["low", "high"]) {
+        series.push({ label: `${runLabel(r)} ${edge}`, class: "band-edge", stroke: "transparent", width: 0, points: { show: false } });
+      }
+      bands.push({ series: [meanIdx + 2, meanIdx + 1], fill: hexAlpha(color, 0.16) });
+    }
+  });
+  const axis = { stroke: "#555", grid: { stroke: "#eceef1", width: 1 }, ticks: { stroke: "#d6d9de", width: 1 }, font: "11px system-ui, sans-serif", labelFont: "11px system-ui, sans-serif" };
+  return {
+    width, height, series, bands,
+    scales: {
+      x: xMode === "log" ? { time: false, distr: 3, log: 10 } : { time: false },
+      y: log ? { distr: 3, log: 10 } : { range: (u, min, max) => [0, max > 0 ? max * 1.05 : 1] },
+    },
+    axes: [
+      { ...axis, label: xLabel, labelSize: 16, size: 30 },
+      { ...axis, label: "steps", labelSize: 16, size: 48 },
+    ],
+    legend: { live: true },
+    cursor: { drag: { x: true, y: false } },
+    hooks: {
+      init: [(u) => {
+        // Drag to zoom into episodes (the zoom then survives live updates); double-click resets.
+        u.over.addEventListener("dblclick", () => { S.chartZoomed = false; });
+      }],
+      setSelect: [(u) => { if (u.select.width > 0) S.chartZoomed = true; }],
+      draw: [(u) => {
+        // Mark where each run's band stops averaging all of its experiments (runs of different
+        // lengths, or a stopped run): the band goes on, over fewer experiments, as the legend says.
+        const ctx = u.ctx;
+        runs.forEach((r, i) => {
+          const at = u.data.counts ? fewerFrom(u.data, i) : null;
+          if (at === null) return;
+          const px = Math.round(u.valToPos(at, "x", true));
+          ctx.save();
+          ctx.strokeStyle = runColor(r.id);
+          ctx.setLineDash([4, 4]);
+          ctx.lineWidth = 1;
+          ctx.beginPath();
+          ctx.moveTo(px, u.bbox.top);
+          ctx.lineTo(px, u.bbox.top + u.bbox.height);
+          ctx.stroke();
+          ctx.restore();
+        });
+      }],
+    },
+  };
+}
+
+/** The chart's key: what the line, the band and the dashed marker mean (each run's name and
+ * colour are in uPlot's own legend under the chart). Written only when it changes. */
+function renderCurveKey(runs, data, band) {
+  setProp("curve-key", "hidden", runs.length === 0);
+  setProp("curve-key-band", "hidden", band === "none");
+  setText("curve-key-band-text", band === "minmax" ? "min–max" : "± 1 std");
+  setProp("curve-key-fewer", "hidden", !runs.some((r, i) => fewerFrom(data, i) !== null));
+}
+
+let chart = null;
+let chartKey = "";
+let chartRuns = []; // run ids of the chart's mean columns, in order
+let chartStride = 1; // columns per run: mean, or mean, low and high
+
+/** Size the chart to its pane, leaving room for the legend under it. */
+export function fitChart() {
+  if (!chart) return;
+  const box = $("curve-plot");
+  const legend = chart.root.querySelector(".u-legend");
+  const height = Math.max(80, box.clientHeight - (legend ? legend.offsetHeight : 0) - 2);
+  chart.setSize({ width: box.clientWidth, height });
+}
+
+export function renderCurves() {
+  if (!S.curveDirty || typeof uPlot === "undefined") return;
+  S.curveDirty = false;
+  const band = $("curve-band").value;
+  const log = $("curve-log").checked;
+  const xMode = $("curve-x").value;
+  const runs = plottedRuns();
+  setProp("curve-empty", "hidden", runs.length > 0);
+  if (!runs.length) {
+    if (chart) { chart.destroy(); chart = null; chartKey = ""; chartRuns = []; }
+    setProp("curve-key", "hidden", true);
+    return;
+  }
+  const key = JSON.stringify([runs.map((r) => [r.id, runLabel(r), runColor(r.id)]), band, log, xMode]);
+  const data = chartData(runs, band, log, xMode);
+  renderCurveKey(runs, data, band);
+  if (chart && key === chartKey) {
+    chart.setData(data, !S.chartZoomed);
+  } else {
+    if (chart) chart.destroy();
+    const box = $("curve-plot");
+    chart = new uPlot(chartOptions(runs, band, log, box.clientWidth, box.clientHeight, xMode), data, box);
+    chartKey = key;
+    chartRuns = runs.map((r) => r.id);
+    chartStride = band === "none" ? 1 : 3;
+    S.chartZoomed = false;
+    fitChart();
+  }
+  S.curveRenders = (S.curveRenders || 0) + 1; // chart redraws with new data (benchmarks read it)
+}
+
+/** Ids of the runs in the chart, in legend order (used by the browser tests). */
+S.plottedRuns = () => (chart ? [...chartRuns] : []);
+
+/** The x where a plotted run starts averaging fewer experiments than it has, or null (tests). */
+S.chartFewerFrom = (id) => (chart && chartRuns.includes(id) ? fewerFrom(chart.data, chartRuns.indexOf(id)) : null);
+
+/** Number of plotted mean-curve points of a run, or of all runs (used by the browser tests). */
+S.curvePoints = (id) => {
+  if (!chart) return 0;
+  let n = 0;
+  chartRuns.forEach((run, i) => {
+    if (id === undefined || run === id) n += chart.data[1 + i * chartStride].filter((v) => v !== null).length;
+  });
+  return n;
+};

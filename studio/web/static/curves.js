@@ -1,0 +1,91 @@
+/* Teach Studio page: a run's learning curve, and the one rule that averages a long curve for the
+ * chart. No DOM and no state: tests/e2e/test_curve_rule.py runs this rule against the server's.
+ *
+ * The rule is the server's (`studio.learning.downsample_curve`, which draws the PNG/SVG figures):
+ * a curve of n episodes is averaged in equal buckets of ceil(n / points) episodes, each point at
+ * its bucket's mean episode, with the mean of its means and of its stds, its lowest min, highest
+ * max and fewest count (a point never claims more experiments than all of its episodes had). The
+ * chart's "episode" axis is that rule, with the same buckets for every run; its "log" and
+ * "fraction" axes bucket the same way over other edges.
+ */
+
+export const CURVE_KEYS = ["episodes", "mean", "std", "min", "max", "count"];
+
+export function emptyCurve() {
+  return Object.fromEntries(CURVE_KEYS.map((k) => [k, []]));
+}
+
+/**
+ * At most MAX_PLOT_POINTS points per run (the server's FIGURE_POINTS), so a 100 000-episode run
+ * draws as fast as a short one and the chart never slows the page down.
+ */
+const MAX_PLOT_POINTS = 600;
+
+/**
+ * Bucket edges of the x axis shared by some lines (``{curve, length}``, length: the episodes per
+ * experiment a fraction-of-run axis divides by): ``x[b]`` is bucket b's x value and
+ * ``bucketOf(line, episode)`` its bucket. "episode": equal buckets of episodes, each at its mean
+ * episode (the server's rule); "log": log-spaced buckets at their upper edges, so a 100-episode
+ * run keeps its shape beside a 50 000-episode one; "fraction": each line over [0, 1] of its length.
+ */
+export function curveAxis(lines, xMode, points = MAX_PLOT_POINTS) {
+  if (xMode === "fraction") {
+    const longest = Math.max(...lines.map((line) => line.length));
+    const n = Math.min(points, longest);
+    const x = Array.from({ length: n }, (_, b) => (b + 1) / n);
+    return { x, bucketOf: (line, e) => Math.min(n - 1, Math.floor(((e - 1) / line.length) * n)) };
+  }
+  let last = 0;
+  for (const line of lines) {
+    const e = line.curve.episodes;
+    last = Math.max(last, e[e.length - 1]);
+  }
+  if (xMode === "log" && last > points) {
+    // upper edges geometric from 1 to last (duplicates merged), so early episodes stay single
+    const edges = [];
+    for (let b = 1; b <= points; b++) {
+      const edge = Math.ceil(Math.exp((Math.log(last) * b) / points));
+      if (!edges.length || edge > edges[edges.length - 1]) edges.push(edge);
+    }
+    edges[edges.length - 1] = last;
+    const bucketOf = (line, e) => {
+      let lo = 0; let hi = edges.length - 1;
+      while (lo < hi) { const mid = (lo + hi) >> 1; if (edges[mid] >= e) hi = mid; else lo = mid + 1; }
+      return lo;
+    };
+    return { x: edges, bucketOf };
+  }
+  const k = Math.max(1, Math.ceil(last / points));
+  const n = Math.ceil(last / k);
+  const x = Array.from({ length: n }, (_, b) => (b * k + 1 + Math.min(last, (b + 1) * k)) / 2);
+  return { x, bucketOf: (line, e) => Math.floor((e - 1) / k) };
+}
+
+/**
+ * One line's curve averaged into the axis's ``n`` buckets: per bucket the mean of its means and
+ * of its stds, its lowest min, highest max and fewest count (null where a bucket holds no
+ * episode, or the curve has no counts); ``most``: the most experiments any episode averages.
+ */
+export function bucketCurve(line, n, bucketOf) {
+  const c = line.curve;
+  const sum = new Float64Array(n); const sd = new Float64Array(n); const cnt = new Uint32Array(n);
+  const lo = new Float64Array(n).fill(Infinity); const hi = new Float64Array(n).fill(-Infinity);
+  const count = new Array(n).fill(null);
+  let most = 0;
+  for (let i = 0; i < c.episodes.length; i++) {
+    const b = bucketOf(line, c.episodes[i]);
+    sum[b] += c.mean[i]; sd[b] += c.std[i] || 0; cnt[b] += 1;
+    lo[b] = Math.min(lo[b], c.min[i]); hi[b] = Math.max(hi[b], c.max[i]);
+    const k = c.count && c.count[i] !== undefined ? c.count[i] : null;
+    if (k !== null) { count[b] = count[b] === null ? k : Math.min(count[b], k); most = Math.max(most, k); }
+  }
+  const out = { mean: [], std: [], min: [], max: [], count, most };
+  for (let b = 0; b < n; b++) {
+    const some = cnt[b] > 0;
+    out.mean.push(some ? sum[b] / cnt[b] : null);
+    out.std.push(some ? sd[b] / cnt[b] : null);
+    out.min.push(some ? lo[b] : null);
+    out.max.push(some ? hi[b] : null);
+  }
+  return out;
+}

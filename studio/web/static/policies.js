@@ -1,0 +1,128 @@
+/* Teach Studio page: policies: the list, watching one in the scene, uploads, and the export buttons. */
+
+import { api, download, guarded, uploadChosen } from "./api.js";
+import { runLabel } from "./chart.js";
+import { $, confirmDialog, el, emptyRow, enc, fillSelect, flashRow, setText, showError } from "./dom.js";
+import { S } from "./state.js";
+
+export async function loadPolicies() {
+  await guarded("policies-error", async () => {
+    S.policies = await api("GET", "/api/policies");
+    renderPolicies();
+    renderWatchChoices();
+  });
+}
+
+// One name per policy: a run's policy goes by its run's label (as in the runs list), an
+// uploaded one by its file name.
+function policyLabel(p) {
+  const run = p.source === "run" && p.run ? S.runs.find((r) => r.id === p.run) : null;
+  return run ? runLabel(run) : p.name;
+}
+
+function policyKey(p) {
+  return p.source === "run" && p.run ? `run:${p.run}` : `policy:${p.name}`;
+}
+
+// What a policy acts on, from its listing's task: the paper's grid or the continuous joints.
+function policyTask(p) {
+  const t = p.task || {};
+  if (t.kind === "arm-grid") return `grid ${t.joints}×${t.bins}`;
+  if (t.kind === "arm-reach") return `continuous ${t.joints} joints`;
+  return t.kind || "";
+}
+
+export function renderPolicies() {
+  const body = $("policies-body");
+  if (!S.policies.length) {
+    body.replaceChildren(emptyRow(4, "No policies: finish a run, or upload a .policy.npz."));
+    return;
+  }
+  body.replaceChildren(...S.policies.map((p) => {
+    const label = policyLabel(p);
+    const what = p.error
+      ? el("span", { class: "badge failed", text: "unreadable", title: p.error, testid: "policy-damaged" })
+      : el("span", { title: policyTask(p), text: `${p.planning} · ${policyTask(p)}` });
+    return el("tr", { "data-name": p.name, "data-key": policyKey(p), testid: "policy-row", title: p.error || "" },
+      el("td", { class: "name", title: [label, p.run && `run ${p.run}`, p.notes].filter(Boolean).join("\n"), text: label }),
+      el("td", { testid: "policy-task" }, what),
+      el("td", { class: "muted", title: p.run || "", text: p.source === "run" ? "run" : "upload" }),
+      el("td", { class: "actions" },
+        p.error ? null : el("button", { class: "icon", title: "watch", testid: "policy-watch", onclick: () => { selectWatch(p); watch(); } }, "▶"),
+        p.source === "upload" ? el("button", { class: "icon", title: "delete", testid: "policy-delete", onclick: () => deletePolicy(p.name) }, "✕") : null,
+      ),
+    );
+  }));
+}
+
+function selectWatch(p) {
+  $("watch-policy").value = policyKey(p);
+}
+
+export function renderWatchChoices() {
+  const items = [];
+  const seenRuns = new Set();
+  for (const r of S.runs) {
+    if (r.has_policy) { items.push([`run:${r.id}`, `run ${runLabel(r)}`]); seenRuns.add(r.id); }
+  }
+  for (const p of S.policies) {
+    if ((p.source === "run" && p.run && seenRuns.has(p.run)) || p.error) continue;
+    items.push([policyKey(p), `${p.source === "upload" ? "file" : "run"} ${policyLabel(p)}`]);
+  }
+  if (!items.length) items.push(["", "(no policy yet)"]);
+  fillSelect($("watch-policy"), items);
+}
+
+function watchTarget() {
+  const v = $("watch-policy").value;
+  if (!v) return null;
+  const i = v.indexOf(":");
+  return { type: v.slice(0, i), id: v.slice(i + 1) };
+}
+
+export async function watch() {
+  const t = watchTarget();
+  if (!t) { showError("watch-error", "There is no policy to watch yet: train a run to the end, or upload a policy file."); return; }
+  const body = { start: $("watch-start").value };
+  if (t.type === "run") body.run = t.id; else body.policy = t.id;
+  if ($("watch-seed").value !== "") body.seed = Number($("watch-seed").value);
+  setText("watch-result", "");
+  await guarded("watch-error", async () => {
+    const w = await api("POST", "/api/watch", body);
+    const secs = w.times && w.times.length ? w.times[w.times.length - 1] : 0;
+    const from = w.seed == null ? "from the current pose" : `from a random start (seed ${w.seed})`;
+    setText("watch-result", `${w.steps} steps, ${secs.toFixed(1)} s ${from} — ${w.reached_goal ? "reaches the goal" : "does not reach the goal"}`);
+    S.watchedRun = t;
+  }, $("watch-go"));
+}
+
+async function deletePolicy(name) {
+  if (!(await confirmDialog(`Delete the uploaded policy ${name}?`))) return;
+  await guarded("policies-error", async () => {
+    await api("DELETE", `/api/policies/${enc(name)}`);
+    await loadPolicies();
+  });
+}
+
+export async function uploadPolicy(input) {
+  await uploadChosen(input, "/api/policies", "policies-error", async (p) => {
+    await loadPolicies();
+    if (p) { selectWatch(p); flashRow("policies-body", p.name); }
+  });
+}
+
+export function exportFile(kind) {
+  const t = watchTarget();
+  if (!t) { showError("export-error", "Choose a run or a policy first."); return; }
+  if (kind === "rollout") { // the selected policy's rollout as last watched, named after it
+    return download(`/api/watch/trajectory.csv?${t.type === "run" ? "run" : "policy"}=${enc(t.id)}`, `${t.id}.rollout.csv`, "export-error");
+  }
+  if (kind === "policy") {
+    if (t.type === "run") return download(`/api/runs/${enc(t.id)}/policy`, `${t.id}.policy.npz`, "export-error");
+    return download(`/api/policies/${enc(t.id)}/file`, `${t.id}.policy.npz`, "export-error");
+  }
+  if (t.type !== "run") { showError("export-error", "Curves and plots belong to a training run; choose a run, not an uploaded file."); return; }
+  const path = { curve: "curve.csv", png: "plot.png", svg: "plot.svg" }[kind];
+  const query = kind === "curve" ? "" : `?log=${$("curve-log").checked}`;
+  return download(`/api/runs/${enc(t.id)}/${path}${query}`, `${t.id}-${path}`, "export-error");
+}

@@ -1,0 +1,109 @@
+/* Teach Studio page: the live source: its status line, the source form, playback, the simulator's reach. */
+
+import { api, guarded } from "./api.js";
+import { $, fmt, setProp, setText, showError } from "./dom.js";
+import { S } from "./state.js";
+
+export function renderSource() {
+  const s = S.source;
+  if (!s) return;
+  setText("top-source-kind", s.kind ? (s.kind === "recording" ? `recording ${s.recording || ""}` : s.kind) : "none");
+  setText("top-rate", fmt(s.rate_hz, 0));
+  setText("top-dropped", s.dropped ?? "–");
+  setText("src-running", s.running ? "yes" : "no");
+  setText("src-rate", fmt(s.rate_hz, 1));
+  setText("src-frames", s.frames ?? "–");
+  setText("src-dropped", s.dropped ?? "–");
+  setText("src-residual", fmt(s.fit_residual_mm, 1));
+  setText("src-q", (s.q_robot || []).map((v) => ((v * 180) / Math.PI).toFixed(0).padStart(4)).join(" ") + " °");
+  // The source's own trouble (no device, a dropped bridge) stays apart from a refused action.
+  showError("source-status-error", s.error ? `Source: ${s.error}` : null);
+  const rejected = s.rejected ? `${s.rejected} datagram${s.rejected === 1 ? "" : "s"} rejected` : "";
+  const warning = [s.warning, rejected].filter(Boolean).join(" · ");
+  setProp("source-warning", "hidden", !warning);
+  setText("source-warning", warning);
+  if (document.activeElement !== $("retarget-mode") && s.retarget) setProp("retarget-mode", "value", s.retarget.mode);
+  if (s.retarget) setProp("retarget-mirror", "checked", !!s.retarget.mirror);
+  const pb = s.playback;
+  setProp("playback", "hidden", !(s.kind === "recording" && pb));
+  if (pb) {
+    setText("playback-toggle", pb.playing ? "❚❚" : "▶");
+    setProp($("playback-toggle").dataset, "playing", pb.playing ? "1" : "0");
+    const seek = $("playback-seek");
+    setProp(seek, "max", String(Math.max(pb.duration, 0.01)));
+    if (!seek.dataset.dragging) setProp(seek, "value", String(pb.t));
+    setText("playback-time", `${pb.t.toFixed(1)} / ${pb.duration.toFixed(1)} s`);
+    if (document.activeElement !== $("playback-speed")) {
+      const sp = String(pb.speed);
+      if ([...$("playback-speed").options].some((o) => o.value === sp)) setProp("playback-speed", "value", sp);
+    }
+    if (!$("playback-loop").dataset.pending) setProp("playback-loop", "checked", !!pb.loop);
+  }
+  // The capture button and the mark button follow it (wired in main.js), then camera.js.
+  document.dispatchEvent(new CustomEvent("studio:source", { detail: s }));
+}
+
+export function syncKindOptions() {
+  const kind = $("source-kind").value;
+  for (const e of document.querySelectorAll(".kind-opt")) e.hidden = !e.dataset.kind.split(" ").includes(kind);
+}
+
+export async function applySource() {
+  const kind = $("source-kind").value;
+  const body = { kind };
+  if (kind === "recording") {
+    body.recording = $("source-recording").value;
+    if (!body.recording) { showError("source-error", "Choose a recording first (or upload one under Record)."); return; }
+    body.speed = Number($("playback-speed").value);
+    body.loop = $("playback-loop").checked;
+  } else if (kind === "network") {
+    if ($("source-port").value !== "") body.port = Number($("source-port").value);
+  } else if (kind === "serial") {
+    body.device = $("source-device").value.trim();
+    if ($("source-calibration").value.trim()) body.calibration = $("source-calibration").value.trim();
+  } else if (kind === "camera" || kind === "hand") {
+    body.side = $("source-side").value;
+  } else if ($("source-seed").value !== "") {
+    body.seed = Number($("source-seed").value);
+  }
+  const switched = await guarded("source-error", async () => {
+    S.source = await api("PUT", "/api/source", body);
+    renderSource();
+    return true;
+  }, $("source-apply"));
+  // A refused switch changed nothing on the server: the selector goes back to the source that
+  // still runs, so the page never names one source while another one feeds it.
+  if (!switched && S.source && S.source.kind) {
+    setProp("source-kind", "value", S.source.kind);
+    syncKindOptions();
+  }
+}
+
+export async function simulatorReach(action) {
+  const body = { action };
+  if (action === "reach") {
+    const f = $("train-form").elements;
+    body.goal_deg = [Number(f.goal0.value), Number(f.goal1.value), Number(f.goal2.value)];
+  }
+  await guarded("source-error", async () => {
+    S.source = await api("POST", "/api/source/reach", body);
+    renderSource();
+  }, $(action === "reach" ? "source-reach" : "source-wander"));
+}
+
+export async function playback(action, extra = {}) {
+  await guarded("source-error", async () => {
+    S.source = await api("POST", "/api/source/playback", { action, ...extra });
+    renderSource();
+  });
+}
+
+export async function setRetarget() {
+  await guarded("source-error", async () => {
+    S.source = await api("PUT", "/api/source/retarget", {
+      mode: $("retarget-mode").value,
+      mirror: $("retarget-mirror").checked,
+    });
+    renderSource();
+  });
+}

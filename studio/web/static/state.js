@@ -1,0 +1,24 @@
+/* Teach Studio page: the page's one state, `window.studio` (the browser tests and the console read it). */
+
+export const S = {
+  config: null,
+  source: null,
+  capture: null,
+  recordings: [],
+  demos: [],
+  runs: [],
+  sweeps: [], // `studio sweep` summaries (GET /api/sweeps); their trials are runs of a group
+  openSweeps: new Set(), // sweep ids unfolded in the run list (table, figure, runs)
+  policies: [],
+  curves: new Map(), // run id -> {episodes, mean, std, min, max, count}
+  shown: new Set(), // run ids plotted
+  shownTouched: false, // the user changed which runs are plotted
+  marking: false,
+  watchedRun: null,
+  curveDirty: true,
+  softwareScene: false, // WebGL is drawn in software here: the scene gets a lower resolution
+};
+window.studio = S; // for the browser tests and for poking around in the console
+
+/** The chart redraws with the next live frame (events.js, renderLive). */
+export function markCurvesDirty() { S.curveDirty = true; }

@@ -1,0 +1,117 @@
+/* Teach Studio page: the train form: the learning package's defaults, its problems by field, starting a run. */
+
+import { ApiError, api } from "./api.js";
+import { emptyCurve } from "./curves.js";
+import { $, el, showError } from "./dom.js";
+import { renderRuns, upsertRun } from "./runs.js";
+import { S, markCurvesDirty } from "./state.js";
+
+/** Form inputs of a field the API names (the goal is three inputs). */
+const TRAIN_INPUTS = { goal_deg: ["goal0", "goal1", "goal2"] };
+
+/** Fill the train form with the learning package's defaults (served by /api/config). */
+export function resetTrainForm() {
+  showTrainErrors(null);
+  const defaults = S.config && S.config.training;
+  if (!defaults) return;
+  const f = $("train-form");
+  const planners = S.config.planners || [defaults.planning];
+  f.elements.planning.replaceChildren(...planners.map((p) => el("option", { value: p, text: p })));
+  for (const [k, v] of Object.entries(defaults)) {
+    if (k === "goal_deg") v.forEach((g, i) => { f.elements[`goal${i}`].value = String(g); });
+    else if (f.elements[k] && !(f.elements[k] instanceof RadioNodeList)) f.elements[k].value = v == null ? "" : String(v);
+  }
+}
+
+/** Show every problem of a refused run beside the form, and mark each bad field (null clears). */
+function showTrainErrors(err) {
+  const f = $("train-form");
+  for (const input of f.querySelectorAll(".bad")) {
+    input.classList.remove("bad");
+    input.removeAttribute("aria-invalid");
+    input.removeAttribute("title");
+  }
+  const box = $("train-error");
+  if (!err) { showError("train-error", null); return; }
+  const data = err.data || {};
+  const problems = data.problems && data.problems.length ? data.problems : [err.message || String(err)];
+  box.replaceChildren(...problems.map((p) => el("div", { testid: "train-problem", text: p })));
+  box.hidden = false;
+  for (const [field, text] of Object.entries(data.by_field || {})) {
+    for (const name of TRAIN_INPUTS[field] || [field]) {
+      const input = f.elements[name];
+      if (!input || !input.classList) continue;
+      input.classList.add("bad");
+      input.setAttribute("aria-invalid", "true");
+      input.setAttribute("title", text);
+    }
+  }
+}
+
+/** Continuous-task fields of the train form (shown only for that task). */
+const REACH_FIELDS = ["joints", "step_deg", "tilings", "tiles"];
+
+/** Show the fields of the chosen task; empty continuous-task fields take /api/config's defaults. */
+export function syncTaskFields() {
+  const f = $("train-form");
+  const reach = f.elements.task.value === "arm-reach";
+  for (const label of f.querySelectorAll(".reach-only")) label.hidden = !reach;
+  f.elements.bins.closest("label").hidden = reach;
+  const defaults = (S.config && S.config.training) || {};
+  for (const k of REACH_FIELDS) {
+    if (f.elements[k].value === "" && defaults[k] != null) f.elements[k].value = String(defaults[k]);
+  }
+}
+
+function readTrainForm() {
+  const f = $("train-form").elements;
+  const empty = [];
+  const num = (k) => {
+    const raw = f[k].value.trim();
+    if (raw === "") empty.push(k);
+    return Number(raw);
+  };
+  const body = {
+    planning: f.planning.value,
+    planning_steps: num("planning_steps"),
+    epsilon: num("epsilon"),
+    alpha: num("alpha"),
+    gamma: num("gamma"),
+    episodes: num("episodes"),
+    experiments: num("experiments"),
+    bins: num("bins"),
+    task: f.task.value,
+    seed: num("seed"),
+    goal_deg: [num("goal0"), num("goal1"), num("goal2")],
+    demonstrations: [...$("train-demos").querySelectorAll("input:checked")].map((i) => i.value),
+  };
+  if (empty.length) {
+    const problems = empty.map((k) => `${k.replace("_", " ")} is empty; enter a number.`);
+    const err = new ApiError(problems.join(" "));
+    err.data = { problems, by_field: Object.fromEntries(empty.map((k, i) => [k, problems[i]])) };
+    throw err;
+  }
+  if (body.task === "arm-reach") for (const k of REACH_FIELDS) body[k] = num(k);
+  if (f.name.value.trim()) body.name = f.name.value.trim();
+  return body;
+}
+
+export async function startRun(ev) {
+  ev.preventDefault();
+  showTrainErrors(null);
+  const button = $("train-start");
+  button.disabled = true;
+  try {
+    const run = await api("POST", "/api/runs", readTrainForm());
+    upsertRun(run);
+    if (!S.shown.has(run.id)) S.shown.add(run.id);
+    S.curves.set(run.id, emptyCurve());
+    renderRuns();
+    markCurvesDirty();
+  } catch (e) {
+    showTrainErrors(e);
+    if (!(e instanceof ApiError)) console.error(e);
+  } finally {
+    button.disabled = false;
+  }
+}

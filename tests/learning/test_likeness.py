@@ -1,0 +1,243 @@
+"""Likeness metrics: exact small cases, the issue's sanity laws, and the card's two columns."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from studio.learning import (
+    LearningError,
+    LikenessCard,
+    dtw_distance,
+    frechet_distance,
+    joint_shares,
+    js_divergence,
+    ldlj,
+    likeness_card,
+    moving_together,
+)
+
+
+def min_jerk(u: np.ndarray) -> np.ndarray:
+    return u**3 * (10.0 - 15.0 * u + 6.0 * u**2)
+
+
+START = np.array([0.0, 0.2, -0.4])
+END = np.array([1.0, -0.3, 0.5])
+
+
+def reach(n: int = 200, duration: float = 2.0, warp: float = 1.0):
+    """A minimum-jerk reach from START to END, sampled at ``u**warp`` of the way in time."""
+    u = np.linspace(0.0, 1.0, n) ** warp
+    return np.linspace(0.0, duration, n), START + min_jerk(u)[:, None] * (END - START)
+
+
+def staircase(n_per_joint: int = 10, duration: float = 2.0):
+    """The same start and end, one joint at a time in small constant-speed steps with stops."""
+    points = [START.copy()]
+    for j in range(3):
+        for k in range(1, n_per_joint + 1):
+            step = points[-1].copy()
+            step[j] = START[j] + (END[j] - START[j]) * k / n_per_joint
+            points += [step, step.copy()]  # move, then stop for as long
+    q = np.repeat(np.array(points), 5, axis=0)
+    for j in range(3):  # linear ramps between the held points (no teleporting)
+        q[:, j] = np.convolve(np.pad(q[:, j], 2, mode="edge"), np.ones(5) / 5, mode="valid")
+    return np.linspace(0.0, duration, len(q)), q
+
+
+def test_dtw_exact_small_cases():
+    assert dtw_distance([0.0, 1.0, 2.0], [0.0, 0.0, 1.0, 2.0]) == 0.0
+    # pairs (0,0), (1,1): costs 0 and 1 over 2 pairs
+    assert dtw_distance([[0.0], [1.0]], [[0.0], [2.0]]) == pytest.approx(0.5)
+    # 2-D: a constant offset of (3, 4) is 5 per pair
+    a = np.array([[0.0, 0.0], [1.0, 1.0], [2.0, 2.0]])
+    assert dtw_distance(a, a + [3.0, 4.0]) == pytest.approx(5.0)
+
+
+def test_dtw_of_a_time_warped_copy_is_below_a_hundredth_of_a_radian():
+    _, q = reach()
+    _, warped = reach(warp=1.6)
+    _, slower = reach(n=350)
+    assert dtw_distance(q, warped) < 0.01
+    assert dtw_distance(q, slower) < 0.01
+    # and it does see a different path
+    assert dtw_distance(q, q + 0.1) > 0.1
+
+
+def test_frechet_exact_small_cases():
+    assert frechet_distance([[0, 0], [1, 0]], [[0, 1], [1, 1]]) == pytest.approx(1.0)
+    # the leash must span the far detour of the second path
+    assert frechet_distance([[0, 0], [2, 0]], [[0, 0], [1, 3], [2, 0]]) == pytest.approx(
+        math.hypot(1, 3)
+    )
+    path = np.random.default_rng(0).normal(size=(20, 3))
+    assert frechet_distance(path, path) == 0.0
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.integers(2, 15), st.integers(2, 15), st.integers(0, 10_000))
+def test_frechet_bounds_dtw_and_endpoints(n, m, seed):
+    rng = np.random.default_rng(seed)
+    a, b = rng.normal(size=(n, 2)), rng.normal(size=(m, 2))
+    d = frechet_distance(a, b)
+    ends = max(np.linalg.norm(a[0] - b[0]), np.linalg.norm(a[-1] - b[-1]))
+    assert d >= ends - 1e-12  # both walkers start and end together
+    assert dtw_distance(a, b) <= d + 1e-12  # a mean along a coupling <= its max
+    assert frechet_distance(b, a) == pytest.approx(d)
+
+
+def reference_dtw(a: np.ndarray, b: np.ndarray) -> float:
+    """Every monotone alignment's total and length by plain recursion over the full table."""
+    n, m = len(a), len(b)
+    best: dict[tuple[int, int], tuple[float, int]] = {(0, 0): (np.linalg.norm(a[0] - b[0]), 1)}
+    for i in range(n):
+        for j in range(m):
+            if (i, j) == (0, 0):
+                continue
+            before = [best[p] for p in ((i - 1, j - 1), (i - 1, j), (i, j - 1)) if min(p) >= 0]
+            total, steps = min(before, key=lambda x: x[0])
+            best[i, j] = (total + np.linalg.norm(a[i] - b[j]), steps + 1)
+    total, steps = best[n - 1, m - 1]
+    return total / steps
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.integers(1, 9), st.integers(1, 9), st.integers(0, 10_000))
+def test_dtw_matches_the_full_table_recursion(n, m, seed):
+    rng = np.random.default_rng(seed)
+    a, b = rng.normal(size=(n, 2)), rng.normal(size=(m, 2))
+    assert dtw_distance(a, b) == pytest.approx(reference_dtw(a, b))
+
+
+def test_js_divergence_exact_small_cases():
+    assert js_divergence([1, 0], [0, 1]) == pytest.approx(1.0)
+    assert js_divergence([0.3, 0.7], [0.3, 0.7]) == 0.0
+    # p = (1, 0), q = (1/2, 1/2): m = (3/4, 1/4)
+    expected = 0.5 * math.log2(4 / 3) + 0.5 * (0.5 * math.log2(2 / 3) + 0.5 * math.log2(2))
+    assert js_divergence([1, 0], [0.5, 0.5]) == pytest.approx(expected)
+    assert math.isnan(js_divergence([0, 0], [1, 0]))
+    with pytest.raises(LearningError, match="same length"):
+        js_divergence([1, 0], [1, 0, 0])
+
+
+def test_minimum_jerk_is_smoother_than_a_staircase_between_the_same_points():
+    t, q = reach()
+    ts, qs = staircase()
+    np.testing.assert_allclose(qs[0], q[0])
+    np.testing.assert_allclose(qs[-1], q[-1])
+    smooth, stairs = ldlj(t, q), ldlj(ts, qs)
+    assert smooth > stairs + 3
+    # the published value for a minimum-jerk reach: -ln(720 / 1.875^2) = -5.24
+    assert smooth == pytest.approx(-math.log(720 / 1.875**2), abs=0.1)
+
+
+def test_ldlj_does_not_depend_on_amplitude_or_duration():
+    t, q = reach()
+    assert ldlj(t * 3, q * 0.1) == pytest.approx(ldlj(t, q))
+    assert math.isnan(ldlj(t, np.zeros_like(q)))
+
+
+def test_joint_shares_and_moving_together():
+    t, q = reach()
+    shares = joint_shares(q)
+    np.testing.assert_allclose(shares, np.abs(END - START) / np.abs(END - START).sum())
+    assert moving_together(t, q) > 0.9
+    ts, qs = staircase()
+    assert moving_together(ts, qs) < 0.1  # one joint at a time
+
+
+def fake_tool(q: np.ndarray) -> np.ndarray:
+    """A stand-in forward kinematics: the first three joints are the position."""
+    return np.asarray(q)[:, :3]
+
+
+def test_the_card_holds_the_policy_and_the_demonstration_side_by_side():
+    t, q = reach()
+    ts, qs = staircase()
+    card = likeness_card(ts, qs, t, q, fake_tool)
+    assert isinstance(card, LikenessCard)
+    assert card.demonstration.ldlj == pytest.approx(ldlj(t, q))
+    assert card.policy.ldlj == pytest.approx(ldlj(ts, qs))
+    assert card.dtw_rad == pytest.approx(dtw_distance(qs, q))
+    assert card.frechet_m == pytest.approx(frechet_distance(qs, q))
+    assert card.policy.duration_s == pytest.approx(2.0)
+    data = json.loads(json.dumps(card.to_dict()))
+    assert set(data) == {"dtw_rad", "frechet_m", "shares_js", "policy", "demonstration"}
+    assert data["policy"]["ldlj"] < data["demonstration"]["ldlj"]
+    text = card.text()
+    assert "DTW" in text and "LDLJ" in text and "demonstration" in text
+    # the same motion is its own perfect likeness
+    same = likeness_card(t, q, t, q, fake_tool)
+    assert same.dtw_rad == 0.0 and same.frechet_m == 0.0 and same.shares_js == 0.0
+
+
+def test_the_card_compares_only_the_learned_joints_when_asked():
+    t, q = reach()
+    noisy = q.copy()
+    noisy[:, 2] += 0.2 * np.sin(np.arange(len(t)))
+    card = likeness_card(t, noisy, t, q, fake_tool, joints=2)
+    assert card.dtw_rad == 0.0
+    assert len(card.policy.joint_shares) == 2
+    assert card.frechet_m > 0  # the tool still sees every joint
+
+
+def test_a_motionless_policy_gives_null_smoothness_not_an_error():
+    t, q = reach()
+    still = np.tile(q[0], (len(t), 1))
+    data = likeness_card(t, still, t, q, fake_tool).to_dict()
+    assert data["policy"]["ldlj"] is None and data["shares_js"] is None
+
+
+def test_bad_input_gets_one_sentence():
+    t, q = reach()
+    with pytest.raises(LearningError, match="same joints"):
+        likeness_card(t, q[:, :2], t, q, fake_tool)
+    with pytest.raises(LearningError, match="increasing time"):
+        likeness_card(t[::-1], q, t, q, fake_tool)
+    bad = q.copy()
+    bad[3, 1] = np.nan
+    with pytest.raises(LearningError, match="finite"):
+        dtw_distance(bad, q)
+
+
+def test_every_policy_kind_gets_a_card_from_the_demonstrations_start(tmp_path):
+    from studio.capture import load_demonstration
+    from studio.learning import (
+        ArmReach,
+        DynaQConfig,
+        TilePolicyFile,
+        fit_dmp_policy,
+        load_policy,
+        policy_likeness_card,
+        save_policy,
+    )
+    from studio.samples import __file__ as samples
+
+    demo = load_demonstration(Path(samples).parent / "sample-reach-2.demo.json")
+    grid = demo.arm_grid()
+    q_table = np.zeros((grid.n_states, grid.n_actions))
+    save_policy(tmp_path / "grid.policy.npz", grid, q_table, DynaQConfig())
+    task = ArmReach(joints=3)
+    coding = task.features(tilings=2, tiles=4)
+    coder = coding.bind(task.lower, task.upper)
+    tile = TilePolicyFile(
+        coder=coder, weights=np.zeros((coder.size, task.n_actions)), config=DynaQConfig(), task=task
+    )
+    dmp = fit_dmp_policy(demo.times, demo.q_robot, learned_joints=3)
+    for policy in (load_policy(tmp_path / "grid.policy.npz"), tile, dmp):
+        card = policy_likeness_card(policy, demo.times, demo.q_robot)
+        assert len(card.policy.joint_shares) == 3 == len(card.demonstration.joint_shares)
+        assert card.demonstration.duration_s == pytest.approx(demo.times[-1] - demo.times[0])
+        assert math.isfinite(card.dtw_rad) and math.isfinite(card.frechet_m)
+    # the primitive is far more like its demonstration than an untrained tile policy
+    assert policy_likeness_card(dmp, demo.times, demo.q_robot).dtw_rad < 0.02
+    assert policy_likeness_card(tile, demo.times, demo.q_robot).dtw_rad > 0.1
+    with pytest.raises(LearningError, match=r"\(N, 6\)"):
+        policy_likeness_card(dmp, demo.times, demo.q_robot[:, :3])
