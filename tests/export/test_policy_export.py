@@ -52,3 +52,20 @@ def test_a_policy_for_another_robot_is_refused(policy, tmp_path, capsys):
     err = capsys.readouterr().err.strip()
     assert "was learnt on the Puma560 (the paper's robot)" in err and "\n" not in err
     assert not out.exists()
+
+
+def test_a_movement_primitive_exports_timed_and_checked(tmp_path, capsys):
+    from studio.capture import load_demonstration
+    from studio.learning import fit_dmp_policy, save_dmp_policy
+    from studio.samples import SAMPLES_DIR
+
+    demo = load_demonstration(SAMPLES_DIR / "sample-reach-2.demo.json")
+    path = tmp_path / "dmp.policy.npz"
+    save_dmp_policy(path, fit_dmp_policy(demo.times, demo.q_robot, learned_joints=3))
+    out = tmp_path / "dmp.csv"
+    assert main(["export", str(path), "--format", "csv", "--out", str(out)]) == 0
+    said = capsys.readouterr().out
+    assert said.startswith("the movement primitive") and "passed the safety checks" in said
+    header, rows = read_csv(out)
+    assert header == ["time", *load_robot("puma560").joint_names]
+    assert np.allclose(rows[0, 1:], demo.q_robot[0], atol=1e-6)  # from the demonstration's start
