@@ -18,6 +18,7 @@ PACKAGES = (
     "studio.learning",
     "studio.web",
     "studio.samples",
+    "studio.export",
 )
 OWNER = re.compile(r"`(studio\.[a-z]+)(?:\.([\w.]+))?`(?: \(([^)|]*)\))?")
 

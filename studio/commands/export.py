@@ -1,13 +1,38 @@
-"""``studio export``: a policy file's greedy rollout as a joint trajectory CSV (time, q1..q6)."""
+"""``studio export``: a policy, a demonstration or a recording as a robot's joint trajectory.
+
+``studio export SOURCE --robot NAME --format csv|mcap|lerobot --out PATH`` times the motion
+(TOPP-RA, within the robot's limits), checks it (positions, velocities, accelerations,
+self-collision) and writes it; the :mod:`studio.export` package does all three. ``SOURCE`` is a
+path, or a name in the data folder or among the shipped samples (``sample-reach-1``).
+
+``studio export POLICY`` alone (no ``--format``, ``--robot`` nor ``--unchecked``) writes the
+policy's greedy rollout at its own pace as before: ``time,q1..q6`` CSV, not checked.
+"""
 
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 
 import numpy as np
 
+from studio.capture import DEMO_SUFFIX, RECORDING_SUFFIXES
+from studio.export import (
+    FORMAT_SUFFIXES,
+    FORMATS,
+    LIMIT_FRACTION,
+    Motion,
+    check_policy_robot,
+    demonstration_motion,
+    export_motion,
+    find_source,
+    recording_motion,
+    source_kind,
+)
+from studio.kinematics import robot_names
 from studio.learning import (
+    POLICY_SUFFIX,
     ROLLOUT_MAX_STEPS,
     ROLLOUT_RATE_HZ,
     ROLLOUT_SECONDS_PER_STEP,
@@ -15,6 +40,7 @@ from studio.learning import (
     TILE_ROLLOUT_SECONDS_PER_STEP,
     DmpPolicyFile,
     LearningError,
+    PolicyFile,
     TilePolicyFile,
     dmp_likeness_card,
     greedy_path,
@@ -26,13 +52,43 @@ from studio.learning import (
 )
 
 NAME = "export"
-HELP = "Roll a policy file out greedily from a start pose and write the joint trajectory as CSV."
+HELP = "Export a policy, demonstration or recording as a robot trajectory checked for safety (CSV, MCAP, LeRobot)."
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
-        "policy", type=Path, help="a .policy.npz file (from studio train or the page)"
+        "policy",
+        metavar="SOURCE",
+        type=Path,
+        help="a policy (.policy.npz), a demonstration (.demo.json) or a recording, by path or by "
+        "name in the data folder or among the samples (sample-reach-1)",
     )
+    parser.add_argument(
+        "--robot",
+        help="the robot to export for (default: puma560; `studio robots` lists them); a "
+        "recording or demonstration retargets to any, a policy drives its own",
+    )
+    parser.add_argument(
+        "--format",
+        choices=FORMATS,
+        help="csv (time,<joint names>), mcap (ROS 2 messages) or lerobot (a LeRobotDataset "
+        "v3.0 folder); without it and --robot, a policy's rollout is written as before",
+    )
+    parser.add_argument(
+        "--unchecked",
+        action="store_true",
+        help="write even when the safety checks find problems, stating them in the file",
+    )
+    parser.add_argument(
+        "--limit-fraction",
+        type=float,
+        default=LIMIT_FRACTION,
+        help=f"share of the velocity and acceleration limits the timing uses (default: {LIMIT_FRACTION:g})",
+    )
+    parser.add_argument(
+        "--data-dir", type=Path, default=Path("."), help="data folder names are looked up in"
+    )
+    parser.add_argument("--task", default="", help="LeRobot task text (default: from the source)")
     start = parser.add_mutually_exclusive_group()
     start.add_argument("--start-state", type=int, help="grid state number to start from")
     start.add_argument(
@@ -43,13 +99,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--rate",
         type=float,
         default=ROLLOUT_RATE_HZ,
-        help=f"control rate in Hz (default: {ROLLOUT_RATE_HZ:g})",
+        help=f"control rate in Hz of a policy or demonstration (default: {ROLLOUT_RATE_HZ:g}); a recording keeps its capture rate",
     )
     parser.add_argument(
         "--seconds-per-step",
         type=float,
         default=None,
-        help=f"seconds per step (default: {ROLLOUT_SECONDS_PER_STEP:g} per grid step, {TILE_ROLLOUT_SECONDS_PER_STEP:g} per joint step of a tile-coded policy)",
+        help=f"seconds per step of a policy (default: {ROLLOUT_SECONDS_PER_STEP:g} per grid step, {TILE_ROLLOUT_SECONDS_PER_STEP:g} per joint step of a tile-coded policy; with --format, default: timed within the robot's limits)",
     )
     parser.add_argument(
         "--max-steps",
@@ -58,7 +114,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help=f"cap on greedy steps (default: {ROLLOUT_MAX_STEPS} grid steps, {TILE_ROLLOUT_MAX_STEPS} joint steps)",
     )
     parser.add_argument(
-        "--out", type=Path, help="CSV path (default: the policy's name with .rollout.csv)"
+        "--out",
+        type=Path,
+        help="the file (a folder for lerobot); default: next to a policy, <name>.rollout.csv; "
+        "with --format or --robot, <name>.<robot>.csv, .mcap or .lerobot in the current folder",
     )
 
 
@@ -84,8 +143,10 @@ def _out_path(args: argparse.Namespace) -> Path:
     )
 
 
-def _run_tile(args: argparse.Namespace, policy: TilePolicyFile) -> int:
-    """Roll out a tile-coded arm policy from --start-deg (joint steps, constant speed)."""
+def _rollout_tile(
+    args: argparse.Namespace, policy: TilePolicyFile, seconds_per_step: float | None
+) -> tuple[np.ndarray, np.ndarray, str]:
+    """A tile-coded arm policy's rollout from --start-deg (joint steps, constant speed)."""
     if args.start_state is not None:
         raise LearningError(
             "--start-state numbers grid states; a tile-coded policy starts from --start-deg angles."
@@ -98,24 +159,20 @@ def _run_tile(args: argparse.Namespace, policy: TilePolicyFile) -> int:
         rate_hz=args.rate,
         max_steps=TILE_ROLLOUT_MAX_STEPS if args.max_steps is None else args.max_steps,
         seconds_per_step=TILE_ROLLOUT_SECONDS_PER_STEP
-        if args.seconds_per_step is None
-        else args.seconds_per_step,
+        if seconds_per_step is None
+        else seconds_per_step,
     )
-    out = _out_path(args)
-    try:
-        save_trajectory_csv(out, times, q)
-    except OSError as err:
-        raise LearningError(f"Cannot write {out} ({err.strerror}); choose another --out.") from None
-    print(
-        f"the greedy policy {'reaches the goal' if reached else 'does NOT reach the goal'} in {times[-1]:.2f} s; "
-        f"wrote {len(times)} samples at {args.rate:g} Hz to {out}"
+    return (
+        times,
+        q,
+        f"the greedy policy {'reaches the goal' if reached else 'does NOT reach the goal'}",
     )
-    return 0
 
 
-def _run_dmp(args: argparse.Namespace, policy: DmpPolicyFile) -> int:
-    """Roll a movement primitive out from --start-deg (default: its demonstration's start) and
-    print its likeness card (from the demonstration's start) beside the demonstration's."""
+def _rollout_dmp(
+    args: argparse.Namespace, policy: DmpPolicyFile
+) -> tuple[np.ndarray, np.ndarray, str]:
+    """A movement primitive's rollout from --start-deg (default: its demonstration's start)."""
     if args.start_state is not None:
         raise LearningError(
             "--start-state numbers grid states; a movement primitive starts from --start-deg angles."
@@ -126,31 +183,18 @@ def _run_dmp(args: argparse.Namespace, policy: DmpPolicyFile) -> int:
         else np.radians(_start_degrees(args.start_deg, len(policy.goal)))
     )
     times, q, reached = rollout_dmp_policy(policy, start, rate_hz=args.rate)
-    out = _out_path(args)
-    try:
-        save_trajectory_csv(out, times, q)
-    except OSError as err:
-        raise LearningError(f"Cannot write {out} ({err.strerror}); choose another --out.") from None
-    print(
-        f"the movement primitive {'reaches the goal' if reached else 'does NOT reach the goal'} in {times[-1]:.2f} s; "
-        f"wrote {len(times)} samples at {args.rate:g} Hz to {out}"
+    return (
+        times,
+        q,
+        f"the movement primitive {'reaches the goal' if reached else 'does NOT reach the goal'}",
     )
-    print(
-        f"likeness to its demonstration, from the demonstration's start:\n{dmp_likeness_card(policy, args.rate).text()}"
-    )
-    return 0
 
 
-def run(args: argparse.Namespace) -> int:
-    policy = load_any_policy(args.policy)
-    if isinstance(policy, TilePolicyFile):
-        return _run_tile(args, policy)
-    if isinstance(policy, DmpPolicyFile):
-        return _run_dmp(args, policy)
-    if args.max_steps is None:
-        args.max_steps = ROLLOUT_MAX_STEPS
-    if args.seconds_per_step is None:
-        args.seconds_per_step = ROLLOUT_SECONDS_PER_STEP
+def _rollout_grid(
+    args: argparse.Namespace, policy: PolicyFile, seconds_per_step: float | None
+) -> tuple[np.ndarray, np.ndarray, str]:
+    """A grid policy's rollout from --start-state or --start-deg (minimum-jerk grid steps)."""
+    max_steps = ROLLOUT_MAX_STEPS if args.max_steps is None else args.max_steps
     grid = policy.grid
     if args.start_state is not None:
         start = args.start_state
@@ -160,18 +204,99 @@ def run(args: argparse.Namespace) -> int:
         policy,
         start,
         rate_hz=args.rate,
-        max_steps=args.max_steps,
-        seconds_per_step=args.seconds_per_step,
+        max_steps=max_steps,
+        seconds_per_step=ROLLOUT_SECONDS_PER_STEP if seconds_per_step is None else seconds_per_step,
     )
-    path = greedy_path(policy, start, args.max_steps)
+    path = greedy_path(policy, start, max_steps)
+    reached = path[-1] == grid.goal_state
+    return (
+        times,
+        q,
+        (
+            f"{len(path) - 1} grid steps from state {start} "
+            f"{'reach the goal' if reached else 'do NOT reach the goal'}"
+        ),
+    )
+
+
+def _rollout(
+    args: argparse.Namespace,
+    policy: PolicyFile | TilePolicyFile | DmpPolicyFile,
+    seconds_per_step: float | None,
+) -> tuple[np.ndarray, np.ndarray, str]:
+    if isinstance(policy, TilePolicyFile):
+        return _rollout_tile(args, policy, seconds_per_step)
+    if isinstance(policy, DmpPolicyFile):
+        return _rollout_dmp(args, policy)
+    return _rollout_grid(args, policy, seconds_per_step)
+
+
+def _run_legacy(
+    args: argparse.Namespace, policy: PolicyFile | TilePolicyFile | DmpPolicyFile
+) -> int:
+    """``studio export POLICY``: the rollout at the policy's own pace, as CSV ``time,q1..q6``."""
+    times, q, summary = _rollout(args, policy, args.seconds_per_step)
     out = _out_path(args)
     try:
         save_trajectory_csv(out, times, q)
     except OSError as err:
         raise LearningError(f"Cannot write {out} ({err.strerror}); choose another --out.") from None
-    reached = path[-1] == grid.goal_state
-    print(
-        f"{len(path) - 1} grid steps from state {start} {'reach the goal' if reached else 'do NOT reach the goal'}; "
-        f"wrote {len(times)} samples ({times[-1]:.2f} s at {args.rate:g} Hz) to {out}"
+    if isinstance(policy, PolicyFile):
+        print(
+            f"{summary}; wrote {len(times)} samples ({times[-1]:.2f} s at {args.rate:g} Hz) to {out}"
+        )
+    else:
+        print(
+            f"{summary} in {times[-1]:.2f} s; wrote {len(times)} samples at {args.rate:g} Hz to {out}"
+        )
+    if isinstance(policy, DmpPolicyFile):
+        print(
+            f"likeness to its demonstration, from the demonstration's start:\n{dmp_likeness_card(policy, args.rate).text()}"
+        )
+    return 0
+
+
+def _motion(args: argparse.Namespace, source: Path, robot: str) -> tuple[Motion, str]:
+    """The source's motion on ``robot``, and a phrase saying what it is."""
+    kind = source_kind(source)
+    if kind == "recording":
+        return recording_motion(source, robot), "recording"
+    if kind == "demonstration":
+        return demonstration_motion(source, robot, args.rate), "demonstration"
+    arm = check_policy_robot(source, robot)
+    policy = load_any_policy(source)
+    times, q, summary = _rollout(args, policy, args.seconds_per_step)
+    timed = args.seconds_per_step is not None
+    return Motion("policy", source.name, arm, times, q, timed, args.rate), summary
+
+
+def run(args: argparse.Namespace) -> int:
+    legacy = args.format is None and args.robot is None and not args.unchecked
+    if legacy and str(args.policy).endswith(".npz"):
+        return _run_legacy(args, load_any_policy(args.policy))
+    source = find_source(args.policy, args.data_dir)
+    fmt = args.format or "csv"
+    motion, summary = _motion(args, source, args.robot or robot_names()[0])
+    stem = source.name
+    for ending in (POLICY_SUFFIX, DEMO_SUFFIX, *RECORDING_SUFFIXES):
+        stem = stem.removesuffix(ending)
+    # by default in the current folder (a shipped sample's folder is the installed package)
+    out = args.out or Path(f"{stem}.{motion.robot.name}{FORMAT_SUFFIXES[fmt]}")
+    done = export_motion(
+        motion, fmt, out, unchecked=args.unchecked, fraction=args.limit_fraction, task=args.task
     )
+    timing = (
+        "timed within the limits (TOPP-RA)" if done.timed_by == "toppra" else "at its own times"
+    )
+    checks = (
+        "passed the safety checks"
+        if not done.findings
+        else f"NOT safe: {len(done.findings)} finding(s) stated in the file"
+    )
+    print(
+        f"{summary}: {len(done.times)} samples over {done.times[-1]:.2f} s for the "
+        f"{motion.robot.spec.title}, {timing}, {checks}; wrote {fmt} to {out}"
+    )
+    for finding in done.findings:
+        print(f"  {finding.sentence}", file=sys.stderr)
     return 0

@@ -1,0 +1,32 @@
+"""Exports: a policy, a demonstration or a recording as a robot's joint trajectory, checked for
+safety, in the formats robot people use (CSV, MCAP with ROS 2 messages, LeRobotDataset v3.0), and
+a robot's URDF with its meshes.
+
+The public names are listed in ``docs/architecture.md``; the formats in ``studio/export/README.md``.
+"""
+
+from ._errors import ExportError as ExportError
+from ._errors import SafetyError as SafetyError
+from ._export import FORMAT_SUFFIXES as FORMAT_SUFFIXES
+from ._export import FORMATS as FORMATS
+from ._export import Exported as Exported
+from ._export import export_motion as export_motion
+from ._formats import JOINT_STATE as JOINT_STATE
+from ._formats import JOINT_TRAJECTORY as JOINT_TRAJECTORY
+from ._formats import write_csv as write_csv
+from ._formats import write_mcap as write_mcap
+from ._lerobot import CODEBASE_VERSION as CODEBASE_VERSION
+from ._lerobot import write_lerobot as write_lerobot
+from ._safety import COLLISION_MARGIN_M as COLLISION_MARGIN_M
+from ._safety import Finding as Finding
+from ._safety import check_trajectory as check_trajectory
+from ._sources import Motion as Motion
+from ._sources import check_policy_robot as check_policy_robot
+from ._sources import demonstration_motion as demonstration_motion
+from ._sources import find_source as find_source
+from ._sources import recording_motion as recording_motion
+from ._sources import source_kind as source_kind
+from ._timing import LIMIT_FRACTION as LIMIT_FRACTION
+from ._timing import time_path as time_path
+from ._urdf import export_urdf as export_urdf
+from ._urdf import portable_urdf as portable_urdf

@@ -1,0 +1,126 @@
+"""One export: time a motion (unless its times are final), check it, then write it.
+
+The checks run on the very samples that are written and before a byte is written; a refusal is
+a :class:`SafetyError` and leaves any earlier file at ``out`` untouched. ``unchecked=True`` writes
+anyway, with every finding stated in the file (CSV comment lines, the MCAP ``teach_studio``
+metadata, ``info.json``'s ``teach_studio`` key).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Literal
+
+import numpy as np
+
+from studio._files import now_iso
+
+from ._formats import write_csv, write_mcap
+from ._lerobot import write_lerobot
+from ._safety import COLLISION_MARGIN_M, Finding, check_trajectory, refuse
+from ._sources import Motion
+from ._timing import LIMIT_FRACTION, time_path
+
+Format = Literal["csv", "mcap", "lerobot"]
+FORMATS: tuple[Format, ...] = ("csv", "mcap", "lerobot")
+"""The trajectory formats ``studio export --format`` writes."""
+FORMAT_SUFFIXES: dict[Format, str] = {"csv": ".csv", "mcap": ".mcap", "lerobot": ".lerobot"}
+"""Each format's default ending after the source's name (a LeRobot dataset is a folder)."""
+
+
+@dataclass(frozen=True)
+class Exported:
+    """What an export wrote.
+
+    Attributes:
+        path: the file or folder.
+        times: the samples' times (s).
+        q: the samples' joints (rad).
+        findings: the safety findings (empty when checked and passed).
+        timed_by: ``"toppra"`` (timed along the path) or ``"source"`` (the source's own times).
+    """
+
+    path: Path
+    times: np.ndarray
+    q: np.ndarray
+    findings: tuple[Finding, ...]
+    timed_by: str
+
+
+def _notes(motion: Motion, findings: list[Finding], checked: bool) -> list[str]:
+    robot = motion.robot
+    head = (
+        f"Teach Studio export of {motion.kind} {motion.name} for the {robot.spec.title} "
+        f"({robot.name}), {now_iso()}"
+    )
+    if not findings:
+        return [head, "safety checks: passed (joint positions, velocities, accelerations, "
+                f"self-collision margin {COLLISION_MARGIN_M * 100:.1f} cm)"]  # fmt: skip
+    state = "NOT checked (--unchecked)" if not checked else "failed"
+    return [head, f"safety checks: {state}; {len(findings)} finding(s):"] + [
+        f.sentence for f in findings
+    ]
+
+
+def export_motion(
+    motion: Motion,
+    fmt: Format,
+    out: Path,
+    *,
+    unchecked: bool = False,
+    fraction: float = LIMIT_FRACTION,
+    task: str = "",
+) -> Exported:
+    """Time, check and write ``motion`` as ``fmt`` at ``out``.
+
+    Args:
+        motion: the robot's motion (:func:`recording_motion`, :func:`demonstration_motion`, or a
+            policy rollout).
+        fmt: ``"csv"``, ``"mcap"`` or ``"lerobot"``.
+        out: the file (a folder for ``lerobot``).
+        unchecked: write even when the checks find problems, stating them in the file.
+        fraction: the share of the limits the timing may use.
+        task: the LeRobot task text (default: the source's name).
+
+    Raises:
+        SafetyError: the checks found problems (nothing written).
+        ExportError: the file cannot be written.
+    """
+    robot = motion.robot
+    if motion.timed:
+        times, q, timed_by = motion.times, motion.q, "source"
+    else:
+        times, q = time_path(robot, motion.q, motion.rate_hz, fraction=fraction)
+        timed_by = "toppra"
+    findings = check_trajectory(robot, times, q, extra=list(motion.findings))
+    if not unchecked:
+        refuse(findings, f"{motion.kind} {motion.name}", robot)
+    notes = _notes(motion, findings, checked=not unchecked)
+    names = robot.joint_names
+    if fmt == "csv":
+        write_csv(out, names, times, q, notes if findings else ())
+    elif fmt == "mcap":
+        metadata = {
+            "source": motion.name,
+            "kind": motion.kind,
+            "robot": robot.name,
+            "timed_by": timed_by,
+            "checked": "passed" if not findings else "no (--unchecked)",
+            "findings": "\n".join(f.sentence for f in findings),
+        }
+        write_mcap(out, names, times, q, states=motion.kind == "recording", metadata=metadata)
+    else:
+        fps = int(round(motion.rate_hz))
+        extra = {
+            "teach_studio": {
+                "source": motion.name,
+                "kind": motion.kind,
+                "timed_by": timed_by,
+                "checked": not findings,
+                "findings": [f.sentence for f in findings],
+            }
+        }
+        task = task or f"Move as in {motion.name}"
+        write_lerobot(out, names, times, q, fps=fps, robot_type=robot.name, task=task, extra=extra)
+    return Exported(out, times, q, tuple(findings), timed_by)

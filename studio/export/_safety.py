@@ -1,0 +1,183 @@
+"""Safety checks of a joint trajectory before it is written for a real arm.
+
+Every sample is checked against the robot's URDF limits (:class:`studio.kinematics.RobotArm`):
+
+- positions within ``lower``/``upper``;
+- velocities, by finite differences between consecutive samples, within ``velocity``;
+- accelerations, by finite differences of those velocities, within ``acceleration``;
+- self-collision: :meth:`RobotArm.self_collisions` (Pinocchio and coal on the URDF's collision
+  geometry, adjacent links and the SRDF's disabled pairs excluded) closer than
+  :data:`COLLISION_MARGIN_M`.
+
+The differences are taken on exactly the samples that go into the file, so what is checked is
+what a controller would be sent. Each problem is one :class:`Finding`; a refusal names the first
+(by time) and counts the rest.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from studio.kinematics import RobotArm
+
+from ._errors import SafetyError
+
+COLLISION_MARGIN_M = 0.005
+"""Two links closer than this (m) count as colliding: a controller's tracking error and the
+collision meshes' own error need room. The meshes are convex hulls, which already err outwards."""
+LIMIT_TOLERANCE = 1e-6
+"""Relative slack on the velocity and acceleration limits (floating-point noise of the
+differences), and absolute slack (rad) on the position limits."""
+
+
+@dataclass(frozen=True)
+class Finding:
+    """One safety problem of a trajectory.
+
+    Attributes:
+        sample: the sample's index (0-based row of the file).
+        time: its time (s).
+        what: ``"position"``, ``"velocity"``, ``"acceleration"``, ``"collision"`` or ``"reach"``.
+        where: the joint's name, or the link pair ``"a/b"``.
+        sentence: the problem in words, with the margin.
+    """
+
+    sample: int
+    time: float
+    what: str
+    where: str
+    sentence: str
+
+
+def _first_over(values: np.ndarray, limit: np.ndarray) -> tuple[int, int] | None:
+    """The first (row, joint) where ``|values|`` exceeds ``limit`` by more than the tolerance."""
+    over = np.abs(values) > limit * (1.0 + LIMIT_TOLERANCE)
+    if not over.any():
+        return None
+    row, joint = np.argwhere(over)[0]
+    return int(row), int(joint)
+
+
+def differences(times: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Velocities (N-1, nq) between consecutive samples and accelerations (N-2, nq) between
+    consecutive velocities: what a controller sent these samples would have to do."""
+    dt = np.diff(times)
+    velocity = np.diff(q, axis=0) / dt[:, None]
+    acceleration = np.diff(velocity, axis=0) / (0.5 * (dt[1:] + dt[:-1]))[:, None]
+    return velocity, acceleration
+
+
+def limit_findings(robot: RobotArm, times: np.ndarray, q: np.ndarray) -> list[Finding]:
+    """The first position, velocity and acceleration violation of each joint (at most one of each
+    kind per joint, so a long over-speed segment is one finding, not thousands)."""
+    found: list[Finding] = []
+    names = robot.joint_names
+    low = q < robot.lower - LIMIT_TOLERANCE
+    high = q > robot.upper + LIMIT_TOLERANCE
+    for j, name in enumerate(names):
+        rows = np.flatnonzero(low[:, j] | high[:, j])
+        if rows.size:
+            i = int(rows[0])
+            bound = robot.lower[j] if low[i, j] else robot.upper[j]
+            found.append(
+                Finding(
+                    i,
+                    float(times[i]),
+                    "position",
+                    name,
+                    f"sample {i} (t = {times[i]:.3f} s): joint {name} at {q[i, j]:.4f} rad is "
+                    f"{abs(q[i, j] - bound):.4f} rad beyond its limit {bound:.4f} rad",
+                )
+            )
+    if len(times) < 2:
+        return found
+    velocity, acceleration = differences(times, q)
+    kinds = [
+        ("velocity", velocity, robot.velocity, "rad/s", 1),
+        ("acceleration", acceleration, robot.acceleration, "rad/s^2", 1),
+    ]
+    for what, values, limit, unit, offset in kinds:
+        for j, name in enumerate(names):
+            hit = _first_over(values[:, j : j + 1], limit[j : j + 1])
+            if hit is None:
+                continue
+            i = hit[0] + offset
+            value = float(values[hit[0], j])
+            found.append(
+                Finding(
+                    i,
+                    float(times[i]),
+                    what,
+                    name,
+                    f"sample {i} (t = {times[i]:.3f} s): joint {name} {what} {abs(value):.3f} "
+                    f"{unit} exceeds its limit {limit[j]:.3f} {unit} by "
+                    f"{abs(value) - limit[j]:.3f} {unit}",
+                )
+            )
+    return found
+
+
+def collision_findings(
+    robot: RobotArm, times: np.ndarray, q: np.ndarray, margin: float = COLLISION_MARGIN_M
+) -> list[Finding]:
+    """The first sample at which each link pair comes closer than ``margin`` (m)."""
+    found: dict[tuple[str, str], Finding] = {}
+    if not robot.checks_collisions:
+        return []
+    for i in range(len(times)):
+        for hit in robot.self_collisions(q[i], margin):
+            pair = (hit.link_a, hit.link_b)
+            if pair in found:
+                continue
+            gap = (
+                f"overlap by {-hit.distance * 100:.2f} cm"
+                if hit.distance < 0
+                else f"are {hit.distance * 100:.2f} cm apart"
+            )
+            found[pair] = Finding(
+                i,
+                float(times[i]),
+                "collision",
+                f"{hit.link_a}/{hit.link_b}",
+                f"sample {i} (t = {times[i]:.3f} s): links {hit.link_a} and {hit.link_b} {gap}, "
+                f"inside the {margin * 100:.1f} cm self-collision margin",
+            )
+    return list(found.values())
+
+
+def check_trajectory(
+    robot: RobotArm,
+    times: np.ndarray,
+    q: np.ndarray,
+    *,
+    margin: float = COLLISION_MARGIN_M,
+    extra: list[Finding] | None = None,
+) -> list[Finding]:
+    """Every safety finding of ``q`` (N, nq) at ``times`` (N,), sorted by time.
+
+    Args:
+        robot: the arm the trajectory is for.
+        times: sample times (s), strictly rising.
+        q: joint angles (rad), one row per sample, in ``robot.joint_names`` order.
+        margin: the self-collision margin (m).
+        extra: findings made earlier (targets out of reach while retargeting).
+    """
+    findings = [*(extra or []), *limit_findings(robot, times, q)]
+    findings += collision_findings(robot, times, q, margin)
+    return sorted(findings, key=lambda f: (f.sample, f.what))
+
+
+def refuse(findings: list[Finding], source: str, robot: RobotArm) -> None:
+    """Raise a :class:`SafetyError` naming the first finding, or return when there is none."""
+    if not findings:
+        return
+    more = len(findings) - 1
+    rest = f" (and {more} more finding{'s' if more > 1 else ''})" if more else ""
+    raise SafetyError(
+        f"Refused: {source} for the {robot.spec.title}: {findings[0].sentence}{rest}; export a "
+        "slower or other motion (a demonstration is timed within the limits) or for another "
+        "robot, or pass --unchecked to write it anyway with the findings stated in the file.",
+        [f.sentence for f in findings],
+    )

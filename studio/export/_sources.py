@@ -1,0 +1,229 @@
+"""What an export starts from: a policy file, a demonstration or a recording, found by path or
+name, and turned into a :class:`Motion` of one robot's joints.
+
+A recording and a demonstration are of the *human* arm, so they retarget onto any robot: their
+frames go through the capture package's fitters (:func:`studio.capture.fitter_for`, the same fit
+the page and the demonstration cutter use) into the human arm's angles, then through
+:class:`studio.kinematics.Retargeter` onto the chosen robot (joint mode for the Puma560, the
+paper's; cartesian, the hand's pose scaled into the robot's workspace, for any other arm). A
+demonstration for the Puma560 keeps the trajectory stored in it. A policy drives the robot it
+was learnt on only.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Literal
+
+import numpy as np
+
+from studio.capture import (
+    DEMO_SUFFIX,
+    RECORDING_SUFFIXES,
+    ObservationRecording,
+    Recording,
+    fitter_for,
+    load_demonstration,
+    read_any_recording,
+)
+from studio.kinematics import Retargeter, RobotArm, RobotIK, load_robot
+from studio.learning import POLICY_SUFFIX
+from studio.samples import SAMPLES_DIR
+
+from ._errors import ExportError
+from ._safety import Finding
+
+SourceKind = Literal["policy", "demonstration", "recording"]
+RECORDINGS_DIR = "recordings"
+"""Where a data folder keeps its recordings and the demonstrations cut from them."""
+POLICIES_DIR = "policies"
+"""Where a data folder keeps uploaded policy files."""
+RUNS_DIR = "runs"
+"""Where a data folder keeps training runs (each with ``policy.policy.npz``)."""
+POLICY_ROBOT = "puma560"
+"""The robot every policy file of this studio was learnt on (the files name no other yet)."""
+REACH_TOLERANCE_M = 0.01
+"""A retargeted tool further than this from the operator's mapped hand is out of reach."""
+SETTLE_TRIES = 5
+"""IK passes on the first frame (each warm-started from the last) before the motion starts."""
+
+
+@dataclass(frozen=True)
+class Motion:
+    """One robot's joint motion, ready to be timed, checked and written.
+
+    Attributes:
+        kind: what it came from (policy, demonstration or recording).
+        name: the source's name, for messages and file metadata.
+        robot: the arm it is for.
+        times: sample times (s, from 0).
+        q: joint angles (rad), one row per sample, in ``robot.joint_names`` order.
+        timed: whether ``times`` are final (a recording's capture times, a policy's fixed pace);
+            otherwise ``q`` is a path that :func:`time_path` times.
+        rate_hz: the capture rate (recordings) or the wanted sample rate.
+        findings: problems met while retargeting (targets out of reach).
+    """
+
+    kind: SourceKind
+    name: str
+    robot: RobotArm
+    times: np.ndarray
+    q: np.ndarray
+    timed: bool
+    rate_hz: float
+    findings: tuple[Finding, ...] = field(default=())
+
+
+def source_kind(path: Path) -> SourceKind:
+    """What the file at ``path`` is, by its name's ending."""
+    name = path.name
+    if name.endswith(POLICY_SUFFIX) or name.endswith(".npz"):
+        return "policy"
+    if name.endswith(DEMO_SUFFIX):
+        return "demonstration"
+    if any(name.endswith(suffix) for suffix in RECORDING_SUFFIXES):
+        return "recording"
+    raise ExportError(
+        f"{path} is neither a policy ({POLICY_SUFFIX}), a demonstration ({DEMO_SUFFIX}) nor a "
+        f"recording ({', '.join(RECORDING_SUFFIXES)}); give one of those."
+    )
+
+
+def find_source(given: str | Path, data_dir: str | Path = ".") -> Path:
+    """The file ``given`` names: a path, else a name in the data folder or among the samples.
+
+    A name is looked for as a demonstration or a recording in ``<data_dir>/recordings/``, a
+    policy in ``<data_dir>/policies/`` or a run ``<data_dir>/runs/<name>/``, then as a shipped
+    sample (``sample-reach-1`` is the demonstration; ``sample-reach-1.tape.csv`` the recording).
+
+    Raises:
+        ExportError: nothing of that name.
+    """
+    given = Path(given)
+    if given.exists() or len(given.parts) != 1:
+        if not given.is_file():
+            what = "is a folder, not a file" if given.is_dir() else "does not exist"
+            raise ExportError(
+                f"{given} {what}; give the path of a policy, demonstration or recording file."
+            )
+        return given
+    root = Path(data_dir)
+    endings = (DEMO_SUFFIX, *RECORDING_SUFFIXES)
+    candidates = [root / RECORDINGS_DIR / given.name, SAMPLES_DIR / given.name]
+    for folder in (root / RECORDINGS_DIR, SAMPLES_DIR):
+        candidates += [folder / f"{given.name}{ending}" for ending in endings]
+    candidates += [
+        root / POLICIES_DIR / f"{given.name}{POLICY_SUFFIX}",
+        root / RUNS_DIR / given.name / f"policy{POLICY_SUFFIX}",
+    ]
+    for candidate in candidates:
+        if candidate.is_file() and candidate.name != "__init__.py":
+            return candidate
+    samples = sorted(p.name.removesuffix(DEMO_SUFFIX) for p in SAMPLES_DIR.glob(f"*{DEMO_SUFFIX}"))
+    raise ExportError(
+        f"There is no file {given}, nor a recording, demonstration, policy or run named "
+        f"{given.name!r} in {root.resolve()} or among the samples ({', '.join(samples)}); check "
+        "the name or give a path."
+    )
+
+
+def _human_angles(rec: Recording | ObservationRecording, rows: slice) -> np.ndarray:
+    """The human arm's angles (N, 7) of a recording's rows, through the capture fitters."""
+    indices = range(*rows.indices(len(rec)))
+    if not len(indices):
+        return np.zeros((0, 7))
+    first = rec.frame_at(indices[0])
+    if isinstance(rec, Recording):
+        fitter = fitter_for(first, tape=rec.config)
+    else:
+        fitter = fitter_for(first, side=rec.side)
+    return np.array([fitter.fit(rec.frame_at(i)).q_human for i in indices])
+
+
+def retarget(
+    robot: RobotArm, times: np.ndarray, q_human: np.ndarray
+) -> tuple[np.ndarray, list[Finding]]:
+    """The robot's joints (N, nq) for human-arm angles (N, 7), and the frames out of reach."""
+    retargeter = Retargeter() if robot.name == POLICY_ROBOT else Retargeter(robot=robot)
+    q = np.empty((len(q_human), robot.nq))
+    findings: list[Finding] = []
+    for _ in range(SETTLE_TRIES if len(q_human) else 0):
+        # the first frame starts the IK cold: let it settle there as a live session would
+        retargeter.robot_from_human(q_human[0])
+        if not isinstance(retargeter.last_ik, RobotIK) or retargeter.last_ik.success:
+            break
+    for i, q_h in enumerate(q_human):
+        q[i] = retargeter.robot_from_human(q_h)
+        ik = retargeter.last_ik
+        if (
+            not findings
+            and isinstance(ik, RobotIK)
+            and not ik.success
+            and ik.position_error > REACH_TOLERANCE_M
+        ):
+            findings.append(
+                Finding(
+                    i,
+                    float(times[i]),
+                    "reach",
+                    robot.spec.tool,
+                    f"frame {i} (t = {times[i]:.3f} s of the source): the hand's target is "
+                    f"{ik.position_error * 100:.1f} cm out of the {robot.spec.title}'s reach "
+                    f"(tolerance {REACH_TOLERANCE_M * 100:.0f} cm)",
+                )
+            )
+    return q, findings
+
+
+def _capture_rate(rec: Recording | ObservationRecording, times: np.ndarray) -> float:
+    if rec.rate_hz > 0:
+        return rec.rate_hz
+    return float(1.0 / np.median(np.diff(times))) if len(times) > 1 else 1.0
+
+
+def recording_motion(path: Path, robot_name: str) -> Motion:
+    """A recording retargeted onto ``robot_name`` at its capture times."""
+    robot = load_robot(robot_name)
+    rec = read_any_recording(path)
+    if len(rec) < 2:
+        raise ExportError(f"The recording {path.name} holds {len(rec)} frame; record a motion.")
+    times = np.asarray(rec.t - rec.t[0], dtype=float)
+    q, findings = retarget(robot, times, _human_angles(rec, slice(None)))
+    return Motion(
+        "recording", path.name, robot, times, q, True, _capture_rate(rec, times), tuple(findings)
+    )
+
+
+def demonstration_motion(path: Path, robot_name: str, rate_hz: float) -> Motion:
+    """A demonstration's path on ``robot_name`` (its stored Puma560 trajectory, or its
+    recording's segment retargeted onto another robot), to be timed."""
+    robot = load_robot(robot_name)
+    demo = load_demonstration(path)
+    if robot.name == POLICY_ROBOT:
+        times = demo.times - demo.times[0]
+        return Motion("demonstration", path.name, robot, times, demo.q_robot, False, rate_hz)
+    recording = demo.recording  # the file name it was cut from, next to the demonstration
+    if not recording.is_file():
+        raise ExportError(
+            f"The demonstration {path.name} was cut from {recording.name}, which is not next to "
+            f"it; a demonstration retargets to the {robot.spec.title} from its recording: put "
+            "the recording back, or export the recording itself."
+        )
+    rec = read_any_recording(recording)
+    rows = rec.segment(demo.t0, demo.t1)
+    times = np.asarray(rec.t[rows] - rec.t[rows][0], dtype=float)
+    q, findings = retarget(robot, times, _human_angles(rec, rows))
+    return Motion("demonstration", path.name, robot, times, q, False, rate_hz, tuple(findings))
+
+
+def check_policy_robot(path: Path, robot_name: str) -> RobotArm:
+    """The robot a policy file drives, or an ExportError when another one is asked for."""
+    robot = load_robot(robot_name)
+    if robot.name != POLICY_ROBOT:
+        raise ExportError(
+            f"The policy {path.name} was learnt on the {load_robot(POLICY_ROBOT).spec.title} and "
+            f"drives only that robot; export it with --robot {POLICY_ROBOT}, or export a "
+            f"recording or demonstration for the {robot.spec.title}."
+        )
+    return robot

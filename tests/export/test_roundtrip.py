@@ -1,0 +1,130 @@
+"""The exports read back: MCAP (with mcap_ros2) against the CSV, LeRobot (with pyarrow alone)
+against the recording, frame by frame."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pyarrow.parquet as pq
+import pytest
+from mcap_ros2.reader import read_ros2_messages
+
+from studio.cli import main
+from studio.export import (
+    JOINT_STATE,
+    JOINT_TRAJECTORY,
+    demonstration_motion,
+    export_motion,
+    recording_motion,
+)
+from studio.kinematics import load_robot
+from studio.samples import SAMPLES_DIR
+
+
+def read_csv(path: Path) -> tuple[list[str], np.ndarray]:
+    lines = [line for line in path.read_text().splitlines() if not line.startswith("#")]
+    return lines[0].split(","), np.loadtxt(lines[1:], delimiter=",", ndmin=2)
+
+
+def read_mcap(path: Path) -> tuple[str, list[str], np.ndarray, np.ndarray]:
+    """The schema name, joint names, times and positions an MCAP file holds."""
+    schemas, names, times, rows = set(), [], [], []
+    for message in read_ros2_messages(str(path)):
+        schemas.add(message.schema.name)
+        msg = message.ros_msg
+        if message.schema.name == JOINT_TRAJECTORY:
+            names = list(msg.joint_names)
+            for point in msg.points:
+                times.append(point.time_from_start.sec + point.time_from_start.nanosec * 1e-9)
+                rows.append(list(point.positions))
+        else:
+            names = list(msg.name)
+            times.append(msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9)
+            rows.append(list(msg.position))
+            assert message.log_time_ns == round(times[-1] * 1e9)
+    assert len(schemas) == 1
+    return schemas.pop(), names, np.array(times), np.array(rows)
+
+
+def test_a_demonstrations_mcap_is_its_csv_as_a_ros2_joint_trajectory(tmp_path):
+    motion = demonstration_motion(SAMPLES_DIR / "sample-reach-2.demo.json", "puma560", 50.0)
+    export_motion(motion, "csv", tmp_path / "demo.csv")
+    export_motion(motion, "mcap", tmp_path / "demo.mcap")
+    header, rows = read_csv(tmp_path / "demo.csv")
+    schema, names, times, q = read_mcap(tmp_path / "demo.mcap")
+    assert schema == "trajectory_msgs/msg/JointTrajectory"
+    assert header == ["time", *names] and names == list(load_robot("puma560").joint_names)
+    np.testing.assert_allclose(times, rows[:, 0], rtol=0, atol=1e-9)
+    np.testing.assert_allclose(q, rows[:, 1:], rtol=0, atol=1e-8)  # %.9g in the CSV
+
+
+def test_a_recordings_mcap_is_joint_states_at_the_capture_rate(slow_recording, tmp_path):
+    motion = recording_motion(slow_recording, "puma560")
+    export_motion(motion, "csv", tmp_path / "rec.csv")
+    export_motion(motion, "mcap", tmp_path / "rec.mcap")
+    header, rows = read_csv(tmp_path / "rec.csv")
+    schema, names, times, q = read_mcap(tmp_path / "rec.mcap")
+    assert schema == JOINT_STATE == "sensor_msgs/msg/JointState"
+    assert header == ["time", *names]
+    assert len(times) == 165 and np.allclose(np.diff(times), 1 / 110)
+    np.testing.assert_allclose(times, rows[:, 0], rtol=0, atol=1e-9)
+    np.testing.assert_allclose(q, rows[:, 1:], rtol=0, atol=1e-8)
+
+
+def test_the_lerobot_dataset_matches_the_recording_frame_by_frame(slow_recording, tmp_path):
+    motion = recording_motion(slow_recording, "puma560")
+    out = tmp_path / "slow.lerobot"
+    export_motion(motion, "lerobot", out)
+    table = pq.read_table(out / "data/chunk-000/file-000.parquet").to_pydict()
+    state = np.array(table["observation.state"])
+    assert state.shape == motion.q.shape == (165, 6)
+    np.testing.assert_allclose(state, motion.q.astype(np.float32), rtol=0, atol=0)
+    np.testing.assert_array_equal(np.array(table["action"])[:-1], state[1:])
+    np.testing.assert_array_equal(np.array(table["action"])[-1], state[-1])
+    np.testing.assert_allclose(table["timestamp"], motion.times.astype(np.float32), atol=0)
+    assert table["frame_index"] == list(range(165)) == table["index"]
+    assert set(table["episode_index"]) == {0} == set(table["task_index"])
+    info = json.loads((out / "meta/info.json").read_text())
+    assert info["fps"] == 110 and info["total_frames"] == 165
+    assert info["features"]["observation.state"]["names"] == list(motion.robot.joint_names)
+    assert info["teach_studio"]["checked"] is True
+
+
+def test_the_cli_exports_a_sample_by_name_in_each_format(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    for fmt in ("csv", "mcap", "lerobot"):
+        argv = ["export", "sample-reach-1", "--robot", "puma560", "--format", fmt]
+        assert main(argv) == 0, capsys.readouterr().err
+        assert "passed the safety checks" in capsys.readouterr().out
+    made = sorted(p.name for p in tmp_path.iterdir())
+    assert made == [f"sample-reach-1.puma560.{end}" for end in ("csv", "lerobot", "mcap")]
+    header, rows = read_csv(tmp_path / "sample-reach-1.puma560.csv")
+    assert header == ["time", *load_robot("puma560").joint_names]
+    assert rows[0, 0] == 0 and np.allclose(np.diff(rows[:, 0]), 1 / 50)  # --rate's default
+
+
+@pytest.mark.parametrize("fmt", ["csv", "mcap", "lerobot"])
+def test_an_unchecked_export_states_its_findings_in_the_file(fmt, tmp_path, capsys):
+    out = tmp_path / f"rec.{fmt}"
+    sample = str(SAMPLES_DIR / "sample-reach-1.tape.csv")
+    assert main(["export", sample, "--format", fmt, "--out", str(out)]) == 2
+    refusal = capsys.readouterr().err.strip()
+    assert refusal.startswith("studio export: Refused: recording sample-reach-1.tape.csv")
+    assert "\n" not in refusal and not out.exists()
+    assert main(["export", sample, "--format", fmt, "--out", str(out), "--unchecked"]) == 0
+    first = refusal.split(": ", 4)[-1].split(" (and")[0]  # the first finding's sentence
+    if fmt == "csv":
+        assert first in out.read_text().split("\ntime,")[0]
+    elif fmt == "mcap":
+        from mcap.reader import make_reader
+
+        with out.open("rb") as f:
+            meta = {m.name: m.metadata for m in make_reader(f).iter_metadata()}
+        assert meta["teach_studio"]["checked"] == "no (--unchecked)"
+        assert first in meta["teach_studio"]["findings"]
+    else:
+        info = json.loads((out / "meta/info.json").read_text())
+        assert info["teach_studio"]["checked"] is False
+        assert any(first in finding for finding in info["teach_studio"]["findings"])
