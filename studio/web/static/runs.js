@@ -5,6 +5,7 @@ import { runColor, runLabel } from "./chart.js";
 import { CURVE_KEYS, emptyCurve } from "./curves.js";
 import { $, confirmDialog, el, emptyRow, enc, fmtCpu, showError } from "./dom.js";
 import { renderPolicies, renderWatchChoices } from "./policies.js";
+import { runMatches, tagChips } from "./runfilter.js";
 import { S, markCurvesDirty } from "./state.js";
 
 export function upsertRun(run) {
@@ -46,12 +47,18 @@ export function renderRuns() {
   }
   const rows = [];
   const grouped = new Set();
-  for (const r of S.runs) { // a sweep's trials show as one group row, at its newest trial's place
+  const kept = S.runs.filter((r) => runMatches(r));
+  if (kept.length < S.runs.length) {
+    rows.push(el("tr", { class: "empty", testid: "runs-filtered" }, el("td", { colspan: 6,
+      text: `${kept.length} of ${S.runs.length} runs match the filter “${S.runFilter}” (Compare runs)` })));
+  }
+  for (const r of kept) { // a sweep's trials show as one group row, at its newest trial's place
     const sweep = sweepOf(r);
     if (!sweep) rows.push(runRow(r));
     else if (!grouped.has(sweep)) { grouped.add(sweep); rows.push(...sweepRows(sweep)); }
   }
   reconcileRows(body, rows);
+  if (S.afterRunsRender) S.afterRunsRender(); // the run table, when it is open
   const failed = S.runs.find((r) => r.status === "failed" && r.error && !r._errorShown);
   if (failed) { failed._errorShown = true; showError("runs-error", `${failed.name || failed.id}: ${failed.error}`); }
 }
@@ -59,7 +66,7 @@ export function renderRuns() {
 /** Put ``rows`` into ``body``, keeping every row that is drawn the same already: a running run
  * refreshes its row a few times a second, and rebuilding the whole list each time would lay out
  * and repaint all of it. Rows are equal when their HTML is (their handlers depend on the id alone). */
-function reconcileRows(body, rows) {
+export function reconcileRows(body, rows) {
   const old = [...body.children];
   rows.forEach((row, i) => {
     if (i >= old.length) body.append(row);
@@ -96,7 +103,7 @@ function runRow(r) {
       type: "checkbox", testid: "run-show", checked: S.shown.has(r.id),
       onchange: (e) => toggleShown(r.id, e.target.checked),
     })),
-    el("td", { class: "name", title: runLabel(r) }, el("span", { class: "swatch", style: `background:${runColor(r.id)}` }), runLabel(r)),
+    el("td", { class: "name", title: runLabel(r) }, el("span", { class: "swatch", style: `background:${runColor(r.id)}` }), runLabel(r), tagChips(r)),
     el("td", {}, el("span", { class: `badge ${r.status}`, testid: "run-status", text: r.note ? "preparing" : r.status })),
     r.note // before its first episode: what the run does (compiling the learner, the first time)
       ? el("td", { class: "run-note", testid: "run-note", text: r.note })
@@ -134,7 +141,7 @@ function foldSweep(id) {
 }
 
 function sweepRows(id) {
-  const runs = S.runs.filter((r) => sweepOf(r) === id);
+  const runs = S.runs.filter((r) => sweepOf(r) === id && runMatches(r));
   const info = S.sweeps.find((s) => s.id === id);
   const open = S.openSweeps.has(id);
   const trials = info ? info.trials : runs.length;
@@ -183,7 +190,7 @@ function sweepDetail(id, info) {
     el("div", { style: "overflow-x:auto" }, table)));
 }
 
-function toggleShown(id, on) {
+export function toggleShown(id, on) {
   S.shownTouched = true;
   if (on) {
     S.shown.add(id);
