@@ -138,4 +138,9 @@ def write_run_notes(run_dir: Path, tags: list[str], notes: str) -> RunNotes:
     stored = RunNotes(checked.tags, checked.notes, now_iso())
     body = {"format": NOTES_FORMAT, "version": NOTES_VERSION, **stored.to_json()}
     atomic_write_text(run_dir / NOTES_FILE, json.dumps(body, ensure_ascii=False, indent=1) + "\n")
+    if not config.is_file():  # deleted meanwhile: leave nothing that would keep its folder
+        (run_dir / NOTES_FILE).unlink(missing_ok=True)
+        raise RunBusyError(
+            f"Run {run_dir.name} was deleted while its notes were saved; nothing was kept."
+        )
     return stored

@@ -123,3 +123,22 @@ def test_several_runs_export_in_one_csv_in_the_one_layout(client, two_runs):
     ]
     assert client.get("/api/run-curves.csv").status_code == 422
     assert client.get("/api/run-curves.csv", params={"run": "nope"}).status_code == 404
+
+
+def test_notes_saved_while_the_run_is_deleted_leave_nothing_behind(tmp_path, monkeypatch):
+    from studio.learning import RunBusyError, _run_notes, write_run_notes
+
+    folder = tmp_path / "run"
+    folder.mkdir()
+    (folder / "config.json").write_text("{}")
+    real = _run_notes.atomic_write_text
+
+    def write_then_delete(path, text):  # the delete removes config.json while notes are written
+        out = real(path, text)
+        (folder / "config.json").unlink()
+        return out
+
+    monkeypatch.setattr(_run_notes, "atomic_write_text", write_then_delete)
+    with pytest.raises(RunBusyError, match="deleted while its notes were saved"):
+        write_run_notes(folder, ["x"], "")
+    assert list(folder.iterdir()) == []
