@@ -144,8 +144,15 @@ def test_the_run_table_highlights_differences_and_saves_tags_and_notes_beside_th
     assert wait_for(lambda: alert.is_visible() and "shorten it" in alert.inner_text(), T)
     assert notes_file.read_text() == before
     shoot(page, "compare-error-1280x720")
+    page.set_viewport_size({"width": 1920, "height": 1080})
+    shoot(page, "compare-error-1920x1080")
+    page.set_viewport_size({"width": 1280, "height": 720})
     page.get_by_role("button", name="Close the run table").click()
     assert not table.is_visible()
+    page.get_by_role("button", name="Compare runs").click()
+    assert wait_for(table.is_visible, T)
+    page.keyboard.press("Escape")
+    assert wait_for(lambda: not table.is_visible(), T)
 
 
 def test_smoothing_other_x_axes_the_legend_and_one_csv_of_the_plotted_runs(
@@ -168,10 +175,11 @@ def test_smoothing_other_x_axes_the_legend_and_one_csv_of_the_plotted_runs(
         page.keyboard.press("ArrowRight")
     assert slider.input_value() == "0.6"
     line = "id => window.studio.chartLine(id)"
-    assert wait_for(lambda: page.evaluate(line, zero["id"])["smooth"] is not None, T)
+    want = pytest.approx(ema(curve["mean"], 0.6))
+    # the chart redraws at its frame rate: wait for the frame after the last key press
+    assert wait_for(lambda: page.evaluate(line, zero["id"])["smooth"] == want, T)
     drawn = page.evaluate(line, zero["id"])
     assert drawn["mean"] == pytest.approx(curve["mean"])  # the raw line stays, behind
-    assert drawn["smooth"] == pytest.approx(ema(curve["mean"], 0.6))
     assert "smoothed" in legend.inner_text()
     shoot(page, "compare-smoothing-1280x720")
 

@@ -11,7 +11,7 @@ import { api, download, guarded } from "./api.js";
 import { runColor, runLabel, runTask } from "./chart.js";
 import { $, el, enc, fmtCpu, setProp, setText, showError } from "./dom.js";
 import { reconcileRows, renderRuns, toggleShown } from "./runs.js";
-import { runMatches, runTags } from "./runfilter.js";
+import { runMatches } from "./runfilter.js";
 import { S, markCurvesDirty } from "./state.js";
 
 /** Settings that say nothing about how a run learns (shown elsewhere, or its name). */
@@ -115,10 +115,8 @@ export function wireCompare() {
     renderCompare();
     $("compare-filter").focus();
   });
+  $("compare-dialog").addEventListener("keydown", (e) => { if (e.key === "Escape") $("compare-dialog").close(); });
   $("compare-dialog").addEventListener("close", () => setProp($("compare-open"), "ariaExpanded", "false"));
   $("compare-filter").addEventListener("input", (e) => { S.runFilter = e.target.value; renderRuns(); });
   $("compare-differing").addEventListener("change", renderCompare);
 }
-
-/** Tags of a run (for the browser tests and the console). */
-S.runTags = (id) => runTags(S.runs.find((r) => r.id === id) || { id });
