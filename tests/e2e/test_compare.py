@@ -108,9 +108,12 @@ def test_the_run_table_highlights_differences_and_saves_tags_and_notes_beside_th
     page.get_by_role("textbox", name=re.compile(r"^Notes of cmp-zero")).click()  # leave the field
     notes_file = studio_server.data_dir / "runs" / zero["id"] / "notes.json"
     assert wait_for(notes_file.exists, T)
-    page.get_by_role("textbox", name=re.compile(r"^Notes of cmp-zero")).fill(
-        "the paper's Dyna-Q(0)"
-    )
+    # the save redraws nothing under the cursor: the person types on in the notes field
+    run_row = page.locator(f"[data-testid='run-row'][data-id='{zero['id']}']")
+    assert wait_for(lambda: "baseline" in run_row.get_by_test_id("run-tags").inner_text(), T)
+    notes_field = page.get_by_role("textbox", name=re.compile(r"^Notes of cmp-zero"))
+    assert notes_field.evaluate("e => e === document.activeElement")
+    page.keyboard.type("the paper's Dyna-Q(0)")
     page.get_by_role("textbox", name=re.compile(r"^Tags of cmp-full")).click()
     assert wait_for(lambda: "Dyna-Q(0)" in notes_file.read_text(), T)
     stored = json.loads(notes_file.read_text())
@@ -119,8 +122,7 @@ def test_the_run_table_highlights_differences_and_saves_tags_and_notes_beside_th
     )
     # the learner's own files are untouched, and the run list shows the tags
     assert json.loads((notes_file.parent / "config.json").read_text())["name"] == "cmp-zero"
-    run_row = page.locator(f"[data-testid='run-row'][data-id='{zero['id']}']")
-    assert wait_for(lambda: "baseline" in run_row.get_by_test_id("run-tags").inner_text(), T)
+    assert "baseline" in run_row.get_by_test_id("run-tags").inner_text()
 
     # filter by tag, by task and by name: the table and the run list follow
     search = page.get_by_role("searchbox", name="Filter runs")

@@ -86,6 +86,7 @@ def write_notes(run_id: str, body: RunNotesUpdate, studio: StudioDep) -> RunNote
         stored = write_run_notes(run.folder.path, body.tags, body.notes)
     except RunBusyError as err:
         raise ConflictError(str(err)) from None
+    studio.runs.on_change("runs")  # other pages show the new tags
     return _public(stored)
 
 

@@ -7,7 +7,7 @@
  * wired here too.
  */
 
-import { api, download, guarded } from "./api.js";
+import { api, download } from "./api.js";
 import { runColor, runLabel, runTask } from "./chart.js";
 import { $, el, enc, fmtCpu, setProp, setText, showError } from "./dom.js";
 import { reconcileRows, renderRuns, toggleShown } from "./runs.js";
@@ -16,14 +16,6 @@ import { S, markCurvesDirty } from "./state.js";
 
 /** Settings that say nothing about how a run learns (shown elsewhere, or its name). */
 const NOT_SETTINGS = new Set(["name"]);
-
-export async function loadNotes() {
-  await guarded("runs-error", async () => {
-    const all = await api("GET", "/api/run-notes");
-    S.notes = new Map(Object.entries(all));
-    renderRuns();
-  });
-}
 
 /** A setting's value as the table shows it (lists joined, nothing as a dash). */
 function shown(v) {
@@ -49,7 +41,6 @@ async function saveNotes(r, row) {
   try {
     const saved = await api("PUT", `/api/runs/${enc(r.id)}/notes`, { tags, notes });
     S.notes.set(r.id, saved);
-    row.dataset.saved = saved.updated || "";
     renderRuns();
   } catch (e) {
     showError("compare-error", `${runLabel(r)}: ${e.message}`);
@@ -57,7 +48,6 @@ async function saveNotes(r, row) {
 }
 
 function compareRow(r, columns) {
-  const n = S.notes.get(r.id) || { tags: [], notes: "" };
   const label = runLabel(r);
   const plotted = S.shown.has(r.id);
   const row = el("tr", { "data-id": r.id, testid: "compare-row", class: plotted ? "" : "unplotted" });
@@ -70,11 +60,25 @@ function compareRow(r, columns) {
     el("td", { text: runTask(r) }),
     ...columns.map((c) => el("td", { class: c.differs && plotted ? "differs" : null, "data-key": c.key, text: shown((r.config || {})[c.key]) })),
     el("td", { class: "num", text: fmtCpu(r.cpu_seconds) }),
-    el("td", {}, el("input", { type: "text", testid: "compare-tags", "aria-label": `Tags of ${label}`, value: n.tags.join(", "),
+    el("td", {}, el("input", { type: "text", testid: "compare-tags", "aria-label": `Tags of ${label}`,
       placeholder: "tags, comma separated", onchange: save })),
-    el("td", {}, el("textarea", { rows: 1, testid: "compare-notes", "aria-label": `Notes of ${label}`, placeholder: "notes", onchange: save }, n.notes)),
+    el("td", {}, el("textarea", { rows: 1, testid: "compare-notes", "aria-label": `Notes of ${label}`, placeholder: "notes", onchange: save })),
   );
+  row.drawn = row.outerHTML; // the browser may touch its fields' attributes (autofill's style)
   return row;
+}
+
+/** Show each run's stored tags and notes in its fields, except in the field being edited. The
+ * values are not in the rows' HTML, so a save (here or in another page) never redraws a row
+ * under the cursor. */
+function syncNoteFields() {
+  for (const row of $("compare-body").children) {
+    const n = S.notes.get(row.dataset.id) || { tags: [], notes: "" };
+    for (const [testid, value] of [["compare-tags", n.tags.join(", ")], ["compare-notes", n.notes]]) {
+      const field = row.querySelector(`[data-testid='${testid}']`);
+      if (field && field !== document.activeElement && field.value !== value) field.value = value;
+    }
+  }
 }
 
 /** Draw the run table (only while it is open: nothing is written to a closed dialog). */
@@ -90,6 +94,7 @@ export function renderCompare() {
     el("th", { class: "num", text: "CPU" }), el("th", { text: "tags" }), el("th", { text: "notes" }));
   reconcileRows($("compare-head"), [head]);
   reconcileRows($("compare-body"), runs.map((r) => compareRow(r, columns)));
+  syncNoteFields();
   const differ = columns.filter((c) => c.differs).length;
   setText("compare-summary", `${runs.length} of ${all.length} runs · ${S.shown.size} plotted · ${differ} setting${differ === 1 ? "" : "s"} differ`);
 }

@@ -16,7 +16,7 @@ import { CURVE_FPS, connectEvents, events, renderLive } from "./events.js";
 import { exportFile, loadPolicies, uploadPolicy, watch } from "./policies.js";
 import { dismissCaptureFailure, loadRecordings, renderCaptureButton, saveRecordingEdit, toggleCapture, uploadRecording } from "./recordings.js";
 import { loadRuns, renderRuns } from "./runs.js";
-import { loadNotes, wireCompare } from "./compare.js";
+import { wireCompare } from "./compare.js";
 import { SOFTWARE_RENDERERS, SOFTWARE_SCENE_DPR, loadConfig, softwareWebGL } from "./scene.js";
 import { applySource, playback, renderSource, setRetarget, simulatorReach, syncKindOptions } from "./sources.js";
 import { S, markCurvesDirty } from "./state.js";
@@ -104,7 +104,7 @@ async function main() {
     S.markT0 = m && m.t0;
     updateMarkButton();
   }).catch(() => {});
-  await Promise.all([initial, cap, mark, loadRecordings(), loadDemos(), loadRuns(), loadPolicies(), loadNotes()]);
+  await Promise.all([initial, cap, mark, loadRecordings(), loadDemos(), loadRuns(), loadPolicies()]);
   if (S.source && S.source.recording) $("source-recording").value = S.source.recording;
   document.body.dataset.ready = "1";
 }

@@ -16,7 +16,10 @@ export function upsertRun(run) {
 
 export async function loadRuns() {
   await guarded("runs-error", async () => {
+    const notes = api("GET", "/api/run-notes").catch(() => null); // tags and notes (compare.js)
     S.runs = await api("GET", "/api/runs");
+    const all = await notes;
+    if (all) S.notes = new Map(Object.entries(all));
     S.sweeps = S.runs.some(sweepOf) ? await api("GET", "/api/sweeps") : [];
     if (!S.shownTouched) {
       // By default plot the newest few runs, so a fresh page shows the latest comparison.
@@ -65,12 +68,15 @@ export function renderRuns() {
 
 /** Put ``rows`` into ``body``, keeping every row that is drawn the same already: a running run
  * refreshes its row a few times a second, and rebuilding the whole list each time would lay out
- * and repaint all of it. Rows are equal when their HTML is (their handlers depend on the id alone). */
+ * and repaint all of it. Rows are equal when their HTML is (their handlers depend on the id alone),
+ * or, for rows with fields a person edits (whose HTML the browser changes), their ``drawn`` HTML
+ * as built. */
 export function reconcileRows(body, rows) {
   const old = [...body.children];
+  const html = (row) => row.drawn || row.outerHTML;
   rows.forEach((row, i) => {
     if (i >= old.length) body.append(row);
-    else if (old[i].outerHTML !== row.outerHTML) old[i].replaceWith(row);
+    else if (html(old[i]) !== html(row)) old[i].replaceWith(row);
   });
   for (const extra of old.slice(rows.length)) extra.remove();
 }
