@@ -102,6 +102,16 @@ from ._reach import ArmReach as ArmReach
 from ._reproduce import ReproduceResult as ReproduceResult
 from ._reproduce import generate_demonstrations as generate_demonstrations
 from ._reproduce import reproduce as reproduce
+from ._run_notes import MAX_NOTES_CHARS as MAX_NOTES_CHARS
+from ._run_notes import MAX_TAG_CHARS as MAX_TAG_CHARS
+from ._run_notes import MAX_TAGS as MAX_TAGS
+from ._run_notes import NOTES_FILE as NOTES_FILE
+from ._run_notes import RunBusyError as RunBusyError
+from ._run_notes import RunNotes as RunNotes
+from ._run_notes import RunNotesError as RunNotesError
+from ._run_notes import check_run_notes as check_run_notes
+from ._run_notes import read_run_notes as read_run_notes
+from ._run_notes import write_run_notes as write_run_notes
 from ._run_record import TASK_KINDS as TASK_KINDS
 from ._run_record import RunRecord as RunRecord
 from ._run_request import REACH_DEFAULTS as REACH_DEFAULTS

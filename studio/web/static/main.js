@@ -16,6 +16,7 @@ import { CURVE_FPS, connectEvents, events, renderLive } from "./events.js";
 import { exportFile, loadPolicies, uploadPolicy, watch } from "./policies.js";
 import { dismissCaptureFailure, loadRecordings, renderCaptureButton, saveRecordingEdit, toggleCapture, uploadRecording } from "./recordings.js";
 import { loadRuns, renderRuns } from "./runs.js";
+import { wireCompare } from "./compare.js";
 import { SOFTWARE_RENDERERS, SOFTWARE_SCENE_DPR, loadConfig, softwareWebGL } from "./scene.js";
 import { applySource, playback, renderSource, setRetarget, simulatorReach, syncKindOptions } from "./sources.js";
 import { S, markCurvesDirty } from "./state.js";
@@ -73,6 +74,7 @@ function wire() {
   $("curve-log").addEventListener("change", markCurvesDirty);
   $("curve-band").addEventListener("change", markCurvesDirty);
   $("curve-x").addEventListener("change", markCurvesDirty);
+  wireCompare(); // the run table, smoothing and the CSV of plotted runs
 
   $("watch-go").addEventListener("click", watch);
   $("watch-stop").addEventListener("click", () => guarded("watch-error", () => api("POST", "/api/watch/stop")));
