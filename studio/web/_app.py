@@ -44,6 +44,7 @@ from .routers import (
     policies,
     recordings,
     runs,
+    scene_controls,
     sources,
     sweeps,
     watch,
@@ -105,6 +106,7 @@ def create_app(settings: Settings | None = None, scene: Scene | None = None) -> 
         sweeps,
         policies,
         watch,
+        scene_controls,
         events,
     ):
         app.include_router(module.router)
