@@ -20,7 +20,6 @@ from tests.web.conftest import make_settings, wait_for
 from tests.web.test_policies import policy_bytes, upload
 from tests.web.test_scene import _playback
 
-
 # ---------------------------------------------------------------------- the pure laws
 
 
