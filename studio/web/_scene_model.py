@@ -141,7 +141,7 @@ def rescheduled(
         t: scrub to this trajectory time (s, clipped to the trajectory); None keeps the time
             reached at ``now``.
         speed: the new speed (None keeps it).
-        paused: pause or resume (None keeps it). Resuming a finished playback starts it over.
+        paused: pause or resume (None keeps it). Resuming at the end starts it over.
         step: move this many samples forward (positive) or back (negative) from the time
             reached, landing on a sample, and pause there.
 
@@ -158,9 +158,9 @@ def rescheduled(
             k = int(np.searchsorted(times, at, side="left")) + step
         at = float(times[min(max(k, 0), len(times) - 1)])
         paused = True
+    if paused is False and at >= playback.duration:
+        at = 0.0  # resuming at the end plays it again from the start
     paused = playback.paused if paused is None else bool(paused)
-    if not paused and playback.paused and at >= playback.duration:
-        at = 0.0  # play again from the start
     return replace(
         playback,
         started=now,

@@ -67,11 +67,14 @@ def test_a_step_lands_on_a_neighbouring_sample_and_pauses(n, start, step):
     assert back.offset == pb.times[inside]
 
 
-def test_resuming_a_finished_paused_playback_starts_it_over_and_speed_is_kept():
+def test_resuming_at_the_end_starts_over_and_keeps_the_speed():
     pb = rescheduled(_playback(5, 2.0), 0.0, t=2.0, paused=True, speed=2.0)
     again = rescheduled(pb, 1.0, paused=False)
     assert again.offset == 0.0 and not again.paused and again.speed == 2.0
     assert playback_time(again, 1.5) == pytest.approx(1.0)
+    ended = _playback(5, 2.0)  # played to its end, never paused
+    assert rescheduled(ended, 9.0, paused=False).offset == 0.0
+    assert rescheduled(ended, 9.0, speed=2.0).offset == 2.0  # a speed change alone keeps it
 
 
 def test_a_fast_playback_holds_its_last_pose_for_the_hold_in_clock_seconds():
