@@ -7,7 +7,6 @@ them. What the robot shows is read back from the scene (``GET /api/scene/playbac
 
 from __future__ import annotations
 
-import io
 import time
 from typing import Any
 
@@ -16,28 +15,16 @@ import pytest
 
 from tests.web.test_policies import policy_bytes
 
-from .conftest import ARTIFACTS, Studio, shot
+from .conftest import Studio, shot
+from .test_stories import _pixels, _scene_png, _wait
 
 pytestmark = pytest.mark.e2e
 
 T = 20_000  # ms: the longest a single UI step may take
 
 
-def _wait(cond, timeout: float = 15.0, step: float = 0.1) -> bool:
-    end = time.monotonic() + timeout
-    while time.monotonic() < end:
-        if cond():
-            return True
-        time.sleep(step)
-    return bool(cond())
-
-
-def _scene_pixels(page: Any, name: str) -> np.ndarray:
-    from PIL import Image
-
-    png = page.locator("[data-testid='scene-frame']").screenshot()
-    (ARTIFACTS / f"{name}.png").write_bytes(png)
-    return np.asarray(Image.open(io.BytesIO(png)).convert("RGB"), dtype=float)
+def _until(cond, timeout: float = 15.0) -> bool:
+    return _wait(cond, timeout)
 
 
 def _watch_uploaded_policy(page: Any, tmp_path: Any) -> None:
@@ -66,33 +53,33 @@ def test_scrub_a_rollout_change_its_speed_and_step_it(
     # To the start and to the end: the robot's joints follow the slider, and stay there.
     slider.focus()
     slider.press("Home")
-    assert _wait(lambda: scene()["paused"] and scene()["sample"] == 0)
+    assert _until(lambda: scene()["paused"] and scene()["sample"] == 0)
     start = np.array(scene()["q_robot_deg"])
     slider.press("End")
-    assert _wait(lambda: scene()["sample"] == scene()["samples"] - 1)
-    assert _wait(lambda: not np.allclose(scene()["q_robot_deg"], start, atol=1e-3))
+    assert _until(lambda: scene()["sample"] == scene()["samples"] - 1)
+    assert _until(lambda: not np.allclose(scene()["q_robot_deg"], start, atol=1e-3))
     end = np.array(scene()["q_robot_deg"])
     shot(page, "23-4-scrubbed-end", "sec-watch")
 
     # One sample back, one forward: the robot moves between neighbouring samples.
     page.get_by_role("button", name="Step back").click()
     last = scene()["samples"] - 1
-    assert _wait(lambda: scene()["sample"] == last - 1)
-    assert _wait(lambda: not np.allclose(scene()["q_robot_deg"], end, atol=1e-6))
+    assert _until(lambda: scene()["sample"] == last - 1)
+    assert _until(lambda: not np.allclose(scene()["q_robot_deg"], end, atol=1e-6))
     page.get_by_role("button", name="Step forward").click()
-    assert _wait(lambda: scene()["sample"] == last)
-    assert _wait(lambda: np.allclose(scene()["q_robot_deg"], end, atol=1e-3))
+    assert _until(lambda: scene()["sample"] == last)
+    assert _until(lambda: np.allclose(scene()["q_robot_deg"], end, atol=1e-3))
     assert page.inner_text("[data-testid='rollout-clock']").endswith(" s")
 
     # Speed 4x, then play from the start: the scene plays at that speed and the slider follows.
     page.get_by_role("combobox", name="Rollout speed").select_option("4")
-    assert _wait(lambda: scene()["speed"] == 4)
+    assert _until(lambda: scene()["speed"] == 4)
     slider.press("Home")
-    assert _wait(lambda: scene()["sample"] == 0)
+    assert _until(lambda: scene()["sample"] == 0)
     page.get_by_role("button", name="Play").click()
-    assert _wait(lambda: not scene()["paused"])
-    assert _wait(lambda: float(slider.input_value()) > 0, 10)
-    assert _wait(lambda: scene()["finished"], 20)
+    assert _until(lambda: not scene()["paused"])
+    assert _until(lambda: float(slider.input_value()) > 0, 10)
+    assert _until(lambda: scene()["finished"], 20)
     assert not page.is_visible("[data-testid='rollout-error']")
     assert not page.errors  # type: ignore[attr-defined]
 
@@ -104,21 +91,21 @@ def test_camera_presets_move_the_scene_camera(page: Any, studio_server: Studio) 
     def cameras() -> list[dict]:
         return studio_server.get("/api/scene/views")["cameras"]
 
-    assert _wait(lambda: len(cameras()) >= 1, 20)
+    assert _until(lambda: len(cameras()) >= 1, 20)
     page.get_by_role("button", name="Top view").click()
-    assert _wait(lambda: all(c["position"][2] > 4.0 for c in cameras()))
+    assert _until(lambda: all(c["position"][2] > 4.0 for c in cameras()))
     time.sleep(0.5)  # the browser draws the new view (no event to wait for inside WebGL)
-    top = _scene_pixels(page, "23-4-top-view")
+    top = _pixels(_scene_png(page, "23-4-top-view"))
     page.get_by_role("button", name="Side view").click()
-    assert _wait(lambda: all(c["position"][0] < -2.0 for c in cameras()))
+    assert _until(lambda: all(c["position"][0] < -2.0 for c in cameras()))
     page.get_by_role("button", name="Front view").click()
-    assert _wait(lambda: all(c["position"][1] < -3.0 for c in cameras()))
-    assert _wait(lambda: np.abs(_scene_pixels(page, "23-4-front-view") - top).mean() > 1.0)
+    assert _until(lambda: all(c["position"][1] < -3.0 for c in cameras()))
+    assert _until(lambda: np.abs(_pixels(_scene_png(page, "23-4-front-view")) - top).mean() > 1.0)
     follow = page.get_by_role("checkbox", name="Follow the tool")
     follow.check()
-    assert _wait(lambda: studio_server.get("/api/scene/views")["following"])
+    assert _until(lambda: studio_server.get("/api/scene/views")["following"])
     follow.uncheck()
-    assert _wait(lambda: not studio_server.get("/api/scene/views")["following"])
+    assert _until(lambda: not studio_server.get("/api/scene/views")["following"])
     shot(page, "23-4-camera", "sec-watch")
 
 
@@ -139,7 +126,7 @@ def test_pose_the_robot_by_hand_and_use_it_as_the_goal(page: Any, studio_server:
     def shown() -> list[float]:
         return studio_server.get("/api/scene/playback")["q_robot_deg"]
 
-    assert _wait(lambda: abs(shown()[0] - 160) < 1e-3 and abs(shown()[1] + 110) < 1e-3)
+    assert _until(lambda: abs(shown()[0] - 160) < 1e-3 and abs(shown()[1] + 110) < 1e-3)
     joint3 = float(page.get_by_role("slider", name="Joint 3").input_value())
     page.get_by_role("button", name="Use this pose as the goal").click()
     goal = [float(page.input_value(f"[data-testid='train-goal-{i}']")) for i in range(3)]
