@@ -45,6 +45,7 @@ from .routers import (
     recordings,
     run_notes,
     runs,
+    scene_controls,
     sources,
     sweeps,
     watch,
@@ -107,6 +108,7 @@ def create_app(settings: Settings | None = None, scene: Scene | None = None) -> 
         sweeps,
         policies,
         watch,
+        scene_controls,
         events,
     ):
         app.include_router(module.router)

@@ -44,8 +44,9 @@ from studio.kinematics import (
 
 from ._hand_handle import HandHandle
 from ._protocols import HandMoved, LivePose
-from ._scene_model import Mode, Playback, SceneLayout, pose_at
+from ._scene_model import Mode, Playback, SceneLayout, playback_time, pose_at, rescheduled
 from ._scene_model import camera_projection as camera_projection
+from ._scene_views import SceneCamera
 
 log = logging.getLogger(__name__)
 
@@ -166,6 +167,7 @@ class StudioScene:
 
         self._build()
         self.hand_handle = HandHandle(server)
+        self.camera = SceneCamera(server, self.layout)  # presets, following the tool
         self._arms: dict[str, HumanArm] = {}  # the hand guide's arm model per side
         self._thread = threading.Thread(target=self._loop, name="studio-scene", daemon=True)
         self._thread.start()
@@ -472,6 +474,8 @@ class StudioScene:
                 self._push_operator(operator, operator.rest, whole=True)
             if robot_changed and pose.q_robot is not None:
                 self._push_robot(self._robot_handles, pose.q_robot)
+                if self.camera.following:
+                    self.camera.follow(self.robot.forward(pose.q_robot)[:3, 3])
             if playback is not None and pose.trace_upto > shown.trace_upto:
                 self._push_trace(playback, pose.trace_upto)
                 shown.trace_upto = pose.trace_upto
@@ -667,6 +671,41 @@ class StudioScene:
         else:
             marks = np.array([0, n - 1])
         playback = Playback(t, q, self.tool_positions(q), marks, time.perf_counter())
+        with self._lock:
+            self._playback = playback
+        self._wake.set()
+
+    def scrub(
+        self,
+        t: float | None = None,
+        speed: float | None = None,
+        paused: bool | None = None,
+        step: int = 0,
+    ) -> tuple[Playback, float] | None:
+        """Reschedule the playback now (:func:`._scene_model.rescheduled`); with no change,
+        only read it. None when nothing was played.
+
+        Returns:
+            The playback in force and its trajectory time now (s).
+        """
+        now = time.perf_counter()
+        with self._lock:
+            playback = self._playback
+            if playback is None:
+                return None
+            if t is not None or speed is not None or paused is not None or step:
+                playback = rescheduled(playback, now, t=t, speed=speed, paused=paused, step=step)
+                self._playback = playback
+        self._wake.set()
+        return playback, playback_time(playback, now)
+
+    def hold_pose(self, q_robot: np.ndarray) -> None:
+        """Show the robot at ``q_robot`` (rad) until the next playback or stop: a jogged pose,
+        a paused playback of one pose."""
+        q = np.repeat(np.asarray(q_robot, dtype=float).reshape(1, -1), 2, axis=0)
+        t = np.array([0.0, 1e-3])
+        marks = np.zeros(0, dtype=int)
+        playback = Playback(t, q, self.tool_positions(q), marks, time.perf_counter(), paused=True)
         with self._lock:
             self._playback = playback
         self._wake.set()

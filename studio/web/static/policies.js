@@ -93,6 +93,7 @@ export async function watch() {
     const from = w.seed == null ? "from the current pose" : `from a random start (seed ${w.seed})`;
     setText("watch-result", `${w.steps} steps, ${secs.toFixed(1)} s ${from} — ${w.reached_goal ? "reaches the goal" : "does not reach the goal"}`);
     S.watchedRun = t;
+    document.dispatchEvent(new CustomEvent("studio:watch", { detail: w })); // watch.js: the scrubber
   }, $("watch-go"));
 }
 
