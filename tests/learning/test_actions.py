@@ -133,3 +133,10 @@ def test_a_bad_action_set_is_refused_in_one_sentence(capsys):
     out = capsys.readouterr().err
     assert "--actions sets the continuous task; add --task arm-reach" in out
     assert "Traceback" not in out and out.count("\n") == 1
+
+
+def test_a_sweep_trial_takes_the_action_set():
+    from studio.learning._sweep_spec import resolve_trial
+
+    record = resolve_trial("arm-reach", {"joints": 3, "actions": "all"}, 1, 2, 0)
+    assert record.arm_reach().n_actions == 26
