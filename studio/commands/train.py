@@ -34,6 +34,7 @@ from typing import cast
 from studio import StudioError, read_json
 from studio.capture import DEMO_FORMAT, DEMO_SUFFIX, load_demonstration
 from studio.learning import (
+    ACTION_SETS,
     DEFAULT_EPISODES,
     DEFAULT_EXPERIMENTS,
     DEFAULT_GOAL_JOINTS_DEG,
@@ -108,6 +109,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--step-deg",
         type=float,
         help=f"arm-reach: joint increment per action, degrees (default: {REACH_DEFAULTS['step_deg']:g})",
+    )
+    parser.add_argument(
+        "--actions",
+        choices=ACTION_SETS,
+        help="arm-reach: what one action moves: one joint, also two joints together, or any "
+        f"joints at once (default: {REACH_DEFAULTS['actions']})",
     )
     parser.add_argument(
         "--tilings",

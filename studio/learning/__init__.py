@@ -98,6 +98,7 @@ from ._prepare import learner_ready as learner_ready
 from ._prepare import prepare_in_background as prepare_in_background
 from ._prepare import prepare_learner as prepare_learner
 from ._prepare import preparing_note as preparing_note
+from ._reach import ACTION_SETS as ACTION_SETS
 from ._reach import ArmReach as ArmReach
 from ._reproduce import ReproduceResult as ReproduceResult
 from ._reproduce import generate_demonstrations as generate_demonstrations

@@ -244,6 +244,7 @@ class RunRecord:
             form.update(
                 joints=self.task.joints,
                 step_deg=self.task.step_deg,
+                actions=self.task.actions,
                 tilings=coding.tilings,
                 tiles=coding.tiles,
             )

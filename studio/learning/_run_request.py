@@ -44,6 +44,7 @@ _FEATURES = ArmReach().features()
 REACH_DEFAULTS: Final = {
     "joints": ArmReach.joints,
     "step_deg": ArmReach.step_deg,
+    "actions": ArmReach.actions,
     "tilings": _FEATURES.tilings,
     "tiles": _FEATURES.tiles,
 }

@@ -368,6 +368,8 @@ class ReachRunCreate(_RunCreateBase):
     """Joints 1..J learnt (3 to 6)."""
     step_deg: float = REACH_DEFAULTS["step_deg"]
     """Joint increment per action, degrees."""
+    actions: str = REACH_DEFAULTS["actions"]
+    """What one action moves: "single" (one joint), "pairs" (also two together), "all"."""
     tilings: int = REACH_DEFAULTS["tilings"]
     """Offset tilings of each joint."""
     tiles: int = REACH_DEFAULTS["tiles"]
@@ -397,6 +399,7 @@ class RunDefaults(GridRunCreate):
 
     joints: int = REACH_DEFAULTS["joints"]
     step_deg: float = REACH_DEFAULTS["step_deg"]
+    actions: str = REACH_DEFAULTS["actions"]
     tilings: int = REACH_DEFAULTS["tilings"]
     tiles: int = REACH_DEFAULTS["tiles"]
 

@@ -91,7 +91,10 @@ function readTrainForm() {
     err.data = { problems, by_field: Object.fromEntries(empty.map((k, i) => [k, problems[i]])) };
     throw err;
   }
-  if (body.task === "arm-reach") for (const k of REACH_FIELDS) body[k] = num(k);
+  if (body.task === "arm-reach") {
+    for (const k of REACH_FIELDS) body[k] = num(k);
+    body.actions = f.actions.value;
+  }
   if (f.name.value.trim()) body.name = f.name.value.trim();
   return body;
 }
