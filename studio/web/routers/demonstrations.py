@@ -10,15 +10,18 @@ from __future__ import annotations
 from fastapi import APIRouter, Response
 
 from studio.capture import RECORDING_SUFFIX, RECORDING_SUFFIXES, Demonstration
-from studio.learning import goal_degrees, has_default_goal
+from studio.learning import ConfigError, goal_degrees, has_default_goal
 
 from .._deps import StudioDep
+from .._runs import prepare_run
 from .._schemas import (
     DemonstrationCreate,
     DemonstrationDetail,
     DemonstrationMark,
     DemonstrationPublic,
     MarkPublic,
+    RunCheckPublic,
+    RunCreate,
 )
 from .._state import Studio
 from .._store import StoredFile
@@ -103,6 +106,18 @@ def mark_demonstration(body: DemonstrationMark, studio: StudioDep) -> MarkPublic
         return MarkPublic(marking=True, t0=studio.mark_start())
     name = studio.mark_stop(body.goal_from_end, body.name)
     return MarkPublic(marking=False, t0=None, demonstration=read_public(studio, name))
+
+
+@router.post("/check")
+def check_run_demonstrations(body: RunCreate, studio: StudioDep) -> RunCheckPublic:
+    """Check a run form as it is filled in (the demonstrations picked against its goal and task)
+    with the one resolver a run is started with; nothing is queued. 422 only for a form that is
+    not a run form at all."""
+    try:
+        prepare_run(body, studio.demonstration_path)
+    except ConfigError as err:
+        return RunCheckPublic(problems=err.problems, by_field=err.by_field)
+    return RunCheckPublic(problems=[], by_field={})
 
 
 @router.get("/{name}")

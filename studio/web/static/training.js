@@ -96,6 +96,28 @@ function readTrainForm() {
   return body;
 }
 
+/** Fields the form checks as they are filled in: the demonstrations picked against the goal. */
+const LIVE_CHECKED = ["demonstrations", "goal_deg"];
+let checkSeq = 0;
+
+/** Check the picked demonstrations against the form's goal and task now, before Start, with the
+ * learning package's own resolver (/api/demonstrations/check); show its sentences by field. */
+export async function checkTrainForm() {
+  const seq = ++checkSeq;
+  let body;
+  try { body = readTrainForm(); } catch { return; } // an empty number: Start will say which
+  if (!body.demonstrations.length) { showTrainErrors(null); return; }
+  let res;
+  try { res = await api("POST", "/api/demonstrations/check", body); } catch { return; }
+  if (seq !== checkSeq) return; // a newer check is on its way
+  const byField = Object.fromEntries(Object.entries(res.by_field || {}).filter(([k]) => LIVE_CHECKED.includes(k)));
+  const problems = Object.values(byField);
+  if (!problems.length) { showTrainErrors(null); return; }
+  const err = new ApiError(problems.join(" "));
+  err.data = { problems, by_field: byField };
+  showTrainErrors(err);
+}
+
 export async function startRun(ev) {
   ev.preventDefault();
   showTrainErrors(null);
