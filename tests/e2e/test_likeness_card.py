@@ -3,25 +3,14 @@ as it is filled in (before Start)."""
 
 from __future__ import annotations
 
-import time
 from typing import Any
 
 from tests.e2e.conftest import Studio, shot
+from tests.e2e.test_continuous import _wait
 
 T = 20_000  # ms: the longest a single UI step may take
 TRAIN_TIMEOUT_S = 180.0
 DEMO = "sample-reach-1"
-
-
-def _wait(predicate: Any, timeout: float) -> Any:
-    """Poll ``predicate`` until it returns something truthy (the event, not a fixed sleep)."""
-    end = time.monotonic() + timeout
-    while time.monotonic() < end:
-        value = predicate()
-        if value:
-            return value
-        time.sleep(0.2)
-    return predicate()
 
 
 def test_watching_a_policy_shows_its_likeness_card_with_both_columns(
