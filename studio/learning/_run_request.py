@@ -242,9 +242,8 @@ def _motions(request: RunRequest, problems: list[tuple[str, str]]) -> list[Demon
         if demo.times is None:
             continue
         try:
-            motions.append(
-                DemonstrationMotion.checked(demo.name, demo.times, demo.q_robot, demo.label)
-            )
+            name = demo.name or demo.label
+            motions.append(DemonstrationMotion.checked(name, demo.times, demo.q_robot, demo.label))
         except LearningError as err:
             problems.append(("demonstrations", str(err)))
     return motions
