@@ -9,19 +9,21 @@ removed. A segment that never reaches the goal, drives the robot into a joint li
 arm badly is refused with the reason; with ``goal_from_end=True`` the goal becomes wherever the
 segment ends, and a ``grid`` with another goal cuts at that goal.
 
-File (``*.demo.json``, next to its recording), version 2: the trajectory and its own goal, and
-nothing derived from them::
+File (``*.demo.json``, next to its recording), version 2: the trajectory and its own goal;
+``grid_path`` is what learning's one path function gave when it was cut (for readers outside the
+studio), checked on load and traced again from the trajectory::
 
     {"format": "teach-studio-demonstration", "version": 2, "robot": "puma560",
      "recording": "reach.tape.csv", "segment": [t0, t1], "mode": "joint",
      "grid": {"joints": 3, "bins": 11, "low_deg": -180, "high_deg": 180, "goal": [5, 6, 2]},
-     "goal": [5, 6, 2], "reached_at": t, "fit": {"residual_max": m, "residual_mean": m},
+     "goal": [5, 6, 2], "grid_path": [state, ...], "reached_at": t,
+     "fit": {"residual_max": m, "residual_mean": m},
      "trajectory": {"t": [...], "q_robot": [[6 angles], ...]}, "name": "...", "created": "..."}
 
 What a task makes of the trajectory is :mod:`studio.learning`'s alone: the grid path
 (``ArmGrid.path_from_joints``, traced again on load and by every run), a continuous run's joint
-path and the likeness card's motion. Version 1 files (today's samples among them) also stored
-``grid_path``, ``mirror`` and ``fit.max_allowed``; they load as before, those fields ignored. A
+path and the likeness card's motion. Version 1 files also stored ``mirror`` and
+``fit.max_allowed``, which nothing read; they load as before. A
 file is refused with one sentence when its joints are for another robot or another number of
 joints, it holds NaN samples or it is a cut of zero length; a run refuses one whose trajectory
 never reaches the run's goal.
@@ -55,7 +57,7 @@ from ._recording_reader import Recording
 DEMO_FORMAT = "teach-studio-demonstration"
 """The ``format`` value of demonstration files."""
 DEMO_VERSION = 2
-"""The version this code writes and the newest it reads (1: with the derived ``grid_path``)."""
+"""The version this code writes and the newest it reads (2 adds ``robot``)."""
 DEMO_ROBOT = "puma560"
 """The robot a demonstration's ``q_robot`` is for (the learning tasks' arm)."""
 MAX_FIT_RESIDUAL_M = 0.03
@@ -159,6 +161,7 @@ class Demonstration:
             "mode": self.mode,
             "grid": {k: v for k, v in self.grid.items() if k != "goal"},
             "goal": list(self.goal),
+            "grid_path": list(self.grid_path),
             "reached_at": self.reached_at,
             "fit": {
                 "residual_max": round(self.residual_max, TRAJECTORY_DECIMALS),
@@ -258,7 +261,9 @@ def load_demonstration(path: str | os.PathLike[str]) -> Demonstration:
             t1=float(read("segment", "two times in seconds", _floats)[1]),
             times=times,
             q_robot=q_robot,
-            grid_path=[],  # traced from the trajectory below (a stored one, version 1, is old)
+            # checked, then traced again from the trajectory below: a path stored by older
+            # code, or edited by hand, never replays
+            grid_path=read("grid_path", "a list of whole grid states", _whole_numbers),
             # the grid's values are checked by ArmGrid when the path is traced below
             grid=cast(GridSpec, read("grid", "a table of grid settings", _table)),
             goal=tuple(read("goal", "whole grid bins, one per joint", _whole_numbers)),
