@@ -99,6 +99,13 @@ function readTrainForm() {
 /** Fields the form checks as they are filled in: the demonstrations picked against the goal. */
 const LIVE_CHECKED = ["demonstrations", "goal_deg"];
 let checkSeq = 0;
+let checkShown = false; // whether the sentences beside the form are the live check's
+
+/** Clear what the live check showed (never a refused Start's sentences). */
+function clearCheck() {
+  if (checkShown) showTrainErrors(null);
+  checkShown = false;
+}
 
 /** Check the picked demonstrations against the form's goal and task now, before Start, with the
  * learning package's own resolver (/api/demonstrations/check); show its sentences by field. */
@@ -106,20 +113,23 @@ export async function checkTrainForm() {
   const seq = ++checkSeq;
   let body;
   try { body = readTrainForm(); } catch { return; } // an empty number: Start will say which
-  if (!body.demonstrations.length) { showTrainErrors(null); return; }
+  if (!body.demonstrations.length) { clearCheck(); return; }
   let res;
   try { res = await api("POST", "/api/demonstrations/check", body); } catch { return; }
   if (seq !== checkSeq) return; // a newer check is on its way
   const byField = Object.fromEntries(Object.entries(res.by_field || {}).filter(([k]) => LIVE_CHECKED.includes(k)));
   const problems = Object.values(byField);
-  if (!problems.length) { showTrainErrors(null); return; }
+  if (!problems.length) { clearCheck(); return; }
   const err = new ApiError(problems.join(" "));
   err.data = { problems, by_field: byField };
   showTrainErrors(err);
+  checkShown = true;
 }
 
 export async function startRun(ev) {
   ev.preventDefault();
+  checkSeq++; // a check still on its way must not redraw the form's sentences
+  checkShown = false;
   showTrainErrors(null);
   const button = $("train-start");
   button.disabled = true;
