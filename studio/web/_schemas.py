@@ -495,15 +495,6 @@ class PolicyPublic(BaseModel):
     notes: str = ""
 
 
-class RunCheckPublic(BaseModel):
-    """What the learning package would refuse in a run form, checked as it is filled in."""
-
-    problems: list[str]
-    """One sentence per problem (empty when the run would start)."""
-    by_field: dict[str, str]
-    """The same sentences keyed by the form's field (``demonstrations``, ``goal_deg``, ...)."""
-
-
 class WatchCreate(_Body):
     """Play a policy on the robot in the scene."""
 

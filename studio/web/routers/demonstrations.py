@@ -10,7 +10,7 @@ from __future__ import annotations
 from fastapi import APIRouter, Response
 
 from studio.capture import RECORDING_SUFFIX, RECORDING_SUFFIXES, Demonstration
-from studio.learning import ConfigError, goal_degrees, has_default_goal
+from studio.learning import goal_degrees, has_default_goal
 
 from .._deps import StudioDep
 from .._runs import prepare_run
@@ -20,7 +20,6 @@ from .._schemas import (
     DemonstrationMark,
     DemonstrationPublic,
     MarkPublic,
-    RunCheckPublic,
     RunCreate,
 )
 from .._state import Studio
@@ -108,16 +107,13 @@ def mark_demonstration(body: DemonstrationMark, studio: StudioDep) -> MarkPublic
     return MarkPublic(marking=False, t0=None, demonstration=read_public(studio, name))
 
 
-@router.post("/check")
-def check_run_demonstrations(body: RunCreate, studio: StudioDep) -> RunCheckPublic:
+@router.post("/check", status_code=204, response_class=Response)
+def check_run_demonstrations(body: RunCreate, studio: StudioDep) -> Response:
     """Check a run form as it is filled in (the demonstrations picked against its goal and task)
-    with the one resolver a run is started with; nothing is queued. 422 only for a form that is
-    not a run form at all."""
-    try:
-        prepare_run(body, studio.demonstration_path)
-    except ConfigError as err:
-        return RunCheckPublic(problems=err.problems, by_field=err.by_field)
-    return RunCheckPublic(problems=[], by_field={})
+    with the one resolver a run is started with; nothing is queued. 204 when it would start, else
+    the 422 starting it would answer (``detail``, ``problems``, ``by_field``)."""
+    prepare_run(body, studio.demonstration_path)
+    return Response(status_code=204)
 
 
 @router.get("/{name}")

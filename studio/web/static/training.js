@@ -114,10 +114,15 @@ export async function checkTrainForm() {
   let body;
   try { body = readTrainForm(); } catch { return; } // an empty number: Start will say which
   if (!body.demonstrations.length) { clearCheck(); return; }
-  let res;
-  try { res = await api("POST", "/api/demonstrations/check", body); } catch { return; }
+  let data = {};
+  try {
+    await api("POST", "/api/demonstrations/check", body); // 204: it would start
+  } catch (e) {
+    if (!(e instanceof ApiError) || !e.data) return; // offline: Start will say
+    data = e.data;
+  }
   if (seq !== checkSeq) return; // a newer check is on its way
-  const byField = Object.fromEntries(Object.entries(res.by_field || {}).filter(([k]) => LIVE_CHECKED.includes(k)));
+  const byField = Object.fromEntries(Object.entries(data.by_field || {}).filter(([k]) => LIVE_CHECKED.includes(k)));
   const problems = Object.values(byField);
   if (!problems.length) { clearCheck(); return; }
   const err = new ApiError(problems.join(" "));
