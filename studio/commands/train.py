@@ -194,8 +194,9 @@ def _grid_paths(data: object, source: Path) -> list[list[int]]:
 def _recorded(source: Path) -> DemonstrationPath:
     """A cut demonstration (``*.demo.json``): its joint trajectory, which the run replays along
     the path the page replays, never the file's stored ``grid_path`` (written by older code, or
-    edited by hand)."""
-    return DemonstrationPath(f"The demonstration {source}", load_demonstration(source).q_robot)
+    edited by hand); its times too, for the run's likeness card."""
+    demo = load_demonstration(source)
+    return DemonstrationPath(f"The demonstration {source}", demo.q_robot, times=demo.times)
 
 
 def _numbers(text: str, flag: str, kind: Callable[[str], float], example: str) -> list[float]:

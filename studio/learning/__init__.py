@@ -33,6 +33,9 @@ from ._curves import curve_statistics as curve_statistics
 from ._curves import curves_csv as curves_csv
 from ._curves import downsample_curve as downsample_curve
 from ._curves import write_curves_csv as write_curves_csv
+from ._demo_motion import DemonstrationMotion as DemonstrationMotion
+from ._demo_motion import demonstration_grid_path as demonstration_grid_path
+from ._demo_motion import motion_problem as motion_problem
 from ._dmp import DMP_BASIS as DMP_BASIS
 from ._dmp import MovementPrimitive as MovementPrimitive
 from ._dmp import fit_movement_primitive as fit_movement_primitive
@@ -103,6 +106,9 @@ from ._reach import ArmReach as ArmReach
 from ._reproduce import ReproduceResult as ReproduceResult
 from ._reproduce import generate_demonstrations as generate_demonstrations
 from ._reproduce import reproduce as reproduce
+from ._run_likeness import LIKENESS_FILE as LIKENESS_FILE
+from ._run_likeness import likeness_cards as likeness_cards
+from ._run_likeness import likeness_document as likeness_document
 from ._run_notes import MAX_NOTES_CHARS as MAX_NOTES_CHARS
 from ._run_notes import MAX_TAG_CHARS as MAX_TAG_CHARS
 from ._run_notes import MAX_TAGS as MAX_TAGS

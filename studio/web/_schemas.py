@@ -505,6 +505,32 @@ class WatchCreate(_Body):
     policy: str | None = None
     start: Literal["random", "current"] = "random"
     seed: int | None = Field(None, ge=0)
+    demonstration: str | None = Field(None, max_length=200)
+    """The demonstration the likeness card compares with (a name from the list); default the
+    run's own first demonstration, or a movement primitive's."""
+
+
+class MotionFiguresPublic(BaseModel):
+    """One motion's own figures (``studio.learning.MotionFigures``; null where undefined)."""
+
+    ldlj: float | None
+    joint_shares: list[float | None]
+    together: float | None
+    duration_s: float | None
+    joint_travel_rad: float | None
+    tool_path_m: float | None
+
+
+class LikenessPublic(BaseModel):
+    """A likeness card (``studio.learning.LikenessCard.to_dict()``) and what it compared."""
+
+    name: str
+    """The demonstration compared with, rolled out from its own start."""
+    dtw_rad: float | None
+    frechet_m: float | None
+    shares_js: float | None
+    policy: MotionFiguresPublic
+    demonstration: MotionFiguresPublic
 
 
 class WatchPublic(BaseModel):
@@ -519,3 +545,7 @@ class WatchPublic(BaseModel):
     times: list[float]
     q_robot: list[list[float]]
     reached_goal: bool
+    likeness: LikenessPublic | None = None
+    """The policy's likeness card against a demonstration, or None when there is none to
+    compare with (``likeness_note`` says why)."""
+    likeness_note: str = ""

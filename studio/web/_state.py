@@ -31,7 +31,13 @@ from studio.capture import (
     SimulatorSource,
     source_from_spec,
 )
-from studio.learning import GOAL_JOINTS, PolicyFile, TilePolicyFile, check_goal_deg
+from studio.learning import (
+    GOAL_JOINTS,
+    DemonstrationPath,
+    PolicyFile,
+    TilePolicyFile,
+    check_goal_deg,
+)
 
 from ._errors import ConflictError, InvalidError, NotFoundError, TooManyRequestsError
 from ._pipeline import Pipeline
@@ -388,8 +394,8 @@ class Studio:
 
     # ------------------------------------------------------------------ demonstrations
 
-    def demonstration_path(self, name: str) -> np.ndarray:
-        """The Puma560 joint path ``(N, 6)`` (rad) of a demonstration, for training runs.
+    def demonstration_path(self, name: str) -> DemonstrationPath:
+        """A demonstration's Puma560 joint path ``(N, 6)`` (rad) and times, for training runs.
 
         Raises:
             InvalidError: no such demonstration (a bad run parameter, so 422 rather than 404).
@@ -400,7 +406,7 @@ class Studio:
             raise InvalidError(
                 f"demonstrations names {name!r}, which does not exist; pick demonstrations from the list."
             ) from None
-        return np.asarray(demo.q_robot, dtype=np.float64)
+        return DemonstrationPath(f"Demonstration {name!r}", demo.q_robot, name, demo.times)
 
     def cut_demonstration(
         self,

@@ -20,7 +20,7 @@ import { wireCompare } from "./compare.js";
 import { SOFTWARE_RENDERERS, SOFTWARE_SCENE_DPR, loadConfig, softwareWebGL } from "./scene.js";
 import { applySource, playback, renderSource, setRetarget, simulatorReach, syncKindOptions } from "./sources.js";
 import { S, markCurvesDirty } from "./state.js";
-import { resetTrainForm, startRun, syncTaskFields } from "./training.js";
+import { checkTrainForm, resetTrainForm, startRun, syncTaskFields } from "./training.js";
 
 function wire() {
   // The buttons that follow the live source; camera.js listens after them.
@@ -69,6 +69,7 @@ function wire() {
 
   $("train-form").addEventListener("submit", startRun);
   $("train-form").elements.task.addEventListener("change", syncTaskFields);
+  $("train-form").addEventListener("change", (ev) => { if (ev.target.closest("#train-demos, .goal3") || ["task", "bins"].includes(ev.target.name)) checkTrainForm(); });
   $("train-defaults").addEventListener("click", resetTrainForm);
   $("train-defaults").addEventListener("click", syncTaskFields); // after the reset above
   $("curve-log").addEventListener("change", markCurvesDirty);
