@@ -43,6 +43,7 @@ from .routers import (
     events,
     policies,
     recordings,
+    robots,
     runs,
     sources,
     sweeps,
@@ -98,6 +99,7 @@ def create_app(settings: Settings | None = None, scene: Scene | None = None) -> 
     for module in (
         config,
         sources,
+        robots,
         capture,
         recordings,
         demonstrations,

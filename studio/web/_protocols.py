@@ -15,6 +15,7 @@ from typing import NamedTuple, Protocol
 import numpy as np
 
 from studio.capture import Observation
+from studio.kinematics import RobotArm
 
 
 class LivePose(NamedTuple):
@@ -70,6 +71,9 @@ class Scene(LiveScene, Protocol):
 
     def stop_playback(self) -> None:
         """Stop a playback."""
+
+    def set_robot(self, arm: RobotArm | None) -> None:
+        """Draw ``arm`` (None: the Puma560) from its own meshes."""
 
     def current_q_robot(self) -> np.ndarray:
         """The robot joints shown now."""

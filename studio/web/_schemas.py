@@ -117,6 +117,12 @@ class SourcePublic(BaseModel):
     )
     camera_fps: float | None = Field(None, description="camera: the frame rate the page reported")
     model: str | None = Field(None, description="camera: the pose model the page reported")
+    robot: str = Field("puma560", description="the robot taught (`studio robots` lists them)")
+    robot_warning: str | None = Field(
+        None,
+        description="why the robot does not follow the hand now (out of its reach, or held "
+        "clear of a self-collision), else null",
+    )
 
 
 class SourceUpdate(_Body):
@@ -516,3 +522,27 @@ class WatchPublic(BaseModel):
     times: list[float]
     q_robot: list[list[float]]
     reached_goal: bool
+
+
+# ----------------------------------------------------------------------------- robots
+
+
+class RobotChoice(_Body):
+    """Choose the robot the operator teaches."""
+
+    name: str = Field(description="one of the names `GET /api/robots` lists")
+
+
+class RobotInfo(BaseModel):
+    """One offered robot."""
+
+    name: str
+    title: str
+    joints: list[str]
+
+
+class RobotsPublic(BaseModel):
+    """The offered robots (the default first) and the one taught now."""
+
+    robots: list[RobotInfo]
+    robot: str

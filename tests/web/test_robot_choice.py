@@ -1,0 +1,90 @@
+"""Choosing the robot the operator teaches: the API, the live chain onto it, and what the page is
+told when it cannot follow the hand."""
+
+from __future__ import annotations
+
+import numpy as np
+from fastapi.testclient import TestClient
+
+from studio.kinematics import RetargetConfig, Retargeter, load_robot, robot_names
+from studio.web._pipeline import robot_note
+
+from .conftest import wait_for
+
+EVIL = "http://evil.example"
+
+
+def test_the_offered_robots_are_listed_with_their_joints_puma560_taught_by_default(
+    client: TestClient,
+) -> None:
+    body = client.get("/api/robots").json()
+    assert [r["name"] for r in body["robots"]] == list(robot_names())
+    panda = next(r for r in body["robots"] if r["name"] == "panda")
+    assert panda["joints"] == list(load_robot("panda").joint_names)
+    assert body["robot"] == "puma560"
+    assert client.get("/api/source").json()["robot"] == "puma560"
+
+
+def test_an_unknown_robot_is_refused_in_one_sentence_and_changes_nothing(
+    client: TestClient,
+) -> None:
+    r = client.put("/api/robot", json={"name": "r2d2"})
+    assert r.status_code == 422
+    detail = r.json()["detail"]
+    assert isinstance(detail, str) and "r2d2" in detail and "panda" in detail
+    assert client.get("/api/robots").json()["robot"] == "puma560"
+
+
+def test_another_site_cannot_switch_the_robot(client: TestClient) -> None:
+    refused = client.put("/api/robot", json={"name": "panda"}, headers={"Origin": EVIL})
+    assert refused.status_code == 403
+    assert client.get("/api/robots").json()["robot"] == "puma560"
+
+
+def test_the_simulator_drives_the_panda_within_its_limits_and_the_puma_again(
+    client: TestClient,
+) -> None:
+    client.put("/api/source", json={"kind": "simulator", "seed": 3})
+    r = client.put("/api/robot", json={"name": "panda"})
+    assert r.status_code == 200 and r.json()["robot"] == "panda"
+    panda = load_robot("panda")
+    seen: list[np.ndarray] = []
+
+    def moved() -> bool:
+        s = client.get("/api/source").json()
+        q = np.array(s["q_robot"])
+        if s["robot"] == "panda" and q.shape == (7,):
+            seen.append(q)
+        return len(seen) >= 2 and not np.allclose(seen[0], seen[-1])
+
+    assert wait_for(moved), f"the Panda did not move with the simulated operator: {client.get('/api/source').json()}"
+    assert all(np.all(q >= panda.lower - 1e-9) and np.all(q <= panda.upper + 1e-9) for q in seen)
+    assert client.get("/api/source").json()["retarget"]["mode"] == "cartesian"
+    joint = client.put("/api/source/retarget", json={"mode": "joint"})
+    assert joint.status_code == 409 and "cartesian" in joint.json()["detail"]
+
+    client.put("/api/robot", json={"name": "puma560"})
+    assert wait_for(lambda: len(client.get("/api/source").json()["q_robot"]) == 6)
+    source = client.get("/api/source").json()
+    assert source["robot"] == "puma560" and source["retarget"]["mode"] == "joint"
+
+
+def test_the_page_is_told_when_the_hand_is_out_of_reach_or_the_pose_is_held() -> None:
+    panda = load_robot("panda")
+    far = Retargeter(robot=panda, config=RetargetConfig(reach_fraction=3.0))
+    reaching = np.zeros(7)
+    reaching[0] = np.pi / 2  # the arm straight out in front
+    for _ in range(40):
+        far.robot_from_human(reaching)
+    note = robot_note(panda, far)
+    assert note is not None and "out of the Franka Emika Panda's reach" in note and "cm" in note
+
+    near = Retargeter(robot=panda)
+    bent = np.zeros(7)
+    bent[0], bent[3] = np.pi / 4, np.pi / 2  # a hand in front of the chest
+    for _ in range(80):  # the robot gets there from its home, 4.5 degrees a frame at most
+        near.robot_from_human(bent)
+    assert robot_note(panda, near) is None
+    near.held = True
+    held = robot_note(panda, near)
+    assert held is not None and held.startswith("The Franka Emika Panda holds its last pose")
