@@ -57,7 +57,9 @@ def test_the_simulator_drives_the_panda_within_its_limits_and_the_puma_again(
             seen.append(q)
         return len(seen) >= 2 and not np.allclose(seen[0], seen[-1])
 
-    assert wait_for(moved), f"the Panda did not move with the simulated operator: {client.get('/api/source').json()}"
+    assert wait_for(moved), (
+        f"the Panda did not move with the simulated operator: {client.get('/api/source').json()}"
+    )
     assert all(np.all(q >= panda.lower - 1e-9) and np.all(q <= panda.upper + 1e-9) for q in seen)
     assert client.get("/api/source").json()["retarget"]["mode"] == "cartesian"
     joint = client.put("/api/source/retarget", json={"mode": "joint"})
