@@ -75,6 +75,14 @@ class Scene(LiveScene, Protocol):
     def set_robot(self, arm: RobotArm | None) -> None:
         """Draw ``arm`` (None: the Puma560) from its own meshes."""
 
+    @property
+    def robot_name(self) -> str:
+        """The robot drawn."""
+
+    @property
+    def robot_mesh_count(self) -> int:
+        """How many meshes draw it."""
+
     def current_q_robot(self) -> np.ndarray:
         """The robot joints shown now."""
 

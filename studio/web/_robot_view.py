@@ -10,6 +10,7 @@ reads at the scene's distance from the operator beside it.
 
 from __future__ import annotations
 
+import logging
 import threading
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -112,6 +113,54 @@ def arm_view(arm: RobotArm, config: MeshConfig) -> RobotView:
     return RobotView(
         arm.name, parts, arm.nq, np.array(arm.home, dtype=float), poses, tool, pedestal
     )
+
+
+log = logging.getLogger(__name__)
+
+
+class RobotViews:
+    """The robots' views, each built once; another robot's meshes are read in the background.
+
+    Args:
+        puma: the scene's Puma560 (its view is built at once: the scene starts with it).
+        config: mesh simplification.
+    """
+
+    def __init__(self, puma: Puma560, config: MeshConfig) -> None:
+        self.puma = puma_view(puma, config)
+        self._config = config
+        self._views = {self.puma.name: self.puma}
+        self._lock = threading.Lock()
+        self._wanted = self.puma.name
+
+    def request(self, arm: RobotArm | None, ready: Callable[[RobotView], None]) -> None:
+        """Build ``arm``'s view (None: the Puma560's) and hand it to ``ready``, unless another
+        robot was requested meanwhile; a mesh that cannot be read is logged (nothing drawn)."""
+        name = self.puma.name if arm is None else arm.name
+        with self._lock:
+            self._wanted = name
+        if arm is None or name in self._views:
+            self._ready(name, self._views[name], ready)
+            return
+        thread = threading.Thread(
+            target=self._load, args=(arm, ready), name="studio-robot-meshes", daemon=True
+        )
+        thread.start()
+
+    def _load(self, arm: RobotArm, ready: Callable[[RobotView], None]) -> None:
+        try:
+            view = arm_view(arm, self._config)
+        except Exception:
+            log.exception("The %s meshes could not be read; the robot drawn stays.", arm.name)
+            return
+        with self._lock:
+            self._views.setdefault(arm.name, view)
+        self._ready(arm.name, self._views[arm.name], ready)
+
+    def _ready(self, name: str, view: RobotView, ready: Callable[[RobotView], None]) -> None:
+        with self._lock:  # under the lock: a robot chosen meanwhile is never overdrawn
+            if self._wanted == name:
+                ready(view)
 
 
 def wxyz_of(rotations: np.ndarray) -> np.ndarray:

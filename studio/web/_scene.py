@@ -44,7 +44,7 @@ from studio.kinematics import (
 
 from ._hand_handle import HandHandle
 from ._protocols import HandMoved, LivePose
-from ._robot_view import RobotView, add_robot, arm_view, puma_view, rgb255, wxyz_of
+from ._robot_view import RobotView, RobotViews, add_robot, rgb255, wxyz_of
 from ._scene_model import Mode, Playback, SceneLayout, pose_at
 from ._scene_model import camera_projection as camera_projection
 
@@ -133,7 +133,8 @@ class StudioScene:
         self._bodies = {body.side: body}  # one per taped arm, sharing the meshes
         self._operator = self._operator_for(body, 0)
         self._switch_lock = threading.Lock()  # one set_side at a time
-        self._view = puma_view(self.robot, self.layout.mesh)  # the robot drawn
+        self._views = RobotViews(self.robot, self.layout.mesh)
+        self._view = self._views.puma  # the robot drawn
         self._next_view: RobotView | None = None  # a robot chosen, for the scene thread to draw
 
         # Inputs, written by any thread under _lock; the loop reads a snapshot.
@@ -277,11 +278,12 @@ class StudioScene:
         if self._pedestal is not None:
             self._pedestal.remove()
             self._pedestal = None
-        self._view = view
-        self._robot_handles = add_robot(self.server, "/robot", view)
-        self._ghost_handles = add_robot(
+        robot = add_robot(self.server, "/robot", view)
+        ghost = add_robot(
             self.server, "/goal/ghost", view, opacity=self.layout.ghost_opacity, visible=False
         )
+        self._robot_handles, self._ghost_handles = robot, ghost
+        self._view = view  # last: readers of the name see its meshes drawn
         self._goal_marker.visible = False
         if view.pedestal > 0:
             self._pedestal = self.server.scene.add_box(
@@ -701,13 +703,12 @@ class StudioScene:
         """Draw ``arm`` (a robot of :func:`~studio.kinematics.load_robot`; None or the
         ``puma560``: the Puma560) from its own meshes, framed where the Puma560 stands.
 
-        Loads its meshes here (a second or two), then returns; the scene thread draws it.
-
-        Raises:
-            KinematicsError: a mesh file is missing or unreadable (the robot drawn stays).
+        Returns at once: its meshes are read in the background (seconds, the first time only)
+        and the scene thread then draws it (:attr:`robot_name` names it once drawn).
         """
-        puma = arm is None or arm.name == "puma560"
-        view = puma_view(self.robot, self.layout.mesh) if puma else arm_view(arm, self.layout.mesh)
+        self._views.request(arm, self._draw_next)
+
+    def _draw_next(self, view: RobotView) -> None:
         with self._lock:
             self._next_view = view
         self._wake.set()
@@ -716,6 +717,11 @@ class StudioScene:
     def robot_name(self) -> str:
         """The name of the robot the scene has drawn (lags :meth:`set_robot` until drawn)."""
         return self._view.name
+
+    @property
+    def robot_mesh_count(self) -> int:
+        """How many meshes the scene draws the robot with."""
+        return len(self._robot_handles)
 
     def current_q_robot(self) -> np.ndarray:
         """The robot joints the scene shows now (rad, (nq,))."""

@@ -546,3 +546,7 @@ class RobotsPublic(BaseModel):
 
     robots: list[RobotInfo]
     robot: str
+    drawn: str | None = Field(
+        None, description="the robot the 3D scene has drawn (null without a scene)"
+    )
+    drawn_meshes: int = Field(0, description="how many meshes the scene draws it with")

@@ -350,7 +350,13 @@ class Studio:
             }
             for name in robot_names()
         ]
-        return {"robots": robots, "robot": self.pipeline.robot_name}
+        scene = self.scene
+        return {
+            "robots": robots,
+            "robot": self.pipeline.robot_name,
+            "drawn": None if scene is None else scene.robot_name,
+            "drawn_meshes": 0 if scene is None else scene.robot_mesh_count,
+        }
 
     def playback(self, action: str, t: float | None, speed: float | None) -> None:
         """Play, pause or seek the recording source.

@@ -17,7 +17,7 @@ import { exportFile, loadPolicies, uploadPolicy, watch } from "./policies.js";
 import { dismissCaptureFailure, loadRecordings, renderCaptureButton, saveRecordingEdit, toggleCapture, uploadRecording } from "./recordings.js";
 import { loadRuns, renderRuns } from "./runs.js";
 import { SOFTWARE_RENDERERS, SOFTWARE_SCENE_DPR, loadConfig, softwareWebGL } from "./scene.js";
-import { applySource, playback, renderSource, setRetarget, simulatorReach, syncKindOptions } from "./sources.js";
+import { applySource, loadRobots, playback, renderSource, setRetarget, setRobot, simulatorReach, syncKindOptions } from "./sources.js";
 import { S, markCurvesDirty } from "./state.js";
 import { resetTrainForm, startRun, syncTaskFields } from "./training.js";
 
@@ -45,6 +45,7 @@ function wire() {
   $("source-wander").addEventListener("click", () => simulatorReach("wander"));
   $("retarget-mode").addEventListener("change", setRetarget);
   $("retarget-mirror").addEventListener("change", setRetarget);
+  $("robot-name").addEventListener("change", setRobot);
 
   $("capture-toggle").addEventListener("click", toggleCapture);
   $("capture-failure-dismiss").addEventListener("click", dismissCaptureFailure);
@@ -102,7 +103,7 @@ async function main() {
     S.markT0 = m && m.t0;
     updateMarkButton();
   }).catch(() => {});
-  await Promise.all([initial, cap, mark, loadRecordings(), loadDemos(), loadRuns(), loadPolicies()]);
+  await Promise.all([initial, cap, mark, loadRobots(), loadRecordings(), loadDemos(), loadRuns(), loadPolicies()]);
   if (S.source && S.source.recording) $("source-recording").value = S.source.recording;
   document.body.dataset.ready = "1";
 }
