@@ -4,10 +4,14 @@ told when it cannot follow the hand."""
 from __future__ import annotations
 
 import numpy as np
+import viser
 from fastapi.testclient import TestClient
 
 from studio.kinematics import RetargetConfig, Retargeter, load_robot, robot_names
 from studio.web._pipeline import robot_note
+from studio.web._protocols import LivePose
+from studio.web._scene import StudioScene
+from studio.web._scene_model import SceneLayout
 
 from .conftest import wait_for
 
@@ -90,3 +94,31 @@ def test_the_page_is_told_when_the_hand_is_out_of_reach_or_the_pose_is_held() ->
     near.held = True
     held = robot_note(panda, near)
     assert held is not None and held.startswith("The Franka Emika Panda holds its last pose")
+
+
+def test_the_scene_draws_the_chosen_robot_from_its_meshes_where_the_puma_stands() -> None:
+    server = viser.ViserServer(host="127.0.0.1", port=0, verbose=False)
+    scene = StudioScene(server, layout=SceneLayout(rate_hz=100.0))
+    try:
+        panda = load_robot("panda")
+        scene.set_robot(panda)
+        assert wait_for(lambda: scene.robot_name == "panda", timeout=120.0)
+        assert scene.robot_mesh_count == len(panda.visual_model.geometryObjects)
+        names = [h.name for h in scene._robot_handles]
+        assert all(n.startswith("/robot/") and "panda_link" in n for n in names[:8])
+        # framed where the Puma560 stands: on the floor at the origin, its shoulder at the
+        # Puma560's height, far from the operator
+        points = np.concatenate(scene.robot_mesh_points(panda.home))
+        assert points[:, 2].min() > 0.0 and np.abs(points[:, :2]).max() < 1.0
+        shoulder = scene.robot_mesh_points(panda.home)[2]  # link2 turns about the shoulder
+        assert abs(np.median(shoulder[:, 2]) - load_robot("puma560").shoulder[2]) < 0.15
+        # it follows a live pose of its seven joints
+        q = np.array(panda.home) + 0.2
+        scene.show_live(LivePose(np.zeros(7), q, None))
+        assert wait_for(lambda: np.allclose(scene.current_q_robot(), q))
+        scene.set_robot(None)
+        assert wait_for(lambda: scene.robot_name == "puma560" and scene.robot_mesh_count == 7)
+        assert scene.errors == 0
+    finally:
+        scene.close()
+        server.stop()
