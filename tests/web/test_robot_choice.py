@@ -3,6 +3,9 @@ told when it cannot follow the hand."""
 
 from __future__ import annotations
 
+import io
+import zipfile
+
 import numpy as np
 import viser
 from fastapi.testclient import TestClient
@@ -122,3 +125,32 @@ def test_the_scene_draws_the_chosen_robot_from_its_meshes_where_the_puma_stands(
     finally:
         scene.close()
         server.stop()
+
+
+def test_a_demonstration_downloads_for_the_robot_in_each_format(client: TestClient) -> None:
+    url = "/api/robot/export/demonstration/sample-reach-1"
+    csv = client.get(url, params={"format": "csv"})
+    assert csv.status_code == 200
+    assert 'filename="sample-reach-1.puma560.csv"' in csv.headers["content-disposition"]
+    header = next(line for line in csv.text.splitlines() if not line.startswith("#"))
+    assert header == "time," + ",".join(load_robot("puma560").joint_names)
+    mcap = client.get(url, params={"format": "mcap"})
+    assert mcap.status_code == 200 and mcap.content.startswith(b"\x89MCAP")
+    lerobot = client.get(url, params={"format": "lerobot"})
+    assert lerobot.status_code == 200
+    names = zipfile.ZipFile(io.BytesIO(lerobot.content)).namelist()
+    assert "meta/info.json" in names and "data/chunk-000/file-000.parquet" in names
+
+
+def test_a_recording_failing_the_checks_is_refused_in_one_sentence_unless_unchecked(
+    client: TestClient,
+) -> None:
+    url = "/api/robot/export/recording/sample-reach-1"
+    refused = client.get(url, params={"format": "csv"})
+    assert refused.status_code == 422
+    detail = refused.json()["detail"]
+    assert isinstance(detail, str) and detail.startswith("Refused") and "joint1" in detail
+    written = client.get(url, params={"format": "csv", "unchecked": "true"})
+    assert written.status_code == 200 and "NOT checked" in written.text
+    missing = client.get("/api/robot/export/recording/nope", params={"format": "csv"})
+    assert missing.status_code == 404 and isinstance(missing.json()["detail"], str)

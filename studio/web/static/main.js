@@ -17,7 +17,7 @@ import { exportFile, loadPolicies, uploadPolicy, watch } from "./policies.js";
 import { dismissCaptureFailure, loadRecordings, renderCaptureButton, saveRecordingEdit, toggleCapture, uploadRecording } from "./recordings.js";
 import { loadRuns, renderRuns } from "./runs.js";
 import { SOFTWARE_RENDERERS, SOFTWARE_SCENE_DPR, loadConfig, softwareWebGL } from "./scene.js";
-import { applySource, loadRobots, playback, renderSource, setRetarget, setRobot, simulatorReach, syncKindOptions } from "./sources.js";
+import { applySource, exportForRobot, loadRobots, playback, renderSource, setRetarget, setRobot, simulatorReach, syncKindOptions } from "./sources.js";
 import { S, markCurvesDirty } from "./state.js";
 import { resetTrainForm, startRun, syncTaskFields } from "./training.js";
 
@@ -46,6 +46,7 @@ function wire() {
   $("retarget-mode").addEventListener("change", setRetarget);
   $("retarget-mirror").addEventListener("change", setRetarget);
   $("robot-name").addEventListener("change", setRobot);
+  $("robot-export").addEventListener("click", exportForRobot);
 
   $("capture-toggle").addEventListener("click", toggleCapture);
   $("capture-failure-dismiss").addEventListener("click", dismissCaptureFailure);

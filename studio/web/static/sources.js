@@ -1,6 +1,6 @@
 /* Teach Studio page: the live source: its status line, the source form, playback, the simulator's reach, the robot taught. */
 
-import { api, guarded } from "./api.js";
+import { api, download, guarded } from "./api.js";
 import { $, fmt, setProp, setText, showError } from "./dom.js";
 import { S } from "./state.js";
 
@@ -150,5 +150,21 @@ export async function setRobot() {
     if (!chosen && S.source && S.source.robot) select.value = S.source.robot;
   } finally {
     delete select.dataset.pending;
+  }
+}
+
+/** Download the recording chosen in the source form as the robot's trajectory (studio export). */
+export async function exportForRobot() {
+  const recording = $("source-recording").value;
+  if (!recording) { showError("robot-export-error", "Choose a recording first (Source → recording)."); return; }
+  const format = $("robot-export-format").value;
+  const params = new URLSearchParams({ format });
+  if ($("robot-export-unchecked").checked) params.set("unchecked", "true");
+  const button = $("robot-export");
+  button.disabled = true;
+  try {
+    await download(`/api/robot/export/recording/${encodeURIComponent(recording)}?${params}`, `${recording}.${format}`, "robot-export-error");
+  } finally {
+    button.disabled = false;
   }
 }
