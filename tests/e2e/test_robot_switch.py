@@ -68,4 +68,18 @@ def test_the_user_switches_to_the_panda_sees_it_drawn_and_driven_then_back(
     assert wait_for(lambda: _q_robot(studio_server).shape == (6,))
     assert wait_for(lambda: page.input_value("#retarget-mode") == "joint")
     assert not page.locator("#retarget-mode option[value='joint']").is_disabled()
+
+    # the recording chosen in the source form downloads as the robot's trajectory
+    page.select_option(
+        "[data-testid='source-kind']", "recording"
+    )  # shows the list, applies nothing
+    page.select_option("#source-recording", "sample-reach-1")
+    page.get_by_role("combobox", name="Export format").select_option("csv")
+    page.check("#robot-export-unchecked")  # the capture-rate recording fails the checks
+    with page.expect_download(timeout=120_000) as download:
+        page.click("#robot-export")
+    assert download.value.suggested_filename == "sample-reach-1.puma560.csv"
+    text = open(download.value.path()).read()  # noqa: PTH123, SIM115
+    assert "time," + ",".join(load_robot("puma560").joint_names) in text
+    page.select_option("[data-testid='source-kind']", "simulator")  # as the source still is
     assert page.errors == []  # type: ignore[attr-defined]
