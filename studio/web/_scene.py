@@ -136,6 +136,7 @@ class StudioScene:
         self._views = RobotViews(self.robot, self.layout.mesh)
         self._view = self._views.puma  # the robot drawn
         self._next_view: RobotView | None = None  # a robot chosen, for the scene thread to draw
+        self._goal: np.ndarray | None = None  # the goal shown on the robot (set_goal)
 
         # Inputs, written by any thread under _lock; the loop reads a snapshot.
         self._lock = threading.Lock()
@@ -283,8 +284,10 @@ class StudioScene:
             self.server, "/goal/ghost", view, opacity=self.layout.ghost_opacity, visible=False
         )
         self._robot_handles, self._ghost_handles = robot, ghost
-        self._view = view  # last: readers of the name see its meshes drawn
-        self._goal_marker.visible = False
+        with self._lock:
+            self._q_robot_shown = view.q0.copy()
+        self._view = view  # last: readers of the name see its meshes and its pose
+        self._place_goal()  # the Puma560's goal again when it comes back
         if view.pedestal > 0:
             self._pedestal = self.server.scene.add_box(
                 "/robot_pedestal",
@@ -437,8 +440,6 @@ class StudioScene:
             with self.server.atomic():
                 self._draw_robot(view)
             shown.q_robot = None
-            with self._lock:
-                self._q_robot_shown = view.q0.copy()
         if (
             slow
             and now - shown.live_at < 1.0 / self.layout.slow_live_rate_hz
@@ -588,15 +589,20 @@ class StudioScene:
     def set_goal(self, q_robot_goal: np.ndarray | None) -> None:
         """Show a translucent ghost robot and a marker at the goal (None, or a goal of another
         robot's width, hides them)."""
+        self._goal = None if q_robot_goal is None else np.asarray(q_robot_goal, dtype=float)
         with self.server.atomic():
-            q = None if q_robot_goal is None else np.asarray(q_robot_goal, dtype=float)
-            visible = q is not None and len(q) == self._view.nq
-            if q is not None and visible:
-                self._push_robot(self._ghost_handles, q)
-                self._goal_marker.position = self._view.tool(q)
-            for h in self._ghost_handles:
-                h.visible = visible
-            self._goal_marker.visible = visible
+            self._place_goal()
+
+    def _place_goal(self) -> None:
+        """Show the goal on the robot drawn (hidden when it is another robot's)."""
+        q = self._goal
+        visible = q is not None and len(q) == self._view.nq
+        if q is not None and visible:
+            self._push_robot(self._ghost_handles, q)
+            self._goal_marker.position = self._view.tool(q)
+        for h in self._ghost_handles:
+            h.visible = visible
+        self._goal_marker.visible = visible
 
     def show_path(self, name: str, q_robot_path: np.ndarray) -> None:
         """Draw the tool path of a robot joint path ``(N, 6)`` (replaces a path of that name)."""

@@ -337,7 +337,7 @@ class Studio:
         with self._robot_lock:
             arm = load_robot(robot_spec(name).name)
             if self.scene is not None:
-                self.scene.set_robot(arm)  # reads the meshes: a failure changes nothing
+                self.scene.set_robot(arm)  # its meshes are read in the background
             self.pipeline.set_robot(arm)
 
     def robots_public(self) -> dict[str, object]:

@@ -104,8 +104,10 @@ def test_the_scene_draws_the_chosen_robot_from_its_meshes_where_the_puma_stands(
     scene = StudioScene(server, layout=SceneLayout(rate_hz=100.0))
     try:
         panda = load_robot("panda")
+        scene.set_goal(np.zeros(6))  # the Puma560's training goal
         scene.set_robot(panda)
         assert wait_for(lambda: scene.robot_name == "panda", timeout=120.0)
+        assert not scene._goal_marker.visible  # a Puma560 goal is not the Panda's
         assert scene.robot_mesh_count == len(panda.visual_model.geometryObjects)
         names = [h.name for h in scene._robot_handles]
         assert all(n.startswith("/robot/") and "panda_link" in n for n in names[:8])
@@ -121,6 +123,7 @@ def test_the_scene_draws_the_chosen_robot_from_its_meshes_where_the_puma_stands(
         assert wait_for(lambda: np.allclose(scene.current_q_robot(), q))
         scene.set_robot(None)
         assert wait_for(lambda: scene.robot_name == "puma560" and scene.robot_mesh_count == 7)
+        assert scene._goal_marker.visible  # its goal is back with it
         assert scene.errors == 0
     finally:
         scene.close()
