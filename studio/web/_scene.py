@@ -343,12 +343,9 @@ class StudioScene:
         return posed.tape if posed.tape is not None else np.array(tape, dtype=float)
 
     def tool_positions(self, q_robot: np.ndarray) -> np.ndarray:
-        """World tool positions of joint configurations ``(N, nq)`` -> ``(N, 3)`` (the drawn
-        robot's; a Puma560 path, 6 wide, beside another robot is the Puma560's)."""
+        """World tool positions of Puma560 joint paths ``(N, 6)`` -> ``(N, 3)`` (policies and
+        demonstrations are the Puma560's, whichever robot is drawn)."""
         q = np.atleast_2d(np.asarray(q_robot, dtype=float))
-        view = self._view
-        if q.shape[1] == view.nq:
-            return np.array([view.tool(qi) for qi in q])
         return np.array([self.robot.forward(qi)[:3, 3] for qi in q])
 
     def robot_mesh_points(self, q_robot: np.ndarray) -> list[np.ndarray]:
@@ -477,7 +474,9 @@ class StudioScene:
                 self._push_operator(operator, live.posed, whole=operator_changed)
             elif operator_changed:
                 self._push_operator(operator, operator.rest, whole=True)
-            if robot_changed and pose.q_robot is not None:
+            # playbacks are the Puma560's (policies, demonstrations); another robot stays live
+            puma_or_live = pose.mode is Mode.LIVE or self._view.name == "puma560"
+            if robot_changed and pose.q_robot is not None and puma_or_live:
                 self._push_robot(self._robot_handles, pose.q_robot)
             if playback is not None and pose.trace_upto > shown.trace_upto:
                 self._push_trace(playback, pose.trace_upto)
@@ -594,9 +593,9 @@ class StudioScene:
             self._place_goal()
 
     def _place_goal(self) -> None:
-        """Show the goal on the robot drawn (hidden when it is another robot's)."""
+        """Show the goal (a Puma560 pose) on the Puma560; hidden beside another robot."""
         q = self._goal
-        visible = q is not None and len(q) == self._view.nq
+        visible = q is not None and self._view.name == "puma560"
         if q is not None and visible:
             self._push_robot(self._ghost_handles, q)
             self._goal_marker.position = self._view.tool(q)
