@@ -13,7 +13,7 @@ from __future__ import annotations
 import logging
 import threading
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import pinocchio as pin
@@ -89,7 +89,8 @@ def arm_view(arm: RobotArm, config: MeshConfig) -> RobotView:
     scale, pedestal = arm_framing(arm)
     parts = [
         MeshPart(p.name, p.frame, p.vertices * np.float32(scale), p.faces, p.rgb)
-        for p in robot_meshes(arm.visual_model, config)
+        # simplified at the size drawn: an enlarged arm keeps the detail of a full-size one
+        for p in robot_meshes(arm.visual_model, replace(config, cell_m=config.cell_m / scale))
     ]
     # Its own scratch data: the arm's own is the retargeting's, in another thread.
     data, geometry_data = arm.model.createData(), arm.visual_model.createData()
