@@ -19,6 +19,7 @@ from ._meshes import HumanBody as HumanBody
 from ._meshes import MeshConfig as MeshConfig
 from ._meshes import MeshPart as MeshPart
 from ._meshes import puma560_meshes as puma560_meshes
+from ._meshes import robot_meshes as robot_meshes
 from ._pose import PoseConfig as PoseConfig
 from ._pose import PoseFit as PoseFit
 from ._pose import fit_pose_landmarks as fit_pose_landmarks

@@ -43,6 +43,7 @@ from .routers import (
     events,
     policies,
     recordings,
+    robots,
     run_notes,
     runs,
     scene_controls,
@@ -100,6 +101,7 @@ def create_app(settings: Settings | None = None, scene: Scene | None = None) -> 
     for module in (
         config,
         sources,
+        robots,
         capture,
         recordings,
         demonstrations,

@@ -15,6 +15,7 @@ from typing import NamedTuple, Protocol
 import numpy as np
 
 from studio.capture import Observation
+from studio.kinematics import RobotArm
 
 from ._scene_model import Playback
 from ._scene_views import SceneCamera
@@ -80,6 +81,17 @@ class Scene(LiveScene, Protocol):
 
     def stop_playback(self) -> None:
         """Stop a playback."""
+
+    def set_robot(self, arm: RobotArm | None) -> None:
+        """Draw ``arm`` (None: the Puma560) from its own meshes."""
+
+    @property
+    def robot_name(self) -> str:
+        """The robot drawn."""
+
+    @property
+    def robot_mesh_count(self) -> int:
+        """How many meshes draw it."""
 
     def current_q_robot(self) -> np.ndarray:
         """The robot joints shown now."""

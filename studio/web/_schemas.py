@@ -117,6 +117,12 @@ class SourcePublic(BaseModel):
     )
     camera_fps: float | None = Field(None, description="camera: the frame rate the page reported")
     model: str | None = Field(None, description="camera: the pose model the page reported")
+    robot: str = Field("puma560", description="the robot taught (`studio robots` lists them)")
+    robot_warning: str | None = Field(
+        None,
+        description="why the robot does not follow the hand now (out of its reach, or held "
+        "clear of a self-collision), else null",
+    )
 
 
 class SourceUpdate(_Body):
@@ -549,3 +555,31 @@ class WatchPublic(BaseModel):
     """The policy's likeness card against a demonstration, or None when there is none to
     compare with (``likeness_note`` says why)."""
     likeness_note: str = ""
+
+
+# ----------------------------------------------------------------------------- robots
+
+
+class RobotChoice(_Body):
+    """Choose the robot the operator teaches."""
+
+    name: str = Field(description="one of the names `GET /api/robots` lists")
+
+
+class RobotInfo(BaseModel):
+    """One offered robot."""
+
+    name: str
+    title: str
+    joints: list[str]
+
+
+class RobotsPublic(BaseModel):
+    """The offered robots (the default first) and the one taught now."""
+
+    robots: list[RobotInfo]
+    robot: str
+    drawn: str | None = Field(
+        None, description="the robot the 3D scene has drawn (null without a scene)"
+    )
+    drawn_meshes: int = Field(0, description="how many meshes the scene draws it with")

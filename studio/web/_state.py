@@ -31,6 +31,7 @@ from studio.capture import (
     SimulatorSource,
     source_from_spec,
 )
+from studio.kinematics import load_robot, robot_names, robot_spec
 from studio.learning import (
     GOAL_JOINTS,
     DemonstrationPath,
@@ -104,6 +105,7 @@ class Studio:
         # the last rollout watched of each policy key: (times, q), the oldest watched first
         self.rollouts: dict[str, tuple[np.ndarray, np.ndarray]] = {}
         self.mark_t0: float | None = None  # live demonstration start, recording time (s)
+        self._robot_lock = threading.Lock()  # one robot switch at a time
 
     def start(self) -> None:
         """Start the run worker and the pipeline (with the configured source, if any)."""
@@ -327,6 +329,40 @@ class Studio:
         if self.pipeline.kind == "recording" and isinstance(source, PlaybackSource):
             status["playback"] = _playback_state(source)
         return status
+
+    # ------------------------------------------------------------------ robot
+
+    def set_robot(self, name: str) -> None:
+        """Teach robot ``name``: the scene draws it from its meshes, and the live chain
+        retargets the operator onto it from the next frame.
+
+        Raises:
+            KinematicsError: an unknown name, or a model or mesh that cannot be read (the
+                robot taught before stays).
+        """
+        with self._robot_lock:
+            arm = load_robot(robot_spec(name).name)
+            if self.scene is not None:
+                self.scene.set_robot(arm)  # its meshes are read in the background
+            self.pipeline.set_robot(arm)
+
+    def robots_public(self) -> dict[str, object]:
+        """``RobotsPublic``: every offered robot with its joints, and the one taught now."""
+        robots = [
+            {
+                "name": name,
+                "title": robot_spec(name).title,
+                "joints": list(load_robot(name, geometry=False).joint_names),
+            }
+            for name in robot_names()
+        ]
+        scene = self.scene
+        return {
+            "robots": robots,
+            "robot": self.pipeline.robot_name,
+            "drawn": None if scene is None else scene.robot_name,
+            "drawn_meshes": 0 if scene is None else scene.robot_mesh_count,
+        }
 
     def playback(self, action: str, t: float | None, speed: float | None) -> None:
         """Play, pause or seek the recording source.

@@ -18,7 +18,7 @@ import { dismissCaptureFailure, loadRecordings, renderCaptureButton, saveRecordi
 import { loadRuns, renderRuns } from "./runs.js";
 import { wireCompare } from "./compare.js";
 import { SOFTWARE_RENDERERS, SOFTWARE_SCENE_DPR, loadConfig, softwareWebGL } from "./scene.js";
-import { applySource, playback, renderSource, setRetarget, simulatorReach, syncKindOptions } from "./sources.js";
+import { applySource, exportForRobot, loadRobots, playback, renderSource, setRetarget, setRobot, simulatorReach, syncKindOptions } from "./sources.js";
 import { S, markCurvesDirty } from "./state.js";
 import { checkTrainForm, resetTrainForm, startRun, syncTaskFields } from "./training.js";
 
@@ -46,6 +46,8 @@ function wire() {
   $("source-wander").addEventListener("click", () => simulatorReach("wander"));
   $("retarget-mode").addEventListener("change", setRetarget);
   $("retarget-mirror").addEventListener("change", setRetarget);
+  $("robot-name").addEventListener("change", setRobot);
+  $("robot-export").addEventListener("click", exportForRobot);
 
   $("capture-toggle").addEventListener("click", toggleCapture);
   $("capture-failure-dismiss").addEventListener("click", dismissCaptureFailure);
@@ -105,7 +107,7 @@ async function main() {
     S.markT0 = m && m.t0;
     updateMarkButton();
   }).catch(() => {});
-  await Promise.all([initial, cap, mark, loadRecordings(), loadDemos(), loadRuns(), loadPolicies()]);
+  await Promise.all([initial, cap, mark, loadRobots(), loadRecordings(), loadDemos(), loadRuns(), loadPolicies()]);
   if (S.source && S.source.recording) $("source-recording").value = S.source.recording;
   document.body.dataset.ready = "1";
 }
