@@ -47,6 +47,7 @@ from ._protocols import HandMoved, LivePose
 from ._robot_view import RobotView, RobotViews, add_robot, rgb255, wxyz_of
 from ._scene_model import Mode, Playback, SceneLayout, playback_time, pose_at, rescheduled
 from ._scene_model import camera_projection as camera_projection
+from ._scene_paths import ScenePaths
 from ._scene_views import SceneCamera
 
 log = logging.getLogger(__name__)
@@ -103,7 +104,7 @@ class _Live:
     version: int
 
 
-class StudioScene:
+class StudioScene(ScenePaths):
     """The studio's viser scene, fed by the live pipeline and by playbacks.
 
     The operator wears one tape: the taped arm follows the fit, the other arm rests (there is no
@@ -606,50 +607,6 @@ class StudioScene:
         for h in self._ghost_handles:
             h.visible = visible
         self._goal_marker.visible = visible
-
-    def show_path(self, name: str, q_robot_path: np.ndarray) -> None:
-        """Draw the tool path of a robot joint path ``(N, 6)`` (replaces a path of that name)."""
-        tool = self.tool_positions(q_robot_path)
-        node = f"/paths/{name}"
-        c = self.layout.colors
-        s = self.server.scene
-        with self._paths_lock, self.server.atomic():
-            for h in self._paths.pop(name, []):
-                h.remove()
-            handles: list[viser.SceneNodeHandle] = [
-                s.add_icosphere(
-                    f"{node}/start", radius=0.02, color=c["path_start"], position=tool[0]
-                ),
-                s.add_icosphere(f"{node}/end", radius=0.02, color=c["path"], position=tool[-1]),
-            ]
-            if len(tool) >= 2:
-                handles.append(
-                    s.add_spline_catmull_rom(
-                        f"{node}/line",
-                        points=tool.astype(np.float32),
-                        thickness=0.01,
-                        color=c["path"],
-                    )
-                )
-            self._paths[name] = handles
-
-    def clear_path(self, name: str | None = None) -> None:
-        """Remove the path called ``name`` (every path when None); unknown names are ignored."""
-        with self._paths_lock, self.server.atomic():
-            names = list(self._paths) if name is None else [name]
-            for n in names:
-                for h in self._paths.pop(n, []):
-                    h.remove()
-
-    def path_names(self) -> list[str]:
-        """Names of the paths drawn now."""
-        with self._paths_lock:
-            return list(self._paths)
-
-    def path_points(self, name: str) -> np.ndarray:
-        """World points of the path line called ``name`` ((N, 3); for tests)."""
-        with self._paths_lock:
-            return np.asarray(self._paths[name][-1].points)
 
     def play_trajectory(
         self,
