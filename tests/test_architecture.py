@@ -84,12 +84,14 @@ def test_every_exported_name_is_in_its_import_block():
 
 
 STUDIO = Path(__file__).resolve().parents[1] / "studio"
-LATE_CYCLES_TO_BREAK = (
-    {"studio.capture._network", "studio.capture._source_spec"},
-    {"studio.learning._prepare", "studio.learning._runs"},
-)
-"""Cycles closed only by an import inside a function, still to be broken (drop each when it is)."""
-DEFS = ast.FunctionDef | ast.AsyncFunctionDef | ast.ClassDef
+CODE = ast.FunctionDef | ast.AsyncFunctionDef | ast.Lambda
+"""What runs only when called: an import inside it is late."""
+
+
+def _is_type_checking(test: ast.expr) -> bool:
+    return (isinstance(test, ast.Name) and test.id == "TYPE_CHECKING") or (
+        isinstance(test, ast.Attribute) and test.attr == "TYPE_CHECKING"
+    )
 
 
 def _module_name(path: Path) -> str:
@@ -97,24 +99,40 @@ def _module_name(path: Path) -> str:
     return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
 
 
-def _imports(body: list[ast.stmt], late: bool) -> Iterator[ast.Import | ast.ImportFrom]:
-    """The imports that run when a module is imported (in its body, and inside its top-level
-    ``if``/``try``/``with``/loops) and, if ``late``, those in its functions and classes, which run when
-    called. Never those under ``if TYPE_CHECKING:``, which never run."""
-    pending = list(body)
+def _imports(body: list[ast.stmt], late: bool) -> Iterator[ast.Import | ast.ImportFrom | str]:
+    """The imports that run when a module is imported (anywhere in its body and in its class
+    bodies, which run then too, inside any ``if``/``try``/``with``/loop/``match``) and, if
+    ``late``, also those in its functions, methods and lambdas, which run when called. Never those
+    under ``if TYPE_CHECKING:``, which never run. ``importlib.import_module("studio....")`` with a
+    literal name counts as an import of that module (yielded as its name)."""
+    pending: list[ast.AST] = list(body)
     while pending:
         node = pending.pop()
         if isinstance(node, ast.Import | ast.ImportFrom):
             yield node
-        elif isinstance(node, ast.If):
-            if not (isinstance(node.test, ast.Name) and node.test.id == "TYPE_CHECKING"):
-                pending.extend(node.body)
+            continue
+        if isinstance(node, CODE) and not late:
+            runs_now = [
+                *getattr(node, "decorator_list", []),
+                *node.args.defaults,
+                *node.args.kw_defaults,
+            ]
+            pending.extend(n for n in runs_now if n is not None)
+            continue
+        if isinstance(node, ast.If) and _is_type_checking(node.test):
             pending.extend(node.orelse)
-        elif isinstance(node, ast.Try):
-            for block in (node.body, node.orelse, node.finalbody, *(h.body for h in node.handlers)):
-                pending.extend(block)
-        elif isinstance(node, ast.With | ast.For | ast.While) or (late and isinstance(node, DEFS)):
-            pending.extend([*node.body, *getattr(node, "orelse", [])])
+            continue
+        if (
+            isinstance(node, ast.Call)
+            and isinstance(node.func, ast.Attribute | ast.Name)
+            and (getattr(node.func, "attr", None) or getattr(node.func, "id", None))
+            in ("import_module", "__import__")
+            and node.args
+            and isinstance(node.args[0], ast.Constant)
+            and isinstance(node.args[0].value, str)
+        ):
+            yield node.args[0].value
+        pending.extend(n for n in ast.iter_child_nodes(node) if n is not None)
 
 
 def _import_graph(late: bool) -> dict[str, set[str]]:
@@ -124,7 +142,9 @@ def _import_graph(late: bool) -> dict[str, set[str]]:
     for name, path in paths.items():
         package = name if path.name == "__init__.py" else name.rpartition(".")[0]
         for node in _imports(ast.parse(path.read_text(), str(path)).body, late):
-            if isinstance(node, ast.Import):
+            if isinstance(node, str):
+                targets = [node]
+            elif isinstance(node, ast.Import):
                 targets = [alias.name for alias in node.names]
             else:
                 base = node.module or ""
@@ -179,5 +199,60 @@ def test_no_import_cycle_through_late_imports():
     learner so): a late import that closes a cycle hides the layering, it does not fix it."""
     graph = _import_graph(late=True)
     assert "studio.learning._linear" in graph["studio.learning._beyond"]
-    cycles = _cycles(graph)
-    assert [c for c in cycles if c not in LATE_CYCLES_TO_BREAK] == []
+    assert _cycles(graph) == []
+
+
+LATE_AND_EARLY = """
+from typing import TYPE_CHECKING
+import studio.a
+if TYPE_CHECKING:
+    import studio.never
+else:
+    import studio.b
+try:
+    from studio import c
+except ImportError:
+    pass
+class Box:
+    import studio.d
+    def method(self):
+        import studio.late_method
+    async def pump(self):
+        async with x:
+            from studio import late_async
+def outer():
+    def inner():
+        match y:
+            case 1:
+                import studio.late_nested
+    return importlib.import_module("studio.late_dynamic")
+f = lambda: __import__("studio.late_lambda")
+"""
+
+
+def _imported(source: str, late: bool) -> set[str]:
+    names = set()
+    for node in _imports(ast.parse(source).body, late):
+        if isinstance(node, str):
+            names.add(node)
+        elif isinstance(node, ast.Import):
+            names |= {alias.name for alias in node.names}
+        else:
+            names |= {f"{node.module}.{alias.name}" for alias in node.names}
+    return names
+
+
+def test_the_import_scan_finds_every_import_that_runs():
+    """Imports at import time include class bodies and both branches of a runtime ``if``; late
+    ones include methods, async blocks, nested functions, ``match`` arms, lambdas and
+    ``importlib.import_module``; ``if TYPE_CHECKING:`` imports are never counted."""
+    early = {"typing.TYPE_CHECKING", "studio.a", "studio.b", "studio.c", "studio.d"}
+    late = {
+        "studio.late_method",
+        "studio.late_async",
+        "studio.late_nested",
+        "studio.late_dynamic",
+        "studio.late_lambda",
+    }
+    assert _imported(LATE_AND_EARLY, late=False) == early
+    assert _imported(LATE_AND_EARLY, late=True) == early | late

@@ -93,8 +93,8 @@ from ._simulator import simulate as simulate
 from ._source import FrameSource as FrameSource
 from ._source import SourceStatus as SourceStatus
 from ._source import ThreadedSource as ThreadedSource
+from ._source import check_seconds as check_seconds
 from ._source_spec import SOURCE_SPECS as SOURCE_SPECS
-from ._source_spec import check_seconds as check_seconds
 from ._source_spec import cli_speed as cli_speed
 from ._source_spec import parse_host_port as parse_host_port
 from ._source_spec import source_from_spec as source_from_spec
