@@ -84,6 +84,96 @@ def test_every_exported_name_is_in_its_import_block():
 
 
 STUDIO = Path(__file__).resolve().parents[1] / "studio"
+
+
+ROOT = Path(__file__).resolve().parents[1]
+NARROW = ("studio.kinematics", "studio.capture", "studio.learning")
+"""Packages that export only what is used outside them: by the other packages, the commands,
+the web layer, the benchmarks, ``recordings/make_samples.py``, or users' scripts as the READMEs
+and ``docs/`` show them."""
+FOR_USERS = {
+    **dict.fromkeys(
+        (
+            "studio.learning.DEFAULT_GOAL_DEG",
+            "studio.learning.MAX_TABLE_ENTRIES",
+            "studio.learning.MAX_EPISODE_RUNS",
+            "studio.learning.MAX_EPISODES",
+            "studio.learning.MAX_EXPERIMENTS",
+            "studio.learning.check_budget",
+            "studio.learning.FIGURE_POINTS",
+            "studio.learning.curve_plot",
+            "studio.learning.curve_statistics",
+            "studio.learning.downsample_curve",
+            "studio.learning.grid_for_goal",
+            "studio.learning.TabularMDP",
+            "studio.learning.load_dmp_policy",
+            "studio.learning.save_dmp_policy",
+            "studio.learning.likeness_card",
+            "studio.learning.LikenessCard",
+            "studio.learning.load_policy",
+        ),
+        "a user's script calls it as studio/learning/README.md or docs/sweeps.md shows",
+    ),
+    "studio.learning.policy_likeness_card": "issue 21: the likeness card of any policy kind",
+    "studio.kinematics.PoseFit": "issue 19: fit_pose_landmarks(landmarks, side) -> PoseFit",
+    **dict.fromkeys(
+        (
+            "studio.kinematics.IKConfig",
+            "studio.kinematics.FitConfig",
+            "studio.kinematics.RetargetConfig",
+            "studio.kinematics.HandIKConfig",
+            "studio.kinematics.PoseConfig",
+            "studio.kinematics.StreamConfig",
+            "studio.capture.OperatorConfig",
+            "studio.capture.Calibration",
+        ),
+        "the settings a public constructor or function takes (config=, ik=, fit=, operator=, calibration=)",
+    ),
+}
+"""Public names that no code outside their package calls, and why each stays public. (Every
+``StudioError`` subclass stays public too: users catch them.)"""
+
+
+def _outside_uses() -> dict[str, set[str]]:
+    """For each package of ``NARROW``, the names that code outside it takes from it."""
+    uses: dict[str, set[str]] = {package: set() for package in NARROW}
+    files = [
+        *STUDIO.rglob("*.py"),
+        *(ROOT / "benchmarks").glob("*.py"),
+        *(ROOT / "recordings").glob("*.py"),
+    ]
+    for path in files:
+        package = _module_name(path) if path.is_relative_to(STUDIO) else ""
+        own = next((n for n in NARROW if package == n or package.startswith(f"{n}.")), None)
+        tree = ast.parse(path.read_text(), str(path))
+        bound: dict[str, str] = {}  # local name -> package of NARROW
+        for node in ast.walk(tree):
+            if isinstance(node, ast.ImportFrom):
+                module = node.module or ""
+                if node.level:  # studio/ itself: resolve against the importing module
+                    parts = package.split(".")
+                    anchor = ".".join(
+                        parts[: len(parts) - node.level + (path.name == "__init__.py")]
+                    )
+                    module = f"{anchor}.{module}" if module else anchor
+                for alias in node.names:
+                    if module in uses and module != own:
+                        uses[module].add(alias.name)
+                    elif f"{module}.{alias.name}" in uses:
+                        bound[alias.asname or alias.name] = f"{module}.{alias.name}"
+            elif isinstance(node, ast.Import):
+                for alias in node.names:
+                    if alias.name in uses:
+                        bound[alias.asname or alias.name] = alias.name
+        for node in ast.walk(tree):
+            if isinstance(node, ast.Attribute):
+                owner = ast.unparse(node.value)
+                owner = bound.get(owner, owner)
+                if owner in uses and owner != own:
+                    uses[owner].add(node.attr)
+    return uses
+
+
 CODE = ast.FunctionDef | ast.AsyncFunctionDef | ast.Lambda
 """What runs only when called: an import inside it is late."""
 
@@ -319,3 +409,28 @@ def test_any_stays_rare_in_studio():
         1 for path in _python_files() for line in path.read_text().splitlines() if word.search(line)
     )
     assert lines <= MAX_ANY_LINES, f"{lines} lines name Any; type them with protocols or TypedDicts"
+
+
+def test_the_narrow_packages_export_only_what_is_used_outside_them():
+    """A name only its own package uses stays in its private module (a test reaches it there),
+    so ``import studio.learning`` shows a newcomer the surface, not the insides."""
+    from studio import StudioError
+
+    uses = _outside_uses()
+    assert {"ArmGrid", "RunFolder", "resolve_run"} <= uses["studio.learning"]
+    assert {"source_from_spec", "load_demonstration"} <= uses["studio.capture"]
+    assert {"TapeConfig", "load_robot"} <= uses["studio.kinematics"]
+    unused = []
+    for package in NARROW:
+        module = importlib.import_module(package)
+        for name in _exports(package):
+            value = getattr(module, name)
+            error = isinstance(value, type) and issubclass(value, StudioError)
+            if name not in uses[package] and f"{package}.{name}" not in FOR_USERS and not error:
+                unused.append(f"{package}.{name}")
+    assert unused == [], (
+        "exported but used only inside their package: import them from their private module, "
+        "or name in FOR_USERS the user who needs them"
+    )
+    stale = [k for k in FOR_USERS if k.rpartition(".")[2] not in _exports(k.rpartition(".")[0])]
+    assert stale == [], "FOR_USERS names what is no longer exported"
