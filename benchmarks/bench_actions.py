@@ -35,14 +35,14 @@ import numpy as np
 
 from studio.learning import (
     ACTION_SETS,
-    ARM_REACH_ID,
     ArmReach,
     DynaQConfig,
     TilePolicyFile,
-    greedy_success,
     policy_likeness_card,
     run_experiments,
 )
+from studio.learning._gym import ARM_REACH_ID
+from studio.learning._linear import greedy_success
 from studio.learning._linear_policy import DEFAULT_SECONDS_PER_STEP
 
 SEED = 0

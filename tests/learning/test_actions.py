@@ -12,7 +12,6 @@ import pytest
 from studio.cli import main
 from studio.learning import (
     ACTION_SETS,
-    ARM_REACH_ID,
     REACH_DEFAULTS,
     ArmReach,
     ConfigError,
@@ -22,8 +21,9 @@ from studio.learning import (
     load_any_policy,
     resolve_run,
     run_experiments,
-    save_tile_policy,
 )
+from studio.learning._gym import ARM_REACH_ID
+from studio.learning._linear_policy import save_tile_policy
 from studio.learning._reach import action_directions, reach_step
 from studio.web._schemas import ReachRunCreate
 
