@@ -144,6 +144,9 @@ def main() -> None:
     parser.add_argument("--joints", type=int, default=6)
     parser.add_argument("--variants", action="store_true", help="also the potential's variants")
     parser.add_argument("--skip-controls", action="store_true")
+    parser.add_argument(
+        "--long", type=int, default=0, help="also greedy success with demonstrations after N"
+    )
     args = parser.parse_args()
     j, n, pairs = args.joints, args.episodes, range(args.pairs)
     print(f"{j} joints, {n} episodes (demonstrations counted), {DEMOS} demonstrations, cap {CAP}")
@@ -165,6 +168,14 @@ def main() -> None:
             rows.append(pair_other(j, n, k, other, ctx))
         report("control: shaping 0, demonstrations to a different goal", rows)
         report("control: default shaping", [pair(j, ArmReach().shaping, n, k) for k in pairs])
+    if args.long:
+        success = []
+        for k in pairs:
+            demos = demonstration_paths(ArmReach(joints=j), DEMOS, np.random.default_rng([k, j]))
+            success.append(one_run(j, 0.0, args.long, k, demos)[1])
+        print(
+            f"\nshaping 0, with demonstrations, {args.long} episodes: success {interval(success)}"
+        )
     print(f"\n({time.perf_counter() - t0:.0f} s wall)")
 
 

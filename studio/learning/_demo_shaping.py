@@ -25,7 +25,9 @@ With ``kappa = 1`` the minimum is reached at a demonstration's last state (the t
 inequality), so ``phi`` is the joint distance to the nearest demonstrated final pose: the task's
 own shaping (:data:`._reach.DEFAULT_SHAPING`) with the goal's joint angles read from the
 demonstrations instead of given. ``kappa > 1`` makes a valley along the demonstrated paths.
-What each gave is measured by ``benchmarks/bench_demos.py`` (package README).
+With ``kappa = 1`` only the demonstrations' last states are kept (the potential is the same,
+each step costs a few more additions instead of ``M``). What each gave is measured by
+``benchmarks/bench_demos.py`` (package README).
 
 Only joint-path demonstrations of the arm task shape; an environment without a compiled twin, or
 action-sequence demonstrations, get the empty potential (no points), which changes nothing.
@@ -87,8 +89,13 @@ def demo_potential(
         for k, a in enumerate(acts):
             reach_step(reach.params, state, int(a))
             states[k + 1] = state
-        keep = np.unique(np.linspace(0, len(acts), min(MAX_POINTS_PER_DEMO, len(acts) + 1)))
-        keep = keep.astype(np.int64)
+        if (
+            kappa == 1.0
+        ):  # the minimum is at the last state: keep it alone (same potential, cheaper)
+            keep = np.array([len(acts)], np.int64)
+        else:
+            count = min(MAX_POINTS_PER_DEMO, len(acts) + 1)
+            keep = np.unique(np.linspace(0, len(acts), count)).astype(np.int64)
         points.append(states[keep])
         togo.append((len(acts) - keep).astype(np.float64))
     return DemoPotential(

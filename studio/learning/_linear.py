@@ -44,9 +44,10 @@ priority heap and the run around the kernels from :mod:`._learner`), seeded per 
 ``(seed, experiment)``; the environment's resets by ``seed`` and the experiment index.
 
 Caching caveat: numba's disk cache of these kernels is keyed on this file alone, yet they compile
-in the dynamics of ``_reach.py`` and ``_linear_env.py``, the features of ``_tiles.py`` and the
-helpers of ``_learner.py``; after editing one of those, touch this file (or delete
-``__pycache__/_linear*.nb*``) so the kernels recompile.
+in the dynamics of ``_reach.py`` and ``_linear_env.py``, the features of ``_tiles.py``, the
+demonstrations' potential of ``_demo_shaping.py`` and the helpers of ``_learner.py``; after
+editing one of those, touch this file (or delete ``__pycache__/_linear*.nb*``) so the kernels
+recompile.
 """
 
 from __future__ import annotations
@@ -481,8 +482,9 @@ def run_linear_experiments(
         episodes: episodes per experiment.
         seed: a non-negative integer.
         demonstrations: replayed as the first episodes: for ``TeachStudio/ArmReach-v0`` joint
-            paths ``(N, joints)`` in radians; for any environment, action sequences replayed from
-            ``env.reset``.
+            paths ``(N, joints)`` in radians, which also shape every reward with a potential
+            read from them (:mod:`._demo_shaping`); for any environment, action sequences
+            replayed from ``env.reset``.
         features: the tile coding (required).
         workers: threads for the compiled kernel (default: one per core).
         live: progress arrays to fill and the stop flag to obey.
