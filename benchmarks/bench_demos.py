@@ -15,7 +15,8 @@ and the run without demonstrations share the seed ``k`` (the same start states, 
 3. Control: the default shaping, with against without demonstrations (goal: never more than 2
    points lower).
 4. Variants of the demonstrations' potential (``--variants``): its weight and kappa
-   (:mod:`studio.learning._demo_shaping`), and the replay alone (weight 0, today's method).
+   (:mod:`studio.learning._demo_shaping`), and the replay alone (weight 0, the earlier method).
+5. ``--long N``: greedy success with demonstrations under the paper's reward after N episodes.
 
 Each figure is the mean over pairs with a 95% t interval of the paired difference or ratio. The
 machine may be shared: the figures are counts (steps, successes), not times, so load does not
