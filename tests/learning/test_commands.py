@@ -161,7 +161,7 @@ SAMPLE_DEMO = (
     ("old", "new", "says"),
     [
         ('"t":[1.0,', '"t":["one",', "trajectory is missing or is not a list of times"),
-        ('"t":[1.0,', '"t":[NaN,', "trajectory holds NaN or infinite values in a list of times"),
+        ('"t":[1.0,', '"t":[NaN,', "holds NaN or infinite samples (sample 1 of"),
         ('"goal":[5,6,2],"grid_path"', '"goal":[Infinity,6,2],"grid_path"', "goal is missing"),
         ('"grid_path":[898,', '"grid_path":[1e999,', "grid_path is missing or is not"),
         ('"reached_at":2.25', '"reached_at":1e999,"x":2.25', "reached_at holds NaN or infinite"),
