@@ -84,6 +84,10 @@ from ._recording_writer import RecordingWriter as RecordingWriter
 from ._recording_writer import recording_meta as recording_meta
 from ._segments import trigger_segments as trigger_segments
 from ._serial import SerialSource as SerialSource
+from ._series import DEFAULT_SERIES_POINTS as DEFAULT_SERIES_POINTS
+from ._series import MAX_SERIES_POINTS as MAX_SERIES_POINTS
+from ._series import RecordingSeries as RecordingSeries
+from ._series import recording_series as recording_series
 from ._simulator import OperatorConfig as OperatorConfig
 from ._simulator import OperatorMotion as OperatorMotion
 from ._simulator import Simulated as Simulated
@@ -98,6 +102,11 @@ from ._source_spec import check_seconds as check_seconds
 from ._source_spec import cli_speed as cli_speed
 from ._source_spec import parse_host_port as parse_host_port
 from ._source_spec import source_from_spec as source_from_spec
+from ._takes import TAKES_FILE as TAKES_FILE
+from ._takes import Take as Take
+from ._takes import TakeSession as TakeSession
+from ._takes import read_takes as read_takes
+from ._takes import write_takes as write_takes
 from ._wire import DEFAULT_PORT as DEFAULT_PORT
 from ._wire import bridge_key as bridge_key
 from ._wire import decode_frame as decode_frame

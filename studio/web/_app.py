@@ -46,6 +46,7 @@ from .routers import (
     runs,
     sources,
     sweeps,
+    takes,
     watch,
 )
 
@@ -100,6 +101,7 @@ def create_app(settings: Settings | None = None, scene: Scene | None = None) -> 
         sources,
         capture,
         recordings,
+        takes,
         demonstrations,
         runs,
         sweeps,
