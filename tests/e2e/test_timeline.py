@@ -54,6 +54,14 @@ def test_cut_on_the_timeline(page: Any, studio_server: Studio) -> None:
     timeline.press(" ")
     assert timeline.get_attribute("data-playing") == "0"
     shot(page, "timeline-ends", "sec-demos")
+    for width, height in ((1280, 720), (1920, 1080)):  # the small and the large screen
+        page.set_viewport_size({"width": width, "height": height})
+        page.wait_for_function(
+            "() => document.querySelector('[data-testid=timeline-plot] canvas').clientWidth"
+            " >= document.querySelector('[data-testid=timeline-plot]').clientWidth - 2"
+        )
+        shot(page, f"timeline-{width}x{height}", "timeline")
+    page.set_viewport_size({"width": 1440, "height": 900})
 
     page.fill("[data-testid='demo-name']", "timeline-demo")
     page.uncheck("[data-testid='demo-goal-from-end']")

@@ -62,7 +62,7 @@ function draw() {
     height: 170,
     legend: { show: false },
     scales: { x: { time: false, range: [0, Math.max(d.duration, 0.01)] } },
-    axes: [{ size: 28 }, { size: 42, values: (u, v) => v.map((x) => `${x}°`) }],
+    axes: [{ size: 28 }, { size: 52, values: (u, v) => v.map((x) => `${x}°`) }],
     series,
     cursor: { drag: { x: true, y: false, setScale: false }, points: { show: false } },
     hooks: {
