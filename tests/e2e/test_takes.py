@@ -32,10 +32,10 @@ def _recorded_for(page: Any, seconds: float) -> None:
     )
 
 
-def _reach(page: Any) -> None:
+def _reach(page: Any, studio: Studio) -> None:
     """Half a second of wandering, then the reach to the goal."""
     _recorded_for(page, 0.5)
-    page.click("[data-testid='source-reach']")
+    studio.send("POST", "/api/source/reach", {"action": "reach"})  # the simulated operator acts
     _recorded_for(page, 3.0)
 
 
@@ -60,7 +60,7 @@ def _record_a_take(page: Any, studio: Studio) -> None:
     left.wait_for(state="visible", timeout=T)
     assert "Recording in 1 s" in left.inner_text()
     _phase(page, "recording")
-    _reach(page)
+    _reach(page, studio)
     page.locator("body").focus()  # the keys act on the page, not on a button
 
 
@@ -94,7 +94,7 @@ def test_record_in_takes(page: Any, studio_server: Studio) -> None:
     page.keyboard.press("ArrowRight")
     page.locator("[data-testid='capture-countdown-left']").wait_for(state="visible", timeout=T)
     _phase(page, "recording")
-    _reach(page)
+    _reach(page, studio_server)
     page.click("[data-testid='take-start']")  # now "Stop take"
     _phase(page, "review")
     page.get_by_role("button", name="Review take").click()
