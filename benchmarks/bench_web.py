@@ -35,18 +35,10 @@ from typing import Any
 from studio.samples import SAMPLES_DIR
 
 REPO = Path(__file__).resolve().parents[1]
-CHROMIUM = "/usr/bin/chromium"
-FLAGS = [
-    "--no-sandbox",
-    "--disable-gpu",
-    "--disable-quic",
-    "--no-first-run",
-    "--disable-background-networking",
-    "--disable-component-update",
-    "--disable-sync",
-    "--use-angle=swiftshader",
-    "--enable-unsafe-swiftshader",
-]
+sys.path.insert(0, str(REPO))
+from tests.e2e.conftest import CHROMIUM  # noqa: E402  (the browser tests' Chromium and flags)
+from tests.e2e.conftest import CHROMIUM_FLAGS as FLAGS  # noqa: E402
+
 BASELINE_HTML = "<!doctype html><html><head><title>baseline</title></head><body><h1>baseline</h1><p>static page</p></body></html>"
 TRAIN = {"planning": "full", "episodes": 500, "experiments": 20, "bins": 31, "seed": 1}
 """A run of a few seconds (a finer grid than the paper's 11 bins, which trains in a blink)."""

@@ -13,8 +13,7 @@ from ._errors import CaptureError
 from ._observation_recording import ObservationWriter
 from ._recording_format import DEFAULT_RATE_HZ, DEFAULT_REGIONS, RecordingSummary
 from ._recording_writer import AppendWriter, RecordingWriter
-from ._source import SourceStatus, ThreadedSource
-from ._source_spec import check_seconds
+from ._source import SourceStatus, ThreadedSource, check_seconds
 
 READ_TIMEOUT_SECONDS = 0.1
 """How long one read waits for frames (bounds how late a stop request is seen)."""

@@ -9,18 +9,24 @@ removed. A segment that never reaches the goal, drives the robot into a joint li
 arm badly is refused with the reason; with ``goal_from_end=True`` the goal becomes wherever the
 segment ends, and a ``grid`` with another goal cuts at that goal.
 
-File (``*.demo.json``, next to its recording)::
+File (``*.demo.json``, next to its recording), version 2: the trajectory and its own goal;
+``grid_path`` is what learning's one path function gave when it was cut (for readers outside the
+studio), checked on load and traced again from the trajectory::
 
-    {"format": "teach-studio-demonstration", "version": 1,
-     "recording": "reach.tape.csv", "segment": [t0, t1], "mode": "joint", "mirror": true,
+    {"format": "teach-studio-demonstration", "version": 2, "robot": "puma560",
+     "recording": "reach.tape.csv", "segment": [t0, t1], "mode": "joint",
      "grid": {"joints": 3, "bins": 11, "low_deg": -180, "high_deg": 180, "goal": [5, 6, 2]},
      "goal": [5, 6, 2], "grid_path": [state, ...], "reached_at": t,
-     "fit": {"residual_max": m, "residual_mean": m, "max_allowed": m},
+     "fit": {"residual_max": m, "residual_mean": m},
      "trajectory": {"t": [...], "q_robot": [[6 angles], ...]}, "name": "...", "created": "..."}
 
-``grid_path`` is what ``studio train --demos`` and the learning engine replay: it is
-``ArmGrid(**grid).path_from_joints(trajectory.q_robot)``, recomputed on load, so a file written by
-older code (which erased loops before cutting at the goal) replays today's path.
+What a task makes of the trajectory is :mod:`studio.learning`'s alone: the grid path
+(``ArmGrid.path_from_joints``, traced again on load and by every run), a continuous run's joint
+path and the likeness card's motion. Version 1 files also stored ``mirror`` and
+``fit.max_allowed``, which nothing read; they load as before. A
+file is refused with one sentence when its joints are for another robot or another number of
+joints, it holds NaN samples or it is a cut of zero length; a run refuses one whose trajectory
+never reaches the run's goal.
 """
 
 from __future__ import annotations
@@ -38,7 +44,7 @@ import numpy as np
 
 from studio import StudioError, read_json
 from studio.kinematics import ArmTracker, Puma560, TrackerConfig
-from studio.learning import ArmGrid, LearningError
+from studio.learning import ArmGrid, LearningError, motion_problem
 
 from ._errors import DemonstrationError
 from ._fitters import fitter_for
@@ -50,8 +56,10 @@ from ._recording_reader import Recording
 
 DEMO_FORMAT = "teach-studio-demonstration"
 """The ``format`` value of demonstration files."""
-DEMO_VERSION = 1
-"""The version this code writes and the newest it reads."""
+DEMO_VERSION = 2
+"""The version this code writes and the newest it reads (2 adds ``robot``)."""
+DEMO_ROBOT = "puma560"
+"""The robot a demonstration's ``q_robot`` is for (the learning tasks' arm)."""
 MAX_FIT_RESIDUAL_M = 0.03
 """Largest RMS landmark residual (m) of any frame's arm fit before a segment counts as a bad fit:
 3 cm is well above the fit of a well-placed tape with sensor noise, and well below a misplaced
@@ -132,7 +140,7 @@ class Demonstration:
     def arm_grid(self) -> ArmGrid:
         """The :class:`studio.learning.ArmGrid` this demonstration's path lives on."""
         make: Callable[..., ArmGrid] = ArmGrid  # it checks each setting read from the file
-        return make(**{**self.grid, "goal": tuple(self.grid["goal"])})
+        return make(**{**self.grid, "goal": tuple(self.goal)})
 
     def default_path(self) -> Path:
         """Where :meth:`save` writes by default: ``<recording stem>.<t0>-<t1>.demo.json``."""
@@ -145,20 +153,19 @@ class Demonstration:
         return {
             "format": DEMO_FORMAT,
             "version": DEMO_VERSION,
+            "robot": DEMO_ROBOT,
             "name": self.name,
             "created": self.created,
             "recording": self.recording.name,
             "segment": [self.t0, self.t1],
             "mode": self.mode,
-            "mirror": True,
-            "grid": self.grid,
+            "grid": {k: v for k, v in self.grid.items() if k != "goal"},
             "goal": list(self.goal),
             "grid_path": list(self.grid_path),
             "reached_at": self.reached_at,
             "fit": {
                 "residual_max": round(self.residual_max, TRAJECTORY_DECIMALS),
                 "residual_mean": round(self.residual_mean, TRAJECTORY_DECIMALS),
-                "max_allowed": MAX_FIT_RESIDUAL_M,
             },
             "trajectory": {
                 "t": np.round(self.times, TRAJECTORY_DECIMALS).tolist(),
@@ -208,13 +215,24 @@ def load_demonstration(path: str | os.PathLike[str]) -> Demonstration:
             f"{path} has demonstration version {data.get('version')!r}; this studio reads 1 to {DEMO_VERSION}, update Teach Studio.",
             "bad_file",
         )
+    robot = data.get("robot", DEMO_ROBOT)
+    if robot != DEMO_ROBOT:
+        raise DemonstrationError(
+            f"{path} is a demonstration for the robot {robot!r}, not the {DEMO_ROBOT} the learning tasks use; cut it again from its recording.",
+            "bad_file",
+        )
     fit = data.get("fit", {})
+    if not isinstance(fit, dict):
+        raise DemonstrationError(
+            f"{path}: fit is not a table of residuals; re-extract the demonstration.", "bad_file"
+        )
 
     def read(key: str, what: str, convert: Callable[[object], T], value: object = None) -> T:
-        """``convert`` of field ``key`` (or of ``value``, a part of it); numbers must be finite."""
+        """``convert`` of field ``key`` (or of ``value``, a part of it); numbers must be finite
+        (the trajectory's samples are judged by learning's :func:`motion_problem`)."""
         try:
             out = convert(data[key] if value is None else value)
-            numeric = convert not in (_table, _text)
+            numeric = convert not in (_table, _text, _joint_rows) and key != "trajectory"
             finite = not numeric or np.isfinite(np.asarray(out, dtype=np.float64)).all()
         except (KeyError, IndexError, TypeError, ValueError, OverflowError):
             finite = None
@@ -230,11 +248,11 @@ def load_demonstration(path: str | os.PathLike[str]) -> Demonstration:
     trajectory = read("trajectory", "a table of t and q_robot", _table)
     times = read("trajectory", "a list of times in seconds (t)", _floats, trajectory.get("t"))
     q_robot = read(
-        "trajectory",
-        "rows of 6 robot joint angles (q_robot)",
-        _joint_rows,
-        trajectory.get("q_robot"),
+        "trajectory", "rows of robot joint angles (q_robot)", _joint_rows, trajectory.get("q_robot")
     )
+    problem = motion_problem(f"The demonstration {path}", times, q_robot)
+    if problem is not None:
+        raise DemonstrationError(problem, "bad_file")
     reached_at = data.get("reached_at")
     try:
         demo = Demonstration(
@@ -243,6 +261,8 @@ def load_demonstration(path: str | os.PathLike[str]) -> Demonstration:
             t1=float(read("segment", "two times in seconds", _floats)[1]),
             times=times,
             q_robot=q_robot,
+            # checked, then traced again from the trajectory below: a path stored by older
+            # code, or edited by hand, never replays
             grid_path=read("grid_path", "a list of whole grid states", _whole_numbers),
             # the grid's values are checked by ArmGrid when the path is traced below
             grid=cast(GridSpec, read("grid", "a table of grid settings", _table)),
@@ -259,20 +279,23 @@ def load_demonstration(path: str | os.PathLike[str]) -> Demonstration:
             f"{path}: segment is missing or is not two times in seconds; re-extract the demonstration.",
             "bad_file",
         ) from None
-    if demo.q_robot.shape[0] > 0:
-        # The grid path is derived from the trajectory by the one path function; a file written
-        # by older code (which erased loops before cutting at the goal) gets today's path, so
-        # the listing, the page and the CLI replay the same steps.
-        try:
-            trace = demo.arm_grid().trace_joints(demo.q_robot, stop_at_goal=True)
-        except (LearningError, TypeError) as err:
-            raise DemonstrationError(
-                f"{path} has a bad grid or trajectory ({err}); re-extract the demonstration.",
-                "bad_file",
-            ) from None
-        if trace.reaches_goal and trace.steps >= 1:
-            demo.grid_path = trace.states
+    demo.grid_path = _own_grid_path(path, demo)
     return demo
+
+
+def _own_grid_path(path: Path, demo: Demonstration) -> list[int]:
+    """The grid path of a loaded demonstration toward its own goal, by learning's one path
+    function: a file written by older code (which erased loops before cutting at the goal) gets
+    today's path, so the listing, the page and the CLI replay the same steps. A trajectory that
+    never reaches the goal keeps the path to where it ends, and a run refuses it with its
+    sentence (the page as the demonstration is picked)."""
+    try:
+        return demo.arm_grid().trace_joints(demo.q_robot, stop_at_goal=True).states
+    except (LearningError, TypeError) as err:
+        raise DemonstrationError(
+            f"{path} has a bad grid or trajectory ({err}); re-extract the demonstration.",
+            "bad_file",
+        ) from None
 
 
 def _table(value: object) -> dict[str, object]:
@@ -294,10 +317,14 @@ def _floats(value: object) -> np.ndarray:
 
 
 def _joint_rows(value: object) -> np.ndarray:
+    """Rows of joint angles, all of one width (which learning's ``motion_problem`` judges)."""
     if not isinstance(value, list) or any(not isinstance(row, list) for row in value):
         raise TypeError("not a list of rows")
     rows = [_floats(row) for row in value]
-    return np.asarray(rows, dtype=np.float64).reshape(-1, 6)
+    if len({len(row) for row in rows}) > 1:
+        raise ValueError("rows of different widths")
+    width = len(rows[0]) if rows else 6
+    return np.asarray(rows, dtype=np.float64).reshape(len(rows), width)
 
 
 def _whole_numbers(value: object) -> list[int]:

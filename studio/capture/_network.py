@@ -24,8 +24,7 @@ from studio import is_loopback
 
 from ._errors import CaptureError
 from ._frames import TapeFrame
-from ._source import DEFAULT_QUEUE_FRAMES, ThreadedSource
-from ._source_spec import check_seconds
+from ._source import DEFAULT_QUEUE_FRAMES, ThreadedSource, check_seconds
 from ._wire import DEFAULT_PORT, WireError, bridge_key, decode_frame, encode_frame
 
 RECEIVE_POLL_SECONDS = 0.1

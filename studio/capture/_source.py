@@ -9,6 +9,7 @@ port) ends the thread and is reported in :meth:`ThreadedSource.status`, never ra
 from __future__ import annotations
 
 import collections
+import math
 import queue
 import threading
 import time
@@ -28,6 +29,19 @@ RATE_WINDOW_SECONDS = 1.0
 (a paused recording, a silent bridge, a stalled device) reads 0 Hz within a second."""
 STOP_JOIN_SECONDS = 2.0
 """How long :meth:`ThreadedSource.stop` waits for the producer thread to end."""
+
+
+def check_seconds(seconds: float | None, what: str = "--seconds") -> float | None:
+    """A duration to capture or stream for: ``None`` (no limit) or a positive, finite number.
+
+    Raises:
+        CaptureError: zero, negative, NaN or infinite.
+    """
+    if seconds is not None and not (seconds > 0 and math.isfinite(seconds)):
+        raise CaptureError(
+            f"{what} is {seconds:g}; give a positive number of seconds, or leave it out to go on until Ctrl-C."
+        )
+    return seconds
 
 
 @dataclass(frozen=True)

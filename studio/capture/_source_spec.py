@@ -8,7 +8,6 @@ page) ``camera[:SIDE]`` and ``hand[:SIDE]`` (a :class:`CameraSource`, a :class:`
 
 from __future__ import annotations
 
-import math
 import os
 from pathlib import Path
 
@@ -113,19 +112,6 @@ def parse_host_port(text: str, default_port: int = DEFAULT_PORT) -> tuple[str, i
             f"'{text}' has no valid port; write HOST:PORT with a port from 1 to {MAX_PORT}, e.g. 127.0.0.1:{default_port}."
         )
     return host or "127.0.0.1", number
-
-
-def check_seconds(seconds: float | None, what: str = "--seconds") -> float | None:
-    """A duration to capture or stream for: ``None`` (no limit) or a positive, finite number.
-
-    Raises:
-        CaptureError: zero, negative, NaN or infinite.
-    """
-    if seconds is not None and not (seconds > 0 and math.isfinite(seconds)):
-        raise CaptureError(
-            f"{what} is {seconds:g}; give a positive number of seconds, or leave it out to go on until Ctrl-C."
-        )
-    return seconds
 
 
 def cli_speed(speed: float) -> float | None:

@@ -27,6 +27,7 @@ from studio.export import (
     demonstration_motion,
     export_motion,
     find_source,
+    likeness_motions,
     recording_motion,
     source_kind,
 )
@@ -42,8 +43,8 @@ from studio.learning import (
     LearningError,
     PolicyFile,
     TilePolicyFile,
-    dmp_likeness_card,
     greedy_path,
+    likeness_cards,
     load_any_policy,
     rollout,
     rollout_dmp_policy,
@@ -89,6 +90,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--data-dir", type=Path, default=Path("."), help="data folder names are looked up in"
     )
     parser.add_argument("--task", default="", help="LeRobot task text (default: from the source)")
+    parser.add_argument(
+        "--demo",
+        metavar="NAME",
+        help="score a policy's likeness card against this demonstration (a path or a name, "
+        "rolled out from its start); default: the run's own demonstrations, or a movement "
+        "primitive's",
+    )
     start = parser.add_mutually_exclusive_group()
     start.add_argument("--start-state", type=int, help="grid state number to start from")
     start.add_argument(
@@ -249,11 +257,24 @@ def _run_legacy(
         print(
             f"{summary} in {times[-1]:.2f} s; wrote {len(times)} samples at {args.rate:g} Hz to {out}"
         )
-    if isinstance(policy, DmpPolicyFile):
-        print(
-            f"likeness to its demonstration, from the demonstration's start:\n{dmp_likeness_card(policy, args.rate).text()}"
-        )
+    _print_likeness(args, args.policy, policy)
     return 0
+
+
+def _print_likeness(
+    args: argparse.Namespace, path: Path, policy: PolicyFile | TilePolicyFile | DmpPolicyFile
+) -> None:
+    """Print the policy's likeness card against each of its demonstrations (or why none)."""
+    motions = likeness_motions(path, policy, args.demo, args.data_dir)
+    if not motions:
+        print(
+            "no likeness card: the policy was not taught from a recorded demonstration; give --demo NAME"
+        )
+    for motion, card in likeness_cards(policy, motions):
+        if isinstance(card, str):
+            print(f"no likeness card for {motion.name}: {card}", file=sys.stderr)
+        else:
+            print(f"likeness to {motion.name}, from the demonstration's start:\n{card.text()}")
 
 
 def _motion(args: argparse.Namespace, source: Path, robot: str) -> tuple[Motion, str]:
@@ -299,4 +320,6 @@ def run(args: argparse.Namespace) -> int:
     )
     for finding in done.findings:
         print(f"  {finding.sentence}", file=sys.stderr)
+    if motion.kind == "policy":
+        _print_likeness(args, source, load_any_policy(source))
     return 0

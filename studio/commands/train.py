@@ -34,6 +34,7 @@ from typing import cast
 from studio import StudioError, read_json
 from studio.capture import DEMO_FORMAT, DEMO_SUFFIX, load_demonstration
 from studio.learning import (
+    ACTION_SETS,
     DEFAULT_EPISODES,
     DEFAULT_EXPERIMENTS,
     DEFAULT_GOAL_JOINTS_DEG,
@@ -108,6 +109,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--step-deg",
         type=float,
         help=f"arm-reach: joint increment per action, degrees (default: {REACH_DEFAULTS['step_deg']:g})",
+    )
+    parser.add_argument(
+        "--actions",
+        choices=ACTION_SETS,
+        help="arm-reach: what one action moves: one joint, also two joints together, or any "
+        f"joints at once (default: {REACH_DEFAULTS['actions']})",
     )
     parser.add_argument(
         "--tilings",
@@ -187,8 +194,9 @@ def _grid_paths(data: object, source: Path) -> list[list[int]]:
 def _recorded(source: Path) -> DemonstrationPath:
     """A cut demonstration (``*.demo.json``): its joint trajectory, which the run replays along
     the path the page replays, never the file's stored ``grid_path`` (written by older code, or
-    edited by hand)."""
-    return DemonstrationPath(f"The demonstration {source}", load_demonstration(source).q_robot)
+    edited by hand); its times too, for the run's likeness card."""
+    demo = load_demonstration(source)
+    return DemonstrationPath(f"The demonstration {source}", demo.q_robot, times=demo.times)
 
 
 def _numbers(text: str, flag: str, kind: Callable[[str], float], example: str) -> list[float]:

@@ -17,6 +17,8 @@ from ._formats import write_csv as write_csv
 from ._formats import write_mcap as write_mcap
 from ._lerobot import CODEBASE_VERSION as CODEBASE_VERSION
 from ._lerobot import write_lerobot as write_lerobot
+from ._likeness import demonstration_of as demonstration_of
+from ._likeness import likeness_motions as likeness_motions
 from ._safety import COLLISION_MARGIN_M as COLLISION_MARGIN_M
 from ._safety import Finding as Finding
 from ._safety import check_trajectory as check_trajectory

@@ -166,6 +166,40 @@ def puma560_meshes(config: MeshConfig | None = None) -> list[MeshPart]:
     return parts
 
 
+def robot_meshes(
+    visual_model: pin.GeometryModel, config: MeshConfig | None = None
+) -> list[MeshPart]:
+    """The visual meshes of a robot of :func:`~studio.kinematics.load_robot`, from its URDF.
+
+    Args:
+        visual_model: the robot's ``RobotArm.visual_model`` (its ``.dae``/``.stl`` meshes).
+        config: simplification (default :class:`MeshConfig`).
+
+    Returns:
+        One part per geometry object, its vertices scaled by the URDF's ``scale`` in the
+        object's own frame; ``frame`` ``i`` indexes ``visual_model.geometryObjects`` (posed by
+        ``pinocchio.updateGeometryPlacements``).
+
+    Raises:
+        KinematicsError: a mesh file is missing or unreadable.
+    """
+    config = config if config is not None else MeshConfig()
+    parts = []
+    for i, geom in enumerate(visual_model.geometryObjects):
+        path = Path(geom.meshPath)
+        try:
+            v, f = _load_stl(path)
+        except (OSError, ValueError) as err:
+            raise KinematicsError(
+                f"The robot mesh {path} cannot be read ({err}); reinstall example-robot-data."
+            ) from None
+        v = v * np.asarray(geom.meshScale, dtype=float)
+        v, f = simplify(v, f, config.cell_m)
+        r, g, b = (float(c) for c in np.asarray(geom.meshColor, dtype=float)[:3])
+        parts.append(MeshPart(f"{i}-{geom.name}", i, v, f, (r, g, b)))
+    return parts
+
+
 def _human_color(link: str) -> tuple[float, float, float]:
     if any(k in link for k in ("head", "hand", "lowerarm")):
         return HUMAN_COLORS["skin"]

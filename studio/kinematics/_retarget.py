@@ -154,6 +154,9 @@ class Retargeter:
         """The last cartesian-mode IK result (``success``, ``error``, ``message``): an
         unreachable hand pose is reported here, while ``robot_from_human`` returns the closest
         configuration within the limits."""
+        self.held = False
+        """Whether the last cartesian-mode frame held the previous pose, because the new one
+        would have brought the robot's links into contact."""
 
     # ---------------------------------------------------------------------------- settings
 
@@ -284,7 +287,10 @@ class Retargeter:
             if self._q_prev is not None:
                 step = self.config.max_joint_step
                 q = self._q_prev + np.clip(q - self._q_prev, -step, step)
-            if robot.checks_collisions and robot.self_collisions(q, self.config.clearance):
+            self.held = robot.checks_collisions and bool(
+                robot.self_collisions(q, self.config.clearance)
+            )
+            if self.held:
                 # hold the last pose free of self-collision (the robot's home before the first)
                 q = robot.home if self._q_prev is None else self._q_prev
         self._q_prev = q.copy()

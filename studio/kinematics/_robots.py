@@ -319,6 +319,11 @@ class RobotArm:
         if len(collision_model.geometryObjects):
             self._set_collision_pairs(srdf)
 
+    @property
+    def tool_frame(self) -> int:
+        """The id of the tool's frame in :attr:`model` (the pose :meth:`forward` gives)."""
+        return self._tool
+
     # ------------------------------------------------------------------------------ kinematics
 
     def check_q(self, q: object, what: str = "q") -> np.ndarray:

@@ -4,7 +4,7 @@
   observation (the grid state number) and Discrete actions; its dynamics are the table of
   :meth:`ArmGrid.mdp`, the one the tabular learner steps.
 - ``TeachStudio/ArmReach-v0`` (:class:`ArmReachEnv`): joints 1..J as a Box observation (radians)
-  and 2J Discrete actions; its ``step`` calls :func:`._reach.reach_step`, the same compiled
+  and Discrete actions (2J moving one joint each, or more with ``actions``); its ``step`` calls :func:`._reach.reach_step`, the same compiled
   function the linear learner's kernel calls.
 
 Both honour ``reset(seed=...)`` (every random draw comes from the environment's ``np_random``),
@@ -48,6 +48,8 @@ class _ReachSettings(TypedDict, total=False):
     goal: tuple[float, ...] | None
     position_tolerance: float
     angle_tolerance_deg: float
+    shaping: float
+    actions: str
 
 
 class ArmGridEnv(gymnasium.Env):
@@ -101,6 +103,9 @@ class ArmReachEnv(gymnasium.Env):
         goal: goal joint angles, radians (``joints`` or 6 values).
         position_tolerance: metres.
         angle_tolerance_deg: degrees.
+        shaping: weight of the potential-based shaping reward.
+        actions: what one action moves: ``"single"`` (one joint), ``"pairs"`` (also two
+            together) or ``"all"`` (any joints at once).
     """
 
     metadata = {"render_modes": []}
@@ -138,7 +143,7 @@ class ArmReachEnv(gymnasium.Env):
         return self.q.copy(), {}
 
     def step(self, action: int) -> tuple[NDArray[np.float64], float, bool, bool, dict[str, object]]:
-        """Move one joint by one step; ``terminated`` at the goal."""
+        """Move the action's joints by one step each; ``terminated`` at the goal."""
         reward, terminated = reach_step(self._params, self.q, int(action))
         return self.q.copy(), float(reward), bool(terminated), False, {}
 

@@ -44,9 +44,10 @@ priority heap and the run around the kernels from :mod:`._learner`), seeded per 
 ``(seed, experiment)``; the environment's resets by ``seed`` and the experiment index.
 
 Caching caveat: numba's disk cache of these kernels is keyed on this file alone, yet they compile
-in the dynamics of ``_reach.py`` and ``_linear_env.py``, the features of ``_tiles.py`` and the
-helpers of ``_learner.py``; after editing one of those, touch this file (or delete
-``__pycache__/_linear*.nb*``) so the kernels recompile.
+in the dynamics of ``_reach.py`` and ``_linear_env.py``, the features of ``_tiles.py``, the
+demonstrations' potential of ``_demo_shaping.py`` and the helpers of ``_learner.py``; after
+editing one of those, touch this file (or delete ``__pycache__/_linear*.nb*``) so the kernels
+recompile.
 """
 
 from __future__ import annotations
@@ -61,6 +62,7 @@ import numpy as np
 from numba import njit
 
 from ._config import MAX_Q_ENTRIES, DynaQConfig
+from ._demo_shaping import demo_potential, potential, shaped
 from ._errors import LearningError
 from ._learner import (
     GOLDEN,
@@ -112,11 +114,12 @@ Agent = namedtuple(
 _STORED, _SLOT, _HEAP, _STAMP = 0, 1, 2, 3
 
 Episodes = namedtuple(
-    "Episodes", "starts demo_starts demo_actions demo_offsets max_steps planning_steps epsilon"
+    "Episodes",
+    "starts demo_starts demo_actions demo_offsets max_steps planning_steps epsilon potential",
 )
 """What the compiled kernel plays: start states ``(episodes, state_dim)``, demonstrations
 (starts ``(n, state_dim)``, actions back to back, offsets ``(n + 1,)``), the step cap, the
-planning budget and epsilon."""
+planning budget, epsilon and the demonstrations' shaping potential (:mod:`._demo_shaping`)."""
 
 
 # --------------------------------------------------------------------------- learning steps
@@ -331,6 +334,7 @@ def _run_compiled(task, params, agent, plays, seed, stop, steps_out, updates_out
             limit = plays.max_steps
         observe(task, state, obs)
         active_features(agent.spec, obs, feats)
+        phi = potential(plays.potential, obs)
         steps = 0
         updates = 0
         while steps < limit:
@@ -340,6 +344,7 @@ def _run_compiled(task, params, agent, plays, seed, stop, steps_out, updates_out
                 action, rng = _act(agent, feats, plays.epsilon, rng)
             reward, terminal = task_step(task, params, state, action)
             observe(task, state, obs_next)
+            reward, phi = shaped(plays.potential, reward, phi, obs_next)
             rng, n = _learn(
                 agent, obs, feats, action, reward, terminal, obs_next, steps > 0, n_plan, rng
             )
@@ -477,8 +482,9 @@ def run_linear_experiments(
         episodes: episodes per experiment.
         seed: a non-negative integer.
         demonstrations: replayed as the first episodes: for ``TeachStudio/ArmReach-v0`` joint
-            paths ``(N, joints)`` in radians; for any environment, action sequences replayed from
-            ``env.reset``.
+            paths ``(N, joints)`` in radians, which also shape every reward with a potential
+            read from them (:mod:`._demo_shaping`); for any environment, action sequences
+            replayed from ``env.reset``.
         features: the tile coding (required).
         workers: threads for the compiled kernel (default: one per core).
         live: progress arrays to fill and the stop flag to obey.
@@ -505,6 +511,7 @@ def run_linear_experiments(
             raise LearningError(problem)
         dims = int(task.low.shape[0])
         demo_starts, demo_actions = env_demonstrations(demonstrations or [], task)
+        pot = demo_potential(task.reach, demo_starts, demo_actions, dims)
         weights = np.zeros((experiments, coder.size, task.n_actions), np.float64)
         agents = [  # each learns into its row of ``weights``, which checkpoints read as it learns
             _new_agent(coder, task.n_actions, dims, config, model_capacity, weights[e])
@@ -517,7 +524,9 @@ def run_linear_experiments(
             if task.code is not None:  # the compiled kernel holds no GIL: it may yield the CPU
                 lower_thread_priority(live.niceness)
             with live.counting_cpu() as spent:
-                runner(envs[e], task, agents[e], config, seed, e, demo_starts, demo_actions, live)
+                runner(
+                    envs[e], task, agents[e], config, seed, e, demo_starts, demo_actions, pot, live
+                )
             cpu_seconds[e] = spent[0]
 
         def so_far() -> LinearResult:
@@ -550,7 +559,7 @@ def weight_problem(experiments: int, coder: TileCoder, n_actions: int) -> str | 
     return f"{experiments} weight tables of {coder.size:,} rows x {n_actions} actions need {entries * 8 / 1e9:.1f} GB; give TileCoding a smaller size or run fewer experiments (at most {MAX_Q_ENTRIES:,} weights in all)."
 
 
-def _compiled_experiment(env, task, agent, config, seed, e, demo_starts, demo_actions, live):
+def _compiled_experiment(env, task, agent, config, seed, e, demo_starts, demo_actions, pot, live):
     episodes = live.steps.shape[1]
     starts = reset_states(env, task, seed, e, episodes)
     dims = starts.shape[1]
@@ -569,6 +578,7 @@ def _compiled_experiment(env, task, agent, config, seed, e, demo_starts, demo_ac
         np.int64(task.max_steps),
         np.int64(config.planning_steps),
         float(config.epsilon),
+        pot,
     )
     _run_compiled(
         np.int64(task.code), task.params, agent, plays, experiment_seed(seed, e),
@@ -576,8 +586,11 @@ def _compiled_experiment(env, task, agent, config, seed, e, demo_starts, demo_ac
     )  # fmt: skip
 
 
-def _python_experiment(env, task, agent, config, seed, e, demo_starts, demo_actions, live):
-    """The same experiment as :func:`_run_compiled`, stepping ``env`` from Python."""
+def _python_experiment(env, task, agent, config, seed, e, demo_starts, demo_actions, pot, live):
+    """The same experiment as :func:`_run_compiled`, stepping ``env`` from Python.
+
+    ``pot`` is always the empty potential here: joint-path demonstrations, which shape, need the
+    arm task's compiled twin."""
     episodes = live.steps.shape[1]
     rng = experiment_seed(seed, e)
     n_active = agent.feats.shape[0]

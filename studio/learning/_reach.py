@@ -1,15 +1,18 @@
 """The continuous arm task: joints 1..J of the Puma560 reach a demonstrated pose, step by step.
 
 The state is the first ``joints`` joint angles (radians, inside the robot's limits); the other
-joints stay at the goal's values. Actions move ONE joint by ``step_deg`` at a time (2J actions:
-joint 1 up, joint 1 down, joint 2 up, ...). A move that would leave the joint's limits leaves the
-arm where it is, as on the paper's grid. Reaching the goal pays :data:`GOAL_REWARD` and ends the
+joints stay at the goal's values. By default (``actions="single"``) an action moves ONE joint by
+``step_deg`` (2J actions: joint 1 up, joint 1 down, joint 2 up, ...); ``actions="pairs"`` adds
+every two joints moving together, each up or down (the diagonals, 2J**2 actions), and
+``actions="all"`` every joint -1/0/+1 at once (3**J - 1 actions); see :data:`ACTION_SETS` and
+:func:`action_directions`. A joint whose move would leave its limits stays where it is, as on
+the paper's grid (the action's other joints still move). Reaching the goal pays :data:`GOAL_REWARD` and ends the
 episode, every other step pays :data:`STEP_REWARD` (the paper's rewards), plus a potential-based
 shaping term (:data:`DEFAULT_SHAPING`). Episodes start uniformly across the limits (a start already
 at the goal is redrawn).
 
-Why one joint at a time rather than every joint -1/0/+1 at once (3**J actions, 729 for six
-joints): a linear learner evaluates every action at every step and learns each action's weights
+Why one joint at a time is the default rather than every joint -1/0/+1 at once (3**J - 1
+actions, 728 for six joints) or the pairs (measured in ``benchmarks/bench_actions.py``): a linear learner evaluates every action at every step and learns each action's weights
 from its own visits, so 12 actions cost 60x less per step and each gets 60x more data; and with one
 joint per action the steps to the goal are a sum of per-joint distances, which per-joint tilings
 represent (:meth:`ArmReach.features`; :data:`DEFAULT_SHAPING` says why the shaping weight matters).
@@ -28,6 +31,7 @@ Dynamics are defined once, here, in numba functions (:func:`reach_step`, :func:`
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -88,6 +92,12 @@ step away), which per-joint tilings represent exactly, and the +100 only settles
 (39 at gamma = 0.95)."""
 MAX_SHAPING = 100.0
 """Upper bound on ``shaping``."""
+ACTION_SETS = ("single", "pairs", "all")
+"""What one action may move: one joint (2J actions), one joint or two together (2J**2), or any
+joints at once (3**J - 1); each set begins with the one before it, in the same order."""
+DEFAULT_ACTIONS = "single"
+"""One joint per action: it learns in fewer real steps than the multi-joint sets (package README;
+``benchmarks/bench_actions.py``)."""
 LIMIT_SLACK_RAD = 1e-9
 """A demonstration may touch its joint limits within this rounding."""
 
@@ -104,7 +114,9 @@ _ALPHA = 46
 _SHAPING = 52
 _POS_TOL = 53
 _ANG_TOL = 54
-_N_PARAMS = 55
+_MULTI = 55  # 0: one joint per action (the fast path), else the table below
+_TABLE = 56  # per action, ROBOT_JOINTS directions -1/0/+1
+_N_PARAMS = 56
 
 
 @dataclass(frozen=True)
@@ -118,6 +130,8 @@ class ArmReach:
             ``joints`` are held there); default: :data:`studio.learning.DEFAULT_GOAL_DEG`.
         position_tolerance: metres.
         angle_tolerance_deg: degrees.
+        shaping: weight of the potential-based shaping reward (:data:`DEFAULT_SHAPING`).
+        actions: what one action moves, one of :data:`ACTION_SETS`.
 
     Raises:
         LearningError: a bad value, or a goal outside the joint limits.
@@ -129,8 +143,16 @@ class ArmReach:
     position_tolerance: float = DEFAULT_POSITION_TOLERANCE
     angle_tolerance_deg: float = DEFAULT_ANGLE_TOLERANCE_DEG
     shaping: float = DEFAULT_SHAPING
+    actions: str = DEFAULT_ACTIONS
 
     def __post_init__(self) -> None:
+        if self.actions not in ACTION_SETS:
+            raise ConfigError(
+                [
+                    f"actions is {self.actions!r}; give {', '.join(map(repr, ACTION_SETS))} (one joint per action, also two together, or any joints at once)."
+                ],
+                ["actions"],
+            )
         if (
             not isinstance(self.joints, int | np.integer)
             or isinstance(self.joints, bool)
@@ -191,8 +213,13 @@ class ArmReach:
 
     @property
     def n_actions(self) -> int:
-        """2J: one joint up or down by one step."""
-        return 2 * self.joints
+        """2J (one joint up or down by one step), 2J**2 with the pairs, 3**J - 1 with all."""
+        return int(self.directions.shape[0])
+
+    @cached_property
+    def directions(self) -> np.ndarray:
+        """Each action's move, in steps per joint: int8 ``(n_actions, joints)`` of -1/0/+1."""
+        return action_directions(self.joints, self.actions)
 
     @property
     def step(self) -> float:
@@ -218,11 +245,13 @@ class ArmReach:
             "position_tolerance": self.position_tolerance,
             "angle_tolerance_deg": self.angle_tolerance_deg,
             "shaping": self.shaping,
+            "actions": self.actions,
         }
 
     @classmethod
     def from_dict(cls, data: dict) -> ArmReach:
-        """Settings from :meth:`to_dict`'s form."""
+        """Settings from :meth:`to_dict`'s form (one written before ``actions`` existed moves one
+        joint per action)."""
         return cls(**{**data, "goal": None if data.get("goal") is None else tuple(data["goal"])})
 
     def features(
@@ -247,7 +276,10 @@ class ArmReach:
     def params(self) -> np.ndarray:
         """The flat parameter array of :func:`reach_step` and friends (read-only)."""
         robot = Puma560()
-        p = np.zeros(_N_PARAMS, np.float64)
+        table = self.directions
+        p = np.zeros(_N_PARAMS + ROBOT_JOINTS * table.shape[0], np.float64)
+        p[_MULTI] = 0.0 if self.actions == "single" else 1.0
+        p[_TABLE:].reshape(-1, ROBOT_JOINTS)[:, : self.joints] = table
         p[_J] = self.joints
         p[_STEP] = self.step
         p[_POS_TOL2] = self.position_tolerance**2
@@ -307,9 +339,11 @@ class ArmReach:
     ) -> tuple[np.ndarray, np.ndarray]:
         """The start and the action sequence that follow a demonstrated joint path.
 
-        The walk starts at the path's first sample and steps toward each later sample in turn,
-        one joint per step (the joint farthest from the sample first), until every joint is within
-        half a step of it; it stops at its first arrival at the goal.
+        The walk starts at the path's first sample and steps toward each later sample in turn
+        until every joint is within half a step of it; it stops at its first arrival at the goal.
+        Each step takes the action that moves only joints more than half a step from the sample,
+        each toward it, with the largest sum of their distances (with one joint per action: the
+        farthest joint first).
 
         Args:
             q_path: joint angles, radians, ``(N, joints)`` or wider (the first ``joints`` columns).
@@ -347,6 +381,26 @@ class ArmReach:
                 f"Demonstration {index} never brings the tool within {self.position_tolerance * 100:g} cm and {self.angle_tolerance_deg:g} deg of the goal; end it at the goal or make the goal its final pose."
             )
         return q[0].copy(), actions[:n].copy()
+
+
+def action_directions(joints: int, actions: str = DEFAULT_ACTIONS) -> np.ndarray:
+    """The moves of action set ``actions`` over ``joints`` joints: int8 ``(n, joints)``, -1/0/+1.
+
+    Singles first (joint 1 up, joint 1 down, joint 2 up, ...), then with ``"pairs"`` or ``"all"``
+    each pair of joints ``j < k`` as (+, +), (+, -), (-, +), (-, -), then with ``"all"`` the
+    moves of three or more joints (in ``itertools.product((1, 0, -1), repeat=joints)`` order).
+    """
+    rows: list[tuple[int, ...]] = []
+    for j in range(joints):
+        for d in (1, -1):
+            rows.append(tuple(d if i == j else 0 for i in range(joints)))
+    if actions in ("pairs", "all"):
+        for j, k in itertools.combinations(range(joints), 2):
+            for dj, dk in ((1, 1), (1, -1), (-1, 1), (-1, -1)):
+                rows.append(tuple(dj if i == j else dk if i == k else 0 for i in range(joints)))
+    if actions == "all":
+        rows += [m for m in itertools.product((1, 0, -1), repeat=joints) if sum(map(abs, m)) > 2]
+    return np.array(rows, dtype=np.int8).reshape(-1, joints)
 
 
 def _limits() -> tuple[np.ndarray, np.ndarray]:
@@ -433,16 +487,26 @@ def reach_potential(params, state):
 def reach_step(params, state, action):
     """Apply ``action`` to ``state`` (in place); returns ``(reward, terminated)``.
 
-    Action ``2 j`` moves joint ``j`` up one step, ``2 j + 1`` down. A move
-    that would leave the joint's limits leaves it where it is. The reward is the paper's (+100 at
+    Action ``2 j`` moves joint ``j`` up one step, ``2 j + 1`` down; a multi-joint task's other
+    actions move the joints of their row of the action table (:func:`action_directions`). A
+    joint whose move would leave its limits stays where it is. The reward is the paper's (+100 at
     the goal, -1 otherwise) plus ``shaping`` times the change of :func:`reach_potential`.
     """
     shaping = params[_SHAPING]
     before = reach_potential(params, state) if shaping != 0.0 else 0.0
-    j = action // 2
-    moved = state[j] + (params[_STEP] if action % 2 == 0 else -params[_STEP])
-    if params[_LOWER + j] <= moved <= params[_UPPER + j]:
-        state[j] = moved
+    if params[_MULTI] == 0.0:
+        j = action // 2
+        moved = state[j] + (params[_STEP] if action % 2 == 0 else -params[_STEP])
+        if params[_LOWER + j] <= moved <= params[_UPPER + j]:
+            state[j] = moved
+    else:
+        row = _TABLE + ROBOT_JOINTS * action
+        for j in range(state.shape[0]):
+            direction = params[row + j]
+            if direction != 0.0:
+                moved = state[j] + direction * params[_STEP]
+                if params[_LOWER + j] <= moved <= params[_UPPER + j]:
+                    state[j] = moved
     done = reach_success(params, state)
     reward = GOAL_REWARD if done else STEP_REWARD
     if shaping != 0.0:
@@ -452,11 +516,12 @@ def reach_step(params, state, action):
 
 @njit(nogil=True, cache=True)
 def _walk(params, path, actions):
-    """Fill ``actions`` with a one-joint-per-step walk along ``path``; returns their number.
+    """Fill ``actions`` with the walk along ``path``; returns their number.
 
     Returns -1 when the walk never reaches the goal. See :meth:`ArmReach.demonstration_actions`.
     """
     joints = path.shape[1]
+    n_actions = (params.shape[0] - _N_PARAMS) // ROBOT_JOINTS
     step = params[_STEP]
     state = path[0].copy()
     if reach_success(params, state):
@@ -465,19 +530,32 @@ def _walk(params, path, actions):
     for i in range(1, path.shape[0]):
         while n < actions.shape[0]:
             best = -1
-            gap = 0.5 * step
-            for j in range(joints):
-                if abs(path[i, j] - state[j]) > gap:
-                    moved = state[j] + (step if path[i, j] > state[j] else -step)
-                    if params[_LOWER + j] <= moved <= params[_UPPER + j]:
-                        gap = abs(path[i, j] - state[j])
-                        best = j
+            best_score = 0.5 * step
+            for a in range(n_actions):
+                row = _TABLE + ROBOT_JOINTS * a
+                score = 0.0
+                for j in range(joints):
+                    direction = params[row + j]
+                    if direction == 0.0:
+                        continue
+                    gap = path[i, j] - state[j]
+                    moved = state[j] + direction * step
+                    if (
+                        abs(gap) <= 0.5 * step
+                        or direction * gap < 0.0
+                        or not params[_LOWER + j] <= moved <= params[_UPPER + j]
+                    ):
+                        score = -1.0
+                        break
+                    score += abs(gap)
+                if score > best_score:
+                    best_score = score
+                    best = a
             if best < 0:
                 break
-            action = 2 * best + (0 if path[i, best] > state[best] else 1)
-            actions[n] = action
+            actions[n] = best
             n += 1
-            _, done = reach_step(params, state, action)
+            _, done = reach_step(params, state, best)
             if done:
                 return n
     return -1

@@ -7,8 +7,11 @@ reads back, the page's and ``studio train``'s from before version 1 included.
 
 ``config.json`` holds ``format`` (``teach-studio-run``), ``version`` (1), ``task``
 (:func:`task_spec`), ``config`` (the :class:`DynaQConfig` fields), ``experiments``, ``episodes``,
-``seed``, ``demonstrations``, ``name``, ``origin``, ``group``, ``created``, and for the page's
-runs ``request``, the form as the user filled it in (:meth:`RunRecord.form`).
+``seed``, ``demonstrations``, ``name``, ``origin``, ``group``, ``created``, for the page's
+runs ``request``, the form as the user filled it in (:meth:`RunRecord.form`), and for runs of
+recorded demonstrations ``demonstration_motions``, their times and joints
+(:meth:`DemonstrationMotion.to_dict`; absent in folders written before it, which then have no
+likeness card).
 """
 
 from __future__ import annotations
@@ -23,6 +26,7 @@ from .._files import now_iso
 from .._numbers import is_int, is_number
 from ._arm import ArmGrid
 from ._config import DEFAULT_SEED, DynaQConfig, check_budget
+from ._demo_motion import DemonstrationMotion
 from ._errors import ConfigError, LearningError
 from ._reach import ArmReach
 from ._tiles import TileCoding
@@ -86,6 +90,8 @@ class RunRecord:
             holds the goal it trains for (the arm grid's goal bin).
         demonstration_names: the names of the recorded demonstrations replayed, when the tool
             that made the run chose them by name (the page).
+        demonstration_motions: the recorded demonstrations' own motions (times and joints),
+            when known, so the run's likeness card is scored without the demonstration files.
     """
 
     task: ArmGrid | ArmReach
@@ -101,6 +107,7 @@ class RunRecord:
     created: str = ""
     goal_deg: tuple[float, ...] | None = None
     demonstration_names: tuple[str, ...] = ()
+    demonstration_motions: tuple[DemonstrationMotion, ...] = ()
 
     @classmethod
     def for_arm_grid(
@@ -117,6 +124,7 @@ class RunRecord:
         group: str | None = None,
         goal_deg: Sequence[float] | None = None,
         demonstration_names: Sequence[str] = (),
+        demonstration_motions: Sequence[DemonstrationMotion] = (),
     ) -> RunRecord:
         """A checked record for the arm grid.
 
@@ -132,6 +140,7 @@ class RunRecord:
             demonstrations=paths,
             **_run_fields(experiments, episodes, seed, name, origin, group, goal_deg),
             demonstration_names=tuple(demonstration_names),
+            demonstration_motions=tuple(demonstration_motions),
         )
 
     @classmethod
@@ -150,6 +159,7 @@ class RunRecord:
         group: str | None = None,
         goal_deg: Sequence[float] | None = None,
         demonstration_names: Sequence[str] = (),
+        demonstration_motions: Sequence[DemonstrationMotion] = (),
     ) -> RunRecord:
         """A checked record for the continuous-joint task learnt with tile coding.
 
@@ -184,6 +194,7 @@ class RunRecord:
             demonstrations=paths,
             **_run_fields(experiments, episodes, seed, name, origin, group, goal_deg),
             demonstration_names=tuple(demonstration_names),
+            demonstration_motions=tuple(demonstration_motions),
         )
 
     @property
@@ -244,6 +255,7 @@ class RunRecord:
             form.update(
                 joints=self.task.joints,
                 step_deg=self.task.step_deg,
+                actions=self.task.actions,
                 tilings=coding.tilings,
                 tiles=coding.tiles,
             )
@@ -269,6 +281,8 @@ class RunRecord:
             "group": self.group,
             "created": self.created,
         }
+        if self.demonstration_motions:
+            data["demonstration_motions"] = [m.to_dict() for m in self.demonstration_motions]
         if self.origin == "page":
             data["request"] = self.form()
         return data
@@ -338,6 +352,9 @@ class RunRecord:
             goal_deg=_goal_of(request.get("goal_deg")),
             demonstration_names=tuple(
                 str(n) for n in request.get("demonstrations") or () if isinstance(n, str)
+            ),
+            demonstration_motions=tuple(
+                DemonstrationMotion.from_dict(m) for m in data.get("demonstration_motions") or ()
             ),
         )
 

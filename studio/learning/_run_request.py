@@ -25,6 +25,7 @@ import numpy as np
 from .._numbers import is_int
 from ._arm import ArmGrid
 from ._config import DEFAULT_EPISODES, DEFAULT_EXPERIMENTS, DEFAULT_SEED, DynaQConfig
+from ._demo_motion import DemonstrationMotion, demonstration_grid_path
 from ._errors import ConfigError, LearningError
 from ._goal import goal_problems, grid_for_goal
 from ._reach import ROBOT_JOINTS, ArmReach
@@ -44,6 +45,7 @@ _FEATURES = ArmReach().features()
 REACH_DEFAULTS: Final = {
     "joints": ArmReach.joints,
     "step_deg": ArmReach.step_deg,
+    "actions": ArmReach.actions,
     "tilings": _FEATURES.tilings,
     "tiles": _FEATURES.tiles,
 }
@@ -65,11 +67,14 @@ class DemonstrationPath:
             recordings/reach-1.demo.json``).
         q_robot: the Puma560 joint path ``(N, 6)``, radians.
         name: the name the page lists it by (kept in the run record), or "".
+        times: its sample times ``(N,)`` (s), when known: the run keeps its motion for the
+            likeness card (``likeness.json``).
     """
 
     label: str
     q_robot: np.ndarray
     name: str = ""
+    times: np.ndarray | None = None
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -213,21 +218,10 @@ def _grid_paths(
     (each must end in the goal bin), then the generated ones."""
     paths = [[int(s) for s in path] for path in request.grid_paths]
     for demo in request.demonstrations:
-        q = np.asarray(demo.q_robot, dtype=np.float64)
         try:
-            path = grid.path_from_joints(q, stop_at_goal=True)
+            paths.append(demonstration_grid_path(demo.label, demo.q_robot, grid))
         except LearningError as err:
-            problems.append(("demonstrations", f"{demo.label} has no usable trajectory: {err}"))
-            continue
-        if path[-1] != grid.goal_state:
-            end = np.degrees(q[-1, :3])
-            problems.append(
-                (
-                    "demonstrations",
-                    f"{demo.label} ends at joints ({end[0]:.0f}, {end[1]:.0f}, {end[2]:.0f}) degrees, not in the goal bin (not in this run's goal bins {tuple(grid.goal)}); choose demonstrations that reach this run's goal or set the goal where they end.",
-                )
-            )
-        paths.append(list(path))
+            problems.append(("demonstrations", str(err)))
     count = request.generated
     if not is_int(count) or count < 0:
         problems.append(
@@ -240,6 +234,20 @@ def _grid_paths(
         rng = np.random.default_rng([cast(int, request.seed), GENERATED_DEMO_STREAM])
         paths += generate_demonstrations(grid, count, rng)
     return paths
+
+
+def _motions(request: RunRequest, problems: list[tuple[str, str]]) -> list[DemonstrationMotion]:
+    """The motions of the demonstrations whose times are known (for the likeness card)."""
+    motions = []
+    for demo in request.demonstrations:
+        if demo.times is None:
+            continue
+        try:
+            name = demo.name or demo.label
+            motions.append(DemonstrationMotion.checked(name, demo.times, demo.q_robot, demo.label))
+        except LearningError as err:
+            problems.append(("demonstrations", str(err)))
+    return motions
 
 
 def _budget(request: RunRequest) -> tuple[int, int, int]:
@@ -257,6 +265,7 @@ def _grid_record(
         request.experiments, request.episodes, request.seed, request.name, grid
     )
     paths = _grid_paths(request, grid, problems) if grid is not None else []
+    motions = _motions(request, problems)
     raise_problems(problems)
     assert grid is not None and config is not None
     return RunRecord.for_arm_grid(
@@ -269,6 +278,7 @@ def _grid_record(
         group=request.group,
         goal_deg=request.goal_deg,
         demonstration_names=[d.name for d in request.demonstrations if d.name],
+        demonstration_motions=motions,
     )
 
 
@@ -330,6 +340,7 @@ def _reach_record(
             group=request.group,
             goal_deg=request.goal_deg,
             demonstration_names=[d.name for d in request.demonstrations if d.name],
+            demonstration_motions=_motions(request, problems),
         )
     except ConfigError as err:
         raise_problems(problems + list(err.by_field.items()))

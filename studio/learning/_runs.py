@@ -70,6 +70,7 @@ from ._errors import ConfigError, LearningError
 from ._learner import ExperimentResult, LiveProgress
 from ._owner import OWNER_FILE, OwnerLock, owner_alive, pid_alive, this_host
 from ._policy import save_policy
+from ._run_likeness import save_run_likeness
 from ._run_record import TASK_ARM_REACH, RunRecord
 from ._run_train import TrainingThread, watch_training
 
@@ -595,6 +596,7 @@ class RunFolder:
             self.save_steps(live.steps)
             if result is not None and result.completed.any() and error is None:
                 self.save_policy(result)
+                save_run_likeness(self.path, self.policy_path, self.record.demonstration_motions)
         except LearningError as err:
             error = error or err
         if result is not None:

@@ -43,7 +43,10 @@ from .routers import (
     events,
     policies,
     recordings,
+    robots,
+    run_notes,
     runs,
+    scene_controls,
     sources,
     sweeps,
     takes,
@@ -99,14 +102,17 @@ def create_app(settings: Settings | None = None, scene: Scene | None = None) -> 
     for module in (
         config,
         sources,
+        robots,
         capture,
         recordings,
         takes,
         demonstrations,
         runs,
+        run_notes,
         sweeps,
         policies,
         watch,
+        scene_controls,
         events,
     ):
         app.include_router(module.router)

@@ -36,7 +36,7 @@ from studio.capture import (
     ObservationFitter,
     fitter_for,
 )
-from studio.kinematics import TapeConfig
+from studio.kinematics import HumanArm, Retargeter, RobotArm, TapeConfig
 
 from ._errors import ConflictError, storage_sentence
 from ._protocols import CaptureWriter, LivePose, LiveScene
@@ -75,6 +75,9 @@ class Pipeline:
         self._mode = "joint"
         self._mirror = True
         self._fitter: ObservationFitter | None = None  # the live chain for the source's kind
+        self._arm: RobotArm | None = None  # the robot taught, when not the Puma560
+        self._arm_retargeter: Retargeter | None = None  # the fitted arm onto it (cartesian)
+        self._robot_note: str | None = None  # why it does not follow the hand now
         self._q_human: np.ndarray | None = None
         self._q_robot = np.zeros(ROBOT_JOINTS)
         self._residual: float | None = None
@@ -132,6 +135,8 @@ class Pipeline:
             self._kind, self._recording, self._source = kind, recording, source
             self._start_error = None
             self._fitter = None
+            self._arm_retargeter = None
+            self._robot_note = None
             self._observable = None
             self._kin_error = None
             self._fit_warning = None
@@ -188,14 +193,45 @@ class Pipeline:
         return self._recording
 
     def set_retarget(self, mode: str, mirror: bool | None) -> None:
-        """Switch the human-to-robot mapping (applies from the next frame)."""
+        """Switch the human-to-robot mapping (applies from the next frame).
+
+        Raises:
+            ConflictError: joint mode for a robot other than the Puma560 (the mode of the
+                Puma560, kept for when it is taught again, does not change).
+        """
         with self._lock:
-            self._mode = mode
+            if self._arm is not None and mode == "joint":
+                raise ConflictError(
+                    f"Joint mode maps the human arm onto the Puma560's joints; the "
+                    f"{self._arm.spec.title} follows the hand in cartesian mode: choose cartesian."
+                )
+            if self._arm is None:
+                self._mode = mode
             if mirror is not None:
                 self._mirror = bool(mirror)
             if self._fitter is not None:
-                self._fitter.mode = mode
+                self._fitter.mode = self._mode
                 self._fitter.mirror = self._mirror
+            if self._arm_retargeter is not None:
+                self._arm_retargeter.mirror = self._mirror
+
+    def set_robot(self, arm: RobotArm | None) -> None:
+        """Teach ``arm`` (None or the ``puma560``: the Puma560, in the chosen mode) from the next
+        frame: the fitted human arm is retargeted onto it in cartesian mode
+        (:class:`~studio.kinematics.Retargeter`), starting from its home pose."""
+        if arm is not None and arm.name == "puma560":
+            arm = None
+        with self._fit_lock, self._lock:
+            self._arm = arm
+            self._arm_retargeter = None
+            self._robot_note = None
+            self._q_robot = np.zeros(ROBOT_JOINTS) if arm is None else np.array(arm.home)
+
+    @property
+    def robot_name(self) -> str:
+        """The robot taught (``puma560`` unless another was chosen)."""
+        arm = self._arm
+        return "puma560" if arm is None else arm.name
 
     @property
     def retarget_mode(self) -> str:
@@ -225,7 +261,12 @@ class Pipeline:
                 or self._rejected_warning(),
                 "rejected": int(getattr(st, "rejected", 0) or 0) + self._capture_rejected,
                 "recording": self._recording,
-                "retarget": {"mode": self._mode, "mirror": self._mirror},
+                "retarget": {
+                    "mode": self._mode if self._arm is None else "cartesian",
+                    "mirror": self._mirror,
+                },
+                "robot": self.robot_name,
+                "robot_warning": self._robot_note,
                 "fit_residual_mm": None if self._residual is None else self._residual * 1000.0,
                 "q_robot": [float(x) for x in self._q_robot],
                 "recording_active": self._writer is not None,
@@ -457,7 +498,7 @@ class Pipeline:
                 fitter = self._live_fitter(observations[0])
                 fitted = None
                 for observation in observations:
-                    fitted = fitter.fit(observation)
+                    fitted = self._onto_arm(fitter.fit(observation))
                     with self._lock:
                         self._q_human = fitted.q_human
                         self._q_robot = fitted.q_robot
@@ -480,6 +521,20 @@ class Pipeline:
                 self._kin_error = message
         return None
 
+    def _onto_arm(self, fitted: Fitted) -> Fitted:
+        """``fitted`` with its robot pose for the robot taught (unchanged for the Puma560)."""
+        arm = self._arm
+        if arm is None:
+            return fitted
+        retargeter = self._arm_retargeter
+        if retargeter is None:
+            human = HumanArm(side=self.side())
+            retargeter = Retargeter(robot=arm, arm=human, mirror=self._mirror)
+            self._arm_retargeter = retargeter
+        q_robot = retargeter.robot_from_human(fitted.q_human)
+        self._robot_note = robot_note(arm, retargeter)
+        return dataclasses.replace(fitted, q_robot=q_robot)
+
     def observe(self, observation: Observation) -> Fitted | None:
         """Fit and record one observation handed in by a fed source (camera, hand guide).
 
@@ -499,3 +554,27 @@ class Pipeline:
         """The teaching arm: a fed or recorded source's ``side``, else the tape's."""
         side = getattr(self._source, "side", None)
         return str(side) if side in ("right", "left") else self.tape_config().side
+
+
+REACH_TOLERANCE_M = 0.01
+"""A tool further than this from the mirrored hand's target is out of reach (the page says so)."""
+
+
+def robot_note(arm: RobotArm, retargeter: Retargeter) -> str | None:
+    """One sentence when ``arm`` does not follow the hand now: held clear of a self-collision,
+    or the hand out of its reach; None while it follows."""
+    title = arm.spec.title
+    if retargeter.held:
+        mm = retargeter.config.clearance * 1000.0
+        return (
+            f"The {title} holds its last pose: following the hand would bring its links closer "
+            f"than {mm:.0f} mm; move the hand back the way it came."
+        )
+    found = retargeter.last_ik
+    error = getattr(found, "position_error", 0.0)
+    if found is not None and not found.success and error > REACH_TOLERANCE_M:
+        return (
+            f"The hand is out of the {title}'s reach: its tool stops {error * 100.0:.0f} cm "
+            "short, as near as it gets; bring the hand closer to the shoulder."
+        )
+    return None

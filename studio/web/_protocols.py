@@ -15,6 +15,10 @@ from typing import NamedTuple, Protocol
 import numpy as np
 
 from studio.capture import Observation
+from studio.kinematics import RobotArm
+
+from ._scene_model import Playback
+from ._scene_views import SceneCamera
 
 
 class LivePose(NamedTuple):
@@ -47,6 +51,13 @@ class LiveScene(Protocol):
         """Make ``side`` the operator's arm that follows the fit."""
 
 
+class JointLimits(Protocol):
+    """A robot's joint limits (rad)."""
+
+    lower: np.ndarray
+    upper: np.ndarray
+
+
 class Scene(LiveScene, Protocol):
     """What the studio and its routers ask of the scene (:class:`~._scene.StudioScene`)."""
 
@@ -71,8 +82,37 @@ class Scene(LiveScene, Protocol):
     def stop_playback(self) -> None:
         """Stop a playback."""
 
+    def set_robot(self, arm: RobotArm | None) -> None:
+        """Draw ``arm`` (None: the Puma560) from its own meshes."""
+
+    @property
+    def robot_name(self) -> str:
+        """The robot drawn."""
+
+    @property
+    def robot_mesh_count(self) -> int:
+        """How many meshes draw it."""
+
     def current_q_robot(self) -> np.ndarray:
         """The robot joints shown now."""
+
+    robot: JointLimits
+    camera: SceneCamera
+
+    def tool_positions(self, q_robot: np.ndarray) -> np.ndarray:
+        """World tool positions of joint configurations ``(N, n)`` -> ``(N, 3)``."""
+
+    def scrub(
+        self,
+        t: float | None = None,
+        speed: float | None = None,
+        paused: bool | None = None,
+        step: int = 0,
+    ) -> tuple[Playback, float] | None:
+        """Reschedule the playback (or only read it); None when nothing was played."""
+
+    def hold_pose(self, q_robot: np.ndarray) -> None:
+        """Show the robot at a pose posed by hand."""
 
     def show_hand_handle(self, side: str | None, on_move: HandMoved | None) -> None:
         """Show the hand guide's handle on ``side``'s hand (None hides it)."""

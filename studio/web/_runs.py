@@ -24,7 +24,6 @@ from collections.abc import Callable, Iterator
 from datetime import UTC, datetime
 from pathlib import Path
 
-import numpy as np
 from pydantic import TypeAdapter
 
 from studio.learning import (
@@ -274,12 +273,14 @@ def run_create_of(record: RunRecord) -> RunCreate:
     return RUN_CREATE.validate_python(form)
 
 
-def prepare_run(create: RunCreate, demonstration_path: Callable[[str], np.ndarray]) -> RunRecord:
+def prepare_run(
+    create: RunCreate, demonstration_path: Callable[[str], DemonstrationPath]
+) -> RunRecord:
     """Check a ``RunCreate`` with the learning package's rules, reporting every bad field at once.
 
     Args:
         create: the request.
-        demonstration_path: the Puma560 joint path (N, 6), radians, of a demonstration by name.
+        demonstration_path: a demonstration by name: its Puma560 joint path and times.
 
     Returns:
         The run's record (:func:`studio.learning.resolve_run`).
@@ -287,10 +288,7 @@ def prepare_run(create: RunCreate, demonstration_path: Callable[[str], np.ndarra
     Raises:
         ConfigError: one sentence per bad field, keyed by field (answered as 422).
     """
-    demonstrations = [
-        DemonstrationPath(f"Demonstration {name!r}", demonstration_path(name), name)
-        for name in create.demonstrations
-    ]
+    demonstrations = [demonstration_path(name) for name in create.demonstrations]
     request = RunRequest.from_form(create.model_dump(), demonstrations=demonstrations)
     return resolve_run(request)
 
@@ -432,7 +430,9 @@ class RunQueue:
                     return run
         return None
 
-    def submit(self, create: RunCreate, demonstration_path: Callable[[str], np.ndarray]) -> Run:
+    def submit(
+        self, create: RunCreate, demonstration_path: Callable[[str], DemonstrationPath]
+    ) -> Run:
         """Validate a run, write its folder (atomically) and queue it."""
         record = prepare_run(create, demonstration_path)
         folder = RunFolder.create(self.folder, record)

@@ -38,14 +38,17 @@ from studio.kinematics import (
     MeshPart,
     PosedBody,
     Puma560,
+    RobotArm,
     pose_body,
-    puma560_meshes,
 )
 
 from ._hand_handle import HandHandle
 from ._protocols import HandMoved, LivePose
-from ._scene_model import Mode, Playback, SceneLayout, pose_at
+from ._robot_view import RobotView, RobotViews, add_robot, rgb255, wxyz_of
+from ._scene_model import Mode, Playback, SceneLayout, playback_time, pose_at, rescheduled
 from ._scene_model import camera_projection as camera_projection
+from ._scene_paths import ScenePaths
+from ._scene_views import SceneCamera
 
 log = logging.getLogger(__name__)
 
@@ -53,11 +56,6 @@ SOFTWARE_WEBGL_NOTICE = "webgl-software-rendering"
 """The id of the notice viser's client raises by itself when WebGL is drawn in software
 (``client/src/BrowserWarning.tsx``). The studio's page says the same in its own words, beside the
 scene rather than over it, so every browser that connects gets this notice closed."""
-
-
-def wxyz_of(rotations: np.ndarray) -> np.ndarray:
-    """Unit quaternions (w, x, y, z) of rotation matrices ``(..., 3, 3)`` (viser's convention)."""
-    return np.asarray(vtf.SO3.from_matrix(np.asarray(rotations, dtype=float)).wxyz)
 
 
 def _close_software_webgl_notice(client: viser.ClientHandle) -> None:
@@ -73,11 +71,6 @@ def _close_software_webgl_notice(client: viser.ClientHandle) -> None:
     client._websock_connection.queue_message(
         _messages.RemoveNotificationMessage(SOFTWARE_WEBGL_NOTICE)
     )
-
-
-def _rgb255(rgb: Sequence[float]) -> tuple[int, int, int]:
-    r, g, b = (int(round(255 * min(max(float(c), 0.0), 1.0))) for c in rgb)
-    return r, g, b
 
 
 @dataclass(frozen=True, eq=False)
@@ -111,7 +104,7 @@ class _Live:
     version: int
 
 
-class StudioScene:
+class StudioScene(ScenePaths):
     """The studio's viser scene, fed by the live pipeline and by playbacks.
 
     The operator wears one tape: the taped arm follows the fit, the other arm rests (there is no
@@ -142,7 +135,10 @@ class StudioScene:
         self._bodies = {body.side: body}  # one per taped arm, sharing the meshes
         self._operator = self._operator_for(body, 0)
         self._switch_lock = threading.Lock()  # one set_side at a time
-        self._robot_parts = puma560_meshes(self.layout.mesh)
+        self._views = RobotViews(self.robot, self.layout.mesh)
+        self._view = self._views.puma  # the robot drawn
+        self._next_view: RobotView | None = None  # a robot chosen, for the scene thread to draw
+        self._goal: np.ndarray | None = None  # the goal shown on the robot (set_goal)
 
         # Inputs, written by any thread under _lock; the loop reads a snapshot.
         self._lock = threading.Lock()
@@ -166,6 +162,7 @@ class StudioScene:
 
         self._build()
         self.hand_handle = HandHandle(server)
+        self.camera = SceneCamera(server, self.layout)  # presets, following the tool
         self._arms: dict[str, HumanArm] = {}  # the hand guide's arm model per side
         self._thread = threading.Thread(target=self._loop, name="studio-scene", daemon=True)
         self._thread.start()
@@ -236,9 +233,9 @@ class StudioScene:
             colors=c["floor_lines"],
             thickness=0.004,
         )
-        self._robot_handles = self._add_robot("/robot", opacity=None)
-        self._ghost_handles = self._add_robot(
-            "/goal/ghost", opacity=lay.ghost_opacity, visible=False
+        self._robot_handles = add_robot(self.server, "/robot", self._view)
+        self._ghost_handles = add_robot(
+            self.server, "/goal/ghost", self._view, opacity=lay.ghost_opacity, visible=False
         )
         self._goal_marker = s.add_icosphere(
             "/goal/marker", radius=0.035, color=c["goal"], opacity=0.85, visible=False
@@ -267,6 +264,7 @@ class StudioScene:
             precision="float32",
             visible=False,
         )
+        self._pedestal: viser.SceneNodeHandle | None = None
         self._push_robot(self._robot_handles, self._q_robot_shown)
         reset = self.server.gui.add_button("Reset view", hint="Frame both bodies again")
         reset.on_click(lambda event: self.reset_view(event.client))
@@ -277,29 +275,30 @@ class StudioScene:
         self.server.gui.main_panel.minimize()
         self.server.on_client_connect(_close_software_webgl_notice)
 
-    def _add_robot(
-        self, root: str, opacity: float | None, visible: bool = True
-    ) -> list[viser.MeshHandle]:
-        s = self.server.scene
-        frames = self.robot.joint_frames(self.robot.qz)
-        handles = []
-        for part in self._robot_parts:
-            pose = frames[int(part.frame)]
-            handles.append(
-                s.add_mesh_simple(
-                    f"{root}/{part.name}",
-                    part.vertices,
-                    part.faces,
-                    color=_rgb255(part.rgb),
-                    opacity=opacity,
-                    cast_shadow=False,
-                    receive_shadow=False,
-                    position=pose[:3, 3],
-                    wxyz=wxyz_of(pose[:3, :3]),
-                    visible=visible,
-                )
+    def _draw_robot(self, view: RobotView) -> None:
+        """Replace the robot (and its ghost) by ``view``'s, on a pedestal when it has one."""
+        for h in [*self._robot_handles, *self._ghost_handles]:
+            h.remove()
+        if self._pedestal is not None:
+            self._pedestal.remove()
+            self._pedestal = None
+        robot = add_robot(self.server, "/robot", view)
+        ghost = add_robot(
+            self.server, "/goal/ghost", view, opacity=self.layout.ghost_opacity, visible=False
+        )
+        self._robot_handles, self._ghost_handles = robot, ghost
+        with self._lock:
+            self._q_robot_shown = view.q0.copy()
+        self._view = view  # last: readers of the name see its meshes and its pose
+        self._place_goal()  # the Puma560's goal again when it comes back
+        if view.pedestal > 0:
+            self._pedestal = self.server.scene.add_box(
+                "/robot_pedestal",
+                color=(150, 152, 158),
+                dimensions=(0.3, 0.3, view.pedestal),
+                position=(0.0, 0.0, view.pedestal / 2),
+                cast_shadow=False,
             )
-        return handles
 
     def _add_operator(self) -> list[viser.MeshHandle]:
         s = self.server.scene
@@ -312,7 +311,7 @@ class StudioScene:
                     f"/operator/{part.name}",
                     part.vertices,
                     part.faces,
-                    color=_rgb255(part.rgb),
+                    color=rgb255(part.rgb),
                     cast_shadow=False,
                     receive_shadow=False,
                     position=pose[:3, 3],
@@ -347,14 +346,16 @@ class StudioScene:
         return posed.tape if posed.tape is not None else np.array(tape, dtype=float)
 
     def tool_positions(self, q_robot: np.ndarray) -> np.ndarray:
-        """World tool positions of joint configurations ``(N, 6)`` -> ``(N, 3)``."""
+        """World tool positions of Puma560 joint paths ``(N, 6)`` -> ``(N, 3)`` (policies and
+        demonstrations are the Puma560's, whichever robot is drawn)."""
         q = np.atleast_2d(np.asarray(q_robot, dtype=float))
         return np.array([self.robot.forward(qi)[:3, 3] for qi in q])
 
     def robot_mesh_points(self, q_robot: np.ndarray) -> list[np.ndarray]:
         """World vertices of each robot link mesh at ``q_robot`` (for framing and tests)."""
-        frames = self.robot.joint_frames(np.asarray(q_robot, dtype=float))
-        return [_placed(p, frames[int(p.frame)]) for p in self._robot_parts]
+        view = self._view
+        poses = view.poses(np.asarray(q_robot, dtype=float))
+        return [_placed(p, m) for p, m in zip(view.parts, poses, strict=True)]
 
     def operator_mesh_points(self, q_human: np.ndarray | None) -> list[np.ndarray]:
         """World vertices of each operator mesh with the taped arm at ``q_human``."""
@@ -366,8 +367,9 @@ class StudioScene:
     # ------------------------------------------------------------------ pushing
 
     def _push_robot(self, handles: list[viser.MeshHandle], q_robot: np.ndarray) -> None:
-        frames = self.robot.joint_frames(q_robot)
-        poses = np.stack([frames[int(p.frame)] for p in self._robot_parts])
+        if len(q_robot) != self._view.nq:
+            return  # a pose of the robot drawn before a switch
+        poses = self._view.poses(q_robot)
         quats = wxyz_of(poses[:, :3, :3])
         for h, pose, wxyz in zip(handles, poses, quats, strict=True):
             h.position = pose[:3, 3]
@@ -433,6 +435,11 @@ class StudioScene:
         with self._lock:
             live, version, playback = self._live, self._live_version, self._playback
             operator, slow = self._operator, self._live_gap >= self.layout.slow_live_s
+            view, self._next_view = self._next_view, None
+        if view is not None:
+            with self.server.atomic():
+                self._draw_robot(view)
+            shown.q_robot = None
         if (
             slow
             and now - shown.live_at < 1.0 / self.layout.slow_live_rate_hz
@@ -470,8 +477,12 @@ class StudioScene:
                 self._push_operator(operator, live.posed, whole=operator_changed)
             elif operator_changed:
                 self._push_operator(operator, operator.rest, whole=True)
-            if robot_changed and pose.q_robot is not None:
+            # playbacks are the Puma560's (policies, demonstrations); another robot stays live
+            puma_or_live = pose.mode is Mode.LIVE or self._view.name == "puma560"
+            if robot_changed and pose.q_robot is not None and puma_or_live:
                 self._push_robot(self._robot_handles, pose.q_robot)
+                if self.camera.following:
+                    self.camera.follow(self.robot.forward(pose.q_robot)[:3, 3])
             if playback is not None and pose.trace_upto > shown.trace_upto:
                 self._push_trace(playback, pose.trace_upto)
                 shown.trace_upto = pose.trace_upto
@@ -580,60 +591,22 @@ class StudioScene:
             return self._side_shown
 
     def set_goal(self, q_robot_goal: np.ndarray | None) -> None:
-        """Show a translucent ghost robot and a marker at the goal (None hides them)."""
+        """Show a translucent ghost robot and a marker at the goal (None, or a goal of another
+        robot's width, hides them)."""
+        self._goal = None if q_robot_goal is None else np.asarray(q_robot_goal, dtype=float)
         with self.server.atomic():
-            visible = q_robot_goal is not None
-            if visible:
-                q = np.asarray(q_robot_goal, dtype=float)
-                self._push_robot(self._ghost_handles, q)
-                self._goal_marker.position = self.robot.forward(q)[:3, 3]
-            for h in self._ghost_handles:
-                h.visible = visible
-            self._goal_marker.visible = visible
+            self._place_goal()
 
-    def show_path(self, name: str, q_robot_path: np.ndarray) -> None:
-        """Draw the tool path of a robot joint path ``(N, 6)`` (replaces a path of that name)."""
-        tool = self.tool_positions(q_robot_path)
-        node = f"/paths/{name}"
-        c = self.layout.colors
-        s = self.server.scene
-        with self._paths_lock, self.server.atomic():
-            for h in self._paths.pop(name, []):
-                h.remove()
-            handles: list[viser.SceneNodeHandle] = [
-                s.add_icosphere(
-                    f"{node}/start", radius=0.02, color=c["path_start"], position=tool[0]
-                ),
-                s.add_icosphere(f"{node}/end", radius=0.02, color=c["path"], position=tool[-1]),
-            ]
-            if len(tool) >= 2:
-                handles.append(
-                    s.add_spline_catmull_rom(
-                        f"{node}/line",
-                        points=tool.astype(np.float32),
-                        thickness=0.01,
-                        color=c["path"],
-                    )
-                )
-            self._paths[name] = handles
-
-    def clear_path(self, name: str | None = None) -> None:
-        """Remove the path called ``name`` (every path when None); unknown names are ignored."""
-        with self._paths_lock, self.server.atomic():
-            names = list(self._paths) if name is None else [name]
-            for n in names:
-                for h in self._paths.pop(n, []):
-                    h.remove()
-
-    def path_names(self) -> list[str]:
-        """Names of the paths drawn now."""
-        with self._paths_lock:
-            return list(self._paths)
-
-    def path_points(self, name: str) -> np.ndarray:
-        """World points of the path line called ``name`` ((N, 3); for tests)."""
-        with self._paths_lock:
-            return np.asarray(self._paths[name][-1].points)
+    def _place_goal(self) -> None:
+        """Show the goal (a Puma560 pose) on the Puma560; hidden beside another robot."""
+        q = self._goal
+        visible = q is not None and self._view.name == "puma560"
+        if q is not None and visible:
+            self._push_robot(self._ghost_handles, q)
+            self._goal_marker.position = self._view.tool(q)
+        for h in self._ghost_handles:
+            h.visible = visible
+        self._goal_marker.visible = visible
 
     def play_trajectory(
         self,
@@ -671,6 +644,41 @@ class StudioScene:
             self._playback = playback
         self._wake.set()
 
+    def scrub(
+        self,
+        t: float | None = None,
+        speed: float | None = None,
+        paused: bool | None = None,
+        step: int = 0,
+    ) -> tuple[Playback, float] | None:
+        """Reschedule the playback now (:func:`._scene_model.rescheduled`); with no change,
+        only read it. None when nothing was played.
+
+        Returns:
+            The playback in force and its trajectory time now (s).
+        """
+        now = time.perf_counter()
+        with self._lock:
+            playback = self._playback
+            if playback is None:
+                return None
+            if t is not None or speed is not None or paused is not None or step:
+                playback = rescheduled(playback, now, t=t, speed=speed, paused=paused, step=step)
+                self._playback = playback
+        self._wake.set()
+        return playback, playback_time(playback, now)
+
+    def hold_pose(self, q_robot: np.ndarray) -> None:
+        """Show the robot at ``q_robot`` (rad) until the next playback or stop: a jogged pose,
+        a paused playback of one pose."""
+        q = np.repeat(np.asarray(q_robot, dtype=float).reshape(1, -1), 2, axis=0)
+        t = np.array([0.0, 1e-3])
+        marks = np.zeros(0, dtype=int)
+        playback = Playback(t, q, self.tool_positions(q), marks, time.perf_counter(), paused=True)
+        with self._lock:
+            self._playback = playback
+        self._wake.set()
+
     def stop_playback(self) -> None:
         """Stop a playback; the robot follows the live pose again."""
         with self._lock:
@@ -692,8 +700,32 @@ class StudioScene:
                 return False
             return self._shown_playback is not playback or self._shown_mode is Mode.PLAYBACK
 
+    def set_robot(self, arm: RobotArm | None) -> None:
+        """Draw ``arm`` (a robot of :func:`~studio.kinematics.load_robot`; None or the
+        ``puma560``: the Puma560) from its own meshes, framed where the Puma560 stands.
+
+        Returns at once: its meshes are read in the background (seconds, the first time only)
+        and the scene thread then draws it (:attr:`robot_name` names it once drawn).
+        """
+        self._views.request(arm, self._draw_next)
+
+    def _draw_next(self, view: RobotView) -> None:
+        with self._lock:
+            self._next_view = view
+        self._wake.set()
+
+    @property
+    def robot_name(self) -> str:
+        """The name of the robot the scene has drawn (lags :meth:`set_robot` until drawn)."""
+        return self._view.name
+
+    @property
+    def robot_mesh_count(self) -> int:
+        """How many meshes the scene draws the robot with."""
+        return len(self._robot_handles)
+
     def current_q_robot(self) -> np.ndarray:
-        """The robot joints the scene shows now (rad, (6,))."""
+        """The robot joints the scene shows now (rad, (nq,))."""
         with self._lock:
             return self._q_robot_shown.copy()
 

@@ -9,7 +9,7 @@ back to live).
 from __future__ import annotations
 
 import enum
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -89,7 +89,12 @@ class Playback:
         q: ``(N, 6)`` rad.
         tool: ``(N, 3)`` world tool positions (m).
         marks: sample indices where a grid bin is marked.
-        started: clock time (``time.perf_counter``) of sample 0.
+        started: clock time (``time.perf_counter``) at which the trajectory stood at ``offset``.
+        offset: trajectory time (s) at ``started``: 0 for a playback from the start, the scrub
+            position after a seek, a step or a change of speed.
+        speed: trajectory seconds per clock second (1 is real time).
+        paused: the trajectory stands still at ``offset`` (and is shown, not released to the
+            live pose, however long it stands).
     """
 
     times: np.ndarray
@@ -97,6 +102,72 @@ class Playback:
     tool: np.ndarray
     marks: np.ndarray
     started: float
+    offset: float = 0.0
+    speed: float = 1.0
+    paused: bool = False
+
+    @property
+    def duration(self) -> float:
+        """Length of the trajectory (s)."""
+        return float(self.times[-1])
+
+
+PLAYBACK_SPEEDS = (0.25, 0.5, 1.0, 2.0, 4.0)
+"""The playback speeds offered (trajectory seconds per clock second); any speed between the
+first and the last is accepted."""
+
+
+def playback_time(playback: Playback, now: float) -> float:
+    """Trajectory time (s) at clock time ``now``: past :attr:`Playback.duration` once finished."""
+    if playback.paused:
+        return playback.offset
+    return playback.offset + (now - playback.started) * playback.speed
+
+
+def rescheduled(
+    playback: Playback,
+    now: float,
+    *,
+    t: float | None = None,
+    speed: float | None = None,
+    paused: bool | None = None,
+    step: int = 0,
+) -> Playback:
+    """The same trajectory rescheduled at clock time ``now``: a pure function of the inputs.
+
+    Args:
+        playback: the playback as it stands.
+        now: clock time (s) of the change.
+        t: scrub to this trajectory time (s, clipped to the trajectory); None keeps the time
+            reached at ``now``.
+        speed: the new speed (None keeps it).
+        paused: pause or resume (None keeps it). Resuming at the end starts it over.
+        step: move this many samples forward (positive) or back (negative) from the time
+            reached, landing on a sample, and pause there.
+
+    Returns:
+        A new :class:`Playback` that stands at the chosen time at ``now``.
+    """
+    times = playback.times
+    at = playback_time(playback, now) if t is None else float(t)
+    at = min(max(at, 0.0), playback.duration)
+    if step:
+        if step > 0:  # the first sample after the time reached, then on
+            k = int(np.searchsorted(times, at, side="right")) - 1 + step
+        else:  # the last sample before it, then back
+            k = int(np.searchsorted(times, at, side="left")) + step
+        at = float(times[min(max(k, 0), len(times) - 1)])
+        paused = True
+    if paused is False and at >= playback.duration:
+        at = 0.0  # resuming at the end plays it again from the start
+    paused = playback.paused if paused is None else bool(paused)
+    return replace(
+        playback,
+        started=now,
+        offset=at,
+        speed=playback.speed if speed is None else float(speed),
+        paused=paused,
+    )
 
 
 @dataclass(frozen=True)
@@ -129,13 +200,16 @@ def pose_at(
         hold_s: how long a finished playback's last pose is held.
 
     Returns:
-        ``playback`` (interpolated between samples) while the trajectory runs, ``hold`` (its
-        last pose) for ``hold_s`` after it ends, ``live`` otherwise.
+        ``playback`` (interpolated between samples) while the trajectory runs or stands paused
+        (:func:`playback_time`: scrubbed, at its speed), ``hold`` (its last pose) for ``hold_s``
+        after it ends, ``live`` otherwise.
     """
     if playback is not None:
         times = playback.times
-        t = now - playback.started
+        t = playback_time(playback, now)
         end = float(times[-1])
+        if playback.paused and t >= end:
+            return ScenePose(Mode.PLAYBACK, playback.q[-1], len(times) - 1)
         if t < end:
             k = int(np.searchsorted(times, t, side="right")) - 1
             k = min(max(k, 0), len(times) - 2)
@@ -143,7 +217,7 @@ def pose_at(
             w = 0.0 if span <= 0 else min(max((t - times[k]) / span, 0.0), 1.0)
             q = (1 - w) * playback.q[k] + w * playback.q[k + 1]
             return ScenePose(Mode.PLAYBACK, q, k)
-        if t < end + hold_s:
+        if t < end + hold_s * playback.speed:  # held hold_s of clock time
             return ScenePose(Mode.HOLD, playback.q[-1], len(times) - 1)
     return ScenePose(Mode.LIVE, live_q_robot, -1)
 

@@ -117,6 +117,12 @@ class SourcePublic(BaseModel):
     )
     camera_fps: float | None = Field(None, description="camera: the frame rate the page reported")
     model: str | None = Field(None, description="camera: the pose model the page reported")
+    robot: str = Field("puma560", description="the robot taught (`studio robots` lists them)")
+    robot_warning: str | None = Field(
+        None,
+        description="why the robot does not follow the hand now (out of its reach, or held "
+        "clear of a self-collision), else null",
+    )
 
 
 class SourceUpdate(_Body):
@@ -417,6 +423,8 @@ class ReachRunCreate(_RunCreateBase):
     """Joints 1..J learnt (3 to 6)."""
     step_deg: float = REACH_DEFAULTS["step_deg"]
     """Joint increment per action, degrees."""
+    actions: str = REACH_DEFAULTS["actions"]
+    """What one action moves: "single" (one joint), "pairs" (also two together), "all"."""
     tilings: int = REACH_DEFAULTS["tilings"]
     """Offset tilings of each joint."""
     tiles: int = REACH_DEFAULTS["tiles"]
@@ -446,6 +454,7 @@ class RunDefaults(GridRunCreate):
 
     joints: int = REACH_DEFAULTS["joints"]
     step_deg: float = REACH_DEFAULTS["step_deg"]
+    actions: str = REACH_DEFAULTS["actions"]
     tilings: int = REACH_DEFAULTS["tilings"]
     tiles: int = REACH_DEFAULTS["tiles"]
 
@@ -551,6 +560,32 @@ class WatchCreate(_Body):
     policy: str | None = None
     start: Literal["random", "current"] = "random"
     seed: int | None = Field(None, ge=0)
+    demonstration: str | None = Field(None, max_length=200)
+    """The demonstration the likeness card compares with (a name from the list); default the
+    run's own first demonstration, or a movement primitive's."""
+
+
+class MotionFiguresPublic(BaseModel):
+    """One motion's own figures (``studio.learning.MotionFigures``; null where undefined)."""
+
+    ldlj: float | None
+    joint_shares: list[float | None]
+    together: float | None
+    duration_s: float | None
+    joint_travel_rad: float | None
+    tool_path_m: float | None
+
+
+class LikenessPublic(BaseModel):
+    """A likeness card (``studio.learning.LikenessCard.to_dict()``) and what it compared."""
+
+    name: str
+    """The demonstration compared with, rolled out from its own start."""
+    dtw_rad: float | None
+    frechet_m: float | None
+    shares_js: float | None
+    policy: MotionFiguresPublic
+    demonstration: MotionFiguresPublic
 
 
 class WatchPublic(BaseModel):
@@ -565,3 +600,35 @@ class WatchPublic(BaseModel):
     times: list[float]
     q_robot: list[list[float]]
     reached_goal: bool
+    likeness: LikenessPublic | None = None
+    """The policy's likeness card against a demonstration, or None when there is none to
+    compare with (``likeness_note`` says why)."""
+    likeness_note: str = ""
+
+
+# ----------------------------------------------------------------------------- robots
+
+
+class RobotChoice(_Body):
+    """Choose the robot the operator teaches."""
+
+    name: str = Field(description="one of the names `GET /api/robots` lists")
+
+
+class RobotInfo(BaseModel):
+    """One offered robot."""
+
+    name: str
+    title: str
+    joints: list[str]
+
+
+class RobotsPublic(BaseModel):
+    """The offered robots (the default first) and the one taught now."""
+
+    robots: list[RobotInfo]
+    robot: str
+    drawn: str | None = Field(
+        None, description="the robot the 3D scene has drawn (null without a scene)"
+    )
+    drawn_meshes: int = Field(0, description="how many meshes the scene draws it with")

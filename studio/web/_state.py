@@ -31,7 +31,14 @@ from studio.capture import (
     SimulatorSource,
     source_from_spec,
 )
-from studio.learning import GOAL_JOINTS, PolicyFile, TilePolicyFile, check_goal_deg
+from studio.kinematics import load_robot, robot_names, robot_spec
+from studio.learning import (
+    GOAL_JOINTS,
+    DemonstrationPath,
+    PolicyFile,
+    TilePolicyFile,
+    check_goal_deg,
+)
 
 from ._errors import ConflictError, InvalidError, NotFoundError, TooManyRequestsError
 from ._pipeline import Pipeline
@@ -98,6 +105,7 @@ class Studio:
         # the last rollout watched of each policy key: (times, q), the oldest watched first
         self.rollouts: dict[str, tuple[np.ndarray, np.ndarray]] = {}
         self.mark_t0: float | None = None  # live demonstration start, recording time (s)
+        self._robot_lock = threading.Lock()  # one robot switch at a time
 
     def start(self) -> None:
         """Start the run worker and the pipeline (with the configured source, if any)."""
@@ -322,6 +330,40 @@ class Studio:
             status["playback"] = _playback_state(source)
         return status
 
+    # ------------------------------------------------------------------ robot
+
+    def set_robot(self, name: str) -> None:
+        """Teach robot ``name``: the scene draws it from its meshes, and the live chain
+        retargets the operator onto it from the next frame.
+
+        Raises:
+            KinematicsError: an unknown name, or a model or mesh that cannot be read (the
+                robot taught before stays).
+        """
+        with self._robot_lock:
+            arm = load_robot(robot_spec(name).name)
+            if self.scene is not None:
+                self.scene.set_robot(arm)  # its meshes are read in the background
+            self.pipeline.set_robot(arm)
+
+    def robots_public(self) -> dict[str, object]:
+        """``RobotsPublic``: every offered robot with its joints, and the one taught now."""
+        robots = [
+            {
+                "name": name,
+                "title": robot_spec(name).title,
+                "joints": list(load_robot(name, geometry=False).joint_names),
+            }
+            for name in robot_names()
+        ]
+        scene = self.scene
+        return {
+            "robots": robots,
+            "robot": self.pipeline.robot_name,
+            "drawn": None if scene is None else scene.robot_name,
+            "drawn_meshes": 0 if scene is None else scene.robot_mesh_count,
+        }
+
     def playback(self, action: str, t: float | None, speed: float | None) -> None:
         """Play, pause or seek the recording source.
 
@@ -388,8 +430,8 @@ class Studio:
 
     # ------------------------------------------------------------------ demonstrations
 
-    def demonstration_path(self, name: str) -> np.ndarray:
-        """The Puma560 joint path ``(N, 6)`` (rad) of a demonstration, for training runs.
+    def demonstration_path(self, name: str) -> DemonstrationPath:
+        """A demonstration's Puma560 joint path ``(N, 6)`` (rad) and times, for training runs.
 
         Raises:
             InvalidError: no such demonstration (a bad run parameter, so 422 rather than 404).
@@ -400,7 +442,7 @@ class Studio:
             raise InvalidError(
                 f"demonstrations names {name!r}, which does not exist; pick demonstrations from the list."
             ) from None
-        return np.asarray(demo.q_robot, dtype=np.float64)
+        return DemonstrationPath(f"Demonstration {name!r}", demo.q_robot, name, demo.times)
 
     def cut_demonstration(
         self,

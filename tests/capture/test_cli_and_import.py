@@ -39,7 +39,7 @@ def test_calibration_from_flat_and_file_round_trip(tmp_path):
     cal = Calibration.from_flat(flat, gains=2e-4, notes="desk")
     assert np.allclose(cal.offsets, flat.mean(axis=0))
     path = cal.save(tmp_path / "c.calibration.json")
-    from studio.capture import load_calibration
+    from studio.capture._calibration import load_calibration
 
     back = load_calibration(path)
     assert np.array_equal(back.offsets, cal.offsets) and back.notes == "desk"

@@ -23,22 +23,21 @@ from studio._json import MAX_JSON_DEPTH, nesting_depth, value_depth
 from studio.capture import (
     CaptureError,
     DemonstrationError,
-    FrameSender,
     NetworkSource,
     RecordingError,
     RecordingWriter,
     TapeFrame,
     capture,
-    load_calibration,
     load_demonstration,
-    read_header,
-    read_raw_text,
     read_recording,
     recording_bytes,
-    summarize_recording,
     update_recording_meta,
 )
+from studio.capture._calibration import load_calibration
+from studio.capture._network import FrameSender
+from studio.capture._raw_import import read_raw_text
 from studio.capture._recording_format import MAX_HEADER_BYTES, MAX_REGIONS
+from studio.capture._recording_reader import read_header, summarize_recording
 from studio.cli import main
 
 from .conftest import synthetic_frames

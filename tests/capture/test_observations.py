@@ -18,19 +18,17 @@ from studio.capture import (
     HandSource,
     LandmarkFrame,
     ObservationRecording,
-    ObservationWriter,
     PlaybackSource,
     RecordingError,
     RecordingWriter,
     describe,
     extract_demonstration,
-    hand_pose,
-    landmark_frame,
     read_any_recording,
     read_recording,
-    recording_kind,
     summarize_any_recording,
 )
+from studio.capture._observation_recording import ObservationWriter, recording_kind
+from studio.capture._observations import hand_pose, landmark_frame
 from studio.kinematics import HumanArm
 
 

@@ -414,7 +414,7 @@ def _with_times(path, changes: dict[int, float]):
 
 
 def test_negative_or_backward_times_load_with_a_warning(tmp_path):
-    from studio.capture import summarize_recording
+    from studio.capture._recording_reader import summarize_recording
 
     odd = _with_times(tmp_path / "odd.tape.csv", {0: -0.5, 38: 0.01, 200: 0.02})
     rec = read_recording(odd)

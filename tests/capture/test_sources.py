@@ -12,7 +12,6 @@ import pytest
 from studio.capture import (
     Calibration,
     CaptureError,
-    FrameSender,
     FrameSource,
     NetworkSource,
     PlaybackSource,
@@ -20,14 +19,13 @@ from studio.capture import (
     SerialSource,
     ShapeTapeEmulator,
     TapeFrame,
-    bridge_key,
-    decode_frame,
     encode_frame,
     read_recording,
     stream_source,
 )
+from studio.capture._network import FrameSender
 from studio.capture._shapetape_protocol import ProtocolError, decode_reply, encode_reply
-from studio.capture._wire import WireError
+from studio.capture._wire import WireError, bridge_key, decode_frame
 
 from .conftest import synthetic_frames
 
@@ -266,7 +264,7 @@ def test_serial_port_that_does_not_exist():
 
 
 def test_dropped_frames_are_counted_when_the_consumer_stalls():
-    from studio.capture import ThreadedSource
+    from studio.capture._source import ThreadedSource
 
     class Burst(ThreadedSource):
         kind = "burst"
@@ -299,7 +297,8 @@ def test_the_rate_is_measured_over_the_last_second_and_falls_to_zero_when_frames
     The rate is measured on a fake clock, so the test checks the arithmetic (frames per second
     over the last second) exactly, whatever the machine is doing.
     """
-    from studio.capture import ThreadedSource, _source
+    from studio.capture import _source
+    from studio.capture._source import ThreadedSource
 
     clock = _FakeClock()
     monkeypatch.setattr(_source, "time", clock)
@@ -331,7 +330,7 @@ def test_the_rate_is_measured_over_the_last_second_and_falls_to_zero_when_frames
 
 
 def test_a_crashing_producer_reports_its_error():
-    from studio.capture import ThreadedSource
+    from studio.capture._source import ThreadedSource
 
     class Broken(ThreadedSource):
         kind = "broken"

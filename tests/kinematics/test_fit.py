@@ -25,10 +25,10 @@ from studio.kinematics import (
     KinematicsError,
     Retargeter,
     TapeConfig,
-    TapeShape,
     reconstruct,
     tape_from_arm,
 )
+from studio.kinematics._tape import TapeShape
 
 ARMS = {side: HumanArm(side) for side in ("right", "left")}
 CONFIGS = {side: TapeConfig(side=side) for side in ("right", "left")}

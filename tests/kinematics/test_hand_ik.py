@@ -7,7 +7,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from studio.kinematics import HandFit, HumanArm, KinematicsError, fit_hand_pose
+from studio.kinematics import HumanArm, KinematicsError, fit_hand_pose
+from studio.kinematics._hand_ik import HandFit
 
 REACH_M = 0.01
 

@@ -11,7 +11,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from studio.kinematics import ArmPose, HumanArm, KinematicsError, _human, _robots, mirror_human_q
+from studio.kinematics import HumanArm, KinematicsError, _human, _robots
+from studio.kinematics._human import ArmPose, mirror_human_q
 
 RIGHT = HumanArm("right")
 LEFT = HumanArm("left")

@@ -10,15 +10,14 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from studio.kinematics import (
-    ConstantVelocityFilter,
     HumanArm,
     KinematicsError,
-    OneEuroFilter,
     PoseStreamFitter,
     arm_motion,
     fit_pose_landmarks,
     landmarks_from_arm,
 )
+from studio.kinematics._filter import ConstantVelocityFilter, OneEuroFilter
 from tests.kinematics.test_pose_landmarks import PERSON, errors, noisy
 
 RATE_HZ = 30.0

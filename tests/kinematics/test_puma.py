@@ -12,17 +12,8 @@ from hypothesis import assume, example, given, settings
 from hypothesis import strategies as st
 
 from studio import StudioError
-from studio.kinematics import (
-    PUMA_QN,
-    PUMA_QR,
-    PUMA_QS,
-    PUMA_QZ,
-    IKConfig,
-    IKResult,
-    KinematicsError,
-    LinkVisual,
-    Puma560,
-)
+from studio.kinematics import IKConfig, KinematicsError, Puma560
+from studio.kinematics._puma import PUMA_QN, PUMA_QR, PUMA_QS, PUMA_QZ, IKResult, LinkVisual
 
 ROBOT = Puma560()
 FAST = settings(max_examples=50, deadline=None)

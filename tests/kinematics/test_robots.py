@@ -9,7 +9,8 @@ import math
 import numpy as np
 import pytest
 
-from studio.kinematics import KinematicsError, load_robot, robot_names, robot_spec
+from studio.kinematics import KinematicsError, load_robot, robot_names
+from studio.kinematics._robots import robot_spec
 
 OFFERED = ("puma560", "panda", "ur3", "ur5", "ur10", "so100", "so101", "xarm7", "z1", "kinova")
 

@@ -11,14 +11,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
-from studio.kinematics import (
-    HumanArm,
-    KinematicsError,
-    TapeConfig,
-    reconstruct,
-    tape_angles,
-    tape_from_arm,
-)
+from studio.kinematics import HumanArm, KinematicsError, TapeConfig, reconstruct, tape_from_arm
+from studio.kinematics._tape import tape_angles
 
 CONFIG = TapeConfig()
 R = CONFIG.regions

@@ -15,11 +15,11 @@ from studio.kinematics import (
     KinematicsError,
     Retargeter,
     TapeConfig,
-    Tracked,
     TrackerConfig,
     reconstruct,
     tape_from_arm,
 )
+from studio.kinematics._tracker import Tracked
 from tests.kinematics.test_fit import observable_box, observable_q
 
 TRACKERS = {side: ArmTracker(TapeConfig(side=side)) for side in ("right", "left")}

@@ -5,14 +5,8 @@ import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
-from studio.learning import (
-    MAX_TABLE_ENTRIES,
-    ArmGrid,
-    DynaQConfig,
-    LearningError,
-    erase_loops,
-    run_experiments,
-)
+from studio.learning import MAX_TABLE_ENTRIES, ArmGrid, DynaQConfig, LearningError, run_experiments
+from studio.learning._arm import erase_loops
 
 grids = st.builds(
     ArmGrid,

@@ -14,7 +14,6 @@ from fastapi.testclient import TestClient
 from studio.cli import main
 from studio.commands import train
 from studio.learning import (
-    CURVE_COLUMNS,
     DEFAULT_EPISODES,
     DEFAULT_EXPERIMENTS,
     DEFAULT_GOAL_JOINTS_DEG,
@@ -22,10 +21,11 @@ from studio.learning import (
     ArmGrid,
     DynaQConfig,
     RunFolder,
-    goal_problems,
     load_any_policy,
     load_policy,
 )
+from studio.learning._curves import CURVE_COLUMNS
+from studio.learning._goal import goal_problems
 from studio.learning._reproduce import CONFIGURATIONS, EXTENSIONS, PAPER_MATLAB_SECONDS
 from studio.web import create_app
 from studio.web._schemas import ReachRunCreate

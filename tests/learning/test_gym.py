@@ -8,7 +8,8 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 
 import studio.learning  # noqa: F401  (registers the environments)
-from studio.learning import ARM_GRID_ID, ARM_REACH_ID, ArmGrid, ArmReach, LearningError
+from studio.learning import ArmGrid, ArmReach, LearningError
+from studio.learning._gym import ARM_GRID_ID, ARM_REACH_ID
 from studio.learning._reach import reach_step
 
 

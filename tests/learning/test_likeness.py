@@ -16,12 +16,10 @@ from studio.learning import (
     LikenessCard,
     dtw_distance,
     frechet_distance,
-    joint_shares,
-    js_divergence,
     ldlj,
     likeness_card,
-    moving_together,
 )
+from studio.learning._likeness import joint_shares, js_divergence, moving_together
 
 
 def min_jerk(u: np.ndarray) -> np.ndarray:
@@ -216,8 +214,8 @@ def test_every_policy_kind_gets_a_card_from_the_demonstrations_start(tmp_path):
         fit_dmp_policy,
         load_policy,
         policy_likeness_card,
-        save_policy,
     )
+    from studio.learning._policy import save_policy
     from studio.samples import __file__ as samples
 
     demo = load_demonstration(Path(samples).parent / "sample-reach-2.demo.json")

@@ -11,15 +11,9 @@ import gymnasium
 import numpy as np
 import pytest
 
-from studio.learning import (
-    ArmReach,
-    DynaQConfig,
-    LearningError,
-    LinearResult,
-    TileCoding,
-    run_experiments,
-)
+from studio.learning import ArmReach, DynaQConfig, LearningError, TileCoding, run_experiments
 from studio.learning._learner import experiment_seed
+from studio.learning._linear import LinearResult
 from studio.learning._linear_env import _MOUNTAIN_CAR_PARAMS, mountain_car_step, reset_seed
 
 REFERENCE = Path(__file__).resolve().parents[2] / "benchmarks" / "tiles_reference.py"

@@ -14,9 +14,9 @@ from studio.learning import (
     load_policy,
     rollout,
     run_experiments,
-    save_policy,
     save_trajectory_csv,
 )
+from studio.learning._policy import save_policy
 
 
 @pytest.fixture(scope="module")

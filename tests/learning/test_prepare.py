@@ -11,17 +11,8 @@ import time
 
 import numpy as np
 
-from studio.learning import (
-    PREPARE_SECONDS,
-    ArmGrid,
-    DynaQConfig,
-    LiveProgress,
-    RunFolder,
-    RunRecord,
-    _prepare,
-    learner_ready,
-    preparing_note,
-)
+from studio.learning import ArmGrid, DynaQConfig, LiveProgress, RunFolder, RunRecord, _prepare
+from studio.learning._prepare import PREPARE_SECONDS, learner_ready, preparing_note
 from tests.conftest import hold_preparation
 from tests.web.conftest import wait_for
 

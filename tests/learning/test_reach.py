@@ -14,7 +14,6 @@ from hypothesis import strategies as st
 from studio.cli import main
 from studio.kinematics import Puma560
 from studio.learning import (
-    ARM_REACH_ID,
     ArmReach,
     DynaQConfig,
     LearningError,
@@ -22,11 +21,12 @@ from studio.learning import (
     RunFolder,
     RunRecord,
     TilePolicyFile,
-    greedy_success,
     load_any_policy,
     run_experiments,
-    save_tile_policy,
 )
+from studio.learning._gym import ARM_REACH_ID
+from studio.learning._linear import greedy_success
+from studio.learning._linear_policy import save_tile_policy
 from studio.learning._reach import reach_step
 
 ROBOT = Puma560()

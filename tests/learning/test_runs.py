@@ -20,7 +20,6 @@ from hypothesis import strategies as st
 
 import studio.learning._run_record as runs_module
 from studio.learning import (
-    CURVE_COLUMNS,
     ArmGrid,
     ConfigError,
     DynaQConfig,
@@ -34,7 +33,7 @@ from studio.learning import (
     find_runs,
     load_policy,
 )
-from studio.learning._curves import curve_plot
+from studio.learning._curves import CURVE_COLUMNS, curve_plot
 
 REPO = Path(__file__).resolve().parents[2]
 

@@ -289,7 +289,8 @@ def test_continuous_joint_trials_equal_serial_runs(local_ray, tmp_path: Path) ->
     """The tile-coded continuous task sweeps too, each trial equal to run_experiments."""
     import gymnasium
 
-    from studio.learning import ARM_REACH_ID, ArmReach
+    from studio.learning import ArmReach
+    from studio.learning._gym import ARM_REACH_ID
 
     spec = parse_sweep_spec(
         spec_dict(

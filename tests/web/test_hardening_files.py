@@ -19,8 +19,10 @@ from pathlib import Path
 import numpy as np
 from numpy.lib import format as npy_format
 
-from studio.capture import FrameSender, RecordingWriter, read_recording
-from studio.learning import ArmGrid, DynaQConfig, save_policy
+from studio.capture import RecordingWriter, read_recording
+from studio.capture._network import FrameSender
+from studio.learning import ArmGrid, DynaQConfig
+from studio.learning._policy import save_policy
 from tests.capture.conftest import synthetic_frames
 from tests.web.conftest import wait_for
 

@@ -36,7 +36,8 @@ def test_switching_sources_stops_the_old_one(open_client):
 def test_the_network_bridge_feeds_the_pipeline(client):
     import socket
 
-    from studio.capture import FrameSender, simulate
+    from studio.capture import simulate
+    from studio.capture._network import FrameSender
 
     with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as probe:
         probe.bind(("127.0.0.1", 0))

@@ -7,7 +7,8 @@ import io
 import numpy as np
 import pytest
 
-from studio.learning import ArmGrid, DynaQConfig, load_policy, save_policy
+from studio.learning import ArmGrid, DynaQConfig, load_policy
+from studio.learning._policy import save_policy
 from tests.web.conftest import TINY_RUN, wait_run
 
 

@@ -11,7 +11,8 @@ import time
 import numpy as np
 import pytest
 
-from studio.learning import CURVE_COLUMNS, load_policy
+from studio.learning import load_policy
+from studio.learning._curves import CURVE_COLUMNS
 from tests.conftest import hold_preparation
 from tests.web.conftest import TINY_RUN, wait_for, wait_run
 
@@ -552,7 +553,8 @@ def test_the_page_marks_where_a_run_averages_fewer_experiments(page_server, brow
     "goal", [[170.0, 0.0, 0.0], [0.0, 120.0, -150.0], [0.0, 0.0], [1, "up", 2]]
 )
 def test_the_simulators_reach_and_a_run_check_a_goal_with_one_function(client, goal):
-    from studio.learning import ConfigError, goal_problems
+    from studio.learning import ConfigError
+    from studio.learning._goal import goal_problems
     from studio.web._state import goal_q_robot
 
     with pytest.raises(ConfigError) as err:

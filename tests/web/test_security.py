@@ -147,7 +147,8 @@ def test_the_network_bridge_stays_on_loopback_in_token_mode(
 def test_a_bridge_host_beyond_loopback_takes_only_signed_frames(
     open_client: Callable[..., TestClient],
 ) -> None:
-    from studio.capture import FrameSender, simulate
+    from studio.capture import simulate
+    from studio.capture._network import FrameSender
     from tests.web.conftest import wait_for
 
     client = open_client(token="t0k-en", bridge_host="0.0.0.0")

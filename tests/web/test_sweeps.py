@@ -13,12 +13,11 @@ from pathlib import Path
 
 import pytest
 
-from studio.learning import parse_sweep_spec
 from studio.learning._runs import RunFolder
 from studio.learning._sweep_folder import prepare_folder as _prepare
 from studio.learning._sweep_folder import set_status as _set_status
 from studio.learning._sweep_folder import trial_run_path
-from studio.learning._sweep_spec import trial_record
+from studio.learning._sweep_spec import parse_sweep_spec, trial_record
 from studio.learning._sweep_summary import write_summary
 
 SPEC = {

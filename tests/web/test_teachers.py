@@ -206,7 +206,8 @@ def test_hand_guide_recording_cuts_into_a_demonstration(client: TestClient) -> N
 
 
 def test_a_pose_recording_plays_back_as_the_source(open_client, tmp_path) -> None:
-    from studio.capture import ObservationWriter, landmark_frame
+    from studio.capture._observation_recording import ObservationWriter
+    from studio.capture._observations import landmark_frame
 
     folder = tmp_path / "recordings"
     folder.mkdir(parents=True, exist_ok=True)

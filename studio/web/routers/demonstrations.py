@@ -13,12 +13,14 @@ from studio.capture import RECORDING_SUFFIX, RECORDING_SUFFIXES, Demonstration
 from studio.learning import goal_degrees, has_default_goal
 
 from .._deps import StudioDep
+from .._runs import prepare_run
 from .._schemas import (
     DemonstrationCreate,
     DemonstrationDetail,
     DemonstrationMark,
     DemonstrationPublic,
     MarkPublic,
+    RunCreate,
 )
 from .._state import Studio
 from .._store import StoredFile
@@ -103,6 +105,15 @@ def mark_demonstration(body: DemonstrationMark, studio: StudioDep) -> MarkPublic
         return MarkPublic(marking=True, t0=studio.mark_start())
     name = studio.mark_stop(body.goal_from_end, body.name)
     return MarkPublic(marking=False, t0=None, demonstration=read_public(studio, name))
+
+
+@router.post("/check", status_code=204, response_class=Response)
+def check_run_demonstrations(body: RunCreate, studio: StudioDep) -> Response:
+    """Check a run form as it is filled in (the demonstrations picked against its goal and task)
+    with the one resolver a run is started with; nothing is queued. 204 when it would start, else
+    the 422 starting it would answer (``detail``, ``problems``, ``by_field``)."""
+    prepare_run(body, studio.demonstration_path)
+    return Response(status_code=204)
 
 
 @router.get("/{name}")

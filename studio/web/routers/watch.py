@@ -9,10 +9,14 @@ import numpy as np
 from fastapi import APIRouter, Response
 
 from studio.learning import (
+    DemonstrationMotion,
     DmpPolicyFile,
+    LearningError,
+    PolicyFile,
     TilePolicyFile,
     greedy_path,
     greedy_rollout,
+    likeness_cards,
     rollout,
     rollout_dmp_policy,
     rollout_tile_policy,
@@ -20,9 +24,12 @@ from studio.learning import (
 )
 
 from .._deps import StudioDep
-from .._errors import ConflictError
-from .._schemas import WatchCreate, WatchPublic
+from .._errors import ConflictError, InvalidError
+from .._schemas import LikenessPublic, WatchCreate, WatchPublic
 from . import file_responses
+
+AnyPolicy = PolicyFile | TilePolicyFile | DmpPolicyFile
+"""A policy of any kind, as the studio loads it."""
 
 router = APIRouter(prefix="/api/watch", tags=["watch"])
 
@@ -42,9 +49,60 @@ def watch(body: WatchCreate, studio: StudioDep) -> WatchPublic:
     a random or the current pose and play it in the scene (409 if the run has no policy yet)."""
     policy, key = studio.load_policy(body.run, body.policy)
     if isinstance(policy, TilePolicyFile):
-        return _watch_tile_policy(body, studio, policy, key)
-    if isinstance(policy, DmpPolicyFile):
-        return _watch_dmp_policy(body, studio, policy, key)
+        watched = _watch_tile_policy(body, studio, policy, key)
+    elif isinstance(policy, DmpPolicyFile):
+        watched = _watch_dmp_policy(body, studio, policy, key)
+    else:
+        watched = _watch_grid_policy(body, studio, policy, key)
+    likeness, note = likeness_public(body, studio, policy, key)
+    return watched.model_copy(update={"likeness": likeness, "likeness_note": note})
+
+
+def _demonstration_motions(
+    body: WatchCreate, studio: StudioDep, policy: AnyPolicy, key: str
+) -> list[DemonstrationMotion]:
+    """The demonstrations to compare with: the one asked for, else the run's own (kept in its
+    record, or by name from the list for a run recorded before motions were kept), else a
+    movement primitive's."""
+    names: list[str] = [body.demonstration] if body.demonstration else []
+    if not names and key.startswith("run:"):
+        record = studio.runs.get(key.removeprefix("run:")).folder.record
+        if record.demonstration_motions:
+            return list(record.demonstration_motions)
+        names = list(record.demonstration_names)
+    if not names and isinstance(policy, DmpPolicyFile):
+        return [DemonstrationMotion("its demonstration", policy.demo_times, policy.demo_q)]
+    motions = []
+    for name in names:
+        demo = studio.demonstrations.load(name)  # 404 with the store's sentence
+        try:
+            motions.append(DemonstrationMotion.checked(name, demo.times, demo.q_robot))
+        except LearningError as err:
+            raise InvalidError(str(err)) from None
+    return motions
+
+
+def likeness_public(
+    body: WatchCreate, studio: StudioDep, policy: AnyPolicy, key: str
+) -> tuple[LikenessPublic | None, str]:
+    """The watched policy's likeness card against its first demonstration, rolled out from that
+    demonstration's own start; or None and the sentence saying why there is none."""
+    motions = _demonstration_motions(body, studio, policy, key)
+    if not motions:
+        return None, (
+            "No likeness card: this policy was not taught from a recorded demonstration; "
+            "choose one to compare with."
+        )
+    motion, card = likeness_cards(policy, motions[:1])[0]
+    if isinstance(card, str):
+        return None, card
+    return LikenessPublic.model_validate({"name": motion.name, **card.to_dict()}), ""
+
+
+def _watch_grid_policy(
+    body: WatchCreate, studio: StudioDep, policy: PolicyFile, key: str
+) -> WatchPublic:
+    """Play a grid policy from a random start or the current pose's bin."""
     grid = policy.grid
     seed = start_seed(body)
     if body.start == "current":

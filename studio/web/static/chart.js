@@ -4,7 +4,7 @@
  * takes about a millisecond, so live curves at CURVE_FPS never compete with training for the CPU.
  */
 
-import { bucketCurve, curveAxis } from "./curves.js";
+import { RUNNING_AXES, bucketCurve, curveAxis, runningAxis, smoothed } from "./curves.js";
 import { $, setProp, setText } from "./dom.js";
 import { S } from "./state.js";
 
@@ -17,7 +17,7 @@ export function runColor(id) {
 
 /** What a run learns, in words: the paper's grid (tabular) or continuous joints (tile coding).
  * A run made before the continuous task existed has no task in its config: it is a grid run. */
-function runTask(r) {
+export function runTask(r) {
   const c = r.config || {};
   return c.task === "arm-reach" ? `continuous, ${c.joints} joints` : "grid";
 }
@@ -38,6 +38,15 @@ export function plottedRuns() {
   });
 }
 
+/** A run's seconds so far on a time axis: its CPU time, or its wall time from start to finish
+ * (to now while it trains); 0 before it starts. */
+export function runSeconds(r, xMode) {
+  if (xMode === "cpu") return r.cpu_seconds || 0;
+  if (xMode !== "wall" || !r.started) return 0;
+  const end = r.finished ? Date.parse(r.finished) : Date.now();
+  return Math.max(0, (end - Date.parse(r.started)) / 1000);
+}
+
 /** Episodes per experiment of a run (its fraction-of-run axis divides by this). */
 function runLength(r) {
   const c = S.curves.get(r.id);
@@ -50,17 +59,26 @@ function runLength(r) {
  * edges. Missing episodes are null (a gap); on a log axis nothing below one step is drawn. Also
  * per run the fewest experiments any point of a bucket averages (``counts``) and the run's most
  * (``full``), so the legend and a marker say where the band stops averaging every experiment.
+ * With ``smoothing`` (an EMA weight, see ``smoothed``) each run also gets its smoothed mean, last.
+ * On a running axis (real steps, wall or CPU time) each run keeps its own buckets: null elsewhere.
  */
-export function chartData(runs, band, log, xMode = "episode") {
+export function chartData(runs, band, log, xMode = "episode", smoothing = 0) {
   const lines = runs.map((r) => ({ curve: S.curves.get(r.id), length: runLength(r) }));
-  const { x, bucketOf } = curveAxis(lines, xMode);
+  let x; let stats;
+  if (RUNNING_AXES.has(xMode)) {
+    ({ x, stats } = runningAxis(lines, xMode, runs.map((r) => runSeconds(r, xMode))));
+  } else {
+    const axis = curveAxis(lines, xMode);
+    x = axis.x;
+    stats = lines.map((line) => bucketCurve(line, x.length, axis.bucketOf));
+  }
   const n = x.length;
   const cols = [x];
   const counts = [];
   const full = [];
   const floor = (v) => (log && v < 1 ? null : v);
   runs.forEach((r, i) => {
-    const s = bucketCurve(lines[i], n, bucketOf);
+    const s = stats[i];
     const mean = new Array(n).fill(null); const low = new Array(n).fill(null); const high = new Array(n).fill(null);
     for (let b = 0; b < n; b++) {
       if (s.mean[b] === null) continue;
@@ -74,6 +92,7 @@ export function chartData(runs, band, log, xMode = "episode") {
     }
     cols.push(mean);
     if (band !== "none") cols.push(low, high);
+    if (smoothing > 0) cols.push(smoothed(mean, smoothing));
     counts.push(s.count);
     full.push(s.most || (r.config && r.config.experiments) || 0);
   });
@@ -96,30 +115,53 @@ function hexAlpha(hex, a) {
   return `rgba(${(n >> 16) & 255},${(n >> 8) & 255},${n & 255},${a})`;
 }
 
+const X_LABELS = {
+  episode: "episode", log: "episode", fraction: "fraction of run", steps: "real steps",
+  wall: "wall time ≈ s (run's time shared out by steps)", cpu: "CPU time ≈ s (run's time shared out by steps)",
+};
+
+/** The last value of a column (the legend shows it while the cursor is off the chart). */
+function lastValue(col) {
+  for (let k = col.length - 1; k >= 0; k--) if (col[k] != null) return col[k];
+  return null;
+}
+
+function fmtX(xMode, v) {
+  if (v == null) return ""; // off the chart: the runs' values are their last ones
+  if (xMode === "fraction") return v.toFixed(3);
+  if (xMode === "wall" || xMode === "cpu") return `${v.toFixed(1)} s`;
+  return xMode === "steps" ? String(Math.round(v)) : String(v);
+}
+
 /** uPlot options for these runs: a mean line per run and, with a band, two unlabelled edges filled;
- * a dashed marker where a run's points start averaging fewer experiments than it has. */
-function chartOptions(runs, band, log, width, height, xMode = "episode") {
-  const xLabel = xMode === "fraction" ? "fraction of run" : "episode";
-  const series = [{ label: xLabel, value: (u, v) => (v == null ? "–" : xMode === "fraction" ? v.toFixed(3) : String(v)) }];
+ * with smoothing, the mean is drawn faint and the smoothed line over it carries the run's name;
+ * a dashed marker where a run's points start averaging fewer experiments than it has. The legend
+ * names every run all the time, with its last value until the cursor points at an x. */
+function chartOptions(runs, band, log, width, height, xMode = "episode", smoothing = 0) {
+  const xLabel = X_LABELS[xMode] || "episode";
+  const gaps = RUNNING_AXES.has(xMode); // runs have their own x: join their points across others' rows
+  const series = [{ label: xLabel.split(" (")[0], value: (u, v) => fmtX(xMode, v) }];
   const bands = [];
+  const valueOf = (i, what) => (u, v, si, di) => {
+    if (di == null) v = lastValue(u.data[si]);
+    if (v == null) return "–";
+    const n = di == null || !u.data.counts ? null : u.data.counts[i][di];
+    const of = u.data.full ? u.data.full[i] : null;
+    return `${di == null ? "last " : ""}${v.toFixed(1)} steps${what}${n != null && of ? ` · ${n} of ${of} exp.` : ""}`;
+  };
   runs.forEach((r, i) => {
     const color = runColor(r.id);
     const meanIdx = series.length;
-    series.push({
-      label: runLabel(r), stroke: color, width: 1.8, spanGaps: false,
-      value: (u, v, si, di) => {
-        if (v == null) return "–";
-        const n = di == null || !u.data.counts ? null : u.data.counts[i][di];
-        const of = u.data.full ? u.data.full[i] : null;
-        return `${v.toFixed(1)} steps${n != null && of ? ` · ${n} of ${of} exp.` : ""}`;
-      },
-    });
+    series.push(smoothing > 0
+      ? { label: `${runLabel(r)} raw`, class: "band-edge", stroke: hexAlpha(color, 0.3), width: 1, spanGaps: gaps, points: { show: false } }
+      : { label: runLabel(r), stroke: color, width: 1.8, spanGaps: gaps, value: valueOf(i, "") });
     if (band !== "none") {
       for (const edge of ["low", "high"]) {
-        series.push({ label: `${runLabel(r)} ${edge}`, class: "band-edge", stroke: "transparent", width: 0, points: { show: false } });
+        series.push({ label: `${runLabel(r)} ${edge}`, class: "band-edge", stroke: "transparent", width: 0, spanGaps: gaps, points: { show: false } });
       }
-      bands.push({ series: [meanIdx + 2, meanIdx + 1], fill: hexAlpha(color, 0.16) });
+      bands.push({ series: [meanIdx + 2, meanIdx + 1], fill: hexAlpha(color, smoothing > 0 ? 0.1 : 0.16) });
     }
+    if (smoothing > 0) series.push({ label: runLabel(r), stroke: color, width: 1.8, spanGaps: gaps, value: valueOf(i, " smoothed") });
   });
   const axis = { stroke: "#555", grid: { stroke: "#eceef1", width: 1 }, ticks: { stroke: "#d6d9de", width: 1 }, font: "11px system-ui, sans-serif", labelFont: "11px system-ui, sans-serif" };
   return {
@@ -175,7 +217,8 @@ function renderCurveKey(runs, data, band) {
 let chart = null;
 let chartKey = "";
 let chartRuns = []; // run ids of the chart's mean columns, in order
-let chartStride = 1; // columns per run: mean, or mean, low and high
+let chartSmooth = false; // each run has a smoothed mean column, its last
+let chartStride = 1; // columns per run: mean, or mean, low and high; then the smoothed mean
 
 /** Size the chart to its pane, leaving room for the legend under it. */
 export function fitChart() {
@@ -192,6 +235,7 @@ export function renderCurves() {
   const band = $("curve-band").value;
   const log = $("curve-log").checked;
   const xMode = $("curve-x").value;
+  const smoothing = Number($("curve-smooth").value) || 0;
   const runs = plottedRuns();
   setProp("curve-empty", "hidden", runs.length > 0);
   if (!runs.length) {
@@ -199,18 +243,19 @@ export function renderCurves() {
     setProp("curve-key", "hidden", true);
     return;
   }
-  const key = JSON.stringify([runs.map((r) => [r.id, runLabel(r), runColor(r.id)]), band, log, xMode]);
-  const data = chartData(runs, band, log, xMode);
+  const key = JSON.stringify([runs.map((r) => [r.id, runLabel(r), runColor(r.id)]), band, log, xMode, smoothing > 0]);
+  const data = chartData(runs, band, log, xMode, smoothing);
   renderCurveKey(runs, data, band);
   if (chart && key === chartKey) {
     chart.setData(data, !S.chartZoomed);
   } else {
     if (chart) chart.destroy();
     const box = $("curve-plot");
-    chart = new uPlot(chartOptions(runs, band, log, box.clientWidth, box.clientHeight, xMode), data, box);
+    chart = new uPlot(chartOptions(runs, band, log, box.clientWidth, box.clientHeight, xMode, smoothing), data, box);
     chartKey = key;
     chartRuns = runs.map((r) => r.id);
-    chartStride = band === "none" ? 1 : 3;
+    chartSmooth = smoothing > 0;
+    chartStride = (band === "none" ? 1 : 3) + (chartSmooth ? 1 : 0);
     S.chartZoomed = false;
     fitChart();
   }
@@ -231,4 +276,12 @@ S.curvePoints = (id) => {
     if (id === undefined || run === id) n += chart.data[1 + i * chartStride].filter((v) => v !== null).length;
   });
   return n;
+};
+
+/** A plotted run's columns as drawn: x, its mean and its smoothed mean (null without smoothing). */
+S.chartLine = (id) => {
+  const i = chart ? chartRuns.indexOf(id) : -1;
+  if (i < 0) return null;
+  const base = 1 + i * chartStride;
+  return { x: [...chart.data[0]], mean: [...chart.data[base]], smooth: chartSmooth ? [...chart.data[base + chartStride - 1]] : null };
 };

@@ -89,3 +89,67 @@ export function bucketCurve(line, n, bucketOf) {
   }
   return out;
 }
+
+/**
+ * TensorBoard's smoothing: an exponential moving average of the non-null values in x order,
+ * debiased so the first points are not pulled towards zero; ``weight`` in [0, 1), 0 leaves the
+ * values as they are. Nulls (gaps) stay null and do not reset the average.
+ */
+export function smoothed(values, weight) {
+  const out = new Array(values.length).fill(null);
+  let last = 0; let n = 0;
+  for (let i = 0; i < values.length; i++) {
+    const v = values[i];
+    if (v === null || v === undefined || !Number.isFinite(v)) continue;
+    last = last * weight + (1 - weight) * v; n += 1;
+    out[i] = weight > 0 ? last / (1 - weight ** n) : v;
+  }
+  return out;
+}
+
+/** The x axes that run on with each run's own work rather than its episode number. */
+export const RUNNING_AXES = new Set(["steps", "wall", "cpu"]);
+
+/**
+ * Each episode's x on a running axis. "steps": the real steps taken up to and including it (the
+ * sum of the mean steps per episode: the mean over experiments of each one's own total while
+ * all of them count). "wall" and "cpu": ``seconds`` (the run's wall or CPU time so far) shared out
+ * in proportion to those steps. A run's files record its total times only (status.json), not a
+ * time per episode; a Dyna-Q step costs about the same all run long (one update and n planning
+ * updates), so this is an estimate that the axis labels with "≈".
+ */
+export function runningX(curve, xMode, seconds = 0) {
+  const x = new Array(curve.episodes.length);
+  let sum = 0;
+  for (let i = 0; i < x.length; i++) { sum += curve.mean[i] > 0 ? curve.mean[i] : 0; x[i] = sum; }
+  if (xMode === "steps") return x;
+  const scale = sum > 0 && seconds > 0 ? seconds / sum : 0;
+  return x.map((v) => v * scale);
+}
+
+/**
+ * Lines bucketed by episode each on its own (the server's rule), then placed on one running
+ * axis (``runningX``, each bucket at the mean x of its episodes), rows merged where runs share an
+ * x: ``{x, stats}`` with each line's ``bucketCurve`` statistics aligned to ``x`` (null elsewhere).
+ */
+export function runningAxis(lines, xMode, seconds, points = MAX_PLOT_POINTS) {
+  const parts = lines.map((line, i) => {
+    const { x: ex, bucketOf } = curveAxis([line], "episode", points);
+    const s = bucketCurve(line, ex.length, bucketOf);
+    const px = runningX(line.curve, xMode, seconds[i]);
+    const sum = new Float64Array(ex.length); const cnt = new Uint32Array(ex.length);
+    line.curve.episodes.forEach((e, k) => { const b = bucketOf(line, e); sum[b] += px[k]; cnt[b] += 1; });
+    return { s, bx: Array.from(sum, (v, b) => (cnt[b] ? v / cnt[b] : null)) };
+  });
+  const rows = [];
+  parts.forEach((p, i) => p.bx.forEach((v, b) => { if (v !== null && p.s.mean[b] !== null) rows.push([v, i, b]); }));
+  rows.sort((a, b) => a[0] - b[0]);
+  const keys = ["mean", "std", "min", "max", "count"];
+  const stats = parts.map((p) => ({ most: p.s.most, ...Object.fromEntries(keys.map((k) => [k, []])) }));
+  const x = [];
+  for (const [v, i, b] of rows) {
+    if (!x.length || x[x.length - 1] !== v) { x.push(v); for (const st of stats) for (const k of keys) st[k].push(null); }
+    for (const k of keys) stats[i][k][x.length - 1] = parts[i].s[k][b];
+  }
+  return { x, stats };
+}

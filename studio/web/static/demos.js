@@ -2,6 +2,7 @@
 
 import { api, guarded } from "./api.js";
 import { $, confirmDialog, el, emptyRow, enc, flashRow, fmt, groupRow, setProp, setText, showError } from "./dom.js";
+import { renderWatchDemos } from "./policies.js";
 import { S } from "./state.js";
 
 function currentDemoRecording() {
@@ -120,6 +121,7 @@ function renderDemos() {
     rows.push(...samples.map(demoRow));
   }
   body.replaceChildren(...rows);
+  renderWatchDemos();
   // The training form's demonstration checkboxes keep their ticks across refreshes.
   const box = $("train-demos");
   const ticked = new Set([...box.querySelectorAll("input:checked")].map((i) => i.value));

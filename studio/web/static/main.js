@@ -16,10 +16,11 @@ import { CURVE_FPS, connectEvents, events, renderLive } from "./events.js";
 import { exportFile, loadPolicies, uploadPolicy, watch } from "./policies.js";
 import { dismissCaptureFailure, loadRecordings, renderCaptureButton, saveRecordingEdit, toggleCapture, uploadRecording } from "./recordings.js";
 import { loadRuns, renderRuns } from "./runs.js";
+import { wireCompare } from "./compare.js";
 import { SOFTWARE_RENDERERS, SOFTWARE_SCENE_DPR, loadConfig, softwareWebGL } from "./scene.js";
-import { applySource, playback, renderSource, setRetarget, simulatorReach, syncKindOptions } from "./sources.js";
+import { applySource, exportForRobot, loadRobots, playback, renderSource, setRetarget, setRobot, simulatorReach, syncKindOptions } from "./sources.js";
 import { S, markCurvesDirty } from "./state.js";
-import { resetTrainForm, startRun, syncTaskFields } from "./training.js";
+import { checkTrainForm, resetTrainForm, startRun, syncTaskFields } from "./training.js";
 
 function wire() {
   // The buttons that follow the live source; camera.js listens after them.
@@ -45,6 +46,8 @@ function wire() {
   $("source-wander").addEventListener("click", () => simulatorReach("wander"));
   $("retarget-mode").addEventListener("change", setRetarget);
   $("retarget-mirror").addEventListener("change", setRetarget);
+  $("robot-name").addEventListener("change", setRobot);
+  $("robot-export").addEventListener("click", exportForRobot);
 
   $("capture-toggle").addEventListener("click", toggleCapture);
   $("capture-failure-dismiss").addEventListener("click", dismissCaptureFailure);
@@ -68,11 +71,13 @@ function wire() {
 
   $("train-form").addEventListener("submit", startRun);
   $("train-form").elements.task.addEventListener("change", syncTaskFields);
+  $("train-form").addEventListener("change", (ev) => { if (ev.target.closest("#train-demos, .goal3") || ["task", "bins"].includes(ev.target.name)) checkTrainForm(); });
   $("train-defaults").addEventListener("click", resetTrainForm);
   $("train-defaults").addEventListener("click", syncTaskFields); // after the reset above
   $("curve-log").addEventListener("change", markCurvesDirty);
   $("curve-band").addEventListener("change", markCurvesDirty);
   $("curve-x").addEventListener("change", markCurvesDirty);
+  wireCompare(); // the run table, smoothing and the CSV of plotted runs
 
   $("watch-go").addEventListener("click", watch);
   $("watch-stop").addEventListener("click", () => guarded("watch-error", () => api("POST", "/api/watch/stop")));
@@ -102,7 +107,7 @@ async function main() {
     S.markT0 = m && m.t0;
     updateMarkButton();
   }).catch(() => {});
-  await Promise.all([initial, cap, mark, loadRecordings(), loadDemos(), loadRuns(), loadPolicies()]);
+  await Promise.all([initial, cap, mark, loadRobots(), loadRecordings(), loadDemos(), loadRuns(), loadPolicies()]);
   if (S.source && S.source.recording) $("source-recording").value = S.source.recording;
   document.body.dataset.ready = "1";
 }

@@ -2,7 +2,7 @@
 
 import { api, download, guarded, uploadChosen } from "./api.js";
 import { runLabel } from "./chart.js";
-import { $, confirmDialog, el, emptyRow, enc, fillSelect, flashRow, setText, showError } from "./dom.js";
+import { $, confirmDialog, el, emptyRow, enc, fillSelect, flashRow, fmt, setText, showError } from "./dom.js";
 import { S } from "./state.js";
 
 export async function loadPolicies() {
@@ -86,14 +86,51 @@ export async function watch() {
   const body = { start: $("watch-start").value };
   if (t.type === "run") body.run = t.id; else body.policy = t.id;
   if ($("watch-seed").value !== "") body.seed = Number($("watch-seed").value);
+  if ($("watch-demo").value) body.demonstration = $("watch-demo").value;
   setText("watch-result", "");
   await guarded("watch-error", async () => {
     const w = await api("POST", "/api/watch", body);
     const secs = w.times && w.times.length ? w.times[w.times.length - 1] : 0;
     const from = w.seed == null ? "from the current pose" : `from a random start (seed ${w.seed})`;
     setText("watch-result", `${w.steps} steps, ${secs.toFixed(1)} s ${from} — ${w.reached_goal ? "reaches the goal" : "does not reach the goal"}`);
+    renderLikeness(w.likeness, w.likeness_note);
     S.watchedRun = t;
+    document.dispatchEvent(new CustomEvent("studio:watch", { detail: w })); // watch.js: the scrubber
   }, $("watch-go"));
+}
+
+/** The demonstrations the likeness card can compare with (the policy's own by default). */
+export function renderWatchDemos() {
+  const usable = S.demos.filter((d) => !d.error).map((d) => [d.name, d.name]);
+  fillSelect($("watch-demo"), [["", "its own demonstration"], ...usable]);
+}
+
+/** The likeness card: each figure for the policy and, beside it, for the demonstration. */
+function renderLikeness(card, note) {
+  const box = $("watch-likeness");
+  box.hidden = false;
+  if (!card) {
+    box.replaceChildren(el("div", { class: "muted", testid: "likeness-note", text: note || "No likeness card." }));
+    return;
+  }
+  const p = card.policy, d = card.demonstration;
+  const pct = (x) => (x == null ? "–" : `${fmt(100 * x, 0)}`);
+  const shares = (m) => m.joint_shares.map(pct).join("/");
+  const rows = [
+    ["DTW, joints (rad/sample)", fmt(card.dtw_rad, 4), `0 (travel ${fmt(d.joint_travel_rad, 2)} rad)`, "mean joint distance along the best time alignment"],
+    ["Fréchet, tool (m)", fmt(card.frechet_m, 4), `0 (path ${fmt(d.tool_path_m, 3)} m)`, "shortest leash joining the two tool paths"],
+    ["smoothness LDLJ", fmt(p.ldlj, 2), fmt(d.ldlj, 2), "log dimensionless jerk: higher is smoother"],
+    ["joint shares (%)", shares(p), shares(d), "each joint's share of the total joint travel"],
+    ["  JS divergence (bits)", fmt(card.shares_js, 3), "0", "0 = the same spread over the joints, 1 = disjoint"],
+    ["joints together (%)", pct(p.together), pct(d.together), "share of the moving time with two or more joints moving"],
+    ["duration (s)", fmt(p.duration_s, 2), fmt(d.duration_s, 2), ""],
+  ];
+  box.replaceChildren(
+    el("div", { class: "muted small", text: `Likeness to ${card.name}, rolled out from its start` }),
+    el("table", { class: "list" },
+      el("thead", {}, el("tr", {}, el("th", { text: "" }), el("th", { class: "num", text: "policy" }), el("th", { class: "num", text: "demonstration" }))),
+      el("tbody", {}, ...rows.map(([what, mine, theirs, help]) => el("tr", { testid: "likeness-row", title: help },
+        el("td", { text: what }), el("td", { class: "num", testid: "likeness-policy", text: mine }), el("td", { class: "num", testid: "likeness-demo", text: theirs }))))));
 }
 
 async function deletePolicy(name) {

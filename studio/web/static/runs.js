@@ -5,6 +5,7 @@ import { runColor, runLabel } from "./chart.js";
 import { CURVE_KEYS, emptyCurve } from "./curves.js";
 import { $, confirmDialog, el, emptyRow, enc, fmtCpu, showError } from "./dom.js";
 import { renderPolicies, renderWatchChoices } from "./policies.js";
+import { runMatches, tagChips } from "./runfilter.js";
 import { S, markCurvesDirty } from "./state.js";
 
 export function upsertRun(run) {
@@ -15,7 +16,10 @@ export function upsertRun(run) {
 
 export async function loadRuns() {
   await guarded("runs-error", async () => {
+    const notes = api("GET", "/api/run-notes").catch(() => null); // tags and notes (compare.js)
     S.runs = await api("GET", "/api/runs");
+    const all = await notes;
+    if (all) S.notes = new Map(Object.entries(all));
     S.sweeps = S.runs.some(sweepOf) ? await api("GET", "/api/sweeps") : [];
     if (!S.shownTouched) {
       // By default plot the newest few runs, so a fresh page shows the latest comparison.
@@ -46,24 +50,33 @@ export function renderRuns() {
   }
   const rows = [];
   const grouped = new Set();
-  for (const r of S.runs) { // a sweep's trials show as one group row, at its newest trial's place
+  const kept = S.runs.filter((r) => runMatches(r));
+  if (kept.length < S.runs.length) {
+    rows.push(el("tr", { class: "empty", testid: "runs-filtered" }, el("td", { colspan: 6,
+      text: `${kept.length} of ${S.runs.length} runs match the filter “${S.runFilter}” (Compare runs)` })));
+  }
+  for (const r of kept) { // a sweep's trials show as one group row, at its newest trial's place
     const sweep = sweepOf(r);
     if (!sweep) rows.push(runRow(r));
     else if (!grouped.has(sweep)) { grouped.add(sweep); rows.push(...sweepRows(sweep)); }
   }
   reconcileRows(body, rows);
+  if (S.afterRunsRender) S.afterRunsRender(); // the run table, when it is open
   const failed = S.runs.find((r) => r.status === "failed" && r.error && !r._errorShown);
   if (failed) { failed._errorShown = true; showError("runs-error", `${failed.name || failed.id}: ${failed.error}`); }
 }
 
 /** Put ``rows`` into ``body``, keeping every row that is drawn the same already: a running run
  * refreshes its row a few times a second, and rebuilding the whole list each time would lay out
- * and repaint all of it. Rows are equal when their HTML is (their handlers depend on the id alone). */
-function reconcileRows(body, rows) {
+ * and repaint all of it. Rows are equal when their HTML is (their handlers depend on the id alone),
+ * or, for rows with fields a person edits (whose HTML the browser changes), their ``drawn`` HTML
+ * as built. */
+export function reconcileRows(body, rows) {
   const old = [...body.children];
+  const html = (row) => row.drawn || row.outerHTML;
   rows.forEach((row, i) => {
     if (i >= old.length) body.append(row);
-    else if (old[i].outerHTML !== row.outerHTML) old[i].replaceWith(row);
+    else if (html(old[i]) !== html(row)) old[i].replaceWith(row);
   });
   for (const extra of old.slice(rows.length)) extra.remove();
 }
@@ -96,7 +109,7 @@ function runRow(r) {
       type: "checkbox", testid: "run-show", checked: S.shown.has(r.id),
       onchange: (e) => toggleShown(r.id, e.target.checked),
     })),
-    el("td", { class: "name", title: runLabel(r) }, el("span", { class: "swatch", style: `background:${runColor(r.id)}` }), runLabel(r)),
+    el("td", { class: "name", title: runLabel(r) }, el("span", { class: "swatch", style: `background:${runColor(r.id)}` }), runLabel(r), tagChips(r)),
     el("td", {}, el("span", { class: `badge ${r.status}`, testid: "run-status", text: r.note ? "preparing" : r.status })),
     r.note // before its first episode: what the run does (compiling the learner, the first time)
       ? el("td", { class: "run-note", testid: "run-note", text: r.note })
@@ -134,7 +147,7 @@ function foldSweep(id) {
 }
 
 function sweepRows(id) {
-  const runs = S.runs.filter((r) => sweepOf(r) === id);
+  const runs = S.runs.filter((r) => sweepOf(r) === id && runMatches(r));
   const info = S.sweeps.find((s) => s.id === id);
   const open = S.openSweeps.has(id);
   const trials = info ? info.trials : runs.length;
@@ -183,7 +196,7 @@ function sweepDetail(id, info) {
     el("div", { style: "overflow-x:auto" }, table)));
 }
 
-function toggleShown(id, on) {
+export function toggleShown(id, on) {
   S.shownTouched = true;
   if (on) {
     S.shown.add(id);

@@ -1,6 +1,6 @@
-/* Teach Studio page: the live source: its status line, the source form, playback, the simulator's reach. */
+/* Teach Studio page: the live source: its status line, the source form, playback, the simulator's reach, the robot taught. */
 
-import { api, guarded } from "./api.js";
+import { api, download, guarded } from "./api.js";
 import { $, fmt, setProp, setText, showError } from "./dom.js";
 import { S } from "./state.js";
 
@@ -23,6 +23,7 @@ export function renderSource() {
   setProp("source-warning", "hidden", !warning);
   setText("source-warning", warning);
   if (document.activeElement !== $("retarget-mode") && s.retarget) setProp("retarget-mode", "value", s.retarget.mode);
+  renderRobot(s);
   if (s.retarget) setProp("retarget-mirror", "checked", !!s.retarget.mirror);
   const pb = s.playback;
   setProp("playback", "hidden", !(s.kind === "recording" && pb));
@@ -106,4 +107,64 @@ export async function setRetarget() {
     });
     renderSource();
   });
+}
+
+// ------------------------------------------------------------------ the robot taught
+
+function renderRobot(s) {
+  const select = $("robot-name");
+  if (s.robot && !select.dataset.pending && document.activeElement !== select && select.querySelector(`option[value="${s.robot}"]`)) {
+    setProp(select, "value", s.robot);
+  }
+  // Joint mode maps the arm onto the Puma560's joints; any other robot follows the hand.
+  const joint = $("retarget-mode").querySelector('option[value="joint"]');
+  if (joint) setProp(joint, "disabled", !!s.robot && s.robot !== "puma560");
+  setProp("robot-warning", "hidden", !s.robot_warning);
+  setText("robot-warning", s.robot_warning || "");
+}
+
+export async function loadRobots() {
+  await guarded("source-error", async () => {
+    const body = await api("GET", "/api/robots");
+    const select = $("robot-name");
+    select.replaceChildren(...body.robots.map((r) => {
+      const o = document.createElement("option");
+      o.value = r.name;
+      o.textContent = r.title;
+      o.title = `${r.joints.length} joints: ${r.joints.join(", ")}`;
+      return o;
+    }));
+    select.value = body.robot;
+  });
+}
+
+export async function setRobot() {
+  const select = $("robot-name");
+  select.dataset.pending = "1";
+  try {
+    const chosen = await guarded("source-error", async () => {
+      const body = await api("PUT", "/api/robot", { name: select.value });
+      select.value = body.robot;
+      return true;
+    }, select);
+    if (!chosen && S.source && S.source.robot) select.value = S.source.robot;
+  } finally {
+    delete select.dataset.pending;
+  }
+}
+
+/** Download the recording chosen in the source form as the robot's trajectory (studio export). */
+export async function exportForRobot() {
+  const recording = $("source-recording").value;
+  if (!recording) { showError("robot-export-error", "Choose a recording first (Source → recording)."); return; }
+  const format = $("robot-export-format").value;
+  const params = new URLSearchParams({ format });
+  if ($("robot-export-unchecked").checked) params.set("unchecked", "true");
+  const button = $("robot-export");
+  button.disabled = true;
+  try {
+    await download(`/api/robot/export/recording/${encodeURIComponent(recording)}?${params}`, `${recording}.${format}`, "robot-export-error");
+  } finally {
+    button.disabled = false;
+  }
 }

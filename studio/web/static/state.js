@@ -13,6 +13,8 @@ export const S = {
   curves: new Map(), // run id -> {episodes, mean, std, min, max, count}
   shown: new Set(), // run ids plotted
   shownTouched: false, // the user changed which runs are plotted
+  notes: new Map(), // run id -> {tags, notes} (GET /api/run-notes; compare.js)
+  runFilter: "", // the run table's filter: words of a name, tag:…, task:… (runfilter.js)
   marking: false,
   watchedRun: null,
   curveDirty: true,

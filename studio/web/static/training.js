@@ -91,13 +91,53 @@ function readTrainForm() {
     err.data = { problems, by_field: Object.fromEntries(empty.map((k, i) => [k, problems[i]])) };
     throw err;
   }
-  if (body.task === "arm-reach") for (const k of REACH_FIELDS) body[k] = num(k);
+  if (body.task === "arm-reach") {
+    for (const k of REACH_FIELDS) body[k] = num(k);
+    body.actions = f.actions.value;
+  }
   if (f.name.value.trim()) body.name = f.name.value.trim();
   return body;
 }
 
+/** Fields the form checks as they are filled in: the demonstrations picked against the goal. */
+const LIVE_CHECKED = ["demonstrations", "goal_deg"];
+let checkSeq = 0;
+let checkShown = false; // whether the sentences beside the form are the live check's
+
+/** Clear what the live check showed (never a refused Start's sentences). */
+function clearCheck() {
+  if (checkShown) showTrainErrors(null);
+  checkShown = false;
+}
+
+/** Check the picked demonstrations against the form's goal and task now, before Start, with the
+ * learning package's own resolver (/api/demonstrations/check); show its sentences by field. */
+export async function checkTrainForm() {
+  const seq = ++checkSeq;
+  let body;
+  try { body = readTrainForm(); } catch { return; } // an empty number: Start will say which
+  if (!body.demonstrations.length) { clearCheck(); return; }
+  let data = {};
+  try {
+    await api("POST", "/api/demonstrations/check", body); // 204: it would start
+  } catch (e) {
+    if (!(e instanceof ApiError) || !e.data) return; // offline: Start will say
+    data = e.data;
+  }
+  if (seq !== checkSeq) return; // a newer check is on its way
+  const byField = Object.fromEntries(Object.entries(data.by_field || {}).filter(([k]) => LIVE_CHECKED.includes(k)));
+  const problems = Object.values(byField);
+  if (!problems.length) { clearCheck(); return; }
+  const err = new ApiError(problems.join(" "));
+  err.data = { problems, by_field: byField };
+  showTrainErrors(err);
+  checkShown = true;
+}
+
 export async function startRun(ev) {
   ev.preventDefault();
+  checkSeq++; // a check still on its way must not redraw the form's sentences
+  checkShown = false;
   showTrainErrors(null);
   const button = $("train-start");
   button.disabled = true;

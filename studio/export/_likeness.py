@@ -1,0 +1,72 @@
+"""Which demonstrations an exported policy is scored against, for its likeness card.
+
+``studio export POLICY`` prints the policy's likeness card against each of them, rolled out from
+that demonstration's own start (:func:`studio.learning.likeness_cards`): the one ``--demo``
+names, else the run's own (kept in its ``config.json``; by name for a run recorded before the
+motions were kept), else a movement primitive's own demonstration.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from studio import StudioError, read_json
+from studio.capture import DEMO_SUFFIX, load_demonstration
+from studio.learning import (
+    DemonstrationMotion,
+    DmpPolicyFile,
+    LearningError,
+    PolicyFile,
+    RunRecord,
+    TilePolicyFile,
+)
+
+from ._errors import ExportError
+from ._sources import find_source, source_kind
+
+RUN_CONFIG = "config.json"
+"""A run folder's record, beside its policy."""
+
+
+def demonstration_of(given: str | Path, data_dir: str | Path = ".") -> DemonstrationMotion:
+    """The motion of the demonstration ``given`` names (a path, or a name as :func:`find_source`
+    looks it up).
+
+    Raises:
+        ExportError: nothing of that name, not a demonstration, or a motion learning refuses.
+    """
+    path = find_source(given, data_dir)
+    if source_kind(path) != "demonstration":
+        raise ExportError(f"--demo names {path.name}, which is not a demonstration (*.demo.json).")
+    demo = load_demonstration(path)
+    name = path.name.removesuffix(DEMO_SUFFIX)
+    try:
+        return DemonstrationMotion.checked(
+            name, demo.times, demo.q_robot, f"The demonstration {path}"
+        )
+    except LearningError as err:
+        raise ExportError(str(err)) from None
+
+
+def likeness_motions(
+    policy_path: Path,
+    policy: PolicyFile | TilePolicyFile | DmpPolicyFile,
+    demo: str | Path | None = None,
+    data_dir: str | Path = ".",
+) -> list[DemonstrationMotion]:
+    """The demonstrations to score ``policy`` (read from ``policy_path``) against (module doc)."""
+    if demo is not None:
+        return [demonstration_of(demo, data_dir)]
+    config = Path(policy_path).parent / RUN_CONFIG
+    if config.is_file():
+        try:
+            record = RunRecord.from_dict(read_json(config))
+        except (StudioError, LearningError):
+            record = None  # not a run folder this studio reads: no run demonstrations
+        if record is not None and record.demonstration_motions:
+            return list(record.demonstration_motions)
+        if record is not None and record.demonstration_names:
+            return [demonstration_of(n, data_dir) for n in record.demonstration_names]
+    if isinstance(policy, DmpPolicyFile):
+        return [DemonstrationMotion("its demonstration", policy.demo_times, policy.demo_q)]
+    return []

@@ -1,0 +1,202 @@
+"""How the scene draws a robot: its meshes, and where each one is at a joint configuration.
+
+The Puma560 is drawn from the Toolbox's link meshes on its DH frames, at the origin, as ever.
+Any other robot of :func:`studio.kinematics.load_robot` is drawn from its URDF's own meshes
+(:func:`studio.kinematics.robot_meshes`), posed by Pinocchio, and framed where the Puma560
+stands: its base at the origin facing +X, raised on a pedestal so its shoulder is at the
+Puma560's, and enlarged (never shrunk) to the Puma560's reach, so a small arm such as the SO-100
+reads at the scene's distance from the operator beside it.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, replace
+
+import numpy as np
+import pinocchio as pin
+import viser
+import viser.transforms as vtf
+
+from studio.kinematics import (
+    MeshConfig,
+    MeshPart,
+    Puma560,
+    RobotArm,
+    load_robot,
+    puma560_meshes,
+    robot_meshes,
+)
+
+
+@dataclass(frozen=True, eq=False)
+class RobotView:
+    """One robot as the scene draws it.
+
+    Attributes:
+        name: the robot's name (``puma560``, ``panda``, ...).
+        parts: its meshes, vertices in the world's scale.
+        nq: its number of joints (a pose of another width is not its pose).
+        q0: the pose it is drawn at before any other.
+        poses: joint angles -> world pose of every part ``(P, 4, 4)``.
+        tool: joint angles -> world position of the tool ``(3,)``.
+        pedestal: height of the pedestal under its base (m; 0: it stands on the floor).
+    """
+
+    name: str
+    parts: list[MeshPart]
+    nq: int
+    q0: np.ndarray
+    poses: Callable[[np.ndarray], np.ndarray]
+    tool: Callable[[np.ndarray], np.ndarray]
+    pedestal: float = 0.0
+
+
+def puma_view(puma: Puma560, config: MeshConfig) -> RobotView:
+    """The Puma560 on its DH frames, its base at the origin."""
+    parts = puma560_meshes(config)
+
+    def poses(q: np.ndarray) -> np.ndarray:
+        frames = puma.joint_frames(np.asarray(q, dtype=float))
+        return np.stack([frames[int(p.frame)] for p in parts])
+
+    def tool(q: np.ndarray) -> np.ndarray:
+        return puma.forward(np.asarray(q, dtype=float))[:3, 3]
+
+    return RobotView("puma560", parts, 6, np.array(puma.qz, dtype=float), poses, tool)
+
+
+def arm_framing(arm: RobotArm) -> tuple[float, float]:
+    """``(scale, pedestal)``: how ``arm`` is framed where the Puma560 stands.
+
+    Enlarged to the Puma560's reach (never shrunk), and raised so its shoulder is at the
+    Puma560's shoulder height.
+    """
+    puma = load_robot("puma560")
+    scale = max(1.0, puma.reach / arm.reach)
+    pedestal = max(0.0, float(puma.shoulder[2]) - scale * float(arm.shoulder[2]))
+    return scale, pedestal
+
+
+def arm_view(arm: RobotArm, config: MeshConfig) -> RobotView:
+    """A robot of :func:`~studio.kinematics.load_robot` drawn from its URDF's meshes.
+
+    Raises:
+        KinematicsError: a mesh file is missing or unreadable.
+    """
+    scale, pedestal = arm_framing(arm)
+    parts = [
+        MeshPart(p.name, p.frame, p.vertices * np.float32(scale), p.faces, p.rgb)
+        # simplified at the size drawn: an enlarged arm keeps the detail of a full-size one
+        for p in robot_meshes(arm.visual_model, replace(config, cell_m=config.cell_m / scale))
+    ]
+    # Its own scratch data: the arm's own is the retargeting's, in another thread.
+    data, geometry_data = arm.model.createData(), arm.visual_model.createData()
+    lock = threading.Lock()
+    lift = np.array([0.0, 0.0, pedestal])
+
+    def poses(q: np.ndarray) -> np.ndarray:
+        with lock:
+            pin.updateGeometryPlacements(
+                arm.model, data, arm.visual_model, geometry_data, np.asarray(q, dtype=float)
+            )
+            out = np.stack([geometry_data.oMg[int(p.frame)].homogeneous for p in parts])
+        out[:, :3, 3] = out[:, :3, 3] * scale + lift
+        return out
+
+    def tool(q: np.ndarray) -> np.ndarray:
+        with lock:
+            pin.framesForwardKinematics(arm.model, data, np.asarray(q, dtype=float))
+            return data.oMf[arm.tool_frame].translation * scale + lift
+
+    return RobotView(
+        arm.name, parts, arm.nq, np.array(arm.home, dtype=float), poses, tool, pedestal
+    )
+
+
+log = logging.getLogger(__name__)
+
+
+class RobotViews:
+    """The robots' views, each built once; another robot's meshes are read in the background.
+
+    Args:
+        puma: the scene's Puma560 (its view is built at once: the scene starts with it).
+        config: mesh simplification.
+    """
+
+    def __init__(self, puma: Puma560, config: MeshConfig) -> None:
+        self.puma = puma_view(puma, config)
+        self._config = config
+        self._views = {self.puma.name: self.puma}
+        self._lock = threading.Lock()
+        self._wanted = self.puma.name
+
+    def request(self, arm: RobotArm | None, ready: Callable[[RobotView], None]) -> None:
+        """Build ``arm``'s view (None: the Puma560's) and hand it to ``ready``, unless another
+        robot was requested meanwhile; a mesh that cannot be read is logged (nothing drawn)."""
+        name = self.puma.name if arm is None else arm.name
+        with self._lock:
+            self._wanted = name
+        if arm is None or name in self._views:
+            self._ready(name, self._views[name], ready)
+            return
+        thread = threading.Thread(
+            target=self._load, args=(arm, ready), name="studio-robot-meshes", daemon=True
+        )
+        thread.start()
+
+    def _load(self, arm: RobotArm, ready: Callable[[RobotView], None]) -> None:
+        try:
+            view = arm_view(arm, self._config)
+        except Exception:
+            log.exception("The %s meshes could not be read; the robot drawn stays.", arm.name)
+            return
+        with self._lock:
+            self._views.setdefault(arm.name, view)
+        self._ready(arm.name, self._views[arm.name], ready)
+
+    def _ready(self, name: str, view: RobotView, ready: Callable[[RobotView], None]) -> None:
+        with self._lock:  # under the lock: a robot chosen meanwhile is never overdrawn
+            if self._wanted == name:
+                ready(view)
+
+
+def wxyz_of(rotations: np.ndarray) -> np.ndarray:
+    """Unit quaternions (w, x, y, z) of rotation matrices ``(..., 3, 3)`` (viser's convention)."""
+    return np.asarray(vtf.SO3.from_matrix(np.asarray(rotations, dtype=float)).wxyz)
+
+
+def rgb255(rgb: Sequence[float]) -> tuple[int, int, int]:
+    """A colour of floats in [0, 1] as viser's 0-255 integers."""
+    r, g, b = (int(round(255 * min(max(float(c), 0.0), 1.0))) for c in rgb)
+    return r, g, b
+
+
+def add_robot(
+    server: viser.ViserServer,
+    root: str,
+    view: RobotView,
+    opacity: float | None = None,
+    visible: bool = True,
+) -> list[viser.MeshHandle]:
+    """Add ``view``'s meshes under ``root``, posed at its ``q0``."""
+    handles = []
+    for part, pose in zip(view.parts, view.poses(view.q0), strict=True):
+        handles.append(
+            server.scene.add_mesh_simple(
+                f"{root}/{part.name}",
+                part.vertices,
+                part.faces,
+                color=rgb255(part.rgb),
+                opacity=opacity,
+                cast_shadow=False,
+                receive_shadow=False,
+                position=pose[:3, 3],
+                wxyz=wxyz_of(pose[:3, :3]),
+                visible=visible,
+            )
+        )
+    return handles

@@ -1,0 +1,226 @@
+"""``/api/scene``: scrub the rollout being watched, point the cameras, pose the robot by hand.
+
+The scene keeps the scrub position, speed and pause as part of its playback
+(:func:`studio.web._scene_model.rescheduled`); this router only checks the values and passes them
+on. Angles are in degrees here, at the user's edge, and radians inside.
+"""
+
+from __future__ import annotations
+
+from typing import Literal
+
+import numpy as np
+from fastapi import APIRouter
+from pydantic import BaseModel, Field
+
+from .._deps import StudioDep
+from .._errors import ConflictError, InvalidError
+from .._protocols import Scene
+from .._scene_model import PLAYBACK_SPEEDS, Playback
+from .._scene_views import VIEW_NAMES
+from .._schemas import _Body
+
+router = APIRouter(prefix="/api/scene", tags=["scene"])
+
+MAX_STEP = 10_000
+"""Most samples one step request may move (a rollout has at most a few thousand)."""
+
+
+class PlaybackChange(_Body):
+    """Scrub, pause, resume, change speed or step the playback (each field optional)."""
+
+    t: float | None = Field(None, description="scrub to this time (s) of the rollout")
+    speed: float | None = Field(None, ge=PLAYBACK_SPEEDS[0], le=PLAYBACK_SPEEDS[-1])
+    paused: bool | None = None
+    step: int = Field(0, ge=-MAX_STEP, le=MAX_STEP, description="samples forward (+) or back (-)")
+
+
+class PlaybackPublic(BaseModel):
+    """The playback the scene shows: where it stands and how it moves."""
+
+    active: bool
+    """A rollout (or a jogged pose) was played and can be scrubbed."""
+    t: float
+    """Time reached in the rollout (s), within ``[0, duration]``."""
+    duration: float
+    samples: int
+    sample: int
+    """Index of the last sample at or before ``t``."""
+    speed: float
+    paused: bool
+    finished: bool
+    """Played to its end (and not paused)."""
+    speeds: list[float]
+    """The speeds the page offers."""
+    q_robot_deg: list[float]
+    """The robot joints the scene shows now (deg)."""
+
+
+class ViewChange(_Body):
+    """Put the browsers' cameras on a preset."""
+
+    view: Literal["front", "top", "side"]
+
+
+class FollowChange(_Body):
+    """Make the browsers' cameras follow the robot's tool, or stop."""
+
+    on: bool
+
+
+class CameraPublic(BaseModel):
+    """A browser's camera (world, m, Z up)."""
+
+    position: list[float]
+    look_at: list[float]
+
+
+class ViewsPublic(BaseModel):
+    """The camera presets, whether the cameras follow the tool, and each browser's camera."""
+
+    views: list[str]
+    following: bool
+    cameras: list[CameraPublic]
+
+
+class JogChange(_Body):
+    """Pose the robot by hand: every joint, in degrees."""
+
+    q_deg: list[float] = Field(..., max_length=32)
+
+
+class JointPublic(BaseModel):
+    """One joint of the robot and its limits."""
+
+    name: str
+    lower_deg: float
+    upper_deg: float
+
+
+class JogPublic(BaseModel):
+    """The robot's joints with their limits, and the pose the scene shows."""
+
+    joints: list[JointPublic]
+    q_deg: list[float]
+
+
+def _scene(studio: StudioDep) -> Scene:
+    if studio.scene is None:
+        raise ConflictError("This studio runs without a 3D scene; start it with its scene.")
+    return studio.scene
+
+
+def _public(scene: Scene, playback: Playback | None, t: float) -> PlaybackPublic:
+    q = np.degrees(scene.current_q_robot()).round(6).tolist()
+    speeds = list(PLAYBACK_SPEEDS)
+    if playback is None:
+        return PlaybackPublic(
+            active=False, t=0, duration=0, samples=0, sample=0, speed=1, paused=False,
+            finished=False, speeds=speeds, q_robot_deg=q,
+        )  # fmt: skip
+    at = min(max(t, 0.0), playback.duration)
+    sample = int(np.searchsorted(playback.times, at, side="right")) - 1
+    return PlaybackPublic(
+        active=True,
+        t=round(at, 6),
+        duration=playback.duration,
+        samples=len(playback.times),
+        sample=max(sample, 0),
+        speed=playback.speed,
+        paused=playback.paused,
+        finished=not playback.paused and t >= playback.duration,
+        speeds=speeds,
+        q_robot_deg=q,
+    )
+
+
+@router.get("/playback")
+def read_playback(studio: StudioDep) -> PlaybackPublic:
+    """Where the playback stands (``active`` false before anything was watched)."""
+    scene = _scene(studio)
+    now = scene.scrub()
+    return _public(scene, None, 0.0) if now is None else _public(scene, *now)
+
+
+@router.post("/playback")
+def change_playback(body: PlaybackChange, studio: StudioDep) -> PlaybackPublic:
+    """Scrub (``t``), pause or resume, change the speed or step by samples; 409 before a watch,
+    422 for a time outside the rollout."""
+    scene = _scene(studio)
+    now = scene.scrub()
+    if now is None:
+        raise ConflictError("Nothing has been watched yet; watch a policy first, then scrub it.")
+    duration = now[0].duration
+    if body.t is not None and not 0 <= body.t <= duration:
+        raise InvalidError(
+            f"t is {body.t:g} s, outside the rollout's 0 to {duration:g} s; choose a time within it."
+        )
+    changed = scene.scrub(t=body.t, speed=body.speed, paused=body.paused, step=body.step)
+    if changed is None:  # stopped meanwhile
+        raise ConflictError("The playback was stopped; watch a policy again, then scrub it.")
+    return _public(scene, *changed)
+
+
+@router.get("/views")
+def read_views(studio: StudioDep) -> ViewsPublic:
+    """The presets, whether the cameras follow the tool, and each browser's camera."""
+    camera = _scene(studio).camera
+    return ViewsPublic(
+        views=list(VIEW_NAMES),
+        following=camera.following,
+        cameras=[CameraPublic(position=list(v.position), look_at=list(v.look_at)) for v in camera.views()],
+    )  # fmt: skip
+
+
+@router.post("/view")
+def change_view(body: ViewChange, studio: StudioDep) -> ViewsPublic:
+    """Put every connected browser's camera on the preset (front, top or side)."""
+    _scene(studio).camera.show(body.view)
+    return read_views(studio)
+
+
+@router.post("/follow")
+def change_follow(body: FollowChange, studio: StudioDep) -> ViewsPublic:
+    """Make every browser's camera follow the robot's tool (``on``), or stop following."""
+    scene = _scene(studio)
+    scene.camera.following = body.on
+    if body.on:
+        scene.camera.follow(scene.tool_positions(scene.current_q_robot())[0])
+    return read_views(studio)
+
+
+def _joints(scene: Scene) -> list[JointPublic]:
+    lower, upper = np.degrees(scene.robot.lower), np.degrees(scene.robot.upper)
+    return [
+        JointPublic(name=f"joint {i + 1}", lower_deg=round(float(lo), 6), upper_deg=round(float(hi), 6))
+        for i, (lo, hi) in enumerate(zip(lower, upper, strict=True))
+    ]  # fmt: skip
+
+
+@router.get("/jog")
+def read_jog(studio: StudioDep) -> JogPublic:
+    """The robot's joints with their limits (deg), and the joints the scene shows."""
+    scene = _scene(studio)
+    q = np.degrees(scene.current_q_robot()).round(6).tolist()
+    return JogPublic(joints=_joints(scene), q_deg=q)
+
+
+@router.post("/jog")
+def jog(body: JogChange, studio: StudioDep) -> JogPublic:
+    """Show the robot at the given joints (deg, each within its limits; 422 otherwise) until
+    the next watch or Stop."""
+    scene = _scene(studio)
+    joints = _joints(scene)
+    if len(body.q_deg) != len(joints):
+        raise InvalidError(
+            f"q_deg has {len(body.q_deg)} angles but the robot has {len(joints)} joints; give one angle per joint."
+        )
+    for j, value in zip(joints, body.q_deg, strict=True):
+        if not j.lower_deg <= value <= j.upper_deg:
+            raise InvalidError(
+                f"{j.name} is {value:g}°, outside its limits {j.lower_deg:g}° to {j.upper_deg:g}°; choose an angle within them."
+            )
+    with studio.watch_lock:
+        studio.watching = None  # a pose by hand replaces the policy being watched
+    scene.hold_pose(np.radians(body.q_deg))
+    return JogPublic(joints=joints, q_deg=list(body.q_deg))

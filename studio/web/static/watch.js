@@ -1,0 +1,208 @@
+/* Teach Studio page: scrubbing a watched rollout, the scene's camera presets, and posing the robot by hand.
+ *
+ * The scene keeps the scrub position, the speed and the pause (POST /api/scene/playback); this
+ * module only shows them and sends the user's changes. Between answers the time shown runs on the
+ * page's own clock at the playback's speed, and only while the rollout plays: a paused or finished
+ * rollout writes nothing to the page. It hears a new watch through the `studio:watch` event that
+ * policies.js fires.
+ *
+ * Posing by hand: a slider per robot joint between its limits (shown at both ends), which moves the
+ * robot in the scene (POST /api/scene/jog, latest wins), and "use this pose as the goal", which
+ * fills the train form's goal with joints 1-3 (degrees, as the form takes it).
+ */
+
+import { api, guarded } from "./api.js";
+import { $, el, fmt, setProp, setText, showError } from "./dom.js";
+import { S } from "./state.js";
+
+const TICK_MS = 100; // the time shown moves this often while a rollout plays
+const VIEWS = [["front", "Front view", "Front"], ["top", "Top view", "Top"], ["side", "Side view", "Side"]];
+const GOAL_JOINTS = 3; // the train form's goal: joints 1-3
+
+// The rollout as the scene last answered, and when (performance.now()).
+S.rollout = null;
+let answeredAt = 0;
+let ticker = null;
+
+function build() {
+  const speeds = [0.25, 0.5, 1, 2, 4];
+  const box = $("watch-controls");
+  box.replaceChildren(
+    el("div", { class: "row playback", id: "rollout", testid: "rollout", hidden: true },
+      el("button", { id: "rollout-back", testid: "rollout-back", "aria-label": "Step back", title: "one sample back", text: "|◀" }),
+      el("button", { id: "rollout-play", testid: "rollout-play", "aria-label": "Pause", title: "play / pause", text: "❚❚" }),
+      el("button", { id: "rollout-forward", testid: "rollout-forward", "aria-label": "Step forward", title: "one sample forward", text: "▶|" }),
+      el("input", { id: "rollout-time", testid: "rollout-time", type: "range", min: "0", max: "1", step: "any", value: "0", class: "grow", "aria-label": "Rollout time" }),
+      el("span", { class: "mono", id: "rollout-clock", testid: "rollout-clock", text: "0.00 / 0.00 s" }),
+      el("select", { id: "rollout-speed", testid: "rollout-speed", "aria-label": "Rollout speed", title: "playback speed" },
+        ...speeds.map((s) => el("option", { value: String(s), text: `${s}×`, selected: s === 1 }))),
+    ),
+    el("div", { class: "row", role: "group", "aria-label": "Camera" },
+      el("span", { class: "muted", text: "camera:" }),
+      ...VIEWS.map(([view, name, text]) => el("button", { testid: `view-${view}`, "aria-label": name, title: `${text} view of the scene`, text, onclick: () => showView(view) })),
+      el("label", { title: "keep the robot's tool in the middle of the scene" },
+        el("input", { type: "checkbox", id: "view-follow", testid: "view-follow", "aria-label": "Follow the tool", onchange: (e) => follow(e.target.checked) }), " follow the tool"),
+    ),
+    el("details", { id: "jog", testid: "jog", ontoggle: (e) => { if (e.target.open) loadJog(); } },
+      el("summary", { text: "Pose by hand" }),
+      el("div", { id: "jog-joints", testid: "jog-joints" }),
+      el("div", { class: "row" },
+        el("button", { id: "jog-goal", testid: "jog-goal", text: "Use this pose as the goal", title: "fill Train → goal with joints 1–3 of this pose", onclick: useAsGoal }),
+      ),
+    ),
+    el("div", { class: "err", id: "rollout-error", testid: "rollout-error", hidden: true }),
+  );
+  $("rollout-back").addEventListener("click", () => change({ step: -1 }));
+  $("rollout-forward").addEventListener("click", () => change({ step: 1 }));
+  $("rollout-play").addEventListener("click", () => change({ paused: !(S.rollout && S.rollout.paused) && !finished() }));
+  $("rollout-speed").addEventListener("change", () => change({ speed: Number($("rollout-speed").value) }));
+  const slider = $("rollout-time");
+  slider.addEventListener("input", () => { slider.dataset.dragging = "1"; scrubTo(Number(slider.value)); });
+  slider.addEventListener("change", () => { delete slider.dataset.dragging; scrubTo(Number(slider.value)); });
+}
+
+// ------------------------------------------------------------------ the rollout
+
+function finished() {
+  const r = S.rollout;
+  return !!r && !r.paused && timeNow() >= r.duration;
+}
+
+function timeNow() {
+  const r = S.rollout;
+  if (!r) return 0;
+  if (r.paused) return r.t;
+  return Math.min(r.t + ((performance.now() - answeredAt) / 1000) * r.speed, r.duration);
+}
+
+/** Take the scene's answer and show it; the clock runs only while the rollout plays. */
+function showRollout(r) {
+  S.rollout = r && r.active ? r : null;
+  answeredAt = performance.now();
+  setProp("rollout", "hidden", !S.rollout);
+  if (!S.rollout) { stopTicker(); return; }
+  $("rollout-time").max = String(r.duration);
+  setProp($("rollout-speed"), "value", String(r.speed));
+  render();
+  if (r.paused || r.finished) stopTicker();
+  else if (!ticker) ticker = setInterval(render, TICK_MS);
+}
+
+function stopTicker() {
+  if (ticker) clearInterval(ticker);
+  ticker = null;
+}
+
+function render() {
+  const r = S.rollout;
+  if (!r) return;
+  const t = timeNow();
+  const slider = $("rollout-time");
+  if (!slider.dataset.dragging) setProp(slider, "value", String(t));
+  setText("rollout-clock", `${fmt(t, 2)} / ${fmt(r.duration, 2)} s`);
+  const playing = !r.paused && t < r.duration;
+  setText("rollout-play", playing ? "❚❚" : "▶");
+  $("rollout-play").setAttribute("aria-label", playing ? "Pause" : "Play");
+  if (!playing) stopTicker();
+}
+
+async function change(body) {
+  await guarded("rollout-error", async () => showRollout(await api("POST", "/api/scene/playback", body)));
+}
+
+// Scrubbing sends the newest position only, one request at a time, and pauses the rollout there.
+let scrubBusy = false;
+let scrubNext = null;
+async function scrubTo(t) {
+  scrubNext = t;
+  if (scrubBusy) return;
+  scrubBusy = true;
+  try {
+    while (scrubNext !== null) {
+      const at = Math.min(Math.max(scrubNext, 0), S.rollout ? S.rollout.duration : 0);
+      scrubNext = null;
+      await change({ t: at, paused: true });
+    }
+  } finally {
+    scrubBusy = false;
+  }
+}
+
+export async function loadRollout() {
+  try { showRollout(await api("GET", "/api/scene/playback")); } catch (e) { /* a studio without a scene */ }
+}
+
+// ------------------------------------------------------------------ camera
+
+async function showView(view) {
+  await guarded("rollout-error", () => api("POST", "/api/scene/view", { view }));
+}
+
+async function follow(on) {
+  await guarded("rollout-error", () => api("POST", "/api/scene/follow", { on }));
+}
+
+// ------------------------------------------------------------------ posing by hand
+
+let jogBusy = false;
+let jogNext = null;
+
+async function loadJog() {
+  await guarded("rollout-error", async () => {
+    const jog = await api("GET", "/api/scene/jog");
+    $("jog-joints").replaceChildren(...jog.joints.map((j, i) => jointRow(j, jog.q_deg[i])));
+  });
+}
+
+function jointRow(j, value) {
+  const label = j.name[0].toUpperCase() + j.name.slice(1);
+  const v = Math.min(Math.max(value, j.lower_deg), j.upper_deg);
+  const input = el("input", { type: "range", class: "grow", min: String(j.lower_deg), max: String(j.upper_deg), step: "0.5", value: String(v), "aria-label": label, testid: "jog-joint" });
+  const shown = el("span", { class: "mono w5", testid: "jog-value", text: `${fmt(v, 1)}°` });
+  input.addEventListener("input", () => { setText(shown, `${fmt(Number(input.value), 1)}°`); jog(); });
+  return el("div", { class: "row jog-row" },
+    el("span", { class: "w5", text: label }),
+    el("span", { class: "muted small mono", testid: "jog-min", title: `${label}'s lower limit`, text: `${fmt(j.lower_deg, 0)}°` }),
+    input,
+    el("span", { class: "muted small mono", testid: "jog-max", title: `${label}'s upper limit`, text: `${fmt(j.upper_deg, 0)}°` }),
+    shown,
+  );
+}
+
+function jogValues() {
+  return [...$("jog-joints").querySelectorAll("input[type=range]")].map((i) => Number(i.value));
+}
+
+/** Send the sliders' pose (latest wins, one request at a time). */
+async function jog() {
+  jogNext = jogValues();
+  if (jogBusy) return;
+  jogBusy = true;
+  try {
+    while (jogNext) {
+      const q = jogNext;
+      jogNext = null;
+      await guarded("rollout-error", () => api("POST", "/api/scene/jog", { q_deg: q }));
+    }
+  } finally {
+    jogBusy = false;
+  }
+  showRollout(null); // a pose by hand replaces the rollout being scrubbed
+}
+
+function useAsGoal() {
+  const q = jogValues();
+  if (q.length < GOAL_JOINTS) { showError("rollout-error", "Open Pose by hand and set the joints first."); return; }
+  const f = $("train-form");
+  for (let i = 0; i < GOAL_JOINTS; i++) {
+    const input = f.elements[`goal${i}`];
+    input.value = String(q[i]);
+    input.dispatchEvent(new Event("change", { bubbles: true }));
+  }
+  showError("rollout-error", null);
+}
+
+build();
+document.addEventListener("studio:watch", loadRollout);
+$("watch-stop").addEventListener("click", () => showRollout(null)); // the robot goes back to live
+loadRollout();

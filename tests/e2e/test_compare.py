@@ -1,0 +1,217 @@
+"""Compare runs as a researcher does in TensorBoard or Weights & Biases: the run table with the
+settings that differ highlighted, tags and notes that land in ``<run>/notes.json``, a filter by
+name, tag and task, smoothing, other x axes, a legend that names every run, and one CSV.
+
+Controls are found by role and accessible name, as a screen reader finds them.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import os
+import re
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from tests.e2e.conftest import Studio
+from tests.web.conftest import wait_for
+
+T = 20.0  # s: the longest one step of the page may take (the machine may be busy)
+SHOTS = Path(os.environ.get("COMPARE_SHOTS", "/tmp/compare-shots"))
+
+
+def ema(values: list[float], weight: float) -> list[float]:
+    """TensorBoard's debiased exponential moving average, written independently of the page."""
+    out, last = [], 0.0
+    for n, v in enumerate(values, start=1):
+        last = last * weight + (1 - weight) * v
+        out.append(last / (1 - weight**n))
+    return out
+
+
+@pytest.fixture(scope="module")
+def two_runs(studio_server: Studio) -> list[dict]:
+    """Two finished grid runs that differ in their planner only."""
+    runs = []
+    for name, planning in (("cmp-zero", "zero"), ("cmp-full", "full")):
+        run = studio_server.send(
+            "POST",
+            "/api/runs",
+            {"name": name, "planning": planning, "episodes": 6, "experiments": 2, "seed": 3},
+        )
+        runs.append(run)
+    for run in runs:
+        assert wait_for(
+            lambda r=run: studio_server.get(f"/api/runs/{r['id']}")["status"] == "done", 180
+        )
+    return [studio_server.get(f"/api/runs/{r['id']}") for r in runs]
+
+
+@pytest.fixture
+def small_page(browser: Any, studio_server: Studio, two_runs: list[dict]) -> Iterator[Any]:
+    """The page at 1280 x 720 with only the two runs plotted."""
+    context = browser.new_context(viewport={"width": 1280, "height": 720}, accept_downloads=True)
+    page = context.new_page()
+    errors: list[str] = []
+    page.on("pageerror", lambda e: errors.append(str(e)))
+    try:
+        page.goto(studio_server.base + "/")
+        page.wait_for_selector("body[data-ready='1']", timeout=T * 3000)
+        ids = [r["id"] for r in two_runs]
+        for row in page.locator("[data-testid='run-row']").all():
+            box = row.get_by_test_id("run-show")
+            if box.count() and box.is_checked() != (row.get_attribute("data-id") in ids):
+                box.click()
+        page.wait_for_function(
+            "ids => JSON.stringify([...window.studio.plottedRuns()].sort()) === JSON.stringify(ids)",
+            arg=sorted(ids),
+            timeout=T * 1000,
+        )
+        page.errors = errors
+        yield page
+    finally:
+        context.close()
+    assert not errors, errors
+
+
+def shoot(page: Any, name: str) -> None:
+    SHOTS.mkdir(parents=True, exist_ok=True)
+    page.screenshot(path=str(SHOTS / f"{name}.png"))
+
+
+def test_the_run_table_highlights_differences_and_saves_tags_and_notes_beside_the_run(
+    small_page: Any, studio_server: Studio, two_runs: list[dict]
+) -> None:
+    page = small_page
+    zero, full = two_runs
+    page.get_by_role("button", name="Compare runs").click()
+    table = page.get_by_role("dialog", name="Compare runs")
+    assert table.is_visible()
+    rows = table.get_by_test_id("compare-row")
+    assert wait_for(lambda: rows.count() >= 2, T)
+    row_zero = table.locator(f"[data-testid='compare-row'][data-id='{zero['id']}']")
+    # the planner differs between the plotted runs, the seed does not
+    assert "differs" in row_zero.locator("td[data-key='planning']").get_attribute("class")
+    assert "differs" not in (row_zero.locator("td[data-key='seed']").get_attribute("class") or "")
+    page.get_by_role("checkbox", name="only settings that differ").check()
+    assert wait_for(lambda: row_zero.locator("td[data-key='seed']").count() == 0, T)
+    assert row_zero.locator("td[data-key='planning']").inner_text() == "zero"
+    shoot(page, "compare-table-1280x720")
+
+    tags = page.get_by_role("textbox", name=re.compile(r"^Tags of cmp-zero"))
+    tags.fill("baseline, no planning")
+    page.get_by_role("textbox", name=re.compile(r"^Notes of cmp-zero")).click()  # leave the field
+    notes_file = studio_server.data_dir / "runs" / zero["id"] / "notes.json"
+    assert wait_for(notes_file.exists, T)
+    # the save redraws nothing under the cursor: the person types on in the notes field
+    run_row = page.locator(f"[data-testid='run-row'][data-id='{zero['id']}']")
+    assert wait_for(lambda: "baseline" in run_row.get_by_test_id("run-tags").inner_text(), T)
+    notes_field = page.get_by_role("textbox", name=re.compile(r"^Notes of cmp-zero"))
+    assert notes_field.evaluate("e => e === document.activeElement")
+    page.keyboard.type("the paper's Dyna-Q(0)")
+    page.get_by_role("textbox", name=re.compile(r"^Tags of cmp-full")).click()
+    assert wait_for(lambda: "Dyna-Q(0)" in notes_file.read_text(), T)
+    stored = json.loads(notes_file.read_text())
+    assert (
+        stored["tags"] == ["baseline", "no planning"] and stored["notes"] == "the paper's Dyna-Q(0)"
+    )
+    # the learner's own files are untouched, and the run list shows the tags
+    assert json.loads((notes_file.parent / "config.json").read_text())["name"] == "cmp-zero"
+    assert "baseline" in run_row.get_by_test_id("run-tags").inner_text()
+
+    # filter by tag, by task and by name: the table and the run list follow
+    search = page.get_by_role("searchbox", name="Filter runs")
+    search.fill("tag:baseline")
+    assert wait_for(lambda: rows.count() == 1, T)
+    assert page.locator(f"[data-testid='run-row'][data-id='{full['id']}']").count() == 0
+    assert page.get_by_test_id("runs-filtered").is_visible()
+    search.fill("task:continuous")
+    assert wait_for(lambda: rows.count() == 0, T)
+    search.fill("cmp-full")
+    assert wait_for(lambda: rows.count() == 1, T)
+    assert rows.first.get_attribute("data-id") == full["id"]
+    search.fill("")
+    assert wait_for(lambda: rows.count() >= 2, T)
+
+    # a tag too long: one sentence, and nothing changes on disk
+    before = notes_file.read_text()
+    tags.fill("x" * 40)
+    page.get_by_role("textbox", name=re.compile(r"^Notes of cmp-zero")).click()
+    alert = table.get_by_role("alert")
+    assert wait_for(lambda: alert.is_visible() and "shorten it" in alert.inner_text(), T)
+    assert notes_file.read_text() == before
+    shoot(page, "compare-error-1280x720")
+    page.set_viewport_size({"width": 1920, "height": 1080})
+    shoot(page, "compare-error-1920x1080")
+    page.set_viewport_size({"width": 1280, "height": 720})
+    page.get_by_role("button", name="Close the run table").click()
+    assert not table.is_visible()
+    page.get_by_role("button", name="Compare runs").click()
+    assert wait_for(table.is_visible, T)
+    page.keyboard.press("Escape")
+    assert wait_for(lambda: not table.is_visible(), T)
+
+
+def test_smoothing_other_x_axes_the_legend_and_one_csv_of_the_plotted_runs(
+    small_page: Any, studio_server: Studio, two_runs: list[dict], tmp_path: Path
+) -> None:
+    page = small_page
+    zero, full = two_runs
+    curve = studio_server.get(f"/api/runs/{zero['id']}/curve")
+    # the legend names every run before the cursor comes near the chart, with its last value
+    legend = page.locator("#curve-plot .u-legend")
+    assert wait_for(
+        lambda: "cmp-zero" in legend.inner_text() and "cmp-full" in legend.inner_text(), T
+    )
+    assert "last" in legend.inner_text()
+    assert "–" not in legend.locator(".u-series:not(.band-edge) .u-value").all_inner_texts()[1]
+
+    slider = page.get_by_role("slider", name="Smoothing")
+    slider.focus()
+    for _ in range(60):  # 0.60, TensorBoard's usual setting, as a keyboard user reaches it
+        page.keyboard.press("ArrowRight")
+    assert slider.input_value() == "0.6"
+    line = "id => window.studio.chartLine(id)"
+    want = pytest.approx(ema(curve["mean"], 0.6))
+    # the chart redraws at its frame rate: wait for the frame after the last key press
+    assert wait_for(lambda: page.evaluate(line, zero["id"])["smooth"] == want, T)
+    drawn = page.evaluate(line, zero["id"])
+    assert drawn["mean"] == pytest.approx(curve["mean"])  # the raw line stays, behind
+    assert "smoothed" in legend.inner_text()
+    shoot(page, "compare-smoothing-1280x720")
+
+    page.get_by_test_id("curve-x").select_option("steps")
+    steps = [sum(curve["mean"][: k + 1]) for k in range(len(curve["mean"]))]
+    assert wait_for(lambda: page.evaluate(line, zero["id"])["x"][-1] != 6, T)
+    xs = page.evaluate(line, zero["id"])
+    mine = [x for x, m in zip(xs["x"], xs["mean"], strict=True) if m is not None]
+    assert mine == pytest.approx(steps)
+    page.get_by_test_id("curve-x").select_option("cpu")
+    assert wait_for(
+        lambda: (
+            (lambda d: [x for x, m in zip(d["x"], d["mean"], strict=True) if m is not None][-1])(
+                page.evaluate(line, zero["id"])
+            )
+            == pytest.approx(zero["cpu_seconds"])
+        ),
+        T,
+    )
+    shoot(page, "compare-cpu-axis-1280x720")
+    page.get_by_test_id("curve-x").select_option("episode")
+
+    with page.expect_download() as got:
+        page.get_by_role("button", name="Export CSV").click()
+    path = tmp_path / "curves.csv"
+    got.value.save_as(path)
+    rows = list(csv.reader(io.StringIO(path.read_text())))
+    assert rows[0][0] == "configuration" and rows[0][1] == "episode"
+    assert {r[0] for r in rows[1:]} == {"cmp-zero", "cmp-full"}
+    own = studio_server.get(f"/api/runs/{full['id']}/curve")
+    assert [float(r[2]) for r in rows[1:] if r[0] == "cmp-full"] == pytest.approx(
+        own["mean"], rel=1e-5
+    )

@@ -1,0 +1,139 @@
+"""Issue 23 items 4 and 5 in a real browser: scrub a watched rollout, change its speed, step it,
+put the scene's camera on a preset, pose the robot by hand and use that pose as the goal.
+
+Controls are found by role and accessible name, as a screen reader (or a user's script) finds
+them. What the robot shows is read back from the scene (``GET /api/scene/playback``).
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Any
+
+import numpy as np
+import pytest
+
+from tests.web.test_policies import policy_bytes
+
+from .conftest import Studio, shot
+from .test_stories import _pixels, _scene_png, _wait
+
+pytestmark = pytest.mark.e2e
+
+T = 20_000  # ms: the longest a single UI step may take
+
+
+def _until(cond, timeout: float = 15.0) -> bool:
+    return _wait(cond, timeout)
+
+
+def _watch_uploaded_policy(page: Any, tmp_path: Any) -> None:
+    path = tmp_path / "scrubbed.policy.npz"
+    path.write_bytes(policy_bytes(tmp_path))
+    page.set_input_files("[data-testid='policy-upload']", str(path))
+    page.locator("[data-testid='policy-row'][data-name='scrubbed']").wait_for(timeout=T)
+    page.select_option("[data-testid='watch-policy']", "policy:scrubbed")
+    page.select_option("[data-testid='watch-start']", "random")
+    page.fill("[data-testid='watch-seed']", "1")
+    page.click("[data-testid='watch-go']")
+    page.wait_for_selector("[data-testid='watch-result']:has-text('steps')", timeout=T)
+
+
+def test_scrub_a_rollout_change_its_speed_and_step_it(
+    page: Any, studio_server: Studio, tmp_path: Any
+) -> None:
+    _watch_uploaded_policy(page, tmp_path)
+    slider = page.get_by_role("slider", name="Rollout time")
+    slider.wait_for(state="visible", timeout=T)
+    page.locator("#sec-watch").scroll_into_view_if_needed()
+
+    def scene() -> dict:
+        return studio_server.get("/api/scene/playback")
+
+    # To the start and to the end: the robot's joints follow the slider, and stay there.
+    slider.focus()
+    slider.press("Home")
+    assert _until(lambda: scene()["paused"] and scene()["sample"] == 0)
+    start = np.array(scene()["q_robot_deg"])
+    slider.press("End")
+    assert _until(lambda: scene()["sample"] == scene()["samples"] - 1)
+    assert _until(lambda: not np.allclose(scene()["q_robot_deg"], start, atol=1e-3))
+    end = np.array(scene()["q_robot_deg"])
+    shot(page, "23-4-scrubbed-end", "sec-watch")
+
+    # One sample back, one forward: the robot moves between neighbouring samples.
+    page.get_by_role("button", name="Step back").click()
+    last = scene()["samples"] - 1
+    assert _until(lambda: scene()["sample"] == last - 1)
+    assert _until(lambda: not np.allclose(scene()["q_robot_deg"], end, atol=1e-6))
+    page.get_by_role("button", name="Step forward").click()
+    assert _until(lambda: scene()["sample"] == last)
+    assert _until(lambda: np.allclose(scene()["q_robot_deg"], end, atol=1e-3))
+    assert page.inner_text("[data-testid='rollout-clock']").endswith(" s")
+
+    # Speed 4x, then play from the start: the scene plays at that speed and the slider follows.
+    page.get_by_role("combobox", name="Rollout speed").select_option("4")
+    assert _until(lambda: scene()["speed"] == 4)
+    slider.press("Home")
+    assert _until(lambda: scene()["sample"] == 0)
+    page.get_by_role("button", name="Play").click()
+    assert _until(lambda: not scene()["paused"])
+    assert _until(lambda: float(slider.input_value()) > 0, 10)
+    assert _until(lambda: scene()["finished"], 20)
+    assert not page.is_visible("[data-testid='rollout-error']")
+    assert not page.errors  # type: ignore[attr-defined]
+
+
+def test_camera_presets_move_the_scene_camera(page: Any, studio_server: Studio) -> None:
+    frame = page.frame_locator("[data-testid='scene-frame']")
+    frame.locator("canvas").first.wait_for(state="visible", timeout=30_000)
+
+    def cameras() -> list[dict]:
+        return studio_server.get("/api/scene/views")["cameras"]
+
+    assert _until(lambda: len(cameras()) >= 1, 20)
+    page.get_by_role("button", name="Top view").click()
+    assert _until(lambda: all(c["position"][2] > 4.0 for c in cameras()))
+    time.sleep(0.5)  # the browser draws the new view (no event to wait for inside WebGL)
+    top = _pixels(_scene_png(page, "23-4-top-view"))
+    page.get_by_role("button", name="Side view").click()
+    assert _until(lambda: all(c["position"][0] < -2.0 for c in cameras()))
+    page.get_by_role("button", name="Front view").click()
+    assert _until(lambda: all(c["position"][1] < -3.0 for c in cameras()))
+    assert _until(lambda: np.abs(_pixels(_scene_png(page, "23-4-front-view")) - top).mean() > 1.0)
+    follow = page.get_by_role("checkbox", name="Follow the tool")
+    follow.check()
+    assert _until(lambda: studio_server.get("/api/scene/views")["following"])
+    follow.uncheck()
+    assert _until(lambda: not studio_server.get("/api/scene/views")["following"])
+    shot(page, "23-4-camera", "sec-watch")
+
+
+def test_pose_the_robot_by_hand_and_use_it_as_the_goal(page: Any, studio_server: Studio) -> None:
+    page.get_by_text("Pose by hand").click()
+    joint1 = page.get_by_role("slider", name="Joint 1")
+    joint1.wait_for(state="visible", timeout=T)
+    rows = page.locator("#jog-joints .jog-row")
+    assert rows.count() == 6
+    # the limits are drawn at both ends of each slider (the Puma560's joint 1: ±160°)
+    assert rows.first.locator("[data-testid='jog-min']").inner_text() == "-160°"
+    assert rows.first.locator("[data-testid='jog-max']").inner_text() == "160°"
+    joint1.focus()
+    joint1.press("End")
+    page.get_by_role("slider", name="Joint 2").focus()
+    page.get_by_role("slider", name="Joint 2").press("Home")
+
+    def shown() -> list[float]:
+        return studio_server.get("/api/scene/playback")["q_robot_deg"]
+
+    assert _until(lambda: abs(shown()[0] - 160) < 1e-3 and abs(shown()[1] + 110) < 1e-3)
+    joint3 = float(page.get_by_role("slider", name="Joint 3").input_value())
+    page.get_by_role("button", name="Use this pose as the goal").click()
+    goal = [float(page.input_value(f"[data-testid='train-goal-{i}']")) for i in range(3)]
+    assert goal == [160.0, -110.0, joint3]
+    shot(page, "23-5-posed", "sec-watch")
+    for size in ((1280, 720), (1920, 1080)):
+        page.set_viewport_size({"width": size[0], "height": size[1]})
+        shot(page, f"23-5-posed-{size[0]}x{size[1]}", "jog")
+    page.set_viewport_size({"width": 1440, "height": 900})
+    assert not page.errors  # type: ignore[attr-defined]
