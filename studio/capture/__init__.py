@@ -59,6 +59,10 @@ from ._recording_reader import recording_bytes as recording_bytes
 from ._recording_writer import RecordingWriter as RecordingWriter
 from ._recording_writer import recording_meta as recording_meta
 from ._serial import SerialSource as SerialSource
+from ._series import DEFAULT_SERIES_POINTS as DEFAULT_SERIES_POINTS
+from ._series import MAX_SERIES_POINTS as MAX_SERIES_POINTS
+from ._series import RecordingSeries as RecordingSeries
+from ._series import recording_series as recording_series
 from ._simulator import OperatorConfig as OperatorConfig
 from ._simulator import SimulatorSource as SimulatorSource
 from ._simulator import goal_configuration as goal_configuration
@@ -70,5 +74,10 @@ from ._source_spec import SOURCE_SPECS as SOURCE_SPECS
 from ._source_spec import cli_speed as cli_speed
 from ._source_spec import parse_host_port as parse_host_port
 from ._source_spec import source_from_spec as source_from_spec
+from ._takes import TAKES_FILE as TAKES_FILE
+from ._takes import Take as Take
+from ._takes import TakeSession as TakeSession
+from ._takes import read_takes as read_takes
+from ._takes import write_takes as write_takes
 from ._wire import DEFAULT_PORT as DEFAULT_PORT
 from ._wire import encode_frame as encode_frame

@@ -49,6 +49,7 @@ from .routers import (
     scene_controls,
     sources,
     sweeps,
+    takes,
     watch,
 )
 
@@ -104,6 +105,7 @@ def create_app(settings: Settings | None = None, scene: Scene | None = None) -> 
         robots,
         capture,
         recordings,
+        takes,
         demonstrations,
         runs,
         run_notes,

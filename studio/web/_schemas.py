@@ -276,6 +276,55 @@ class RecordingUpdate(_Body):
     operator: str | None = Field(None, max_length=200)
 
 
+class TimelinePublic(BaseModel):
+    """A recording's joints over time, downsampled for the timeline (degrees)."""
+
+    name: str
+    kind: str
+    duration: float = Field(description="the whole recording's length, s")
+    times: list[float] = Field(description="s after the first frame")
+    human: list[list[float]] = Field(description="the human arm's 7 joints per time, degrees")
+    robot: list[list[float]] = Field(description="the Puma560's 6 joints per time, degrees")
+    residual_mm: list[float] = Field(description="how far the fitted arm misses, mm")
+
+
+class RecordingReview(_Body):
+    """Show a recording on the robot: hold the pose at ``t``, or draw and play ``[t0, t1]``."""
+
+    t: float | None = Field(None, ge=0)
+    t0: float | None = Field(None, ge=0)
+    t1: float | None = Field(None, ge=0)
+
+
+class TakeStart(_Body):
+    """Start the next take."""
+
+    operator: str | None = Field(None, max_length=200)
+
+
+class TakesFinish(_Body):
+    """Make the session's kept takes into demonstrations."""
+
+    goal_from_end: StrictBool = False
+
+
+class TakePublic(BaseModel):
+    """One take of the session."""
+
+    recording: str
+    state: Literal["recording", "review", "kept"]
+    demonstration: str | None = None
+    error: str | None = None
+
+
+class TakesPublic(BaseModel):
+    """The take session (``started`` None when no session is open)."""
+
+    started: str | None = None
+    finished: str | None = None
+    takes: list[TakePublic] = Field(default_factory=list)
+
+
 # ----------------------------------------------------------------------------- demonstrations
 
 

@@ -1,4 +1,5 @@
-"""``/api/recordings``: list, upload, download, copy, rename, annotate and delete recordings.
+"""``/api/recordings``: list, upload, download, copy, rename, annotate and delete recordings; a
+recording's timeline (its joints over time) and its review on the robot.
 
 The shipped samples are listed first; they can be played, cut and copied, never changed.
 """
@@ -7,15 +8,23 @@ from __future__ import annotations
 
 from typing import Annotated
 
-from fastapi import APIRouter, File, Response, UploadFile
+import numpy as np
+from fastapi import APIRouter, File, Query, Response, UploadFile
 from fastapi.responses import StreamingResponse
 from starlette.concurrency import run_in_threadpool
 
-from studio.capture import RecordingError, recording_bytes
+from studio.capture import DEFAULT_SERIES_POINTS, MAX_SERIES_POINTS, RecordingError, recording_bytes
 
 from .._deps import SettingsDep, StudioDep
 from .._errors import ConflictError, NotFoundError
-from .._schemas import RecordingCopy, RecordingPublic, RecordingUpdate
+from .._review import ReviewerDep
+from .._schemas import (
+    RecordingCopy,
+    RecordingPublic,
+    RecordingReview,
+    RecordingUpdate,
+    TimelinePublic,
+)
 from .._state import Studio
 from .._store import RecordingSummary, StoredFile, receive_upload
 from . import file_responses
@@ -160,3 +169,35 @@ def delete_recording(name: str, studio: StudioDep) -> Response:
     except RecordingError as err:
         raise ConflictError(str(err)) from None
     return Response(status_code=204)
+
+
+@router.get("/{name}/timeline")
+def read_timeline(
+    name: str,
+    reviewer: ReviewerDep,
+    points: Annotated[int, Query(ge=2, le=MAX_SERIES_POINTS)] = DEFAULT_SERIES_POINTS,
+) -> TimelinePublic:
+    """The human arm's and the robot's joints over the whole recording, at about ``points``
+    evenly spaced frames (degrees), fitted as a demonstration cut from it would be."""
+
+    series = reviewer.plotted(name, points)
+    return TimelinePublic(
+        name=name,
+        kind=series.kind,
+        duration=series.duration,
+        times=series.times.round(4).tolist(),
+        human=np.degrees(series.q_human).round(2).tolist(),
+        robot=np.degrees(series.q_robot).round(2).tolist(),
+        residual_mm=(series.residual * 1000).round(2).tolist(),
+    )
+
+
+@router.post("/{name}/review", status_code=202, response_class=Response)
+def review_recording(name: str, body: RecordingReview, reviewer: ReviewerDep) -> Response:
+    """Show the recording on the robot: with ``t``, hold the pose at ``t`` s (the timeline's
+    cursor); else draw the tool path of ``[t0, t1]`` (default: all of it) and play it."""
+    if body.t is not None:
+        reviewer.hold(name, body.t)
+    else:
+        reviewer.play(name, body.t0, body.t1)
+    return Response(status_code=202)

@@ -387,14 +387,15 @@ function renderObservable(observable) {
 let countdownRun = null; // {cancel()} while a countdown runs
 
 /**
- * Count down before a recording of the camera or the hand guide starts, so the user can get into
- * place. Resolves true to start, false when cancelled (the Record button pressed again).
+ * Count down before a recording of the camera or the hand guide starts (before a take, whatever
+ * the source: ``always``), so the user can get into place. Resolves true to start, false when
+ * cancelled (the same button pressed again, or Escape during a take's countdown).
  */
-function recordCountdown() {
+function recordCountdown(always = false, cancelHint = "press Record again to cancel") {
   if (countdownRun) { countdownRun.cancel(); return Promise.resolve(false); }
   const kind = S.source && S.source.kind;
   const seconds = Math.max(0, Math.min(10, Math.round(Number($("capture-countdown").value) || 0)));
-  if (!["camera", "hand"].includes(kind) || !seconds) return Promise.resolve(true);
+  if ((!always && !["camera", "hand"].includes(kind)) || !seconds) return Promise.resolve(true);
   const left = $("capture-countdown-left");
   return new Promise((resolve) => {
     let n = seconds;
@@ -405,7 +406,7 @@ function recordCountdown() {
       setText(left, "");
       resolve(go);
     };
-    const show = () => setText(left, `Recording in ${n} s (press Record again to cancel)`);
+    const show = () => setText(left, `Recording in ${n} s (${cancelHint})`);
     const timer = setInterval(() => {
       n -= 1;
       if (n <= 0) finish(true);

@@ -69,6 +69,7 @@ function recordingRow(r) {
   const title = [r.error, r.notes, r.operator && `operator: ${r.operator}`, r.created].filter(Boolean).join("\n");
   const actions = [];
   if (!r.error) actions.push(el("button", { class: "icon", title: "play as the live source", testid: "recording-play", onclick: () => useRecording(r.name) }, "▶"));
+  if (!r.error && !r.capturing) actions.push(el("button", { class: "icon", title: "timeline: see the joints over time and cut a demonstration", "aria-label": `Timeline of ${r.name}`, testid: "recording-timeline", onclick: () => openTimeline(r.name) }, "∿"));
   if (r.sample) {
     actions.push(el("button", { class: "icon", title: "copy to my recordings", testid: "recording-copy", onclick: () => copyRecording(r.name) }, "copy"));
   } else if (!r.capturing) {
@@ -108,6 +109,16 @@ async function copyRecording(name) {
     await loadRecordings();
     flashRow("recordings-body", rec && rec.name);
   });
+}
+
+/** Plot the recording on the Demonstrations section's timeline (timeline.js follows the select). */
+function openTimeline(name) {
+  const select = $("demo-recording");
+  select.value = name;
+  select.dispatchEvent(new Event("change"));
+  $("sec-demos").open = true;
+  $("timeline").scrollIntoView({ block: "nearest" });
+  $("timeline").focus({ preventScroll: true });
 }
 
 async function useRecording(name) {

@@ -1,0 +1,95 @@
+"""A recording's joints over time, downsampled for a timeline: the human arm's and the robot's.
+
+Every kind of recording (tape, pose landmarks, hand poses) goes through its own fitter
+(:func:`~studio.capture.fitter_for`), the very fitting the live pipeline and demonstration
+extraction use, so the timeline shows the joints a demonstration cut from it would hold.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+
+import numpy as np
+
+from ._fitters import fitter_for
+from ._observation_recording import ObservationRecording, read_any_recording
+from ._recording_reader import Recording
+
+DEFAULT_SERIES_POINTS = 400
+"""How many samples a timeline gets by default: one per pixel of a wide panel, or fewer."""
+MAX_SERIES_POINTS = 5000
+"""The most samples a timeline may ask for."""
+
+
+@dataclass(frozen=True)
+class RecordingSeries:
+    """A recording's joints at evenly spaced frames.
+
+    Attributes:
+        times: seconds after the recording's first frame ``(N,)``.
+        q_human: the human arm's joints ``(N, 7)``, rad.
+        q_robot: the Puma560's joints ``(N, 6)``, rad.
+        residual: how far the fitted arm misses each observation ``(N,)``, m.
+        duration: the whole recording's length, s.
+        kind: ``"tape"``, ``"pose"`` or ``"hand"``.
+    """
+
+    times: np.ndarray
+    q_human: np.ndarray
+    q_robot: np.ndarray
+    residual: np.ndarray
+    duration: float
+    kind: str
+
+
+def recording_series(
+    recording: Recording | ObservationRecording | str | os.PathLike[str],
+    points: int = DEFAULT_SERIES_POINTS,
+    t0: float | None = None,
+    t1: float | None = None,
+    mode: str = "joint",
+) -> RecordingSeries:
+    """The joints of ``[t0, t1]`` (the whole recording by default) at about ``points`` frames.
+
+    Frames are taken at an even stride and fitted in order, each fit seeded by the one before,
+    so a long recording costs ``points`` fits, not one per frame.
+
+    Args:
+        recording: a recording of any kind, or its path.
+        points: how many frames at most (1 to :data:`MAX_SERIES_POINTS`).
+        t0: start, s after the first frame (default 0).
+        t1: end, s after the first frame (default the end).
+        mode: retargeting mode, ``"joint"`` or ``"cartesian"``.
+    """
+    rec = (
+        recording
+        if isinstance(recording, Recording | ObservationRecording)
+        else read_any_recording(recording)
+    )
+    points = max(1, min(int(points), MAX_SERIES_POINTS))
+    start, stop, _ = rec.segment(
+        0.0 if t0 is None else t0, rec.duration if t1 is None else t1
+    ).indices(len(rec))
+    rows = np.unique(np.linspace(start, stop - 1, min(points, stop - start)).round().astype(int))
+    rows = rows[(rows >= start) & (rows < stop)]
+    q_human = np.zeros((len(rows), 7))
+    q_robot = np.zeros((len(rows), 6))
+    residual = np.zeros(len(rows))
+    if len(rows):
+        first = rec.frame_at(int(rows[0]))
+        tape = rec.config if isinstance(rec, Recording) else None
+        side = rec.side if isinstance(rec, ObservationRecording) else None
+        fitter = fitter_for(first, tape=tape, side=side, mode=mode)
+        for i, row in enumerate(rows):
+            fitted = fitter.fit(first if i == 0 else rec.frame_at(int(row)))
+            q_human[i], q_robot[i], residual[i] = fitted.q_human, fitted.q_robot, fitted.residual
+    origin = float(rec.t[0]) if len(rec) else 0.0
+    return RecordingSeries(
+        times=rec.t[rows] - origin,
+        q_human=q_human,
+        q_robot=q_robot,
+        residual=residual,
+        duration=rec.duration,
+        kind=rec.kind_name,
+    )

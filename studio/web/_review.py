@@ -1,0 +1,104 @@
+"""A recording's timeline and its review on the robot: the series the page plots, the pose at the
+timeline's cursor, and a segment's robot path drawn and played in the scene.
+
+The joints come from :func:`studio.capture.recording_series` (the capture package's fitters);
+this module only caches them per file and hands them to the scene.
+"""
+
+from __future__ import annotations
+
+import threading
+from collections import OrderedDict
+from typing import Annotated
+
+import numpy as np
+from fastapi import Depends, Request
+
+from studio.capture import RecordingSeries, recording_series
+
+from ._state import Studio
+
+REVIEW_PATH = "review"
+"""The scene path that shows the segment under review (one at a time, replaced by the next)."""
+CACHED_SERIES = 8
+"""How many series are kept (a timeline's pose lookups read the one it plotted)."""
+
+
+class Reviewer:
+    """Series of a studio's recordings, cached until their file changes, and shown on its robot."""
+
+    def __init__(self, studio: Studio) -> None:
+        self.studio = studio
+        self._lock = threading.Lock()
+        self._cache: OrderedDict[tuple[object, ...], RecordingSeries] = OrderedDict()
+        self._plotted: dict[str, RecordingSeries] = {}
+
+    def series(
+        self, name: str, points: int, t0: float | None = None, t1: float | None = None
+    ) -> RecordingSeries:
+        """The joints of recording ``name`` (404 if none) over ``[t0, t1]`` at ``points`` frames."""
+        path = self.studio.recordings.path(name)
+        stat = path.stat()
+        mode = self.studio.pipeline.retarget_mode
+        key = (str(path), stat.st_mtime_ns, stat.st_size, mode, points, t0, t1)
+        with self._lock:
+            found = self._cache.get(key)
+            if found is not None:
+                self._cache.move_to_end(key)
+        if found is None:
+            found = recording_series(path, points, t0, t1, mode=mode)
+            with self._lock:
+                self._cache[key] = found
+                while len(self._cache) > CACHED_SERIES:
+                    self._cache.popitem(last=False)
+        return found
+
+    def plotted(self, name: str, points: int) -> RecordingSeries:
+        """The whole-recording series a timeline plots; its cursor's poses are read from it."""
+        series = self.series(name, points)
+        with self._lock:
+            self._plotted[name] = series
+        return series
+
+    def hold(self, name: str, t: float) -> np.ndarray:
+        """Hold the robot at the pose of recording ``name`` at ``t`` s (the timeline's cursor).
+
+        Returns:
+            The robot joints shown (rad, (6,)).
+        """
+        with self._lock:
+            series = self._plotted.get(name)
+        if series is None or not len(series.times):
+            series = self.plotted(name, 400)
+        if not len(series.times):
+            return np.zeros(6)
+        q = np.array([np.interp(t, series.times, col) for col in series.q_robot.T])
+        scene = self.studio.scene
+        if scene is not None:
+            scene.play_trajectory(np.zeros(1), q[None, :])
+        return q
+
+    def play(self, name: str, t0: float | None = None, t1: float | None = None) -> RecordingSeries:
+        """Draw the robot's tool path of ``[t0, t1]`` (the whole recording by default) and play
+        it on the robot in real time."""
+        series = self.series(name, 400, t0, t1)
+        scene = self.studio.scene
+        if scene is not None and len(series.times):
+            scene.show_path(REVIEW_PATH, series.q_robot)
+            scene.play_trajectory(series.times, series.q_robot)
+        return series
+
+
+_create_lock = threading.Lock()
+
+
+def get_reviewer(request: Request) -> Reviewer:
+    """The one reviewer of the app serving this request (made on first use)."""
+    state = request.app.state
+    with _create_lock:
+        if getattr(state, "reviewer", None) is None:
+            state.reviewer = Reviewer(state.studio)
+        return state.reviewer
+
+
+ReviewerDep = Annotated[Reviewer, Depends(get_reviewer)]

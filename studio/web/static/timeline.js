@@ -1,0 +1,201 @@
+/* Teach Studio page: a recording's timeline, to cut demonstrations seeing the signal.
+ *
+ * Choosing a recording to cut from (or its row's timeline button) plots the robot's joints (solid)
+ * and the human arm's (dashed) over the whole recording, served downsampled by
+ * GET /api/recordings/{name}/timeline (uPlot, as the curve chart). The robot in the scene follows
+ * the playhead: hovering the plot moves it, as do the arrow keys. Dragging selects the segment to
+ * cut (its robot path is drawn and played in the scene); `[` and `]` set its ends at the playhead;
+ * space plays and pauses. The segment is the Demonstrations section's t0 and t1, so Cut cuts it.
+ */
+
+import { api, guarded } from "./api.js";
+import { setDemoRange } from "./demos.js";
+import { $, enc, fmt, setProp, setText } from "./dom.js";
+import { S } from "./state.js";
+
+const ROBOT = ["#1f4e9c", "#2a7bd8", "#0f8b8d", "#23874b", "#6b4fbb", "#b83280"];
+const HUMAN = ["#d9822b", "#b8661f", "#a0522d", "#c9a227", "#e05a47", "#8c6d46", "#7a7a7a"];
+const STEP_S = 0.1;
+
+const T = { name: null, data: null, chart: null, playhead: 0, playing: false, last: 0, want: null, sending: false };
+S.timeline = T; // for the browser tests and the console
+
+function duration() { return T.data ? T.data.duration : 0; }
+function clamp(t) { return Math.max(0, Math.min(duration(), t)); }
+function ends() { return [Number($("demo-t0").value) || 0, Number($("demo-t1").value) || 0]; }
+
+/** Plot recording ``name``'s joints (hidden with no name). */
+export async function showTimeline(name) {
+  pause();
+  T.name = name || null;
+  setProp("timeline", "hidden", !name);
+  if (!name) return;
+  const box = $("timeline-plot");
+  const points = Math.max(100, Math.min(600, box.clientWidth || 400));
+  setText("timeline-time", "fitting the arm to the recording…");
+  await guarded("timeline-error", async () => {
+    const data = await api("GET", `/api/recordings/${enc(name)}/timeline?points=${points}`);
+    if (T.name !== name) return; // another recording was chosen meanwhile
+    T.data = data;
+    T.playhead = 0;
+    draw();
+  });
+}
+
+function draw() {
+  if (T.chart) { T.chart.destroy(); T.chart = null; }
+  if (typeof uPlot === "undefined" || !T.data) return;
+  const d = T.data;
+  const cols = [d.times];
+  const series = [{ label: "t (s)" }];
+  for (let j = 0; j < 6; j++) {
+    cols.push(d.robot.map((q) => q[j]));
+    series.push({ label: `robot ${j + 1}`, stroke: ROBOT[j], width: 1.5 });
+  }
+  for (let j = 0; j < 7; j++) {
+    cols.push(d.human.map((q) => q[j]));
+    series.push({ label: `human ${j + 1}`, stroke: HUMAN[j], width: 1, dash: [4, 3] });
+  }
+  const box = $("timeline-plot");
+  T.chart = new uPlot({
+    width: Math.max(200, box.clientWidth),
+    height: 170,
+    legend: { show: false },
+    scales: { x: { time: false, range: [0, Math.max(d.duration, 0.01)] } },
+    axes: [{ size: 28 }, { size: 52, values: (u, v) => v.map((x) => `${x}°`) }],
+    series,
+    cursor: { drag: { x: true, y: false, setScale: false }, points: { show: false } },
+    hooks: {
+      setSelect: [onSelect],
+      setCursor: [onCursor],
+      draw: [drawPlayhead],
+    },
+  }, cols, box);
+  setProp("timeline", "ariaValueMax", fmt(d.duration, 2));
+  showSelection();
+  movePlayhead(T.playhead, false);
+}
+
+function drawPlayhead(u) {
+  const x = Math.round(u.valToPos(T.playhead, "x", true));
+  const ctx = u.ctx;
+  ctx.save();
+  ctx.strokeStyle = "#d33";
+  ctx.lineWidth = 2;
+  ctx.beginPath();
+  ctx.moveTo(x, u.bbox.top);
+  ctx.lineTo(x, u.bbox.top + u.bbox.height);
+  ctx.stroke();
+  ctx.restore();
+}
+
+/** Draw the Demonstrations section's segment as the plot's selection. */
+function showSelection() {
+  const u = T.chart;
+  if (!u) return;
+  const [t0, t1] = ends();
+  if (!(t1 > t0)) { u.setSelect({ left: 0, width: 0, top: 0, height: 0 }, false); return; }
+  const left = u.valToPos(clamp(t0), "x");
+  u.setSelect({ left, width: u.valToPos(clamp(t1), "x") - left, top: 0, height: u.bbox.height / devicePixelRatio }, false);
+}
+
+function onSelect(u) {
+  if (u.select.width < 3) { showSelection(); return; } // a click, not a drag: keep the segment
+  const t0 = clamp(u.posToVal(u.select.left, "x"));
+  const t1 = clamp(u.posToVal(u.select.left + u.select.width, "x"));
+  setEnds(t0, t1);
+}
+
+function onCursor(u) {
+  if (T.playing || u.cursor.left === undefined || u.cursor.left < 0) return;
+  movePlayhead(clamp(u.posToVal(u.cursor.left, "x")));
+}
+
+/** Set the segment to cut: the Demonstrations section's t0 and t1, its path drawn and played. */
+function setEnds(t0, t1) {
+  setDemoRange(Math.min(t0, t1), Math.max(t0, t1));
+  showSelection();
+  const [a, b] = ends();
+  if (b > a && T.name) guarded("timeline-error", () => api("POST", `/api/recordings/${enc(T.name)}/review`, { t0: a, t1: b }));
+}
+
+/** Move the playhead to ``t`` s; the robot in the scene follows (the latest pose wins). */
+function movePlayhead(t, scrub = true) {
+  T.playhead = t;
+  const el = $("timeline");
+  setProp(el, "ariaValueNow", fmt(t, 2));
+  setProp(el, "ariaValueText", `${fmt(t, 2)} s`);
+  const [t0, t1] = ends();
+  setText("timeline-time", `${fmt(t, 2)} s of ${fmt(duration(), 2)} s · segment ${fmt(t0, 2)}–${fmt(t1, 2)} s`);
+  if (T.chart) T.chart.redraw(false, false);
+  if (scrub) scrubTo(t);
+}
+
+async function scrubTo(t) {
+  T.want = t;
+  if (T.sending || !T.name) return;
+  T.sending = true;
+  try {
+    while (T.want !== null) {
+      const want = T.want;
+      T.want = null;
+      await api("POST", `/api/recordings/${enc(T.name)}/review`, { t: want }).catch(() => {});
+    }
+  } finally {
+    T.sending = false;
+  }
+}
+
+function play() {
+  if (!T.data) return;
+  const [t0, t1] = ends();
+  const stop = t1 > t0 ? t1 : duration();
+  if (T.playhead >= stop - 1e-3) movePlayhead(t1 > t0 ? t0 : 0);
+  T.playing = true;
+  T.last = performance.now();
+  setProp($("timeline").dataset, "playing", "1");
+  const step = (now) => {
+    if (!T.playing) return;
+    const t = Math.min(stop, T.playhead + (now - T.last) / 1000);
+    T.last = now;
+    movePlayhead(t);
+    if (t >= stop) pause();
+    else requestAnimationFrame(step);
+  };
+  requestAnimationFrame(step);
+}
+
+function pause() {
+  T.playing = false;
+  setProp($("timeline").dataset, "playing", "0");
+}
+
+function onKey(ev) {
+  if (!T.data || ev.altKey || ev.ctrlKey || ev.metaKey) return;
+  const big = ev.shiftKey ? 10 : 1;
+  const [t0, t1] = ends();
+  const keys = {
+    " ": () => (T.playing ? pause() : play()),
+    "[": () => setEnds(T.playhead, t1 > T.playhead ? t1 : duration()),
+    "]": () => setEnds(t0 < T.playhead ? t0 : 0, T.playhead),
+    ArrowLeft: () => movePlayhead(clamp(T.playhead - STEP_S * big)),
+    ArrowRight: () => movePlayhead(clamp(T.playhead + STEP_S * big)),
+    Home: () => movePlayhead(0),
+    End: () => movePlayhead(duration()),
+  };
+  const act = keys[ev.key];
+  if (!act) return;
+  ev.preventDefault();
+  if (ev.key !== " ") pause();
+  act();
+}
+
+function wire() {
+  $("timeline").addEventListener("keydown", onKey);
+  $("demo-recording").addEventListener("change", () => showTimeline($("demo-recording").value));
+  for (const id of ["demo-t0", "demo-t1"]) $(id).addEventListener("change", () => { showSelection(); movePlayhead(T.playhead, false); });
+  for (const id of ["demo-t0-range", "demo-t1-range"]) $(id).addEventListener("input", showSelection);
+  new ResizeObserver(() => { if (T.chart) T.chart.setSize({ width: Math.max(200, $("timeline-plot").clientWidth), height: 170 }); }).observe($("timeline-plot"));
+}
+
+wire();
