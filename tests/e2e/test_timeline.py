@@ -26,7 +26,9 @@ def test_cut_on_the_timeline(page: Any, studio_server: Studio) -> None:
     assert page.input_value("[data-testid='demo-recording']") == "sample-reach-1"
 
     # Dragging across the plot selects a segment: the section's t0 and t1.
-    over = page.locator("[data-testid='timeline-plot'] .u-over").bounding_box()
+    plot = page.locator("[data-testid='timeline-plot'] .u-over")
+    plot.scroll_into_view_if_needed()  # as a person scrolls to it: earlier panels may push it down
+    over = plot.bounding_box()
     y = over["y"] + over["height"] / 2
     page.mouse.move(over["x"] + over["width"] * 0.2, y)
     page.mouse.down()
