@@ -27,8 +27,6 @@ from pathlib import Path
 
 import numpy as np
 
-from studio import JSONFileError, loads_json
-
 from ._dmp import (
     DMP_BASIS,
     DMP_SETTLE_RAD,
@@ -38,7 +36,7 @@ from ._dmp import (
 )
 from ._errors import LearningError, PolicyFileError
 from ._likeness import LikenessCard, likeness_card, puma_tool_positions
-from ._policy import MAX_HEADER_CHARS, MAX_NPZ_BYTES, ROBOT_JOINTS, ROLLOUT_RATE_HZ, BoundedNpz
+from ._policy import MAX_NPZ_BYTES, ROBOT_JOINTS, ROLLOUT_RATE_HZ, BoundedNpz, read_header
 
 FORMAT_NAME = "teach-studio-dmp-policy"
 FORMAT_VERSION = 1
@@ -196,14 +194,7 @@ def load_dmp_policy(path: str | Path) -> DmpPolicyFile:
             f"Policy file {name} does not exist; give the path of a .policy.npz file."
         )
     with BoundedNpz(path, name, MAX_NPZ_BYTES) as archive:
-        try:
-            header = loads_json(
-                archive.read_text("header", MAX_HEADER_CHARS),
-                f"{name}'s header",
-                max_bytes=MAX_HEADER_CHARS,
-            )
-        except JSONFileError as err:
-            raise PolicyFileError(str(err)) from None
+        header = read_header(archive, name)
         if not isinstance(header, dict) or header.get("format") != FORMAT_NAME:
             raise PolicyFileError(f"{name} is not a DMP policy file; export the policy again.")
         version = header.get("version")

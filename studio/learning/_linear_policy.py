@@ -39,8 +39,6 @@ from pathlib import Path
 
 import numpy as np
 
-from studio import JSONFileError, loads_json
-
 from ._config import DynaQConfig
 from ._dmp_policy import FORMAT_NAME as DMP_FORMAT_NAME
 from ._dmp_policy import DmpPolicyFile, load_dmp_policy
@@ -50,13 +48,13 @@ from ._policy import (
     FORMAT_NAME as TABULAR_FORMAT_NAME,
 )
 from ._policy import (
-    MAX_HEADER_CHARS,
     MAX_NPZ_BYTES,
     BoundedNpz,
     PolicyFile,
     curve_header,
     load_policy,
     read_curve_header,
+    read_header,
 )
 from ._reach import ArmReach
 from ._tiles import TileCoder, TileCoding
@@ -219,14 +217,7 @@ def _read_header(archive: BoundedNpz, name: str) -> object:
         raise PolicyFileError(
             f"{name} lacks its header; it is not a Teach Studio policy file, export one again."
         )
-    try:
-        return loads_json(
-            archive.read_text("header", MAX_HEADER_CHARS),
-            f"{name}'s header",
-            max_bytes=MAX_HEADER_CHARS,
-        )
-    except JSONFileError as err:
-        raise PolicyFileError(str(err)) from None
+    return read_header(archive, name)
 
 
 def _check_header(name: str, header: object) -> tuple[TileCoder, DynaQConfig, ArmReach | None, int]:

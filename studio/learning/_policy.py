@@ -268,6 +268,19 @@ class PolicyFile:
         }
 
 
+def read_header(archive: BoundedNpz, name: str) -> object:
+    """The JSON header of a policy archive (every policy kind has one), bounded like every JSON
+    the studio reads; a damaged one is a :class:`PolicyFileError` naming the file."""
+    try:
+        return loads_json(
+            archive.read_text("header", MAX_HEADER_CHARS),
+            f"{name}'s header",
+            max_bytes=MAX_HEADER_CHARS,
+        )
+    except JSONFileError as err:
+        raise PolicyFileError(str(err)) from None
+
+
 class CurveHeader(TypedDict):
     """A policy header's ``curve``: mean steps per episode (``None`` where no experiment ran
     that episode) and how many experiments they average."""
@@ -388,14 +401,7 @@ def load_policy(path: str | Path) -> PolicyFile:
             raise PolicyFileError(
                 f"{name} lacks {', '.join(sorted(missing))}; it is not a Teach Studio policy file, export one again."
             )
-        try:
-            header = loads_json(
-                archive.read_text("header", MAX_HEADER_CHARS),
-                f"{name}'s header",
-                max_bytes=MAX_HEADER_CHARS,
-            )
-        except JSONFileError as err:
-            raise PolicyFileError(str(err)) from None
+        header = read_header(archive, name)
         header, grid, config, mean_steps, experiments = _check_header(name, header)
         q = archive.read("q", (grid.n_states, grid.n_actions), "fiu").astype(np.float64, copy=False)
         greedy = archive.read("greedy", (grid.n_states,), "iu").astype(np.int64, copy=False)
