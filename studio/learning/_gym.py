@@ -50,6 +50,7 @@ class _ReachSettings(TypedDict, total=False):
     angle_tolerance_deg: float
     shaping: float
     actions: str
+    robot: str
 
 
 class ArmGridEnv(gymnasium.Env):
@@ -98,7 +99,7 @@ class ArmReachEnv(gymnasium.Env):
     """The continuous arm task as a Gymnasium environment.
 
     Args:
-        joints: joints learned, from joint 1 (3 to 6).
+        joints: joints learned, from joint 1 (3 to 6, at most the robot's).
         step_deg: joint increment per action, degrees.
         goal: goal joint angles, radians (``joints`` or 6 values).
         position_tolerance: metres.
@@ -106,6 +107,8 @@ class ArmReachEnv(gymnasium.Env):
         shaping: weight of the potential-based shaping reward.
         actions: what one action moves: ``"single"`` (one joint), ``"pairs"`` (also two
             together) or ``"all"`` (any joints at once).
+        robot: the robot's registry name (``studio robots``; default ``"puma560"``): its first
+            ``joints`` joints, limits and forward kinematics.
     """
 
     metadata = {"render_modes": []}
