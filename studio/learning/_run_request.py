@@ -172,14 +172,17 @@ def resolve_run(request: RunRequest) -> RunRecord:
         check_robot(request.robot)
     except ConfigError as err:
         raise_problems(problems + list(err.by_field.items()))
-    problems += [
-        (
-            "demonstrations",
-            f"{demo.label} holds the {robot_title(demo.robot)}'s joints, not the {robot_title(request.robot)}'s; retarget it to the {request.robot} from its recording, or train on the {demo.robot}.",
-        )
-        for demo in request.demonstrations
-        if demo.robot != request.robot
-    ]
+    for demo in request.demonstrations:
+        if demo.robot != request.robot:  # its joints mean nothing on this robot: say only that
+            raise_problems(
+                problems
+                + [
+                    (
+                        "demonstrations",
+                        f"{demo.label} holds joints of the {robot_title(demo.robot)}, not of the {robot_title(request.robot)}; retarget it to the {request.robot} from its recording, or train on the {demo.robot}.",
+                    )
+                ]
+            )
     config = _dynaq_config(request.config, problems)
     if request.task == TASK_ARM_REACH:
         return _reach_record(request, config, problems)

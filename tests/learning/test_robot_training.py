@@ -278,3 +278,30 @@ def test_studio_train_takes_a_robot_for_both_tasks(tmp_path, capsys):
     assert main(["train", "--robot", "nosuch", "--episodes", "1"]) == 2
     err = capsys.readouterr().err.strip()
     assert "Unknown robot 'nosuch'" in err and "\n" not in err
+
+
+def test_a_run_on_the_panda_replays_demonstrations_retargeted_to_the_panda(tmp_path):
+    """A demonstration holds the Puma560's joints; for the Panda its recording's segment is
+    retargeted (the export's path), and the run's goal is where the Panda's path ends."""
+    from studio.export import training_demonstration
+    from studio.learning import RunRequest, resolve_run
+    from studio.samples import SAMPLES_DIR
+
+    demo_file = SAMPLES_DIR / "sample-reach-1.demo.json"
+    out = tmp_path / "demo-run"
+    args = ["train", "--task", "arm-reach", "--robot", "panda", "--joints", "3"]
+    args += ["--demos", "sample-reach-1", "--planning", "zero", "--episodes", "2"]
+    assert main([*args, "--experiments", "1", "--out", str(out), "--no-progress"]) == 0
+    record = RunFolder.load(out).record
+    panda = training_demonstration(demo_file, "panda", "The demonstration")
+    assert panda.robot == "panda" and panda.q_robot.shape[1] == 7
+    assert np.allclose(record.arm_reach().goal, panda.q_robot[-1], atol=1e-9)
+    assert np.allclose(record.demonstrations[0], panda.q_robot[:, :3], atol=1e-9)
+    assert record.demonstration_motions[0].q_robot.shape[1] == 7
+    puma = training_demonstration(demo_file, "puma560", "The demonstration")
+    with pytest.raises(LearningError) as err:
+        resolve_run(RunRequest(task="arm-reach", robot="panda", demonstrations=[puma]))
+    assert str(err.value) == (
+        "The demonstration holds joints of the Puma560 (the paper's robot), not of the Franka "
+        "Emika Panda; retarget it to the panda from its recording, or train on the puma560."
+    )
