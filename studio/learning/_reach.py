@@ -444,6 +444,22 @@ def action_directions(joints: int, actions: str = DEFAULT_ACTIONS) -> np.ndarray
     return np.array(rows, dtype=np.int8).reshape(-1, joints)
 
 
+def tool_positions(robot: str, q: np.ndarray) -> np.ndarray:
+    """``robot``'s tool positions ``(N, 3)`` (m) for joint angles ``(N, nq)`` (rad), by the
+    compiled forward kinematics (no shared scratch data: safe from any thread)."""
+    arm = task_arm(robot)
+    q = np.asarray(q, dtype=np.float64).reshape(-1, arm.nq)
+    joints = min(MAX_JOINTS, arm.nq)
+    p = ArmReach(joints=joints, robot=robot).params.copy()
+    out = np.empty((q.shape[0], 3))
+    pose = np.empty((4, 4))
+    for i, row in enumerate(q):
+        p[_HOLD : _HOLD + arm.nq] = row
+        tool_pose(p, np.ascontiguousarray(row[:joints]), pose)
+        out[i] = pose[:3, 3]
+    return out
+
+
 def _limits(robot: str) -> tuple[np.ndarray, np.ndarray]:
     """Every joint's limits of ``robot``, radians ``(nq,)`` each."""
     arm = task_arm(robot)

@@ -253,6 +253,11 @@ def test_studio_train_takes_a_robot_for_both_tasks(tmp_path, capsys):
     )
     err = capsys.readouterr().err.strip()
     assert "Franka Emika Panda" in err and "Puma560" in err and "\n" not in err and not out.exists()
+    # ...and exports it for the Panda: its joint names, every joint (the seventh held)
+    args = ["export", str(reach / "policy.policy.npz"), "--robot", "panda", "--unchecked"]
+    assert main([*args, "--start-deg=10,-30,20", "--out", str(out)]) == 0
+    header = out.read_text().splitlines()[0].split(",")
+    assert header == ["time", *load_robot("panda").joint_names]
     grid = tmp_path / "grid"
     assert (
         main(
@@ -298,6 +303,8 @@ def test_a_run_on_the_panda_replays_demonstrations_retargeted_to_the_panda(tmp_p
     assert np.allclose(record.arm_reach().goal, panda.q_robot[-1], atol=1e-9)
     assert np.allclose(record.demonstrations[0], panda.q_robot[:, :3], atol=1e-9)
     assert record.demonstration_motions[0].q_robot.shape[1] == 7
+    card = json.loads((out / "likeness.json").read_text())["cards"][0]
+    assert "error" not in card and card["card"]["frechet_m"] >= 0  # scored on the Panda's FK
     puma = training_demonstration(demo_file, "puma560", "The demonstration")
     with pytest.raises(LearningError) as err:
         resolve_run(RunRequest(task="arm-reach", robot="panda", demonstrations=[puma]))
