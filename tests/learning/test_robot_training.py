@@ -312,3 +312,13 @@ def test_a_run_on_the_panda_replays_demonstrations_retargeted_to_the_panda(tmp_p
         "The demonstration holds joints of the Puma560 (the paper's robot), not of the Franka "
         "Emika Panda; retarget it to the panda from its recording, or train on the puma560."
     )
+
+
+def test_a_sweep_trial_names_its_robot():
+    from studio.learning._sweep_spec import resolve_trial
+
+    assert resolve_trial("arm-reach", {"robot": "panda", "joints": 3}, 1, 2, 0).robot == "panda"
+    assert resolve_trial("arm-grid", {"robot": "ur5"}, 1, 2, 0).arm_grid().robot == "ur5"
+    assert resolve_trial("arm-grid", {}, 1, 2, 0).robot == "puma560"
+    with pytest.raises(LearningError, match="Unknown robot"):
+        resolve_trial("arm-grid", {"robot": "nosuch"}, 1, 2, 0)
