@@ -34,7 +34,7 @@ from typing import cast
 from studio import StudioError, read_json
 from studio.capture import DEMO_FORMAT, DEMO_SUFFIX
 from studio.export import ExportError, training_demonstration
-from studio.kinematics import DEFAULT_ROBOT, robot_names
+from studio.kinematics import DEFAULT_ROBOT, robot_names, robot_spec
 from studio.learning import (
     ACTION_SETS,
     DEFAULT_EPISODES,
@@ -414,7 +414,7 @@ def run(args: argparse.Namespace) -> int:
     wall = time.perf_counter() - start
     mean = result.mean_steps()
     print(
-        f"Trained {record.experiments} x {record.episodes} episodes ({record.config.planning} planning) in {wall:.2f} s "
+        f"Trained the {robot_spec(record.robot).title} {record.experiments} x {record.episodes} episodes ({record.config.planning} planning) in {wall:.2f} s "
         f"({result.cpu_seconds.sum():.2f} CPU s): mean steps {mean[0]:.0f} in episode 1, "
         f"{mean[-1]:.1f} in episode {record.episodes}."
     )
