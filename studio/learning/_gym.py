@@ -35,9 +35,10 @@ class _GridSettings(TypedDict, total=False):
 
     joints: int
     bins: int
-    low_deg: float
-    high_deg: float
+    low_deg: float | tuple[float, ...] | None
+    high_deg: float | tuple[float, ...] | None
     goal: tuple[int, ...] | None
+    robot: str
 
 
 class _ReachSettings(TypedDict, total=False):
@@ -57,7 +58,7 @@ class ArmGridEnv(gymnasium.Env):
     """The paper's arm grid as a Gymnasium environment.
 
     Args:
-        joints, bins, low_deg, high_deg, goal: as :class:`ArmGrid`.
+        joints, bins, low_deg, high_deg, goal, robot: as :class:`ArmGrid`.
     """
 
     metadata = {"render_modes": []}

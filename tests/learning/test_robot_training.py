@@ -322,3 +322,12 @@ def test_a_sweep_trial_names_its_robot():
     assert resolve_trial("arm-grid", {}, 1, 2, 0).robot == "puma560"
     with pytest.raises(LearningError, match="Unknown robot"):
         resolve_trial("arm-grid", {"robot": "nosuch"}, 1, 2, 0)
+
+
+def test_the_grid_environment_takes_a_robot():
+    from studio.learning._summary import has_default_goal
+
+    env = gymnasium.make("TeachStudio/ArmGrid-v0", robot="panda")
+    assert env.unwrapped.grid == ArmGrid(robot="panda")
+    assert has_default_goal(ArmGrid(robot="panda"))
+    assert not has_default_goal(ArmGrid(robot="panda", goal=(0, 0, 0)))
