@@ -315,13 +315,25 @@ def test_a_run_on_the_panda_replays_demonstrations_retargeted_to_the_panda(tmp_p
 
 
 def test_a_sweep_trial_names_its_robot():
-    from studio.learning._sweep_spec import resolve_trial
+    from studio.learning._sweep_spec import parse_sweep_spec, resolve_trial, trial_record
 
     assert resolve_trial("arm-reach", {"robot": "panda", "joints": 3}, 1, 2, 0).robot == "panda"
     assert resolve_trial("arm-grid", {"robot": "ur5"}, 1, 2, 0).arm_grid().robot == "ur5"
     assert resolve_trial("arm-grid", {}, 1, 2, 0).robot == "puma560"
     with pytest.raises(LearningError, match="Unknown robot"):
         resolve_trial("arm-grid", {"robot": "nosuch"}, 1, 2, 0)
+    spec = parse_sweep_spec(
+        {
+            "name": "robots",
+            "task": "arm-reach",
+            "experiments": 1,
+            "episodes": 2,
+            "metric": {"name": "final_steps"},
+            "fixed": {"joints": 3, "planning": "zero"},
+            "space": {"robot": ["puma560", "panda"]},
+        }
+    )
+    assert [trial_record(spec, t).robot for t in spec.trials()] == ["puma560", "panda"]
 
 
 def test_the_grid_environment_takes_a_robot():
