@@ -284,8 +284,8 @@ def _motion(args: argparse.Namespace, source: Path, robot: str) -> tuple[Motion,
         return recording_motion(source, robot), "recording"
     if kind == "demonstration":
         return demonstration_motion(source, robot, args.rate), "demonstration"
-    arm = check_policy_robot(source, robot)
     policy = load_any_policy(source)
+    arm = check_policy_robot(source, policy.robot, robot)
     times, q, summary = _rollout(args, policy, args.seconds_per_step)
     timed = args.seconds_per_step is not None
     return Motion("policy", source.name, arm, times, q, timed, args.rate), summary

@@ -32,7 +32,9 @@ from pathlib import Path
 from typing import cast
 
 from studio import StudioError, read_json
-from studio.capture import DEMO_FORMAT, DEMO_SUFFIX, load_demonstration
+from studio.capture import DEMO_FORMAT, DEMO_SUFFIX
+from studio.export import ExportError, training_demonstration
+from studio.kinematics import DEFAULT_ROBOT, robot_names, robot_spec
 from studio.learning import (
     ACTION_SETS,
     DEFAULT_EPISODES,
@@ -99,6 +101,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "tile coding, as the page's Task choice (default: %(default)s)",
     )
     parser.add_argument(
+        "--robot",
+        help=f"the robot trained on: the grid's first three joints or the continuous task's "
+        f"first --joints (default: {DEFAULT_ROBOT}, the paper's; `studio robots` lists them: "
+        f"{', '.join(robot_names())})",
+    )
+    parser.add_argument(
         "--joints",
         type=int,
         help=f"grid joints (default: {_GRID.joints}); with --task arm-reach, joints 1..J learnt "
@@ -124,7 +132,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--tiles",
         type=int,
-        help=f"arm-reach: tiles per joint in each tiling (default: {REACH_DEFAULTS['tiles']})",
+        help="arm-reach: tiles per joint in each tiling (default: 32, or more for a robot whose "
+        "joints 1-3 turn further, so none of their tiles is wider than 10 degrees)",
     )
     goal = parser.add_mutually_exclusive_group()
     goal.add_argument(
@@ -133,8 +142,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     goal.add_argument(
         "--goal-deg",
-        help="goal as joint 1-3 angles in degrees, comma-separated, checked against the Puma560's "
-        "limits as the page does; write --goal-deg=-30,45,-90 when the first is negative",
+        help="goal as joint 1-3 angles in degrees, comma-separated, checked against the robot's "
+        "limits as the page does; write --goal-deg=-30,45,-90 when the first is negative "
+        "(default: the robot's default goal)",
     )
     parser.add_argument(
         "--demos",
@@ -191,12 +201,15 @@ def _grid_paths(data: object, source: Path) -> list[list[int]]:
     return data
 
 
-def _recorded(source: Path) -> DemonstrationPath:
-    """A cut demonstration (``*.demo.json``): its joint trajectory, which the run replays along
-    the path the page replays, never the file's stored ``grid_path`` (written by older code, or
-    edited by hand); its times too, for the run's likeness card."""
-    demo = load_demonstration(source)
-    return DemonstrationPath(f"The demonstration {source}", demo.q_robot, times=demo.times)
+def _recorded(source: Path, robot: str) -> DemonstrationPath:
+    """A cut demonstration (``*.demo.json``): its joint trajectory on ``robot`` (the stored
+    Puma560 one, or its recording's segment retargeted onto another robot), which the run
+    replays along the path the page replays, never the file's stored ``grid_path`` (written by
+    older code, or edited by hand); its times too, for the run's likeness card."""
+    try:
+        return training_demonstration(source, robot, f"The demonstration {source}")
+    except ExportError as err:
+        raise LearningError(str(err)) from None
 
 
 def _numbers(text: str, flag: str, kind: Callable[[str], float], example: str) -> list[float]:
@@ -273,6 +286,7 @@ def run_request(args: argparse.Namespace) -> RunRequest:
     ]
     spec = _spec_of(args)
     grid = dict(cast(dict, spec.get("grid", {})))
+    robot = args.robot or str(grid.pop("robot", DEFAULT_ROBOT))
     grid.update({k: getattr(args, k) for k in ("joints", "bins") if getattr(args, k) is not None})
     if args.goal is not None:
         grid["goal"] = [int(g) for g in _numbers(args.goal, "--goal", int, "5,6,2")]
@@ -284,7 +298,7 @@ def run_request(args: argparse.Namespace) -> RunRequest:
         demo_file = demonstration_file(args.demos)
         data = _read_json(demo_file, "demonstrations")
         if isinstance(data, dict) and data.get("format") == DEMO_FORMAT:
-            grid_paths, recorded = [], [_recorded(demo_file)]
+            grid_paths, recorded = [], [_recorded(demo_file, robot)]
         else:
             grid_paths = _grid_paths(data, demo_file)
     if args.generated_demos:
@@ -293,6 +307,7 @@ def run_request(args: argparse.Namespace) -> RunRequest:
     if args.goal_deg is not None:
         goal_deg = _numbers(args.goal_deg, "--goal-deg", float, "0,45,-90")
     return RunRequest(
+        robot=robot,
         config={**cast(dict, spec.get("config", {})), **_dynaq_flags(args)},
         grid=grid,
         goal_deg=goal_deg,
@@ -318,7 +333,9 @@ def _reach_request(args: argparse.Namespace) -> RunRequest:
         )
         if getattr(args, flag) is not None
     ]
-    goal_deg = list(DEFAULT_GOAL_JOINTS_DEG)
+    robot = args.robot or DEFAULT_ROBOT
+    # the Puma560's goal in degrees as the page sends it; another robot's default goal pose whole
+    goal_deg = list(DEFAULT_GOAL_JOINTS_DEG) if robot == DEFAULT_ROBOT else None
     if args.goal_deg is not None:
         goal_deg = _numbers(args.goal_deg, "--goal-deg", float, "0,45,-90")
     recorded = []
@@ -329,9 +346,10 @@ def _reach_request(args: argparse.Namespace) -> RunRequest:
             raise LearningError(
                 f"{demo_file} is not a cut demonstration; the continuous task replays a *.demo.json (its joint path)."
             )
-        recorded = [_recorded(demo_file)]
+        recorded = [_recorded(demo_file, robot)]
     return RunRequest(
         task=args.task,
+        robot=robot,
         config=_dynaq_flags(args),
         reach={k: getattr(args, k) for k in REACH_DEFAULTS if getattr(args, k) is not None},
         goal_deg=goal_deg,
@@ -396,7 +414,7 @@ def run(args: argparse.Namespace) -> int:
     wall = time.perf_counter() - start
     mean = result.mean_steps()
     print(
-        f"Trained {record.experiments} x {record.episodes} episodes ({record.config.planning} planning) in {wall:.2f} s "
+        f"Trained the {robot_spec(record.robot).title} {record.experiments} x {record.episodes} episodes ({record.config.planning} planning) in {wall:.2f} s "
         f"({result.cpu_seconds.sum():.2f} CPU s): mean steps {mean[0]:.0f} in episode 1, "
         f"{mean[-1]:.1f} in episode {record.episodes}."
     )

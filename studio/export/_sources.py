@@ -7,11 +7,13 @@ the page and the demonstration cutter use) into the human arm's angles, then thr
 :class:`studio.kinematics.Retargeter` onto the chosen robot (joint mode for the Puma560, the
 paper's; cartesian, the hand's pose scaled into the robot's workspace, for any other arm). A
 demonstration for the Puma560 keeps the trajectory stored in it. A policy drives the robot it
-was learnt on only.
+was learnt on only (its file names it; one written before policies named a robot is the
+Puma560's).
 """
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Literal
@@ -28,7 +30,8 @@ from studio.capture import (
     read_any_recording,
 )
 from studio.kinematics import Retargeter, RobotArm, RobotIK, load_robot
-from studio.learning import POLICY_SUFFIX
+from studio.learning import POLICY_SUFFIX, DemonstrationPath, LearningError
+from studio.learning import check_policy_robot as check_policy_robot_named
 from studio.samples import SAMPLES_DIR
 
 from ._errors import ExportError
@@ -41,8 +44,9 @@ POLICIES_DIR = "policies"
 """Where a data folder keeps uploaded policy files."""
 RUNS_DIR = "runs"
 """Where a data folder keeps training runs (each with ``policy.policy.npz``)."""
-POLICY_ROBOT = "puma560"
-"""The robot every policy file of this studio was learnt on (the files name no other yet)."""
+PUMA560 = "puma560"
+"""The paper's robot: a demonstration keeps its stored trajectory for it, and joint mode maps the
+human arm onto it."""
 REACH_TOLERANCE_M = 0.01
 """A retargeted tool further than this from the operator's mapped hand is out of reach."""
 SETTLE_TRIES = 5
@@ -145,7 +149,7 @@ def retarget(
     robot: RobotArm, times: np.ndarray, q_human: np.ndarray
 ) -> tuple[np.ndarray, list[Finding]]:
     """The robot's joints (N, nq) for human-arm angles (N, 7), and the frames out of reach."""
-    retargeter = Retargeter() if robot.name == POLICY_ROBOT else Retargeter(robot=robot)
+    retargeter = Retargeter() if robot.name == PUMA560 else Retargeter(robot=robot)
     q = np.empty((len(q_human), robot.nq))
     findings: list[Finding] = []
     for _ in range(SETTLE_TRIES if len(q_human) else 0):
@@ -200,7 +204,7 @@ def demonstration_motion(path: Path, robot_name: str, rate_hz: float) -> Motion:
     recording's segment retargeted onto another robot), to be timed."""
     robot = load_robot(robot_name)
     demo = load_demonstration(path)
-    if robot.name == POLICY_ROBOT:
+    if robot.name == PUMA560:
         times = demo.times - demo.times[0]
         return Motion("demonstration", path.name, robot, times, demo.q_robot, False, rate_hz)
     recording = demo.recording  # the file name it was cut from, next to the demonstration
@@ -217,13 +221,56 @@ def demonstration_motion(path: Path, robot_name: str, rate_hz: float) -> Motion:
     return Motion("demonstration", path.name, robot, times, q, False, rate_hz, tuple(findings))
 
 
-def check_policy_robot(path: Path, robot_name: str) -> RobotArm:
-    """The robot a policy file drives, or an ExportError when another one is asked for."""
+def training_demonstration(
+    path: Path, robot_name: str, label: str, name: str = ""
+) -> DemonstrationPath:
+    """A demonstration file as a training run replays it on ``robot_name``: its stored Puma560
+    trajectory, or for another robot its recording's segment retargeted onto that robot (the
+    path :func:`demonstration_motion` exports), with its sample times.
+
+    Args:
+        path: the ``*.demo.json`` file.
+        robot_name: the robot the run trains.
+        label: how messages name it (``Demonstration 'reach-1'``).
+        name: the name the page lists it by, or "".
+
+    Raises:
+        ExportError: an unknown robot, or the recording it was cut from is missing.
+    """
+    if robot_name == PUMA560:
+        demo = load_demonstration(path)
+        return DemonstrationPath(label, demo.q_robot, name, demo.times)
+    times, q = _retargeted(path, path.stat().st_mtime_ns, robot_name)
+    return DemonstrationPath(label, q, name, times, robot_name)
+
+
+@functools.lru_cache(maxsize=32)
+def _retargeted(path: Path, mtime_ns: int, robot_name: str) -> tuple[np.ndarray, np.ndarray]:
+    """``(times, q)`` of a demonstration retargeted onto ``robot_name``, kept while the file is
+    unchanged (``mtime_ns``): a run form checked as it is filled in asks again and again."""
+    motion = demonstration_motion(path, robot_name, 1.0)
+    return motion.times, motion.q
+
+
+def check_policy_robot(path: Path, policy_robot: str | None, robot_name: str) -> RobotArm:
+    """The robot a policy file drives, or an ExportError when another one is asked for.
+
+    Args:
+        path: the policy file (for the sentence).
+        policy_robot: the robot its file names (None: not an arm's policy, refused when rolled
+            out).
+        robot_name: the robot asked for.
+    """
     robot = load_robot(robot_name)
-    if robot.name != POLICY_ROBOT:
-        raise ExportError(
-            f"The policy {path.name} was learnt on the {load_robot(POLICY_ROBOT).spec.title} and "
-            f"drives only that robot; export it with --robot {POLICY_ROBOT}, or export a "
-            f"recording or demonstration for the {robot.spec.title}."
-        )
+    if policy_robot is not None:
+        try:
+            check_policy_robot_named(
+                policy_robot,
+                robot.name,
+                f"The policy {path.name}",
+                f"export it with --robot {policy_robot}, or export a recording or demonstration "
+                f"for the {robot.spec.title}",
+            )
+        except LearningError as err:
+            raise ExportError(str(err)) from None
     return robot

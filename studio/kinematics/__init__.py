@@ -23,6 +23,7 @@ from ._puma import IKConfig as IKConfig
 from ._puma import Puma560 as Puma560
 from ._retarget import RetargetConfig as RetargetConfig
 from ._retarget import Retargeter as Retargeter
+from ._robots import DEFAULT_ROBOT as DEFAULT_ROBOT
 from ._robots import RobotArm as RobotArm
 from ._robots import RobotIK as RobotIK
 from ._robots import load_robot as load_robot

@@ -52,6 +52,8 @@ class RobotSpec:
             than six joints cannot reach every orientation, so it follows the position only).
         acceleration: joint acceleration limits (rad/s^2), or empty for twice the velocity limit.
         elbow: the joint (1-based) whose origin is the arm's elbow, for the null-space task.
+        ready: a pose in the middle of the workspace (degrees) that tasks aim for by default,
+            where :attr:`RobotArm.home` is a poor aim; empty: ``home``.
     """
 
     name: str
@@ -63,7 +65,12 @@ class RobotSpec:
     orientation: bool = True
     acceleration: tuple[float, ...] = field(default=())
     elbow: int = 3
+    ready: tuple[float, ...] = field(default=())
 
+
+UR_READY_DEG = (0.0, -90.0, 90.0, -90.0, -90.0, 0.0)
+"""The UR arms' ready pose: upper arm up, forearm level and forward, tool pointing down. Their
+``home`` (every joint 0) is the arm stretched out level, at the edge of the workspace."""
 
 ROBOT_SPECS: dict[str, RobotSpec] = {
     spec.name: spec
@@ -87,6 +94,7 @@ ROBOT_SPECS: dict[str, RobotSpec] = {
             "ur_description/srdf/ur5.srdf",
             "tool0",
             6,
+            ready=UR_READY_DEG,
         ),
         RobotSpec(
             "ur5",
@@ -95,6 +103,7 @@ ROBOT_SPECS: dict[str, RobotSpec] = {
             "ur_description/srdf/ur5.srdf",
             "tool0",
             6,
+            ready=UR_READY_DEG,
         ),
         RobotSpec(
             "ur10",
@@ -103,6 +112,7 @@ ROBOT_SPECS: dict[str, RobotSpec] = {
             "ur_description/srdf/ur5.srdf",
             "tool0",
             6,
+            ready=UR_READY_DEG,
         ),
         RobotSpec(
             "so100",
@@ -249,6 +259,26 @@ class RobotIK:
 
 
 @dataclass(frozen=True)
+class SerialChain:
+    """A serial arm of revolute joints as plain arrays (:meth:`RobotArm.serial_chain`).
+
+    The tool pose is ``prod_i (parentMjoint_i @ rot(axis_i, q_i)) @ jointMtool`` over joints
+    ``1..tool_joint``, Pinocchio's own composition (``oMi = oMparent * jointPlacement * M(q)``).
+
+    Attributes:
+        placements: each joint's placement in its parent joint's frame, ``(nq, 4, 4)``.
+        axes: each joint's unit rotation axis in its own frame, ``(nq, 3)``.
+        tool_joint: how many joints, from the first, move the tool (the tool frame's parent).
+        jointMtool: the tool frame in that joint's frame, ``(4, 4)``.
+    """
+
+    placements: np.ndarray
+    axes: np.ndarray
+    tool_joint: int
+    jointMtool: np.ndarray
+
+
+@dataclass(frozen=True)
 class Collision:
     """Two links closer than the margin: ``distance`` is negative when they overlap (m)."""
 
@@ -349,6 +379,41 @@ class RobotArm:
         arr = self.check_q(q)
         pin.forwardKinematics(self.model, self.data, arr)
         return np.array([self.data.oMi[i].translation for i in range(1, self.model.njoints)])
+
+    def serial_chain(self) -> SerialChain:
+        """The arm as a serial chain of revolute joints, for code that computes its forward
+        kinematics without Pinocchio (the learning tasks' compiled twins).
+
+        Raises:
+            KinematicsError: a joint that is not revolute, or a tree rather than a chain.
+        """
+        model = self.model
+        data = model.createData()  # scratch of our own: this may run beside the live thread
+        pin.computeJointJacobians(model, data, np.clip(np.zeros(self.nq), self.lower, self.upper))
+        placements, axes = [], []
+        for i in range(1, model.njoints):
+            joint = model.joints[i]
+            column = pin.getJointJacobian(model, data, i, pin.ReferenceFrame.LOCAL)[:, joint.idx_v]
+            if (
+                model.parents[i] != i - 1
+                or joint.nq != 1
+                or joint.nv != 1
+                or np.linalg.norm(column[:3]) > 1e-9
+                or abs(np.linalg.norm(column[3:]) - 1.0) > 1e-9
+            ):
+                raise KinematicsError(
+                    f"The {self.spec.title}'s joint {self.joint_names[i - 1]!r} is not a revolute "
+                    "joint of a serial chain; the learning tasks need one."
+                )
+            placements.append(model.jointPlacements[i].homogeneous)
+            axes.append(column[3:])
+        frame = model.frames[self._tool]
+        return SerialChain(
+            np.array(placements),
+            np.array(axes),
+            int(frame.parentJoint),
+            frame.placement.homogeneous,
+        )
 
     def elbow(self, q: np.ndarray) -> np.ndarray:
         """The elbow's position at ``q`` (the third joint's origin; m)."""

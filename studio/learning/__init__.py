@@ -11,7 +11,6 @@ The public names (see ``docs/architecture.md`` and this package's ``README.md``)
 
 from __future__ import annotations
 
-from ._arm import DEFAULT_GOAL_DEG as DEFAULT_GOAL_DEG
 from ._arm import MAX_TABLE_ENTRIES as MAX_TABLE_ENTRIES
 from ._arm import ArmGrid as ArmGrid
 from ._config import DEFAULT_EPISODES as DEFAULT_EPISODES
@@ -80,6 +79,9 @@ from ._reach import ACTION_SETS as ACTION_SETS
 from ._reach import ArmReach as ArmReach
 from ._reproduce import generate_demonstrations as generate_demonstrations
 from ._reproduce import reproduce as reproduce
+from ._robot import DEFAULT_GOAL_DEG as DEFAULT_GOAL_DEG
+from ._robot import check_policy_robot as check_policy_robot
+from ._robot import default_goal as default_goal
 from ._run_likeness import likeness_cards as likeness_cards
 from ._run_notes import RunBusyError as RunBusyError
 from ._run_notes import RunNotes as RunNotes

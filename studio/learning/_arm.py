@@ -1,6 +1,8 @@
-"""The paper's arm task: joints 1..J of a Puma560 on a grid of joint-angle bins.
+"""The paper's arm task: joints 1..J of a robot (the paper's Puma560) on a grid of joint-angle bins.
 
-Each joint's range ``[low_deg, high_deg]`` is cut into ``bins`` equal bins; a state is one bin per
+Each joint's range ``[low_deg, high_deg]`` is cut into ``bins`` equal bins (the Puma560's: the
+paper's [-180, 180] degrees for every joint; another robot's: each joint's own limits, so every
+bin centre is a pose the arm can take); a state is one bin per
 joint, and an action moves every joint by -1, 0 or +1 bin at once (3**J actions). A move that would
 leave the range leaves that joint where it is. Reaching the goal pays +100 and ends the episode,
 every other transition pays -1. Episodes start uniformly from every state but the goal. With the
@@ -13,7 +15,8 @@ Numbering: states and actions are mixed-radix numbers with joint 1 as the most s
 
 Default goal: the paper shows its goal only as a picture (Fig. 7), so we pick the bins nearest to
 joint angles (0, 45, -90) degrees for joints 1-3 (an arm reaching forward and down, inside the
-Puma560's limits) and 0 degrees for joints 4-6. With 11 bins that is bins (5, 6, 2).
+Puma560's limits) and 0 degrees for joints 4-6. With 11 bins that is bins (5, 6, 2). Another
+robot's default goal is the bins nearest its default goal pose (:func:`default_goal`).
 """
 
 from __future__ import annotations
@@ -26,9 +29,12 @@ import numpy as np
 
 from ._errors import LearningError
 from ._mdp import TabularMDP
+from ._robot import PUMA560, check_robot, default_goal, task_arm
 
 MAX_JOINTS = 6
-"""The Puma560 has six joints."""
+"""Most joints a grid covers (the Puma560 has six)."""
+PAPER_RANGE_DEG = (-180.0, 180.0)
+"""The paper's range of every joint, degrees: the Puma560's grid spans it."""
 MAX_TABLE_ENTRIES = 12_000_000
 """Largest states x actions table a grid may have: one Q table is then 96 MB, the task's tables
 200 MB, and each running experiment's working memory (Q, visit list, model; prioritized sweeping's
@@ -37,20 +43,22 @@ GOAL_REWARD = 100.0
 """Reward for the step that reaches the goal (paper)."""
 STEP_REWARD = -1.0
 """Reward for every other step (paper)."""
-DEFAULT_GOAL_DEG = (0.0, 45.0, -90.0, 0.0, 0.0, 0.0)
-"""Joint angles whose nearest bins are the default goal (see the module docstring)."""
 
 
 @dataclass(frozen=True)
 class ArmGrid:
-    """A grid of joint-angle bins over the first ``joints`` joints of the arm.
+    """A grid of joint-angle bins over the first ``joints`` joints of a robot's arm.
 
     Args:
-        joints: how many joints, from joint 1, the grid covers (1 to 6; the paper used 3).
+        joints: how many joints, from joint 1, the grid covers (1 to 6, at most the robot's;
+            the paper used 3).
         bins: bins per joint (the paper used 11).
-        low_deg: lower end of every joint's range, degrees.
-        high_deg: upper end of every joint's range, degrees.
-        goal: the goal's bin per joint; default: the bins nearest :data:`DEFAULT_GOAL_DEG`.
+        low_deg: lower end of every joint's range, degrees, or one per joint; default: the
+            paper's -180 for the Puma560, each joint's lower limit for another robot.
+        high_deg: upper end, likewise (the paper's 180, or each joint's upper limit).
+        goal: the goal's bin per joint; default: the bins nearest the robot's default goal
+            (:data:`DEFAULT_GOAL_DEG` for the Puma560).
+        robot: the robot's registry name (``studio robots``).
 
     Raises:
         LearningError: for a bad value, or a grid whose table would not fit in memory.
@@ -58,26 +66,37 @@ class ArmGrid:
 
     joints: int = 3
     bins: int = 11
-    low_deg: float = -180.0
-    high_deg: float = 180.0
+    low_deg: float | tuple[float, ...] | None = None
+    high_deg: float | tuple[float, ...] | None = None
     goal: tuple[int, ...] | None = None
+    robot: str = PUMA560
 
     def __post_init__(self) -> None:
+        arm = task_arm(check_robot(self.robot))
         for name in ("joints", "bins"):
             value = getattr(self, name)
             if not isinstance(value, int | np.integer) or isinstance(value, bool):
                 raise LearningError(f"{name} is {value!r}; give a whole number.")
-        if not 1 <= self.joints <= MAX_JOINTS:
+        most = min(MAX_JOINTS, arm.nq)
+        if not 1 <= self.joints <= most:
             raise LearningError(
-                f"joints is {self.joints}; give 1 to {MAX_JOINTS} (the arm has six joints)."
+                f"joints is {self.joints}; give 1 to {most} (the {arm.spec.title} has {arm.nq} joints)."
             )
         if self.bins < 2:
             raise LearningError(f"bins is {self.bins}; give at least 2 bins per joint.")
-        for name in ("low_deg", "high_deg"):
+        paper = self.robot == PUMA560
+        ends = []
+        for name, own, limit in (
+            ("low_deg", PAPER_RANGE_DEG[0], arm.lower),
+            ("high_deg", PAPER_RANGE_DEG[1], arm.upper),
+        ):
             value = getattr(self, name)
-            if not isinstance(value, int | float | np.floating) or not np.isfinite(value):
-                raise LearningError(f"{name} is {value!r}; give a finite angle in degrees.")
-        if not self.low_deg < self.high_deg:
+            if value is None:
+                value = own if paper else tuple(float(x) for x in np.degrees(limit[: self.joints]))
+            ends.append(_range_end(name, value, self.joints))
+            object.__setattr__(self, name, ends[-1])
+        low, high = (np.broadcast_to(np.asarray(e, np.float64), (self.joints,)) for e in ends)
+        if not np.all(low < high):
             raise LearningError(
                 f"The joint range [{self.low_deg}, {self.high_deg}] degrees is empty; give low_deg below high_deg."
             )
@@ -88,10 +107,8 @@ class ArmGrid:
             )
         object.__setattr__(self, "joints", int(self.joints))
         object.__setattr__(self, "bins", int(self.bins))
-        object.__setattr__(self, "low_deg", float(self.low_deg))
-        object.__setattr__(self, "high_deg", float(self.high_deg))
         if self.goal is None:
-            goal = self.bins_of_angles(np.radians(DEFAULT_GOAL_DEG[: self.joints]))
+            goal = self.bins_of_angles(default_goal(self.robot)[: self.joints])
         else:
             goal = np.asarray(self.goal)
             if goal.shape != (self.joints,) or not np.issubdtype(goal.dtype, np.integer):
@@ -128,17 +145,29 @@ class ArmGrid:
 
     @property
     def bin_width(self) -> float:
-        """Width of one bin, radians."""
-        return float(np.radians(self.high_deg - self.low_deg) / self.bins)
+        """Width of one bin, radians (the widest joint's when their ranges differ)."""
+        return float(np.max(self._widths))
+
+    @cached_property
+    def _lows(self) -> np.ndarray:
+        """Each joint's lower range end, radians ``(joints,)``."""
+        return np.broadcast_to(np.radians(np.asarray(self.low_deg, np.float64)), (self.joints,))
+
+    @cached_property
+    def _widths(self) -> np.ndarray:
+        """Each joint's bin width, radians ``(joints,)``."""
+        high, low = np.asarray(self.high_deg, np.float64), np.asarray(self.low_deg, np.float64)
+        return np.broadcast_to(np.radians(high - low) / self.bins, (self.joints,))
 
     def to_dict(self) -> dict:
         """The grid spec as JSON-ready values (the inverse of ``ArmGrid(**spec)``)."""
         return {
             "joints": self.joints,
             "bins": self.bins,
-            "low_deg": self.low_deg,
-            "high_deg": self.high_deg,
+            "low_deg": self.low_deg if isinstance(self.low_deg, float) else list(self.low_deg),
+            "high_deg": self.high_deg if isinstance(self.high_deg, float) else list(self.high_deg),
             "goal": list(self.goal),
+            "robot": self.robot,
         }
 
     def state_of(self, bins: Sequence[int] | np.ndarray) -> int:
@@ -172,8 +201,7 @@ class ArmGrid:
             raise LearningError(
                 "The joint angles hold NaN or infinite values; give finite angles in radians."
             )
-        low = np.radians(self.low_deg)
-        b = np.floor((q - low) / self.bin_width).astype(np.int64)
+        b = np.floor((q - self._lows) / self._widths).astype(np.int64)
         return np.clip(b, 0, self.bins - 1)
 
     def state_of_angles(self, q_rad: Sequence[float] | np.ndarray) -> int:
@@ -181,7 +209,7 @@ class ArmGrid:
         return self.state_of(self.bins_of_angles(q_rad))
 
     def _centres(self, bins: np.ndarray) -> np.ndarray:
-        return np.radians(self.low_deg) + (bins + 0.5) * self.bin_width
+        return self._lows + (bins + 0.5) * self._widths
 
     def _check_state(self, state: int) -> None:
         if (
@@ -312,6 +340,24 @@ class ArmGrid:
             states, samples = states[:end], samples[:end]
         states, samples = _erase_loops(states, samples)
         return GridPath(states=states, samples=samples, reaches_goal=reaches_goal)
+
+
+def _range_end(name: str, value: object, joints: int) -> float | tuple[float, ...]:
+    """A range end as given: one finite angle for every joint, or ``joints`` of them."""
+    if isinstance(value, list | tuple | np.ndarray):
+        ends = np.asarray(value, dtype=np.float64) if len(value) == joints else None
+        if ends is None or not np.all(np.isfinite(ends)):
+            raise LearningError(
+                f"{name} is {value!r}; give one finite angle in degrees, or {joints}, one per joint."
+            )
+        return tuple(float(x) for x in ends)
+    if (
+        not isinstance(value, int | float | np.integer | np.floating)
+        or isinstance(value, bool)
+        or not np.isfinite(value)
+    ):
+        raise LearningError(f"{name} is {value!r}; give a finite angle in degrees.")
+    return float(value)
 
 
 @dataclass(frozen=True)

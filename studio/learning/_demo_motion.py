@@ -20,7 +20,7 @@ import numpy as np
 
 from ._arm import ArmGrid
 from ._errors import LearningError
-from ._policy import ROBOT_JOINTS
+from ._reach import MAX_CHAIN
 
 MOTION_DECIMALS = 6
 """Seconds and radians are kept to a micro-unit, as the demonstration files store them."""
@@ -29,15 +29,15 @@ MOTION_DECIMALS = 6
 def motion_problem(label: str, times: object, q_robot: object) -> str | None:
     """The one sentence refusing a demonstration's motion, or None when it is usable.
 
-    Refused: joints for another robot or another number of joints (not ``(N, 6)``), NaN or
+    Refused: not one row of joint angles per sample (up to the seven of the largest arm), NaN or
     infinite samples, a cut of zero length (fewer than two samples, or no time between its ends),
     and times that do not increase.
     """
     q = np.asarray(q_robot, dtype=np.float64)
     t = np.asarray(times, dtype=np.float64).reshape(-1)
-    if q.ndim != 2 or q.shape[1] != ROBOT_JOINTS:
+    if q.ndim != 2 or not 1 <= q.shape[1] <= MAX_CHAIN:
         width = q.shape[1] if q.ndim == 2 else "no"
-        return f"{label} holds {width} joint angles per sample, not the Puma560's {ROBOT_JOINTS}; it was made for another robot: cut it again from its recording."
+        return f"{label} holds {width} joint angles per sample, not one row of a robot's joints; cut it again from its recording."
     if q.shape[0] < 2 or t.shape[0] != q.shape[0] or (t.size and t[-1] - t[0] <= 0):
         return f"{label} is a cut of zero length ({q.shape[0]} samples); cut a longer segment of its recording."
     bad = ~np.isfinite(q).all(axis=1) | ~np.isfinite(t)
@@ -56,7 +56,7 @@ class DemonstrationMotion:
     Attributes:
         name: the name the page lists it by (or its file's name).
         times: sample times ``(N,)`` (s).
-        q_robot: Puma560 joints ``(N, 6)`` (rad).
+        q_robot: the run's robot's joints ``(N, nq)`` (rad; the Puma560's six by default).
     """
 
     name: str

@@ -37,6 +37,7 @@ from ._dmp import (
 from ._errors import LearningError, PolicyFileError
 from ._likeness import LikenessCard, likeness_card, puma_tool_positions
 from ._policy import MAX_NPZ_BYTES, ROBOT_JOINTS, ROLLOUT_RATE_HZ, BoundedNpz, read_header
+from ._robot import PUMA560
 
 FORMAT_NAME = "teach-studio-dmp-policy"
 FORMAT_VERSION = 1
@@ -69,6 +70,11 @@ class DmpPolicyFile:
     notes: str = ""
     mean_steps: np.ndarray = field(default_factory=lambda: np.zeros(0))
     experiments: int = 1
+
+    @property
+    def robot(self) -> str:
+        """The robot it drives: the Puma560, whose joints its demonstration holds."""
+        return PUMA560
 
     def header(self, likeness: LikenessCard | None = None) -> dict[str, object]:
         """The JSON header written to the file."""

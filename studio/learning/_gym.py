@@ -35,9 +35,10 @@ class _GridSettings(TypedDict, total=False):
 
     joints: int
     bins: int
-    low_deg: float
-    high_deg: float
+    low_deg: float | tuple[float, ...] | None
+    high_deg: float | tuple[float, ...] | None
     goal: tuple[int, ...] | None
+    robot: str
 
 
 class _ReachSettings(TypedDict, total=False):
@@ -50,13 +51,14 @@ class _ReachSettings(TypedDict, total=False):
     angle_tolerance_deg: float
     shaping: float
     actions: str
+    robot: str
 
 
 class ArmGridEnv(gymnasium.Env):
     """The paper's arm grid as a Gymnasium environment.
 
     Args:
-        joints, bins, low_deg, high_deg, goal: as :class:`ArmGrid`.
+        joints, bins, low_deg, high_deg, goal, robot: as :class:`ArmGrid`.
     """
 
     metadata = {"render_modes": []}
@@ -98,7 +100,7 @@ class ArmReachEnv(gymnasium.Env):
     """The continuous arm task as a Gymnasium environment.
 
     Args:
-        joints: joints learned, from joint 1 (3 to 6).
+        joints: joints learned, from joint 1 (3 to 6, at most the robot's).
         step_deg: joint increment per action, degrees.
         goal: goal joint angles, radians (``joints`` or 6 values).
         position_tolerance: metres.
@@ -106,6 +108,8 @@ class ArmReachEnv(gymnasium.Env):
         shaping: weight of the potential-based shaping reward.
         actions: what one action moves: ``"single"`` (one joint), ``"pairs"`` (also two
             together) or ``"all"`` (any joints at once).
+        robot: the robot's registry name (``studio robots``; default ``"puma560"``): its first
+            ``joints`` joints, limits and forward kinematics.
     """
 
     metadata = {"render_modes": []}

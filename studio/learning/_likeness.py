@@ -34,6 +34,8 @@ from numba import njit
 from studio.kinematics import Puma560
 
 from ._errors import LearningError
+from ._reach import tool_positions
+from ._robot import PUMA560
 
 MOVING_SPEED_FRACTION = 0.05
 """A joint counts as moving when its speed exceeds this fraction of the path's peak joint speed
@@ -366,6 +368,15 @@ def likeness_card(
         policy=policy,
         demonstration=demonstration,
     )
+
+
+def robot_tool_positions(robot: str, q: np.ndarray) -> np.ndarray:
+    """``robot``'s tool positions ``(N, 3)`` (m) for its joint angles ``(N, nq)`` (rad): the
+    Puma560's by :func:`puma_tool_positions`, another arm's by the tasks' compiled forward
+    kinematics (:func:`._reach.tool_positions`, held equal to Pinocchio's by a test)."""
+    if robot == PUMA560:
+        return puma_tool_positions(q)
+    return tool_positions(robot, q)
 
 
 def puma_tool_positions(q: np.ndarray) -> np.ndarray:

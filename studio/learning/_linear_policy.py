@@ -98,6 +98,12 @@ class TilePolicyFile:
         """Actions of the environment."""
         return int(self.weights.shape[1])
 
+    @property
+    def robot(self) -> str | None:
+        """The robot it was learnt on (the task's; a file written before tasks named one: the
+        Puma560), or None for another environment's policy."""
+        return None if self.task is None else self.task.robot
+
     def header(self) -> dict[str, object]:
         """The JSON header written to the file."""
         coder = self.coder
@@ -300,7 +306,7 @@ def rollout_tile_policy(
     *,
     seconds_per_step: float = DEFAULT_SECONDS_PER_STEP,
 ) -> tuple[np.ndarray, np.ndarray, bool]:
-    """The greedy policy from ``start_q`` as a Puma560 joint trajectory.
+    """The greedy policy from ``start_q`` as a joint trajectory of its robot.
 
     Each action moves one joint by one step at constant speed over ``seconds_per_step``; the
     trajectory is sampled at ``rate_hz`` (joints beyond the task's held at the goal's values).
@@ -313,7 +319,7 @@ def rollout_tile_policy(
         seconds_per_step: duration of one step.
 
     Returns:
-        ``(times (N,), q (N, 6), reached)``.
+        ``(times (N,), q (N, nq), reached)``: every joint of the robot (six for the Puma560).
 
     Raises:
         LearningError: a policy of another environment, or a bad start or rate.

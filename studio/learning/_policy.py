@@ -44,6 +44,7 @@ from studio import JSONFileError, loads_json
 from ._arm import ArmGrid
 from ._config import MAX_EPISODES, DynaQConfig
 from ._errors import LearningError, PolicyFileError
+from ._robot import default_goal, task_arm
 
 FORMAT_NAME = "teach-studio-policy"
 FORMAT_VERSION = 1
@@ -251,6 +252,12 @@ class PolicyFile:
     experiments: int = 1
     created: str = ""
     notes: str = ""
+
+    @property
+    def robot(self) -> str:
+        """The robot it was learnt on (the grid's; a file written before grids named one: the
+        Puma560)."""
+        return self.grid.robot
 
     def header(self) -> dict[str, object]:
         """The JSON header written to the file."""
@@ -486,7 +493,7 @@ def rollout(
     seconds_per_step: float = ROLLOUT_SECONDS_PER_STEP,
     hold: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """The greedy policy from ``start_state`` as a Puma560 joint trajectory.
+    """The greedy policy from ``start_state`` as a joint trajectory of its robot.
 
     Consecutive bin centres are joined by minimum-jerk segments of ``seconds_per_step`` each
     (the arm starts and stops smoothly at every grid state) sampled at ``rate_hz``.
@@ -497,24 +504,25 @@ def rollout(
         rate_hz: control rate of the samples.
         max_steps: cap on greedy steps (see :func:`greedy_path`).
         seconds_per_step: duration of one grid step.
-        hold: angles (rad, ``(6,)``) for the joints the grid does not cover; default 0.
+        hold: angles (rad, one per robot joint) for the joints the grid does not cover;
+            default: the robot's default goal's (0 for the Puma560's wrist).
 
     Returns:
-        ``(times (N,), q (N, 6))`` in seconds and radians, from t = 0 to the end.
+        ``(times (N,), q (N, nq))`` in seconds and radians, from t = 0 to the end (the
+        Puma560's ``nq`` is 6).
     """
     for name, value in (("rate_hz", rate_hz), ("seconds_per_step", seconds_per_step)):
         if not isinstance(value, int | float) or not np.isfinite(value) or value <= 0:
             raise LearningError(f"{name} is {value!r}; give a positive number.")
     if not isinstance(max_steps, int) or max_steps < 0:
         raise LearningError(f"max_steps is {max_steps!r}; give a whole number >= 0.")
-    if hold is None:
-        hold = np.zeros(ROBOT_JOINTS)
-    hold = np.asarray(hold, dtype=np.float64)
-    if hold.shape != (ROBOT_JOINTS,) or not np.all(np.isfinite(hold)):
-        raise LearningError(
-            f"hold has shape {hold.shape}; give {ROBOT_JOINTS} finite joint angles in radians."
-        )
     grid = policy.grid
+    width = task_arm(grid.robot).nq
+    hold = default_goal(grid.robot) if hold is None else np.asarray(hold, dtype=np.float64)
+    if hold.shape != (width,) or not np.all(np.isfinite(hold)):
+        raise LearningError(
+            f"hold has shape {hold.shape}; give {width} finite joint angles in radians."
+        )
     path = greedy_path(policy, start_state, max_steps)
     centres = np.array([grid.angles_of(s) for s in path])  # (K, joints)
     samples_per_step = max(1, round(seconds_per_step * rate_hz))

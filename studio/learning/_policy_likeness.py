@@ -11,9 +11,10 @@ import numpy as np
 
 from ._dmp_policy import DmpPolicyFile, rollout_dmp_policy
 from ._errors import LearningError
-from ._likeness import LikenessCard, likeness_card, puma_tool_positions
+from ._likeness import LikenessCard, likeness_card, robot_tool_positions
 from ._linear_policy import TilePolicyFile, rollout_tile_policy
-from ._policy import ROBOT_JOINTS, ROLLOUT_RATE_HZ, PolicyFile, rollout
+from ._policy import ROLLOUT_RATE_HZ, PolicyFile, rollout
+from ._robot import PUMA560, robot_title, task_arm
 
 
 def policy_likeness_card(
@@ -31,17 +32,20 @@ def policy_likeness_card(
     Args:
         policy: a policy of any kind (:func:`load_any_policy`).
         demo_times: the demonstration's sample times ``(N,)`` (s).
-        demo_q: its Puma560 joints ``(N, 6)`` (rad), for example a demonstration's ``q_robot``.
+        demo_q: its joints on the policy's robot ``(N, nq)`` (rad), for example a
+            demonstration's ``q_robot`` (the Puma560's six).
         rate_hz: the rollout's sample rate.
 
     Raises:
-        LearningError: a demonstration that is not ``(N, 6)`` finite angles, a start outside
+        LearningError: a demonstration that is not ``(N, nq)`` finite angles, a start outside
             the task's joint limits, or a tile-coded policy of another environment.
     """
     q_demo = np.asarray(demo_q, dtype=np.float64)
-    if q_demo.ndim != 2 or q_demo.shape[1] != ROBOT_JOINTS or q_demo.shape[0] < 1:
+    robot = policy.robot or PUMA560
+    width = task_arm(robot).nq
+    if q_demo.ndim != 2 or q_demo.shape[1] != width or q_demo.shape[0] < 1:
         raise LearningError(
-            f"The demonstration's joints have shape {q_demo.shape}; give (N, {ROBOT_JOINTS}) Puma560 angles in radians."
+            f"The demonstration's joints have shape {q_demo.shape}; give (N, {width}) {robot_title(robot)} angles in radians."
         )
     if not np.all(np.isfinite(q_demo)):
         raise LearningError("The demonstration holds NaN angles; re-record it.")
@@ -60,4 +64,8 @@ def policy_likeness_card(
         grid = policy.grid
         joints = grid.joints
         times, q = rollout(policy, grid.state_of_angles(start[:joints]), rate_hz, hold=start)
-    return likeness_card(times, q, demo_times, q_demo, puma_tool_positions, joints=joints)
+
+    def tool(q: np.ndarray) -> np.ndarray:
+        return robot_tool_positions(robot, q)
+
+    return likeness_card(times, q, demo_times, q_demo, tool, joints=joints)

@@ -1,7 +1,8 @@
-"""The continuous arm task: joints 1..J of the Puma560 reach a demonstrated pose, step by step.
+"""The continuous arm task: joints 1..J of a robot reach a demonstrated pose, step by step.
 
-The state is the first ``joints`` joint angles (radians, inside the robot's limits); the other
-joints stay at the goal's values. By default (``actions="single"``) an action moves ONE joint by
+The robot is any arm of the registry (``studio.kinematics.robot_names``; ``robot``, the Puma560
+by default). The state is its first ``joints`` joint angles (radians, inside the robot's limits,
+at most six); the other joints stay at the goal's values. By default (``actions="single"``) an action moves ONE joint by
 ``step_deg`` (2J actions: joint 1 up, joint 1 down, joint 2 up, ...); ``actions="pairs"`` adds
 every two joints moving together, each up or down (the diagonals, 2J**2 actions), and
 ``actions="all"`` every joint -1/0/+1 at once (3**J - 1 actions); see :data:`ACTION_SETS` and
@@ -20,10 +21,14 @@ The price is longer paths (the sum of the joints' distances
 instead of the largest). There is no "stay" action: it never helps a reach, and with function
 approximation its estimate can stick above the moves' and freeze the arm.
 
-The goal is judged where a user sees it: the tool (Puma560 DH frame 6) within
+The goal is judged where a user sees it: the robot's tool frame (the Puma560's DH frame 6) within
 ``position_tolerance`` metres and ``angle_tolerance_deg`` degrees of the goal's tool pose, by
-forward kinematics. :func:`tool_pose` is a numba twin of :meth:`studio.kinematics.Puma560.forward`
-built from the same DH table (a test holds them equal), so the kernels can call it.
+forward kinematics. :func:`tool_pose` is a numba twin of the robot's forward kinematics, so the
+kernels can call it: for the Puma560 the product of its DH table's transforms (the paper's robot,
+computed as it always was), for every other arm the serial chain Pinocchio builds from its URDF
+(each joint's fixed placement and rotation axis, then the tool frame's placement:
+:meth:`studio.kinematics.RobotArm.serial_chain`). A test holds both equal to Pinocchio's
+forward kinematics for every offered robot.
 
 Dynamics are defined once, here, in numba functions (:func:`reach_step`, :func:`reach_success`): the learner's compiled kernel and the Gymnasium environment
 ``TeachStudio/ArmReach-v0`` both call them.
@@ -42,12 +47,15 @@ from numba import njit
 
 from studio.kinematics import Puma560
 
-from ._arm import DEFAULT_GOAL_DEG, GOAL_REWARD, STEP_REWARD
+from ._arm import GOAL_REWARD, STEP_REWARD
 from ._errors import ConfigError, LearningError
+from ._robot import PUMA560, check_robot, default_goal, task_arm
 from ._tiles import TileCoding
 
-ROBOT_JOINTS = 6
-"""The Puma560's joints."""
+MAX_JOINTS = 6
+"""Most joints a task learns (the first six of a seven-joint arm such as the Panda)."""
+MAX_CHAIN = 7
+"""Most joints of an arm whose forward kinematics the compiled twin computes."""
 MIN_JOINTS = 3
 """Fewest joints the continuous task offers (the paper's three)."""
 DEFAULT_JOINTS = 6
@@ -67,9 +75,16 @@ DEFAULT_MAX_EPISODE_STEPS = 3_000
 DEFAULT_TILINGS = 8
 """Offset tilings of the arm's default features."""
 DEFAULT_TILES = 32
-"""Tiles per joint of the arm's default features (each joint tiled alone, see
-:meth:`ArmReach.features`): about 17 degrees of the widest joint each, about 2 degrees resolution
-over 8 tilings."""
+"""Fewest tiles per joint of the arm's default features (each joint tiled alone, see
+:meth:`ArmReach.features`): on the Puma560 about 17 degrees of the widest joint each, about 2
+degrees resolution over 8 tilings, and 10 degrees of joint 1 (:attr:`ArmReach.default_tiles`)."""
+MAX_TILE_DEG = 10.0
+"""Widest tile of joints 1-3 in the default features, degrees: the Puma560's joint 1 at 32 tiles
+(320 / 32). Joints 1-3 place the tool, so near the goal the greedy policy must tell a step up from
+a step down within a degree or two of them; where they turn further (the UR arms' +-360 degrees)
+the default adds tiles to keep this width. Measured on the UR5 (6 joints, 4,000 episodes, its
+ready goal): 32 tiles (22.5 degrees) 85% greedy success, the greedy policy stepping back and forth
+one or two degrees from the goal angles; 64 tiles 100%."""
 DEFAULT_SHAPING = 5.0
 """Weight of the potential-based shaping reward (Ng, Harada & Russell 1999): ``shaping`` times the
 change of :func:`reach_potential` (minus the joints' distance to the goal's angles, in steps). It
@@ -105,33 +120,40 @@ LIMIT_SLACK_RAD = 1e-9
 _J, _STEP, _POS_TOL2, _MIN_TRACE = 0, 1, 2, 3
 _GOAL_P = 4  # 3 values
 _GOAL_R = 7  # 9 values, row-major
-_LOWER = 16  # 6 values
+_LOWER = 16  # MAX_JOINTS values
 _UPPER = 22
-_HOLD = 28
-_D = 34
-_A = 40
-_ALPHA = 46
-_SHAPING = 52
-_POS_TOL = 53
-_ANG_TOL = 54
-_MULTI = 55  # 0: one joint per action (the fast path), else the table below
-_TABLE = 56  # per action, ROBOT_JOINTS directions -1/0/+1
-_N_PARAMS = 56
+_D = 28  # the Puma560's DH table, MAX_JOINTS values each
+_A = 34
+_ALPHA = 40
+_SHAPING = 46
+_POS_TOL = 47
+_ANG_TOL = 48
+_MULTI = 49  # 0: one joint per action (the fast path), else the table below
+_CHAIN_N = 50  # 0: the DH product above; else the serial chain's joints that move the tool
+_HOLD = 51  # MAX_CHAIN values: every joint's angle when not learned (the goal's)
+_CHAIN = _HOLD + MAX_CHAIN  # per joint: placement rotation (9, row-major), translation, axis
+_LINK = 15
+_TOOL = _CHAIN + _LINK * MAX_CHAIN  # jointMtool: rotation (9, row-major), translation (3)
+_TABLE = _TOOL + 12  # per action, MAX_JOINTS directions -1/0/+1
+_N_PARAMS = _TABLE
 
 
 @dataclass(frozen=True)
 class ArmReach:
-    """The continuous reaching task over joints 1..``joints`` of the Puma560.
+    """The continuous reaching task over joints 1..``joints`` of a robot.
 
     Attributes:
-        joints: joints learned, from joint 1 (3 to 6).
+        joints: joints learned, from joint 1 (3 to 6, and at most the robot's).
         step_deg: joint increment per action, degrees.
-        goal: goal joint angles in radians: ``joints`` values, or six (the joints beyond
-            ``joints`` are held there); default: :data:`studio.learning.DEFAULT_GOAL_DEG`.
+        goal: goal joint angles in radians: ``joints`` values, or one per robot joint (the
+            joints beyond ``joints`` are held there); default: the robot's
+            (:func:`studio.learning.default_goal`: the Puma560's is
+            :data:`studio.learning.DEFAULT_GOAL_DEG`).
         position_tolerance: metres.
         angle_tolerance_deg: degrees.
         shaping: weight of the potential-based shaping reward (:data:`DEFAULT_SHAPING`).
         actions: what one action moves, one of :data:`ACTION_SETS`.
+        robot: the robot's registry name (``studio robots`` lists them).
 
     Raises:
         LearningError: a bad value, or a goal outside the joint limits.
@@ -144,8 +166,11 @@ class ArmReach:
     angle_tolerance_deg: float = DEFAULT_ANGLE_TOLERANCE_DEG
     shaping: float = DEFAULT_SHAPING
     actions: str = DEFAULT_ACTIONS
+    robot: str = PUMA560
 
     def __post_init__(self) -> None:
+        arm = task_arm(check_robot(self.robot))
+        most = min(MAX_JOINTS, arm.nq)
         if self.actions not in ACTION_SETS:
             raise ConfigError(
                 [
@@ -156,11 +181,11 @@ class ArmReach:
         if (
             not isinstance(self.joints, int | np.integer)
             or isinstance(self.joints, bool)
-            or not MIN_JOINTS <= self.joints <= ROBOT_JOINTS
+            or not MIN_JOINTS <= self.joints <= most
         ):
             raise ConfigError(
                 [
-                    f"joints is {self.joints!r}; give {MIN_JOINTS} to {ROBOT_JOINTS} (joints 1..J of the arm)."
+                    f"joints is {self.joints!r}; give {MIN_JOINTS} to {most} (joints 1..J of the {arm.spec.title})."
                 ],
                 ["joints"],
             )
@@ -182,19 +207,17 @@ class ArmReach:
                     [f"{name} is {value!r}; give a number from {low} to {high}."], [name]
                 )
             object.__setattr__(self, name, float(value))
-        lower, upper = _limits()
-        if self.goal is None:
-            goal = np.radians(DEFAULT_GOAL_DEG)
-        else:
+        lower, upper = _limits(self.robot)
+        goal = default_goal(self.robot)
+        if self.goal is not None:
             g = np.asarray(self.goal, dtype=np.float64).reshape(-1)
-            if g.shape not in ((self.joints,), (ROBOT_JOINTS,)) or not np.all(np.isfinite(g)):
+            if g.shape not in ((self.joints,), (arm.nq,)) or not np.all(np.isfinite(g)):
                 raise ConfigError(
                     [
-                        f"goal is {self.goal!r}; give {self.joints} or {ROBOT_JOINTS} finite joint angles in radians."
+                        f"goal is {self.goal!r}; give {self.joints} or {arm.nq} finite joint angles in radians."
                     ],
                     ["goal"],
                 )
-            goal = np.radians(DEFAULT_GOAL_DEG).copy()
             goal[: g.shape[0]] = g
         outside = np.flatnonzero(
             (goal < lower - LIMIT_SLACK_RAD) | (goal > upper + LIMIT_SLACK_RAD)
@@ -229,12 +252,12 @@ class ArmReach:
     @property
     def lower(self) -> np.ndarray:
         """Lower limits of the learned joints, radians ``(joints,)``."""
-        return _limits()[0][: self.joints].copy()
+        return _limits(self.robot)[0][: self.joints].copy()
 
     @property
     def upper(self) -> np.ndarray:
         """Upper limits of the learned joints, radians ``(joints,)``."""
-        return _limits()[1][: self.joints].copy()
+        return _limits(self.robot)[1][: self.joints].copy()
 
     def to_dict(self) -> dict:
         """JSON-ready settings (the inverse of ``ArmReach(**d)``)."""
@@ -246,18 +269,30 @@ class ArmReach:
             "angle_tolerance_deg": self.angle_tolerance_deg,
             "shaping": self.shaping,
             "actions": self.actions,
+            "robot": self.robot,
         }
 
     @classmethod
     def from_dict(cls, data: dict) -> ArmReach:
         """Settings from :meth:`to_dict`'s form (one written before ``actions`` existed moves one
-        joint per action)."""
+        joint per action; one written before ``robot`` existed is the Puma560's)."""
         return cls(**{**data, "goal": None if data.get("goal") is None else tuple(data["goal"])})
 
+    @property
+    def default_tiles(self) -> int:
+        """Tiles per joint of :meth:`features` by default: :data:`DEFAULT_TILES`, or more where
+        joints 1-3 turn further than 32 tiles of :data:`MAX_TILE_DEG` (32 for the Puma560 and
+        the Panda, 72 for the UR arms)."""
+        lower, upper = _limits(self.robot)
+        placing = slice(0, min(3, self.joints))
+        widest = float(np.degrees(np.max(upper[placing] - lower[placing])))
+        return max(DEFAULT_TILES, math.ceil(widest / MAX_TILE_DEG - 1e-6))
+
     def features(
-        self, tilings: int = DEFAULT_TILINGS, tiles: int = DEFAULT_TILES, size: int | None = None
+        self, tilings: int = DEFAULT_TILINGS, tiles: int | None = None, size: int | None = None
     ) -> TileCoding:
-        """The default tile coding of this task: every joint tiled on its own.
+        """The default tile coding of this task: every joint tiled on its own, ``tiles`` per
+        joint (default: :attr:`default_tiles`).
 
         One grid over all joints would need ``(tiles + 1) ** joints`` tiles per tiling (1.3e9
         for six joints at 32 tiles) and generalise only within a few degrees in every joint at
@@ -270,31 +305,37 @@ class ArmReach:
         (see the package README); pass ``TileCoding(groups=...)`` for other choices.
         """
         singles = tuple((j,) for j in range(self.joints))
+        tiles = self.default_tiles if tiles is None else tiles
         return TileCoding(tilings=tilings, tiles=tiles, size=size, groups=singles)
 
     @cached_property
     def params(self) -> np.ndarray:
         """The flat parameter array of :func:`reach_step` and friends (read-only)."""
-        robot = Puma560()
         table = self.directions
-        p = np.zeros(_N_PARAMS + ROBOT_JOINTS * table.shape[0], np.float64)
+        p = np.zeros(_N_PARAMS + MAX_JOINTS * table.shape[0], np.float64)
         p[_MULTI] = 0.0 if self.actions == "single" else 1.0
-        p[_TABLE:].reshape(-1, ROBOT_JOINTS)[:, : self.joints] = table
+        p[_TABLE:].reshape(-1, MAX_JOINTS)[:, : self.joints] = table
         p[_J] = self.joints
         p[_STEP] = self.step
         p[_POS_TOL2] = self.position_tolerance**2
         p[_MIN_TRACE] = 1.0 + 2.0 * math.cos(math.radians(self.angle_tolerance_deg))
-        lower, upper = _limits()
-        p[_LOWER : _LOWER + 6] = lower
-        p[_UPPER : _UPPER + 6] = upper
-        p[_HOLD : _HOLD + 6] = self.goal
-        p[_D : _D + 6] = [row.d for row in robot.dh]
-        p[_A : _A + 6] = [row.a for row in robot.dh]
-        p[_ALPHA : _ALPHA + 6] = [row.alpha for row in robot.dh]
+        lower, upper = _limits(self.robot)
+        p[_LOWER : _LOWER + self.joints] = lower[: self.joints]
+        p[_UPPER : _UPPER + self.joints] = upper[: self.joints]
+        p[_HOLD : _HOLD + len(self.goal)] = self.goal
         p[_SHAPING] = self.shaping
         p[_POS_TOL] = self.position_tolerance
         p[_ANG_TOL] = math.radians(self.angle_tolerance_deg)
-        oMgoal = robot.forward(np.asarray(self.goal))
+        if self.robot == PUMA560:
+            robot = Puma560()
+            p[_D : _D + 6] = [row.d for row in robot.dh]
+            p[_A : _A + 6] = [row.a for row in robot.dh]
+            p[_ALPHA : _ALPHA + 6] = [row.alpha for row in robot.dh]
+            oMgoal = robot.forward(np.asarray(self.goal))
+        else:
+            _put_chain(p, self.robot)
+            oMgoal = np.empty((4, 4))
+            tool_pose(p, np.asarray(self.goal[: self.joints]), oMgoal)
         p[_GOAL_P : _GOAL_P + 3] = oMgoal[:3, 3]
         p[_GOAL_R : _GOAL_R + 9] = oMgoal[:3, :3].reshape(-1)
         p.flags.writeable = False
@@ -314,7 +355,7 @@ class ArmReach:
         return out
 
     def full_q(self, q: Sequence[float] | np.ndarray) -> np.ndarray:
-        """All six joint angles: ``q`` for the learned joints, the goal's for the others."""
+        """All the robot's joint angles: ``q`` for the learned joints, the goal's for the others."""
         full = np.array(self.goal, dtype=np.float64)
         full[: self.joints] = self._state(q)
         return full
@@ -403,19 +444,47 @@ def action_directions(joints: int, actions: str = DEFAULT_ACTIONS) -> np.ndarray
     return np.array(rows, dtype=np.int8).reshape(-1, joints)
 
 
-def _limits() -> tuple[np.ndarray, np.ndarray]:
-    robot = _robot()
-    return np.asarray(robot.lower, dtype=np.float64), np.asarray(robot.upper, dtype=np.float64)
+def tool_positions(robot: str, q: np.ndarray) -> np.ndarray:
+    """``robot``'s tool positions ``(N, 3)`` (m) for joint angles ``(N, nq)`` (rad), by the
+    compiled forward kinematics (no shared scratch data: safe from any thread)."""
+    arm = task_arm(robot)
+    q = np.asarray(q, dtype=np.float64).reshape(-1, arm.nq)
+    joints = min(MAX_JOINTS, arm.nq)
+    p = ArmReach(joints=joints, robot=robot).params.copy()
+    out = np.empty((q.shape[0], 3))
+    pose = np.empty((4, 4))
+    for i, row in enumerate(q):
+        p[_HOLD : _HOLD + arm.nq] = row
+        tool_pose(p, np.ascontiguousarray(row[:joints]), pose)
+        out[i] = pose[:3, 3]
+    return out
 
 
-_ROBOT: list[Puma560] = []
+def _limits(robot: str) -> tuple[np.ndarray, np.ndarray]:
+    """Every joint's limits of ``robot``, radians ``(nq,)`` each."""
+    arm = task_arm(robot)
+    return np.asarray(arm.lower, dtype=np.float64), np.asarray(arm.upper, dtype=np.float64)
 
 
-def _robot() -> Puma560:
-    """One shared Puma560 (building its Pinocchio model costs a few milliseconds)."""
-    if not _ROBOT:
-        _ROBOT.append(Puma560())
-    return _ROBOT[0]
+def _put_chain(p: np.ndarray, robot: str) -> None:
+    """Write ``robot``'s serial chain (:meth:`studio.kinematics.RobotArm.serial_chain`) into
+    the parameter array ``p``."""
+    chain = task_arm(robot).serial_chain()
+    if chain.tool_joint > MAX_CHAIN or chain.tool_joint < 1:
+        raise ConfigError(
+            [
+                f"The {robot} moves its tool with {chain.tool_joint} joints; give an arm of 1 to {MAX_CHAIN}."
+            ],
+            ["robot"],
+        )
+    p[_CHAIN_N] = chain.tool_joint
+    for i in range(chain.tool_joint):
+        link = p[_CHAIN + _LINK * i : _CHAIN + _LINK * (i + 1)]
+        link[:9] = chain.placements[i, :3, :3].reshape(-1)
+        link[9:12] = chain.placements[i, :3, 3]
+        link[12:] = chain.axes[i]
+    p[_TOOL : _TOOL + 9] = chain.jointMtool[:3, :3].reshape(-1)
+    p[_TOOL + 9 : _TOOL + 12] = chain.jointMtool[:3, 3]
 
 
 def _walk_capacity(q: np.ndarray, step: float) -> int:
@@ -429,16 +498,26 @@ def _walk_capacity(q: np.ndarray, step: float) -> int:
 
 @njit(nogil=True, cache=True)
 def tool_pose(params, state, out):
+    """The tool pose ``oMtool`` at ``state`` into ``out`` (4x4): the numba twin of the robot's
+    forward kinematics. ``state`` holds the learned joints, the others come from the held goal
+    angles in ``params``."""
+    if params[_CHAIN_N] == 0.0:
+        _dh_pose(params, state, out)
+    else:
+        _chain_pose(params, state, out)
+
+
+@njit(nogil=True, cache=True)
+def _dh_pose(params, state, out):
     """Standard-DH forward kinematics ``prod_i Rz(q_i) Tz(d_i) Tx(a_i) Rx(alpha_i)`` into ``out``.
 
-    The numba twin of :meth:`studio.kinematics.Puma560.forward`: ``state`` holds the learned
-    joints, the others come from the held goal angles in ``params``.
+    The numba twin of :meth:`studio.kinematics.Puma560.forward`.
     """
     joints = int(params[_J])
     for i in range(4):
         for k in range(4):
             out[i, k] = 1.0 if i == k else 0.0
-    for i in range(ROBOT_JOINTS):
+    for i in range(MAX_JOINTS):
         theta = state[i] if i < joints else params[_HOLD + i]
         ct, st = math.cos(theta), math.sin(theta)
         ca, sa = math.cos(params[_ALPHA + i]), math.sin(params[_ALPHA + i])
@@ -450,6 +529,48 @@ def tool_pose(params, state, out):
             out[r, 1] = -x * st * ca + y * ct * ca + z * sa
             out[r, 2] = x * st * sa - y * ct * sa + z * ca
             out[r, 3] = x * a * ct + y * a * st + z * d + p
+
+
+@njit(nogil=True, cache=True)
+def _chain_pose(params, state, out):
+    """Serial-chain forward kinematics into ``out``: per joint its fixed placement, then the
+    rotation by its angle about its axis (Rodrigues), then the tool frame's placement; the
+    composition of Pinocchio's ``oMi = oMparent * jointPlacement * M(q)``."""
+    joints = int(params[_J])
+    for i in range(4):
+        for k in range(4):
+            out[i, k] = 1.0 if i == k else 0.0
+    rotation = np.empty(12)
+    for i in range(int(params[_CHAIN_N])):
+        base = _CHAIN + _LINK * i
+        _compose(out, params, base)
+        theta = state[i] if i < joints else params[_HOLD + i]
+        c, s = math.cos(theta), math.sin(theta)
+        ux, uy, uz = params[base + 12], params[base + 13], params[base + 14]
+        t = 1.0 - c
+        rotation[0] = c + t * ux * ux
+        rotation[1] = t * ux * uy - s * uz
+        rotation[2] = t * ux * uz + s * uy
+        rotation[3] = t * ux * uy + s * uz
+        rotation[4] = c + t * uy * uy
+        rotation[5] = t * uy * uz - s * ux
+        rotation[6] = t * ux * uz - s * uy
+        rotation[7] = t * uy * uz + s * ux
+        rotation[8] = c + t * uz * uz
+        rotation[9] = rotation[10] = rotation[11] = 0.0
+        _compose(out, rotation, 0)
+    _compose(out, params, _TOOL)
+
+
+@njit(nogil=True, cache=True, inline="always")
+def _compose(out, values, base):
+    """``out = out @ M`` with ``M``'s rotation row-major at ``values[base:base + 9]`` and its
+    translation at ``values[base + 9:base + 12]``."""
+    for r in range(3):
+        x, y, z = out[r, 0], out[r, 1], out[r, 2]
+        for c in range(3):
+            out[r, c] = x * values[base + c] + y * values[base + 3 + c] + z * values[base + 6 + c]
+        out[r, 3] += x * values[base + 9] + y * values[base + 10] + z * values[base + 11]
 
 
 @njit(nogil=True, cache=True)
@@ -500,7 +621,7 @@ def reach_step(params, state, action):
         if params[_LOWER + j] <= moved <= params[_UPPER + j]:
             state[j] = moved
     else:
-        row = _TABLE + ROBOT_JOINTS * action
+        row = _TABLE + MAX_JOINTS * action
         for j in range(state.shape[0]):
             direction = params[row + j]
             if direction != 0.0:
@@ -521,7 +642,7 @@ def _walk(params, path, actions):
     Returns -1 when the walk never reaches the goal. See :meth:`ArmReach.demonstration_actions`.
     """
     joints = path.shape[1]
-    n_actions = (params.shape[0] - _N_PARAMS) // ROBOT_JOINTS
+    n_actions = (params.shape[0] - _N_PARAMS) // MAX_JOINTS
     step = params[_STEP]
     state = path[0].copy()
     if reach_success(params, state):
@@ -532,7 +653,7 @@ def _walk(params, path, actions):
             best = -1
             best_score = 0.5 * step
             for a in range(n_actions):
-                row = _TABLE + ROBOT_JOINTS * a
+                row = _TABLE + MAX_JOINTS * a
                 score = 0.0
                 for j in range(joints):
                     direction = params[row + j]

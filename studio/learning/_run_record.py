@@ -223,6 +223,11 @@ class RunRecord:
             )
         return self.task
 
+    @property
+    def robot(self) -> str:
+        """The robot the run learns on (the Puma560 for a run written before runs named one)."""
+        return self.task.robot
+
     def dynaq_config(self) -> DynaQConfig:
         """The Dyna-Q settings."""
         return self.config
@@ -247,6 +252,7 @@ class RunRecord:
             "episodes": self.episodes,
             "experiments": self.experiments,
             "task": self.kind,
+            "robot": self.task.robot,
         }
         if isinstance(self.task, ArmGrid):
             form["bins"] = self.task.bins

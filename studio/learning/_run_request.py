@@ -28,8 +28,9 @@ from ._config import DEFAULT_EPISODES, DEFAULT_EXPERIMENTS, DEFAULT_SEED, DynaQC
 from ._demo_motion import DemonstrationMotion, demonstration_grid_path
 from ._errors import ConfigError, LearningError
 from ._goal import goal_problems, grid_for_goal
-from ._reach import ROBOT_JOINTS, ArmReach
+from ._reach import ArmReach
 from ._reproduce import generate_demonstrations
+from ._robot import PUMA560, check_robot, default_goal, robot_title, task_arm
 from ._run_record import (
     CONFIG_FORM_FIELDS,
     TASK_ARM_GRID,
@@ -47,10 +48,11 @@ REACH_DEFAULTS: Final = {
     "step_deg": ArmReach.step_deg,
     "actions": ArmReach.actions,
     "tilings": _FEATURES.tilings,
-    "tiles": _FEATURES.tiles,
+    "tiles": None,
 }
 """The continuous task's settings a person sets, and their defaults (:class:`ArmReach` and its
-default :meth:`ArmReach.features`)."""
+default :meth:`ArmReach.features`; ``tiles`` None: the robot's :attr:`ArmReach.default_tiles`,
+32 for the Puma560)."""
 CODING_SETTINGS = ("tilings", "tiles", "size")
 """The continuous task's tile-coding settings (:meth:`ArmReach.features`); its other settings
 are :class:`ArmReach` fields."""
@@ -65,16 +67,20 @@ class DemonstrationPath:
     Attributes:
         label: how a message names it (``Demonstration 'reach-1'``, ``The demonstration
             recordings/reach-1.demo.json``).
-        q_robot: the Puma560 joint path ``(N, 6)``, radians.
+        q_robot: the robot's joint path ``(N, nq)``, radians (a demonstration file stores the
+            Puma560's; for another robot, its recording's segment retargeted:
+            ``studio.export.demonstration_motion``).
         name: the name the page lists it by (kept in the run record), or "".
         times: its sample times ``(N,)`` (s), when known: the run keeps its motion for the
             likeness card (``likeness.json``).
+        robot: the robot whose joints ``q_robot`` holds.
     """
 
     label: str
     q_robot: np.ndarray
     name: str = ""
     times: np.ndarray | None = None
+    robot: str = PUMA560
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -84,6 +90,8 @@ class RunRequest:
     Attributes:
         task: ``"arm-grid"`` (the paper's grid, tabular) or ``"arm-reach"`` (continuous joints,
             tile coding).
+        robot: the robot learnt on (a registry name, ``studio robots``; the Puma560 by default):
+            the grid's first three joints or the continuous task's first ``joints``.
         config: :class:`DynaQConfig` fields set (the others take its defaults).
         grid: :class:`ArmGrid` fields set (``joints``, ``bins``, ``low_deg``, ``high_deg``,
             ``goal`` as bins), for the arm grid.
@@ -105,6 +113,7 @@ class RunRequest:
     """
 
     task: str = TASK_ARM_GRID
+    robot: str = PUMA560
     config: Mapping[str, object] = field(default_factory=dict)
     grid: Mapping[str, object] = field(default_factory=dict)
     reach: Mapping[str, object] = field(default_factory=dict)
@@ -137,6 +146,7 @@ class RunRequest:
         goal = form.get("goal_deg")
         return cls(
             task=str(task),
+            robot=str(form.get("robot") or PUMA560),
             config={k: form[k] for k in CONFIG_FORM_FIELDS if k in form},
             grid={"bins": form["bins"]} if not reach and "bins" in form else {},
             reach={k: form[k] for k in REACH_DEFAULTS if k in form} if reach else {},
@@ -158,6 +168,21 @@ def resolve_run(request: RunRequest) -> RunRecord:
     if request.task not in TASK_KINDS:
         problems.append(("task", f"task is {request.task!r}; give one of {', '.join(TASK_KINDS)}."))
         raise_problems(problems)
+    try:
+        check_robot(request.robot)
+    except ConfigError as err:
+        raise_problems(problems + list(err.by_field.items()))
+    for demo in request.demonstrations:
+        if demo.robot != request.robot:  # its joints mean nothing on this robot: say only that
+            raise_problems(
+                problems
+                + [
+                    (
+                        "demonstrations",
+                        f"{demo.label} holds joints of the {robot_title(demo.robot)}, not of the {robot_title(request.robot)}; retarget it to the {request.robot} from its recording, or train on the {demo.robot}.",
+                    )
+                ]
+            )
     config = _dynaq_config(request.config, problems)
     if request.task == TASK_ARM_REACH:
         return _reach_record(request, config, problems)
@@ -178,17 +203,17 @@ def _dynaq_config(
 def _grid(request: RunRequest, problems: list[tuple[str, str]]) -> ArmGrid | None:
     """The arm grid the request sets (a goal in degrees put on its bins), or None with its
     problems added to ``problems``."""
-    spec = dict(request.grid)
+    spec = {**request.grid, "robot": request.robot}
     if spec.get("goal") is not None:
         spec["goal"] = tuple(cast(Sequence[int], spec["goal"]))
     try:
         if request.goal_deg is None:
             return ArmGrid(**spec)  # type: ignore[arg-type]
-        wrong = goal_problems(request.goal_deg)
+        wrong = goal_problems(request.goal_deg, request.robot)
         if wrong:
             problems += [("goal_deg", text) for text in wrong]
             return None
-        if set(spec) - {"bins", "joints"} or spec.get("joints", 3) != 3:
+        if set(spec) - {"bins", "joints", "robot"} or spec.get("joints", 3) != 3:
             problems.append(
                 (
                     "goal_deg",
@@ -196,7 +221,9 @@ def _grid(request: RunRequest, problems: list[tuple[str, str]]) -> ArmGrid | Non
                 )
             )
             return None
-        return grid_for_goal(request.goal_deg, cast(int, spec.get("bins", ArmGrid.bins)))
+        return grid_for_goal(
+            request.goal_deg, cast(int, spec.get("bins", ArmGrid.bins)), request.robot
+        )
     except ConfigError as err:
         problems += list(err.by_field.items())
     except TypeError as err:
@@ -286,7 +313,8 @@ def _reach_task(
     request: RunRequest, goal: tuple[float, ...] | None, problems: list[tuple[str, str]]
 ) -> tuple[ArmReach, TileCoding] | None:
     """The continuous task and its tile coding, or None with their problems added."""
-    settings = {**REACH_DEFAULTS, **request.reach}
+    most = min(cast(int, REACH_DEFAULTS["joints"]), task_arm(request.robot).nq)
+    settings = {**REACH_DEFAULTS, "joints": most, **request.reach, "robot": request.robot}
     coding_settings = {k: settings.pop(k) for k in CODING_SETTINGS if k in settings}
     if goal is not None:
         settings["goal"] = goal
@@ -312,14 +340,16 @@ def _reach_record(
     pose, else ``goal_deg`` for joints 1-3 with the wrist at zero, else the task's default."""
     paths = [np.asarray(d.q_robot, dtype=np.float64) for d in request.demonstrations]
     goal: tuple[float, ...] | None = None
+    robot = request.robot
     if paths:
-        goal = tuple(paths[0][-1, :ROBOT_JOINTS])
+        goal = tuple(paths[0][-1])
     elif request.goal_deg is not None:
-        wrong = goal_problems(request.goal_deg)
+        wrong = goal_problems(request.goal_deg, robot)
         problems += [("goal_deg", text) for text in wrong]
         if not wrong:
-            padded = [*request.goal_deg, *([0.0] * (ROBOT_JOINTS - len(request.goal_deg)))]
-            goal = tuple(np.radians(padded))
+            full = default_goal(robot)  # the joints beyond the goal's at the robot's default
+            full[: len(request.goal_deg)] = np.radians(request.goal_deg)
+            goal = tuple(full)
     built = _reach_task(request, goal, problems)
     if built is None or config is None:
         raise_problems(

@@ -29,13 +29,18 @@ def goal_degrees(grid: ArmGrid) -> list[float]:
 
 
 def has_default_goal(grid: ArmGrid) -> bool:
-    """Whether ``grid``'s goal is the default goal of a grid with the same joints, bins and range.
+    """Whether ``grid``'s goal is the default goal of a grid with the same robot, joints, bins and
+    range.
 
     A demonstration whose goal was set from where it ends (``goal_from_end``) answers false: it
     trains a different task than the paper's.
     """
     default = ArmGrid(
-        joints=grid.joints, bins=grid.bins, low_deg=grid.low_deg, high_deg=grid.high_deg
+        joints=grid.joints,
+        bins=grid.bins,
+        low_deg=grid.low_deg,
+        high_deg=grid.high_deg,
+        robot=grid.robot,
     )
     return tuple(grid.goal) == tuple(default.goal)
 

@@ -32,6 +32,7 @@ from ._config import DynaQConfig
 from ._errors import ConfigError, LearningError
 from ._reach import ArmReach
 from ._reproduce import CONVERGENCE_FACTOR
+from ._robot import PUMA560
 from ._run_record import TASK_ARM_GRID, TASK_ARM_REACH, RunRecord
 from ._run_request import CODING_SETTINGS, RunRequest, resolve_run
 
@@ -42,10 +43,10 @@ TASKS = (TASK_ARM_GRID, TASK_ARM_REACH)
 """Tasks a sweep can train (the run record's ``task.kind``): the paper's grid (tabular) and the
 continuous joints (tile-coded linear Dyna-Q)."""
 GRID_FIELDS = tuple(f.name for f in fields(ArmGrid))
-"""Task settings of the arm grid: joints, bins, low_deg, high_deg, goal."""
+"""Task settings of the arm grid: joints, bins, low_deg, high_deg, goal, robot."""
 REACH_FIELDS = tuple(f.name for f in fields(ArmReach))
-"""Task settings of the continuous joints: joints, step_deg, goal, tolerances, shaping (and the
-tile coding's ``CODING_SETTINGS``)."""
+"""Task settings of the continuous joints: joints, step_deg, goal, tolerances, shaping, actions,
+robot (and the tile coding's ``CODING_SETTINGS``)."""
 CONFIG_FIELDS = tuple(f.name for f in fields(DynaQConfig))
 """Learning settings: every :class:`DynaQConfig` field."""
 RUN_SETTINGS = ("demonstrations",)
@@ -315,6 +316,7 @@ def resolve_trial(
     """
     request = RunRequest(
         task=task,
+        robot=str(settings.get("robot", PUMA560)),  # both tasks' field, fixed or swept
         config=_pick(settings, CONFIG_FIELDS),
         grid=_pick(settings, GRID_FIELDS) if task == TASK_ARM_GRID else {},
         reach=_pick(settings, (*REACH_FIELDS, *CODING_SETTINGS)) if task == TASK_ARM_REACH else {},

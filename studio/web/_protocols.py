@@ -75,9 +75,13 @@ class Scene(LiveScene, Protocol):
         """Remove a path (every path when None)."""
 
     def play_trajectory(
-        self, times: np.ndarray, q_robot: np.ndarray, states: Sequence[int] | None = None
+        self,
+        times: np.ndarray,
+        q_robot: np.ndarray,
+        states: Sequence[int] | None = None,
+        robot: str = "puma560",
     ) -> None:
-        """Animate the robot along a trajectory."""
+        """Animate ``robot`` along a trajectory (it moves while it is the robot drawn)."""
 
     def stop_playback(self) -> None:
         """Stop a playback."""

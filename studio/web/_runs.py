@@ -26,6 +26,7 @@ from pathlib import Path
 
 from pydantic import TypeAdapter
 
+from studio.kinematics import DEFAULT_ROBOT
 from studio.learning import (
     DEFAULT_GOAL_JOINTS_DEG,
     DemonstrationPath,
@@ -274,13 +275,13 @@ def run_create_of(record: RunRecord) -> RunCreate:
 
 
 def prepare_run(
-    create: RunCreate, demonstration_path: Callable[[str], DemonstrationPath]
+    create: RunCreate, demonstration_path: Callable[[str, str], DemonstrationPath]
 ) -> RunRecord:
     """Check a ``RunCreate`` with the learning package's rules, reporting every bad field at once.
 
     Args:
         create: the request.
-        demonstration_path: a demonstration by name: its Puma560 joint path and times.
+        demonstration_path: a demonstration by name, on a robot: its joint path and times.
 
     Returns:
         The run's record (:func:`studio.learning.resolve_run`).
@@ -288,7 +289,8 @@ def prepare_run(
     Raises:
         ConfigError: one sentence per bad field, keyed by field (answered as 422).
     """
-    demonstrations = [demonstration_path(name) for name in create.demonstrations]
+    robot = create.robot or DEFAULT_ROBOT
+    demonstrations = [demonstration_path(name, robot) for name in create.demonstrations]
     request = RunRequest.from_form(create.model_dump(), demonstrations=demonstrations)
     return resolve_run(request)
 
@@ -431,7 +433,7 @@ class RunQueue:
         return None
 
     def submit(
-        self, create: RunCreate, demonstration_path: Callable[[str], DemonstrationPath]
+        self, create: RunCreate, demonstration_path: Callable[[str, str], DemonstrationPath]
     ) -> Run:
         """Validate a run, write its folder (atomically) and queue it."""
         record = prepare_run(create, demonstration_path)

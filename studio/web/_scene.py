@@ -147,6 +147,7 @@ class StudioScene(ScenePaths):
         self._live_at = -np.inf  # when the latest live pose came
         self._live_gap = np.inf  # the gap between live poses, smoothed (s)
         self._playback: Playback | None = None
+        self._playback_robot = "puma560"  # whose joints the playback holds
         # Published by the loop (under _lock) for readers.
         self._q_robot_shown = np.array(self.robot.qz, dtype=float)
         self._q_human_shown = np.zeros(7)
@@ -434,6 +435,7 @@ class StudioScene(ScenePaths):
     def _tick(self, now: float, shown: _Shown) -> None:
         with self._lock:
             live, version, playback = self._live, self._live_version, self._playback
+            playback_robot = self._playback_robot
             operator, slow = self._operator, self._live_gap >= self.layout.slow_live_s
             view, self._next_view = self._next_view, None
         if view is not None:
@@ -477,8 +479,9 @@ class StudioScene(ScenePaths):
                 self._push_operator(operator, live.posed, whole=operator_changed)
             elif operator_changed:
                 self._push_operator(operator, operator.rest, whole=True)
-            # playbacks are the Puma560's (policies, demonstrations); another robot stays live
-            puma_or_live = pose.mode is Mode.LIVE or self._view.name == "puma560"
+            # a playback drives the robot it is for (a policy names its own; demonstrations are
+            # the Puma560's); another robot drawn stays live
+            puma_or_live = pose.mode is Mode.LIVE or self._view.name == playback_robot
             if robot_changed and pose.q_robot is not None and puma_or_live:
                 self._push_robot(self._robot_handles, pose.q_robot)
                 if self.camera.following:
@@ -613,6 +616,7 @@ class StudioScene(ScenePaths):
         times: np.ndarray,
         q_robot: np.ndarray,
         states: Sequence[int] | None = None,
+        robot: str = "puma560",
     ) -> None:
         """Animate the robot along a trajectory in real time, tracing the tool and bins.
 
@@ -622,6 +626,7 @@ class StudioScene(ScenePaths):
             states: the grid states visited, one per sample or one per step (then spread evenly
                 over the samples); each is marked as the robot passes it. None marks only the
                 start and the end.
+            robot: the robot the joints are of (a policy's own): it moves only while drawn.
         """
         t = np.asarray(times, dtype=float).reshape(-1)
         q = np.asarray(q_robot, dtype=float).reshape(len(t), -1)
@@ -639,9 +644,13 @@ class StudioScene(ScenePaths):
             marks = np.round(np.linspace(0, n - 1, len(states))).astype(int)
         else:
             marks = np.array([0, n - 1])
-        playback = Playback(t, q, self.tool_positions(q), marks, time.perf_counter())
+        view = self._view
+        tool = np.array([view.tool(qi) for qi in q]) if view.name == robot else None
+        tool = self.tool_positions(q) if tool is None else tool
+        playback = Playback(t, q, tool, marks, time.perf_counter())
         with self._lock:
             self._playback = playback
+            self._playback_robot = robot
         self._wake.set()
 
     def scrub(
@@ -677,6 +686,7 @@ class StudioScene(ScenePaths):
         playback = Playback(t, q, self.tool_positions(q), marks, time.perf_counter(), paused=True)
         with self._lock:
             self._playback = playback
+            self._playback_robot = "puma560"
         self._wake.set()
 
     def stop_playback(self) -> None:

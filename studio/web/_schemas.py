@@ -386,6 +386,10 @@ class _RunCreateBase(_Body):
     once."""
 
     name: str | None = None
+    robot: str | None = None
+    """The robot trained on, by the name ``studio robots`` lists (its first three joints on the
+    grid, its first ``joints`` on the continuous task); left out: the robot chosen in the page
+    (``PUT /api/robot``), the Puma560 by default. An unknown name is refused (422)."""
     planning: PlanningName = _DYNAQ.planning  # type: ignore[assignment]
     planning_steps: int = _DYNAQ.planning_steps
     epsilon: float = _DYNAQ.epsilon
@@ -427,8 +431,10 @@ class ReachRunCreate(_RunCreateBase):
     """What one action moves: "single" (one joint), "pairs" (also two together), "all"."""
     tilings: int = REACH_DEFAULTS["tilings"]
     """Offset tilings of each joint."""
-    tiles: int = REACH_DEFAULTS["tiles"]
-    """Tiles per joint in each tiling."""
+    tiles: int | None = REACH_DEFAULTS["tiles"]
+    """Tiles per joint in each tiling; left out (null): the robot's default (32 for the Puma560,
+    more for an arm whose joints 1-3 turn further, so none of their tiles is wider than 10
+    degrees)."""
     bins: int | None = None
     """Not used by this task: the page's form sends its grid field along with every run."""
 
@@ -456,7 +462,7 @@ class RunDefaults(GridRunCreate):
     step_deg: float = REACH_DEFAULTS["step_deg"]
     actions: str = REACH_DEFAULTS["actions"]
     tilings: int = REACH_DEFAULTS["tilings"]
-    tiles: int = REACH_DEFAULTS["tiles"]
+    tiles: int | None = REACH_DEFAULTS["tiles"]
 
 
 class RunPublic(BaseModel):

@@ -31,7 +31,14 @@ from studio.capture import (
     SimulatorSource,
     source_from_spec,
 )
-from studio.kinematics import load_robot, robot_names, robot_spec
+from studio.export import ExportError, training_demonstration
+from studio.kinematics import (
+    DEFAULT_ROBOT,
+    KinematicsError,
+    load_robot,
+    robot_names,
+    robot_spec,
+)
 from studio.learning import (
     GOAL_JOINTS,
     DemonstrationPath,
@@ -44,6 +51,7 @@ from ._errors import ConflictError, InvalidError, NotFoundError, TooManyRequests
 from ._pipeline import Pipeline
 from ._protocols import Scene
 from ._runs import RunQueue
+from ._schemas import RunCreate
 from ._settings import Settings
 from ._store import (
     demonstration_store,
@@ -430,19 +438,32 @@ class Studio:
 
     # ------------------------------------------------------------------ demonstrations
 
-    def demonstration_path(self, name: str) -> DemonstrationPath:
-        """A demonstration's Puma560 joint path ``(N, 6)`` (rad) and times, for training runs.
+    def with_robot(self, create: RunCreate) -> RunCreate:
+        """``create`` with its robot filled in: the one chosen in the page when it names none."""
+        if create.robot is not None:
+            return create
+        return create.model_copy(update={"robot": self.pipeline.robot_name})
+
+    def demonstration_path(self, name: str, robot: str = DEFAULT_ROBOT) -> DemonstrationPath:
+        """A demonstration's joint path on ``robot`` (rad) and times, for training runs: its
+        stored Puma560 path, or its recording's segment retargeted onto another robot
+        (:func:`studio.export.training_demonstration`).
 
         Raises:
-            InvalidError: no such demonstration (a bad run parameter, so 422 rather than 404).
+            InvalidError: no such demonstration, or it cannot be retargeted (a bad run parameter,
+                so 422 rather than 404).
         """
         try:
-            demo = self.demonstrations.load(name)
+            self.demonstrations.load(name)
+            return training_demonstration(
+                self.demonstrations.path(name), robot, f"Demonstration {name!r}", name
+            )
         except NotFoundError:
             raise InvalidError(
                 f"demonstrations names {name!r}, which does not exist; pick demonstrations from the list."
             ) from None
-        return DemonstrationPath(f"Demonstration {name!r}", demo.q_robot, name, demo.times)
+        except (ExportError, KinematicsError) as err:
+            raise InvalidError(str(err)) from None
 
     def cut_demonstration(
         self,

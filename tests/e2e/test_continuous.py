@@ -39,8 +39,10 @@ def continuous_run(page: Any, studio_server: Studio) -> dict:
     page.select_option("[data-testid='train-task']", "arm-reach")
     assert page.is_visible("[data-testid='train-joints']")
     assert not page.is_visible("[data-testid='train-bins']")
-    for key, field in (("joints", "joints"), ("step_deg", "step"), ("tiles", "tiles")):
+    for key, field in (("joints", "joints"), ("step_deg", "step")):
         assert float(page.input_value(f"[data-testid='train-{field}']")) == defaults[key]
+    assert defaults["tiles"] is None  # the robot's own default
+    assert page.input_value("[data-testid='train-tiles']") == ""
     page.fill("[data-testid='train-name']", RUN_NAME)
     page.fill("[data-testid='train-joints']", "3")
     page.select_option("[data-testid='train-planning']", "zero")

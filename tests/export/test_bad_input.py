@@ -4,10 +4,14 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from studio.cli import main
 from studio.export import ExportError, export_urdf, find_source, portable_urdf
+from studio.kinematics import robot_spec
+from studio.learning import ArmGrid, DynaQConfig
+from studio.learning._policy import save_policy
 from studio.samples import SAMPLES_DIR
 
 
@@ -26,15 +30,21 @@ def test_an_unknown_robot_is_one_sentence_and_writes_nothing(tmp_path, monkeypat
     assert list(tmp_path.iterdir()) == []
 
 
-def test_a_policy_for_another_robot_is_refused_in_one_sentence(tmp_path, capsys):
+@pytest.mark.parametrize(("learnt", "asked"), [("puma560", "ur5"), ("panda", "puma560")])
+def test_a_policy_for_another_robot_is_refused_in_one_sentence(tmp_path, capsys, learnt, asked):
+    grid = ArmGrid(robot=learnt)
     policy = tmp_path / "arm.policy.npz"
-    policy.write_bytes(b"a policy learnt on the Puma560")
+    save_policy(policy, grid, np.zeros((grid.n_states, grid.n_actions)), DynaQConfig())
     out = tmp_path / "arm.csv"
     assert (
-        main(["export", str(policy), "--robot", "ur5", "--format", "csv", "--out", str(out)]) == 2
+        main(["export", str(policy), "--robot", asked, "--format", "csv", "--out", str(out)]) == 2
     )
     err = _one_sentence(capsys.readouterr().err)
-    assert "was learnt on the Puma560" in err and "--robot puma560" in err
+    learnt_title, asked_title = robot_spec(learnt).title, robot_spec(asked).title
+    assert (
+        f"was learnt on the {learnt_title} and drives only that robot, not the {asked_title}" in err
+    )
+    assert f"--robot {learnt}" in err
     assert not out.exists()
 
 

@@ -346,7 +346,7 @@ def test_train_takes_the_continuous_defaults_and_checks_from_the_page(tmp_path) 
         form = client.get("/api/config").json()["training"]
     task, coding = settings.arm_reach(), settings.tile_coding()
     assert task.joints == form["joints"] and task.step_deg == form["step_deg"]
-    assert coding.tiles == form["tiles"]
+    assert form["tiles"] is None and coding.tiles == task.default_tiles == 32  # the robot's own
     assert coding.tilings == form["tilings"]
     page = ReachRunCreate(task="arm-reach")
     keys = ("planning", "planning_steps", "alpha", "gamma", "epsilon")

@@ -41,7 +41,7 @@ def test_a_record_keeps_the_motions_and_reads_older_files_without_them():
 @pytest.mark.parametrize(
     ("times", "q", "words"),
     [
-        (np.arange(3.0), np.zeros((3, 7)), "7 joint angles"),
+        (np.arange(3.0), np.zeros((3, 8)), "8 joint angles"),
         (np.arange(1.0), np.zeros((1, 6)), "zero length"),
         (np.zeros(3), np.zeros((3, 6)), "zero length"),
         (np.arange(3.0), np.array([[0.0] * 6, [math.nan] * 6, [0.0] * 6]), "NaN"),

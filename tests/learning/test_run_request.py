@@ -144,5 +144,5 @@ def test_a_page_config_json_of_the_previous_layout_loads_typed(tmp_path):
     grid_form = {
         k: v for k, v in request.items() if k not in ("joints", "step_deg", "tilings", "tiles")
     }
-    assert written["request"] == grid_form
+    assert written["request"] == {**grid_form, "robot": "puma560"}  # the form names its robot
     assert RunRecord.from_dict(written) == record

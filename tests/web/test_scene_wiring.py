@@ -39,7 +39,7 @@ class FakeScene:
     def clear_path(self, name=None) -> None:
         self.calls.append(("clear_path", (name,)))
 
-    def play_trajectory(self, times, q_robot, states=None) -> None:
+    def play_trajectory(self, times, q_robot, states=None, robot="puma560") -> None:
         self.playing = True
         self.calls.append(("play_trajectory", (times, q_robot, states)))
 

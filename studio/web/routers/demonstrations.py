@@ -112,7 +112,7 @@ def check_run_demonstrations(body: RunCreate, studio: StudioDep) -> Response:
     """Check a run form as it is filled in (the demonstrations picked against its goal and task)
     with the one resolver a run is started with; nothing is queued. 204 when it would start, else
     the 422 starting it would answer (``detail``, ``problems``, ``by_field``)."""
-    prepare_run(body, studio.demonstration_path)
+    prepare_run(studio.with_robot(body), studio.demonstration_path)
     return Response(status_code=204)
 
 

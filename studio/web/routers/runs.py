@@ -36,7 +36,7 @@ def list_runs(studio: StudioDep) -> list[RunPublic]:
 def create_run(body: RunCreate, studio: StudioDep) -> RunPublic:
     """Validate and queue a run; it trains when the runs before it are done (422 naming every
     bad field: ``detail`` joins them, ``problems`` lists them, ``by_field`` keys them by field)."""
-    run = studio.runs.submit(body, studio.demonstration_path)
+    run = studio.runs.submit(studio.with_robot(body), studio.demonstration_path)
     return run.model()
 
 

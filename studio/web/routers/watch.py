@@ -14,6 +14,8 @@ from studio.learning import (
     LearningError,
     PolicyFile,
     TilePolicyFile,
+    check_policy_robot,
+    default_goal,
     greedy_path,
     greedy_rollout,
     likeness_cards,
@@ -48,6 +50,16 @@ def watch(body: WatchCreate, studio: StudioDep) -> WatchPublic:
     """Roll the greedy policy of a run or an uploaded policy (exactly one; 422 otherwise) out from
     a random or the current pose and play it in the scene (409 if the run has no policy yet)."""
     policy, key = studio.load_policy(body.run, body.policy)
+    if policy.robot is not None:  # (None: not an arm's policy, refused below)
+        try:
+            check_policy_robot(
+                policy.robot,
+                studio.pipeline.robot_name,
+                "This policy",
+                f"pick the {policy.robot} under Source to watch it",
+            )
+        except LearningError as err:
+            raise ConflictError(str(err)) from None
     if isinstance(policy, TilePolicyFile):
         watched = _watch_tile_policy(body, studio, policy, key)
     elif isinstance(policy, DmpPolicyFile):
@@ -115,17 +127,17 @@ def _watch_grid_policy(
     else:
         starts = grid.mdp().start_states
         start = int(starts[np.random.default_rng(seed).integers(len(starts))])
-    hold = np.zeros(6)
-    if body.start == "current":
-        hold[grid.joints :] = np.asarray(q_now)[grid.joints : 6]
+    hold = default_goal(grid.robot)  # the joints beyond the grid's
+    if body.start == "current" and len(q_now) == len(hold):
+        hold[grid.joints :] = np.asarray(q_now)[grid.joints :]
     times, q = rollout(policy, start, ROLLOUT_RATE_HZ, hold=hold)
     states = greedy_path(policy, start)
     studio.keep_rollout(key, times, q)
     if studio.scene is not None:
-        goal = np.zeros(6)
+        goal = default_goal(grid.robot)
         goal[: grid.joints] = grid.angles_of(grid.goal_state)
         studio.scene.set_goal(goal)
-        studio.scene.play_trajectory(times, q, states)
+        studio.scene.play_trajectory(times, q, states, robot=grid.robot)
     return WatchPublic(
         steps=len(states) - 1,
         seed=seed,
@@ -167,11 +179,11 @@ def _watch_tile_policy(
             if key.startswith("run:")
             else []
         )
-        if demos:
+        if demos and task.robot == "puma560":  # the scene draws paths of the Puma560's joints
             path = np.tile(np.asarray(task.goal), (len(demos[0]), 1))
             path[:, : task.joints] = np.asarray(demos[0])[:, : task.joints]
             studio.scene.show_path(TILE_DEMONSTRATION_PATH, path)
-        studio.scene.play_trajectory(times, q)
+        studio.scene.play_trajectory(times, q, robot=task.robot)
     return WatchPublic(
         steps=len(path) - 1,
         seed=seed,

@@ -116,6 +116,7 @@ function renderRobot(s) {
   if (s.robot && !select.dataset.pending && document.activeElement !== select && select.querySelector(`option[value="${s.robot}"]`)) {
     setProp(select, "value", s.robot);
   }
+  showTrainedRobot();
   // Joint mode maps the arm onto the Puma560's joints; any other robot follows the hand.
   const joint = $("retarget-mode").querySelector('option[value="joint"]');
   if (joint) setProp(joint, "disabled", !!s.robot && s.robot !== "puma560");
@@ -135,7 +136,14 @@ export async function loadRobots() {
       return o;
     }));
     select.value = body.robot;
+    showTrainedRobot();
   });
+}
+
+/** The train form says which robot a run trains: the one chosen here. */
+function showTrainedRobot() {
+  const option = $("robot-name").selectedOptions[0];
+  if (option) setText("train-robot", option.textContent);
 }
 
 export async function setRobot() {
@@ -145,6 +153,7 @@ export async function setRobot() {
     const chosen = await guarded("source-error", async () => {
       const body = await api("PUT", "/api/robot", { name: select.value });
       select.value = body.robot;
+      showTrainedRobot();
       return true;
     }, select);
     if (!chosen && S.source && S.source.robot) select.value = S.source.robot;

@@ -92,9 +92,12 @@ function readTrainForm() {
     throw err;
   }
   if (body.task === "arm-reach") {
-    for (const k of REACH_FIELDS) body[k] = num(k);
+    // an empty tiles field leaves the robot's default (the API's null)
+    for (const k of REACH_FIELDS) if (k !== "tiles" || f[k].value.trim() !== "") body[k] = num(k);
     body.actions = f.actions.value;
   }
+  const robot = $("robot-name").value; // the robot chosen under Source, shown in the form
+  if (robot) body.robot = robot;
   if (f.name.value.trim()) body.name = f.name.value.trim();
   return body;
 }
