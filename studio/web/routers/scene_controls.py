@@ -185,7 +185,7 @@ def change_follow(body: FollowChange, studio: StudioDep) -> ViewsPublic:
     scene = _scene(studio)
     scene.camera.following = body.on
     if body.on:
-        scene.camera.follow(scene.tool_positions(scene.current_q_robot())[0])
+        scene.camera.follow(scene.tool_positions(scene.current_q_robot(), scene.robot_name)[0])
     return read_views(studio)
 
 

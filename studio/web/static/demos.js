@@ -2,6 +2,7 @@
 
 import { api, guarded } from "./api.js";
 import { $, confirmDialog, el, emptyRow, enc, flashRow, fmt, groupRow, setProp, setText, showError } from "./dom.js";
+import { fillExportItems } from "./exports.js";
 import { renderWatchDemos } from "./policies.js";
 import { S } from "./state.js";
 
@@ -122,6 +123,7 @@ function renderDemos() {
   }
   body.replaceChildren(...rows);
   renderWatchDemos();
+  fillExportItems("demonstration");
   // The training form's demonstration checkboxes keep their ticks across refreshes.
   const box = $("train-demos");
   const ticked = new Set([...box.querySelectorAll("input:checked")].map((i) => i.value));
