@@ -43,7 +43,7 @@ export function buildExportControl(kind) {
   if (k.items) {
     parts.push(el("select", { id: `${kind}-export-item`, testid: `${kind}-export-item`, class: "grow", "aria-label": `${noun} to export` }));
   }
-  parts.push(el("select", { id: `${kind}-export-format`, testid: `${kind}-export-format`, "aria-label": `${noun} export format` },
+  parts.push(el("select", { id: `${kind}-export-format`, testid: `${kind}-export-format`, class: "export-format", "aria-label": `${noun} export format` },
     ...k.formats.map(([value, label]) => el("option", { value, text: label }))));
   parts.push(el("button", { id: `${kind}-export-go`, testid: k.testid || `${kind}-export-go`, title: k.title, onclick: () => exportNow(kind, false) }, `Export ${k.noun}`));
   const anyway = el("button", { id: `${kind}-export-anyway`, testid: `${kind}-export-anyway`, hidden: true, title: "write the file even though the safety checks refuse it; every finding is stated in it", onclick: () => exportNow(kind, true) }, ANYWAY);
