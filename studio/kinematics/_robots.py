@@ -520,6 +520,18 @@ class RobotArm:
         return self._collision_data is not None
 
 
+def _visual_mesh_loader() -> object:
+    """The mesh loader of the visual meshes: axis-aligned boxes around their triangles.
+
+    The visual meshes are only drawn and exported, never queried for distances, so the tree
+    built around their triangles can be the cheapest; Coal's default (oriented boxes and swept
+    spheres) takes about twice as long on the finely meshed arms (SO-101: 4.4 s -> 1.7 s).
+    """
+    import coal  # Pinocchio's collision library, installed with it
+
+    return coal.MeshLoader(coal.BV_AABB)
+
+
 def _convex(geom: pin.GeometryModel) -> None:
     """Replace each collision mesh by its convex hull.
 
@@ -613,8 +625,11 @@ def load_robot(name: str, geometry: bool = True) -> RobotArm:
         model = pin.buildModelFromXML(text)
         if geometry:
             geoms = [
-                pin.buildGeomFromUrdfString(model, text, kind, None, package_dirs)
-                for kind in (pin.GeometryType.VISUAL, pin.GeometryType.COLLISION)
+                pin.buildGeomFromUrdfString(model, text, kind, None, package_dirs, loader)
+                for kind, loader in (
+                    (pin.GeometryType.VISUAL, _visual_mesh_loader()),
+                    (pin.GeometryType.COLLISION, None),
+                )
             ]
         else:
             geoms = [pin.GeometryModel(), pin.GeometryModel()]
