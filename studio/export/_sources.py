@@ -167,7 +167,7 @@ def recording_motion(
             a long take); the retargeting's step cap then grows k-fold, so the robot follows
             as it would frame by frame. None: every frame, as an export needs.
     """
-    robot = load_robot(robot_name)
+    robot = load_robot(robot_name).scratch_copy()  # its own scratch data: any thread
     rec = read_any_recording(path)
     rows = rec.segment(0.0 if t0 is None else t0, rec.duration if t1 is None else t1)
     start, stop, _ = rows.indices(len(rec))
@@ -191,7 +191,7 @@ def recording_motion(
 def demonstration_motion(path: Path, robot_name: str, rate_hz: float) -> Motion:
     """A demonstration's path on ``robot_name`` (its stored Puma560 trajectory, or its
     recording's segment retargeted onto another robot), to be timed."""
-    robot = load_robot(robot_name)
+    robot = load_robot(robot_name).scratch_copy()  # its own scratch data: any thread
     demo = load_demonstration(path)
     if robot.name == POLICY_ROBOT:
         times = demo.times - demo.times[0]
@@ -212,7 +212,7 @@ def demonstration_motion(path: Path, robot_name: str, rate_hz: float) -> Motion:
 
 def check_policy_robot(path: Path, robot_name: str) -> RobotArm:
     """The robot a policy file drives, or an ExportError when another one is asked for."""
-    robot = load_robot(robot_name)
+    robot = load_robot(robot_name).scratch_copy()  # its own scratch data: any thread
     if robot.name != POLICY_ROBOT:
         raise ExportError(
             f"The policy {path.name} was learnt on the {load_robot(POLICY_ROBOT).spec.title} and "

@@ -366,7 +366,8 @@ def retarget_path(
     The Puma560 in joint mode (the paper's), any other arm in cartesian mode; the first frame is
     settled first (the IK starts cold there, so it gets ``config.settle_tries`` passes). The
     frames are taken in order, each warm-started from the one before, so the path is the one a
-    live session would have shown.
+    live session would have shown. Safe beside a live session of the same robot: it computes on
+    scratch data of its own (:meth:`RobotArm.scratch_copy`).
 
     Raises:
         KinematicsError: angles of the wrong shape or not finite.
@@ -374,7 +375,10 @@ def retarget_path(
     config = config or RetargetConfig()
     q_h = np.asarray(q_human, dtype=float).reshape(-1, 7)
     puma = robot.name == "puma560"
-    retargeter = Retargeter(config=config) if puma else Retargeter(robot=robot, config=config)
+    if puma:
+        retargeter = Retargeter(config=config)
+    else:
+        retargeter = Retargeter(robot=robot.scratch_copy(), config=config)
     q = np.empty((len(q_h), robot.nq))
     error = np.zeros(len(q_h))
     out = np.zeros(len(q_h), dtype=bool)

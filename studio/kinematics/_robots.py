@@ -19,6 +19,7 @@ published (Panda) and otherwise twice the velocity limit per second, a conservat
 
 from __future__ import annotations
 
+import copy
 import functools
 import importlib.metadata
 import math
@@ -260,7 +261,8 @@ class Collision:
 class RobotArm:
     """One robot's arm: Pinocchio model of its arm joints, limits, IK and self-collision.
 
-    Build it with :func:`load_robot` (cached per name). Not thread-safe: one per thread.
+    Build it with :func:`load_robot` (cached per name). Not thread-safe: one per thread
+    (:meth:`scratch_copy` gives another thread its own).
 
     Attributes:
         spec: the :class:`RobotSpec`.
@@ -318,6 +320,15 @@ class RobotArm:
         self._collision_data: pin.GeometryData | None = None
         if len(collision_model.geometryObjects):
             self._set_collision_pairs(srdf)
+
+    def scratch_copy(self) -> RobotArm:
+        """The same robot with scratch data of its own, for another thread: the model and the
+        geometry are shared (never written), the data each computation writes is not."""
+        other = copy.copy(self)
+        other.data = self.model.createData()
+        if self._collision_data is not None:
+            other._collision_data = pin.GeometryData(self.collision_model)
+        return other
 
     @property
     def tool_frame(self) -> int:

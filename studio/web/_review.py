@@ -89,7 +89,7 @@ class Reviewer:
             with self._lock:
                 retargeter = self._cursor.get(robot)
                 if retargeter is None:
-                    arm = load_robot(robot)
+                    arm = load_robot(robot).scratch_copy()  # the live thread has its own
                     retargeter = Retargeter(robot=arm, config=CURSOR_RETARGET)
                     self._cursor = {robot: retargeter}
                 q = retargeter.robot_from_human(q_human)

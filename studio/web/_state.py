@@ -353,7 +353,7 @@ class Studio:
                 self._robot_switching = None
             if self.scene is not None:
                 self.scene.set_robot(arm)  # its meshes are read in the background
-            self.pipeline.set_robot(arm)
+            self.pipeline.set_robot(arm.scratch_copy())  # the live thread's own scratch data
 
     def robot_state(self) -> dict[str, object]:
         """The robot the scene draws, the one whose meshes it reads, and one sentence for each

@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import math
+import sys
+import threading
 
 import numpy as np
 import pytest
@@ -253,3 +255,31 @@ def test_a_path_retargets_onto_the_puma_by_the_joint_map_and_onto_an_arm_frame_b
         if live.last_ik is not None and live.last_ik.success:
             break
     assert np.allclose(path.q, [live.robot_from_human(q) for q in q_human])
+
+
+def test_paths_retargeted_in_threads_at_once_are_each_the_one_retargeted_alone() -> None:
+    panda = load_robot("panda")
+    rng = np.random.default_rng(3)
+    paths = [np.cumsum(rng.normal(0.0, 0.01, (80, 7)), axis=0) + [0.5, 0, 0, 0.6, 0, 0, 0]]
+    paths.append(paths[0][::-1].copy())
+    alone = [retarget_path(panda, p).q for p in paths]
+    together: list[np.ndarray | None] = [None, None]
+
+    def run(i: int) -> None:
+        together[i] = retarget_path(panda, paths[i]).q
+
+    threads = [threading.Thread(target=run, args=(i,)) for i in range(2)]
+    interval = sys.getswitchinterval()
+    sys.setswitchinterval(1e-6)  # the threads take turns between almost every two steps
+    try:
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join()
+    finally:
+        sys.setswitchinterval(interval)
+    for a, b in zip(alone, together, strict=True):
+        assert b is not None and np.array_equal(a, b)
+    copy = panda.scratch_copy()
+    assert copy.model is panda.model and copy.data is not panda.data
+    assert np.allclose(copy.forward(panda.home), panda.forward(panda.home))
