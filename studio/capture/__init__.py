@@ -62,6 +62,7 @@ from ._serial import SerialSource as SerialSource
 from ._series import DEFAULT_SERIES_POINTS as DEFAULT_SERIES_POINTS
 from ._series import MAX_SERIES_POINTS as MAX_SERIES_POINTS
 from ._series import RecordingSeries as RecordingSeries
+from ._series import human_angles as human_angles
 from ._series import recording_series as recording_series
 from ._simulator import OperatorConfig as OperatorConfig
 from ._simulator import SimulatorSource as SimulatorSource

@@ -43,6 +43,24 @@ class RecordingSeries:
     kind: str
 
 
+def human_angles(
+    recording: Recording | ObservationRecording, rows: slice | np.ndarray
+) -> np.ndarray:
+    """The human arm's angles ``(N, 7)`` at ``rows`` of a recording (a slice, or row indices in
+    order), each frame fitted by the recording's own fitter seeded by the frame before: the arm a
+    live session would have shown, ready to be retargeted onto any robot.
+    """
+    indices = range(*rows.indices(len(recording))) if isinstance(rows, slice) else rows
+    if not len(indices):
+        return np.zeros((0, 7))
+    first = recording.frame_at(int(indices[0]))
+    if isinstance(recording, Recording):
+        fitter = fitter_for(first, tape=recording.config)
+    else:
+        fitter = fitter_for(first, side=recording.side)
+    return np.array([fitter.fit(recording.frame_at(int(i))).q_human for i in indices])
+
+
 def recording_series(
     recording: Recording | ObservationRecording | str | os.PathLike[str],
     points: int = DEFAULT_SERIES_POINTS,

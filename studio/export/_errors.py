@@ -16,6 +16,9 @@ class SafetyError(ExportError):
     there are; ``--unchecked`` writes the file anyway with all of them stated in it.
     """
 
+    reason = "safety"
+    """What refused it, for a program (the page offers to export anyway, findings stated)."""
+
     def __init__(self, message: str, findings: list[str]) -> None:
         super().__init__(message)
         self.findings = findings

@@ -14,7 +14,7 @@ Puma560's).
 from __future__ import annotations
 
 import functools
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Literal
 
@@ -25,11 +25,11 @@ from studio.capture import (
     RECORDING_SUFFIXES,
     ObservationRecording,
     Recording,
-    fitter_for,
+    human_angles,
     load_demonstration,
     read_any_recording,
 )
-from studio.kinematics import Retargeter, RobotArm, RobotIK, load_robot
+from studio.kinematics import RetargetConfig, RobotArm, load_robot, retarget_path
 from studio.learning import POLICY_SUFFIX, DemonstrationPath, LearningError
 from studio.learning import check_policy_robot as check_policy_robot_named
 from studio.samples import SAMPLES_DIR
@@ -47,10 +47,6 @@ RUNS_DIR = "runs"
 PUMA560 = "puma560"
 """The paper's robot: a demonstration keeps its stored trajectory for it, and joint mode maps the
 human arm onto it."""
-REACH_TOLERANCE_M = 0.01
-"""A retargeted tool further than this from the operator's mapped hand is out of reach."""
-SETTLE_TRIES = 5
-"""IK passes on the first frame (each warm-started from the last) before the motion starts."""
 
 
 @dataclass(frozen=True)
@@ -132,52 +128,26 @@ def find_source(given: str | Path, data_dir: str | Path = ".") -> Path:
     )
 
 
-def _human_angles(rec: Recording | ObservationRecording, rows: slice) -> np.ndarray:
-    """The human arm's angles (N, 7) of a recording's rows, through the capture fitters."""
-    indices = range(*rows.indices(len(rec)))
-    if not len(indices):
-        return np.zeros((0, 7))
-    first = rec.frame_at(indices[0])
-    if isinstance(rec, Recording):
-        fitter = fitter_for(first, tape=rec.config)
-    else:
-        fitter = fitter_for(first, side=rec.side)
-    return np.array([fitter.fit(rec.frame_at(i)).q_human for i in indices])
-
-
 def retarget(
-    robot: RobotArm, times: np.ndarray, q_human: np.ndarray
+    robot: RobotArm, times: np.ndarray, q_human: np.ndarray, config: RetargetConfig | None = None
 ) -> tuple[np.ndarray, list[Finding]]:
-    """The robot's joints (N, nq) for human-arm angles (N, 7), and the frames out of reach."""
-    retargeter = Retargeter() if robot.name == PUMA560 else Retargeter(robot=robot)
-    q = np.empty((len(q_human), robot.nq))
+    """The robot's joints (N, nq) for human-arm angles (N, 7)
+    (:func:`studio.kinematics.retarget_path`), and the first frame out of reach as a finding."""
+    path = retarget_path(robot, q_human, config)
     findings: list[Finding] = []
-    for _ in range(SETTLE_TRIES if len(q_human) else 0):
-        # the first frame starts the IK cold: let it settle there as a live session would
-        retargeter.robot_from_human(q_human[0])
-        if not isinstance(retargeter.last_ik, RobotIK) or retargeter.last_ik.success:
-            break
-    for i, q_h in enumerate(q_human):
-        q[i] = retargeter.robot_from_human(q_h)
-        ik = retargeter.last_ik
-        if (
-            not findings
-            and isinstance(ik, RobotIK)
-            and not ik.success
-            and ik.position_error > REACH_TOLERANCE_M
-        ):
-            findings.append(
-                Finding(
-                    i,
-                    float(times[i]),
-                    "reach",
-                    robot.spec.tool,
-                    f"frame {i} (t = {times[i]:.3f} s of the source): the hand's target is "
-                    f"{ik.position_error * 100:.1f} cm out of the {robot.spec.title}'s reach "
-                    f"(tolerance {REACH_TOLERANCE_M * 100:.0f} cm)",
-                )
+    for i in np.flatnonzero(path.out_of_reach)[:1]:
+        findings.append(
+            Finding(
+                int(i),
+                float(times[i]),
+                "reach",
+                robot.spec.tool,
+                f"frame {i} (t = {times[i]:.3f} s of the source): the hand's target is "
+                f"{path.position_error[i] * 100:.1f} cm out of the {robot.spec.title}'s reach "
+                f"(tolerance {RetargetConfig().reach_tolerance * 100:.0f} cm)",
             )
-    return q, findings
+        )
+    return path.q, findings
 
 
 def _capture_rate(rec: Recording | ObservationRecording, times: np.ndarray) -> float:
@@ -186,23 +156,46 @@ def _capture_rate(rec: Recording | ObservationRecording, times: np.ndarray) -> f
     return float(1.0 / np.median(np.diff(times))) if len(times) > 1 else 1.0
 
 
-def recording_motion(path: Path, robot_name: str) -> Motion:
-    """A recording retargeted onto ``robot_name`` at its capture times."""
-    robot = load_robot(robot_name)
+def recording_motion(
+    path: Path,
+    robot_name: str,
+    t0: float | None = None,
+    t1: float | None = None,
+    most_frames: int | None = None,
+) -> Motion:
+    """A recording (its ``[t0, t1]`` s, the whole by default) retargeted onto ``robot_name`` at
+    its capture times, from 0.
+
+    Args:
+        most_frames: take every k-th frame when the segment holds more than this (a preview of
+            a long take); the retargeting's step cap then grows k-fold, so the robot follows
+            as it would frame by frame. None: every frame, as an export needs.
+    """
+    robot = load_robot(robot_name).scratch_copy()  # its own scratch data: any thread
     rec = read_any_recording(path)
-    if len(rec) < 2:
-        raise ExportError(f"The recording {path.name} holds {len(rec)} frame; record a motion.")
-    times = np.asarray(rec.t - rec.t[0], dtype=float)
-    q, findings = retarget(robot, times, _human_angles(rec, slice(None)))
-    return Motion(
-        "recording", path.name, robot, times, q, True, _capture_rate(rec, times), tuple(findings)
-    )
+    rows = rec.segment(0.0 if t0 is None else t0, rec.duration if t1 is None else t1)
+    start, stop, _ = rows.indices(len(rec))
+    if stop - start < 2:
+        raise ExportError(
+            f"The recording {path.name} holds {max(stop - start, 0)} frame there; choose a "
+            "longer stretch, or record a motion."
+        )
+    stride = 1 if most_frames is None else max(1, -(-(stop - start) // max(int(most_frames), 2)))
+    rows = slice(start, stop, stride)
+    config = None
+    if stride > 1:
+        default = RetargetConfig()
+        config = replace(default, max_joint_step=default.max_joint_step * stride)
+    times = np.asarray(rec.t[rows] - rec.t[start], dtype=float)
+    q, findings = retarget(robot, times, human_angles(rec, rows), config)
+    rate = _capture_rate(rec, times) / stride
+    return Motion("recording", path.name, robot, times, q, True, rate, tuple(findings))
 
 
 def demonstration_motion(path: Path, robot_name: str, rate_hz: float) -> Motion:
     """A demonstration's path on ``robot_name`` (its stored Puma560 trajectory, or its
     recording's segment retargeted onto another robot), to be timed."""
-    robot = load_robot(robot_name)
+    robot = load_robot(robot_name).scratch_copy()  # its own scratch data: any thread
     demo = load_demonstration(path)
     if robot.name == PUMA560:
         times = demo.times - demo.times[0]
@@ -217,7 +210,7 @@ def demonstration_motion(path: Path, robot_name: str, rate_hz: float) -> Motion:
     rec = read_any_recording(recording)
     rows = rec.segment(demo.t0, demo.t1)
     times = np.asarray(rec.t[rows] - rec.t[rows][0], dtype=float)
-    q, findings = retarget(robot, times, _human_angles(rec, rows))
+    q, findings = retarget(robot, times, human_angles(rec, rows))
     return Motion("demonstration", path.name, robot, times, q, False, rate_hz, tuple(findings))
 
 
@@ -261,7 +254,7 @@ def check_policy_robot(path: Path, policy_robot: str | None, robot_name: str) ->
             out).
         robot_name: the robot asked for.
     """
-    robot = load_robot(robot_name)
+    robot = load_robot(robot_name).scratch_copy()  # its own scratch data: any thread
     if policy_robot is not None:
         try:
             check_policy_robot_named(

@@ -23,9 +23,9 @@ from ._puma import IKConfig as IKConfig
 from ._puma import Puma560 as Puma560
 from ._retarget import RetargetConfig as RetargetConfig
 from ._retarget import Retargeter as Retargeter
+from ._retarget import retarget_path as retarget_path
 from ._robots import DEFAULT_ROBOT as DEFAULT_ROBOT
 from ._robots import RobotArm as RobotArm
-from ._robots import RobotIK as RobotIK
 from ._robots import load_robot as load_robot
 from ._robots import robot_names as robot_names
 from ._robots import robot_spec as robot_spec

@@ -93,6 +93,11 @@ class RetargetConfig:
             pose closer than that is not taken (the last one is held). Convex-hull distances
             near contact vary by about a millimetre between evaluations, so the margin keeps
             every pose taken clear of contact for any later check.
+        reach_tolerance: a tool further than this from the hand's target is out of reach (m):
+            the page says so live, a path counts the frame (:func:`retarget_path`) and an
+            export names it.
+        settle_tries: IK passes on a path's first frame (each warm-started from the last)
+            before the path starts, as a live session settles before it moves.
     """
 
     reach_fraction: float = 0.95
@@ -101,6 +106,8 @@ class RetargetConfig:
     floor_softness: float = 0.05
     max_joint_step: float = math.radians(4.5)
     clearance: float = 0.005
+    reach_tolerance: float = 0.01
+    settle_tries: int = 5
 
     def __post_init__(self) -> None:
         positive_number(self.reach_fraction, "RetargetConfig.reach_fraction")
@@ -109,6 +116,8 @@ class RetargetConfig:
         positive_number(self.floor_softness, "RetargetConfig.floor_softness")
         positive_number(self.max_joint_step, "RetargetConfig.max_joint_step")
         positive_number(self.clearance, "RetargetConfig.clearance")
+        positive_number(self.reach_tolerance, "RetargetConfig.reach_tolerance")
+        whole_number(self.settle_tries, "RetargetConfig.settle_tries", 1)
 
 
 def _soft_floor(z: float, floor: float, width: float) -> float:
@@ -331,3 +340,56 @@ class Retargeter:
         for j, (i, _, offset, _) in enumerate(JOINT_MAP):
             q_human[i] = (q[j] - offset) * signs[j]
         return np.minimum(np.maximum(q_human, self.arm.lower), self.arm.upper)
+
+
+@dataclass(frozen=True)
+class RetargetedPath:
+    """A human-arm path retargeted onto one robot, frame by frame (:func:`retarget_path`).
+
+    Attributes:
+        q: the robot's joints, one row per frame (rad, ``(N, nq)``).
+        position_error: how far the tool stays from the hand's target per frame (m; 0 in joint
+            mode, which has no target).
+        out_of_reach: the frames whose target is out of reach (``RetargetConfig.reach_tolerance``).
+    """
+
+    q: np.ndarray
+    position_error: np.ndarray
+    out_of_reach: np.ndarray
+
+
+def retarget_path(
+    robot: RobotArm, q_human: np.ndarray, config: RetargetConfig | None = None
+) -> RetargetedPath:
+    """Retarget a human-arm path ``(N, 7)`` onto ``robot``, frame after frame, as live.
+
+    The Puma560 in joint mode (the paper's), any other arm in cartesian mode; the first frame is
+    settled first (the IK starts cold there, so it gets ``config.settle_tries`` passes). The
+    frames are taken in order, each warm-started from the one before, so the path is the one a
+    live session would have shown. Safe beside a live session of the same robot: it computes on
+    scratch data of its own (:meth:`RobotArm.scratch_copy`).
+
+    Raises:
+        KinematicsError: angles of the wrong shape or not finite.
+    """
+    config = config or RetargetConfig()
+    q_h = np.asarray(q_human, dtype=float).reshape(-1, 7)
+    puma = robot.name == "puma560"
+    if puma:
+        retargeter = Retargeter(config=config)
+    else:
+        retargeter = Retargeter(robot=robot.scratch_copy(), config=config)
+    q = np.empty((len(q_h), robot.nq))
+    error = np.zeros(len(q_h))
+    out = np.zeros(len(q_h), dtype=bool)
+    for _ in range(config.settle_tries if len(q_h) else 0):
+        retargeter.robot_from_human(q_h[0])
+        if not isinstance(retargeter.last_ik, RobotIK) or retargeter.last_ik.success:
+            break
+    for i, q_frame in enumerate(q_h):
+        q[i] = retargeter.robot_from_human(q_frame)
+        ik = retargeter.last_ik
+        if isinstance(ik, RobotIK):
+            error[i] = ik.position_error
+            out[i] = not ik.success and ik.position_error > config.reach_tolerance
+    return RetargetedPath(q, error, out)

@@ -556,10 +556,6 @@ class Pipeline:
         return str(side) if side in ("right", "left") else self.tape_config().side
 
 
-REACH_TOLERANCE_M = 0.01
-"""A tool further than this from the mirrored hand's target is out of reach (the page says so)."""
-
-
 def robot_note(arm: RobotArm, retargeter: Retargeter) -> str | None:
     """One sentence when ``arm`` does not follow the hand now: held clear of a self-collision,
     or the hand out of its reach; None while it follows."""
@@ -572,7 +568,7 @@ def robot_note(arm: RobotArm, retargeter: Retargeter) -> str | None:
         )
     found = retargeter.last_ik
     error = getattr(found, "position_error", 0.0)
-    if found is not None and not found.success and error > REACH_TOLERANCE_M:
+    if found is not None and not found.success and error > retargeter.config.reach_tolerance:
         return (
             f"The hand is out of the {title}'s reach: its tool stops {error * 100.0:.0f} cm "
             "short, as near as it gets; bring the hand closer to the shoulder."

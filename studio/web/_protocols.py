@@ -65,11 +65,11 @@ class Scene(LiveScene, Protocol):
     def playing(self) -> bool:
         """Whether a playback runs."""
 
-    def set_goal(self, q_robot_goal: np.ndarray | None) -> None:
-        """Show the goal's ghost robot (None hides it)."""
+    def set_goal(self, q_robot_goal: np.ndarray | None, robot: str | None = None) -> None:
+        """Show ``robot``'s goal (the Puma560's when None) as its ghost (None forgets goals)."""
 
-    def show_path(self, name: str, q_robot_path: np.ndarray) -> None:
-        """Draw the tool path of a robot joint path."""
+    def show_path(self, name: str, q_robot_path: np.ndarray, robot: str | None = None) -> None:
+        """Draw the tool path of ``robot``'s joint path (the Puma560's when None)."""
 
     def clear_path(self, name: str | None = None) -> None:
         """Remove a path (every path when None)."""
@@ -79,9 +79,9 @@ class Scene(LiveScene, Protocol):
         times: np.ndarray,
         q_robot: np.ndarray,
         states: Sequence[int] | None = None,
-        robot: str = "puma560",
+        robot: str | None = None,
     ) -> None:
-        """Animate ``robot`` along a trajectory (it moves while it is the robot drawn)."""
+        """Animate ``robot`` (the Puma560 when None) along a trajectory of its joints."""
 
     def stop_playback(self) -> None:
         """Stop a playback."""
@@ -97,14 +97,21 @@ class Scene(LiveScene, Protocol):
     def robot_mesh_count(self) -> int:
         """How many meshes draw it."""
 
+    @property
+    def robot_loading(self) -> str | None:
+        """The robot chosen whose meshes are being read (None once drawn)."""
+
+    def robot_notes(self) -> list[str]:
+        """Sentences saying what cannot be shown on the robot drawn now, and why."""
+
     def current_q_robot(self) -> np.ndarray:
         """The robot joints shown now."""
 
     robot: JointLimits
     camera: SceneCamera
 
-    def tool_positions(self, q_robot: np.ndarray) -> np.ndarray:
-        """World tool positions of joint configurations ``(N, n)`` -> ``(N, 3)``."""
+    def tool_positions(self, q_robot: np.ndarray, robot: str | None = None) -> np.ndarray:
+        """World tool positions of ``robot``'s joint configurations ``(N, n)`` -> ``(N, 3)``."""
 
     def scrub(
         self,

@@ -2,7 +2,10 @@
 timeline's cursor, and a segment's robot path drawn and played in the scene.
 
 The joints come from :func:`studio.capture.recording_series` (the capture package's fitters);
-this module only caches them per file and hands them to the scene.
+this module only caches them per file and hands them to the scene. On a robot other than the
+Puma560 the human arm's joints are retargeted onto it: the cursor's pose at once (one IK solve,
+warm-started from the pose before), a played stretch in the background by the studio's
+:class:`~._robot_playback.RobotPlayer`.
 """
 
 from __future__ import annotations
@@ -15,13 +18,18 @@ import numpy as np
 from fastapi import Depends, Request
 
 from studio.capture import RecordingSeries, recording_series
+from studio.export import recording_motion
+from studio.kinematics import RetargetConfig, Retargeter, load_robot
 
+from ._robot_playback import PREVIEW_FRAMES
 from ._state import Studio
 
 REVIEW_PATH = "review"
 """The scene path that shows the segment under review (one at a time, replaced by the next)."""
 CACHED_SERIES = 8
 """How many series are kept (a timeline's pose lookups read the one it plotted)."""
+CURSOR_RETARGET = RetargetConfig(max_joint_step=float(np.pi))
+"""The timeline's cursor jumps anywhere: its pose on a robot is not held to a frame's step."""
 
 
 class Reviewer:
@@ -32,6 +40,7 @@ class Reviewer:
         self._lock = threading.Lock()
         self._cache: OrderedDict[tuple[object, ...], RecordingSeries] = OrderedDict()
         self._plotted: dict[str, RecordingSeries] = {}
+        self._cursor: dict[str, Retargeter] = {}  # per robot, warm from the last cursor pose
 
     def series(
         self, name: str, points: int, t0: float | None = None, t1: float | None = None
@@ -64,29 +73,54 @@ class Reviewer:
         """Hold the robot at the pose of recording ``name`` at ``t`` s (the timeline's cursor).
 
         Returns:
-            The robot joints shown (rad, (6,)).
+            The robot joints shown (rad, (nq,) of the robot taught).
         """
         with self._lock:
             series = self._plotted.get(name)
         if series is None or not len(series.times):
             series = self.plotted(name, 400)
+        robot = self.studio.pipeline.robot_name
         if not len(series.times):
-            return np.zeros(6)
-        q = np.array([np.interp(t, series.times, col) for col in series.q_robot.T])
+            return np.zeros(load_robot(robot, geometry=False).nq)
+        if robot == "puma560":
+            q = np.array([np.interp(t, series.times, col) for col in series.q_robot.T])
+        else:
+            q_human = np.array([np.interp(t, series.times, col) for col in series.q_human.T])
+            with self._lock:
+                retargeter = self._cursor.get(robot)
+                if retargeter is None:
+                    arm = load_robot(robot).scratch_copy()  # the live thread has its own
+                    retargeter = Retargeter(robot=arm, config=CURSOR_RETARGET)
+                    self._cursor = {robot: retargeter}
+                q = retargeter.robot_from_human(q_human)
         scene = self.studio.scene
         if scene is not None:
-            scene.play_trajectory(np.zeros(1), q[None, :])
+            scene.play_trajectory(np.zeros(1), q[None, :], robot=robot)
         return q
 
-    def play(self, name: str, t0: float | None = None, t1: float | None = None) -> RecordingSeries:
+    def play(self, name: str, t0: float | None = None, t1: float | None = None) -> None:
         """Draw the robot's tool path of ``[t0, t1]`` (the whole recording by default) and play
-        it on the robot in real time."""
+        it on the robot taught in real time (on another robot than the Puma560, once retargeted
+        in the background)."""
+        scene, player = self.studio.scene, self.studio.player
+        robot = self.studio.pipeline.robot_name
+        if robot != "puma560" and scene is not None and player is not None:
+            path = self.studio.recordings.path(name)
+            stat = path.stat()
+            player.play(
+                robot,
+                f"the recording {name}",
+                ("recording", str(path), stat.st_mtime_ns, stat.st_size, robot, t0, t1),
+                lambda: recording_motion(path, robot, t0, t1, most_frames=PREVIEW_FRAMES),
+                REVIEW_PATH,
+            )
+            return
         series = self.series(name, 400, t0, t1)
-        scene = self.studio.scene
         if scene is not None and len(series.times):
             scene.show_path(REVIEW_PATH, series.q_robot)
             scene.play_trajectory(series.times, series.q_robot)
-        return series
+            if player is not None:
+                player.clear_note()
 
 
 _create_lock = threading.Lock()

@@ -1,6 +1,6 @@
-"""A recording or a demonstration, downloaded from the page as the chosen robot's trajectory
-through :mod:`studio.export` (the same retargeting, timing, safety checks and formats as
-``studio export``)."""
+"""A recording or a demonstration downloaded from the page as the chosen robot's trajectory, and
+a policy's watched rollout as its robot's, through :mod:`studio.export` (the same retargeting,
+timing, safety checks and formats as ``studio export``)."""
 
 from __future__ import annotations
 
@@ -9,10 +9,14 @@ import tempfile
 from pathlib import Path
 from typing import Literal, get_args
 
+import numpy as np
+
 from studio.capture import DEMO_SUFFIX, RECORDING_SUFFIXES
 from studio.export import (
     FORMAT_SUFFIXES,
     FORMATS,
+    Motion,
+    check_policy_robot,
     demonstration_motion,
     export_motion,
     recording_motion,
@@ -58,6 +62,37 @@ def export_for_robot(
         export_motion(motion, fmt, out, unchecked=unchecked)
         if fmt == "lerobot":
             out = Path(shutil.make_archive(str(out), "zip", root_dir=out))
+    except BaseException:
+        shutil.rmtree(folder, ignore_errors=True)
+        raise
+    return out, out.name, folder
+
+
+def export_rollout(
+    policy: Path,
+    robot: str,
+    name: str,
+    times: np.ndarray,
+    q: np.ndarray,
+    unchecked: bool = False,
+) -> tuple[Path, str, Path]:
+    """A policy's watched rollout ``(times, q)`` as an MCAP of its robot's
+    ``JointTrajectory``, at the rollout's own times, checked for safety first (``unchecked``:
+    written despite failed checks, the findings stated in it).
+
+    Returns:
+        ``(file, download name, folder)``, as :func:`export_for_robot`.
+
+    Raises:
+        SafetyError: the rollout fails the safety checks (nothing is written).
+        ExportError: the file cannot be written, or ``robot`` is not one offered.
+    """
+    arm = check_policy_robot(policy, robot, robot)
+    motion = Motion("policy", policy.name, arm, times, q, True, ROLLOUT_RATE_HZ)
+    folder = Path(tempfile.mkdtemp(prefix="studio-export-"))
+    try:
+        out = folder / f"{name}.rollout{FORMAT_SUFFIXES['mcap']}"
+        export_motion(motion, "mcap", out, unchecked=unchecked)
     except BaseException:
         shutil.rmtree(folder, ignore_errors=True)
         raise

@@ -14,6 +14,7 @@ import logging
 import threading
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
+from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
@@ -28,7 +29,10 @@ from studio.kinematics import (
     load_robot,
     puma560_meshes,
     robot_meshes,
+    robot_spec,
 )
+
+from ._mesh_cache import cached_parts, mesh_key
 
 
 @dataclass(frozen=True, eq=False)
@@ -62,10 +66,18 @@ def puma_view(puma: Puma560, config: MeshConfig) -> RobotView:
         frames = puma.joint_frames(np.asarray(q, dtype=float))
         return np.stack([frames[int(p.frame)] for p in parts])
 
+    return RobotView(
+        "puma560", parts, 6, np.array(puma.qz, dtype=float), poses, puma_view_tool(puma)
+    )
+
+
+def puma_view_tool(puma: Puma560) -> Callable[[np.ndarray], np.ndarray]:
+    """Joint angles -> world position of the Puma560's tool (its base is the world's origin)."""
+
     def tool(q: np.ndarray) -> np.ndarray:
         return puma.forward(np.asarray(q, dtype=float))[:3, 3]
 
-    return RobotView("puma560", parts, 6, np.array(puma.qz, dtype=float), poses, tool)
+    return tool
 
 
 def arm_framing(arm: RobotArm) -> tuple[float, float]:
@@ -80,22 +92,48 @@ def arm_framing(arm: RobotArm) -> tuple[float, float]:
     return scale, pedestal
 
 
-def arm_view(arm: RobotArm, config: MeshConfig) -> RobotView:
-    """A robot of :func:`~studio.kinematics.load_robot` drawn from its URDF's meshes.
+def arm_tool(arm: RobotArm) -> Callable[[np.ndarray], np.ndarray]:
+    """Joint angles -> world position of ``arm``'s tool, framed as :func:`arm_view` draws it
+    (needs no meshes: a path's tool line is ready before its robot is drawn)."""
+    if arm.name == "puma560":
+        return puma_view_tool(Puma560())
+    scale, pedestal = arm_framing(arm)
+    data = arm.model.createData()  # its own scratch data, as the retargeting has its own
+    lock = threading.Lock()
+    lift = np.array([0.0, 0.0, pedestal])
+
+    def tool(q: np.ndarray) -> np.ndarray:
+        with lock:
+            pin.framesForwardKinematics(arm.model, data, np.asarray(q, dtype=float))
+            return data.oMf[arm.tool_frame].translation * scale + lift
+
+    return tool
+
+
+def arm_view(arm: RobotArm, config: MeshConfig, cache: Path | None = None) -> RobotView:
+    """A robot of :func:`~studio.kinematics.load_robot` drawn from its URDF's meshes (kept
+    simplified in the ``cache`` folder, :mod:`._mesh_cache`, when one is given).
 
     Raises:
         KinematicsError: a mesh file is missing or unreadable.
     """
     scale, pedestal = arm_framing(arm)
-    parts = [
-        MeshPart(p.name, p.frame, p.vertices * np.float32(scale), p.faces, p.rgb)
-        # simplified at the size drawn: an enlarged arm keeps the detail of a full-size one
-        for p in robot_meshes(arm.visual_model, replace(config, cell_m=config.cell_m / scale))
-    ]
+    # simplified at the size drawn: an enlarged arm keeps the detail of a full-size one
+    simplified = replace(config, cell_m=config.cell_m / scale)
+
+    def build() -> list[MeshPart]:
+        return [
+            MeshPart(p.name, p.frame, p.vertices * np.float32(scale), p.faces, p.rgb)
+            for p in robot_meshes(arm.visual_model, simplified)
+        ]
+
+    files = [str(g.meshPath) for g in arm.visual_model.geometryObjects]
+    parts = cached_parts(cache, arm.name, mesh_key(files, simplified.cell_m, scale), build)
     # Its own scratch data: the arm's own is the retargeting's, in another thread.
     data, geometry_data = arm.model.createData(), arm.visual_model.createData()
     lock = threading.Lock()
     lift = np.array([0.0, 0.0, pedestal])
+    tool = arm_tool(arm)
 
     def poses(q: np.ndarray) -> np.ndarray:
         with lock:
@@ -105,11 +143,6 @@ def arm_view(arm: RobotArm, config: MeshConfig) -> RobotView:
             out = np.stack([geometry_data.oMg[int(p.frame)].homogeneous for p in parts])
         out[:, :3, 3] = out[:, :3, 3] * scale + lift
         return out
-
-    def tool(q: np.ndarray) -> np.ndarray:
-        with lock:
-            pin.framesForwardKinematics(arm.model, data, np.asarray(q, dtype=float))
-            return data.oMf[arm.tool_frame].translation * scale + lift
 
     return RobotView(
         arm.name, parts, arm.nq, np.array(arm.home, dtype=float), poses, tool, pedestal
@@ -125,14 +158,35 @@ class RobotViews:
     Args:
         puma: the scene's Puma560 (its view is built at once: the scene starts with it).
         config: mesh simplification.
+        cache: the folder keeping the simplified meshes (None: none kept).
     """
 
-    def __init__(self, puma: Puma560, config: MeshConfig) -> None:
+    def __init__(self, puma: Puma560, config: MeshConfig, cache: Path | None = None) -> None:
         self.puma = puma_view(puma, config)
         self._config = config
+        self._cache = cache
         self._views = {self.puma.name: self.puma}
         self._lock = threading.Lock()
         self._wanted = self.puma.name
+        self.failed = ""
+        """Why the robot last chosen could not be drawn (empty when it could)."""
+
+    @property
+    def wanted(self) -> str:
+        """The robot chosen last."""
+        with self._lock:
+            return self._wanted
+
+    def built(self, name: str) -> RobotView | None:
+        """The view of robot ``name`` if it has been built."""
+        with self._lock:
+            return self._views.get(name)
+
+    @staticmethod
+    def title(name: str) -> str:
+        """A robot's name as a sentence says it (its title without the remark in brackets:
+        ``Franka Emika Panda``, ``Puma560``)."""
+        return robot_spec(name).title.split(" (")[0]
 
     def request(self, arm: RobotArm | None, ready: Callable[[RobotView], None]) -> None:
         """Build ``arm``'s view (None: the Puma560's) and hand it to ``ready``, unless another
@@ -140,6 +194,7 @@ class RobotViews:
         name = self.puma.name if arm is None else arm.name
         with self._lock:
             self._wanted = name
+            self.failed = ""
         if arm is None or name in self._views:
             self._ready(name, self._views[name], ready)
             return
@@ -150,9 +205,15 @@ class RobotViews:
 
     def _load(self, arm: RobotArm, ready: Callable[[RobotView], None]) -> None:
         try:
-            view = arm_view(arm, self._config)
-        except Exception:
+            view = arm_view(arm, self._config, self._cache)
+        except Exception as err:
             log.exception("The %s meshes could not be read; the robot drawn stays.", arm.name)
+            with self._lock:
+                if self._wanted == arm.name:
+                    self.failed = (
+                        f"The {arm.spec.title}'s meshes could not be read ({err}); the robot "
+                        "drawn stays: reinstall example-robot-data, or pick another robot."
+                    )
             return
         with self._lock:
             self._views.setdefault(arm.name, view)

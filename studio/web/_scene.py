@@ -27,6 +27,7 @@ import threading
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 import viser
@@ -38,16 +39,16 @@ from studio.kinematics import (
     MeshPart,
     PosedBody,
     Puma560,
-    RobotArm,
     pose_body,
 )
 
 from ._hand_handle import HandHandle
 from ._protocols import HandMoved, LivePose
-from ._robot_view import RobotView, RobotViews, add_robot, rgb255, wxyz_of
+from ._robot_view import RobotViews, rgb255, wxyz_of
 from ._scene_model import Mode, Playback, SceneLayout, playback_time, pose_at, rescheduled
 from ._scene_model import camera_projection as camera_projection
 from ._scene_paths import ScenePaths
+from ._scene_robot import PUMA, SceneRobot
 from ._scene_views import SceneCamera
 
 log = logging.getLogger(__name__)
@@ -104,7 +105,7 @@ class _Live:
     version: int
 
 
-class StudioScene(ScenePaths):
+class StudioScene(ScenePaths, SceneRobot):
     """The studio's viser scene, fed by the live pipeline and by playbacks.
 
     The operator wears one tape: the taped arm follows the fit, the other arm rests (there is no
@@ -117,6 +118,7 @@ class StudioScene(ScenePaths):
         body: the operator's meshes (``HumanBody(side)`` by default); its ``side`` is the taped
             arm.
         layout: placement, camera, colours and the push rate.
+        mesh_cache: the folder keeping the drawn robots' simplified meshes (None: none kept).
     """
 
     def __init__(
@@ -127,6 +129,7 @@ class StudioScene(ScenePaths):
         side: str = "right",
         body: HumanBody | None = None,
         layout: SceneLayout | None = None,
+        mesh_cache: Path | None = None,
     ) -> None:
         self.server = server
         self.layout = layout if layout is not None else SceneLayout()
@@ -135,10 +138,7 @@ class StudioScene(ScenePaths):
         self._bodies = {body.side: body}  # one per taped arm, sharing the meshes
         self._operator = self._operator_for(body, 0)
         self._switch_lock = threading.Lock()  # one set_side at a time
-        self._views = RobotViews(self.robot, self.layout.mesh)
-        self._view = self._views.puma  # the robot drawn
-        self._next_view: RobotView | None = None  # a robot chosen, for the scene thread to draw
-        self._goal: np.ndarray | None = None  # the goal shown on the robot (set_goal)
+        self._init_robot(RobotViews(self.robot, self.layout.mesh, mesh_cache))
 
         # Inputs, written by any thread under _lock; the loop reads a snapshot.
         self._lock = threading.Lock()
@@ -147,7 +147,6 @@ class StudioScene(ScenePaths):
         self._live_at = -np.inf  # when the latest live pose came
         self._live_gap = np.inf  # the gap between live poses, smoothed (s)
         self._playback: Playback | None = None
-        self._playback_robot = "puma560"  # whose joints the playback holds
         # Published by the loop (under _lock) for readers.
         self._q_robot_shown = np.array(self.robot.qz, dtype=float)
         self._q_human_shown = np.zeros(7)
@@ -234,13 +233,7 @@ class StudioScene(ScenePaths):
             colors=c["floor_lines"],
             thickness=0.004,
         )
-        self._robot_handles = add_robot(self.server, "/robot", self._view)
-        self._ghost_handles = add_robot(
-            self.server, "/goal/ghost", self._view, opacity=lay.ghost_opacity, visible=False
-        )
-        self._goal_marker = s.add_icosphere(
-            "/goal/marker", radius=0.035, color=c["goal"], opacity=0.85, visible=False
-        )
+        self._build_robot()
         self._operator_handles = self._add_operator()
         self._tape = s.add_spline_catmull_rom(
             "/operator/tape",
@@ -265,8 +258,6 @@ class StudioScene(ScenePaths):
             precision="float32",
             visible=False,
         )
-        self._pedestal: viser.SceneNodeHandle | None = None
-        self._push_robot(self._robot_handles, self._q_robot_shown)
         reset = self.server.gui.add_button("Reset view", hint="Frame both bodies again")
         reset.on_click(lambda event: self.reset_view(event.client))
         # viser's control panel floats over the scene by default (its connection status and
@@ -275,31 +266,6 @@ class StudioScene(ScenePaths):
         self.server.gui.main_panel.dock_right()
         self.server.gui.main_panel.minimize()
         self.server.on_client_connect(_close_software_webgl_notice)
-
-    def _draw_robot(self, view: RobotView) -> None:
-        """Replace the robot (and its ghost) by ``view``'s, on a pedestal when it has one."""
-        for h in [*self._robot_handles, *self._ghost_handles]:
-            h.remove()
-        if self._pedestal is not None:
-            self._pedestal.remove()
-            self._pedestal = None
-        robot = add_robot(self.server, "/robot", view)
-        ghost = add_robot(
-            self.server, "/goal/ghost", view, opacity=self.layout.ghost_opacity, visible=False
-        )
-        self._robot_handles, self._ghost_handles = robot, ghost
-        with self._lock:
-            self._q_robot_shown = view.q0.copy()
-        self._view = view  # last: readers of the name see its meshes and its pose
-        self._place_goal()  # the Puma560's goal again when it comes back
-        if view.pedestal > 0:
-            self._pedestal = self.server.scene.add_box(
-                "/robot_pedestal",
-                color=(150, 152, 158),
-                dimensions=(0.3, 0.3, view.pedestal),
-                position=(0.0, 0.0, view.pedestal / 2),
-                cast_shadow=False,
-            )
 
     def _add_operator(self) -> list[viser.MeshHandle]:
         s = self.server.scene
@@ -346,12 +312,6 @@ class StudioScene(ScenePaths):
         posed = pose_body(self.body, q_human, tape, self.layout.tape_lift_m)
         return posed.tape if posed.tape is not None else np.array(tape, dtype=float)
 
-    def tool_positions(self, q_robot: np.ndarray) -> np.ndarray:
-        """World tool positions of Puma560 joint paths ``(N, 6)`` -> ``(N, 3)`` (policies and
-        demonstrations are the Puma560's, whichever robot is drawn)."""
-        q = np.atleast_2d(np.asarray(q_robot, dtype=float))
-        return np.array([self.robot.forward(qi)[:3, 3] for qi in q])
-
     def robot_mesh_points(self, q_robot: np.ndarray) -> list[np.ndarray]:
         """World vertices of each robot link mesh at ``q_robot`` (for framing and tests)."""
         view = self._view
@@ -366,15 +326,6 @@ class StudioScene(ScenePaths):
         return [_placed(p, m) for p, m in zip(operator.body.parts, poses, strict=True)]
 
     # ------------------------------------------------------------------ pushing
-
-    def _push_robot(self, handles: list[viser.MeshHandle], q_robot: np.ndarray) -> None:
-        if len(q_robot) != self._view.nq:
-            return  # a pose of the robot drawn before a switch
-        poses = self._view.poses(q_robot)
-        quats = wxyz_of(poses[:, :3, :3])
-        for h, pose, wxyz in zip(handles, poses, quats, strict=True):
-            h.position = pose[:3, 3]
-            h.wxyz = wxyz
 
     def _push_operator(self, operator: _Operator, posed: PosedBody, whole: bool = False) -> None:
         """Place the taped arm's meshes (every mesh when ``whole``: the taped arm changed, and
@@ -435,13 +386,14 @@ class StudioScene(ScenePaths):
     def _tick(self, now: float, shown: _Shown) -> None:
         with self._lock:
             live, version, playback = self._live, self._live_version, self._playback
-            playback_robot = self._playback_robot
             operator, slow = self._operator, self._live_gap >= self.layout.slow_live_s
             view, self._next_view = self._next_view, None
         if view is not None:
             with self.server.atomic():
                 self._draw_robot(view)
             shown.q_robot = None
+        if playback is not None and playback.robot != self._view.name:
+            playback = None  # another robot's joints: the robot drawn follows the live pose
         if (
             slow
             and now - shown.live_at < 1.0 / self.layout.slow_live_rate_hz
@@ -479,13 +431,10 @@ class StudioScene(ScenePaths):
                 self._push_operator(operator, live.posed, whole=operator_changed)
             elif operator_changed:
                 self._push_operator(operator, operator.rest, whole=True)
-            # a playback drives the robot it is for (a policy names its own; demonstrations are
-            # the Puma560's); another robot drawn stays live
-            puma_or_live = pose.mode is Mode.LIVE or self._view.name == playback_robot
-            if robot_changed and pose.q_robot is not None and puma_or_live:
+            if robot_changed and pose.q_robot is not None:
                 self._push_robot(self._robot_handles, pose.q_robot)
-                if self.camera.following:
-                    self.camera.follow(self.robot.forward(pose.q_robot)[:3, 3])
+                if self.camera.following and len(pose.q_robot) == self._view.nq:
+                    self.camera.follow(self._view.tool(pose.q_robot))
             if playback is not None and pose.trace_upto > shown.trace_upto:
                 self._push_trace(playback, pose.trace_upto)
                 shown.trace_upto = pose.trace_upto
@@ -593,40 +542,23 @@ class StudioScene(ScenePaths):
         with self._lock:
             return self._side_shown
 
-    def set_goal(self, q_robot_goal: np.ndarray | None) -> None:
-        """Show a translucent ghost robot and a marker at the goal (None, or a goal of another
-        robot's width, hides them)."""
-        self._goal = None if q_robot_goal is None else np.asarray(q_robot_goal, dtype=float)
-        with self.server.atomic():
-            self._place_goal()
-
-    def _place_goal(self) -> None:
-        """Show the goal (a Puma560 pose) on the Puma560; hidden beside another robot."""
-        q = self._goal
-        visible = q is not None and self._view.name == "puma560"
-        if q is not None and visible:
-            self._push_robot(self._ghost_handles, q)
-            self._goal_marker.position = self._view.tool(q)
-        for h in self._ghost_handles:
-            h.visible = visible
-        self._goal_marker.visible = visible
-
     def play_trajectory(
         self,
         times: np.ndarray,
         q_robot: np.ndarray,
         states: Sequence[int] | None = None,
-        robot: str = "puma560",
+        robot: str | None = None,
     ) -> None:
         """Animate the robot along a trajectory in real time, tracing the tool and bins.
 
         Args:
             times: sample times ``(N,)``, s, non-decreasing.
-            q_robot: joints ``(N, 6)``, rad.
+            q_robot: joints ``(N, nq)``, rad.
             states: the grid states visited, one per sample or one per step (then spread evenly
                 over the samples); each is marked as the robot passes it. None marks only the
                 start and the end.
-            robot: the robot the joints are of (a policy's own): it moves only while drawn.
+            robot: the robot whose joints these are (None: the Puma560's, as a policy's); it
+                plays while that robot is drawn, and any other follows the live pose.
         """
         t = np.asarray(times, dtype=float).reshape(-1)
         q = np.asarray(q_robot, dtype=float).reshape(len(t), -1)
@@ -644,13 +576,11 @@ class StudioScene(ScenePaths):
             marks = np.round(np.linspace(0, n - 1, len(states))).astype(int)
         else:
             marks = np.array([0, n - 1])
-        view = self._view
-        tool = np.array([view.tool(qi) for qi in q]) if view.name == robot else None
-        tool = self.tool_positions(q) if tool is None else tool
-        playback = Playback(t, q, tool, marks, time.perf_counter())
+        name = robot or PUMA
+        tool = self.tool_positions(q, name)
+        playback = Playback(t, q, tool, marks, time.perf_counter(), robot=name)
         with self._lock:
             self._playback = playback
-            self._playback_robot = robot
         self._wake.set()
 
     def scrub(
@@ -686,7 +616,6 @@ class StudioScene(ScenePaths):
         playback = Playback(t, q, self.tool_positions(q), marks, time.perf_counter(), paused=True)
         with self._lock:
             self._playback = playback
-            self._playback_robot = "puma560"
         self._wake.set()
 
     def stop_playback(self) -> None:
@@ -706,33 +635,9 @@ class StudioScene(ScenePaths):
         """Whether a playback runs (true until the scene has shown its last pose)."""
         with self._lock:
             playback = self._playback
-            if playback is None:
+            if playback is None or playback.robot != self._view.name:
                 return False
             return self._shown_playback is not playback or self._shown_mode is Mode.PLAYBACK
-
-    def set_robot(self, arm: RobotArm | None) -> None:
-        """Draw ``arm`` (a robot of :func:`~studio.kinematics.load_robot`; None or the
-        ``puma560``: the Puma560) from its own meshes, framed where the Puma560 stands.
-
-        Returns at once: its meshes are read in the background (seconds, the first time only)
-        and the scene thread then draws it (:attr:`robot_name` names it once drawn).
-        """
-        self._views.request(arm, self._draw_next)
-
-    def _draw_next(self, view: RobotView) -> None:
-        with self._lock:
-            self._next_view = view
-        self._wake.set()
-
-    @property
-    def robot_name(self) -> str:
-        """The name of the robot the scene has drawn (lags :meth:`set_robot` until drawn)."""
-        return self._view.name
-
-    @property
-    def robot_mesh_count(self) -> int:
-        """How many meshes the scene draws the robot with."""
-        return len(self._robot_handles)
 
     def current_q_robot(self) -> np.ndarray:
         """The robot joints the scene shows now (rad, (nq,))."""

@@ -86,7 +86,7 @@ class Playback:
 
     Attributes:
         times: ``(N,)`` s, non-decreasing, from 0.
-        q: ``(N, 6)`` rad.
+        q: ``(N, nq)`` rad.
         tool: ``(N, 3)`` world tool positions (m).
         marks: sample indices where a grid bin is marked.
         started: clock time (``time.perf_counter``) at which the trajectory stood at ``offset``.
@@ -95,6 +95,8 @@ class Playback:
         speed: trajectory seconds per clock second (1 is real time).
         paused: the trajectory stands still at ``offset`` (and is shown, not released to the
             live pose, however long it stands).
+        robot: the robot whose joints ``q`` are (``puma560``, ``panda``, ...): the scene moves
+            only that robot with it.
     """
 
     times: np.ndarray
@@ -105,6 +107,7 @@ class Playback:
     offset: float = 0.0
     speed: float = 1.0
     paused: bool = False
+    robot: str = "puma560"
 
     @property
     def duration(self) -> float:

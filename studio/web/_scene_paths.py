@@ -23,11 +23,12 @@ class ScenePaths:
     layout: SceneLayout
     _paths: dict[str, list[viser.SceneNodeHandle]]
     _paths_lock: threading.Lock
-    tool_positions: Callable[[np.ndarray], np.ndarray]
+    tool_positions: Callable[[np.ndarray, str | None], np.ndarray]
 
-    def show_path(self, name: str, q_robot_path: np.ndarray) -> None:
-        """Draw the tool path of a robot joint path ``(N, 6)`` (replaces a path of that name)."""
-        tool = self.tool_positions(q_robot_path)
+    def show_path(self, name: str, q_robot_path: np.ndarray, robot: str | None = None) -> None:
+        """Draw the tool path of ``robot``'s joint path ``(N, nq)`` (the Puma560's when None),
+        replacing a path of that name."""
+        tool = self.tool_positions(q_robot_path, robot)
         node = f"/paths/{name}"
         c = self.layout.colors
         s = self.server.scene

@@ -118,6 +118,17 @@ class SourcePublic(BaseModel):
     camera_fps: float | None = Field(None, description="camera: the frame rate the page reported")
     model: str | None = Field(None, description="camera: the pose model the page reported")
     robot: str = Field("puma560", description="the robot taught (`studio robots` lists them)")
+    robot_drawn: str | None = Field(
+        None, description="the robot the 3D scene has drawn (null without a scene)"
+    )
+    robot_loading: str | None = Field(
+        None, description="the robot chosen whose meshes the scene is reading (null when drawn)"
+    )
+    robot_notes: list[str] = Field(
+        default_factory=list,
+        description="one sentence each: meshes loading, a motion being retargeted onto the "
+        "robot, or what cannot be shown on it and why",
+    )
     robot_warning: str | None = Field(
         None,
         description="why the robot does not follow the hand now (out of its reach, or held "

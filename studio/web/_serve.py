@@ -221,7 +221,7 @@ def start_scene(
         )
         guard.install(server)
         server.gui.configure_theme(show_share_button=False)
-        scene = StudioScene(server)
+        scene = StudioScene(server, mesh_cache=settings.mesh_cache_dir)
     except BaseException:
         server.stop()
         raise

@@ -77,6 +77,11 @@ class Settings(BaseModel):
         return self.data_dir / "policies"
 
     @property
+    def mesh_cache_dir(self) -> Path:
+        """Where the drawn robots' simplified meshes are kept (a cache: safe to delete)."""
+        return self.data_dir / "cache" / "meshes"
+
+    @property
     def is_loopback(self) -> bool:
         """Whether ``host`` only accepts connections from this machine."""
         return is_loopback(self.host)

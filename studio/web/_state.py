@@ -50,6 +50,8 @@ from studio.learning import (
 from ._errors import ConflictError, InvalidError, NotFoundError, TooManyRequestsError
 from ._pipeline import Pipeline
 from ._protocols import Scene
+from ._robot_playback import RobotPlayer
+from ._robot_view import RobotViews
 from ._runs import RunQueue
 from ._schemas import RunCreate
 from ._settings import Settings
@@ -102,6 +104,7 @@ class Studio:
         changed = self.changes.bump
         self.scene = scene
         self.pipeline = Pipeline(scene, on_change=changed)
+        self.player = None if scene is None else RobotPlayer(scene)
         self.runs = RunQueue(settings.runs_dir, changed, settings.run_workers)
         self.recordings = recording_store(settings.recordings_dir, self.pipeline, changed)
         self.policies = policy_store(settings.policies_dir, changed, self._policy_playing)
@@ -114,6 +117,7 @@ class Studio:
         self.rollouts: dict[str, tuple[np.ndarray, np.ndarray]] = {}
         self.mark_t0: float | None = None  # live demonstration start, recording time (s)
         self._robot_lock = threading.Lock()  # one robot switch at a time
+        self._robot_switching: str | None = None  # the robot whose model loads (set_robot)
 
     def start(self) -> None:
         """Start the run worker and the pipeline (with the configured source, if any)."""
@@ -332,6 +336,7 @@ class Studio:
     def source_public(self) -> dict[str, object]:
         """``SourcePublic``: the pipeline status plus the playback state."""
         status = self.pipeline.status()
+        status.update(self.robot_state())
         status["playback"] = None
         source = self.pipeline.source
         if self.pipeline.kind == "recording" and isinstance(source, PlaybackSource):
@@ -349,10 +354,34 @@ class Studio:
                 robot taught before stays).
         """
         with self._robot_lock:
-            arm = load_robot(robot_spec(name).name)
+            self._robot_switching = robot_spec(name).name
+            try:
+                arm = load_robot(self._robot_switching)  # seconds the first time
+            finally:
+                self._robot_switching = None
             if self.scene is not None:
                 self.scene.set_robot(arm)  # its meshes are read in the background
-            self.pipeline.set_robot(arm)
+            self.pipeline.set_robot(arm.scratch_copy())  # the live thread's own scratch data
+
+    def robot_state(self) -> dict[str, object]:
+        """The robot the scene draws, the one whose meshes it reads, and one sentence for each
+        thing the page should know about them (loading, retargeting, what cannot be shown)."""
+        scene, player = self.scene, self.player
+        if scene is None or player is None:
+            return {"robot_drawn": None, "robot_loading": None, "robot_notes": []}
+        busy, note = player.status()
+        notes = [*scene.robot_notes(), *(s for s in (busy, note) if s)]
+        switching = self._robot_switching
+        if switching is not None:
+            title = RobotViews.title(switching)
+            notes.insert(
+                0, f"Loading the {title}'s model and meshes; the robot drawn stays meanwhile."
+            )
+        return {
+            "robot_drawn": scene.robot_name,
+            "robot_loading": switching or scene.robot_loading,
+            "robot_notes": notes,
+        }
 
     def robots_public(self) -> dict[str, object]:
         """``RobotsPublic``: every offered robot with its joints, and the one taught now."""
@@ -499,8 +528,7 @@ class Studio:
         tmp = self.settings.recordings_dir / f".cut-{uuid.uuid4().hex}.tmp"
         demo.save(tmp)  # then named without replacing a file that took the name meanwhile
         final = self.demonstrations.claim(tmp, final, exact=name is not None)
-        if self.scene is not None:
-            self.scene.show_path(f"demo-{final}", np.asarray(demo.q_robot))
+        self.show_demonstration(final, play=False)
         return final
 
     def mark_start(self) -> float:
@@ -528,12 +556,45 @@ class Studio:
         return self.cut_demonstration(recording, t0, t1, goal_from_end, name)
 
     def preview_demonstration(self, name: str) -> None:
-        """Draw a demonstration's path and play it on the robot."""
+        """Draw a demonstration's path and play it on the robot taught."""
+        self.show_demonstration(name, play=True)
+
+    def show_demonstration(self, name: str, play: bool) -> None:
+        """Draw demonstration ``name``'s tool path on the robot taught and play it (``play``).
+
+        The Puma560 plays the joint path stored in the file at once; any other robot plays the
+        demonstration's recording segment retargeted onto it (in the background: the page is
+        told meanwhile), its end pose shown as that robot's goal.
+
+        Raises:
+            NotFoundError: no such demonstration (or a damaged one: the reader's sentence).
+        """
+        from studio.export import demonstration_motion
+        from studio.learning import ROLLOUT_RATE_HZ
+
         demo = self.demonstrations.load(name)
-        if self.scene is not None:
+        scene, player = self.scene, self.player
+        if scene is None or player is None:
+            return
+        robot = self.pipeline.robot_name
+        if robot == "puma560":
             q = np.asarray(demo.q_robot, dtype=float)
-            self.scene.show_path(f"demo-{name}", q)
-            self.scene.play_trajectory(np.asarray(demo.times, dtype=float), q)
+            scene.show_path(f"demo-{name}", q)
+            if play:
+                scene.play_trajectory(np.asarray(demo.times, dtype=float), q)
+            player.clear_note()
+            return
+        path = self.demonstrations.path(name)
+        stat = path.stat()
+        player.play(
+            robot,
+            f"the demonstration {name}",
+            ("demonstration", str(path), stat.st_mtime_ns, stat.st_size, robot),
+            lambda: demonstration_motion(path, robot, ROLLOUT_RATE_HZ),
+            f"demo-{name}",
+            goal=True,
+            play=play,
+        )
 
     def delete_demonstration(self, name: str) -> None:
         """Delete a demonstration (409 for a sample, or while a queued or running run replays

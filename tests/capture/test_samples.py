@@ -9,7 +9,13 @@ from pathlib import Path
 
 import numpy as np
 
-from studio.capture import load_demonstration, read_recording
+from studio.capture import (
+    human_angles,
+    load_demonstration,
+    read_any_recording,
+    read_recording,
+    recording_series,
+)
 from studio.learning import ArmGrid
 from studio.samples import SAMPLES_DIR
 
@@ -54,3 +60,13 @@ def test_the_committed_script_regenerates_the_samples(tmp_path):
             ta, tb = a.pop("trajectory"), b.pop("trajectory")
             assert a == b, name
             assert np.allclose(ta["q_robot"], tb["q_robot"], atol=2e-6) and ta["t"] == tb["t"]
+
+
+def test_human_angles_are_the_frames_fitted_in_order_as_the_timeline_fits_them() -> None:
+    rec = read_any_recording(SAMPLES_DIR / "sample-reach-1.tape.csv")
+    every = human_angles(rec, slice(None))
+    assert every.shape == (len(rec), 7) and np.all(np.isfinite(every))
+    assert np.allclose(every, recording_series(rec, points=len(rec)).q_human)
+    rows = rec.segment(1.0, 2.0)
+    assert np.allclose(human_angles(rec, rows)[0], human_angles(rec, np.array([rows.start]))[0])
+    assert human_angles(rec, slice(0, 0)).shape == (0, 7)

@@ -1,5 +1,7 @@
-"""In a real browser: the user picks the Panda, the scene draws it from its own meshes, the
-simulated operator drives it, and the Puma560 comes back."""
+"""In a real browser: the user picks the Panda, the page says its meshes are loading, the scene
+draws it from its own meshes and the simulated operator drives it; a demonstration plays on the
+Panda and exports for it (refused by the safety checks, then written with the findings in it);
+the Puma560 comes back and a recording exports for it."""
 
 from __future__ import annotations
 
@@ -16,6 +18,10 @@ pytestmark = pytest.mark.e2e
 
 DRAW_TIMEOUT_S = 120.0
 """Reading a robot's meshes takes seconds alone, far longer on a machine shared by many."""
+DEMO = "sample-reach-1"
+ANYWAY = "Export anyway, findings written in the file"
+SIZES = ((1280, 720), (1920, 1080))
+"""The screens the page is looked at on: a laptop's and a desktop monitor's."""
 
 
 def _robot_select(page: Any) -> Any:
@@ -26,7 +32,23 @@ def _q_robot(studio_server: Studio) -> np.ndarray:
     return np.array(studio_server.get("/api/source")["q_robot"])
 
 
-def test_the_user_switches_to_the_panda_sees_it_drawn_and_driven_then_back(
+def _download_anyway(page: Any, kind: str, name: str, fmt: str) -> tuple[str, str]:
+    """Export ``name`` from the ``kind`` list as ``fmt``: refused by the checks (the sentence
+    shown), then written anyway. Returns the file's name and text."""
+    noun = kind.capitalize()
+    page.get_by_role("combobox", name=f"{noun} to export").select_option(name)
+    page.get_by_role("combobox", name=f"{noun} export format").select_option(fmt)
+    page.get_by_role("button", name=f"Export {kind}", exact=True).click()
+    error = page.get_by_test_id(f"{kind}-export-error")
+    error.wait_for(state="visible", timeout=DRAW_TIMEOUT_S * 1000)
+    assert error.inner_text().startswith("Refused"), error.inner_text()
+    with page.expect_download(timeout=DRAW_TIMEOUT_S * 1000) as download:
+        page.get_by_role("button", name=ANYWAY, exact=True).click()
+    text = open(download.value.path()).read()  # noqa: PTH123, SIM115
+    return download.value.suggested_filename, text
+
+
+def test_the_user_teaches_the_panda_plays_and_exports_a_demonstration_then_back(
     page: Any, studio_server: Studio
 ) -> None:
     select = _robot_select(page)
@@ -36,6 +58,15 @@ def test_the_user_switches_to_the_panda_sees_it_drawn_and_driven_then_back(
     studio_server.send("PUT", "/api/source", {"kind": "simulator"})
     assert wait_for(lambda: studio_server.get("/api/source")["running"])
 
+    # every line the robot's notes show, as they come and go
+    page.evaluate(
+        """() => {
+        window.robotNotes = [];
+        const box = document.getElementById("robot-notes");
+        new MutationObserver(() => window.robotNotes.push(box.innerText))
+          .observe(box, { childList: true, subtree: true, characterData: true });
+      }"""
+    )
     select.select_option("panda")
     panda = load_robot("panda")
     drawn = len(panda.visual_model.geometryObjects)
@@ -43,8 +74,12 @@ def test_the_user_switches_to_the_panda_sees_it_drawn_and_driven_then_back(
         lambda: (
             studio_server.get("/api/robots")["drawn"] == "panda"
             and studio_server.get("/api/robots")["drawn_meshes"] == drawn
-        )
+        ),
+        timeout=DRAW_TIMEOUT_S,
     ), (page.inner_text("#source-error"), studio_server.log_tail())
+    # meanwhile the page said what it was doing, rather than appear stuck
+    notes = page.evaluate("window.robotNotes")
+    assert any("Loading the Franka Emika Panda" in n for n in notes), notes
     assert studio_server.get("/api/robots")["robot"] == "panda"
     # the live chain drives its seven joints, within its limits
     assert wait_for(lambda: _q_robot(studio_server).shape == (7,))
@@ -52,11 +87,44 @@ def test_the_user_switches_to_the_panda_sees_it_drawn_and_driven_then_back(
     assert wait_for(lambda: not np.allclose(_q_robot(studio_server), first, atol=1e-3))
     q = _q_robot(studio_server)
     assert np.all(q >= panda.lower - 1e-9) and np.all(q <= panda.upper + 1e-9)
-    # the page shows seven angles, and joint mode (the Puma560's) cannot be chosen
     assert wait_for(lambda: len(page.inner_text("#src-q").split()) == 8)  # 7 angles and "°"
     assert page.locator("#retarget-mode option[value='joint']").is_disabled()
     assert page.input_value("#retarget-mode") == "cartesian"
     shot(page, "robot-panda", "sec-source")
+
+    # a demonstration plays on the Panda: retargeted, its seven joints moving
+    row = page.locator(f"[data-testid='demo-row'][data-name='{DEMO}']")
+    row.get_by_role("button", name=f"Preview {DEMO} on the robot").click()
+    seen: list[np.ndarray] = []
+
+    def panda_plays() -> bool:
+        p = studio_server.get("/api/scene/playback")
+        if p["active"] and p["robot"] == "panda" and p["drawn"] == "panda" and not p["finished"]:
+            seen.append(np.radians(p["q_robot_deg"]))
+        return len(seen) >= 2 and not np.allclose(seen[0], seen[-1], atol=1e-4)
+
+    assert wait_for(panda_plays, timeout=DRAW_TIMEOUT_S, step=0.02), (
+        studio_server.get("/api/source")["robot_notes"],
+        studio_server.log_tail(),
+    )
+    for q in seen:
+        assert q.shape == (7,)
+        assert np.all(q >= panda.lower - 1e-6) and np.all(q <= panda.upper + 1e-6)
+    # its end is the Panda's goal, and the page says where the hand left the Panda's reach
+    assert wait_for(
+        lambda: "out of the Franka Emika Panda's reach" in page.inner_text("#robot-notes")
+    )
+    for width, height in SIZES:
+        page.set_viewport_size({"width": width, "height": height})
+        shot(page, f"robot-panda-demonstration-{width}x{height}", "sec-demos")
+        shot(page, f"robot-panda-notes-{width}x{height}", "sec-source")
+    page.set_viewport_size({"width": 1440, "height": 900})
+
+    # the demonstration exports for the Panda: the checks refuse it (a frame out of reach), then
+    # "export anyway" writes it with the findings in it
+    name, text = _download_anyway(page, "demonstration", DEMO, "csv")
+    assert name == f"{DEMO}.panda.csv"
+    assert "NOT checked" in text and "time," + ",".join(panda.joint_names) in text
 
     select.select_option("puma560")
     assert wait_for(
@@ -69,17 +137,9 @@ def test_the_user_switches_to_the_panda_sees_it_drawn_and_driven_then_back(
     assert wait_for(lambda: page.input_value("#retarget-mode") == "joint")
     assert not page.locator("#retarget-mode option[value='joint']").is_disabled()
 
-    # the recording chosen in the source form downloads as the robot's trajectory
-    page.select_option(
-        "[data-testid='source-kind']", "recording"
-    )  # shows the list, applies nothing
-    page.select_option("#source-recording", "sample-reach-1")
-    page.get_by_role("combobox", name="Export format").select_option("csv")
-    page.check("#robot-export-unchecked")  # the capture-rate recording fails the checks
-    with page.expect_download(timeout=120_000) as download:
-        page.click("#robot-export")
-    assert download.value.suggested_filename == "sample-reach-1.puma560.csv"
-    text = open(download.value.path()).read()  # noqa: PTH123, SIM115
+    # a recording exports for the Puma560 from the recordings list (its capture-rate fitting
+    # noise fails the acceleration check: refused, then written anyway)
+    name, text = _download_anyway(page, "recording", DEMO, "csv")
+    assert name == f"{DEMO}.puma560.csv"
     assert "time," + ",".join(load_robot("puma560").joint_names) in text
-    page.select_option("[data-testid='source-kind']", "simulator")  # as the source still is
     assert page.errors == []  # type: ignore[attr-defined]

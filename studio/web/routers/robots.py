@@ -9,8 +9,11 @@ from fastapi import APIRouter
 from fastapi.responses import FileResponse
 from starlette.background import BackgroundTask
 
+from studio.kinematics import DEFAULT_ROBOT, robot_spec
+
 from .._deps import StudioDep
-from .._robot_export import MEDIA_TYPES, ExportFormat, export_for_robot
+from .._errors import ConflictError
+from .._robot_export import MEDIA_TYPES, ExportFormat, export_for_robot, export_rollout
 from .._schemas import RobotChoice, RobotsPublic
 from . import file_responses
 
@@ -42,18 +45,55 @@ def export_for_the_robot(
     studio: StudioDep,
     format: ExportFormat = "csv",
     unchecked: bool = False,
+    robot: str | None = None,
 ) -> FileResponse:
     """A recording or demonstration as the chosen robot's joint trajectory, retargeted, timed
     and checked for safety as ``studio export SOURCE --robot NAME --format FORMAT`` does: CSV,
     MCAP (ROS 2 messages) or a zipped LeRobotDataset v3.0. Failed checks answer 422 with one
     sentence naming the sample, joint and margin; ``unchecked`` writes the file anyway with the
-    findings stated in it. 404 for no such recording or demonstration."""
+    findings stated in it (``reason`` "safety" in the 422 says the checks refused it). For the
+    robot taught unless ``robot`` names another (an unknown name: 422 with the list). 404 for no
+    such recording or demonstration."""
     store = studio.recordings if kind == "recording" else studio.demonstrations
     path = store.path(name)
-    out, filename, folder = export_for_robot(path, studio.pipeline.robot_name, format, unchecked)
+    target = robot_spec(robot).name if robot is not None else studio.pipeline.robot_name
+    out, filename, folder = export_for_robot(path, target, format, unchecked)
     return FileResponse(
         out,
         media_type=MEDIA_TYPES[format],
+        filename=filename,
+        background=BackgroundTask(shutil.rmtree, folder, ignore_errors=True),
+    )
+
+
+@router.get("/api/robot/export/rollout.mcap", responses=file_responses("application/octet-stream"))
+def export_the_rollout(
+    studio: StudioDep,
+    run: str | None = None,
+    policy: str | None = None,
+    unchecked: bool = False,
+) -> FileResponse:
+    """The rollout last watched of a run's policy (``?run=<id>``) or an uploaded one
+    (``?policy=<name>``) as an MCAP of ROS 2 ``trajectory_msgs/msg/JointTrajectory`` for the
+    robot it was learnt on, at its own times, checked for safety as ``studio export`` checks it
+    (``/api/watch/trajectory.csv`` is the same rollout as CSV). Failed checks answer 422 with
+    one sentence (``reason`` "safety"); ``unchecked`` writes it anyway with the findings stated
+    in it. 409 when that policy has not been watched yet."""
+    path, key = studio.policy_file(run, policy)
+    last = studio.watched_rollout(key)
+    kind, name = key.split(":", 1)
+    if last is None:
+        raise ConflictError(
+            f"{'Run' if kind == 'run' else 'Policy'} {name} has not been watched yet; watch it "
+            "first, then export its rollout."
+        )
+    _, times, q = last
+    watched, _ = studio.load_policy(run, policy)
+    robot = watched.robot or DEFAULT_ROBOT  # (None: not an arm's policy; never watched)
+    out, filename, folder = export_rollout(path, robot, name, times, q, unchecked)
+    return FileResponse(
+        out,
+        media_type=MEDIA_TYPES["mcap"],
         filename=filename,
         background=BackgroundTask(shutil.rmtree, folder, ignore_errors=True),
     )

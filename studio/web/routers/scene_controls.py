@@ -54,6 +54,10 @@ class PlaybackPublic(BaseModel):
     """The speeds the page offers."""
     q_robot_deg: list[float]
     """The robot joints the scene shows now (deg)."""
+    robot: str = "puma560"
+    """The robot whose joints the playback holds (it moves only while that robot is drawn)."""
+    drawn: str = "puma560"
+    """The robot the scene draws now."""
 
 
 class ViewChange(_Body):
@@ -116,7 +120,7 @@ def _public(scene: Scene, playback: Playback | None, t: float) -> PlaybackPublic
     if playback is None:
         return PlaybackPublic(
             active=False, t=0, duration=0, samples=0, sample=0, speed=1, paused=False,
-            finished=False, speeds=speeds, q_robot_deg=q,
+            finished=False, speeds=speeds, q_robot_deg=q, drawn=scene.robot_name,
         )  # fmt: skip
     at = min(max(t, 0.0), playback.duration)
     sample = int(np.searchsorted(playback.times, at, side="right")) - 1
@@ -131,6 +135,8 @@ def _public(scene: Scene, playback: Playback | None, t: float) -> PlaybackPublic
         finished=not playback.paused and t >= playback.duration,
         speeds=speeds,
         q_robot_deg=q,
+        robot=playback.robot,
+        drawn=scene.robot_name,
     )
 
 
@@ -185,7 +191,7 @@ def change_follow(body: FollowChange, studio: StudioDep) -> ViewsPublic:
     scene = _scene(studio)
     scene.camera.following = body.on
     if body.on:
-        scene.camera.follow(scene.tool_positions(scene.current_q_robot())[0])
+        scene.camera.follow(scene.tool_positions(scene.current_q_robot(), scene.robot_name)[0])
     return read_views(studio)
 
 

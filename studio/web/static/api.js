@@ -58,7 +58,8 @@ export async function guarded(errId, fn, button) {
   }
 }
 
-/** Fetch a file and save it, so that a refusal (409, 404) shows up as a message, not a page. */
+/** Fetch a file and save it, so that a refusal (409, 404) shows up as a message, not a page.
+ * Returns the refusal's body (``{detail, reason}``) when the studio refused, else null. */
 export async function download(url, fallbackName, errId) {
   showError(errId, null);
   let resp;
@@ -66,14 +67,14 @@ export async function download(url, fallbackName, errId) {
     resp = await fetch(url);
   } catch (e) {
     showError(errId, "The studio server is not reachable.");
-    return;
+    return { detail: "The studio server is not reachable." };
   }
   if (!resp.ok) {
     const text = await resp.text();
     let data = null;
     try { data = JSON.parse(text); } catch (e) { data = null; }
     showError(errId, detailOf(data, resp, text));
-    return;
+    return data || { detail: detailOf(data, resp, text) };
   }
   const blob = await resp.blob();
   const cd = resp.headers.get("Content-Disposition") || "";
@@ -85,6 +86,7 @@ export async function download(url, fallbackName, errId) {
   document.body.appendChild(a);
   a.click();
   setTimeout(() => { URL.revokeObjectURL(a.href); a.remove(); }, 1000);
+  return null;
 }
 
 /** Upload the file chosen in ``input`` to ``path`` and hand the studio's answer to ``then``

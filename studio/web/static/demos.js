@@ -2,6 +2,7 @@
 
 import { api, guarded } from "./api.js";
 import { $, confirmDialog, el, emptyRow, enc, flashRow, fmt, groupRow, setProp, setText, showError } from "./dom.js";
+import { fillExportItems } from "./exports.js";
 import { renderWatchDemos } from "./policies.js";
 import { S } from "./state.js";
 
@@ -99,7 +100,7 @@ function demoRow(d) {
     ? el("span", { class: "badge failed", text: "unreadable", title: d.error, testid: "demo-damaged" })
     : el("span", { class: d.reaches_goal ? "badge done" : "badge warn", text: d.reaches_goal ? "reached" : "not reached", title: `goal ${(d.goal || []).map((g) => fmt(g, 0)).join(", ")}°` });
   const actions = [];
-  if (!d.error) actions.push(el("button", { class: "icon", title: "preview on the robot", testid: "demo-preview", onclick: () => previewDemo(d.name) }, "▶"));
+  if (!d.error) actions.push(el("button", { class: "icon", title: "preview on the robot", "aria-label": `Preview ${d.name} on the robot`, testid: "demo-preview", onclick: () => previewDemo(d.name) }, "▶"));
   if (!d.sample) actions.push(el("button", { class: "icon", title: "delete", testid: "demo-delete", onclick: () => deleteDemo(d.name) }, "✕"));
   return el("tr", { "data-name": d.name, testid: "demo-row", title: d.error || "" },
     el("td", { class: "name", title: d.name }, d.name, d.sample ? " " : null, d.sample ? el("span", { class: "badge", text: "sample", title: "shipped with the studio: read-only" }) : null),
@@ -122,6 +123,7 @@ function renderDemos() {
   }
   body.replaceChildren(...rows);
   renderWatchDemos();
+  fillExportItems("demonstration");
   // The training form's demonstration checkboxes keep their ticks across refreshes.
   const box = $("train-demos");
   const ticked = new Set([...box.querySelectorAll("input:checked")].map((i) => i.value));

@@ -18,7 +18,8 @@ import { dismissCaptureFailure, loadRecordings, renderCaptureButton, saveRecordi
 import { loadRuns, renderRuns } from "./runs.js";
 import { wireCompare } from "./compare.js";
 import { SOFTWARE_RENDERERS, SOFTWARE_SCENE_DPR, loadConfig, softwareWebGL } from "./scene.js";
-import { applySource, exportForRobot, loadRobots, playback, renderSource, setRetarget, setRobot, simulatorReach, syncKindOptions } from "./sources.js";
+import { buildExportControl } from "./exports.js";
+import { applySource, loadRobots, playback, renderSource, setRetarget, setRobot, simulatorReach, syncKindOptions } from "./sources.js";
 import { S, markCurvesDirty } from "./state.js";
 import { checkTrainForm, resetTrainForm, startRun, syncTaskFields } from "./training.js";
 
@@ -47,7 +48,7 @@ function wire() {
   $("retarget-mode").addEventListener("change", setRetarget);
   $("retarget-mirror").addEventListener("change", setRetarget);
   $("robot-name").addEventListener("change", setRobot);
-  $("robot-export").addEventListener("click", exportForRobot);
+  for (const kind of ["recording", "demonstration", "rollout"]) buildExportControl(kind);
 
   $("capture-toggle").addEventListener("click", toggleCapture);
   $("capture-failure-dismiss").addEventListener("click", dismissCaptureFailure);

@@ -73,7 +73,7 @@ export function renderWatchChoices() {
   fillSelect($("watch-policy"), items);
 }
 
-function watchTarget() {
+export function watchTarget() {
   const v = $("watch-policy").value;
   if (!v) return null;
   const i = v.indexOf(":");
@@ -151,9 +151,6 @@ export async function uploadPolicy(input) {
 export function exportFile(kind) {
   const t = watchTarget();
   if (!t) { showError("export-error", "Choose a run or a policy first."); return; }
-  if (kind === "rollout") { // the selected policy's rollout as last watched, named after it
-    return download(`/api/watch/trajectory.csv?${t.type === "run" ? "run" : "policy"}=${enc(t.id)}`, `${t.id}.rollout.csv`, "export-error");
-  }
   if (kind === "policy") {
     if (t.type === "run") return download(`/api/runs/${enc(t.id)}/policy`, `${t.id}.policy.npz`, "export-error");
     return download(`/api/policies/${enc(t.id)}/file`, `${t.id}.policy.npz`, "export-error");

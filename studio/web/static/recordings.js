@@ -2,6 +2,7 @@
 
 import { api, download, guarded, uploadChosen } from "./api.js";
 import { syncDemoRange } from "./demos.js";
+import { fillExportItems } from "./exports.js";
 import { $, confirmDialog, el, emptyRow, enc, fillSelect, flashRow, fmt, fmtDuration, groupRow, setProp, setText, showError } from "./dom.js";
 import { applySource, syncKindOptions } from "./sources.js";
 import { S } from "./state.js";
@@ -101,6 +102,7 @@ function renderRecordings() {
   fillSelect($("source-recording"), items);
   fillSelect($("demo-recording"), items);
   syncDemoRange();
+  fillExportItems("recording");
 }
 
 async function copyRecording(name) {

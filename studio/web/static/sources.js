@@ -1,6 +1,6 @@
 /* Teach Studio page: the live source: its status line, the source form, playback, the simulator's reach, the robot taught. */
 
-import { api, download, guarded } from "./api.js";
+import { api, guarded } from "./api.js";
 import { $, fmt, setProp, setText, showError } from "./dom.js";
 import { S } from "./state.js";
 
@@ -122,6 +122,27 @@ function renderRobot(s) {
   if (joint) setProp(joint, "disabled", !!s.robot && s.robot !== "puma560");
   setProp("robot-warning", "hidden", !s.robot_warning);
   setText("robot-warning", s.robot_warning || "");
+  renderRobotNotes(s.robot_notes || []);
+}
+
+/** One line per sentence the studio gives about the robot drawn (its meshes loading, a motion
+ * being retargeted onto it, what cannot be shown on it and why); while a switch is on its way,
+ * the page's own "loading" line. */
+function renderRobotNotes(notes) {
+  const select = $("robot-name");
+  const pending = select.dataset.pending ? [`Loading the ${robotTitle(select.value)}'s meshes…`] : [];
+  const lines = [...pending, ...notes];
+  const box = $("robot-notes");
+  if (box.dataset.text !== lines.join("\n")) {
+    box.dataset.text = lines.join("\n");
+    box.replaceChildren(...lines.map((line) => { const p = document.createElement("p"); p.textContent = line; return p; }));
+  }
+  setProp(box, "hidden", !lines.length);
+}
+
+function robotTitle(name) {
+  const option = $("robot-name").querySelector(`option[value="${name}"]`);
+  return option ? option.textContent.split(" (")[0] : name;
 }
 
 export async function loadRobots() {
@@ -149,6 +170,7 @@ function showTrainedRobot() {
 export async function setRobot() {
   const select = $("robot-name");
   select.dataset.pending = "1";
+  renderRobotNotes((S.source && S.source.robot_notes) || []);
   try {
     const chosen = await guarded("source-error", async () => {
       const body = await api("PUT", "/api/robot", { name: select.value });
@@ -159,21 +181,6 @@ export async function setRobot() {
     if (!chosen && S.source && S.source.robot) select.value = S.source.robot;
   } finally {
     delete select.dataset.pending;
-  }
-}
-
-/** Download the recording chosen in the source form as the robot's trajectory (studio export). */
-export async function exportForRobot() {
-  const recording = $("source-recording").value;
-  if (!recording) { showError("robot-export-error", "Choose a recording first (Source → recording)."); return; }
-  const format = $("robot-export-format").value;
-  const params = new URLSearchParams({ format });
-  if ($("robot-export-unchecked").checked) params.set("unchecked", "true");
-  const button = $("robot-export");
-  button.disabled = true;
-  try {
-    await download(`/api/robot/export/recording/${encodeURIComponent(recording)}?${params}`, `${recording}.${format}`, "robot-export-error");
-  } finally {
-    button.disabled = false;
+    renderRobotNotes((S.source && S.source.robot_notes) || []);
   }
 }

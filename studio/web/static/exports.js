@@ -1,0 +1,102 @@
+/* Teach Studio page: exporting a recording, a demonstration or a policy's rollout as a robot's
+ * trajectory. One control for the three lists: what to export, a format, an Export button; a
+ * refusal by the safety checks is shown in one sentence with "Export anyway, findings written in
+ * the file" (the page's `studio export --unchecked`).
+ *
+ * Recordings and demonstrations export for the robot chosen above (GET
+ * /api/robot/export/{recording|demonstration}/{name}: retargeted, timed and checked as `studio
+ * export --robot` does); a rollout, the one last watched of the policy chosen under Watch, for the
+ * robot it was learnt on (CSV as ever from /api/watch/trajectory.csv, MCAP from
+ * /api/robot/export/rollout.mcap).
+ */
+
+import { download } from "./api.js";
+import { $, el, enc, fillSelect, setProp, showError } from "./dom.js";
+import { watchTarget } from "./policies.js";
+import { S } from "./state.js";
+
+const ALL_FORMATS = [["csv", "CSV"], ["mcap", "MCAP (ROS 2)"], ["lerobot", "LeRobot dataset (zip)"]];
+const ENDINGS = { csv: "csv", mcap: "mcap", lerobot: "lerobot.zip" };
+const ANYWAY = "Export anyway, findings written in the file";
+const HOW = "retargeted onto the robot chosen under Source, timed within its limits and checked for safety, as `studio export --robot` writes it";
+
+const KINDS = {
+  recording: {
+    noun: "recording", formats: ALL_FORMATS, title: `the recording as the robot's joint trajectory, ${HOW}`,
+    items: () => S.recordings.filter((r) => !r.error && !r.capturing).map((r) => [r.name, r.name]),
+  },
+  demonstration: {
+    noun: "demonstration", formats: ALL_FORMATS, title: `the demonstration as the robot's joint trajectory, ${HOW}`,
+    items: () => S.demos.filter((d) => !d.error).map((d) => [d.name, d.name]),
+  },
+  rollout: {
+    noun: "rollout", formats: ALL_FORMATS.slice(0, 2), testid: "download-rollout",
+    title: "the rollout last watched of the policy chosen above, for the robot it was learnt on: CSV time,q1..q6, or MCAP (ROS 2 JointTrajectory) checked for safety",
+  },
+};
+
+/** Build the export control of ``kind`` (recording, demonstration, rollout) into its box. */
+export function buildExportControl(kind) {
+  const k = KINDS[kind];
+  const noun = k.noun[0].toUpperCase() + k.noun.slice(1);
+  const parts = [];
+  if (k.items) {
+    parts.push(el("select", { id: `${kind}-export-item`, testid: `${kind}-export-item`, class: "grow", "aria-label": `${noun} to export` }));
+  }
+  parts.push(el("select", { id: `${kind}-export-format`, testid: `${kind}-export-format`, class: "export-format", "aria-label": `${noun} export format` },
+    ...k.formats.map(([value, label]) => el("option", { value, text: label }))));
+  parts.push(el("button", { id: `${kind}-export-go`, testid: k.testid || `${kind}-export-go`, title: k.title, onclick: () => exportNow(kind, false) }, `Export ${k.noun}`));
+  const anyway = el("button", { id: `${kind}-export-anyway`, testid: `${kind}-export-anyway`, hidden: true, title: "write the file even though the safety checks refuse it; every finding is stated in it", onclick: () => exportNow(kind, true) }, ANYWAY);
+  $(`${kind}-export`).replaceChildren(
+    el("div", { class: "row" }, ...parts),
+    el("div", { class: "err", id: `${kind}-export-error`, testid: `${kind}-export-error`, role: "alert", hidden: true }),
+    anyway,
+  );
+  fillExportItems(kind);
+}
+
+/** Offer the list's current items (kept chosen across refreshes). */
+export function fillExportItems(kind) {
+  const k = KINDS[kind];
+  const select = $(`${kind}-export-item`);
+  if (!k.items || !select) return;
+  const items = k.items();
+  fillSelect(select, items.length ? items : [["", `(no ${k.noun} yet)`]]);
+}
+
+function target(kind, unchecked) {
+  const k = KINDS[kind];
+  const format = $(`${kind}-export-format`).value;
+  const query = new URLSearchParams();
+  if (kind === "rollout") {
+    const t = watchTarget();
+    if (!t) return { error: "Choose a run or a policy under Watch first, watch it, then export its rollout." };
+    query.set(t.type === "run" ? "run" : "policy", t.id);
+    if (format === "csv") return { url: `/api/watch/trajectory.csv?${query}`, name: `${t.id}.rollout.csv` };
+    if (unchecked) query.set("unchecked", "true");
+    return { url: `/api/robot/export/rollout.mcap?${query}`, name: `${t.id}.rollout.mcap` };
+  }
+  const name = $(`${kind}-export-item`).value;
+  if (!name) return { error: `Choose a ${k.noun} to export first.` };
+  query.set("format", format);
+  if (unchecked) query.set("unchecked", "true");
+  const robot = (S.source && S.source.robot) || "robot";
+  return { url: `/api/robot/export/${kind}/${enc(name)}?${query}`, name: `${name}.${robot}.${ENDINGS[format]}` };
+}
+
+async function exportNow(kind, unchecked) {
+  const errId = `${kind}-export-error`;
+  const anyway = $(`${kind}-export-anyway`);
+  setProp(anyway, "hidden", true);
+  const t = target(kind, unchecked);
+  if (t.error) { showError(errId, t.error); return; }
+  const button = $(`${kind}-export-go`);
+  button.disabled = true;
+  try {
+    const answer = await download(t.url, t.name, errId);
+    // refused by the safety checks: say why, and offer to write it with the findings in it
+    if (answer && answer.reason === "safety") setProp(anyway, "hidden", false);
+  } finally {
+    button.disabled = false;
+  }
+}
