@@ -46,6 +46,7 @@ from typing import Literal
 import numpy as np
 
 from ._checks import instance_of, positive_number, whole_number
+from ._clearance import ClearanceGuard
 from ._errors import KinematicsError
 from ._human import SAGITTAL_MIRROR, HumanArm, _as_q
 from ._puma import IKConfig, IKResult, Puma560
@@ -154,6 +155,7 @@ class Retargeter:
         """The last cartesian-mode IK result (``success``, ``error``, ``message``): an
         unreachable hand pose is reported here, while ``robot_from_human`` returns the closest
         configuration within the limits."""
+        self._guard: ClearanceGuard | None = None
         self.held = False
         """Whether the last cartesian-mode frame held the previous pose, because the new one
         would have brought the robot's links into contact."""
@@ -287,14 +289,18 @@ class Retargeter:
             if self._q_prev is not None:
                 step = self.config.max_joint_step
                 q = self._q_prev + np.clip(q - self._q_prev, -step, step)
-            self.held = robot.checks_collisions and bool(
-                robot.self_collisions(q, self.config.clearance)
-            )
+            self.held = bool(self._clearance(robot).collisions(q))
             if self.held:
                 # hold the last pose free of self-collision (the robot's home before the first)
                 q = robot.home if self._q_prev is None else self._q_prev
         self._q_prev = q.copy()
         return q.copy()
+
+    def _clearance(self, robot: RobotArm) -> ClearanceGuard:
+        """The self-collision guard for the configured clearance (made again if it changed)."""
+        if self._guard is None or self._guard.margin != self.config.clearance:
+            self._guard = ClearanceGuard(robot, self.config.clearance)
+        return self._guard
 
     def _solve_arm(self, robot: RobotArm, oMdes: np.ndarray, q_human: np.ndarray) -> RobotIK:
         """The arm's IK for one frame: the pose, else the position; one elbow step a frame."""

@@ -30,6 +30,7 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
+from ._chain_ik import ChainSolve, SerialChain, solve
 from ._checks import real_array
 from ._errors import KinematicsError
 
@@ -278,6 +279,7 @@ class RobotArm:
         shoulder: the origin of the second joint at ``home`` (m, base frame): the point the
             operator's shoulder is mapped to.
         reach: the largest distance from ``shoulder`` to the tool over the limits (sampled, m).
+        chain: the arm's joints as the compiled IK reads them (:class:`SerialChain`).
         urdf_text: the URDF the model was built from (for export).
     """
 
@@ -313,6 +315,7 @@ class RobotArm:
         self.home.setflags(write=False)
         pin.forwardKinematics(model, self.data, self.home)
         self._elbow_joint = min(spec.elbow, model.njoints - 1)
+        self.chain = SerialChain.from_model(model, self._tool, self._elbow_joint)
         self.shoulder = np.array(self.data.oMi[min(2, model.njoints - 1)].translation)
         self.reach = self._sampled_reach()
         self._collision_data: pin.GeometryData | None = None
@@ -415,49 +418,27 @@ class RobotArm:
             pos_only = True
         q = np.clip(self.home if q0 is None else self.check_q(q0, "q0"), self.lower, self.upper)
         elbow_target = None if elbow is None else real_array(elbow, "elbow").reshape(3)
-        model, data, tool = self.model, self.data, self._tool
-        rows = 3 if pos_only else 6
-        elbow_steps = elbow_iterations
-        damp = np.eye(rows) * damping**2
-        e = np.empty(rows)
-        pos_err = rot_err = math.inf
-        it = 0
-        for it in range(iterations + 1):
-            pin.forwardKinematics(model, data, q)
-            oMtool = pin.updateFramePlacement(model, data, tool)
-            e[:3] = target_p - oMtool.translation
-            pos_err = float(np.linalg.norm(e[:3]))
-            if pos_only:
-                rot_err = 0.0
-            else:
-                e[3:] = pin.log3(target_R @ oMtool.rotation.T)
-                rot_err = float(np.linalg.norm(e[3:]))
-            reached = pos_err <= position_tolerance and rot_err <= rotation_tolerance
-            if it == iterations or (reached and elbow_target is None):
-                break
-            pin.computeJointJacobians(model, data, q)
-            J = pin.getFrameJacobian(model, data, tool, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)[
-                :rows
-            ]
-            JJt = J @ J.T + damp
-            dq = J.T @ np.linalg.solve(JJt, e)
-            if elbow_target is not None and self.nq > rows:
-                Je = pin.getJointJacobian(
-                    model, data, self._elbow_joint, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
-                )[:3]
-                pull = Je.T @ (elbow_target - data.oMi[self._elbow_joint].translation)
-                null = np.eye(self.nq) - J.T @ np.linalg.solve(JJt, J)
-                secondary = 0.5 * null @ pull
-                if reached and (elbow_steps <= 0 or float(np.abs(secondary).max()) < 1e-4):
-                    break  # the elbow is as near as the tool lets it be, or left to next time
-                elbow_steps -= reached
-                dq += secondary
-            biggest = float(np.abs(dq).max())
-            if biggest > max_step:
-                dq *= max_step / biggest
-            q = np.minimum(np.maximum(q + dq, self.lower), self.upper)
+        settings = ChainSolve(
+            iterations=iterations,
+            elbow_iterations=elbow_iterations,
+            position_tolerance=position_tolerance,
+            rotation_tolerance=rotation_tolerance,
+            damping=damping,
+            max_step=max_step,
+        )
+        q, pos_err, rot_err, it = solve(
+            self.chain,
+            self.lower,
+            self.upper,
+            q,
+            target_R,
+            target_p,
+            pos_only,
+            elbow_target,
+            settings,
+        )
         success = pos_err <= position_tolerance and rot_err <= rotation_tolerance
-        return RobotIK(q.copy(), bool(success), pos_err, rot_err, it)
+        return RobotIK(q, bool(success), pos_err, rot_err, it)
 
     # ------------------------------------------------------------------------- self-collision
 
@@ -521,16 +502,19 @@ class RobotArm:
 
 
 def _convex(geom: pin.GeometryModel) -> None:
-    """Replace each collision mesh by its convex hull.
+    """Replace each collision mesh by its convex hull (qhull, through coal).
 
     Distances between hulls cost a fraction of mesh-to-mesh ones (a 5-joint SO-101 check drops
     from about a second to milliseconds), and a hull contains its mesh, so a clearance found on
-    hulls holds for the meshes: the check errs on the safe side.
+    hulls holds for the meshes: the check errs on the safe side. The hull is computed, not
+    assumed: coal's GJK walks a convex shape's vertex graph to find support points, and on a
+    mesh taken as its own hull that walk stops at local extremes, so distances came out
+    centimetres too large and changed from one query to the next.
     """
     for obj in geom.geometryObjects:
         shape = obj.geometry
-        if hasattr(shape, "buildConvexRepresentation"):
-            shape.buildConvexRepresentation(False)
+        if hasattr(shape, "buildConvexHull"):
+            shape.buildConvexHull(True, "Qt")
             obj.geometry = shape.convex
 
 
