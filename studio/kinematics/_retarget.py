@@ -87,6 +87,10 @@ class RetargetConfig:
             this far above its base plane (m), ...
         floor_softness: ... by a soft floor of this width (m), so a hand lowered below it
             slides along the table instead of stopping dead.
+        reach_softness: raising such a robot's shoulder above the table carries the far side of
+            the scaled hand's sphere beyond the arm's reach; a target further than
+            ``reach_fraction`` of the reach from the robot's shoulder is drawn back inside that
+            sphere, smoothly over this width (m), and left exactly where it is nearer.
         max_joint_step: largest change of any joint of such a robot from one frame to the next
             (rad): a target that moves the IK's answer further (a wrist flip, a jump back into
             reach) is followed over several frames, never in one.
@@ -100,6 +104,7 @@ class RetargetConfig:
     ik_iterations: int = 20
     floor_height: float = 0.05
     floor_softness: float = 0.05
+    reach_softness: float = 0.1
     max_joint_step: float = math.radians(4.5)
     clearance: float = 0.005
 
@@ -108,6 +113,7 @@ class RetargetConfig:
         whole_number(self.ik_iterations, "RetargetConfig.ik_iterations", 1)
         positive_number(self.floor_height, "RetargetConfig.floor_height")
         positive_number(self.floor_softness, "RetargetConfig.floor_softness")
+        positive_number(self.reach_softness, "RetargetConfig.reach_softness")
         positive_number(self.max_joint_step, "RetargetConfig.max_joint_step")
         positive_number(self.clearance, "RetargetConfig.clearance")
 
@@ -116,6 +122,13 @@ def _soft_floor(z: float, floor: float, width: float) -> float:
     """``z`` kept above ``floor`` smoothly: a softplus of width ``width`` (equal to ``z`` well above)."""
     x = (z - floor) / width
     return floor + width * (x + math.log1p(math.exp(-x)) if x > 0 else math.log1p(math.exp(x)))
+
+
+def _soft_ceiling(r: float, ceiling: float, width: float) -> float:
+    """``r`` kept below ``ceiling`` smoothly: unchanged up to ``ceiling - width``, then bent
+    (continuous slope) towards ``ceiling``, which it never reaches."""
+    knee = ceiling - width
+    return r if r <= knee else knee + width * math.tanh((r - knee) / width)
 
 
 class Retargeter:
@@ -156,6 +169,9 @@ class Retargeter:
         unreachable hand pose is reported here, while ``robot_from_human`` returns the closest
         configuration within the limits."""
         self._guard: ClearanceGuard | None = None
+        self.pulled_in = 0.0
+        """How far (m) the last cartesian-mode hand target was drawn back into the robot's reach
+        (0 while the scaled hand lies within it; see ``RetargetConfig.reach_softness``)."""
         self.held = False
         """Whether the last cartesian-mode frame held the previous pose, because the new one
         would have brought the robot's links into contact."""
@@ -257,8 +273,14 @@ class Retargeter:
 
         Returns:
             ``oMdes``: the mirrored (if set), scaled hand-centre pose placed at the Puma's
-            shoulder, with the tool's approach axis along the fingers.
+            shoulder, with the tool's approach axis along the fingers. For a robot on a table
+            the target is then kept above the table and within the arm's reach, both softly
+            (see :class:`RetargetConfig`).
         """
+        return self._target(q_human)[0]
+
+    def _target(self, q_human: object) -> tuple[np.ndarray, float]:
+        """The hand target and how far it was drawn back into reach (m)."""
         pose = self.arm.forward(q_human).hand
         p, R = self._mirrored(pose[:3, 3]), pose[:3, :3]
         if self._mirror:
@@ -266,14 +288,21 @@ class Retargeter:
         oMdes = np.eye(4)
         oMdes[:3, :3] = R @ HAND_TO_TOOL
         oMdes[:3, 3] = self._shoulder() + self._scale() * p
-        if isinstance(self.robot, RobotArm):
-            oMdes[2, 3] = _soft_floor(
-                float(oMdes[2, 3]), self.config.floor_height, self.config.floor_softness
-            )
-        return oMdes
+        robot, config = self.robot, self.config
+        if not isinstance(robot, RobotArm):
+            return oMdes, 0.0
+        oMdes[:3, :3] = oMdes[:3, :3] @ robot.tool_axes
+        oMdes[2, 3] = _soft_floor(float(oMdes[2, 3]), config.floor_height, config.floor_softness)
+        # Between two points above the table, so the drawn-back target stays above it too.
+        offset = oMdes[:3, 3] - robot.shoulder
+        distance = float(np.linalg.norm(offset))
+        kept = _soft_ceiling(distance, config.reach_fraction * robot.reach, config.reach_softness)
+        if kept < distance:
+            oMdes[:3, 3] = robot.shoulder + offset * (kept / distance)
+        return oMdes, distance - kept
 
     def _cartesian(self, q_human: np.ndarray) -> np.ndarray:
-        oMdes = self.hand_target(q_human)
+        oMdes, self.pulled_in = self._target(q_human)
         robot = self.robot
         if isinstance(robot, RobotArm):
             found: IKResult | RobotIK = self._solve_arm(robot, oMdes, q_human)

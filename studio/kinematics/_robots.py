@@ -53,6 +53,8 @@ class RobotSpec:
             than six joints cannot reach every orientation, so it follows the position only).
         acceleration: joint acceleration limits (rad/s^2), or empty for twice the velocity limit.
         elbow: the joint (1-based) whose origin is the arm's elbow, for the null-space task.
+        approach: the tool frame's axis that points out of the tool, along its fingers
+            (``"z"``, the ROS convention, or ``"x"`` where the URDF's tool frame has it so).
     """
 
     name: str
@@ -64,7 +66,15 @@ class RobotSpec:
     orientation: bool = True
     acceleration: tuple[float, ...] = field(default=())
     elbow: int = 3
+    approach: str = "z"
 
+
+TOOL_AXES = {
+    "z": np.eye(3),
+    # tool x along the fingers, tool y kept, tool z opposite the studio's tool x
+    "x": np.array([[0.0, 0.0, -1.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]]),
+}
+"""A robot's tool axes (columns) in the studio's tool frame (z along the fingers), by approach."""
 
 ROBOT_SPECS: dict[str, RobotSpec] = {
     spec.name: spec
@@ -139,6 +149,7 @@ ROBOT_SPECS: dict[str, RobotSpec] = {
             "",
             "gripperStator",
             6,
+            approach="x",
         ),
         RobotSpec(
             "kinova",
@@ -147,6 +158,7 @@ ROBOT_SPECS: dict[str, RobotSpec] = {
             "kinova_description/srdf/kinova.srdf",
             "j2s6s200_end_effector",
             6,
+            approach="x",
         ),
     )
 }
@@ -276,9 +288,13 @@ class RobotArm:
         acceleration: acceleration limits (rad/s^2).
         home: a pose inside the limits the arm starts from (the middle of each joint's range,
             or 0 where 0 is inside it).
-        shoulder: the origin of the second joint at ``home`` (m, base frame): the point the
-            operator's shoulder is mapped to.
+        shoulder: the point of the first joint's axis level with the second joint's origin (m,
+            base frame): the centre of the arm's reach, whatever the first joint's angle (the
+            second joint's origin itself swings around the axis on arms with a shoulder offset,
+            such as the UR's).
         reach: the largest distance from ``shoulder`` to the tool over the limits (sampled, m).
+        tool_axes: the tool frame's axes in the studio's tool frame, whose z points along the
+            fingers (:data:`TOOL_AXES`).
         chain: the arm's joints as the compiled IK reads them (:class:`SerialChain`).
         urdf_text: the URDF the model was built from (for export).
     """
@@ -316,7 +332,8 @@ class RobotArm:
         pin.forwardKinematics(model, self.data, self.home)
         self._elbow_joint = min(spec.elbow, model.njoints - 1)
         self.chain = SerialChain.from_model(model, self._tool, self._elbow_joint)
-        self.shoulder = np.array(self.data.oMi[min(2, model.njoints - 1)].translation)
+        self.shoulder = _shoulder(model, self.data, self.chain.axes[0])
+        self.tool_axes = TOOL_AXES[spec.approach]
         self.reach = self._sampled_reach()
         self._collision_data: pin.GeometryData | None = None
         if len(collision_model.geometryObjects):
@@ -516,6 +533,14 @@ def _convex(geom: pin.GeometryModel) -> None:
         if hasattr(shape, "buildConvexHull"):
             shape.buildConvexHull(True, "Qt")
             obj.geometry = shape.convex
+
+
+def _shoulder(model: pin.Model, data: pin.Data, axis: np.ndarray) -> np.ndarray:
+    """The point of joint 1's axis nearest joint 2's origin (``data`` holds a forward pass)."""
+    base = data.oMi[1]
+    origin, direction = np.array(base.translation), base.rotation @ axis
+    second = np.array(data.oMi[min(2, model.njoints - 1)].translation)
+    return origin + direction * float(direction @ (second - origin))
 
 
 def _home(
