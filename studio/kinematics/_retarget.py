@@ -83,6 +83,8 @@ class RetargetConfig:
         reach_fraction: the arm's full reach maps to this fraction of the robot's, keeping
             cartesian targets off the Puma's outstretched singularity.
         ik_iterations: IK iterations per attempt on the live path (warm starts need few).
+        restart_iterations: IK iterations of each restart, when the warm-started solve of a
+            robot of :func:`load_robot` misses the pose (a restart starts further away).
         floor_height: a robot of :func:`load_robot` stands on a table: hand targets are kept
             this far above its base plane (m), ...
         floor_softness: ... by a soft floor of this width (m), so a hand lowered below it
@@ -91,9 +93,15 @@ class RetargetConfig:
             the scaled hand's sphere beyond the arm's reach; a target further than
             ``reach_fraction`` of the reach from the robot's shoulder is drawn back inside that
             sphere, smoothly over this width (m), and left exactly where it is nearer.
-        max_joint_step: largest change of any joint of such a robot from one frame to the next
+        max_joint_step: largest change of any joint of the robot from one frame to the next
             (rad): a target that moves the IK's answer further (a wrist flip, a jump back into
-            reach) is followed over several frames, never in one.
+            reach, the Puma560's shoulder passing near its first axis) is followed over several
+            frames, never in one.
+        input_jump: the Puma560's cartesian mode also answers single poses exactly: when the
+            operator's arm changes by more than this in one frame (rad, any joint; a human arm
+            turns at most about 10 rad/s, 0.09 rad a frame at 110 Hz), the new arm is a new pose
+            rather than a motion, and the Puma560 goes straight to its answer. Every other
+            robot always keeps to ``max_joint_step``.
         clearance: such a robot's links keep at least this distance from each other (m); a
             pose closer than that is not taken (the last one is held). Convex-hull distances
             near contact vary by about a millimetre between evaluations, so the margin keeps
@@ -102,19 +110,23 @@ class RetargetConfig:
 
     reach_fraction: float = 0.95
     ik_iterations: int = 20
+    restart_iterations: int = 60
     floor_height: float = 0.05
     floor_softness: float = 0.05
     reach_softness: float = 0.1
     max_joint_step: float = math.radians(4.5)
+    input_jump: float = 0.15
     clearance: float = 0.005
 
     def __post_init__(self) -> None:
         positive_number(self.reach_fraction, "RetargetConfig.reach_fraction")
         whole_number(self.ik_iterations, "RetargetConfig.ik_iterations", 1)
+        whole_number(self.restart_iterations, "RetargetConfig.restart_iterations", 1)
         positive_number(self.floor_height, "RetargetConfig.floor_height")
         positive_number(self.floor_softness, "RetargetConfig.floor_softness")
         positive_number(self.reach_softness, "RetargetConfig.reach_softness")
         positive_number(self.max_joint_step, "RetargetConfig.max_joint_step")
+        positive_number(self.input_jump, "RetargetConfig.input_jump")
         positive_number(self.clearance, "RetargetConfig.clearance")
 
 
@@ -129,6 +141,17 @@ def _soft_ceiling(r: float, ceiling: float, width: float) -> float:
     (continuous slope) towards ``ceiling``, which it never reaches."""
     knee = ceiling - width
     return r if r <= knee else knee + width * math.tanh((r - knee) / width)
+
+
+PINNED = 0.01
+"""A joint within this share of its range from a limit counts as pinned there."""
+
+
+def _unpinned(robot: RobotArm, q: np.ndarray) -> np.ndarray:
+    """``q`` with every joint pinned at a limit moved to its home angle."""
+    margin = PINNED * (robot.upper - robot.lower)
+    pinned = (q <= robot.lower + margin) | (q >= robot.upper - margin)
+    return np.where(pinned, robot.home, q)
 
 
 class Retargeter:
@@ -164,6 +187,8 @@ class Retargeter:
         self.mirror = bool(mirror)
         self.mode = mode or ("joint" if isinstance(self.robot, Puma560) else "cartesian")
         self._q_prev: np.ndarray | None = None
+        self._q_ik: np.ndarray | None = None
+        self._q_human_prev: np.ndarray | None = None
         self.last_ik: IKResult | RobotIK | None = None
         """The last cartesian-mode IK result (``success``, ``error``, ``message``): an
         unreachable hand pose is reported here, while ``robot_from_human`` returns the closest
@@ -209,6 +234,8 @@ class Retargeter:
     def reset(self) -> None:
         """Forget the previous cartesian solution (the next IK starts cold)."""
         self._q_prev = None
+        self._q_ik = None
+        self._q_human_prev = None
 
     # ---------------------------------------------------------------------------- mapping
 
@@ -309,21 +336,30 @@ class Retargeter:
         else:
             found = robot.inverse(oMdes, q0=self._q_prev)
             if not found.success:
-                position = robot.inverse(oMdes[:3, 3], q0=found.q, position_only=True)
+                start = found.q if self._q_prev is None else self._q_prev
+                position = robot.inverse(oMdes[:3, 3], q0=start, position_only=True)
                 if position.success or position.error < found.error:
                     found = position
         self.last_ik = found
         q = found.q
+        if self._q_prev is not None and (isinstance(robot, RobotArm) or self._smooth(q_human)):
+            step = self.config.max_joint_step
+            q = self._q_prev + np.clip(q - self._q_prev, -step, step)
+        self._q_human_prev = q_human
         if isinstance(robot, RobotArm):
-            if self._q_prev is not None:
-                step = self.config.max_joint_step
-                q = self._q_prev + np.clip(q - self._q_prev, -step, step)
             self.held = bool(self._clearance(robot).collisions(q))
             if self.held:
                 # hold the last pose free of self-collision (the robot's home before the first)
                 q = robot.home if self._q_prev is None else self._q_prev
         self._q_prev = q.copy()
+        self._q_ik = found.q.copy()
         return q.copy()
+
+    def _smooth(self, q_human: np.ndarray) -> bool:
+        """Whether ``q_human`` continues the last frame's arm (no joint turned further than a
+        human arm turns in a frame)."""
+        last = self._q_human_prev
+        return last is not None and float(np.abs(q_human - last).max()) <= self.config.input_jump
 
     def _clearance(self, robot: RobotArm) -> ClearanceGuard:
         """The self-collision guard for the configured clearance (made again if it changed)."""
@@ -332,10 +368,27 @@ class Retargeter:
         return self._guard
 
     def _solve_arm(self, robot: RobotArm, oMdes: np.ndarray, q_human: np.ndarray) -> RobotIK:
-        """The arm's IK for one frame: the pose, else the position; one elbow step a frame."""
+        """The arm's IK for one frame: the pose, else the position; one elbow step a frame.
+
+        The solve starts from the last frame's IK answer. When that fails, a joint is often
+        pinned at a limit in a basin that no longer holds the pose; the solve is tried again
+        from that answer with its pinned joints moved home, and from home, and the answer
+        nearest the last one that reaches the pose is taken (the step cap then walks the robot
+        there over as many frames as it needs).
+        """
         elbow = self.elbow_target(q_human) if robot.nq > 6 else None
         settings = {"elbow": elbow, "iterations": self.config.ik_iterations, "elbow_iterations": 1}
-        found = robot.inverse(oMdes, q0=self._q_prev, **settings)
+        start = robot.home if self._q_ik is None else self._q_ik
+        found = robot.inverse(oMdes, q0=start, **settings)
+        if not found.success:
+            settings["iterations"] = self.config.restart_iterations
+            nearest = math.inf
+            for seed in (_unpinned(robot, found.q), robot.home):
+                other = robot.inverse(oMdes, q0=seed, **settings)
+                distance = float(np.abs(other.q - start).max())
+                if other.success and distance < nearest:
+                    found, nearest = other, distance
+            settings["iterations"] = self.config.ik_iterations
         if not found.success and robot.spec.orientation:
             position = robot.inverse(oMdes[:3, 3], q0=found.q, **settings)
             if position.success or position.position_error < found.position_error:
