@@ -83,8 +83,8 @@ class RetargetConfig:
         reach_fraction: the arm's full reach maps to this fraction of the robot's, keeping
             cartesian targets off the Puma's outstretched singularity.
         ik_iterations: IK iterations per attempt on the live path (warm starts need few).
-        restart_iterations: IK iterations of each restart, when the warm-started solve of a
-            robot of :func:`load_robot` misses the pose (a restart starts further away).
+        restart_iterations: IK iterations of each further attempt, when the warm-started solve
+            of a robot of :func:`load_robot` misses the pose.
         floor_height: a robot of :func:`load_robot` stands on a table: hand targets are kept
             this far above its base plane (m), ...
         floor_softness: ... by a soft floor of this width (m), so a hand lowered below it
@@ -187,7 +187,6 @@ class Retargeter:
         self.mirror = bool(mirror)
         self.mode = mode or ("joint" if isinstance(self.robot, Puma560) else "cartesian")
         self._q_prev: np.ndarray | None = None
-        self._q_ik: np.ndarray | None = None
         self._q_human_prev: np.ndarray | None = None
         self.last_ik: IKResult | RobotIK | None = None
         """The last cartesian-mode IK result (``success``, ``error``, ``message``): an
@@ -234,7 +233,6 @@ class Retargeter:
     def reset(self) -> None:
         """Forget the previous cartesian solution (the next IK starts cold)."""
         self._q_prev = None
-        self._q_ik = None
         self._q_human_prev = None
 
     # ---------------------------------------------------------------------------- mapping
@@ -352,7 +350,6 @@ class Retargeter:
                 # hold the last pose free of self-collision (the robot's home before the first)
                 q = robot.home if self._q_prev is None else self._q_prev
         self._q_prev = q.copy()
-        self._q_ik = found.q.copy()
         return q.copy()
 
     def _smooth(self, q_human: np.ndarray) -> bool:
@@ -370,18 +367,21 @@ class Retargeter:
     def _solve_arm(self, robot: RobotArm, oMdes: np.ndarray, q_human: np.ndarray) -> RobotIK:
         """The arm's IK for one frame: the pose, else the position; one elbow step a frame.
 
-        The solve starts from the last frame's IK answer. When that fails, a joint is often
-        pinned at a limit in a basin that no longer holds the pose; the solve is tried again
-        from that answer with its pinned joints moved home, and from home, and the answer
-        nearest the last one that reaches the pose is taken (the step cap then walks the robot
-        there over as many frames as it needs).
+        The solve starts from the last frame's pose, and goes on from where it stopped if
+        it falls short. When that fails too, a joint is often pinned at a limit in a basin
+        that no longer holds the pose; the solve is tried again from that answer with its
+        pinned joints moved home, and from home, and the answer nearest the last one that
+        reaches the pose is taken (the step cap then walks the robot there over as many frames
+        as it needs).
         """
         elbow = self.elbow_target(q_human) if robot.nq > 6 else None
         settings = {"elbow": elbow, "iterations": self.config.ik_iterations, "elbow_iterations": 1}
-        start = robot.home if self._q_ik is None else self._q_ik
+        start = robot.home if self._q_prev is None else self._q_prev
         found = robot.inverse(oMdes, q0=start, **settings)
+        settings["iterations"] = self.config.restart_iterations
+        if not found.success:  # the pose may have moved further than a few iterations go
+            found = robot.inverse(oMdes, q0=found.q, **settings)
         if not found.success:
-            settings["iterations"] = self.config.restart_iterations
             nearest = math.inf
             for seed in (_unpinned(robot, found.q), robot.home):
                 other = robot.inverse(oMdes, q0=seed, **settings)
