@@ -26,6 +26,7 @@ from ._retarget import Retargeter as Retargeter
 from ._robots import RobotArm as RobotArm
 from ._robots import RobotIK as RobotIK
 from ._robots import load_robot as load_robot
+from ._robots import prepare_arm_ik_in_background as prepare_arm_ik_in_background
 from ._robots import robot_names as robot_names
 from ._robots import robot_spec as robot_spec
 from ._sleeve import SLEEVE_LIFT_M as SLEEVE_LIFT_M

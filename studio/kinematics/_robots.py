@@ -19,11 +19,16 @@ published (Panda) and otherwise twice the velocity limit per second, a conservat
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import importlib.metadata
 import math
 import re
+import subprocess
+import sys
 import sysconfig
+import threading
+import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -646,3 +651,36 @@ def _puma_arm(spec: RobotSpec) -> RobotArm:
     model = puma.model.copy()
     model.velocityLimit = np.full(6, PUMA_VELOCITY)
     return RobotArm(spec, model, empty, pin.GeometryModel(), puma.urdf())
+
+
+def prepare_arm_ik() -> float:
+    """Load (or, the first time on this machine, compile) the IK kernel; returns the seconds.
+
+    The kernel is cached on disk: compiling it takes seconds (tens on a loaded machine), which
+    would otherwise stall the first frame of the first arm chosen in the studio.
+    """
+    start = time.perf_counter()
+    arm = load_robot("puma560", geometry=False)
+    arm.inverse(arm.forward(arm.home), arm.home, iterations=2)
+    return time.perf_counter() - start
+
+
+def prepare_arm_ik_in_background() -> threading.Thread:
+    """Run :func:`prepare_arm_ik` in a child process (a compile holds its interpreter's GIL),
+    waited for by the returned daemon thread. If the child cannot start, the first arm chosen
+    compiles the kernel itself."""
+    code = "from studio.kinematics._robots import prepare_arm_ik; prepare_arm_ik()"
+
+    def child() -> None:
+        with contextlib.suppress(OSError):
+            subprocess.run(
+                [sys.executable, "-c", code],
+                stdin=subprocess.DEVNULL,
+                stdout=subprocess.DEVNULL,
+                stderr=subprocess.DEVNULL,
+                check=False,
+            )
+
+    thread = threading.Thread(target=child, name="studio-prepare-ik", daemon=True)
+    thread.start()
+    return thread
