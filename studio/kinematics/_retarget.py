@@ -29,7 +29,8 @@ dropped; :meth:`Retargeter.human_from_robot` sets it to zero.
 *cartesian* - the hand-centre pose relative to the shoulder is mirrored, scaled by the ratio of
 the robot's reach to the arm's (times ``reach_fraction``), placed at the robot's shoulder and
 solved by the robot's IK, warm-started from the previous solution; when the full pose is out of
-reach of the wrist, the position alone is solved.
+reach of the wrist, the position alone is solved. While the arm moves, no joint turns more than
+``max_joint_step`` a frame (a change of IK branch is walked over several frames).
 
 Any robot of :func:`load_robot` (a :class:`RobotArm`) is driven in cartesian mode, the only one
 that means something for an arm whose joints are not the human arm's; on a redundant arm (Panda,
@@ -343,7 +344,7 @@ class Retargeter:
         if self._q_prev is not None and (isinstance(robot, RobotArm) or self._smooth(q_human)):
             step = self.config.max_joint_step
             q = self._q_prev + np.clip(q - self._q_prev, -step, step)
-        self._q_human_prev = q_human
+        self._q_human_prev = q_human.copy()
         if isinstance(robot, RobotArm):
             self.held = bool(self._clearance(robot).collisions(q))
             if self.held:
