@@ -27,6 +27,7 @@ from ._retarget import retarget_path as retarget_path
 from ._robots import DEFAULT_ROBOT as DEFAULT_ROBOT
 from ._robots import RobotArm as RobotArm
 from ._robots import load_robot as load_robot
+from ._robots import prepare_arm_ik_in_background as prepare_arm_ik_in_background
 from ._robots import robot_names as robot_names
 from ._robots import robot_spec as robot_spec
 from ._sleeve import SLEEVE_LIFT_M as SLEEVE_LIFT_M

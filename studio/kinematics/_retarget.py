@@ -29,7 +29,8 @@ dropped; :meth:`Retargeter.human_from_robot` sets it to zero.
 *cartesian* - the hand-centre pose relative to the shoulder is mirrored, scaled by the ratio of
 the robot's reach to the arm's (times ``reach_fraction``), placed at the robot's shoulder and
 solved by the robot's IK, warm-started from the previous solution; when the full pose is out of
-reach of the wrist, the position alone is solved.
+reach of the wrist, the position alone is solved. While the arm moves, no joint turns more than
+``max_joint_step`` a frame (a change of IK branch is walked over several frames).
 
 Any robot of :func:`load_robot` (a :class:`RobotArm`) is driven in cartesian mode, the only one
 that means something for an arm whose joints are not the human arm's; on a redundant arm (Panda,
@@ -46,6 +47,7 @@ from typing import Literal
 import numpy as np
 
 from ._checks import instance_of, positive_number, whole_number
+from ._clearance import ClearanceGuard
 from ._errors import KinematicsError
 from ._human import SAGITTAL_MIRROR, HumanArm, _as_q
 from ._puma import IKConfig, IKResult, Puma560
@@ -82,13 +84,25 @@ class RetargetConfig:
         reach_fraction: the arm's full reach maps to this fraction of the robot's, keeping
             cartesian targets off the Puma's outstretched singularity.
         ik_iterations: IK iterations per attempt on the live path (warm starts need few).
+        restart_iterations: IK iterations of each further attempt, when the warm-started solve
+            of a robot of :func:`load_robot` misses the pose.
         floor_height: a robot of :func:`load_robot` stands on a table: hand targets are kept
             this far above its base plane (m), ...
         floor_softness: ... by a soft floor of this width (m), so a hand lowered below it
             slides along the table instead of stopping dead.
-        max_joint_step: largest change of any joint of such a robot from one frame to the next
+        reach_softness: raising such a robot's shoulder above the table carries the far side of
+            the scaled hand's sphere beyond the arm's reach; a target further than
+            ``reach_fraction`` of the reach from the robot's shoulder is drawn back inside that
+            sphere, smoothly over this width (m), and left exactly where it is nearer.
+        max_joint_step: largest change of any joint of the robot from one frame to the next
             (rad): a target that moves the IK's answer further (a wrist flip, a jump back into
-            reach) is followed over several frames, never in one.
+            reach, the Puma560's shoulder passing near its first axis) is followed over several
+            frames, never in one.
+        input_jump: the Puma560's cartesian mode also answers single poses exactly: when the
+            operator's arm changes by more than this in one frame (rad, any joint; a human arm
+            turns at most about 10 rad/s, 0.09 rad a frame at 110 Hz), the new arm is a new pose
+            rather than a motion, and the Puma560 goes straight to its answer. Every other
+            robot always keeps to ``max_joint_step``.
         clearance: such a robot's links keep at least this distance from each other (m); a
             pose closer than that is not taken (the last one is held). Convex-hull distances
             near contact vary by about a millimetre between evaluations, so the margin keeps
@@ -102,9 +116,12 @@ class RetargetConfig:
 
     reach_fraction: float = 0.95
     ik_iterations: int = 20
+    restart_iterations: int = 60
     floor_height: float = 0.05
     floor_softness: float = 0.05
+    reach_softness: float = 0.1
     max_joint_step: float = math.radians(4.5)
+    input_jump: float = 0.15
     clearance: float = 0.005
     reach_tolerance: float = 0.01
     settle_tries: int = 5
@@ -112,9 +129,12 @@ class RetargetConfig:
     def __post_init__(self) -> None:
         positive_number(self.reach_fraction, "RetargetConfig.reach_fraction")
         whole_number(self.ik_iterations, "RetargetConfig.ik_iterations", 1)
+        whole_number(self.restart_iterations, "RetargetConfig.restart_iterations", 1)
         positive_number(self.floor_height, "RetargetConfig.floor_height")
         positive_number(self.floor_softness, "RetargetConfig.floor_softness")
+        positive_number(self.reach_softness, "RetargetConfig.reach_softness")
         positive_number(self.max_joint_step, "RetargetConfig.max_joint_step")
+        positive_number(self.input_jump, "RetargetConfig.input_jump")
         positive_number(self.clearance, "RetargetConfig.clearance")
         positive_number(self.reach_tolerance, "RetargetConfig.reach_tolerance")
         whole_number(self.settle_tries, "RetargetConfig.settle_tries", 1)
@@ -124,6 +144,24 @@ def _soft_floor(z: float, floor: float, width: float) -> float:
     """``z`` kept above ``floor`` smoothly: a softplus of width ``width`` (equal to ``z`` well above)."""
     x = (z - floor) / width
     return floor + width * (x + math.log1p(math.exp(-x)) if x > 0 else math.log1p(math.exp(x)))
+
+
+def _soft_ceiling(r: float, ceiling: float, width: float) -> float:
+    """``r`` kept below ``ceiling`` smoothly: unchanged up to ``ceiling - width``, then bent
+    (continuous slope) towards ``ceiling``, which it never reaches."""
+    knee = ceiling - width
+    return r if r <= knee else knee + width * math.tanh((r - knee) / width)
+
+
+PINNED = 0.01
+"""A joint within this share of its range from a limit counts as pinned there."""
+
+
+def _unpinned(robot: RobotArm, q: np.ndarray) -> np.ndarray:
+    """``q`` with every joint pinned at a limit moved to its home angle."""
+    margin = PINNED * (robot.upper - robot.lower)
+    pinned = (q <= robot.lower + margin) | (q >= robot.upper - margin)
+    return np.where(pinned, robot.home, q)
 
 
 class Retargeter:
@@ -159,10 +197,15 @@ class Retargeter:
         self.mirror = bool(mirror)
         self.mode = mode or ("joint" if isinstance(self.robot, Puma560) else "cartesian")
         self._q_prev: np.ndarray | None = None
+        self._q_human_prev: np.ndarray | None = None
         self.last_ik: IKResult | RobotIK | None = None
         """The last cartesian-mode IK result (``success``, ``error``, ``message``): an
         unreachable hand pose is reported here, while ``robot_from_human`` returns the closest
         configuration within the limits."""
+        self._guard: ClearanceGuard | None = None
+        self.pulled_in = 0.0
+        """How far (m) the last cartesian-mode hand target was drawn back into the robot's reach
+        (0 while the scaled hand lies within it; see ``RetargetConfig.reach_softness``)."""
         self.held = False
         """Whether the last cartesian-mode frame held the previous pose, because the new one
         would have brought the robot's links into contact."""
@@ -200,6 +243,7 @@ class Retargeter:
     def reset(self) -> None:
         """Forget the previous cartesian solution (the next IK starts cold)."""
         self._q_prev = None
+        self._q_human_prev = None
 
     # ---------------------------------------------------------------------------- mapping
 
@@ -264,8 +308,14 @@ class Retargeter:
 
         Returns:
             ``oMdes``: the mirrored (if set), scaled hand-centre pose placed at the Puma's
-            shoulder, with the tool's approach axis along the fingers.
+            shoulder, with the tool's approach axis along the fingers. For a robot on a table
+            the target is then kept above the table and within the arm's reach, both softly
+            (see :class:`RetargetConfig`).
         """
+        return self._target(q_human)[0]
+
+    def _target(self, q_human: object) -> tuple[np.ndarray, float]:
+        """The hand target and how far it was drawn back into reach (m)."""
         pose = self.arm.forward(q_human).hand
         p, R = self._mirrored(pose[:3, 3]), pose[:3, :3]
         if self._mirror:
@@ -273,43 +323,82 @@ class Retargeter:
         oMdes = np.eye(4)
         oMdes[:3, :3] = R @ HAND_TO_TOOL
         oMdes[:3, 3] = self._shoulder() + self._scale() * p
-        if isinstance(self.robot, RobotArm):
-            oMdes[2, 3] = _soft_floor(
-                float(oMdes[2, 3]), self.config.floor_height, self.config.floor_softness
-            )
-        return oMdes
+        robot, config = self.robot, self.config
+        if not isinstance(robot, RobotArm):
+            return oMdes, 0.0
+        oMdes[:3, :3] = oMdes[:3, :3] @ robot.tool_axes
+        oMdes[2, 3] = _soft_floor(float(oMdes[2, 3]), config.floor_height, config.floor_softness)
+        # Between two points above the table, so the drawn-back target stays above it too.
+        offset = oMdes[:3, 3] - robot.shoulder
+        distance = float(np.linalg.norm(offset))
+        kept = _soft_ceiling(distance, config.reach_fraction * robot.reach, config.reach_softness)
+        if kept < distance:
+            oMdes[:3, 3] = robot.shoulder + offset * (kept / distance)
+        return oMdes, distance - kept
 
     def _cartesian(self, q_human: np.ndarray) -> np.ndarray:
-        oMdes = self.hand_target(q_human)
+        oMdes, self.pulled_in = self._target(q_human)
         robot = self.robot
         if isinstance(robot, RobotArm):
             found: IKResult | RobotIK = self._solve_arm(robot, oMdes, q_human)
         else:
             found = robot.inverse(oMdes, q0=self._q_prev)
             if not found.success:
-                position = robot.inverse(oMdes[:3, 3], q0=found.q, position_only=True)
+                start = found.q if self._q_prev is None else self._q_prev
+                position = robot.inverse(oMdes[:3, 3], q0=start, position_only=True)
                 if position.success or position.error < found.error:
                     found = position
         self.last_ik = found
         q = found.q
+        if self._q_prev is not None and (isinstance(robot, RobotArm) or self._smooth(q_human)):
+            step = self.config.max_joint_step
+            q = self._q_prev + np.clip(q - self._q_prev, -step, step)
+        self._q_human_prev = q_human.copy()
         if isinstance(robot, RobotArm):
-            if self._q_prev is not None:
-                step = self.config.max_joint_step
-                q = self._q_prev + np.clip(q - self._q_prev, -step, step)
-            self.held = robot.checks_collisions and bool(
-                robot.self_collisions(q, self.config.clearance)
-            )
+            self.held = bool(self._clearance(robot).collisions(q))
             if self.held:
                 # hold the last pose free of self-collision (the robot's home before the first)
                 q = robot.home if self._q_prev is None else self._q_prev
         self._q_prev = q.copy()
         return q.copy()
 
+    def _smooth(self, q_human: np.ndarray) -> bool:
+        """Whether ``q_human`` continues the last frame's arm (no joint turned further than a
+        human arm turns in a frame)."""
+        last = self._q_human_prev
+        return last is not None and float(np.abs(q_human - last).max()) <= self.config.input_jump
+
+    def _clearance(self, robot: RobotArm) -> ClearanceGuard:
+        """The self-collision guard for the configured clearance (made again if it changed)."""
+        if self._guard is None or self._guard.margin != self.config.clearance:
+            self._guard = ClearanceGuard(robot, self.config.clearance)
+        return self._guard
+
     def _solve_arm(self, robot: RobotArm, oMdes: np.ndarray, q_human: np.ndarray) -> RobotIK:
-        """The arm's IK for one frame: the pose, else the position; one elbow step a frame."""
+        """The arm's IK for one frame: the pose, else the position; one elbow step a frame.
+
+        The solve starts from the last frame's pose, and goes on from where it stopped if
+        it falls short. When that fails too, a joint is often pinned at a limit in a basin
+        that no longer holds the pose; the solve is tried again from that answer with its
+        pinned joints moved home, and from home, and the answer nearest the last one that
+        reaches the pose is taken (the step cap then walks the robot there over as many frames
+        as it needs).
+        """
         elbow = self.elbow_target(q_human) if robot.nq > 6 else None
         settings = {"elbow": elbow, "iterations": self.config.ik_iterations, "elbow_iterations": 1}
-        found = robot.inverse(oMdes, q0=self._q_prev, **settings)
+        start = robot.home if self._q_prev is None else self._q_prev
+        found = robot.inverse(oMdes, q0=start, **settings)
+        settings["iterations"] = self.config.restart_iterations
+        if not found.success:  # the pose may have moved further than a few iterations go
+            found = robot.inverse(oMdes, q0=found.q, **settings)
+        if not found.success:
+            nearest = math.inf
+            for seed in (_unpinned(robot, found.q), robot.home):
+                other = robot.inverse(oMdes, q0=seed, **settings)
+                distance = float(np.abs(other.q - start).max())
+                if other.success and distance < nearest:
+                    found, nearest = other, distance
+            settings["iterations"] = self.config.ik_iterations
         if not found.success and robot.spec.orientation:
             position = robot.inverse(oMdes[:3, 3], q0=found.q, **settings)
             if position.success or position.position_error < found.position_error:

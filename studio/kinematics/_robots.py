@@ -19,18 +19,24 @@ published (Panda) and otherwise twice the velocity limit per second, a conservat
 
 from __future__ import annotations
 
+import contextlib
 import copy
 import functools
 import importlib.metadata
 import math
 import re
+import subprocess
+import sys
 import sysconfig
+import threading
+import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
 
+from ._chain_ik import ChainSolve, SerialChain, solve
 from ._checks import real_array
 from ._errors import KinematicsError
 
@@ -55,6 +61,8 @@ class RobotSpec:
         elbow: the joint (1-based) whose origin is the arm's elbow, for the null-space task.
         ready: a pose in the middle of the workspace (degrees) that tasks aim for by default,
             where :attr:`RobotArm.home` is a poor aim; empty: ``home``.
+        approach: the tool frame's axis that points out of the tool, along its fingers
+            (``"z"``, the ROS convention, or ``"x"`` where the URDF's tool frame has it so).
     """
 
     name: str
@@ -67,11 +75,19 @@ class RobotSpec:
     acceleration: tuple[float, ...] = field(default=())
     elbow: int = 3
     ready: tuple[float, ...] = field(default=())
+    approach: str = "z"
 
 
 UR_READY_DEG = (0.0, -90.0, 90.0, -90.0, -90.0, 0.0)
 """The UR arms' ready pose: upper arm up, forearm level and forward, tool pointing down. Their
 ``home`` (every joint 0) is the arm stretched out level, at the edge of the workspace."""
+
+TOOL_AXES = {
+    "z": np.eye(3),
+    # tool x along the fingers, tool y kept, tool z opposite the studio's tool x
+    "x": np.array([[0.0, 0.0, -1.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]]),
+}
+"""A robot's tool axes (columns) in the studio's tool frame (z along the fingers), by approach."""
 
 ROBOT_SPECS: dict[str, RobotSpec] = {
     spec.name: spec
@@ -149,6 +165,7 @@ ROBOT_SPECS: dict[str, RobotSpec] = {
             "",
             "gripperStator",
             6,
+            approach="x",
         ),
         RobotSpec(
             "kinova",
@@ -157,6 +174,7 @@ ROBOT_SPECS: dict[str, RobotSpec] = {
             "kinova_description/srdf/kinova.srdf",
             "j2s6s200_end_effector",
             6,
+            approach="x",
         ),
     )
 }
@@ -260,26 +278,6 @@ class RobotIK:
 
 
 @dataclass(frozen=True)
-class SerialChain:
-    """A serial arm of revolute joints as plain arrays (:meth:`RobotArm.serial_chain`).
-
-    The tool pose is ``prod_i (parentMjoint_i @ rot(axis_i, q_i)) @ jointMtool`` over joints
-    ``1..tool_joint``, Pinocchio's own composition (``oMi = oMparent * jointPlacement * M(q)``).
-
-    Attributes:
-        placements: each joint's placement in its parent joint's frame, ``(nq, 4, 4)``.
-        axes: each joint's unit rotation axis in its own frame, ``(nq, 3)``.
-        tool_joint: how many joints, from the first, move the tool (the tool frame's parent).
-        jointMtool: the tool frame in that joint's frame, ``(4, 4)``.
-    """
-
-    placements: np.ndarray
-    axes: np.ndarray
-    tool_joint: int
-    jointMtool: np.ndarray
-
-
-@dataclass(frozen=True)
 class Collision:
     """Two links closer than the margin: ``distance`` is negative when they overlap (m)."""
 
@@ -307,9 +305,14 @@ class RobotArm:
         acceleration: acceleration limits (rad/s^2).
         home: a pose inside the limits the arm starts from (the middle of each joint's range,
             or 0 where 0 is inside it).
-        shoulder: the origin of the second joint at ``home`` (m, base frame): the point the
-            operator's shoulder is mapped to.
+        shoulder: the point of the first joint's axis level with the second joint's origin (m,
+            base frame): the centre of the arm's reach, whatever the first joint's angle (the
+            second joint's origin itself swings around the axis on arms with a shoulder offset,
+            such as the UR's).
         reach: the largest distance from ``shoulder`` to the tool over the limits (sampled, m).
+        tool_axes: the tool frame's axes in the studio's tool frame, whose z points along the
+            fingers (:data:`TOOL_AXES`).
+        chain: the arm's joints as the compiled IK reads them (:class:`SerialChain`).
         urdf_text: the URDF the model was built from (for export).
     """
 
@@ -345,7 +348,9 @@ class RobotArm:
         self.home.setflags(write=False)
         pin.forwardKinematics(model, self.data, self.home)
         self._elbow_joint = min(spec.elbow, model.njoints - 1)
-        self.shoulder = np.array(self.data.oMi[min(2, model.njoints - 1)].translation)
+        self.chain = SerialChain.from_model(model, self._tool, self._elbow_joint)
+        self.shoulder = _shoulder(model, self.data, self.chain.axes[0])
+        self.tool_axes = TOOL_AXES[spec.approach]
         self.reach = self._sampled_reach()
         self._collision_data: pin.GeometryData | None = None
         if len(collision_model.geometryObjects):
@@ -390,41 +395,6 @@ class RobotArm:
         arr = self.check_q(q)
         pin.forwardKinematics(self.model, self.data, arr)
         return np.array([self.data.oMi[i].translation for i in range(1, self.model.njoints)])
-
-    def serial_chain(self) -> SerialChain:
-        """The arm as a serial chain of revolute joints, for code that computes its forward
-        kinematics without Pinocchio (the learning tasks' compiled twins).
-
-        Raises:
-            KinematicsError: a joint that is not revolute, or a tree rather than a chain.
-        """
-        model = self.model
-        data = model.createData()  # scratch of our own: this may run beside the live thread
-        pin.computeJointJacobians(model, data, np.clip(np.zeros(self.nq), self.lower, self.upper))
-        placements, axes = [], []
-        for i in range(1, model.njoints):
-            joint = model.joints[i]
-            column = pin.getJointJacobian(model, data, i, pin.ReferenceFrame.LOCAL)[:, joint.idx_v]
-            if (
-                model.parents[i] != i - 1
-                or joint.nq != 1
-                or joint.nv != 1
-                or np.linalg.norm(column[:3]) > 1e-9
-                or abs(np.linalg.norm(column[3:]) - 1.0) > 1e-9
-            ):
-                raise KinematicsError(
-                    f"The {self.spec.title}'s joint {self.joint_names[i - 1]!r} is not a revolute "
-                    "joint of a serial chain; the learning tasks need one."
-                )
-            placements.append(model.jointPlacements[i].homogeneous)
-            axes.append(column[3:])
-        frame = model.frames[self._tool]
-        return SerialChain(
-            np.array(placements),
-            np.array(axes),
-            int(frame.parentJoint),
-            frame.placement.homogeneous,
-        )
 
     def elbow(self, q: np.ndarray) -> np.ndarray:
         """The elbow's position at ``q`` (the third joint's origin; m)."""
@@ -491,49 +461,27 @@ class RobotArm:
             pos_only = True
         q = np.clip(self.home if q0 is None else self.check_q(q0, "q0"), self.lower, self.upper)
         elbow_target = None if elbow is None else real_array(elbow, "elbow").reshape(3)
-        model, data, tool = self.model, self.data, self._tool
-        rows = 3 if pos_only else 6
-        elbow_steps = elbow_iterations
-        damp = np.eye(rows) * damping**2
-        e = np.empty(rows)
-        pos_err = rot_err = math.inf
-        it = 0
-        for it in range(iterations + 1):
-            pin.forwardKinematics(model, data, q)
-            oMtool = pin.updateFramePlacement(model, data, tool)
-            e[:3] = target_p - oMtool.translation
-            pos_err = float(np.linalg.norm(e[:3]))
-            if pos_only:
-                rot_err = 0.0
-            else:
-                e[3:] = pin.log3(target_R @ oMtool.rotation.T)
-                rot_err = float(np.linalg.norm(e[3:]))
-            reached = pos_err <= position_tolerance and rot_err <= rotation_tolerance
-            if it == iterations or (reached and elbow_target is None):
-                break
-            pin.computeJointJacobians(model, data, q)
-            J = pin.getFrameJacobian(model, data, tool, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)[
-                :rows
-            ]
-            JJt = J @ J.T + damp
-            dq = J.T @ np.linalg.solve(JJt, e)
-            if elbow_target is not None and self.nq > rows:
-                Je = pin.getJointJacobian(
-                    model, data, self._elbow_joint, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
-                )[:3]
-                pull = Je.T @ (elbow_target - data.oMi[self._elbow_joint].translation)
-                null = np.eye(self.nq) - J.T @ np.linalg.solve(JJt, J)
-                secondary = 0.5 * null @ pull
-                if reached and (elbow_steps <= 0 or float(np.abs(secondary).max()) < 1e-4):
-                    break  # the elbow is as near as the tool lets it be, or left to next time
-                elbow_steps -= reached
-                dq += secondary
-            biggest = float(np.abs(dq).max())
-            if biggest > max_step:
-                dq *= max_step / biggest
-            q = np.minimum(np.maximum(q + dq, self.lower), self.upper)
+        settings = ChainSolve(
+            iterations=iterations,
+            elbow_iterations=elbow_iterations,
+            position_tolerance=position_tolerance,
+            rotation_tolerance=rotation_tolerance,
+            damping=damping,
+            max_step=max_step,
+        )
+        q, pos_err, rot_err, it = solve(
+            self.chain,
+            self.lower,
+            self.upper,
+            q,
+            target_R,
+            target_p,
+            pos_only,
+            elbow_target,
+            settings,
+        )
         success = pos_err <= position_tolerance and rot_err <= rotation_tolerance
-        return RobotIK(q.copy(), bool(success), pos_err, rot_err, it)
+        return RobotIK(q, bool(success), pos_err, rot_err, it)
 
     # ------------------------------------------------------------------------- self-collision
 
@@ -609,17 +557,28 @@ def _visual_mesh_loader() -> object:
 
 
 def _convex(geom: pin.GeometryModel) -> None:
-    """Replace each collision mesh by its convex hull.
+    """Replace each collision mesh by its convex hull (qhull, through coal).
 
     Distances between hulls cost a fraction of mesh-to-mesh ones (a 5-joint SO-101 check drops
     from about a second to milliseconds), and a hull contains its mesh, so a clearance found on
-    hulls holds for the meshes: the check errs on the safe side.
+    hulls holds for the meshes: the check errs on the safe side. The hull is computed, not
+    assumed: coal's GJK walks a convex shape's vertex graph to find support points, and on a
+    mesh taken as its own hull that walk stops at local extremes, so distances came out
+    centimetres too large and changed from one query to the next.
     """
     for obj in geom.geometryObjects:
         shape = obj.geometry
-        if hasattr(shape, "buildConvexRepresentation"):
-            shape.buildConvexRepresentation(False)
+        if hasattr(shape, "buildConvexHull"):
+            shape.buildConvexHull(True, "Qt")
             obj.geometry = shape.convex
+
+
+def _shoulder(model: pin.Model, data: pin.Data, axis: np.ndarray) -> np.ndarray:
+    """The point of joint 1's axis nearest joint 2's origin (``data`` holds a forward pass)."""
+    base = data.oMi[1]
+    origin, direction = np.array(base.translation), base.rotation @ axis
+    second = np.array(data.oMi[min(2, model.njoints - 1)].translation)
+    return origin + direction * float(direction @ (second - origin))
 
 
 def _home(
@@ -728,3 +687,36 @@ def _puma_arm(spec: RobotSpec) -> RobotArm:
     model = puma.model.copy()
     model.velocityLimit = np.full(6, PUMA_VELOCITY)
     return RobotArm(spec, model, empty, pin.GeometryModel(), puma.urdf())
+
+
+def prepare_arm_ik() -> float:
+    """Load (or, the first time on this machine, compile) the IK kernel; returns the seconds.
+
+    The kernel is cached on disk: compiling it takes seconds (tens on a loaded machine), which
+    would otherwise stall the first frame of the first arm chosen in the studio.
+    """
+    start = time.perf_counter()
+    arm = load_robot("puma560", geometry=False)
+    arm.inverse(arm.forward(arm.home), arm.home, iterations=2)
+    return time.perf_counter() - start
+
+
+def prepare_arm_ik_in_background() -> threading.Thread:
+    """Run :func:`prepare_arm_ik` in a child process (a compile holds its interpreter's GIL),
+    waited for by the returned daemon thread. If the child cannot start, the first arm chosen
+    compiles the kernel itself."""
+    code = "from studio.kinematics._robots import prepare_arm_ik; prepare_arm_ik()"
+
+    def child() -> None:
+        with contextlib.suppress(OSError):
+            subprocess.run(
+                [sys.executable, "-c", code],
+                stdin=subprocess.DEVNULL,
+                stdout=subprocess.DEVNULL,
+                stderr=subprocess.DEVNULL,
+                check=False,
+            )
+
+    thread = threading.Thread(target=child, name="studio-prepare-ik", daemon=True)
+    thread.start()
+    return thread

@@ -27,7 +27,7 @@ forward kinematics. :func:`tool_pose` is a numba twin of the robot's forward kin
 kernels can call it: for the Puma560 the product of its DH table's transforms (the paper's robot,
 computed as it always was), for every other arm the serial chain Pinocchio builds from its URDF
 (each joint's fixed placement and rotation axis, then the tool frame's placement:
-:meth:`studio.kinematics.RobotArm.serial_chain`). A test holds both equal to Pinocchio's
+:attr:`studio.kinematics.RobotArm.chain`). A test holds both equal to Pinocchio's
 forward kinematics for every offered robot.
 
 Dynamics are defined once, here, in numba functions (:func:`reach_step`, :func:`reach_success`): the learner's compiled kernel and the Gymnasium environment
@@ -467,24 +467,23 @@ def _limits(robot: str) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _put_chain(p: np.ndarray, robot: str) -> None:
-    """Write ``robot``'s serial chain (:meth:`studio.kinematics.RobotArm.serial_chain`) into
-    the parameter array ``p``."""
-    chain = task_arm(robot).serial_chain()
-    if chain.tool_joint > MAX_CHAIN or chain.tool_joint < 1:
+    """Write ``robot``'s serial chain (:attr:`studio.kinematics.RobotArm.chain`, the one reading
+    of its Pinocchio model, which the compiled IK also runs on) into the parameter array ``p``."""
+    chain = task_arm(robot).chain
+    moving = chain.tool_joint + 1  # the joints, from the first, that move the tool
+    if moving > MAX_CHAIN or moving < 1:
         raise ConfigError(
-            [
-                f"The {robot} moves its tool with {chain.tool_joint} joints; give an arm of 1 to {MAX_CHAIN}."
-            ],
+            [f"The {robot} moves its tool with {moving} joints; give an arm of 1 to {MAX_CHAIN}."],
             ["robot"],
         )
-    p[_CHAIN_N] = chain.tool_joint
-    for i in range(chain.tool_joint):
+    p[_CHAIN_N] = moving
+    for i in range(moving):
         link = p[_CHAIN + _LINK * i : _CHAIN + _LINK * (i + 1)]
-        link[:9] = chain.placements[i, :3, :3].reshape(-1)
-        link[9:12] = chain.placements[i, :3, 3]
+        link[:9] = chain.rotations[i].reshape(-1)
+        link[9:12] = chain.translations[i]
         link[12:] = chain.axes[i]
-    p[_TOOL : _TOOL + 9] = chain.jointMtool[:3, :3].reshape(-1)
-    p[_TOOL + 9 : _TOOL + 12] = chain.jointMtool[:3, 3]
+    p[_TOOL : _TOOL + 9] = chain.tool_rotation.reshape(-1)
+    p[_TOOL + 9 : _TOOL + 12] = chain.tool_translation
 
 
 def _walk_capacity(q: np.ndarray, step: float) -> int:

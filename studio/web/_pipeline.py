@@ -573,4 +573,10 @@ def robot_note(arm: RobotArm, retargeter: Retargeter) -> str | None:
             f"The hand is out of the {title}'s reach: its tool stops {error * 100.0:.0f} cm "
             "short, as near as it gets; bring the hand closer to the shoulder."
         )
+    if retargeter.pulled_in > retargeter.config.reach_tolerance:
+        return (
+            f"The hand is beyond the {title}'s reach: its target is drawn "
+            f"{retargeter.pulled_in * 100.0:.0f} cm back into it; bring the hand closer to the "
+            "shoulder to follow it exactly."
+        )
     return None

@@ -25,6 +25,7 @@ from typing import TYPE_CHECKING
 from urllib.parse import urlsplit
 
 from studio import StudioError, is_loopback
+from studio.kinematics import prepare_arm_ik_in_background
 from studio.learning import prepare_in_background
 
 from ._guard import SiteRule
@@ -291,13 +292,14 @@ def prepare_data_dir(data_dir: Path) -> None:
 
 
 def _prepare_when_up(http: uvicorn.Server) -> None:
-    """Once the API answers, compile the learner's kernels in the background if they are not
-    cached (a first run then loads them instead of compiling them); after, so that the compile
-    never slows the start."""
+    """Once the API answers, compile the learner's kernels and the arms' IK in the background if
+    they are not cached (a first run, or a first robot chosen, then loads them instead of
+    compiling them); after, so that the compile never slows the start."""
     while not http.started and not http.should_exit:
         time.sleep(UP_POLL_S)
     if http.started:
         prepare_in_background()
+        prepare_arm_ik_in_background()
 
 
 def serve(settings: Settings, open_browser: bool = True) -> None:

@@ -1,7 +1,7 @@
 """In a real browser: the user picks the Panda, the page says its meshes are loading, the scene
 draws it from its own meshes and the simulated operator drives it; a demonstration plays on the
-Panda and exports for it (refused by the safety checks, then written with the findings in it);
-the Puma560 comes back and a recording exports for it."""
+Panda and exports checked for it, while its recording is refused by the safety checks, then
+written with the findings in it; the Puma560 comes back and a recording exports for it."""
 
 from __future__ import annotations
 
@@ -44,6 +44,18 @@ def _download_anyway(page: Any, kind: str, name: str, fmt: str) -> tuple[str, st
     assert error.inner_text().startswith("Refused"), error.inner_text()
     with page.expect_download(timeout=DRAW_TIMEOUT_S * 1000) as download:
         page.get_by_role("button", name=ANYWAY, exact=True).click()
+    text = open(download.value.path()).read()  # noqa: PTH123, SIM115
+    return download.value.suggested_filename, text
+
+
+def _download(page: Any, kind: str, name: str, fmt: str) -> tuple[str, str]:
+    """Export ``name`` from the ``kind`` list as ``fmt``, passing the checks. Returns the file's
+    name and text."""
+    noun = kind.capitalize()
+    page.get_by_role("combobox", name=f"{noun} to export").select_option(name)
+    page.get_by_role("combobox", name=f"{noun} export format").select_option(fmt)
+    with page.expect_download(timeout=DRAW_TIMEOUT_S * 1000) as download:
+        page.get_by_role("button", name=f"Export {kind}", exact=True).click()
     text = open(download.value.path()).read()  # noqa: PTH123, SIM115
     return download.value.suggested_filename, text
 
@@ -110,21 +122,23 @@ def test_the_user_teaches_the_panda_plays_and_exports_a_demonstration_then_back(
     for q in seen:
         assert q.shape == (7,)
         assert np.all(q >= panda.lower - 1e-6) and np.all(q <= panda.upper + 1e-6)
-    # its end is the Panda's goal, and the page says where the hand left the Panda's reach
-    assert wait_for(
-        lambda: "out of the Franka Emika Panda's reach" in page.inner_text("#robot-notes")
-    )
+    # its end is the Panda's goal, and its hand stays within the Panda's reach
+    assert "out of the Franka Emika Panda's reach" not in page.inner_text("#robot-notes")
     for width, height in SIZES:
         page.set_viewport_size({"width": width, "height": height})
         shot(page, f"robot-panda-demonstration-{width}x{height}", "sec-demos")
         shot(page, f"robot-panda-notes-{width}x{height}", "sec-source")
     page.set_viewport_size({"width": 1440, "height": 900})
 
-    # the demonstration exports for the Panda: the checks refuse it (a frame out of reach), then
-    # "export anyway" writes it with the findings in it
-    name, text = _download_anyway(page, "demonstration", DEMO, "csv")
+    # the demonstration exports for the Panda, timed and checked
+    name, text = _download(page, "demonstration", DEMO, "csv")
     assert name == f"{DEMO}.panda.csv"
-    assert "NOT checked" in text and "time," + ",".join(panda.joint_names) in text
+    assert "NOT checked" not in text and "time," + ",".join(panda.joint_names) in text
+    # its recording, at the capture rate, breaks the Panda's acceleration limits: refused, then
+    # "export anyway" writes it with the findings in it
+    name, text = _download_anyway(page, "recording", DEMO, "csv")
+    assert name == f"{DEMO}.panda.csv"
+    assert "NOT checked" in text and "acceleration" in text
 
     select.select_option("puma560")
     assert wait_for(

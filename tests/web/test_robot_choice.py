@@ -99,6 +99,17 @@ def test_the_page_is_told_when_the_hand_is_out_of_reach_or_the_pose_is_held() ->
     assert held is not None and held.startswith("The Franka Emika Panda holds its last pose")
 
 
+def test_the_page_is_told_when_the_hand_is_drawn_back_into_reach() -> None:
+    ur5 = load_robot("ur5", geometry=False)
+    retargeter = Retargeter(robot=ur5)
+    raised = np.array([1.2, 0.0, 0.0, 0.2, 0.0, 0.0, 0.0])  # the arm raised forward, outstretched
+    for _ in range(80):
+        retargeter.robot_from_human(raised)
+    note = robot_note(ur5, retargeter)
+    assert retargeter.pulled_in > 0.01
+    assert note is not None and "beyond the Universal Robots UR5's reach" in note and "cm" in note
+
+
 def test_the_scene_draws_the_chosen_robot_from_its_meshes_where_the_puma_stands() -> None:
     server = viser.ViserServer(host="127.0.0.1", port=0, verbose=False)
     scene = StudioScene(server, layout=SceneLayout(rate_hz=100.0))

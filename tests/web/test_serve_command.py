@@ -200,6 +200,7 @@ def test_the_learner_is_compiled_in_the_background_once_the_api_is_up(monkeypatc
 
     calls: list[int] = []
     monkeypatch.setattr(_serve, "prepare_in_background", lambda: calls.append(1))
+    monkeypatch.setattr(_serve, "prepare_arm_ik_in_background", lambda: calls.append(2))
     http = types.SimpleNamespace(started=False, should_exit=False)
     waiter = threading.Thread(target=_serve._prepare_when_up, args=(http,))
     waiter.start()
@@ -208,7 +209,7 @@ def test_the_learner_is_compiled_in_the_background_once_the_api_is_up(monkeypatc
     else:  # stopped before it ever answered: nothing to prepare for
         http.should_exit = True
     waiter.join(30)
-    assert calls == ([1] if comes_up else [])
+    assert calls == ([1, 2] if comes_up else [])  # the learners' kernels, then the arms' IK
 
 
 def test_a_data_folder_under_a_missing_folder_is_refused_not_created(tmp_path):

@@ -1,0 +1,404 @@
+"""Compiled damped-least-squares IK for a serial chain of revolute joints (every offered arm).
+
+:meth:`RobotArm.inverse` runs on the live retargeting path once per 110 Hz frame, for every
+robot. Written as a loop of Pinocchio and NumPy calls, an iteration costs tens of microseconds of
+Python overhead for 6x6 algebra, and a frame's solve took milliseconds. Here the same algorithm
+runs as one numba kernel over the chain's constant geometry, read once from the Pinocchio model
+(:class:`SerialChain`): the forward kinematics, the geometric Jacobian, the rotation error (SO(3)
+log) and the damped solve are each a few lines of arithmetic, and a whole solve takes tens of
+microseconds. Pinocchio stays the one model: the chain is its joints' placements and axes, and the
+tests hold the kernel's poses to Pinocchio's.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+from numba import njit
+
+from ._errors import KinematicsError
+
+_AXES = {"RX": (1.0, 0.0, 0.0), "RY": (0.0, 1.0, 0.0), "RZ": (0.0, 0.0, 1.0)}
+
+
+@dataclass(frozen=True)
+class SerialChain:
+    """The constant geometry of a serial arm, as the kernel reads it.
+
+    Attributes:
+        rotations, translations: each joint's placement in its parent joint's frame at zero
+            angle, shapes (n, 3, 3) and (n, 3).
+        axes: each joint's rotation axis in its own frame, shape (n, 3).
+        tool_rotation, tool_translation: the tool frame in the frame of joint ``tool_joint``.
+        tool_joint: the 0-based joint that carries the tool.
+        elbow_joint: the 0-based joint whose origin is the elbow.
+    """
+
+    rotations: np.ndarray
+    translations: np.ndarray
+    axes: np.ndarray
+    tool_rotation: np.ndarray
+    tool_translation: np.ndarray
+    tool_joint: int
+    elbow_joint: int
+
+    @classmethod
+    def from_model(cls, model: pin.Model, tool_frame: int, elbow_joint: int) -> SerialChain:
+        """The chain of ``model`` (every joint revolute, each the child of the one before).
+
+        Args:
+            model: the Pinocchio model.
+            tool_frame: the tool frame's id.
+            elbow_joint: the elbow's Pinocchio joint index (1-based).
+
+        Raises:
+            KinematicsError: a joint that is not revolute, or a branching tree.
+        """
+        n = model.njoints - 1
+        rotations, translations, axes = np.empty((n, 3, 3)), np.empty((n, 3)), np.empty((n, 3))
+        for i in range(1, n + 1):
+            joint = model.joints[i]
+            kind = joint.shortname().removeprefix("JointModel")
+            if kind in _AXES:
+                axes[i - 1] = _AXES[kind]
+            elif kind == "RevoluteUnaligned":
+                axes[i - 1] = np.asarray(joint.axis, dtype=float)
+            else:
+                raise KinematicsError(
+                    f"Joint {model.names[i]!r} of {model.name!r} is a {kind} joint; the arm "
+                    "IK drives revolute joints only."
+                )
+            if model.parents[i] != i - 1:
+                raise KinematicsError(
+                    f"{model.name!r} is not a serial chain; the arm IK needs one."
+                )
+            placement = model.jointPlacements[i]
+            rotations[i - 1], translations[i - 1] = placement.rotation, placement.translation
+        frame = model.frames[tool_frame]
+        return cls(
+            rotations,
+            translations,
+            axes,
+            np.array(frame.placement.rotation),
+            np.array(frame.placement.translation),
+            int(frame.parentJoint) - 1,
+            int(elbow_joint) - 1,
+        )
+
+    def forward(self, q: np.ndarray) -> np.ndarray:
+        """The tool pose (4x4) at ``q``, computed by the kernel (for tests and checks)."""
+        R, p = np.empty((len(self.axes), 3, 3)), np.empty((len(self.axes), 3))
+        tool_R, tool_p = np.empty((3, 3)), np.empty(3)
+        _forward(self.rotations, self.translations, self.axes, np.asarray(q, float), R, p)
+        _tool(self, R, p, tool_R, tool_p)
+        out = np.eye(4)
+        out[:3, :3], out[:3, 3] = tool_R, tool_p
+        return out
+
+
+def _tool(chain: SerialChain, R: np.ndarray, p: np.ndarray, tool_R: np.ndarray, tool_p: np.ndarray):
+    j = chain.tool_joint
+    tool_R[:] = R[j] @ chain.tool_rotation
+    tool_p[:] = p[j] + R[j] @ chain.tool_translation
+
+
+@dataclass(frozen=True)
+class ChainSolve:
+    """The settings of one :func:`solve` call (see :meth:`RobotArm.inverse`)."""
+
+    iterations: int
+    elbow_iterations: int
+    position_tolerance: float
+    rotation_tolerance: float
+    damping: float
+    max_step: float
+
+
+def solve(
+    chain: SerialChain,
+    lower: np.ndarray,
+    upper: np.ndarray,
+    q0: np.ndarray,
+    target_R: np.ndarray,
+    target_p: np.ndarray,
+    position_only: bool,
+    elbow: np.ndarray | None,
+    settings: ChainSolve,
+) -> tuple[np.ndarray, float, float, int]:
+    """Projected DLS from ``q0`` towards the tool pose; returns (q, position error, rotation
+    error, iterations). ``q`` is always within ``lower``..``upper``."""
+    q = np.array(q0, dtype=float)
+    out = np.zeros(3)
+    use_elbow = elbow is not None
+    it = _solve(
+        chain.rotations,
+        chain.translations,
+        chain.axes,
+        chain.tool_rotation,
+        chain.tool_translation,
+        chain.tool_joint,
+        chain.elbow_joint,
+        lower,
+        upper,
+        q,
+        np.ascontiguousarray(target_R, dtype=float),
+        np.ascontiguousarray(target_p, dtype=float),
+        position_only,
+        np.zeros(3) if elbow is None else np.ascontiguousarray(elbow, dtype=float),
+        use_elbow,
+        settings.iterations,
+        settings.elbow_iterations,
+        settings.position_tolerance,
+        settings.rotation_tolerance,
+        settings.damping,
+        settings.max_step,
+        out,
+    )
+    return q, float(out[0]), float(out[1]), int(it)
+
+
+@njit(nogil=True, cache=True, inline="always")
+def _matmul3(A, B, out):  # pragma: no cover - compiled
+    """``out = A @ B`` for 3x3 matrices (written out: BLAS costs more than the product)."""
+    for i in range(3):
+        a0, a1, a2 = A[i, 0], A[i, 1], A[i, 2]
+        for j in range(3):
+            out[i, j] = a0 * B[0, j] + a1 * B[1, j] + a2 * B[2, j]
+
+
+@njit(nogil=True, cache=True, inline="always")
+def _matvec3(A, v, out):  # pragma: no cover - compiled
+    """``out = A @ v`` for a 3x3 matrix."""
+    x, y, z = v[0], v[1], v[2]
+    for i in range(3):
+        out[i] = A[i, 0] * x + A[i, 1] * y + A[i, 2] * z
+
+
+@njit(nogil=True, cache=True)
+def _forward(rotations, translations, axes, q, R, p):  # pragma: no cover - compiled
+    """Each joint frame's rotation ``R[k]`` and origin ``p[k]`` in the base frame at ``q``."""
+    n = q.shape[0]
+    Rk = np.empty((3, 3))
+    rot = np.empty((3, 3))
+    step = np.empty(3)
+    for k in range(n):
+        # the parent frame, then the fixed placement, then the rotation about the joint's axis
+        if k == 0:
+            Rk[:, :] = rotations[0]
+            p[0] = translations[0]
+        else:
+            _matmul3(R[k - 1], rotations[k], Rk)
+            _matvec3(R[k - 1], translations[k], step)
+            for i in range(3):
+                p[k, i] = p[k - 1, i] + step[i]
+        x, y, z = axes[k, 0], axes[k, 1], axes[k, 2]
+        c, s = math.cos(q[k]), math.sin(q[k])
+        t = 1.0 - c
+        rot[0, 0] = c + x * x * t
+        rot[0, 1] = x * y * t - z * s
+        rot[0, 2] = x * z * t + y * s
+        rot[1, 0] = y * x * t + z * s
+        rot[1, 1] = c + y * y * t
+        rot[1, 2] = y * z * t - x * s
+        rot[2, 0] = z * x * t - y * s
+        rot[2, 1] = z * y * t + x * s
+        rot[2, 2] = c + z * z * t
+        _matmul3(Rk, rot, R[k])
+
+
+@njit(nogil=True, cache=True)
+def _log3(M, w):  # pragma: no cover - compiled
+    """``w`` = the rotation vector of the rotation matrix ``M`` (SO(3) log)."""
+    cos = 0.5 * (M[0, 0] + M[1, 1] + M[2, 2] - 1.0)
+    cos = min(1.0, max(-1.0, cos))
+    theta = math.acos(cos)
+    vx, vy, vz = M[2, 1] - M[1, 2], M[0, 2] - M[2, 0], M[1, 0] - M[0, 1]
+    if theta < 1e-6:
+        w[0], w[1], w[2] = 0.5 * vx, 0.5 * vy, 0.5 * vz
+    elif theta < math.pi - 1e-4:
+        f = theta / (2.0 * math.sin(theta))
+        w[0], w[1], w[2] = f * vx, f * vy, f * vz
+    else:  # near a half turn: the axis from the symmetric part, its sign from the skew part
+        k = 0
+        if M[1, 1] > M[k, k]:
+            k = 1
+        if M[2, 2] > M[k, k]:
+            k = 2
+        one_minus = 1.0 - cos
+        axis = np.empty(3)
+        axis[k] = math.sqrt(max(0.0, (M[k, k] - cos) / one_minus))
+        for j in range(3):
+            if j != k:
+                axis[j] = (M[k, j] + M[j, k]) / (2.0 * one_minus * axis[k])
+        if axis[0] * vx + axis[1] * vy + axis[2] * vz < 0.0:
+            axis = -axis
+        norm = math.sqrt(axis[0] ** 2 + axis[1] ** 2 + axis[2] ** 2)
+        for j in range(3):
+            w[j] = theta * axis[j] / norm
+
+
+@njit(nogil=True, cache=True)
+def _spd_solve(A, b):  # pragma: no cover - compiled
+    """``A^-1 b`` for a small symmetric positive-definite ``A`` (Cholesky)."""
+    n = A.shape[0]
+    L = np.zeros((n, n))
+    for i in range(n):
+        for j in range(i + 1):
+            s = A[i, j]
+            for k in range(j):
+                s -= L[i, k] * L[j, k]
+            if i == j:
+                L[i, i] = math.sqrt(max(s, 1e-300))
+            else:
+                L[i, j] = s / L[j, j]
+    y = np.empty(n)
+    for i in range(n):
+        s = b[i]
+        for k in range(i):
+            s -= L[i, k] * y[k]
+        y[i] = s / L[i, i]
+    x = np.empty(n)
+    for i in range(n - 1, -1, -1):
+        s = y[i]
+        for k in range(i + 1, n):
+            s -= L[k, i] * x[k]
+        x[i] = s / L[i, i]
+    return x
+
+
+@njit(nogil=True, cache=True, inline="always")
+def _transpose_times(J, y):  # pragma: no cover - compiled
+    """``J.T @ y``."""
+    out = np.zeros(J.shape[1])
+    for i in range(J.shape[0]):
+        for k in range(J.shape[1]):
+            out[k] += J[i, k] * y[i]
+    return out
+
+
+@njit(nogil=True, cache=True, inline="always")
+def _jacobian(R, p, axes, point, columns, J):  # pragma: no cover - compiled
+    """The geometric Jacobian (world axes) of ``point`` in the first ``columns`` joints' frames;
+    rows 0-2 its velocity, rows 3-5 (when ``J`` has them) the angular velocity."""
+    J[:, :] = 0.0
+    z = np.empty(3)
+    for k in range(columns):
+        _matvec3(R[k], axes[k], z)
+        d = point - p[k]
+        J[0, k] = z[1] * d[2] - z[2] * d[1]
+        J[1, k] = z[2] * d[0] - z[0] * d[2]
+        J[2, k] = z[0] * d[1] - z[1] * d[0]
+        if J.shape[0] == 6:
+            J[3, k], J[4, k], J[5, k] = z[0], z[1], z[2]
+
+
+@njit(nogil=True, cache=True, inline="always")
+def _damped_gram(J, damping, A):  # pragma: no cover - compiled
+    """``A = J J^T + damping^2 I``."""
+    rows, n = J.shape
+    for i in range(rows):
+        for j in range(i + 1):
+            total = 0.0
+            for k in range(n):
+                total += J[i, k] * J[j, k]
+            A[i, j] = total
+            A[j, i] = total
+        A[i, i] += damping * damping
+
+
+@njit(nogil=True, cache=True, inline="always")
+def _elbow_pull(R, p, axes, elbow_joint, elbow):  # pragma: no cover - compiled
+    """``J_e^T (elbow - p_e)``: the joint motion that pulls the elbow's origin towards ``elbow``."""
+    Je = np.zeros((3, R.shape[0]))
+    _jacobian(R, p, axes, p[elbow_joint], elbow_joint, Je)
+    return _transpose_times(Je, elbow - p[elbow_joint])
+
+
+@njit(nogil=True, cache=True)
+def _solve(  # noqa: PLR0913 - the kernel's flat arguments  # pragma: no cover - compiled
+    rotations,
+    translations,
+    axes,
+    tool_rotation,
+    tool_translation,
+    tool_joint,
+    elbow_joint,
+    lower,
+    upper,
+    q,
+    target_R,
+    target_p,
+    position_only,
+    elbow,
+    use_elbow,
+    iterations,
+    elbow_iterations,
+    position_tolerance,
+    rotation_tolerance,
+    damping,
+    max_step,
+    out,
+):
+    """Projected DLS in place on ``q``; ``out`` = (position error, rotation error); returns the
+    iterations used. The algorithm of :meth:`RobotArm.inverse`."""
+    n = q.shape[0]
+    rows = 3 if position_only else 6
+    R = np.empty((n, 3, 3))
+    p = np.empty((n, 3))
+    tool_R = np.empty((3, 3))
+    tool_p = np.empty(3)
+    err_R = np.empty((3, 3))
+    e = np.zeros(rows)
+    w = np.zeros(3)
+    J = np.zeros((rows, n))
+    A = np.empty((rows, rows))
+    pos_err = math.inf
+    rot_err = math.inf
+    elbow_steps = elbow_iterations
+    it = 0
+    for it in range(iterations + 1):
+        _forward(rotations, translations, axes, q, R, p)
+        _matmul3(R[tool_joint], tool_rotation, tool_R)
+        _matvec3(R[tool_joint], tool_translation, tool_p)
+        for i in range(3):
+            tool_p[i] += p[tool_joint, i]
+            e[i] = target_p[i] - tool_p[i]
+        pos_err = math.sqrt(e[0] ** 2 + e[1] ** 2 + e[2] ** 2)
+        if position_only:
+            rot_err = 0.0
+        else:
+            _matmul3(target_R, tool_R.T, err_R)
+            _log3(err_R, w)
+            e[3], e[4], e[5] = w[0], w[1], w[2]
+            rot_err = math.sqrt(w[0] ** 2 + w[1] ** 2 + w[2] ** 2)
+        reached = pos_err <= position_tolerance and rot_err <= rotation_tolerance
+        if it == iterations or (reached and not use_elbow):
+            break
+        _jacobian(R, p, axes, tool_p, min(n, tool_joint + 1), J)
+        _damped_gram(J, damping, A)
+        dq = _transpose_times(J, _spd_solve(A, e))
+        if use_elbow and n > rows:
+            # the elbow's pull, J_e^T (target - elbow), projected into the tool task's null space
+            pull = _elbow_pull(R, p, axes, elbow_joint, elbow)
+            Jpull = np.zeros(rows)
+            for i in range(rows):
+                for k in range(n):
+                    Jpull[i] += J[i, k] * pull[k]
+            secondary = 0.5 * (pull - _transpose_times(J, _spd_solve(A, Jpull)))
+            biggest_secondary = np.abs(secondary).max()
+            if reached and (elbow_steps <= 0 or biggest_secondary < 1e-4):
+                break  # the elbow is as near as the tool lets it be, or left to next time
+            if reached:
+                elbow_steps -= 1
+            dq += secondary
+        biggest = np.abs(dq).max()
+        if biggest > max_step:
+            dq *= max_step / biggest
+        for k in range(n):
+            q[k] = min(max(q[k] + dq[k], lower[k]), upper[k])
+    out[0] = pos_err
+    out[1] = rot_err
+    return it
