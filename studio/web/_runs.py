@@ -133,12 +133,12 @@ class Run:
             now = time.monotonic()
             if live is not None and self.status == "running":
                 if now - when > CURVE_CACHE_SECONDS or source is not live.steps:
-                    self._curve.update(live.steps)
+                    self._curve.update(live.steps, seconds=live.episode_seconds)
                     self._curve_taken = (now, live.steps)
             elif self.status != "queued":  # (a queued run has no steps yet)
                 steps = self.folder.steps()
                 if source is not steps:
-                    self._curve.update(steps)
+                    self._curve.update(steps, times=self.folder.episode_times())
                     self._curve_taken = (now, steps)
         return self._curve
 

@@ -505,6 +505,11 @@ class CurvePublic(BaseModel):
     min: list[float]
     max: list[float]
     count: list[int]
+    wall_seconds: list[float | None] | None = None
+    """Per episode, the mean over the experiments that finished it of each one's own wall seconds
+    from its start to that episode's end; absent for a run saved without times (older runs)."""
+    cpu_seconds: list[float | None] | None = None
+    """The same in CPU seconds."""
 
 
 class SweepPublic(BaseModel):

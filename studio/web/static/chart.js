@@ -4,7 +4,7 @@
  * takes about a millisecond, so live curves at CURVE_FPS never compete with training for the CPU.
  */
 
-import { RUNNING_AXES, bucketCurve, curveAxis, runningAxis, smoothed } from "./curves.js";
+import { RUNNING_AXES, TIME_KEYS, bucketCurve, curveAxis, measuredSeconds, runningAxis, smoothed } from "./curves.js";
 import { $, setProp, setText } from "./dom.js";
 import { S } from "./state.js";
 
@@ -38,13 +38,21 @@ export function plottedRuns() {
   });
 }
 
-/** A run's seconds so far on a time axis: its CPU time, or its wall time from start to finish
- * (to now while it trains); 0 before it starts. */
+/** An experiment's seconds so far on a time axis, for a run saved without times per episode:
+ * its CPU time over its experiments, or its wall time from start to finish (to now while it
+ * trains) over the experiments each thread ran in turn (one thread per core); 0 before it starts. */
 export function runSeconds(r, xMode) {
-  if (xMode === "cpu") return r.cpu_seconds || 0;
+  const experiments = Math.max(1, (r.config && r.config.experiments) || 1);
+  if (xMode === "cpu") return (r.cpu_seconds || 0) / experiments;
   if (xMode !== "wall" || !r.started) return 0;
   const end = r.finished ? Date.parse(r.finished) : Date.now();
-  return Math.max(0, (end - Date.parse(r.started)) / 1000);
+  const threads = Math.min(experiments, navigator.hardwareConcurrency || 1);
+  return (Math.max(0, (end - Date.parse(r.started)) / 1000) * threads) / experiments;
+}
+
+/** Whether a time axis is an estimate for some of these runs (saved without times per episode). */
+export function estimatedTime(runs, xMode) {
+  return Boolean(TIME_KEYS[xMode]) && runs.some((r) => !measuredSeconds(S.curves.get(r.id), xMode));
 }
 
 /** Episodes per experiment of a run (its fraction-of-run axis divides by this). */
@@ -117,8 +125,14 @@ function hexAlpha(hex, a) {
 
 const X_LABELS = {
   episode: "episode", log: "episode", fraction: "fraction of run", steps: "real steps",
-  wall: "wall time ≈ s (run's time shared out by steps)", cpu: "CPU time ≈ s (run's time shared out by steps)",
+  wall: "wall time per experiment, s", cpu: "CPU time per experiment, s",
 };
+
+/** The x axis's label; a time axis on which some run's time is estimated says so with "≈". */
+export function xLabelOf(runs, xMode) {
+  if (estimatedTime(runs, xMode)) return `${xMode === "cpu" ? "CPU" : "wall"} time ≈ per experiment, s (older runs: their time shared out by steps)`;
+  return X_LABELS[xMode] || "episode";
+}
 
 /** The last value of a column (the legend shows it while the cursor is off the chart). */
 function lastValue(col) {
@@ -138,7 +152,7 @@ function fmtX(xMode, v) {
  * a dashed marker where a run's points start averaging fewer experiments than it has. The legend
  * names every run all the time, with its last value until the cursor points at an x. */
 function chartOptions(runs, band, log, width, height, xMode = "episode", smoothing = 0) {
-  const xLabel = X_LABELS[xMode] || "episode";
+  const xLabel = xLabelOf(runs, xMode);
   const gaps = RUNNING_AXES.has(xMode); // runs have their own x: join their points across others' rows
   const series = [{ label: xLabel.split(" (")[0], value: (u, v) => fmtX(xMode, v) }];
   const bands = [];
@@ -243,7 +257,7 @@ export function renderCurves() {
     setProp("curve-key", "hidden", true);
     return;
   }
-  const key = JSON.stringify([runs.map((r) => [r.id, runLabel(r), runColor(r.id)]), band, log, xMode, smoothing > 0]);
+  const key = JSON.stringify([runs.map((r) => [r.id, runLabel(r), runColor(r.id)]), band, log, xMode, smoothing > 0, xLabelOf(runs, xMode)]);
   const data = chartData(runs, band, log, xMode, smoothing);
   renderCurveKey(runs, data, band);
   if (chart && key === chartKey) {
