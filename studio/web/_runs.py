@@ -28,6 +28,7 @@ from pydantic import TypeAdapter
 
 from studio.learning import (
     DEFAULT_GOAL_JOINTS_DEG,
+    ConfigError,
     DemonstrationPath,
     LearningError,
     LiveCurve,
@@ -39,6 +40,7 @@ from studio.learning import (
     find_runs,
     goal_degrees,
     resolve_run,
+    without_demonstrations,
 )
 
 from .._files import now_iso
@@ -273,6 +275,14 @@ def run_create_of(record: RunRecord) -> RunCreate:
     return RUN_CREATE.validate_python(form)
 
 
+def run_request(
+    create: RunCreate, demonstration_path: Callable[[str], DemonstrationPath]
+) -> RunRequest:
+    """The learning package's request of a ``RunCreate``, its demonstrations by their paths."""
+    demonstrations = [demonstration_path(name) for name in create.demonstrations]
+    return RunRequest.from_form(create.model_dump(), demonstrations=demonstrations)
+
+
 def prepare_run(
     create: RunCreate, demonstration_path: Callable[[str], DemonstrationPath]
 ) -> RunRecord:
@@ -288,9 +298,7 @@ def prepare_run(
     Raises:
         ConfigError: one sentence per bad field, keyed by field (answered as 422).
     """
-    demonstrations = [demonstration_path(name) for name in create.demonstrations]
-    request = RunRequest.from_form(create.model_dump(), demonstrations=demonstrations)
-    return resolve_run(request)
+    return resolve_run(run_request(create, demonstration_path))
 
 
 class RunQueue:
@@ -434,7 +442,29 @@ class RunQueue:
         self, create: RunCreate, demonstration_path: Callable[[str], DemonstrationPath]
     ) -> Run:
         """Validate a run, write its folder (atomically) and queue it."""
-        record = prepare_run(create, demonstration_path)
+        return self._queue_record(prepare_run(create, demonstration_path))
+
+    def submit_pair(
+        self, create: RunCreate, demonstration_path: Callable[[str], DemonstrationPath]
+    ) -> tuple[Run, Run]:
+        """Queue a run with demonstrations and its twin without them (same settings, seed and
+        goal: :func:`studio.learning.without_demonstrations`), both checked before either is
+        queued.
+
+        Raises:
+            ConfigError: a bad field of the run (as :meth:`submit`), or no demonstration picked.
+        """
+        if not create.demonstrations:
+            raise ConfigError(
+                ["Pick at least one demonstration to compare a run with them against one without."],
+                ["demonstrations"],
+            )
+        request = run_request(create, demonstration_path)
+        record = resolve_run(request)
+        baseline = resolve_run(without_demonstrations(request, record))
+        return self._queue_record(record), self._queue_record(baseline)
+
+    def _queue_record(self, record: RunRecord) -> Run:
         folder = RunFolder.create(self.folder, record)
         # the kernels' threads run at a lower priority: training must never starve the studio
         live = LiveProgress(record.experiments, record.episodes, niceness=self.niceness)

@@ -21,7 +21,7 @@ import numpy as np
 import pytest
 
 from studio.learning import curve_statistics, curves_csv
-from tests.e2e.conftest import ARTIFACTS, Studio
+from tests.e2e.conftest import ARTIFACTS, Studio, own_page
 from tests.web.conftest import wait_for
 
 T = 20.0  # s: the longest one step of the page may take (the machine may be busy)
@@ -58,13 +58,7 @@ def two_runs(studio_server: Studio) -> list[dict]:
 @pytest.fixture
 def small_page(browser: Any, studio_server: Studio, two_runs: list[dict]) -> Iterator[Any]:
     """The page at 1280 x 720 with only the two runs plotted."""
-    context = browser.new_context(viewport={"width": 1280, "height": 720}, accept_downloads=True)
-    page = context.new_page()
-    errors: list[str] = []
-    page.on("pageerror", lambda e: errors.append(str(e)))
-    try:
-        page.goto(studio_server.base + "/")
-        page.wait_for_selector("body[data-ready='1']", timeout=T * 3000)
+    with own_page(browser, studio_server, 1280, 720, accept_downloads=True) as page:
         ids = [r["id"] for r in two_runs]
         for row in page.locator("[data-testid='run-row']").all():
             box = row.get_by_test_id("run-show")
@@ -75,11 +69,8 @@ def small_page(browser: Any, studio_server: Studio, two_runs: list[dict]) -> Ite
             arg=sorted(ids),
             timeout=T * 1000,
         )
-        page.errors = errors
         yield page
-    finally:
-        context.close()
-    assert not errors, errors
+        assert not page.errors, page.errors
 
 
 def shoot(page: Any, name: str) -> None:
