@@ -276,8 +276,17 @@ class RecordingUpdate(_Body):
     operator: str | None = Field(None, max_length=200)
 
 
+class TimelineSignal(BaseModel):
+    """One group of a recording's own values on its timeline (``studio.capture``'s ``Signal``)."""
+
+    name: str = Field(description='"tape bend", "tape twist", "landmark visibility", "hand position"')
+    unit: str = Field(description='"deg", "0-1" or "cm"')
+    labels: list[str] = Field(description="one per column: a tape region, a landmark, an axis")
+    values: list[list[float | None]] = Field(description="per time, one per label; null: none")
+
+
 class TimelinePublic(BaseModel):
-    """A recording's joints over time, downsampled for the timeline (degrees)."""
+    """A recording's joints over time, downsampled for the timeline (degrees), and its own values."""
 
     name: str
     kind: str
@@ -286,6 +295,10 @@ class TimelinePublic(BaseModel):
     human: list[list[float]] = Field(description="the human arm's 7 joints per time, degrees")
     robot: list[list[float]] = Field(description="the Puma560's 6 joints per time, degrees")
     residual_mm: list[float] = Field(description="how far the fitted arm misses, mm")
+    signals: list[TimelineSignal] = Field(
+        default_factory=list,
+        description="the recording's own values at the same times: a tape's bend and twist per region, a camera's landmark visibility, a hand guide's hand position",
+    )
 
 
 class RecordingReview(_Body):
