@@ -44,7 +44,9 @@ class Signal:
     values: np.ndarray
 
 
-def recording_signals(rec: Recording | ObservationRecording, rows: np.ndarray) -> tuple[Signal, ...]:
+def recording_signals(
+    rec: Recording | ObservationRecording, rows: np.ndarray
+) -> tuple[Signal, ...]:
     """The recording's own values at frames ``rows``: a tape's bend and twist per region
     (degrees), a camera's visibility of the teaching arm's shoulder, elbow and wrist (0-1), or a
     hand guide's hand position in the arm's frame (cm)."""

@@ -120,8 +120,9 @@ class EpisodeClock:
         self._done = np.zeros(experiments, np.int64)  # episodes stamped, per experiment
         self._last = np.zeros((2, experiments))  # the last stamp, per experiment
 
-    def sample(self) -> None:
-        """Stamp the episodes finished since the last call."""
+    def sample(self) -> int:
+        """Stamp the episodes finished since the last call; returns how many episodes are
+        finished in all (:attr:`LiveProgress.completed`, counted once for both)."""
         live = self._live
         clocks = live.experiment_seconds()  # before the steps: a stamp is never too early
         done = np.count_nonzero(live.steps >= 0, axis=1)
@@ -136,6 +137,7 @@ class EpisodeClock:
             live.episode_seconds[:, e, first:last] = start[:, None] + np.outer(clock - start, share)
             self._last[:, e] = clock
             self._done[e] = last
+        return int(done.sum())
 
 
 def watch_training(
@@ -162,11 +164,10 @@ def watch_training(
     while not thread.ended.is_set():
         try:
             thread.ended.wait(poll_seconds)
-            clock.sample()
+            done = clock.sample()
             if on_checkpoint is not None:
                 on_checkpoint(live)
             now = time.monotonic()
-            done = live.completed
             if now - last >= every and done != saved and not thread.ended.is_set():
                 checkpoint()
                 saved, last = done, time.monotonic()

@@ -279,7 +279,9 @@ class RecordingUpdate(_Body):
 class TimelineSignal(BaseModel):
     """One group of a recording's own values on its timeline (``studio.capture``'s ``Signal``)."""
 
-    name: str = Field(description='"tape bend", "tape twist", "landmark visibility", "hand position"')
+    name: str = Field(
+        description='"tape bend", "tape twist", "landmark visibility", "hand position"'
+    )
     unit: str = Field(description='"deg", "0-1" or "cm"')
     labels: list[str] = Field(description="one per column: a tape region, a landmark, an axis")
     values: list[list[float | None]] = Field(description="per time, one per label; null: none")
