@@ -125,12 +125,12 @@ function hexAlpha(hex, a) {
 
 const X_LABELS = {
   episode: "episode", log: "episode", fraction: "fraction of run", steps: "real steps",
-  wall: "wall time per experiment, s", cpu: "CPU time per experiment, s",
+  wall: "wall time per experiment", cpu: "CPU time per experiment",
 };
 
 /** The x axis's label; a time axis on which some run's time is estimated says so with "≈". */
 export function xLabelOf(runs, xMode) {
-  if (estimatedTime(runs, xMode)) return `${xMode === "cpu" ? "CPU" : "wall"} time ≈ per experiment, s (older runs: their time shared out by steps)`;
+  if (estimatedTime(runs, xMode)) return `${xMode === "cpu" ? "CPU" : "wall"} time ≈ per experiment (older runs: their time shared out by steps)`;
   return X_LABELS[xMode] || "episode";
 }
 
@@ -140,10 +140,17 @@ function lastValue(col) {
   return null;
 }
 
+/** A time axis's tick: seconds, or milliseconds below one second (a short run's ticks would
+ * otherwise all round to 0). */
+function fmtSeconds(v) {
+  if (v == null) return "";
+  return Math.abs(v) < 1 && v !== 0 ? `${+(v * 1000).toPrecision(3)} ms` : `${+v.toPrecision(4)} s`;
+}
+
 function fmtX(xMode, v) {
   if (v == null) return ""; // off the chart: the runs' values are their last ones
   if (xMode === "fraction") return v.toFixed(3);
-  if (xMode === "wall" || xMode === "cpu") return `${v.toFixed(1)} s`;
+  if (xMode === "wall" || xMode === "cpu") return fmtSeconds(v);
   return xMode === "steps" ? String(Math.round(v)) : String(v);
 }
 
@@ -185,7 +192,7 @@ function chartOptions(runs, band, log, width, height, xMode = "episode", smoothi
       y: log ? { distr: 3, log: 10 } : { range: (u, min, max) => [0, max > 0 ? max * 1.05 : 1] },
     },
     axes: [
-      { ...axis, label: xLabel, labelSize: 16, size: 30 },
+      { ...axis, label: xLabel, labelSize: 16, size: 30, ...(TIME_KEYS[xMode] ? { values: (u, ticks) => ticks.map(fmtSeconds) } : {}) },
       { ...axis, label: "steps", labelSize: 16, size: 48 },
     ],
     legend: { live: true },
