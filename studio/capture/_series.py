@@ -1,8 +1,11 @@
-"""A recording's joints over time, downsampled for a timeline: the human arm's and the robot's.
+"""A recording's joints over time, downsampled for a timeline: the human arm's and the robot's,
+and what the recording itself holds (its :class:`Signal` groups).
 
 Every kind of recording (tape, pose landmarks, hand poses) goes through its own fitter
 (:func:`~studio.capture.fitter_for`), the very fitting the live pipeline and demonstration
-extraction use, so the timeline shows the joints a demonstration cut from it would hold.
+extraction use, so the timeline shows the joints a demonstration cut from it would hold. Beside
+them come the observations as recorded: a tape's bend and twist per region, a camera's visibility
+of the arm's landmarks, a hand guide's hand position.
 """
 
 from __future__ import annotations
@@ -12,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._fitters import fitter_for
+from ._fitters import ARM_LANDMARKS, fitter_for
 from ._observation_recording import ObservationRecording, read_any_recording
 from ._recording_reader import Recording
 
@@ -20,6 +23,51 @@ DEFAULT_SERIES_POINTS = 400
 """How many samples a timeline gets by default: one per pixel of a wide panel, or fewer."""
 MAX_SERIES_POINTS = 5000
 """The most samples a timeline may ask for."""
+
+
+@dataclass(frozen=True)
+class Signal:
+    """One group of a recording's own values over time, as a timeline plots them together.
+
+    Attributes:
+        name: what it is (``"tape bend"``, ``"tape twist"``, ``"landmark visibility"``,
+            ``"hand position"``).
+        unit: the values' unit (``"deg"``, ``"0-1"``, ``"cm"``).
+        labels: one per column (``"region 1"``, ``"shoulder"``, ``"x"``).
+        values: ``(N, len(labels))`` at the series' times; NaN where the frame has none (a camera
+            frame without a person).
+    """
+
+    name: str
+    unit: str
+    labels: tuple[str, ...]
+    values: np.ndarray
+
+
+def recording_signals(
+    rec: Recording | ObservationRecording, rows: np.ndarray
+) -> tuple[Signal, ...]:
+    """The recording's own values at frames ``rows``: a tape's bend and twist per region
+    (degrees), a camera's visibility of the teaching arm's shoulder, elbow and wrist (0-1), or a
+    hand guide's hand position in the arm's frame (cm)."""
+    rows = np.asarray(rows, dtype=np.int64)
+    if isinstance(rec, Recording):
+        labels = tuple(f"region {i + 1}" for i in range(rec.regions))
+        return (
+            Signal("tape bend", "deg", labels, np.degrees(rec.bend[rows])),
+            Signal("tape twist", "deg", labels, np.degrees(rec.twist[rows])),
+        )
+    frames = [rec.frame_at(int(row)) for row in rows]
+    if rec.kind_name == "pose":
+        marks = ARM_LANDMARKS[rec.side]
+        values = np.full((len(rows), len(marks)), np.nan)
+        for i, frame in enumerate(frames):
+            if frame.world is not None:  # type: ignore[union-attr]
+                values[i] = frame.world[list(marks), 3]  # type: ignore[union-attr]
+        labels = ("shoulder", "elbow", "wrist")
+        return (Signal("landmark visibility", "0-1", labels, values),)
+    position = np.array([f.position for f in frames]).reshape(len(rows), 3)  # type: ignore[union-attr]
+    return (Signal("hand position", "cm", ("x", "y", "z"), position * 100.0),)
 
 
 @dataclass(frozen=True)
@@ -33,6 +81,7 @@ class RecordingSeries:
         residual: how far the fitted arm misses each observation ``(N,)``, m.
         duration: the whole recording's length, s.
         kind: ``"tape"``, ``"pose"`` or ``"hand"``.
+        signals: the recording's own values at the same times (:func:`recording_signals`).
     """
 
     times: np.ndarray
@@ -41,6 +90,7 @@ class RecordingSeries:
     residual: np.ndarray
     duration: float
     kind: str
+    signals: tuple[Signal, ...] = ()
 
 
 def human_angles(
@@ -110,4 +160,5 @@ def recording_series(
         residual=residual,
         duration=rec.duration,
         kind=rec.kind_name,
+        signals=recording_signals(rec, rows),
     )

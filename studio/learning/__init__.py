@@ -94,6 +94,7 @@ from ._run_request import REACH_DEFAULTS as REACH_DEFAULTS
 from ._run_request import DemonstrationPath as DemonstrationPath
 from ._run_request import RunRequest as RunRequest
 from ._run_request import resolve_run as resolve_run
+from ._run_request import without_demonstrations as without_demonstrations
 from ._runs import RunFolder as RunFolder
 from ._runs import delete_run_folder as delete_run_folder
 from ._runs import find_runs as find_runs

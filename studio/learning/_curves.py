@@ -37,12 +37,21 @@ CURVE_COLUMNS = (
 """The one ``curves.csv`` layout: per episode (1-based), statistics of the real steps over the
 ``experiments`` that finished it. ``studio reproduce`` puts a ``configuration`` column first."""
 STATISTICS = CURVE_COLUMNS[1:-1]
+TIME_COLUMNS = ("wall_seconds", "cpu_seconds")
+"""Two more ``curves.csv`` columns, after :data:`CURVE_COLUMNS`, in a run trained since they were
+added: per episode, the mean over the experiments that finished it of each experiment's own wall
+and CPU seconds from its start to that episode's end (:func:`episode_seconds`). A file without
+them (an older run, a run recovered after a crash) still reads: its curve has no times."""
+MAX_CURVES_BYTES_PER_EPISODE = 256
+"""Largest ``curves.csv`` row read back (the studio writes under 120 bytes)."""
 
 
 # ----------------------------------------------------------------------------- statistics
 
 
-def curve_statistics(steps: np.ndarray, start: int = 0) -> dict[str, list]:
+def curve_statistics(
+    steps: np.ndarray, start: int = 0, times: np.ndarray | None = None
+) -> dict[str, list]:
     """Learning-curve statistics of an ``(experiments, episodes)`` steps array, -1 for not done.
 
     Episodes run from index ``start`` up to the last one that any experiment finished. Each
@@ -51,9 +60,15 @@ def curve_statistics(steps: np.ndarray, start: int = 0) -> dict[str, list]:
     run end at different episodes, so ``count`` falls towards the end: a plot shows it rather than
     pretend every point averages all experiments.
 
+    Args:
+        steps: real steps per episode, ``(experiments, episodes)``, -1 where not done.
+        start: the first episode (0-based) to return.
+        times: float ``(2, episodes)``, the run's :func:`episode_seconds` (NaN where unknown);
+            when given, the curve also has :data:`TIME_COLUMNS` (None where unknown).
+
     Returns:
         ``{"episodes": [1-based], "mean", "std", "median", "p10", "p90", "min", "max", "count"}``,
-        lists of equal length.
+        lists of equal length (and :data:`TIME_COLUMNS` with ``times``).
     """
     steps = np.asarray(steps)
     if steps.ndim != 2:
@@ -67,6 +82,8 @@ def curve_statistics(steps: np.ndarray, start: int = 0) -> dict[str, list]:
     values = steps[:, start:last].astype(np.float64)
     values[values < 0] = np.nan
     out: dict[str, list] = {"episodes": list(range(start + 1, last + 1))}
+    if times is not None:
+        out.update(time_lists(times[:, start:last]))
     if values.shape[1] == 0:
         out.update({key: [] for key in STATISTICS})
         out["count"] = []
@@ -86,6 +103,50 @@ def curve_statistics(steps: np.ndarray, start: int = 0) -> dict[str, list]:
     for key in STATISTICS:
         out[key] = np.round(np.nan_to_num(stats[key]), 3).tolist()
     out["count"] = count[start:last].astype(np.int64).tolist()
+    return out
+
+
+def episode_seconds(steps: np.ndarray, seconds: np.ndarray) -> np.ndarray:
+    """The :data:`TIME_COLUMNS` of a run, per episode: float ``(2, episodes)``, the mean over the
+    experiments that finished each episode (and whose time was stamped) of
+    ``seconds`` (``(2, experiments, episodes)``, :attr:`LiveProgress.episode_seconds`); NaN where
+    no experiment has both."""
+    seconds = np.asarray(seconds, dtype=np.float64)
+    known = (np.asarray(steps) >= 0)[None] & np.isfinite(seconds)
+    count = known.sum(axis=1)
+    total = np.where(known, seconds, 0.0).sum(axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(count > 0, total / np.maximum(count, 1), np.nan)
+
+
+def time_lists(times: np.ndarray) -> dict[str, list]:
+    """:data:`TIME_COLUMNS` of a ``(2, n)`` array as lists, rounded to the millisecond, None for
+    NaN (JSON has no NaN)."""
+    return {
+        key: [None if np.isnan(v) else v for v in np.round(row, 3).tolist()]
+        for key, row in zip(TIME_COLUMNS, np.asarray(times, dtype=np.float64), strict=True)
+    }
+
+
+def read_curve_times(text: str, episodes: int) -> np.ndarray | None:
+    """The :data:`TIME_COLUMNS` of a run's ``curves.csv`` text as float ``(2, episodes)`` (NaN
+    where a row or a cell is missing), or None when the file has no such columns (an older run)
+    or does not parse (the curve then shows without times)."""
+    rows = csv.reader(io.StringIO(text))
+    header = next(rows, [])
+    if not all(key in header for key in TIME_COLUMNS) or "episode" not in header:
+        return None
+    at = [header.index(key) for key in ("episode", *TIME_COLUMNS)]
+    out = np.full((2, episodes), np.nan)
+    try:
+        for row in rows:
+            if len(row) <= max(at):
+                continue
+            episode = int(row[at[0]]) - 1
+            if 0 <= episode < episodes:
+                out[:, episode] = [float(row[i]) if row[i] else np.nan for i in at[1:]]
+    except ValueError:
+        return None
     return out
 
 
@@ -132,6 +193,9 @@ def downsample_curve(curve: dict[str, list], points: int = FIGURE_POINTS) -> dic
     out["min"] = reduce("min", np.minimum.reduceat)
     out["max"] = reduce("max", np.maximum.reduceat)
     out["count"] = [int(c) for c in reduce("count", np.minimum.reduceat)]
+    if all(key in curve for key in TIME_COLUMNS):  # None (unknown) makes its bucket unknown
+        times = [[np.nan if v is None else v for v in curve[key]] for key in TIME_COLUMNS]
+        out.update(time_lists(np.stack([mean_of(np.asarray(t), edges) for t in times])))
     return out
 
 
@@ -153,15 +217,23 @@ def write_curves_csv(
 ) -> None:
     """Write curves to an open text stream: a header, then one row per episode per curve.
 
-    A ``configuration`` column comes first when the curves are named (several runs in one file).
+    A ``configuration`` column comes first when the curves are named (several runs in one file);
+    :data:`TIME_COLUMNS` come last when any curve has them (empty where a curve has none).
     """
     named = any(name is not None for name, _ in curves)
+    timed = any(all(key in curve for key in TIME_COLUMNS) for _, curve in curves)
     writer = csv.writer(stream, lineterminator="\n")
-    writer.writerow((["configuration"] if named else []) + list(CURVE_COLUMNS))
+    header = list(CURVE_COLUMNS) + (list(TIME_COLUMNS) if timed else [])
+    writer.writerow((["configuration"] if named else []) + header)
     for name, curve in curves:
         columns = [curve["episodes"], *(curve[k] for k in STATISTICS), curve["count"]]
+        n = len(curve["episodes"])
+        if timed:
+            columns += [curve.get(key) or [None] * n for key in TIME_COLUMNS]
+        k = len(STATISTICS) + 1  # the count's column
         for row in zip(*columns, strict=True):
-            values = [row[0], *(f"{v:.6g}" for v in row[1:-1]), row[-1]]
+            values = [row[0], *(f"{v:.6g}" for v in row[1:k]), row[k]]
+            values += ["" if v is None else f"{v:.6g}" for v in row[k + 1 :]]
             writer.writerow(([name] if named else []) + values)
 
 

@@ -162,6 +162,13 @@ class LiveProgress:
     tables (or weights) are the very arrays the kernels update in place, so a checkpoint can save
     the policy learnt so far without stopping them (or copying every table).
 
+    The kernels read no clock. Each experiment's thread enters :meth:`counting_cpu` as the
+    experiment starts, and both learners start experiments in index order, so the n-th entry is
+    experiment n (two threads starting together may swap two starts microseconds apart):
+    :meth:`experiment_seconds` then gives each experiment's own wall and CPU seconds so far, and
+    the run's watcher (``_run_train.EpisodeClock``) stamps every finished episode with them in
+    :attr:`episode_seconds`.
+
     Args:
         experiments: number of experiments of the run this object will follow.
         episodes: episodes per experiment.
@@ -182,6 +189,11 @@ class LiveProgress:
         self._cpu_lock = threading.Lock()
         self._cpu_done = 0.0
         self._cpu_running: dict[int, float] = {}  # thread ident -> its CPU clock at start
+        self._starts: list[tuple[int, float, float]] = []  # per experiment: ident, wall, CPU
+        self._ends: dict[int, tuple[float, float]] = {}  # experiment -> wall and CPU seconds
+        self.episode_seconds = np.full((2, experiments, episodes), np.nan, np.float32)
+        """Per finished episode, its experiment's own wall (``[0]``) and CPU (``[1]``) seconds from
+        the experiment's start to the episode's end; NaN until the run's watcher stamps it."""
 
     @contextmanager
     def counting_cpu(self) -> Iterator[list[float]]:
@@ -195,6 +207,8 @@ class LiveProgress:
         start = time.thread_time()
         with self._cpu_lock:
             self._cpu_running[ident] = start
+            experiment = len(self._starts)
+            self._starts.append((ident, time.monotonic(), start))
         try:
             yield spent
         finally:
@@ -202,6 +216,22 @@ class LiveProgress:
             with self._cpu_lock:
                 del self._cpu_running[ident]
                 self._cpu_done += spent[0]
+                self._ends[experiment] = (time.monotonic() - self._starts[experiment][1], spent[0])
+
+    def experiment_seconds(self) -> np.ndarray:
+        """float ``(2, experiments)``: each experiment's wall (``[0]``) and CPU (``[1]``) seconds
+        since it started, final once it ended; NaN before it starts."""
+        out = np.full((2, self.steps.shape[0]), np.nan)
+        now = time.monotonic()
+        with self._cpu_lock:
+            for e, (ident, wall, cpu) in enumerate(self._starts[: out.shape[1]]):
+                if e in self._ends:
+                    out[:, e] = self._ends[e]
+                    continue
+                out[0, e] = now - wall
+                with suppress(OSError, AttributeError, OverflowError):  # no per-thread clocks
+                    out[1, e] = time.clock_gettime(time.pthread_getcpuclockid(ident)) - cpu
+        return out
 
     @property
     def cpu_seconds(self) -> float:

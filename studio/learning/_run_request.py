@@ -17,7 +17,7 @@ Use::
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Final, cast
 
 import numpy as np
@@ -187,6 +187,31 @@ def resolve_run(request: RunRequest) -> RunRecord:
     if request.task == TASK_ARM_REACH:
         return _reach_record(request, config, problems)
     return _grid_record(request, config, problems)
+
+
+BASELINE_SUFFIX = " · no demos"
+"""Added to the name of a run's twin without demonstrations (:func:`without_demonstrations`)."""
+
+
+def without_demonstrations(request: RunRequest, record: RunRecord) -> RunRequest:
+    """The same run without its demonstrations, to compare with: the same settings, budget, seed
+    and goal (a continuous run's goal is its first demonstration's final pose, kept as such).
+
+    Args:
+        request: the run as asked for, with demonstrations.
+        record: ``resolve_run(request)``.
+
+    Returns:
+        The request of its twin, named ``<name> · no demos`` when the run is named.
+    """
+    name = request.name[: 100 - len(BASELINE_SUFFIX)] + BASELINE_SUFFIX if request.name else ""
+    if record.kind == TASK_ARM_REACH:
+        goal = record.arm_reach().goal
+        reach = {**request.reach, "goal": goal}
+        return replace(
+            request, demonstrations=(), generated=0, goal_deg=None, reach=reach, name=name
+        )
+    return replace(request, demonstrations=(), grid_paths=(), generated=0, name=name)
 
 
 def _dynaq_config(

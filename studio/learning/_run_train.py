@@ -4,6 +4,8 @@ The kernels release the GIL, so a run learns in a daemon thread (:class:`Trainin
 the thread that started it (the page's queue worker, ``studio train``'s main thread) checkpoints
 the curve and the policy at most every :data:`CHECKPOINT_SECONDS` and reports progress
 (:func:`watch_training`); a Ctrl-C there stops the learner at the next episode boundary.
+At every poll it also stamps the episodes finished meanwhile with their experiment's wall and CPU
+time (:class:`EpisodeClock`): the kernels read no clock, so time per episode is measured here.
 :meth:`studio.learning.RunFolder.train` puts the two together with the run folder's files.
 """
 
@@ -102,6 +104,42 @@ class TrainingThread:
             self.ended.set()
 
 
+class EpisodeClock:
+    """Stamps each finished episode with its experiment's wall and CPU seconds so far
+    (:attr:`LiveProgress.episode_seconds`), sampled where the run's thread polls the learner.
+
+    An episode seen finished at a poll gets its experiment's clocks at that poll, or the
+    experiment's final clocks when it has ended: exact to within one poll. When several episodes
+    of an experiment finished since the last poll, the time between the two polls is shared out
+    among them in proportion to their Q updates (real and planning), the learner's work.
+    """
+
+    def __init__(self, live: LiveProgress) -> None:
+        self._live = live
+        experiments = live.steps.shape[0]
+        self._done = np.zeros(experiments, np.int64)  # episodes stamped, per experiment
+        self._last = np.zeros((2, experiments))  # the last stamp, per experiment
+
+    def sample(self) -> int:
+        """Stamp the episodes finished since the last call; returns how many episodes are
+        finished in all (:attr:`LiveProgress.completed`, counted once for both)."""
+        live = self._live
+        clocks = live.experiment_seconds()  # before the steps: a stamp is never too early
+        done = np.count_nonzero(live.steps >= 0, axis=1)
+        for e in np.flatnonzero(done > self._done):
+            if not np.isfinite(clocks[:, e]).all():  # its start is not registered yet
+                continue
+            first, last = int(self._done[e]), int(done[e])
+            work = np.maximum(live.updates[e, first:last], 1).astype(np.float64)
+            share = np.cumsum(work) / work.sum()
+            start = self._last[:, e]
+            clock = np.maximum(clocks[:, e], start)  # clocks never run back
+            live.episode_seconds[:, e, first:last] = start[:, None] + np.outer(clock - start, share)
+            self._last[:, e] = clock
+            self._done[e] = last
+        return int(done.sum())
+
+
 def watch_training(
     thread: TrainingThread,
     live: LiveProgress,
@@ -111,7 +149,8 @@ def watch_training(
 ) -> tuple[bool, LearningError | None]:
     """Wait for ``thread`` to end, calling ``checkpoint`` when the curve moved and at most every
     :data:`CHECKPOINT_SECONDS` (less often when one takes over a tenth of that), and
-    ``on_checkpoint`` every ``poll_seconds``.
+    ``on_checkpoint`` every ``poll_seconds``, stamping finished episodes with their time
+    (:class:`EpisodeClock`) at each poll.
 
     A Ctrl-C, or a :class:`LearningError` from ``checkpoint`` (a full disk), stops the learner
     at its next episode boundary and waits for it.
@@ -121,13 +160,14 @@ def watch_training(
     """
     interrupted, disk = False, None
     saved, last, every = 0, time.monotonic(), CHECKPOINT_SECONDS
+    clock = EpisodeClock(live)
     while not thread.ended.is_set():
         try:
             thread.ended.wait(poll_seconds)
+            done = clock.sample()
             if on_checkpoint is not None:
                 on_checkpoint(live)
             now = time.monotonic()
-            done = live.completed
             if now - last >= every and done != saved and not thread.ended.is_set():
                 checkpoint()
                 saved, last = done, time.monotonic()
@@ -140,4 +180,5 @@ def watch_training(
             log.warning("run %s: %s", thread.run_id, err)
             live.stop()
             disk = disk or err
+    clock.sample()  # the episodes of the last poll, at their experiments' final clocks
     return interrupted, disk

@@ -23,7 +23,8 @@ A run folder ``<parent>/<id>/`` holds:
   takes over a tenth of that), so a killed process loses about that much of its curve;
 - ``curves.csv``: the :func:`curve_statistics` of ``steps.csv`` in the layout
   :data:`CURVE_COLUMNS`, written when the run ends (or by :meth:`RunFolder.recover` after a
-  crash);
+  crash), with each episode's wall and CPU time (:data:`TIME_COLUMNS`, measured while it trained;
+  a run recovered after a crash has none);
 - ``policy.policy.npz``: the best experiment's Q table (see ``_policy.py``), saved with every
   ``steps.csv`` checkpoint from the tables the kernels are filling (:attr:`LiveProgress.snapshot`)
   and again when the run ends, also when it was stopped (Stop, Ctrl-C). A process killed with
@@ -65,7 +66,13 @@ from studio import StudioError, read_bytes_bounded, read_json
 from .._files import atomic_write_text, now_iso
 from .._numbers import is_int
 from ._config import MAX_STEPS_PER_EPISODE, check_budget
-from ._curves import curve_statistics, curves_csv
+from ._curves import (
+    MAX_CURVES_BYTES_PER_EPISODE,
+    curve_statistics,
+    curves_csv,
+    episode_seconds,
+    read_curve_times,
+)
 from ._errors import ConfigError, LearningError
 from ._learner import ExperimentResult, LiveProgress
 from ._owner import OWNER_FILE, OwnerLock, owner_alive, pid_alive, this_host
@@ -193,6 +200,7 @@ class RunFolder:
         self.host: dict[str, str | None] | None = None  # this_host() of the process training it
         self.interrupted = False  # read as stopped because its training process is gone
         self._steps: np.ndarray | None = None
+        self._times: np.ndarray | None = None  # per episode wall and CPU seconds, (2, episodes)
         self._owner: OwnerLock | None = None  # held while this process owns a live run
 
     @property
@@ -342,6 +350,7 @@ class RunFolder:
         steps = self._read_steps()
         if steps is not None:
             self._steps = steps
+            self._times = self._read_times()
         default = "done" if steps is not None and bool(np.all(steps >= 0)) else "stopped"
         state = status.get("status", default)
         self.status = state if state in STATUSES else "stopped"
@@ -388,6 +397,18 @@ class RunFolder:
             return None
         return steps
 
+    def _read_times(self) -> np.ndarray | None:
+        path = self.path / CURVES_FILE
+        if not path.exists() or path.is_symlink():
+            return None
+        limit = STEPS_HEADER_BYTES + self.record.episodes * MAX_CURVES_BYTES_PER_EPISODE
+        try:
+            text = read_bytes_bounded(path, limit).decode("utf-8")
+        except (StudioError, ValueError, OSError) as err:
+            log.warning("run %s: unreadable %s, its times dropped: %s", self.id, path, err)
+            return None
+        return read_curve_times(text, self.record.episodes)
+
     # ------------------------------------------------------------------ views
 
     def steps(self) -> np.ndarray:
@@ -396,9 +417,14 @@ class RunFolder:
             return self._steps
         return np.full((self.record.experiments, self.record.episodes), -1, np.int64)
 
+    def episode_times(self) -> np.ndarray | None:
+        """Each episode's wall and CPU time as saved in ``curves.csv`` (:data:`TIME_COLUMNS`,
+        ``(2, episodes)``, NaN where unknown), or None for a run saved without them."""
+        return self._times
+
     def curve(self, start: int = 0) -> dict[str, list]:
-        """The saved curve (:func:`curve_statistics`)."""
-        return curve_statistics(self.steps(), start)
+        """The saved curve (:func:`curve_statistics`, with the episodes' times when saved)."""
+        return curve_statistics(self.steps(), start, self._times)
 
     # ------------------------------------------------------------------ writes
 
@@ -422,17 +448,25 @@ class RunFolder:
             self._owner.release()  # the final status is written: nobody owns a finished run
             self._owner = None
 
-    def save_steps(self, steps: np.ndarray, curves: bool = True) -> None:
+    def save_steps(
+        self, steps: np.ndarray, curves: bool = True, seconds: np.ndarray | None = None
+    ) -> None:
         """Write ``steps.csv`` and, unless ``curves`` is false (a checkpoint), ``curves.csv``,
-        each atomically. ``steps.csv`` is the truth; ``curves.csv`` is derived from it."""
+        each atomically. ``steps.csv`` is the truth; ``curves.csv`` is derived from it, with the
+        episodes' times from ``seconds`` (:attr:`LiveProgress.episode_seconds`) when given, else
+        the ones saved before."""
         steps = np.asarray(steps, dtype=np.int64).copy()
+        times = self._times if seconds is None else episode_seconds(steps, seconds)
         try:
             atomic_write_text(self.path / STEPS_FILE, steps_text(steps))
             if curves:
-                atomic_write_text(self.path / CURVES_FILE, curves_csv(curve_statistics(steps)))
+                text = curves_csv(curve_statistics(steps, times=times))
+                atomic_write_text(self.path / CURVES_FILE, text)
         except OSError as err:
             raise _disk_error(err, "the run's curve", self.path) from None
         self._steps = steps
+        if curves:
+            self._times = times
 
     def recover(self) -> None:
         """Write down what :meth:`load` found for a run whose process died: its ``stopped``
@@ -593,7 +627,7 @@ class RunFolder:
         self.finished = now_iso()
         self.pid = None
         try:
-            self.save_steps(live.steps)
+            self.save_steps(live.steps, seconds=live.episode_seconds)
             if result is not None and result.completed.any() and error is None:
                 self.save_policy(result)
                 save_run_likeness(self.path, self.policy_path, self.record.demonstration_motions)

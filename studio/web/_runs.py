@@ -29,6 +29,7 @@ from pydantic import TypeAdapter
 from studio.kinematics import DEFAULT_ROBOT
 from studio.learning import (
     DEFAULT_GOAL_JOINTS_DEG,
+    ConfigError,
     DemonstrationPath,
     LearningError,
     LiveCurve,
@@ -40,6 +41,7 @@ from studio.learning import (
     find_runs,
     goal_degrees,
     resolve_run,
+    without_demonstrations,
 )
 
 from .._files import now_iso
@@ -134,12 +136,12 @@ class Run:
             now = time.monotonic()
             if live is not None and self.status == "running":
                 if now - when > CURVE_CACHE_SECONDS or source is not live.steps:
-                    self._curve.update(live.steps)
+                    self._curve.update(live.steps, seconds=live.episode_seconds)
                     self._curve_taken = (now, live.steps)
             elif self.status != "queued":  # (a queued run has no steps yet)
                 steps = self.folder.steps()
                 if source is not steps:
-                    self._curve.update(steps)
+                    self._curve.update(steps, times=self.folder.episode_times())
                     self._curve_taken = (now, steps)
         return self._curve
 
@@ -274,6 +276,16 @@ def run_create_of(record: RunRecord) -> RunCreate:
     return RUN_CREATE.validate_python(form)
 
 
+def run_request(
+    create: RunCreate, demonstration_path: Callable[[str, str], DemonstrationPath]
+) -> RunRequest:
+    """The learning package's request of a ``RunCreate``, its demonstrations by their paths on
+    the run's robot."""
+    robot = create.robot or DEFAULT_ROBOT
+    demonstrations = [demonstration_path(name, robot) for name in create.demonstrations]
+    return RunRequest.from_form(create.model_dump(), demonstrations=demonstrations)
+
+
 def prepare_run(
     create: RunCreate, demonstration_path: Callable[[str, str], DemonstrationPath]
 ) -> RunRecord:
@@ -289,10 +301,7 @@ def prepare_run(
     Raises:
         ConfigError: one sentence per bad field, keyed by field (answered as 422).
     """
-    robot = create.robot or DEFAULT_ROBOT
-    demonstrations = [demonstration_path(name, robot) for name in create.demonstrations]
-    request = RunRequest.from_form(create.model_dump(), demonstrations=demonstrations)
-    return resolve_run(request)
+    return resolve_run(run_request(create, demonstration_path))
 
 
 class RunQueue:
@@ -436,7 +445,29 @@ class RunQueue:
         self, create: RunCreate, demonstration_path: Callable[[str, str], DemonstrationPath]
     ) -> Run:
         """Validate a run, write its folder (atomically) and queue it."""
-        record = prepare_run(create, demonstration_path)
+        return self._queue_record(prepare_run(create, demonstration_path))
+
+    def submit_pair(
+        self, create: RunCreate, demonstration_path: Callable[[str, str], DemonstrationPath]
+    ) -> tuple[Run, Run]:
+        """Queue a run with demonstrations and its twin without them (same settings, seed and
+        goal: :func:`studio.learning.without_demonstrations`), both checked before either is
+        queued.
+
+        Raises:
+            ConfigError: a bad field of the run (as :meth:`submit`), or no demonstration picked.
+        """
+        if not create.demonstrations:
+            raise ConfigError(
+                ["Pick at least one demonstration to compare a run with them against one without."],
+                ["demonstrations"],
+            )
+        request = run_request(create, demonstration_path)
+        record = resolve_run(request)
+        baseline = resolve_run(without_demonstrations(request, record))
+        return self._queue_record(record), self._queue_record(baseline)
+
+    def _queue_record(self, record: RunRecord) -> Run:
         folder = RunFolder.create(self.folder, record)
         # the kernels' threads run at a lower priority: training must never starve the studio
         live = LiveProgress(record.experiments, record.episodes, niceness=self.niceness)

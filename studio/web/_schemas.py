@@ -287,8 +287,19 @@ class RecordingUpdate(_Body):
     operator: str | None = Field(None, max_length=200)
 
 
+class TimelineSignal(BaseModel):
+    """One group of a recording's own values on its timeline (``studio.capture``'s ``Signal``)."""
+
+    name: str = Field(
+        description='"tape bend", "tape twist", "landmark visibility", "hand position"'
+    )
+    unit: str = Field(description='"deg", "0-1" or "cm"')
+    labels: list[str] = Field(description="one per column: a tape region, a landmark, an axis")
+    values: list[list[float | None]] = Field(description="per time, one per label; null: none")
+
+
 class TimelinePublic(BaseModel):
-    """A recording's joints over time, downsampled for the timeline (degrees)."""
+    """A recording's joints over time, downsampled for the timeline (degrees), and its own values."""
 
     name: str
     kind: str
@@ -297,6 +308,10 @@ class TimelinePublic(BaseModel):
     human: list[list[float]] = Field(description="the human arm's 7 joints per time, degrees")
     robot: list[list[float]] = Field(description="the Puma560's 6 joints per time, degrees")
     residual_mm: list[float] = Field(description="how far the fitted arm misses, mm")
+    signals: list[TimelineSignal] = Field(
+        default_factory=list,
+        description="the recording's own values at the same times: a tape's bend and twist per region, a camera's landmark visibility, a hand guide's hand position",
+    )
 
 
 class RecordingReview(_Body):
@@ -522,6 +537,11 @@ class CurvePublic(BaseModel):
     min: list[float]
     max: list[float]
     count: list[int]
+    wall_seconds: list[float | None] | None = None
+    """Per episode, the mean over the experiments that finished it of each one's own wall seconds
+    from its start to that episode's end; absent for a run saved without times (older runs)."""
+    cpu_seconds: list[float | None] | None = None
+    """The same in CPU seconds."""
 
 
 class SweepPublic(BaseModel):

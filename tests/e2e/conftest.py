@@ -16,6 +16,7 @@ import time
 import urllib.error
 import urllib.request
 from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -158,6 +159,25 @@ def page(browser: Any, studio_server: Studio) -> Iterator[Any]:
     pg.errors = errors  # type: ignore[attr-defined]
     try:
         yield pg
+    finally:
+        context.close()
+
+
+@contextmanager
+def own_page(
+    browser: Any, studio: Studio, width: int = 1440, height: int = 900, **options: Any
+) -> Iterator[Any]:
+    """A page of its own on the studio, ready, at ``width`` x ``height``; ``page.errors`` holds
+    its script errors. Its browser context is closed afterwards."""
+    context = browser.new_context(viewport={"width": width, "height": height}, **options)
+    page = context.new_page()
+    errors: list[str] = []
+    page.on("pageerror", lambda e: errors.append(str(e)))
+    try:
+        page.goto(studio.base + "/")
+        page.wait_for_selector("body[data-ready='1']", timeout=60_000)
+        page.errors = errors
+        yield page
     finally:
         context.close()
 

@@ -12,17 +12,20 @@ import io
 import json
 import os
 import re
+import shutil
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pytest
 
-from tests.e2e.conftest import Studio
+from studio.learning import curve_statistics, curves_csv
+from tests.e2e.conftest import ARTIFACTS, Studio, own_page
 from tests.web.conftest import wait_for
 
 T = 20.0  # s: the longest one step of the page may take (the machine may be busy)
-SHOTS = Path(os.environ.get("COMPARE_SHOTS", "/tmp/compare-shots"))
+SHOTS = Path(os.environ.get("COMPARE_SHOTS", str(ARTIFACTS)))
 
 
 def ema(values: list[float], weight: float) -> list[float]:
@@ -55,13 +58,7 @@ def two_runs(studio_server: Studio) -> list[dict]:
 @pytest.fixture
 def small_page(browser: Any, studio_server: Studio, two_runs: list[dict]) -> Iterator[Any]:
     """The page at 1280 x 720 with only the two runs plotted."""
-    context = browser.new_context(viewport={"width": 1280, "height": 720}, accept_downloads=True)
-    page = context.new_page()
-    errors: list[str] = []
-    page.on("pageerror", lambda e: errors.append(str(e)))
-    try:
-        page.goto(studio_server.base + "/")
-        page.wait_for_selector("body[data-ready='1']", timeout=T * 3000)
+    with own_page(browser, studio_server, 1280, 720, accept_downloads=True) as page:
         ids = [r["id"] for r in two_runs]
         for row in page.locator("[data-testid='run-row']").all():
             box = row.get_by_test_id("run-show")
@@ -72,11 +69,8 @@ def small_page(browser: Any, studio_server: Studio, two_runs: list[dict]) -> Ite
             arg=sorted(ids),
             timeout=T * 1000,
         )
-        page.errors = errors
         yield page
-    finally:
-        context.close()
-    assert not errors, errors
+        assert not page.errors, page.errors
 
 
 def shoot(page: Any, name: str) -> None:
@@ -191,16 +185,21 @@ def test_smoothing_other_x_axes_the_legend_and_one_csv_of_the_plotted_runs(
     xs = page.evaluate(line, zero["id"])
     mine = [x for x, m in zip(xs["x"], xs["mean"], strict=True) if m is not None]
     assert mine == pytest.approx(steps)
-    page.get_by_test_id("curve-x").select_option("cpu")
-    assert wait_for(
-        lambda: (
-            (lambda d: [x for x, m in zip(d["x"], d["mean"], strict=True) if m is not None][-1])(
-                page.evaluate(line, zero["id"])
-            )
-            == pytest.approx(zero["cpu_seconds"])
-        ),
-        T,
+    # the CPU axis: each episode at the CPU time its experiments had spent by its end, as
+    # measured while the run trained (curves.csv's cpu_seconds), and no "≈" on the axis
+    assert all(v is not None for v in curve["cpu_seconds"])
+    assert curve["cpu_seconds"][-1] * zero["config"]["experiments"] == pytest.approx(
+        zero["cpu_seconds"], rel=0.05, abs=0.01
     )
+    page.get_by_test_id("curve-x").select_option("cpu")
+
+    def cpu_xs() -> list[float]:
+        d = page.evaluate(line, zero["id"])
+        return [x for x, m in zip(d["x"], d["mean"], strict=True) if m is not None]
+
+    assert wait_for(lambda: cpu_xs() == pytest.approx(curve["cpu_seconds"]), T)
+    assert "CPU time per experiment" in page.locator("#curve-plot").inner_text()
+    assert "≈" not in page.locator("#curve-plot").inner_text()
     shoot(page, "compare-cpu-axis-1280x720")
     page.get_by_test_id("curve-x").select_option("episode")
 
@@ -215,3 +214,42 @@ def test_smoothing_other_x_axes_the_legend_and_one_csv_of_the_plotted_runs(
     assert [float(r[2]) for r in rows[1:] if r[0] == "cmp-full"] == pytest.approx(
         own["mean"], rel=1e-5
     )
+
+
+def test_a_run_saved_without_times_per_episode_keeps_the_estimated_time_axes(
+    small_page: Any, studio_server: Studio, two_runs: list[dict]
+) -> None:
+    """A run folder from before the times were recorded: its curves.csv in the old layout. Its
+    curve loads, and the time axes share its total out by steps, saying so with "≈"."""
+    page = small_page
+    zero = two_runs[0]
+    runs = studio_server.data_dir / "runs"
+    old = runs / "cmp-older"
+    if not old.exists():
+        shutil.copytree(runs / zero["id"], old)
+        config = json.loads((old / "config.json").read_text())
+        config["name"] = "cmp-older"
+        (old / "config.json").write_text(json.dumps(config))
+        steps = np.loadtxt(old / "steps.csv", delimiter=",", dtype=np.int64, ndmin=2)
+        (old / "curves.csv").write_text(curves_csv(curve_statistics(steps)))
+    listed = {r["id"]: r for r in studio_server.get("/api/runs")}  # the studio finds it
+    assert "wall_seconds" not in studio_server.get("/api/runs/cmp-older/curve")
+    row = page.locator("[data-testid='run-row'][data-id='cmp-older']")
+    assert wait_for(lambda: row.count() == 1, T)
+    row.get_by_test_id("run-show").check()
+    page.wait_for_function(
+        "() => window.studio.plottedRuns().includes('cmp-older')", timeout=T * 1000
+    )
+    page.get_by_test_id("curve-x").select_option("cpu")
+    plot = page.locator("#curve-plot")
+    assert wait_for(lambda: "CPU time ≈ per experiment" in plot.inner_text(), T)
+    line = "id => window.studio.chartLine(id)"
+    drawn = page.evaluate(line, "cmp-older")
+    xs = [x for x, m in zip(drawn["x"], drawn["mean"], strict=True) if m is not None]
+    # the estimate ends at the run's CPU time over its experiments
+    per_experiment = listed["cmp-older"]["cpu_seconds"] / zero["config"]["experiments"]
+    assert xs[-1] == pytest.approx(per_experiment, rel=1e-3, abs=1e-3)
+    shoot(page, "compare-estimated-cpu-axis-1280x720")
+    row.get_by_test_id("run-show").uncheck()
+    assert wait_for(lambda: "≈" not in plot.inner_text(), T)
+    page.get_by_test_id("curve-x").select_option("episode")

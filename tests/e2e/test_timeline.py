@@ -16,6 +16,18 @@ def _ends(page: Any) -> tuple[float, float]:
     )
 
 
+def _shoot_small_and_large(page: Any, name: str) -> None:
+    """Screenshots of the timeline on the small and the large screen, once its plot fits each."""
+    for width, height in ((1280, 720), (1920, 1080)):
+        page.set_viewport_size({"width": width, "height": height})
+        page.wait_for_function(
+            "() => document.querySelector('[data-testid=timeline-plot] canvas').clientWidth"
+            " >= document.querySelector('[data-testid=timeline-plot]').clientWidth - 2"
+        )
+        shot(page, f"{name}-{width}x{height}", "timeline")
+    page.set_viewport_size({"width": 1440, "height": 900})
+
+
 def test_cut_on_the_timeline(page: Any, studio_server: Studio) -> None:
     page.get_by_role("button", name="Timeline of sample-reach-1").click()
     timeline = page.get_by_role("slider", name="Timeline")
@@ -56,14 +68,7 @@ def test_cut_on_the_timeline(page: Any, studio_server: Studio) -> None:
     timeline.press(" ")
     assert timeline.get_attribute("data-playing") == "0"
     shot(page, "timeline-ends", "sec-demos")
-    for width, height in ((1280, 720), (1920, 1080)):  # the small and the large screen
-        page.set_viewport_size({"width": width, "height": height})
-        page.wait_for_function(
-            "() => document.querySelector('[data-testid=timeline-plot] canvas').clientWidth"
-            " >= document.querySelector('[data-testid=timeline-plot]').clientWidth - 2"
-        )
-        shot(page, f"timeline-{width}x{height}", "timeline")
-    page.set_viewport_size({"width": 1440, "height": 900})
+    _shoot_small_and_large(page, "timeline")
 
     page.fill("[data-testid='demo-name']", "timeline-demo")
     page.uncheck("[data-testid='demo-goal-from-end']")
@@ -77,4 +82,38 @@ def test_cut_on_the_timeline(page: Any, studio_server: Studio) -> None:
     )
     t0, t1 = demo["segment"]
     assert t0 == 1.0 and abs(t1 - duration) < 0.01
+    assert not page.errors  # type: ignore[attr-defined]
+
+
+def test_a_tape_timeline_plots_its_bend_and_twist_per_region(
+    page: Any, studio_server: Studio
+) -> None:
+    page.get_by_role("button", name="Timeline of sample-reach-2").click()
+    page.wait_for_function(
+        "() => (window.studio.timeline.data || {}).name === 'sample-reach-2'",
+        timeout=60_000,
+    )
+    served = studio_server.get("/api/recordings/sample-reach-2/timeline?points=50")
+    regions = len(served["signals"][0]["labels"])
+    show = page.get_by_role("combobox", name="Timeline shows")
+    options = show.locator("option").all_inner_texts()
+    assert options == ["joints (robot and human arm)", "tape bend", "tape twist"]
+    assert len(page.evaluate("window.studio.timelineShown")) == 13  # 6 robot, 7 human joints
+    show.select_option("tape bend")
+    shown = page.evaluate("window.studio.timelineShown")
+    assert shown == [f"tape bend region {i + 1}" for i in range(regions)]
+    # the plotted values are the recording's own, in degrees, as the server serves them
+    drawn, own = page.evaluate(
+        "() => { const d = window.studio.timeline; "
+        "return [d.chart.data[1], d.data.signals[0].values.map((v) => v[0])]; }"
+    )
+    assert drawn == own and len(set(own)) > 1  # region 1's bend, as it varies over the reach
+    assert own[0] == served["signals"][0]["values"][0][0]  # the first frame's, as served
+    page.locator("#timeline").scroll_into_view_if_needed()
+    shot(page, "timeline-tape-bend", "timeline")
+    show.select_option("tape twist")
+    assert page.evaluate("window.studio.timelineShown")[0] == "tape twist region 1"
+    _shoot_small_and_large(page, "timeline-tape-twist")
+    show.select_option("joints")
+    assert len(page.evaluate("window.studio.timelineShown")) == 13
     assert not page.errors  # type: ignore[attr-defined]

@@ -7,6 +7,7 @@ them. What the robot shows is read back from the scene (``GET /api/scene/playbac
 
 from __future__ import annotations
 
+import re
 import time
 from typing import Any
 
@@ -81,6 +82,61 @@ def test_scrub_a_rollout_change_its_speed_and_step_it(
     assert _until(lambda: float(slider.input_value()) > 0, 10)
     assert _until(lambda: scene()["finished"], 20)
     assert not page.is_visible("[data-testid='rollout-error']")
+    assert not page.errors  # type: ignore[attr-defined]
+
+
+def test_keyboard_shortcuts_scrub_the_rollout_but_not_while_typing(
+    page: Any, studio_server: Studio, tmp_path: Any
+) -> None:
+    """Space plays and pauses, ←/→ step one sample, Shift+←/→ ten, Home/End go to the ends; the
+    keys are listed beside the controls and in their tooltips, and do nothing in a text field."""
+    if not page.get_by_role("slider", name="Rollout time").is_visible():
+        _watch_uploaded_policy(page, tmp_path)
+    page.locator("#sec-watch").scroll_into_view_if_needed()
+
+    def scene() -> dict:
+        return studio_server.get("/api/scene/playback")
+
+    keys = page.get_by_test_id("rollout-keys")
+    assert "Shift+←/→" in keys.inner_text() and "Home/End" in keys.inner_text()
+    assert "(space)" in (
+        page.get_by_role("button", name=re.compile("^(Play|Pause)$")).get_attribute("title") or ""
+    )
+    page.locator("body").click(position={"x": 5, "y": 5})  # focus on nothing in particular
+    page.keyboard.press("Home")
+    assert _until(lambda: scene()["paused"] and scene()["sample"] == 0)
+    page.keyboard.press("ArrowRight")
+    assert _until(lambda: scene()["sample"] == 1)
+    page.keyboard.press("Shift+ArrowRight")
+    assert _until(lambda: scene()["sample"] == 11)
+    page.keyboard.press("Shift+ArrowLeft")
+    page.keyboard.press("ArrowLeft")
+    assert _until(lambda: scene()["sample"] == 0)
+    page.keyboard.press("End")
+    assert _until(lambda: scene()["sample"] == scene()["samples"] - 1)
+    page.keyboard.press("Home")
+    assert _until(lambda: scene()["sample"] == 0)
+    page.keyboard.press(" ")
+    assert _until(lambda: not scene()["paused"])
+    page.keyboard.press(" ")
+    assert _until(lambda: scene()["paused"])
+    paused_at = scene()["sample"]
+    shot(page, "23-4-rollout-keys", "sec-watch")
+    page.set_viewport_size({"width": 1280, "height": 720})
+    page.locator("#sec-watch").scroll_into_view_if_needed()
+    shot(page, "23-4-rollout-keys-1280x720")
+    page.set_viewport_size({"width": 1920, "height": 1080})
+    page.locator("#sec-watch").scroll_into_view_if_needed()
+    shot(page, "23-4-rollout-keys-1920x1080")
+    page.set_viewport_size({"width": 1440, "height": 900})
+
+    # typing in a field: the keys are the field's, the rollout stays where it is
+    seed = page.locator("[data-testid='watch-seed']")
+    seed.click()
+    for key in (" ", "ArrowRight", "End", "Shift+ArrowLeft", "Home"):
+        seed.press(key)
+    time.sleep(0.5)  # nothing to wait for: a request the keys would send would be back by now
+    assert scene()["sample"] == paused_at and scene()["paused"]
     assert not page.errors  # type: ignore[attr-defined]
 
 

@@ -10,7 +10,7 @@ import os
 import pytest
 
 from studio.learning import curves_csv
-from studio.learning._curves import CURVE_COLUMNS
+from studio.learning._curves import CURVE_COLUMNS, TIME_COLUMNS
 from studio.learning._run_notes import MAX_NOTES_CHARS, MAX_TAG_CHARS, MAX_TAGS, NOTES_FILE
 from tests.web.conftest import TINY_RUN, wait_run
 
@@ -108,7 +108,7 @@ def test_several_runs_export_in_one_csv_in_the_one_layout(client, two_runs):
     r = client.get("/api/run-curves.csv", params=[("run", b), ("run", a)])
     assert r.status_code == 200 and "attachment" in r.headers["content-disposition"]
     rows = list(csv.reader(io.StringIO(r.text)))
-    assert rows[0] == ["configuration", *CURVE_COLUMNS]
+    assert rows[0] == ["configuration", *CURVE_COLUMNS, *TIME_COLUMNS]
     assert [row[0] for row in rows[1:]] == ["beta"] * 4 + ["alpha"] * 4
     # each run's rows are exactly its own curves.csv, with the run's name in front
     own = client.get(f"/api/runs/{a}/curve.csv").text.splitlines()[1:]

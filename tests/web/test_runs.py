@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from studio.learning import load_policy
-from studio.learning._curves import CURVE_COLUMNS
+from studio.learning._curves import CURVE_COLUMNS, TIME_COLUMNS
 from tests.conftest import hold_preparation
 from tests.web.conftest import TINY_RUN, wait_for, wait_run
 
@@ -82,7 +82,7 @@ def test_a_tiny_run_trains_and_yields_a_loadable_policy(client, tmp_path):
     csv = client.get(f"/api/runs/{run['id']}/curve.csv")
     assert csv.headers["content-type"].startswith("text/csv")
     rows = csv.text.strip().splitlines()
-    assert rows[0] == ",".join(CURVE_COLUMNS) and len(rows) == 5
+    assert rows[0] == ",".join(CURVE_COLUMNS + TIME_COLUMNS) and len(rows) == 5
     assert float(rows[1].split(",")[1]) == pytest.approx(curve["mean"][0])
 
     png = client.get(f"/api/runs/{run['id']}/plot.png?log=true")
@@ -359,7 +359,7 @@ def test_csv_of_curve_is_parseable(client):
     data = np.loadtxt(
         io.StringIO(client.get(f"/api/runs/{run['id']}/curve.csv").text), delimiter=",", skiprows=1
     )
-    assert data.shape == (4, len(CURVE_COLUMNS)) and list(data[:, 0]) == [1, 2, 3, 4]
+    assert data.shape == (4, len(CURVE_COLUMNS + TIME_COLUMNS)) and list(data[:, 0]) == [1, 2, 3, 4]
 
 
 def test_a_failing_run_shows_why_and_the_queue_goes_on(client, monkeypatch):

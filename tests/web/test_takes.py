@@ -85,6 +85,11 @@ def test_the_timeline_serves_both_arms_joints_downsampled(open_client, recording
     assert len(timeline["times"]) == len(timeline["human"]) == len(timeline["robot"]) <= 50
     assert len(timeline["human"][0]) == 7 and len(timeline["robot"][0]) == 6
     assert timeline["times"][-1] == pytest.approx(timeline["duration"], abs=0.05)
+    # and the tape's own bend and twist, per region, at the same times
+    bend, twist = timeline["signals"]
+    assert (bend["name"], twist["name"], bend["unit"]) == ("tape bend", "tape twist", "deg")
+    assert len(bend["values"]) == len(timeline["times"]) and len(bend["values"][0]) == 16
+    assert bend["labels"][0] == "region 1"
     assert client.post(f"/api/recordings/{recording}/review", json={"t": 1.5}).status_code == 202
     assert (
         client.post(f"/api/recordings/{recording}/review", json={"t0": 1, "t1": 3}).status_code

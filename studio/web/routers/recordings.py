@@ -24,6 +24,7 @@ from .._schemas import (
     RecordingReview,
     RecordingUpdate,
     TimelinePublic,
+    TimelineSignal,
 )
 from .._state import Studio
 from .._store import RecordingSummary, StoredFile, receive_upload
@@ -178,7 +179,8 @@ def read_timeline(
     points: Annotated[int, Query(ge=2, le=MAX_SERIES_POINTS)] = DEFAULT_SERIES_POINTS,
 ) -> TimelinePublic:
     """The human arm's and the robot's joints over the whole recording, at about ``points``
-    evenly spaced frames (degrees), fitted as a demonstration cut from it would be."""
+    evenly spaced frames (degrees), fitted as a demonstration cut from it would be; and the
+    recording's own values at the same frames (``signals``)."""
 
     series = reviewer.plotted(name, points)
     return TimelinePublic(
@@ -189,6 +191,18 @@ def read_timeline(
         human=np.degrees(series.q_human).round(2).tolist(),
         robot=np.degrees(series.q_robot).round(2).tolist(),
         residual_mm=(series.residual * 1000).round(2).tolist(),
+        signals=[
+            TimelineSignal(
+                name=signal.name,
+                unit=signal.unit,
+                labels=list(signal.labels),
+                values=[
+                    [None if np.isnan(v) else v for v in row]
+                    for row in signal.values.round(3).tolist()
+                ],
+            )
+            for signal in series.signals
+        ],
     )
 
 

@@ -40,6 +40,15 @@ def create_run(body: RunCreate, studio: StudioDep) -> RunPublic:
     return run.model()
 
 
+@router.post("/pair", response_model=list[RunPublic], status_code=201)
+def create_run_pair(body: RunCreate, studio: StudioDep) -> list[RunPublic]:
+    """Queue a run with its demonstrations and, after it, the same run without them (same
+    settings, seed and goal), to compare the two; both are checked before either is queued (422
+    as ``POST /api/runs``, and when no demonstration is picked)."""
+    pair = studio.runs.submit_pair(studio.with_robot(body), studio.demonstration_path)
+    return [run.model() for run in pair]
+
+
 @router.get("/{run_id}", response_model=RunPublic)
 def read_run(run_id: str, studio: StudioDep) -> RunPublic:
     """One run."""

@@ -4,7 +4,7 @@
  * takes about a millisecond, so live curves at CURVE_FPS never compete with training for the CPU.
  */
 
-import { RUNNING_AXES, bucketCurve, curveAxis, runningAxis, smoothed } from "./curves.js";
+import { RUNNING_AXES, TIME_KEYS, bucketCurve, curveAxis, measuredSeconds, runningAxis, smoothed } from "./curves.js";
 import { $, setProp, setText } from "./dom.js";
 import { S } from "./state.js";
 
@@ -38,13 +38,21 @@ export function plottedRuns() {
   });
 }
 
-/** A run's seconds so far on a time axis: its CPU time, or its wall time from start to finish
- * (to now while it trains); 0 before it starts. */
+/** An experiment's seconds so far on a time axis, for a run saved without times per episode:
+ * its CPU time over its experiments, or its wall time from start to finish (to now while it
+ * trains) over the experiments each thread ran in turn (one thread per core); 0 before it starts. */
 export function runSeconds(r, xMode) {
-  if (xMode === "cpu") return r.cpu_seconds || 0;
+  const experiments = Math.max(1, (r.config && r.config.experiments) || 1);
+  if (xMode === "cpu") return (r.cpu_seconds || 0) / experiments;
   if (xMode !== "wall" || !r.started) return 0;
   const end = r.finished ? Date.parse(r.finished) : Date.now();
-  return Math.max(0, (end - Date.parse(r.started)) / 1000);
+  const threads = Math.min(experiments, navigator.hardwareConcurrency || 1);
+  return (Math.max(0, (end - Date.parse(r.started)) / 1000) * threads) / experiments;
+}
+
+/** Whether a time axis is an estimate for some of these runs (saved without times per episode). */
+export function estimatedTime(runs, xMode) {
+  return Boolean(TIME_KEYS[xMode]) && runs.some((r) => !measuredSeconds(S.curves.get(r.id), xMode));
 }
 
 /** Episodes per experiment of a run (its fraction-of-run axis divides by this). */
@@ -117,8 +125,14 @@ function hexAlpha(hex, a) {
 
 const X_LABELS = {
   episode: "episode", log: "episode", fraction: "fraction of run", steps: "real steps",
-  wall: "wall time ≈ s (run's time shared out by steps)", cpu: "CPU time ≈ s (run's time shared out by steps)",
+  wall: "wall time per experiment", cpu: "CPU time per experiment",
 };
+
+/** The x axis's label; a time axis on which some run's time is estimated says so with "≈". */
+export function xLabelOf(runs, xMode) {
+  if (estimatedTime(runs, xMode)) return `${xMode === "cpu" ? "CPU" : "wall"} time ≈ per experiment (older runs: their time shared out by steps)`;
+  return X_LABELS[xMode] || "episode";
+}
 
 /** The last value of a column (the legend shows it while the cursor is off the chart). */
 function lastValue(col) {
@@ -126,10 +140,17 @@ function lastValue(col) {
   return null;
 }
 
+/** A time axis's tick: seconds, or milliseconds below one second (a short run's ticks would
+ * otherwise all round to 0). */
+function fmtSeconds(v) {
+  if (v == null) return "";
+  return Math.abs(v) < 1 && v !== 0 ? `${+(v * 1000).toPrecision(3)} ms` : `${+v.toPrecision(4)} s`;
+}
+
 function fmtX(xMode, v) {
   if (v == null) return ""; // off the chart: the runs' values are their last ones
   if (xMode === "fraction") return v.toFixed(3);
-  if (xMode === "wall" || xMode === "cpu") return `${v.toFixed(1)} s`;
+  if (xMode === "wall" || xMode === "cpu") return fmtSeconds(v);
   return xMode === "steps" ? String(Math.round(v)) : String(v);
 }
 
@@ -138,7 +159,7 @@ function fmtX(xMode, v) {
  * a dashed marker where a run's points start averaging fewer experiments than it has. The legend
  * names every run all the time, with its last value until the cursor points at an x. */
 function chartOptions(runs, band, log, width, height, xMode = "episode", smoothing = 0) {
-  const xLabel = X_LABELS[xMode] || "episode";
+  const xLabel = xLabelOf(runs, xMode);
   const gaps = RUNNING_AXES.has(xMode); // runs have their own x: join their points across others' rows
   const series = [{ label: xLabel.split(" (")[0], value: (u, v) => fmtX(xMode, v) }];
   const bands = [];
@@ -171,7 +192,7 @@ function chartOptions(runs, band, log, width, height, xMode = "episode", smoothi
       y: log ? { distr: 3, log: 10 } : { range: (u, min, max) => [0, max > 0 ? max * 1.05 : 1] },
     },
     axes: [
-      { ...axis, label: xLabel, labelSize: 16, size: 30 },
+      { ...axis, label: xLabel, labelSize: 16, size: 30, ...(TIME_KEYS[xMode] ? { values: (u, ticks) => ticks.map(fmtSeconds) } : {}) },
       { ...axis, label: "steps", labelSize: 16, size: 48 },
     ],
     legend: { live: true },
@@ -243,7 +264,7 @@ export function renderCurves() {
     setProp("curve-key", "hidden", true);
     return;
   }
-  const key = JSON.stringify([runs.map((r) => [r.id, runLabel(r), runColor(r.id)]), band, log, xMode, smoothing > 0]);
+  const key = JSON.stringify([runs.map((r) => [r.id, runLabel(r), runColor(r.id)]), band, log, xMode, smoothing > 0, xLabelOf(runs, xMode)]);
   const data = chartData(runs, band, log, xMode, smoothing);
   renderCurveKey(runs, data, band);
   if (chart && key === chartKey) {

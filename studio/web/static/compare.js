@@ -105,6 +105,15 @@ function exportCsv() {
   download(`/api/run-curves.csv?${ids.map((id) => `run=${enc(id)}`).join("&")}`, "curves.csv", "curve-error");
 }
 
+/** Open the run table (on the plotted runs: tick the ones to compare first). */
+export function openCompare() {
+  const dlg = $("compare-dialog");
+  if (!dlg.open) dlg.show();
+  setProp($("compare-open"), "ariaExpanded", "true");
+  renderCompare();
+  $("compare-filter").focus();
+}
+
 export function wireCompare() {
   S.afterRunsRender = renderCompare;
   $("curve-smooth").addEventListener("input", () => {
@@ -113,12 +122,8 @@ export function wireCompare() {
   });
   $("curve-csv").addEventListener("click", exportCsv);
   $("compare-open").addEventListener("click", () => {
-    const dlg = $("compare-dialog");
-    if (dlg.open) { dlg.close(); return; }
-    dlg.show();
-    setProp($("compare-open"), "ariaExpanded", "true");
-    renderCompare();
-    $("compare-filter").focus();
+    if ($("compare-dialog").open) { $("compare-dialog").close(); return; }
+    openCompare();
   });
   $("compare-dialog").addEventListener("keydown", (e) => { if (e.key === "Escape") $("compare-dialog").close(); });
   $("compare-dialog").addEventListener("close", () => setProp($("compare-open"), "ariaExpanded", "false"));

@@ -9,7 +9,18 @@
  * "fraction" axes bucket the same way over other edges.
  */
 
-export const CURVE_KEYS = ["episodes", "mean", "std", "min", "max", "count"];
+export const CURVE_KEYS = ["episodes", "mean", "std", "min", "max", "count", "wall_seconds", "cpu_seconds"];
+
+/** A curve's measured time per episode, by x axis (``studio.learning``'s TIME_COLUMNS): the mean
+ * over the experiments that finished the episode of each one's own seconds up to its end. */
+export const TIME_KEYS = { wall: "wall_seconds", cpu: "cpu_seconds" };
+
+/** The curve's measured seconds for a time axis, or null when its run saved none (an older run,
+ * one recovered after a crash): that axis is then an estimate. */
+export function measuredSeconds(curve, xMode) {
+  const t = curve[TIME_KEYS[xMode]];
+  return t && t.length === curve.episodes.length && t.some((v) => v !== null) ? t : null;
+}
 
 export function emptyCurve() {
   return Object.fromEntries(CURVE_KEYS.map((k) => [k, []]));
@@ -113,12 +124,15 @@ export const RUNNING_AXES = new Set(["steps", "wall", "cpu"]);
 /**
  * Each episode's x on a running axis. "steps": the real steps taken up to and including it (the
  * sum of the mean steps per episode: the mean over experiments of each one's own total while
- * all of them count). "wall" and "cpu": ``seconds`` (the run's wall or CPU time so far) shared out
- * in proportion to those steps. A run's files record its total times only (status.json), not a
- * time per episode; a Dyna-Q step costs about the same all run long (one update and n planning
- * updates), so this is an estimate that the axis labels with "≈".
+ * all of them count). "wall" and "cpu": the seconds an experiment had spent by the episode's end,
+ * as measured while the run trained (``measuredSeconds``; null where not stamped yet). A run saved
+ * without them gets ``seconds`` (an experiment's wall or CPU time so far) shared out in proportion
+ * to its steps: a Dyna-Q step costs about the same all run long (one update and n planning
+ * updates), so that is an estimate, which the axis labels with "≈".
  */
 export function runningX(curve, xMode, seconds = 0) {
+  const measured = TIME_KEYS[xMode] ? measuredSeconds(curve, xMode) : null;
+  if (measured) return measured.map((v) => (v === undefined ? null : v));
   const x = new Array(curve.episodes.length);
   let sum = 0;
   for (let i = 0; i < x.length; i++) { sum += curve.mean[i] > 0 ? curve.mean[i] : 0; x[i] = sum; }
@@ -138,7 +152,10 @@ export function runningAxis(lines, xMode, seconds, points = MAX_PLOT_POINTS) {
     const s = bucketCurve(line, ex.length, bucketOf);
     const px = runningX(line.curve, xMode, seconds[i]);
     const sum = new Float64Array(ex.length); const cnt = new Uint32Array(ex.length);
-    line.curve.episodes.forEach((e, k) => { const b = bucketOf(line, e); sum[b] += px[k]; cnt[b] += 1; });
+    line.curve.episodes.forEach((e, k) => {
+      if (px[k] === null) return; // a time not stamped yet
+      const b = bucketOf(line, e); sum[b] += px[k]; cnt[b] += 1;
+    });
     return { s, bx: Array.from(sum, (v, b) => (cnt[b] ? v / cnt[b] : null)) };
   });
   const rows = [];
@@ -148,7 +165,11 @@ export function runningAxis(lines, xMode, seconds, points = MAX_PLOT_POINTS) {
   const stats = parts.map((p) => ({ most: p.s.most, ...Object.fromEntries(keys.map((k) => [k, []])) }));
   const x = [];
   for (const [v, i, b] of rows) {
-    if (!x.length || x[x.length - 1] !== v) { x.push(v); for (const st of stats) for (const k of keys) st[k].push(null); }
+    // a row per x shared by runs; a run's own episodes at one x (ended within the same
+    // millisecond) keep a row each, so none is lost
+    if (!x.length || x[x.length - 1] !== v || stats[i].mean[x.length - 1] !== null) {
+      x.push(v); for (const st of stats) for (const k of keys) st[k].push(null);
+    }
     for (const k of keys) stats[i][k][x.length - 1] = parts[i].s[k][b];
   }
   return { x, stats };

@@ -2,7 +2,9 @@
 
 import { api, download, guarded } from "./api.js";
 import { runColor, runLabel } from "./chart.js";
-import { CURVE_KEYS, emptyCurve } from "./curves.js";
+import { CURVE_KEYS, TIME_KEYS, emptyCurve } from "./curves.js";
+
+const TIME_KEY_SET = new Set(Object.values(TIME_KEYS));
 import { $, confirmDialog, el, emptyRow, enc, fmtCpu, showError } from "./dom.js";
 import { renderPolicies, renderWatchChoices } from "./policies.js";
 import { runMatches, tagChips } from "./runfilter.js";
@@ -243,7 +245,7 @@ export function mergeCurve(id, piece, from, to) {
   if (!c) { c = emptyCurve(); S.curves.set(id, c); }
   if (to !== undefined && to !== null) { // episodes [from, to) changed: replace just those
     for (let e = c.episodes.length; e < from; e++) { // episodes nobody finished yet: empty
-      for (const k of CURVE_KEYS) c[k].push(k === "episodes" ? e + 1 : 0);
+      for (const k of CURVE_KEYS) c[k].push(k === "episodes" ? e + 1 : TIME_KEY_SET.has(k) ? null : 0);
     }
     for (const k of CURVE_KEYS) c[k].splice(from, to - from, ...(piece[k] || []));
     markCurvesDirty();

@@ -2,7 +2,9 @@
  *
  * Choosing a recording to cut from (or its row's timeline button) plots the robot's joints (solid)
  * and the human arm's (dashed) over the whole recording, served downsampled by
- * GET /api/recordings/{name}/timeline (uPlot, as the curve chart). The robot in the scene follows
+ * GET /api/recordings/{name}/timeline (uPlot, as the curve chart). "Timeline shows" plots the
+ * recording's own values instead, as the server serves them (``signals``): a tape's bend or twist
+ * per region, a camera's landmark visibility, a hand guide's hand position. The robot in the scene follows
  * the playhead: hovering the plot moves it, as do the arrow keys. Dragging selects the segment to
  * cut (its robot path is drawn and played in the scene); `[` and `]` set its ends at the playhead;
  * space plays and pauses. The segment is the Demonstrations section's t0 and t1, so Cut cuts it.
@@ -10,14 +12,16 @@
 
 import { api, guarded } from "./api.js";
 import { setDemoRange } from "./demos.js";
-import { $, enc, fmt, setProp, setText } from "./dom.js";
+import { $, el, enc, fmt, setProp, setText } from "./dom.js";
 import { S } from "./state.js";
 
 const ROBOT = ["#1f4e9c", "#2a7bd8", "#0f8b8d", "#23874b", "#6b4fbb", "#b83280"];
 const HUMAN = ["#d9822b", "#b8661f", "#a0522d", "#c9a227", "#e05a47", "#8c6d46", "#7a7a7a"];
 const STEP_S = 0.1;
 
-const T = { name: null, data: null, chart: null, playhead: 0, playing: false, last: 0, want: null, sending: false };
+const UNITS = { deg: (x) => `${x}°`, cm: (x) => `${x} cm` };
+
+const T = { name: null, show: "joints", data: null, chart: null, playhead: 0, playing: false, last: 0, want: null, sending: false };
 S.timeline = T; // for the browser tests and the console
 
 function duration() { return T.data ? T.data.duration : 0; }
@@ -29,6 +33,7 @@ export async function showTimeline(name) {
   pause();
   T.name = name || null;
   setProp("timeline", "hidden", !name);
+  setProp("timeline-bar", "hidden", !name);
   if (!name) return;
   const box = $("timeline-plot");
   const points = Math.max(100, Math.min(600, box.clientWidth || 400));
@@ -38,16 +43,33 @@ export async function showTimeline(name) {
     if (T.name !== name) return; // another recording was chosen meanwhile
     T.data = data;
     T.playhead = 0;
+    showChoices();
     draw();
   });
 }
 
-function draw() {
-  if (T.chart) { T.chart.destroy(); T.chart = null; }
-  if (typeof uPlot === "undefined" || !T.data) return;
-  const d = T.data;
+/** "Timeline shows": the joints, then what this recording itself holds; the choice stays when
+ * the next recording has it too. */
+function showChoices() {
+  const names = ["joints", ...(T.data.signals || []).map((g) => g.name)];
+  if (!names.includes(T.show)) T.show = "joints";
+  const select = $("timeline-show");
+  select.replaceChildren(...names.map((n) => el("option", { value: n, text: n === "joints" ? "joints (robot and human arm)" : n, selected: n === T.show })));
+}
+
+/** The plotted columns and their series: the joints, or one group of the recording's values. */
+function plotted(d) {
   const cols = [d.times];
   const series = [{ label: "t (s)" }];
+  const group = (d.signals || []).find((g) => g.name === T.show);
+  if (group) {
+    const n = group.labels.length;
+    group.labels.forEach((label, j) => {
+      cols.push(group.values.map((v) => v[j]));
+      series.push({ label: `${group.name} ${label}`, stroke: `hsl(${Math.round(220 - (200 * j) / Math.max(1, n - 1))}, 65%, 42%)`, width: 1.3 });
+    });
+    return { cols, series, unit: UNITS[group.unit] || String };
+  }
   for (let j = 0; j < 6; j++) {
     cols.push(d.robot.map((q) => q[j]));
     series.push({ label: `robot ${j + 1}`, stroke: ROBOT[j], width: 1.5 });
@@ -56,13 +78,22 @@ function draw() {
     cols.push(d.human.map((q) => q[j]));
     series.push({ label: `human ${j + 1}`, stroke: HUMAN[j], width: 1, dash: [4, 3] });
   }
+  return { cols, series, unit: UNITS.deg };
+}
+
+function draw() {
+  if (T.chart) { T.chart.destroy(); T.chart = null; }
+  if (typeof uPlot === "undefined" || !T.data) return;
+  const d = T.data;
+  const { cols, series, unit } = plotted(d);
+  S.timelineShown = series.slice(1).map((s) => s.label); // for the browser tests
   const box = $("timeline-plot");
   T.chart = new uPlot({
     width: Math.max(200, box.clientWidth),
     height: 170,
     legend: { show: false },
     scales: { x: { time: false, range: [0, Math.max(d.duration, 0.01)] } },
-    axes: [{ size: 28 }, { size: 52, values: (u, v) => v.map((x) => `${x}°`) }],
+    axes: [{ size: 28 }, { size: 52, values: (u, v) => v.map(unit) }],
     series,
     cursor: { drag: { x: true, y: false, setScale: false }, points: { show: false } },
     hooks: {
@@ -192,6 +223,7 @@ function onKey(ev) {
 
 function wire() {
   $("timeline").addEventListener("keydown", onKey);
+  $("timeline-show").addEventListener("change", (e) => { T.show = e.target.value; draw(); });
   $("demo-recording").addEventListener("change", () => showTimeline($("demo-recording").value));
   for (const id of ["demo-t0", "demo-t1"]) $(id).addEventListener("change", () => { showSelection(); movePlayhead(T.playhead, false); });
   for (const id of ["demo-t0-range", "demo-t1-range"]) $(id).addEventListener("input", showSelection);

@@ -3,6 +3,7 @@
 import { ApiError, api } from "./api.js";
 import { emptyCurve } from "./curves.js";
 import { $, el, showError } from "./dom.js";
+import { openCompare } from "./compare.js";
 import { renderRuns, upsertRun } from "./runs.js";
 import { S, markCurvesDirty } from "./state.js";
 
@@ -145,12 +146,19 @@ export async function startRun(ev) {
   const button = $("train-start");
   button.disabled = true;
   try {
-    const run = await api("POST", "/api/runs", readTrainForm());
-    upsertRun(run);
-    if (!S.shown.has(run.id)) S.shown.add(run.id);
-    S.curves.set(run.id, emptyCurve());
+    const body = readTrainForm();
+    const pair = $("train-form").elements.baseline.checked;
+    // with "also train without demonstrations": the run and its twin, plotted alone and compared
+    const runs = pair ? await api("POST", "/api/runs/pair", body) : [await api("POST", "/api/runs", body)];
+    if (pair) S.shown = new Set();
+    for (const run of runs) {
+      upsertRun(run);
+      S.shown.add(run.id);
+      S.curves.set(run.id, emptyCurve());
+    }
     renderRuns();
     markCurvesDirty();
+    if (pair) openCompare();
   } catch (e) {
     showTrainErrors(e);
     if (!(e instanceof ApiError)) console.error(e);

@@ -18,6 +18,9 @@ import { S } from "./state.js";
 const TICK_MS = 100; // the time shown moves this often while a rollout plays
 const VIEWS = [["front", "Front view", "Front"], ["top", "Top view", "Top"], ["side", "Side view", "Side"]];
 const GOAL_JOINTS = 3; // the train form's goal: joints 1-3
+const BIG_STEP = 10; // samples a Shift+arrow steps
+/** The rollout's keyboard shortcuts, as the page's tooltips and help list them. */
+export const ROLLOUT_KEYS = "space play/pause · ←/→ one sample · Shift+←/→ ten samples · Home/End start/end";
 
 // The rollout as the scene last answered, and when (performance.now()).
 S.rollout = null;
@@ -28,14 +31,15 @@ function build() {
   const speeds = [0.25, 0.5, 1, 2, 4];
   const box = $("watch-controls");
   box.replaceChildren(
-    el("div", { class: "row playback", id: "rollout", testid: "rollout", hidden: true },
-      el("button", { id: "rollout-back", testid: "rollout-back", "aria-label": "Step back", title: "one sample back", text: "|◀" }),
-      el("button", { id: "rollout-play", testid: "rollout-play", "aria-label": "Pause", title: "play / pause", text: "❚❚" }),
-      el("button", { id: "rollout-forward", testid: "rollout-forward", "aria-label": "Step forward", title: "one sample forward", text: "▶|" }),
-      el("input", { id: "rollout-time", testid: "rollout-time", type: "range", min: "0", max: "1", step: "any", value: "0", class: "grow", "aria-label": "Rollout time" }),
+    el("div", { class: "row wrap playback", id: "rollout", testid: "rollout", hidden: true },
+      el("button", { id: "rollout-back", testid: "rollout-back", "aria-label": "Step back", "aria-keyshortcuts": "ArrowLeft Shift+ArrowLeft", title: "one sample back (←; Shift+← ten)", text: "|◀" }),
+      el("button", { id: "rollout-play", testid: "rollout-play", "aria-label": "Pause", "aria-keyshortcuts": "Space", title: "play / pause (space)", text: "❚❚" }),
+      el("button", { id: "rollout-forward", testid: "rollout-forward", "aria-label": "Step forward", "aria-keyshortcuts": "ArrowRight Shift+ArrowRight", title: "one sample forward (→; Shift+→ ten)", text: "▶|" }),
+      el("input", { id: "rollout-time", testid: "rollout-time", type: "range", min: "0", max: "1", step: "any", value: "0", class: "grow", "aria-label": "Rollout time", "aria-keyshortcuts": "Home End", title: `drag to scrub; keys: ${ROLLOUT_KEYS}` }),
       el("span", { class: "mono", id: "rollout-clock", testid: "rollout-clock", text: "0.00 / 0.00 s" }),
       el("select", { id: "rollout-speed", testid: "rollout-speed", "aria-label": "Rollout speed", title: "playback speed" },
         ...speeds.map((s) => el("option", { value: String(s), text: `${s}×`, selected: s === 1 }))),
+      el("span", { class: "muted keys", testid: "rollout-keys", title: "keyboard shortcuts while a rollout is shown (not while typing in a field)", text: `⌨ ${ROLLOUT_KEYS}` }),
     ),
     el("div", { class: "row", role: "group", "aria-label": "Camera" },
       el("span", { class: "muted", text: "camera:" }),
@@ -59,6 +63,7 @@ function build() {
   const slider = $("rollout-time");
   slider.addEventListener("input", () => { slider.dataset.dragging = "1"; scrubTo(Number(slider.value)); });
   slider.addEventListener("change", () => { delete slider.dataset.dragging; scrubTo(Number(slider.value)); });
+  document.addEventListener("keydown", onKey);
 }
 
 // ------------------------------------------------------------------ the rollout
@@ -130,6 +135,34 @@ async function scrubTo(t) {
 
 export async function loadRollout() {
   try { showRollout(await api("GET", "/api/scene/playback")); } catch (e) { /* a studio without a scene */ }
+}
+
+/** Whether a key press belongs to where it happened: typing in a field, a focused button's own
+ * space or Enter, the timeline's own keys, or a take under way (its ← and → keep and redo). */
+function keyTakenElsewhere(ev) {
+  const target = ev.target;
+  if (!target || !target.closest) return false;
+  if (target.isContentEditable || ["INPUT", "TEXTAREA", "SELECT"].includes(target.tagName)) return true;
+  if ((ev.key === " " || ev.key === "Enter") && target.closest("button, summary, a, [role='button']")) return true;
+  if (target.closest("[data-keys='own'], dialog[open]")) return true;
+  const take = S.takesPhase ? S.takesPhase() : "idle";
+  return take !== "idle" && take !== "kept";
+}
+
+/** The rollout's keyboard shortcuts (``ROLLOUT_KEYS``), while a watched rollout is shown. */
+function onKey(ev) {
+  if (!S.rollout || ev.altKey || ev.ctrlKey || ev.metaKey || keyTakenElsewhere(ev)) return;
+  const n = ev.shiftKey ? BIG_STEP : 1;
+  const action = {
+    " ": () => change({ paused: !S.rollout.paused && !finished() }),
+    ArrowLeft: () => change({ step: -n }),
+    ArrowRight: () => change({ step: n }),
+    Home: () => scrubTo(0),
+    End: () => scrubTo(S.rollout.duration),
+  }[ev.key];
+  if (!action) return;
+  ev.preventDefault();
+  action();
 }
 
 // ------------------------------------------------------------------ camera
