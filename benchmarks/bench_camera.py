@@ -9,8 +9,14 @@ index.
    its stamp read, the copy given to the model) against the studio page with the camera as its
    source (drawing, sending landmarks, the 3D scene), in alternating windows of the same run,
    for the lite and the full model. Both sides run beside the same studio server with the same
-   API probe: they differ by the studio page alone. Goal: the studio slows inference by at most
-   10%.
+   API probe, and each opens the camera only for its own windows: they differ by the studio page
+   alone. Goal: the studio slows inference by at most 10%.
+
+   Beside the frame rates, the CPU seconds each process spends per inferred frame, from /proc
+   (``process_cpu.py``): the renderer of each page (bare, studio, the scene's iframe), the GPU
+   process (where SwiftShader draws every page's WebGL: the pose model's and the scene's, split
+   by thread), the browser, its utilities and the studio server. On a shared machine this moves
+   far less with other work than frames/s do.
 2. Camera-to-scene latency while the studio page runs: from the picture's capture time (the
    video frame's ``captureTime``, else when the page took it) to the landmarks (the model's
    result), to the scene, and to the page hearing the answer of ``POST /api/source/landmarks``;
@@ -25,8 +31,9 @@ index.
 4. The scene's pushes for a camera at the bare package's rate on an idle machine without a GPU
    (3.5 frames/s, lite), landmarks of a known arm motion posted straight to the studio (no
    browser, so the figure does not depend on the machine's load): how many robot poses a second
-   reach a viser client. viser's page redraws for a quarter of a second after each, in the
-   browser's software-GL process that also runs the pose model.
+   reach a viser client. viser's page draws each in about two frames (the studio limits its
+   frames while a slow stream drives it), in the browser's software-GL process that also runs the
+   pose model.
 
 On a 2-core machine without a GPU the model runs at a few frames a second and figures swing with
 other work on the machine: read the ratios of neighbouring windows, and rerun.
@@ -45,11 +52,13 @@ import tempfile
 import threading
 import time
 import urllib.request
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 from bench_web import CHROMIUM, FLAGS, http, start_studio
+from process_cpu import ROLE_ORDER, ProcessCpu, frame_id, machine_busy_s, renderer_roles
 
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
@@ -109,20 +118,33 @@ async function setModel(model) {
   await pose.initialize();
 }
 async function loop() {
-  while (true) {
+  while (window.bench.running) {
     await nextFrame();
-    if (!window.bench.running || video.readyState < 2 || !video.videoWidth) continue;
+    if (!window.bench.running) break;
+    if (video.readyState < 2 || !video.videoWidth) continue;
     const frame = grab();
     window.bench.tag = readStamp(frame);
     await pose.send({ image: frame });
   }
 }
-(async () => {
+// The camera is open only while the page measures, as in the studio page (which opens it when
+// the camera becomes the source and closes it after): neither page decodes frames while the
+// other one runs.
+window.benchStart = async () => {
+  window.bench.times = [];
   video.srcObject = await navigator.mediaDevices.getUserMedia({ video: { width: 640, height: 480 } });
   await video.play();
+  window.bench.running = true;
+  loop();
+};
+window.benchStop = () => {
+  window.bench.running = false;
+  for (const track of video.srcObject ? video.srcObject.getTracks() : []) track.stop();
+  video.srcObject = null;
+};
+(async () => {
   await setModel("lite");
   window.bench.ready = true;
-  loop();
 })();
 </script></body></html>"""
 )
@@ -215,16 +237,47 @@ class SceneWatch:
         return None
 
 
+def total(cpu: dict[str, float]) -> float:
+    """The CPU seconds of every process (the GPU process's threads are already in it)."""
+    return sum(cpu.get(role, 0.0) for role in ROLE_ORDER)
+
+
+@dataclass
+class Window:
+    """One measuring window: its frame rate, and the CPU spent over its measured frames."""
+
+    fps: float
+    frames: int  # results between the two CPU snapshots (after the warm-up)
+    cpu: dict[str, float]  # CPU seconds by role (process_cpu.ROLE_ORDER)
+    seconds: float
+    others: float  # cores the rest of the machine kept busy meanwhile
+
+
 def window(
-    page: Any, start_js: str, stop_js: str, times_js: str, frames: int, timeout_s: float
-) -> float:
-    """Run one measuring window of ``frames`` results (after the warm-up); its frame rate."""
+    page: Any,
+    start_js: str,
+    stop_js: str,
+    times_js: str,
+    frames: int,
+    timeout_s: float,
+    cpu: ProcessCpu,
+) -> Window:
+    """Run one measuring window of ``frames`` results after the warm-up.
+
+    CPU is counted from the warm-up's last result to the window's last, and divided by the
+    results in between.
+    """
     page.evaluate(start_js)
-    need = frames + WARMUP_FRAMES
-    page.wait_for_function(f"() => ({times_js}).length >= {need}", timeout=timeout_s * 1000)
+    count = f"() => ({times_js}).length"
+    page.wait_for_function(f"{count} >= {WARMUP_FRAMES}", timeout=timeout_s * 1000)
+    n0, c0, b0, t0 = page.evaluate(count), cpu.snapshot(), machine_busy_s(), time.perf_counter()
+    page.wait_for_function(f"{count} >= {n0 + frames}", timeout=timeout_s * 1000)
+    n1, c1, b1, t1 = page.evaluate(count), cpu.snapshot(), machine_busy_s(), time.perf_counter()
     times = page.evaluate(f"() => ({times_js}).slice()")
     page.evaluate(stop_js)
-    return rate(times)
+    spent = ProcessCpu.spent(c0, c1)
+    others = max(0.0, (b1 - b0) - total(spent)) / (t1 - t0)
+    return Window(rate(times), n1 - n0, spent, t1 - t0, others)
 
 
 def scene_latencies(
@@ -248,8 +301,9 @@ def scene_latencies(
     return out, missed
 
 
-VISER_SETTLE_S = 0.25
-"""How long viser's page (1.1) keeps redrawing after each update it receives (RENDER_SETTLE_MS)."""
+FRAMES_PER_SLOW_PUSH = 2
+"""Frames viser's page draws for each pose of a slow stream (the update and its settling), the
+studio's frame limit (``studio/web/_scene_frames.py``) in place of viser's quarter-second burst."""
 FED_RATE_HZ = 3.5
 """The lite model's rate in a bare page on an idle 2-core machine with software WebGL."""
 
@@ -278,15 +332,84 @@ def fed_scene_rate(base: str, scene: SceneWatch, seconds: float) -> tuple[float,
     return sent / took, (len(scene.arrivals) - before) / took
 
 
-def bare_window(bare: Any, frames: int, timeout_s: float) -> float:
+def bare_window(bare: Any, frames: int, timeout_s: float, cpu: ProcessCpu) -> Window:
     return window(
         bare,
-        "() => { window.bench.times = []; window.bench.running = true; }",
-        "() => { window.bench.running = false; }",
+        "() => window.benchStart()",
+        "() => window.benchStop()",
         "window.bench.times",
         frames,
         timeout_s,
+        cpu,
     )
+
+
+def page_frames(bare: Any, page: Any) -> dict[str, str]:
+    """``{DevTools frame id: role}`` of the bare page, the studio page and its scene iframe."""
+    scene = page.frame(url=lambda url: url.startswith(page.get_attribute("#scene", "src")))
+    return {
+        frame_id(bare.context, bare): "renderer: bare page",
+        frame_id(page.context, page): "renderer: studio page",
+        frame_id(page.context, scene): "renderer: scene",
+    }
+
+
+def print_rates(results: dict[str, dict[str, list[Window]]]) -> None:
+    print("\nInference frame rate (alternating windows of the same run; a busy machine swings):")
+    for model, sides in results.items():
+        bare = [w.fps for w in sides["bare"]]
+        studio = [w.fps for w in sides["studio"]]
+        b, s = statistics.median(bare), statistics.median(studio)
+        slowdown = 1 - s / b
+        verdict = "meets" if slowdown <= SLOWDOWN_GOAL else "misses"
+        ratios = [st / ba for ba, st in zip(bare, studio, strict=True)]
+        print(
+            f"  {model}: bare package {b:.2f} frames/s, studio page {s:.2f} frames/s: "
+            f"the studio slows inference by {slowdown:+.0%} ({verdict} the goal <= {SLOWDOWN_GOAL:.0%}); "
+            f"studio/bare per pair {', '.join(f'{r:.2f}' for r in ratios)}"
+        )
+    if "lite" in results and "full" in results:
+        lite = statistics.median(w.fps for w in results["lite"]["studio"])
+        full = statistics.median(w.fps for w in results["full"]["studio"])
+        print(f"  lite / full in the studio page: {lite / full:.2f}x")
+
+
+def print_cpu(results: dict[str, dict[str, list[Window]]]) -> None:
+    """CPU seconds per measured frame by process, bare against studio (sums over the windows)."""
+    print("\nCPU seconds per inferred frame, by process (all windows' CPU / all their frames):")
+    for model, sides in results.items():
+        per = {}
+        for side, windows in sides.items():
+            frames = sum(w.frames for w in windows)
+            per[side] = {r: sum(w.cpu.get(r, 0.0) for w in windows) / frames for r in ROLE_ORDER}
+        print(f"  {model:26s} {'bare':>7s} {'studio':>7s} {'studio-bare':>11s}")
+        for role in ROLE_ORDER:
+            b, s = per["bare"][role], per["studio"][role]
+            print(f"    {role:24s} {b:7.3f} {s:7.3f} {s - b:+11.3f}")
+        b, s = sum(per["bare"].values()), sum(per["studio"].values())
+        print(f"    {'total':24s} {b:7.3f} {s:7.3f} {s - b:+11.3f}   studio/bare {s / b:.2f}")
+        gpu = {
+            role
+            for ws in sides.values()
+            for w in ws
+            for role, t in w.cpu.items()
+            if role.startswith("GPU: ") and t > 0.01 * w.frames
+        }
+        for role in sorted(gpu):
+            b, s = (
+                sum(w.cpu.get(role, 0.0) for w in ws) / sum(w.frames for w in ws)
+                for ws in (sides["bare"], sides["studio"])
+            )
+            print(f"      {role:22s} {b:7.3f} {s:7.3f} {s - b:+11.3f}")
+        pairs = [
+            (total(st.cpu) / st.frames) / (total(ba.cpu) / ba.frames)
+            for ba, st in zip(sides["bare"], sides["studio"], strict=True)
+        ]
+        others = [w.others for ws in sides.values() for w in ws]
+        print(
+            f"    total CPU per frame, studio/bare per pair: {', '.join(f'{r:.2f}' for r in pairs)}"
+            f"; other work on the machine {min(others):.1f}-{max(others):.1f} cores"
+        )
 
 
 def main() -> int:
@@ -306,6 +429,7 @@ def main() -> int:
     studio, base = start_studio(tmp / "data")
     probe = ApiProbe(base)
     scene = SceneWatch(http("GET", base + "/api/config")["viser_url"])
+    cpu = ProcessCpu(studio.pid)
     flags = [
         *FLAGS,
         "--use-fake-ui-for-media-stream",
@@ -313,7 +437,7 @@ def main() -> int:
         f"--use-file-for-fake-video-capture={clip}",
     ]
     fed = fed_scene_rate(base, scene, args.fed)
-    results: dict[str, dict[str, list[float]]] = {}
+    results: dict[str, dict[str, list[Window]]] = {}
     latency: dict[str, list[float]] = {"landmarks": [], "scene": [], "answer": []}
     missed = 0
     idle: list[tuple[float, float]] = []  # (start, end) of the bare windows: the studio is still
@@ -333,6 +457,10 @@ def main() -> int:
             page.goto(base + "/")
             page.wait_for_selector("body[data-ready='1']", timeout=120_000)
             page.evaluate(COLLECT_FRAMES_JS)
+            # the bare page idles with its camera closed: a timer shows whose renderer it is
+            bare.evaluate("() => { window.tick = setInterval(() => {}, 50); }")
+            cpu.renderers = renderer_roles(browser, page_frames(bare, page))
+            bare.evaluate("() => clearInterval(window.tick)")
             origin_s = page.evaluate("() => performance.timeOrigin") / 1000
             page.select_option("[data-testid='source-kind']", "camera")  # shows its controls
             http("PUT", base + "/api/source", IDLE_SOURCE)
@@ -347,18 +475,19 @@ def main() -> int:
                         probe.side = side
                         if side == "bare":
                             t0 = time.time()
-                            fps = bare_window(bare, args.frames, args.timeout)
+                            w = bare_window(bare, args.frames, args.timeout, cpu)
                             idle.append((t0, time.time()))
                         else:
                             page.evaluate("() => { window.__frames = []; }")
                             http("PUT", base + "/api/source", {"kind": "camera", "side": "right"})
-                            fps = window(
+                            w = window(
                                 page,
                                 "() => {}",
                                 "() => {}",
                                 "window.__frames.map((f) => f.tResult)",
                                 args.frames,
                                 args.timeout,
+                                cpu,
                             )
                             http("PUT", base + "/api/source", IDLE_SOURCE)
                             frames = page.evaluate("() => window.__frames")[WARMUP_FRAMES:]
@@ -374,29 +503,21 @@ def main() -> int:
                             latency["scene"] += to_scene
                             missed += lost
                             page.wait_for_function("() => !window.studio.camera.running")
-                        results[model][side].append(fps)
-                        print(f"{model:4s} {side:6s} {fps:5.2f} frames/s", flush=True)
+                        results[model][side].append(w)
+                        print(
+                            f"{model:4s} {side:6s} {w.fps:5.2f} frames/s, "
+                            f"{total(w.cpu) / w.frames:.2f} CPU s/frame "
+                            f"(others on the machine: {w.others:.1f} cores)",
+                            flush=True,
+                        )
             browser.close()
     finally:
         probe.stop.set()
         studio.terminate()
         studio.wait(timeout=10)
 
-    print("\nInference frame rate (alternating windows of the same run; a busy machine swings):")
-    for model, sides in results.items():
-        b, s = statistics.median(sides["bare"]), statistics.median(sides["studio"])
-        slowdown = 1 - s / b
-        verdict = "meets" if slowdown <= SLOWDOWN_GOAL else "misses"
-        ratios = [st / ba for ba, st in zip(sides["bare"], sides["studio"], strict=True)]
-        print(
-            f"  {model}: bare package {b:.2f} frames/s, studio page {s:.2f} frames/s: "
-            f"the studio slows inference by {slowdown:+.0%} ({verdict} the goal <= {SLOWDOWN_GOAL:.0%}); "
-            f"studio/bare per pair {', '.join(f'{r:.2f}' for r in ratios)}"
-        )
-    if "lite" in results and "full" in results:
-        lite = statistics.median(results["lite"]["studio"])
-        full = statistics.median(results["full"]["studio"])
-        print(f"  lite / full in the studio page: {lite / full:.2f}x")
+    print_rates(results)
+    print_cpu(results)
     print("\nCamera-to-scene latency while the studio page runs (ms, from the picture's capture):")
     names = {
         "landmarks": "landmarks (the model's result)",
@@ -416,8 +537,8 @@ def main() -> int:
     )
     print(
         f"\nScene pushes for a camera at {fed[0]:.1f} frames/s (landmarks posted, no browser): "
-        f"{fed[1]:.1f} robot poses/s reach the scene; viser's page redraws about "
-        f"{min(1.0, fed[1] * VISER_SETTLE_S):.0%} of the time for them"
+        f"{fed[1]:.1f} robot poses/s reach the scene; viser's page draws about "
+        f"{fed[1] * FRAMES_PER_SLOW_PUSH:.1f} frames/s for them (at most 2 a pose)"
     )
     api_ms = [v * 1000 for v in probe.latencies]
     p99 = pct(api_ms, 99)

@@ -45,6 +45,7 @@ from studio.kinematics import (
 from ._hand_handle import HandHandle
 from ._protocols import HandMoved, LivePose
 from ._robot_view import RobotViews, rgb255, wxyz_of
+from ._scene_frames import FramePacer
 from ._scene_model import Mode, Playback, SceneLayout, playback_time, pose_at, rescheduled
 from ._scene_model import camera_projection as camera_projection
 from ._scene_paths import ScenePaths
@@ -52,6 +53,9 @@ from ._scene_robot import PUMA, SceneRobot
 from ._scene_views import SceneCamera
 
 log = logging.getLogger(__name__)
+
+STREAM_STOPPED_S = 2.0
+"""A live stream with no pose for this long no longer drives the scene (its frames are free)."""
 
 SOFTWARE_WEBGL_NOTICE = "webgl-software-rendering"
 """The id of the notice viser's client raises by itself when WebGL is drawn in software
@@ -161,6 +165,7 @@ class StudioScene(ScenePaths, SceneRobot):
         self._closed = threading.Event()
 
         self._build()
+        self.frames = FramePacer(server)  # viser's page draws less while a slow stream drives it
         self.hand_handle = HandHandle(server)
         self.camera = SceneCamera(server, self.layout)  # presets, following the tool
         self._arms: dict[str, HumanArm] = {}  # the hand guide's arm model per side
@@ -387,7 +392,9 @@ class StudioScene(ScenePaths, SceneRobot):
         with self._lock:
             live, version, playback = self._live, self._live_version, self._playback
             operator, slow = self._operator, self._live_gap >= self.layout.slow_live_s
+            streaming = now - self._live_at < STREAM_STOPPED_S
             view, self._next_view = self._next_view, None
+        self.frames.slow(slow and streaming and playback is None)
         if view is not None:
             with self.server.atomic():
                 self._draw_robot(view)

@@ -4,19 +4,26 @@ viser's page redraws for a quarter of a second after every push. A camera whose 
 at a few frames a second in software WebGL would make the page redraw most of the time, in the
 browser process that also runs the model. So a slow stream's poses are pushed at most
 ``slow_live_rate_hz`` times a second (latest wins), while a fast one (the tape, a camera with a
-GPU, a dragged hand) is pushed as it comes.
+GPU, a dragged hand) is pushed as it comes, and while a slow stream drives the scene viser's
+page is asked to draw fewer frames (``studio/web/_scene_frames.py``).
 """
 
 from __future__ import annotations
 
+import asyncio
+import threading
 import time
 
+import msgspec
 import numpy as np
 import pytest
 import viser
+import websockets
+import zstandard
 
 from studio.kinematics import HumanBody
-from studio.web._scene import SceneLayout, StudioScene
+from studio.web._scene import STREAM_STOPPED_S, SceneLayout, StudioScene
+from studio.web._scene_frames import SLOW_FRAME_GAP_MS
 from tests.conftest import free_port
 from tests.web.conftest import wait_for
 
@@ -65,3 +72,89 @@ def test_a_fast_stream_is_pushed_as_it_comes(scene):
     pushed, took, last = _stream(scene, count=200, gap_s=0.002)
     assert pushed > took * SLOW["slow_live_rate_hz"] + 2, f"{pushed} pushes in {took:.2f} s"
     assert wait_for(lambda: np.allclose(scene.current_q_robot(), last))
+
+
+CAMERA = {
+    "type": "ViewerCameraMessage",
+    "wxyz": (1.0, 0.0, 0.0, 0.0),
+    "position": (3.0, 0.0, 1.5),
+    "fov": 1.0,
+    "near": 0.01,
+    "far": 100.0,
+    "image_height": 480,
+    "image_width": 640,
+    "look_at": (0.0, 0.0, 1.0),
+    "up_direction": (0.0, 0.0, 1.0),
+}
+"""What a browser sends first: viser counts a client as connected from its first camera."""
+
+
+class _ScriptWatch:
+    """A viser client of the scene, in a thread: the scripts (``RunJavascriptMessage``) it gets."""
+
+    def __init__(self, port: int) -> None:
+        self.scripts: list[str] = []
+        self.connected = threading.Event()
+        self.stop = threading.Event()
+        self.thread = threading.Thread(target=lambda: asyncio.run(self._run(port)), daemon=True)
+        self.thread.start()
+        assert self.connected.wait(20), "could not connect to the scene"
+
+    async def _run(self, port: int) -> None:
+        unzip = zstandard.ZstdDecompressor()
+        async with websockets.connect(
+            f"ws://127.0.0.1:{port}",
+            subprotocols=[f"viser-v{viser.__version__}"],
+            max_size=None,
+            origin=f"http://127.0.0.1:{port}",
+        ) as ws:
+            await ws.send(msgspec.msgpack.encode(CAMERA))  # viser counts a client from its camera
+            self.connected.set()
+            while not self.stop.is_set():
+                try:
+                    raw = await asyncio.wait_for(ws.recv(), 0.1)
+                except TimeoutError:
+                    continue
+                except websockets.ConnectionClosed:
+                    return  # the scene stopped
+                size, packed = (int.from_bytes(raw[k : k + 8], "little") for k in (0, 8))
+                inner = unzip.decompress(raw[16 : 16 + packed], max_output_size=size)
+                for m in msgspec.msgpack.decode(inner)["messages"]:
+                    if m.get("type") == "RunJavascriptMessage":
+                        self.scripts.append(m["source"])
+
+    def gap(self) -> float | None:
+        """The frame gap the last script set, or None before any script."""
+        return (
+            float(self.scripts[-1].split("p.gapMs = ")[1].split(";")[0]) if self.scripts else None
+        )
+
+
+def test_a_slow_stream_limits_the_browsers_frames_and_a_fast_one_lifts_the_limit():
+    """While a slow stream drives the scene, every browser showing it (and one that connects
+    then) is asked to draw a frame at most every SLOW_FRAME_GAP_MS; a fast stream, or the slow
+    one stopping, lifts the limit."""
+    port = free_port()
+    server = viser.ViserServer(host="127.0.0.1", port=port, verbose=False)
+    sc = StudioScene(server, body=HumanBody("right"), layout=SceneLayout(**SLOW))
+    early = _ScriptWatch(port)
+    try:
+        _stream(sc, count=200, gap_s=0.002)
+        assert wait_for(lambda: early.gap() in (None, 0.0)), "a fast stream draws freely"
+        slow = threading.Thread(target=_stream, args=(sc, 60, 0.06))  # 3.6 s of a slow stream
+        slow.start()
+        assert wait_for(lambda: early.gap() == SLOW_FRAME_GAP_MS), early.scripts[-1:]
+        late = _ScriptWatch(port)  # connects while the slow stream drives the scene
+        assert wait_for(lambda: late.gap() == SLOW_FRAME_GAP_MS)
+        slow.join()
+        _stream(sc, count=200, gap_s=0.002)
+        assert wait_for(lambda: early.gap() == 0.0 and late.gap() == 0.0)
+        _stream(sc, count=12, gap_s=0.06)
+        assert wait_for(lambda: early.gap() == SLOW_FRAME_GAP_MS)
+        # the slow stream stops: its last pose stays, the frames are free again
+        assert wait_for(lambda: early.gap() == 0.0, timeout=STREAM_STOPPED_S + 5)
+        late.stop.set()
+    finally:
+        early.stop.set()
+        sc.close()
+        server.stop()

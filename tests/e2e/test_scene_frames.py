@@ -1,0 +1,118 @@
+"""viser's page draws fewer frames while a slow live stream drives the scene, and still shows it.
+
+``studio/web/_scene_frames.py`` wraps the page's ``requestAnimationFrame`` so that frames start
+at least ``SLOW_FRAME_GAP_MS`` apart while a slow stream (pose estimation without a GPU) drives
+the scene. These tests run the wrapper in Chromium: alone (it delays frames and never drops one,
+and a cancelled request never runs), and in viser's own page beside a real scene (each pose is
+drawn, in a few frames instead of a burst, and a fast stream lifts the limit).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import time
+from collections.abc import Iterator
+from typing import Any
+
+import numpy as np
+import pytest
+import viser
+
+from studio.kinematics import HumanBody
+from studio.web._scene import SceneLayout, StudioScene
+from studio.web._scene_frames import SLOW_FRAME_GAP_MS, pacing_js
+from tests.conftest import free_port
+from tests.web.conftest import wait_for
+
+FRAMES_JS = """(n) => new Promise((resolve) => {
+  const times = [];
+  const step = (t) => { times.push(performance.now()); if (times.length < n) requestAnimationFrame(step); else resolve(times); };
+  requestAnimationFrame(step);
+})"""
+"""A chain of ``n`` frames, each requested from the one before (as three.js does): their times."""
+
+
+@pytest.fixture
+def blank(browser: Any) -> Iterator[Any]:
+    page = browser.new_page()
+    page.set_content("<!doctype html><title>frames</title><p>frames</p>")
+    yield page
+    page.close()
+
+
+def test_the_limit_delays_frames_and_never_drops_one(blank: Any) -> None:
+    blank.evaluate(f"() => {{ {pacing_js(SLOW_FRAME_GAP_MS)} }}")
+    times = blank.evaluate(FRAMES_JS, 4)
+    assert len(times) == 4, "every requested frame runs"
+    gaps = np.diff(times)
+    assert np.all(gaps >= SLOW_FRAME_GAP_MS - 5), f"frames {gaps} ms apart"
+    assert blank.evaluate("() => window.__studioFramePacing.frames") >= 4
+
+
+def test_a_cancelled_frame_never_runs_and_no_limit_passes_frames_through(blank: Any) -> None:
+    blank.evaluate(f"() => {{ {pacing_js(SLOW_FRAME_GAP_MS)} }}")
+    blank.evaluate(FRAMES_JS, 1)  # a frame just ran: the next request waits for its turn
+    ran = blank.evaluate(
+        """(gap) => new Promise((resolve) => {
+          let ran = false;
+          const id = requestAnimationFrame(() => { ran = true; });
+          cancelAnimationFrame(id);
+          setTimeout(() => resolve(ran), 2 * gap);
+        })""",
+        SLOW_FRAME_GAP_MS,
+    )
+    assert ran is False
+    blank.evaluate(f"() => {{ {pacing_js(0)} }}")  # the same page, the limit lifted
+    assert len(blank.evaluate(FRAMES_JS, 5)) == 5
+
+
+@pytest.fixture
+def scene_page(browser: Any) -> Iterator[tuple[StudioScene, Any]]:
+    port = free_port()
+    server = viser.ViserServer(host="127.0.0.1", port=port, verbose=False)
+    scene = StudioScene(server, body=HumanBody("right"), layout=SceneLayout())
+    page = browser.new_page(viewport={"width": 990, "height": 586})
+    page.goto(f"http://127.0.0.1:{port}/?fixedDpr=0.5")
+    page.wait_for_selector("canvas", timeout=60_000)
+    try:
+        yield scene, page
+    finally:
+        page.close()
+        scene.close()
+        server.stop()
+
+
+def _pose(scene: StudioScene, k: int) -> None:
+    """A live pose that differs visibly for each ``k``."""
+    q_robot = scene.robot.qz + np.array([0.3 * k, 0.2, -0.2 * k, 0.0, 0.1 * k, 0.0])
+    scene.update_live(np.array([0.1 * k, 0.3, 0.0, 0.5 + 0.1 * k, 0.0, 0.0, 0.0]), q_robot, None)
+
+
+def _pacing(page: Any) -> dict[str, float] | None:
+    return page.evaluate(
+        "() => window.__studioFramePacing && "
+        "({ gap: window.__studioFramePacing.gapMs, frames: window.__studioFramePacing.frames })"
+    )
+
+
+def test_a_slow_stream_is_drawn_in_few_frames_each_pose_shown(scene_page) -> None:
+    """One pose a second (the camera without a GPU): each pose reaches the picture, in a few
+    frames (the update, its settling, viser's idle frame once a second) rather than a burst."""
+    scene, page = scene_page
+    pictures, frames = [], []
+    for k in range(6):
+        _pose(scene, k)
+        time.sleep(1.0)
+        if k == 0:
+            assert wait_for(lambda: (_pacing(page) or {}).get("gap") == SLOW_FRAME_GAP_MS)
+            start = _pacing(page)["frames"]
+        frames.append(_pacing(page)["frames"])
+        pictures.append(hashlib.sha256(page.screenshot()).hexdigest())
+    assert len(set(pictures)) == len(pictures), "every pose shows in the scene"
+    per_pose = (frames[-1] - start) / (len(frames) - 1)
+    assert per_pose <= 4, f"{per_pose:.1f} frames a pose"
+    # a fast stream (the tape, a camera with a GPU) lifts the limit
+    for k in range(200):
+        _pose(scene, k % 7)
+        time.sleep(0.005)
+    assert wait_for(lambda: _pacing(page)["gap"] == 0)
