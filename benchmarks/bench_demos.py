@@ -132,6 +132,11 @@ def pair(joints, shaping, episodes, k, context=None):
     steps_without, success_without = without(joints, shaping, episodes, k)
     first_with = int(steps_with[DEMOS : DEMOS + FIRST_OWN].sum())
     first_without = int(steps_without[:FIRST_OWN].sum())
+    print(
+        f"    pair {k}: first {FIRST_OWN} {first_with} / {first_without}, success "
+        f"{success_with:.3f} / {success_without:.3f}",
+        flush=True,
+    )
     return first_with, first_without, success_with, success_without
 
 
@@ -187,6 +192,7 @@ def main() -> None:
         for k in pairs:
             demos = demonstrations(ArmReach(joints=j), k)
             success.append(one_run(j, 0.0, args.long, k, demos)[1])
+            print(f"    pair {k}: {success[-1]:.3f}", flush=True)
         print(
             f"\nshaping 0, with demonstrations, {args.long} episodes: success {interval(success)}"
         )

@@ -95,9 +95,12 @@ MAX_SHAPING = 100.0
 ACTION_SETS = ("single", "pairs", "all")
 """What one action may move: one joint (2J actions), one joint or two together (2J**2), or any
 joints at once (3**J - 1); each set begins with the one before it, in the same order."""
-DEFAULT_ACTIONS = "single"
-"""One joint per action: it learns in fewer real steps than the multi-joint sets (package README;
-``benchmarks/bench_actions.py``)."""
+DEFAULT_ACTIONS = "pairs"
+"""One joint or two together per action, learned with a factored action value
+(:mod:`._factored`): measured, it learns in fewer real steps than one joint per action and moves
+joints together (package README; ``benchmarks/bench_actions.py``)."""
+STORED_ACTIONS = "single"
+"""What a task stored before ``actions`` existed moves: one joint per action."""
 LIMIT_SLACK_RAD = 1e-9
 """A demonstration may touch its joint limits within this rounding."""
 
@@ -252,7 +255,8 @@ class ArmReach:
     def from_dict(cls, data: dict) -> ArmReach:
         """Settings from :meth:`to_dict`'s form (one written before ``actions`` existed moves one
         joint per action)."""
-        return cls(**{**data, "goal": None if data.get("goal") is None else tuple(data["goal"])})
+        goal = None if data.get("goal") is None else tuple(data["goal"])
+        return cls(**{"actions": STORED_ACTIONS, **data, "goal": goal})
 
     def features(
         self, tilings: int = DEFAULT_TILINGS, tiles: int = DEFAULT_TILES, size: int | None = None
