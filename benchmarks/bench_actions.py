@@ -68,6 +68,11 @@ VARIANTS = (
 """(action set, factored value): one joint per action has one column per action either way."""
 
 
+def name(actions: str, factored: bool) -> str:
+    """A variant's name on the command line: the action set, ``+factored`` when factored."""
+    return actions + ("+factored" if factored else "")
+
+
 @contextmanager
 def columns_per_action(factored: bool):
     """Learn a multi-joint set with one weight column per action (``factored=False``)."""
@@ -183,6 +188,13 @@ def main() -> None:
     parser.add_argument("--quick", action="store_true", help="two budgets, one experiment")
     parser.add_argument("--experiments", type=int, default=2)
     parser.add_argument("--joints", type=int, nargs="*", default=[3, 6])
+    parser.add_argument(
+        "--variants",
+        nargs="*",
+        default=[name(a, f) for a, f in VARIANTS],
+        choices=[name(a, f) for a, f in VARIANTS],
+        help="which rows to measure (default: all)",
+    )
     parser.add_argument("--speed", action="store_true", help="only the learner's speed")
     args = parser.parse_args()
     if args.speed:
@@ -203,6 +215,8 @@ def main() -> None:
     print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     for joints in args.joints:
         for actions, factored in VARIANTS:
+            if name(actions, factored) not in args.variants:
+                continue
             r = one(joints, actions, factored, budgets[joints], experiments)
             print(row(r), flush=True)
     print()

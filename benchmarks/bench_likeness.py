@@ -23,18 +23,23 @@ each ``studio/samples/sample-reach-*.demo.json``:
    :data:`LEARN_EPISODES` episodes, one experiment per seed in :data:`LEARN_SEEDS`), rolled out
    from the demonstration's start and scored on the likeness card. Goals: DTW <= 0.05 rad per
    sample on all six joints, LDLJ within 20% of the demonstration's. For comparison: the same
-   with one joint per action (the earlier default).
+   with one joint per action (the earlier default), and (``--path-potential``) with the
+   demonstrations' potential over the whole demonstrated path (kappa 2, weight 5 on top of the
+   task's shaping; :mod:`studio.learning._demo_shaping`), which pulls the greedy path along the
+   demonstration rather than only to its end.
 """
 
 from __future__ import annotations
 
 import argparse
+import functools
 import time
 from pathlib import Path
 
 import gymnasium
 import numpy as np
 
+import studio.learning._linear as linear
 from studio.capture import load_demonstration
 from studio.learning import (
     DMP_BASIS,
@@ -145,6 +150,15 @@ def timing(path: Path) -> None:
     )
 
 
+def path_potential() -> None:
+    """Every later run: the demonstrations' potential along their whole path (kappa 2), weight 5
+    beyond the task's own shaping."""
+    from studio.learning._demo_shaping import demo_potential
+
+    shaping = ArmReach().shaping
+    linear.demo_potential = functools.partial(demo_potential, weight=5.0 + shaping, kappa=2.0)
+
+
 def learned(path: Path, actions: str | None) -> tuple[int, int]:
     """The learned policy's card figures against one sample; returns (seeds meeting both goals, seeds)."""
     demo = load_demonstration(path)
@@ -182,14 +196,20 @@ def learned(path: Path, actions: str | None) -> tuple[int, int]:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--learned", action="store_true", help="only the learned policies (5)")
+    parser.add_argument(
+        "--path-potential", action="store_true", help="(5) with the potential along the path"
+    )
     args = parser.parse_args()
-    if args.learned:
+    if args.path_potential:
+        path_potential()
+        print("with the demonstrations' potential along the whole path (kappa 2, weight 5)")
+    if args.learned or args.path_potential:
         print(
             f"learned policies: {LEARN_EPISODES} episodes, one demonstration, from its start; "
             f"goals DTW <= {GOAL_POLICY_DTW_RAD} rad/sample (six joints), LDLJ within "
             f"{GOAL_LDLJ_SHARE:.0%} of the demonstration's"
         )
-        for actions in (None, "single"):
+        for actions in (None,) if args.path_potential else (None, "single"):
             met = [learned(path, actions) for path in SAMPLES]
             print(f"  met for {sum(m for m, _ in met)}/{sum(n for _, n in met)} policies\n")
         return
