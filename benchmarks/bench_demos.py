@@ -160,6 +160,7 @@ def report(name, rows):
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--pairs", type=int, default=6)
+    parser.add_argument("--first", type=int, default=0, help="the first pair's seed")
     parser.add_argument("--episodes", type=int, default=1000)
     parser.add_argument("--joints", type=int, default=6)
     parser.add_argument("--variants", action="store_true", help="also the potential's variants")
@@ -175,7 +176,7 @@ def main() -> None:
         "--long", type=int, default=0, help="also greedy success with demonstrations after N"
     )
     args = parser.parse_args()
-    j, n, pairs = args.joints, args.episodes, range(args.pairs)
+    j, n, pairs = args.joints, args.episodes, range(args.first, args.first + args.pairs)
     print(f"{j} joints, {n} episodes (demonstrations counted), {DEMOS} demonstrations, cap {CAP}")
     t0 = time.perf_counter()
     if "paper" in args.sections:

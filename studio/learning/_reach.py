@@ -1,9 +1,9 @@
 """The continuous arm task: joints 1..J of the Puma560 reach a demonstrated pose, step by step.
 
 The state is the first ``joints`` joint angles (radians, inside the robot's limits); the other
-joints stay at the goal's values. By default (``actions="single"``) an action moves ONE joint by
-``step_deg`` (2J actions: joint 1 up, joint 1 down, joint 2 up, ...); ``actions="pairs"`` adds
-every two joints moving together, each up or down (the diagonals, 2J**2 actions), and
+joints stay at the goal's values. With ``actions="single"`` an action moves ONE joint by
+``step_deg`` (2J actions: joint 1 up, joint 1 down, joint 2 up, ...); ``actions="pairs"`` (the
+default) adds every two joints moving together, each up or down (the diagonals, 2J**2 actions), and
 ``actions="all"`` every joint -1/0/+1 at once (3**J - 1 actions); see :data:`ACTION_SETS` and
 :func:`action_directions`. A joint whose move would leave its limits stays where it is, as on
 the paper's grid (the action's other joints still move). Reaching the goal pays :data:`GOAL_REWARD` and ends the
@@ -11,13 +11,13 @@ episode, every other step pays :data:`STEP_REWARD` (the paper's rewards), plus a
 shaping term (:data:`DEFAULT_SHAPING`). Episodes start uniformly across the limits (a start already
 at the goal is redrawn).
 
-Why one joint at a time is the default rather than every joint -1/0/+1 at once (3**J - 1
-actions, 728 for six joints) or the pairs (measured in ``benchmarks/bench_actions.py``): a linear learner evaluates every action at every step and learns each action's weights
-from its own visits, so 12 actions cost 60x less per step and each gets 60x more data; and with one
-joint per action the steps to the goal are a sum of per-joint distances, which per-joint tilings
-represent (:meth:`ArmReach.features`; :data:`DEFAULT_SHAPING` says why the shaping weight matters).
-The price is longer paths (the sum of the joints' distances
-instead of the largest). There is no "stay" action: it never helps a reach, and with function
+Why one or two joints per action is the default (measured in ``benchmarks/bench_actions.py``):
+with one weight column per action, each multi-joint move learned only from its own visits and
+the multi-joint sets learned far worse than one joint per action; the learner's factored action
+value (:mod:`._factored`) shares what each joint's part of a move learned among every move that
+has it, and with it the pairs learn in fewer real steps than single joints and move joints
+together. Every joint -1/0/+1 at once (3**J - 1 actions, 728 for six joints) overshoots near the
+goal even so. There is no "stay" action: it never helps a reach, and with function
 approximation its estimate can stick above the moves' and freeze the arm.
 
 The goal is judged where a user sees it: the tool (Puma560 DH frame 6) within
