@@ -1,9 +1,12 @@
 """Which action set of the continuous arm task learns and looks better: one joint per action,
-also two joints together (the diagonals), or any joints at once.
+also two joints together (the diagonals), or any joints at once; and for the multi-joint sets,
+one weight column per action against the factored action value (``studio.learning._factored``:
+a per-joint term for each joint's part of the move, each learning from its joint's share of the
+reward).
 
-``python benchmarks/bench_actions.py [--quick]`` (a few minutes on one free core). For 3 and 6
-joints and each of :data:`studio.learning.ACTION_SETS`, with the environment's default reward
-(shaping 5), zero planning and the default per-joint tilings:
+``python benchmarks/bench_actions.py [--quick]`` (several minutes on one free core). For 3 and 6
+joints and each variant of :data:`VARIANTS`, with the environment's default reward (shaping 5),
+zero planning and the default per-joint tilings:
 
 - learning: each budget of episodes is trained afresh (same seeds, so a budget's run is a prefix
   of the next one's), and its greedy policy is judged from 200 held-out random starts; the table
@@ -29,10 +32,12 @@ from __future__ import annotations
 
 import argparse
 import functools
+from contextlib import contextmanager
 
 import gymnasium
 import numpy as np
 
+import studio.learning._linear as linear
 from studio.learning import (
     ACTION_SETS,
     ArmReach,
@@ -53,6 +58,31 @@ SUCCESS = 0.95
 CAP = 3_000
 BUDGETS = {3: (250, 500, 1000, 2000, 4000), 6: (500, 1000, 2000, 4000)}
 QUICK_BUDGETS = {3: (250, 1000), 6: (500, 2000)}
+VARIANTS = (
+    ("single", False),
+    ("pairs", False),
+    ("pairs", True),
+    ("all", False),
+    ("all", True),
+)
+"""(action set, factored value): one joint per action has one column per action either way."""
+
+
+def name(actions: str, factored: bool) -> str:
+    """A variant's name on the command line: the action set, ``+factored`` when factored."""
+    return actions + ("+factored" if factored else "")
+
+
+@contextmanager
+def columns_per_action(factored: bool):
+    """Learn a multi-joint set with one weight column per action (``factored=False``)."""
+    original = linear.value_factors
+    if not factored:
+        linear.value_factors = lambda *args: None
+    try:
+        yield
+    finally:
+        linear.value_factors = original
 
 
 def straight_line(task: ArmReach, start: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -67,7 +97,12 @@ def straight_line(task: ArmReach, start: np.ndarray) -> tuple[np.ndarray, np.nda
     return tau * 1.875 * peak, q
 
 
-def one(joints: int, actions: str, budgets: tuple[int, ...], experiments: int) -> dict:
+def one(joints: int, actions: str, factored: bool, budgets, experiments: int) -> dict:
+    with columns_per_action(factored):
+        return _one(joints, actions, factored, budgets, experiments)
+
+
+def _one(joints: int, actions: str, factored: bool, budgets, experiments: int) -> dict:
     task = ArmReach(joints=joints, actions=actions)
     rng = np.random.default_rng([7, joints])
     starts = np.array([task.random_start(rng) for _ in range(STARTS)])
@@ -77,6 +112,7 @@ def one(joints: int, actions: str, budgets: tuple[int, ...], experiments: int) -
     reached = None
     result = None
     success = 0.0
+    first = 0.0
     for n in budgets:
         result = run_experiments(
             make, config, experiments, n, SEED, features=task.features(), workers=1
@@ -86,6 +122,7 @@ def one(joints: int, actions: str, budgets: tuple[int, ...], experiments: int) -
                 [greedy_success(task, result.coder, w, starts, CAP).mean() for w in result.weights]
             )
         )
+        first = float(result.steps[:, :20].sum() / experiments)
         if reached is None and success >= SUCCESS:
             reached = (n, result.steps.sum() / experiments, float(np.mean(result.cpu_seconds)))
     assert result is not None
@@ -100,8 +137,9 @@ def one(joints: int, actions: str, budgets: tuple[int, ...], experiments: int) -
                 cards.append(policy_likeness_card(policy, times, q))
     return {
         "joints": joints,
-        "actions": actions,
+        "actions": actions + (" factored" if factored and actions != "single" else ""),
         "n_actions": task.n_actions,
+        "first": first,
         "reached": reached,
         "final": success,
         "last_budget": budgets[-1],
@@ -133,12 +171,13 @@ def speed() -> None:
 
 def row(r: dict) -> str:
     if r["reached"] is None:
-        learn = f"not in {r['last_budget']:,} episodes | - | -"
+        learn = "not reached | - | -"
     else:
         n, steps, cpu = r["reached"]
         learn = f"{n:,} episodes | {steps / 1e3:,.0f} k | {cpu:.2f} s"
     return (
-        f"| {r['joints']} | {r['actions']} ({r['n_actions']}) | {learn} | {100 * r['final']:.0f}% "
+        f"| {r['joints']} | {r['actions']} ({r['n_actions']}) | {r['first']:,.0f} | {learn} "
+        f"| {100 * r['final']:.0f}% "
         f"| {r['ldlj']:.2f} ({r['line_ldlj']:.2f}) | {r['js']:.3f} | {100 * r['together']:.0f}% "
         f"| {r['dtw']:.3f} | {r['duration']:.1f} ({r['line_duration']:.1f}) | {r['looked']} |"
     )
@@ -148,6 +187,14 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="two budgets, one experiment")
     parser.add_argument("--experiments", type=int, default=2)
+    parser.add_argument("--joints", type=int, nargs="*", default=[3, 6])
+    parser.add_argument(
+        "--variants",
+        nargs="*",
+        default=[name(a, f) for a, f in VARIANTS],
+        choices=[name(a, f) for a, f in VARIANTS],
+        help="which rows to measure (default: all)",
+    )
     parser.add_argument("--speed", action="store_true", help="only the learner's speed")
     args = parser.parse_args()
     if args.speed:
@@ -161,14 +208,17 @@ def main() -> None:
         "policy against the straight joint line (its value in brackets)\n"
     )
     print(
-        f"| joints | actions (n) | first budget at {SUCCESS:.0%} | real steps | CPU | success at "
-        "the last budget | LDLJ (line) | shares JS | joints together | DTW rad/sample "
-        "| duration s (line) | rollouts reaching |"
+        f"| joints | actions (n) | first 20 episodes' real steps | first budget at {SUCCESS:.0%} "
+        "| real steps | CPU | success at the last budget | LDLJ (line) | shares JS "
+        "| joints together | DTW rad/sample | duration s (line) | rollouts reaching |"
     )
-    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
-    for joints in (3, 6):
-        for actions in ACTION_SETS:
-            print(row(one(joints, actions, budgets[joints], experiments)), flush=True)
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+    for joints in args.joints:
+        for actions, factored in VARIANTS:
+            if name(actions, factored) not in args.variants:
+                continue
+            r = one(joints, actions, factored, budgets[joints], experiments)
+            print(row(r), flush=True)
     print()
     speed()
 

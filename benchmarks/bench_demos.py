@@ -44,6 +44,7 @@ CAP = 3_000
 DEMOS = 3
 STARTS = 200
 FIRST_OWN = 20
+SECTIONS = ("paper", "other-goal", "default", "long")
 
 
 def interval(values: np.ndarray) -> str:
@@ -132,6 +133,11 @@ def pair(joints, shaping, episodes, k, context=None):
     steps_without, success_without = without(joints, shaping, episodes, k)
     first_with = int(steps_with[DEMOS : DEMOS + FIRST_OWN].sum())
     first_without = int(steps_without[:FIRST_OWN].sum())
+    print(
+        f"    pair {k}: first {FIRST_OWN} {first_with} / {first_without}, success "
+        f"{success_with:.3f} / {success_without:.3f}",
+        flush=True,
+    )
     return first_with, first_without, success_with, success_without
 
 
@@ -154,24 +160,34 @@ def report(name, rows):
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--pairs", type=int, default=6)
+    parser.add_argument("--first", type=int, default=0, help="the first pair's seed")
     parser.add_argument("--episodes", type=int, default=1000)
     parser.add_argument("--joints", type=int, default=6)
     parser.add_argument("--variants", action="store_true", help="also the potential's variants")
     parser.add_argument("--skip-controls", action="store_true")
     parser.add_argument(
+        "--sections",
+        nargs="*",
+        choices=SECTIONS,
+        default=list(SECTIONS),
+        help="which figures to measure (default: all; lets several processes share a run)",
+    )
+    parser.add_argument(
         "--long", type=int, default=0, help="also greedy success with demonstrations after N"
     )
     args = parser.parse_args()
-    j, n, pairs = args.joints, args.episodes, range(args.pairs)
+    j, n, pairs = args.joints, args.episodes, range(args.first, args.first + args.pairs)
     print(f"{j} joints, {n} episodes (demonstrations counted), {DEMOS} demonstrations, cap {CAP}")
     t0 = time.perf_counter()
-    report("paper's reward (shaping 0), the default method", [pair(j, 0.0, n, k) for k in pairs])
+    if "paper" in args.sections:
+        rows = [pair(j, 0.0, n, k) for k in pairs]
+        report("paper's reward (shaping 0), the default method", rows)
     if args.variants:
         for weight, kappa in ((0.0, None), (1.0, None), (5.0, 2.0), (10.0, None)):
             ctx = functools.partial(potential_variant, weight, kappa)
             rows = [pair(j, 0.0, n, k, ctx) for k in pairs]
             report(f"shaping 0, potential weight {weight}, kappa {kappa or 'default'}", rows)
-    if not args.skip_controls:
+    if not args.skip_controls and "other-goal" in args.sections:
         rows = []
         for k in pairs:
             other = ArmReach(
@@ -181,12 +197,14 @@ def main() -> None:
             ctx = functools.partial(demonstrations_for, other)
             rows.append(pair_other(j, n, k, other, ctx))
         report("control: shaping 0, demonstrations to a different goal", rows)
+    if not args.skip_controls and "default" in args.sections:
         report("control: default shaping", [pair(j, ArmReach().shaping, n, k) for k in pairs])
-    if args.long:
+    if args.long and "long" in args.sections:
         success = []
         for k in pairs:
             demos = demonstrations(ArmReach(joints=j), k)
             success.append(one_run(j, 0.0, args.long, k, demos)[1])
+            print(f"    pair {k}: {success[-1]:.3f}", flush=True)
         print(
             f"\nshaping 0, with demonstrations, {args.long} episodes: success {interval(success)}"
         )

@@ -17,27 +17,46 @@ each ``studio/samples/sample-reach-*.demo.json``:
    rolled to the demonstration's goal: how many arrive, their LDLJ and their duration.
 4. CPU time of one fit + rollout against the straight line's, interleaved, median of 5 (the
    machine is shared: treat the times as rough).
+5. The learned policy (``--learned``, a few minutes): the continuous task with its defaults
+   (six joints, the default action set and shaping, the default features), its goal the
+   demonstration's last pose, trained on that one demonstration (zero planning,
+   :data:`LEARN_EPISODES` episodes, one experiment per seed in :data:`LEARN_SEEDS`), rolled out
+   from the demonstration's start and scored on the likeness card. Goals: DTW <= 0.05 rad per
+   sample on all six joints, LDLJ within 20% of the demonstration's. For comparison: the same
+   with one joint per action (the earlier default), and (``--path-potential``) with the
+   demonstrations' potential over the whole demonstrated path (kappa 2, weight 5 on top of the
+   task's shaping; :mod:`studio.learning._demo_shaping`), which pulls the greedy path along the
+   demonstration rather than only to its end.
 """
 
 from __future__ import annotations
 
+import argparse
+import functools
 import time
 from pathlib import Path
 
+import gymnasium
 import numpy as np
 
+import studio.learning._linear as linear
 from studio.capture import load_demonstration
 from studio.learning import (
     DMP_BASIS,
+    ArmReach,
+    DynaQConfig,
+    TilePolicyFile,
     dmp_likeness_card,
     dtw_distance,
     fit_dmp_policy,
     fit_movement_primitive,
     frechet_distance,
     ldlj,
+    policy_likeness_card,
     puma_tool_positions,
     roll_out_primitive,
     rollout_dmp_policy,
+    run_experiments,
 )
 
 SAMPLES = sorted((Path(__file__).resolve().parents[1] / "studio" / "samples").glob("*.demo.json"))
@@ -45,6 +64,11 @@ GOAL_DTW_RAD = 0.02
 NEW_STARTS = 20
 START_SPREAD_RAD = 0.5
 REPEATS = 5
+GOAL_POLICY_DTW_RAD = 0.05
+GOAL_LDLJ_SHARE = 0.2
+LEARN_EPISODES = 1000
+LEARN_SEEDS = (0, 1, 2)
+CAP = 3_000
 
 
 def straight(times: np.ndarray, q: np.ndarray, min_jerk: bool) -> np.ndarray:
@@ -126,7 +150,69 @@ def timing(path: Path) -> None:
     )
 
 
+def path_potential() -> None:
+    """Every later run: the demonstrations' potential along their whole path (kappa 2), weight 5
+    beyond the task's own shaping."""
+    from studio.learning._demo_shaping import demo_potential
+
+    shaping = ArmReach().shaping
+    linear.demo_potential = functools.partial(demo_potential, weight=5.0 + shaping, kappa=2.0)
+
+
+def learned(path: Path, actions: str | None) -> tuple[int, int]:
+    """The learned policy's card figures against one sample; returns (seeds meeting both goals, seeds)."""
+    demo = load_demonstration(path)
+    settings = {} if actions is None else {"actions": actions}
+    task = ArmReach(goal=tuple(demo.q_robot[-1]), **settings)
+    config = DynaQConfig(planning="zero", max_steps_per_episode=CAP)
+    make = lambda: gymnasium.make(  # noqa: E731
+        "TeachStudio/ArmReach-v0", goal=task.goal, **settings
+    )
+    met = 0
+    label = task.actions + (" (the default)" if actions is None else "")
+    for seed in LEARN_SEEDS:
+        result = run_experiments(
+            make, config, 1, LEARN_EPISODES, seed, [demo.q_robot], task.features(), workers=1
+        )
+        policy = TilePolicyFile(
+            coder=result.coder, weights=result.weights[0], config=config, task=task
+        )
+        card = policy_likeness_card(policy, demo.times, demo.q_robot)
+        share = abs(card.policy.ldlj - card.demonstration.ldlj) / abs(card.demonstration.ldlj)
+        ok = card.dtw_rad <= GOAL_POLICY_DTW_RAD and share <= GOAL_LDLJ_SHARE
+        met += ok
+        print(
+            f"  {path.name} {label:<16} seed {seed}: DTW {card.dtw_rad:.3f} rad/sample, "
+            f"LDLJ {card.policy.ldlj:.2f} (demonstration {card.demonstration.ldlj:.2f}, "
+            f"{100 * share:.0f}% off), together {100 * card.policy.together:.0f}% "
+            f"(demonstration {100 * card.demonstration.together:.0f}%), duration "
+            f"{card.policy.duration_s:.1f} s ({card.demonstration.duration_s:.1f} s): "
+            f"{'both goals met' if ok else 'goal missed'}",
+            flush=True,
+        )
+    return met, len(LEARN_SEEDS)
+
+
 def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--learned", action="store_true", help="only the learned policies (5)")
+    parser.add_argument(
+        "--path-potential", action="store_true", help="(5) with the potential along the path"
+    )
+    args = parser.parse_args()
+    if args.path_potential:
+        path_potential()
+        print("with the demonstrations' potential along the whole path (kappa 2, weight 5)")
+    if args.learned or args.path_potential:
+        print(
+            f"learned policies: {LEARN_EPISODES} episodes, one demonstration, from its start; "
+            f"goals DTW <= {GOAL_POLICY_DTW_RAD} rad/sample (six joints), LDLJ within "
+            f"{GOAL_LDLJ_SHARE:.0%} of the demonstration's"
+        )
+        for actions in (None,) if args.path_potential else (None, "single"):
+            met = [learned(path, actions) for path in SAMPLES]
+            print(f"  met for {sum(m for m, _ in met)}/{sum(n for _, n in met)} policies\n")
+        return
     fit_movement_primitive(np.arange(3.0), np.zeros((3, 1)))  # compile nothing, warm numpy
     dtw_distance(np.zeros((2, 1)), np.zeros((2, 1)))  # compile the numba kernels once
     frechet_distance(np.zeros((2, 1)), np.zeros((2, 1)))

@@ -108,11 +108,11 @@ def demo_potential(
 
 
 @njit(nogil=True, cache=True, inline="always")
-def potential(pot, obs):
-    """``phi(obs)`` (0 for the empty potential)."""
-    if pot.points.shape[0] == 0:
-        return 0.0
+def nearest(pot, obs):
+    """``(i, min_i (kappa |obs - p_i|_1 / step + togo_i))``: the demonstrated state that sets
+    ``phi(obs)`` (the first on ties) and its cost (needs at least one point)."""
     best = np.inf
+    at = 0
     for i in range(pot.points.shape[0]):
         d = 0.0
         for j in range(obs.shape[0]):
@@ -120,7 +120,16 @@ def potential(pot, obs):
         v = pot.kappa * d * pot.inv_step + pot.togo[i]
         if v < best:
             best = v
-    return -pot.weight * best
+            at = i
+    return at, best
+
+
+@njit(nogil=True, cache=True, inline="always")
+def potential(pot, obs):
+    """``phi(obs)`` (0 for the empty potential)."""
+    if pot.points.shape[0] == 0:
+        return 0.0
+    return -pot.weight * nearest(pot, obs)[1]
 
 
 @njit(nogil=True, cache=True, inline="always")

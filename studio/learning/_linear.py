@@ -62,8 +62,21 @@ import numpy as np
 from numba import njit
 
 from ._config import MAX_Q_ENTRIES, DynaQConfig
-from ._demo_shaping import demo_potential, potential, shaped
+from ._demo_shaping import demo_potential, no_potential, potential, shaped
 from ._errors import LearningError
+from ._factored import (
+    FACTORED_ACTION_SETS,
+    action_components,
+    column_sums,
+    expand,
+    factored_add,
+    factored_values,
+    no_components,
+    reward_split,
+    row_joints,
+    slot_joints,
+    split_reward,
+)
 from ._learner import (
     GOLDEN,
     PLANNER_CODE,
@@ -105,9 +118,14 @@ Agent = namedtuple(
     "Agent",
     "w spec gamma step planner threshold "
     "model_obs model_next model_action model_reward model_terminal model_stamp model_follows "
-    "heap_idx heap_pri heap_pos counters feats feats_next plan_s plan_next qvals",
+    "heap_idx heap_pri heap_pos counters feats feats_next plan_s plan_next qvals comp slots sums split pot deltas",
 )
 """The learner's arrays and settings as one numba-friendly value (see :func:`_new_agent`).
+
+``comp`` ``(actions, J)``: each action's weight column per joint when the value is factored
+(:mod:`._factored`), ``(actions, 0)`` for one column per action; ``slots`` the joint each active
+feature slot feeds, ``split`` and ``pot`` what splits a reward among the joints, ``sums`` and
+``deltas`` scratch.
 
 ``counters`` int64: ``[stored, next slot, heap size, transitions ever stored]``.
 """
@@ -135,6 +153,24 @@ def _q_values(w, feats, out):
         f = feats[i]
         for a in range(n_actions):
             out[a] += w[f, a]
+
+
+@njit(nogil=True, cache=True, inline="always")
+def _values(agent, feats, out):
+    """``out[a] = Q(s, a)`` under the agent's weights, factored or one column per action."""
+    if agent.comp.shape[1] == 0:
+        _q_values(agent.w, feats, out)
+    else:
+        factored_values(agent.w, agent.comp, agent.slots, agent.sums, feats, out)
+
+
+@njit(nogil=True, cache=True, inline="always")
+def _value(agent, feats, action):
+    """``Q(s, action)`` under the agent's weights."""
+    value = 0.0
+    for i in range(feats.shape[0]):
+        value += agent.w[feats[i], action]
+    return value
 
 
 @njit(nogil=True, cache=True, inline="always")
@@ -177,19 +213,50 @@ def _choose(q, epsilon, rng):
 
 
 @njit(nogil=True, cache=True)
-def _td_update(agent, feats_s, action, reward, terminal, feats_next):
-    """Semi-gradient Q-learning on one transition; returns the TD error before the update."""
+def _factored_deltas(agent, obs, feats_s, action, reward, terminal, obs_next, feats_next):
+    """Each joint term's TD error into ``agent.deltas`` (its share of the reward, plus gamma
+    times its term at the next state's greedy action, minus its term now); returns their sum."""
+    comp = agent.comp
+    deltas = agent.deltas
+    split_reward(agent.split, agent.pot, obs, obs_next, reward, terminal, deltas)
+    if not terminal:
+        q = agent.qvals
+        factored_values(agent.w, comp, agent.slots, agent.sums, feats_next, q)
+        best = 0
+        for a in range(1, q.shape[0]):
+            if q[a] > q[best]:
+                best = a
+        for j in range(comp.shape[1]):
+            deltas[j] += agent.gamma * agent.sums[comp[best, j]]
+    column_sums(agent.w, agent.slots, feats_s, agent.sums)
+    total = 0.0
+    for j in range(comp.shape[1]):
+        deltas[j] -= agent.sums[comp[action, j]]
+        total += deltas[j]
+    return total
+
+
+@njit(nogil=True, cache=True)
+def _td_update(agent, obs, feats_s, action, reward, terminal, obs_next, feats_next):
+    """Semi-gradient Q-learning on one transition; returns the TD error before the update.
+
+    With a factored value each joint's term learns from its own TD error (:mod:`._factored`)."""
+    if agent.comp.shape[1] != 0:
+        delta = _factored_deltas(
+            agent, obs, feats_s, action, reward, terminal, obs_next, feats_next
+        )
+        for j in range(agent.deltas.shape[0]):
+            agent.deltas[j] *= agent.step
+        factored_add(agent.w, agent.comp, agent.slots, feats_s, action, agent.deltas)
+        return delta
     q = agent.qvals
     target = reward
     if not terminal:
-        _q_values(agent.w, feats_next, q)
+        _values(agent, feats_next, q)
         target += agent.gamma * _max(q)
-    w = agent.w
-    value = 0.0
-    for i in range(feats_s.shape[0]):
-        value += w[feats_s[i], action]
-    delta = target - value
+    delta = target - _value(agent, feats_s, action)
     change = agent.step * delta
+    w = agent.w
     for i in range(feats_s.shape[0]):
         w[feats_s[i], action] += change
     return delta
@@ -200,16 +267,20 @@ def _error(agent, slot):
     """Absolute TD error of stored transition ``slot`` under the current weights."""
     active_features(agent.spec, agent.model_obs[slot], agent.plan_s)
     active_features(agent.spec, agent.model_next[slot], agent.plan_next)
+    if agent.comp.shape[1] != 0:
+        return abs(
+            _factored_deltas(
+                agent, agent.model_obs[slot], agent.plan_s, agent.model_action[slot],
+                agent.model_reward[slot], agent.model_terminal[slot], agent.model_next[slot],
+                agent.plan_next,
+            )
+        )  # fmt: skip
     q = agent.qvals
     target = agent.model_reward[slot]
     if not agent.model_terminal[slot]:
-        _q_values(agent.w, agent.plan_next, q)
+        _values(agent, agent.plan_next, q)
         target += agent.gamma * _max(q)
-    value = 0.0
-    a = agent.model_action[slot]
-    for i in range(agent.plan_s.shape[0]):
-        value += agent.w[agent.plan_s[i], a]
-    return abs(target - value)
+    return abs(target - _value(agent, agent.plan_s, agent.model_action[slot]))
 
 
 @njit(nogil=True, cache=True)
@@ -218,8 +289,9 @@ def _replay(agent, slot):
     active_features(agent.spec, agent.model_obs[slot], agent.plan_s)
     active_features(agent.spec, agent.model_next[slot], agent.plan_next)
     _td_update(
-        agent, agent.plan_s, agent.model_action[slot], agent.model_reward[slot],
-        agent.model_terminal[slot], agent.plan_next,
+        agent, agent.model_obs[slot], agent.plan_s, agent.model_action[slot],
+        agent.model_reward[slot], agent.model_terminal[slot], agent.model_next[slot],
+        agent.plan_next,
     )  # fmt: skip
 
 
@@ -270,7 +342,7 @@ def _learn(agent, obs, feats_s, action, reward, terminal, obs_next, follows, n_p
     Leaves the active features of ``obs_next`` in ``agent.feats_next``.
     """
     active_features(agent.spec, obs_next, agent.feats_next)
-    _td_update(agent, feats_s, action, reward, terminal, agent.feats_next)
+    _td_update(agent, obs, feats_s, action, reward, terminal, obs_next, agent.feats_next)
     updates = 1
     if agent.model_stamp.shape[0] == 0:
         return rng, updates
@@ -300,7 +372,7 @@ def _learn(agent, obs, feats_s, action, reward, terminal, obs_next, follows, n_p
 @njit(nogil=True, cache=True)
 def _act(agent, feats, epsilon, rng):
     """Epsilon-greedy action at the state with active ``feats``; returns ``(a, rng)``."""
-    _q_values(agent.w, feats, agent.qvals)
+    _values(agent, feats, agent.qvals)
     return _choose(agent.qvals, epsilon, rng)
 
 
@@ -399,17 +471,27 @@ def _new_agent(
     config: DynaQConfig,
     capacity: int,
     weights: np.ndarray | None = None,
+    factors: tuple | None = None,
 ) -> Agent:
-    """Zero weights (``weights``, a zeroed ``(size, actions)`` table to learn into, when given),
-    an empty model (none at all for zero planning) and scratch arrays."""
+    """Zero weights (``weights``, a zeroed ``(size, columns)`` table to learn into, when given),
+    an empty model (none at all for zero planning) and scratch arrays. ``factors`` (from
+    :func:`value_factors`) factors the value (:mod:`._factored`; None: one column per action)."""
+    comp, slots, split, pot = factors or (
+        no_components(n_actions),
+        np.zeros(0, np.int64),
+        np.zeros(0),
+        no_potential(dims),
+    )
+    touched = coder.n_active // max(comp.shape[1], 1)  # the slots that feed one term
+    columns = n_actions if comp.shape[1] == 0 else int(comp.max()) + 1
     planner = PLANNER_CODE[config.planning]
     cap = 0 if planner == ZERO or config.planning_steps == 0 else capacity
     queue = cap if planner == PRIORITIZED else 0
     return Agent(
-        np.zeros((coder.size, n_actions), np.float64) if weights is None else weights,
+        np.zeros((coder.size, columns), np.float64) if weights is None else weights,
         coder.spec,
         float(config.gamma),
-        float(config.alpha) / coder.n_active,
+        float(config.alpha) / touched,
         planner,
         float(config.priority_threshold),
         np.zeros((cap, dims), np.float64),
@@ -428,7 +510,26 @@ def _new_agent(
         np.zeros(coder.n_active, np.int64),
         np.zeros(coder.n_active, np.int64),
         np.zeros(n_actions, np.float64),
+        comp,
+        slots,
+        np.zeros(columns if comp.shape[1] else 0, np.float64),
+        split,
+        pot,
+        np.zeros(comp.shape[1], np.float64),
     )
+
+
+def value_factors(task, coder: TileCoder, pot) -> tuple | None:
+    """``(components, slots, split, potential)`` of the factored value when the arm task's
+    action set is learned factored (:data:`FACTORED_ACTION_SETS`) on features that tile each
+    joint alone, else None (one column per action)."""
+    reach = task.reach
+    if reach is None or reach.actions not in FACTORED_ACTION_SETS:
+        return None
+    slots = slot_joints(coder, reach.joints)
+    if slots is None:
+        return None
+    return action_components(reach.directions), slots, reward_split(reach), pot
 
 
 @dataclass(frozen=True, eq=False)
@@ -512,9 +613,12 @@ def run_linear_experiments(
         dims = int(task.low.shape[0])
         demo_starts, demo_actions = env_demonstrations(demonstrations or [], task)
         pot = demo_potential(task.reach, demo_starts, demo_actions, dims)
-        weights = np.zeros((experiments, coder.size, task.n_actions), np.float64)
-        agents = [  # each learns into its row of ``weights``, which checkpoints read as it learns
-            _new_agent(coder, task.n_actions, dims, config, model_capacity, weights[e])
+        factors = value_factors(task, coder, pot)
+        comp = None if factors is None else factors[0]
+        columns = task.n_actions if comp is None else int(comp.max()) + 1
+        learned = np.zeros((experiments, coder.size, columns), np.float64)
+        agents = [  # each learns into its row of ``learned``, which checkpoints read as it learns
+            _new_agent(coder, task.n_actions, dims, config, model_capacity, learned[e], factors)
             for e in range(experiments)
         ]
         cpu_seconds = np.zeros(experiments)
@@ -530,6 +634,7 @@ def run_linear_experiments(
             cpu_seconds[e] = spent[0]
 
         def so_far() -> LinearResult:
+            weights = learned if comp is None else expand(learned, comp, row_joints(coder))
             return result_so_far(
                 LinearResult, live, cpu_seconds, weights, config, seed,
                 weights=weights, coder=coder, task=task.reach, env_id=task.env_id,

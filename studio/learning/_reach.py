@@ -2,9 +2,10 @@
 
 The robot is any arm of the registry (``studio.kinematics.robot_names``; ``robot``, the Puma560
 by default). The state is its first ``joints`` joint angles (radians, inside the robot's limits,
-at most six); the other joints stay at the goal's values. By default (``actions="single"``) an action moves ONE joint by
-``step_deg`` (2J actions: joint 1 up, joint 1 down, joint 2 up, ...); ``actions="pairs"`` adds
-every two joints moving together, each up or down (the diagonals, 2J**2 actions), and
+at most six); the other joints stay at the goal's values. With ``actions="single"`` an action moves
+ONE joint by ``step_deg`` (2J actions: joint 1 up, joint 1 down, joint 2 up, ...);
+``actions="pairs"`` (the default) adds every two joints moving together, each up or down (the
+diagonals, 2J**2 actions), and
 ``actions="all"`` every joint -1/0/+1 at once (3**J - 1 actions); see :data:`ACTION_SETS` and
 :func:`action_directions`. A joint whose move would leave its limits stays where it is, as on
 the paper's grid (the action's other joints still move). Reaching the goal pays :data:`GOAL_REWARD` and ends the
@@ -12,13 +13,13 @@ episode, every other step pays :data:`STEP_REWARD` (the paper's rewards), plus a
 shaping term (:data:`DEFAULT_SHAPING`). Episodes start uniformly across the limits (a start already
 at the goal is redrawn).
 
-Why one joint at a time is the default rather than every joint -1/0/+1 at once (3**J - 1
-actions, 728 for six joints) or the pairs (measured in ``benchmarks/bench_actions.py``): a linear learner evaluates every action at every step and learns each action's weights
-from its own visits, so 12 actions cost 60x less per step and each gets 60x more data; and with one
-joint per action the steps to the goal are a sum of per-joint distances, which per-joint tilings
-represent (:meth:`ArmReach.features`; :data:`DEFAULT_SHAPING` says why the shaping weight matters).
-The price is longer paths (the sum of the joints' distances
-instead of the largest). There is no "stay" action: it never helps a reach, and with function
+Why one or two joints per action is the default (measured in ``benchmarks/bench_actions.py``):
+with one weight column per action, each multi-joint move learned only from its own visits and
+the multi-joint sets learned far worse than one joint per action; the learner's factored action
+value (:mod:`._factored`) shares what each joint's part of a move learned among every move that
+has it, and with it the pairs learn in fewer real steps than single joints and move joints
+together. Every joint -1/0/+1 at once (3**J - 1 actions, 728 for six joints) overshoots near the
+goal even so. There is no "stay" action: it never helps a reach, and with function
 approximation its estimate can stick above the moves' and freeze the arm.
 
 The goal is judged where a user sees it: the robot's tool frame (the Puma560's DH frame 6) within
@@ -110,9 +111,12 @@ MAX_SHAPING = 100.0
 ACTION_SETS = ("single", "pairs", "all")
 """What one action may move: one joint (2J actions), one joint or two together (2J**2), or any
 joints at once (3**J - 1); each set begins with the one before it, in the same order."""
-DEFAULT_ACTIONS = "single"
-"""One joint per action: it learns in fewer real steps than the multi-joint sets (package README;
-``benchmarks/bench_actions.py``)."""
+DEFAULT_ACTIONS = "pairs"
+"""One joint or two together per action, learned with a factored action value
+(:mod:`._factored`): measured, it learns in fewer real steps than one joint per action and moves
+joints together (package README; ``benchmarks/bench_actions.py``)."""
+STORED_ACTIONS = "single"
+"""What a task stored before ``actions`` existed moves: one joint per action."""
 LIMIT_SLACK_RAD = 1e-9
 """A demonstration may touch its joint limits within this rounding."""
 
@@ -276,7 +280,8 @@ class ArmReach:
     def from_dict(cls, data: dict) -> ArmReach:
         """Settings from :meth:`to_dict`'s form (one written before ``actions`` existed moves one
         joint per action; one written before ``robot`` existed is the Puma560's)."""
-        return cls(**{**data, "goal": None if data.get("goal") is None else tuple(data["goal"])})
+        goal = None if data.get("goal") is None else tuple(data["goal"])
+        return cls(**{"actions": STORED_ACTIONS, **data, "goal": goal})
 
     @property
     def default_tiles(self) -> int:

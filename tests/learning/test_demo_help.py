@@ -15,8 +15,9 @@ from studio.learning._demo_shaping import DEMO_SHAPING, demo_potential, potentia
 ARM = "TeachStudio/ArmReach-v0"
 
 
-def arm(joints: int, shaping: float):
-    return lambda: gymnasium.make(ARM, joints=joints, shaping=shaping)
+def arm(joints: int, shaping: float, actions: str | None = None):
+    kwargs = {} if actions is None else {"actions": actions}
+    return lambda: gymnasium.make(ARM, joints=joints, shaping=shaping, **kwargs)
 
 
 def test_demonstrations_cut_the_first_own_episodes_under_the_papers_reward():
@@ -71,7 +72,9 @@ NO_DEMO_GOLDEN = {  # measured before demonstrations shaped: runs without them m
 @pytest.mark.parametrize("planning", NO_DEMO_GOLDEN)
 def test_runs_without_demonstrations_are_unchanged_bit_for_bit(planning):
     config = DynaQConfig(planning=planning, planning_steps=3, max_steps_per_episode=400)
-    result = run_experiments(arm(6, ArmReach().shaping), config, 2, 3, 7, [], ArmReach().features())
+    result = run_experiments(
+        arm(6, ArmReach().shaping, "single"), config, 2, 3, 7, [], ArmReach().features()
+    )
     steps, updates, digest = NO_DEMO_GOLDEN[planning]
     assert result.steps.tolist() == steps
     assert int(result.updates.sum()) == updates

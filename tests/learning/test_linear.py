@@ -216,8 +216,8 @@ def test_fixed_seed_results_are_unchanged(planning):
     demos = [np.linspace(start, task.goal, 20)]
     config = DynaQConfig(planning=planning, planning_steps=3, max_steps_per_episode=400)
     result = run_experiments(
-        lambda: gymnasium.make("TeachStudio/ArmReach-v0", joints=6), config, 2, 3, 7, demos,
-        task.features(),
+        lambda: gymnasium.make("TeachStudio/ArmReach-v0", joints=6, actions="single"), config, 2,
+        3, 7, demos, task.features(),
     )  # fmt: skip
     updates, weights_digest = GOLDEN_WEIGHTS[planning]
     assert result.compiled

@@ -57,7 +57,7 @@ def test_success_is_judged_on_the_tool_pose():
 
 
 def test_one_joint_moves_per_action_by_one_step_within_limits():
-    task = ArmReach(joints=6, step_deg=2.0)
+    task = ArmReach(joints=6, step_deg=2.0, actions="single")
     assert task.n_actions == 12
     rng = np.random.default_rng(0)
     for _ in range(200):
