@@ -43,7 +43,7 @@ from typing import TypedDict, TypeVar, cast
 import numpy as np
 
 from studio import StudioError, read_json
-from studio.kinematics import ArmTracker, Puma560, TrackerConfig
+from studio.kinematics import ArmTracker, Puma560, TrackerConfig, robot_spec
 from studio.learning import ArmGrid, LearningError, motion_problem
 
 from ._errors import DemonstrationError
@@ -159,7 +159,8 @@ class Demonstration:
             "recording": self.recording.name,
             "segment": [self.t0, self.t1],
             "mode": self.mode,
-            "grid": {k: v for k, v in self.grid.items() if k != "goal"},
+            # the goal and the robot are stored once, at the top
+            "grid": {k: v for k, v in self.grid.items() if k not in ("goal", "robot")},
             "goal": list(self.goal),
             "grid_path": list(self.grid_path),
             "reached_at": self.reached_at,
@@ -251,6 +252,12 @@ def load_demonstration(path: str | os.PathLike[str]) -> Demonstration:
         "trajectory", "rows of robot joint angles (q_robot)", _joint_rows, trajectory.get("q_robot")
     )
     problem = motion_problem(f"The demonstration {path}", times, q_robot)
+    width = robot_spec(DEMO_ROBOT).arm_joints
+    if problem is None and q_robot.shape[1] != width:
+        problem = (
+            f"The demonstration {path} holds {q_robot.shape[1]} joint angles per sample, not the "
+            f"{DEMO_ROBOT}'s {width}: it is for another robot; cut it again from its recording."
+        )
     if problem is not None:
         raise DemonstrationError(problem, "bad_file")
     reached_at = data.get("reached_at")

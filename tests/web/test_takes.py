@@ -6,10 +6,14 @@ import json
 import shutil
 import time
 
+import numpy as np
 import pytest
 
 from studio.capture import TAKES_FILE, read_takes, write_takes
 from studio.samples import SAMPLES_DIR
+
+AWAY_DEG = [-40.0, 20.0, -40.0]
+"""Robot joints 1-3 (degrees) the simulated operator waits at before a take, far from the goal."""
 
 
 def _wait_frames(client, seconds: float) -> None:
@@ -19,6 +23,18 @@ def _wait_frames(client, seconds: float) -> None:
     while client.get("/api/capture").json()["seconds"] < start + seconds:
         assert time.monotonic() < deadline, "the capture took in no frames"
         time.sleep(0.05)
+
+
+def _away_from_the_goal(client) -> None:
+    """Send the simulated operator to a pose far from the goal, and wait until it is there."""
+    client.post("/api/source/reach", json={"action": "reach", "goal_deg": AWAY_DEG})
+    deadline = time.monotonic() + 30
+    while True:
+        q = np.degrees(client.get("/api/source").json()["q_robot"][:3])
+        if np.abs(q - AWAY_DEG).max() < 10:
+            return
+        assert time.monotonic() < deadline, f"the operator stayed at {q}"
+        time.sleep(0.1)
 
 
 def test_a_session_of_takes_becomes_demonstrations(open_client, tmp_path):
@@ -36,8 +52,13 @@ def test_a_session_of_takes_becomes_demonstrations(open_client, tmp_path):
     assert client.get(f"/api/recordings/{first}").status_code == 404  # thrown away
 
     for _ in range(2):
+        # each take starts away from where it ends, so its end (the goal) is another grid cell
+        # whatever the simulated operator's wandering did before
+        _away_from_the_goal(client)
         client.post("/api/takes/start")
-        _wait_frames(client, 0.8)
+        _wait_frames(client, 0.3)
+        client.post("/api/source/reach", json={"action": "reach"})
+        _wait_frames(client, 2.5)
         client.post("/api/takes/stop")
         assert client.post("/api/takes/review").status_code == 202
         client.post("/api/takes/keep")
