@@ -23,7 +23,7 @@ each ``studio/samples/sample-reach-*.demo.json``:
    :data:`LEARN_EPISODES` episodes, one experiment per seed in :data:`LEARN_SEEDS`), rolled out
    from the demonstration's start and scored on the likeness card. Goals: DTW <= 0.05 rad per
    sample on all six joints, LDLJ within 20% of the demonstration's. For comparison: the same
-   with one joint per action (the earlier default), and (``--path-potential``) with the
+   with the other action set (one joint per action beside the pairs), and (``--path-potential``) with the
    demonstrations' potential over the whole demonstrated path (kappa 2, weight 5 on top of the
    task's shaping; :mod:`studio.learning._demo_shaping`), which pulls the greedy path along the
    demonstration rather than only to its end.
@@ -209,7 +209,7 @@ def main() -> None:
             f"goals DTW <= {GOAL_POLICY_DTW_RAD} rad/sample (six joints), LDLJ within "
             f"{GOAL_LDLJ_SHARE:.0%} of the demonstration's"
         )
-        for actions in (None,) if args.path_potential else (None, "single"):
+        for actions in (None,) if args.path_potential else (None, "pairs"):
             met = [learned(path, actions) for path in SAMPLES]
             print(f"  met for {sum(m for m, _ in met)}/{sum(n for _, n in met)} policies\n")
         return

@@ -2,9 +2,9 @@
 
 The robot is any arm of the registry (``studio.kinematics.robot_names``; ``robot``, the Puma560
 by default). The state is its first ``joints`` joint angles (radians, inside the robot's limits,
-at most six); the other joints stay at the goal's values. With ``actions="single"`` an action moves
+at most six); the other joints stay at the goal's values. With ``actions="single"`` (the default) an action moves
 ONE joint by ``step_deg`` (2J actions: joint 1 up, joint 1 down, joint 2 up, ...);
-``actions="pairs"`` (the default) adds every two joints moving together, each up or down (the
+``actions="pairs"`` adds every two joints moving together, each up or down (the
 diagonals, 2J**2 actions), and
 ``actions="all"`` every joint -1/0/+1 at once (3**J - 1 actions); see :data:`ACTION_SETS` and
 :func:`action_directions`. A joint whose move would leave its limits stays where it is, as on
@@ -13,13 +13,14 @@ episode, every other step pays :data:`STEP_REWARD` (the paper's rewards), plus a
 shaping term (:data:`DEFAULT_SHAPING`). Episodes start uniformly across the limits (a start already
 at the goal is redrawn).
 
-Why one or two joints per action is the default (measured in ``benchmarks/bench_actions.py``):
-with one weight column per action, each multi-joint move learned only from its own visits and
-the multi-joint sets learned far worse than one joint per action; the learner's factored action
-value (:mod:`._factored`) shares what each joint's part of a move learned among every move that
-has it, and with it the pairs learn in fewer real steps than single joints and move joints
-together. Every joint -1/0/+1 at once (3**J - 1 actions, 728 for six joints) overshoots near the
-goal even so. There is no "stay" action: it never helps a reach, and with function
+Why one joint per action is the default (measured in ``benchmarks/bench_actions.py`` and
+``benchmarks/bench_robots_learning.py``): with one weight column per action, each multi-joint move
+learned only from its own visits and the multi-joint sets learned far worse; the learner's
+factored action value (:mod:`._factored`) shares what each joint's part of a move learned among
+every move that has it, and with it the pairs learn in fewer real steps and move joints together,
+but their greedy success is not steady over training (:data:`DEFAULT_ACTIONS`). Every joint
+-1/0/+1 at once (3**J - 1 actions, 728 for six joints) overshoots near the goal even so. There is
+no "stay" action: it never helps a reach, and with function
 approximation its estimate can stick above the moves' and freeze the arm.
 
 The goal is judged where a user sees it: the robot's tool frame (the Puma560's DH frame 6) within
@@ -111,10 +112,14 @@ MAX_SHAPING = 100.0
 ACTION_SETS = ("single", "pairs", "all")
 """What one action may move: one joint (2J actions), one joint or two together (2J**2), or any
 joints at once (3**J - 1); each set begins with the one before it, in the same order."""
-DEFAULT_ACTIONS = "pairs"
-"""One joint or two together per action, learned with a factored action value
-(:mod:`._factored`): measured, it learns in fewer real steps than one joint per action and moves
-joints together (package README; ``benchmarks/bench_actions.py``)."""
+DEFAULT_ACTIONS = "single"
+"""One joint per action. ``"pairs"``, learned with the factored action value (:mod:`._factored`),
+reaches 95% greedy success in fewer real steps (81 k against 321 k at six joints) and moves joints
+together, but its greedy success swings as training goes on: at six joints, 2 experiments, Puma560
+93% / 78% / 99% / 92% after 500 / 1,000 / 2,000 / 4,000 episodes and UR5 70% / 81% / 63% / 42%,
+where one joint per action ends at 100% on the Puma560, the Panda and the UR5; with 3 demonstrations
+under the paper's reward 0.84 after 4,000 episodes against 0.97 (package README). A default that
+gets worse with more training is the wrong default; ``actions="pairs"`` is one setting away."""
 STORED_ACTIONS = "single"
 """What a task stored before ``actions`` existed moves: one joint per action."""
 LIMIT_SLACK_RAD = 1e-9

@@ -44,9 +44,9 @@ def test_each_action_set_has_its_size_and_begins_with_the_one_before(joints):
         assert single[2 * j, j] == 1 and single[2 * j + 1, j] == -1
 
 
-def test_the_default_moves_one_joint_or_two_together():
-    assert ArmReach().actions == "pairs" == REACH_DEFAULTS["actions"]
-    assert ArmReach(joints=6).n_actions == 72
+def test_the_default_moves_one_joint_per_action():
+    assert ArmReach().actions == "single" == REACH_DEFAULTS["actions"]
+    assert ArmReach(joints=6).n_actions == 12
 
 
 def test_a_diagonal_move_changes_two_joints_in_one_step():

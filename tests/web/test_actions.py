@@ -7,12 +7,12 @@ from tests.web.test_runs_create import PAGE_REACH
 
 
 def test_the_page_offers_the_action_set_and_a_run_keeps_it(client):
-    assert client.get("/api/config").json()["training"]["actions"] == "pairs"
-    body = {**PAGE_REACH, "actions": "single", "episodes": 2, "experiments": 1}
+    assert client.get("/api/config").json()["training"]["actions"] == "single"
+    body = {**PAGE_REACH, "actions": "pairs", "episodes": 2, "experiments": 1}
     r = client.post("/api/runs", json=body)
     assert r.status_code == 201, r.text
     run = wait_run(client, r.json()["id"])
-    assert run["status"] == "done" and run["config"]["actions"] == "single"
+    assert run["status"] == "done" and run["config"]["actions"] == "pairs"
     r = client.post("/api/runs", json={**body, "actions": "diagonal"})
     assert r.status_code == 422
     assert r.json()["detail"].startswith("actions is 'diagonal'; give 'single', 'pairs', 'all'")
