@@ -1,6 +1,7 @@
 """Real steps and CPU to 95% greedy success: the studio's learner against Stable-Baselines3.
 
-``python benchmarks/bench_peers.py [--joints 3 6] [--seeds 3] [--budget STEPS] [--quick]``
+``python benchmarks/bench_peers.py [--joints 3 6] [--seeds 3] [--budget STEPS] [--quick]
+[--stop-at-target] [--learners NAME ...] [--first-seed K]``
 
 Every learner trains on ``TeachStudio/ArmReach-v0`` with the environment's defaults (one joint per
 action, the default shaping, the episode cap of 3,000 steps) and is judged the same way: every
@@ -12,14 +13,17 @@ the same 200 held-out random starts (``default_rng([7, joints])``, as ``bench_ac
   that never does counts as missing, shown as ``-``);
 - **CPU to 95%**: the process CPU seconds (``time.process_time``) spent learning until then,
   the evaluations left out;
-- **final**: greedy success at the end of the budget.
+- **final**: greedy success at the end of the budget (with ``--stop-at-target``, which ends each
+  run at its first evaluation at >= 95% to save CPU, at that evaluation).
 
 The learners:
 
 - **studio** through the public API: ``run_experiments(env, DynaQConfig(), ...)`` with
   ``ArmReach(joints).features()``, the defaults the studio trains the arm task with (no
   demonstrations: a run has none unless a person gives them), plus ``planning="zero"`` and
-  ``planning_steps=10`` for reference. To evaluate it mid-run the environment is wrapped, so the
+  ``planning_steps=10`` for reference, and the default learner on a wider tile coding (32 tilings
+  of 8 tiles per joint instead of 8 of 32: tiles four times wider, the same resolution), the
+  setting that wins at 3 joints. To evaluate it mid-run the environment is wrapped, so the
   learner steps it from Python; that loop learns exactly as the compiled kernel does (asserted
   here: the per-episode steps match), and the CPU figure is the compiled kernel's, re-run to the
   episode where 95% was reached and prorated to the step.
@@ -27,20 +31,24 @@ The learners:
   [-1, 1] (the same box the studio's tile coder is given). Settings from the RL Zoo's tuned
   hyperparameters for discrete-action classic-control tasks (``rl-baselines3-zoo/hyperparams``,
   ``dqn.yml`` and ``ppo.yml``): DQN as tuned for MountainCar-v0 (a reach-the-goal task with -1 a
-  step) and for Acrobot-v1; PPO as tuned for CartPole-v1 and as given for Acrobot-v1 (with
-  ``VecNormalize``). ``exploration_fraction`` is a share of the budget, as in the Zoo.
+  step; the best peer here) and for Acrobot-v1; PPO as tuned for CartPole-v1 and as given for
+  Acrobot-v1 (with ``VecNormalize``). ``exploration_fraction`` is a share of the budget, as in
+  the Zoo's ``n_timesteps``.
 
 Seeds are paired: seed ``s`` is the studio's ``run_experiments`` seed and SB3's ``seed``. The
 closing lines compare the studio's defaults with the best peer (fewest mean steps to 95%) per
 joint count: the steps ratio (goal < 1) and the CPU ratio (goal >= 10).
 
 Without SB3 installed it measures the studio side only and says how to install the extra.
-``--quick`` runs a small budget at 3 joints, one seed, studio only (a smoke test).
+``--quick`` runs 6,000 steps at 3 joints, one seed, the studio's defaults and the wider tiling.
+``--learners`` keeps the rows whose names contain any of the words given (``--learners "studio
+defaults" "DQN (zoo MountainCar)"``); ``--first-seed`` lets seeds run in separate processes.
 """
 
 from __future__ import annotations
 
 import argparse
+import sys
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -124,6 +132,14 @@ class Trace:
         return next((i for i, s in enumerate(self.success) if s >= SUCCESS), None)
 
 
+def progress(who: str, trace: Trace) -> None:
+    """The latest evaluation, on stderr (long runs on a loaded machine)."""
+    cpu = f", {trace.cpu[-1]:.1f} s CPU" if trace.cpu else ""
+    print(
+        f"  {who}: {trace.steps[-1]:,} steps, success {trace.success[-1]:.3f}{cpu}", file=sys.stderr
+    )
+
+
 def held_out_starts(joints: int) -> np.ndarray:
     task = ArmReach(joints=joints)
     rng = np.random.default_rng([7, joints])
@@ -177,6 +193,7 @@ def studio_trace(
         now = live.snapshot()
         trace.steps.append(n)
         trace.success.append(success(now.weights[0], now.coder))
+        progress(f"studio seed {seed}", trace)
         return stop_at_target and trace.success[-1] >= SUCCESS
 
     def make() -> gymnasium.Env:
@@ -308,6 +325,7 @@ def peer_trace(
                 trace.success.append(peer_success(model, task, starts, norm))
                 trace.cpu.append(t - spent["start"] - spent["eval"])
                 spent["eval"] += time.process_time() - t
+                progress(f"{peer.algo} seed {seed}", trace)
                 while self.next_tick <= self.num_timesteps:
                     self.next_tick += rhythm
                 return not (stop_at_target and trace.success[-1] >= SUCCESS)
@@ -398,7 +416,8 @@ def compare(rows: list[Row], joints: int) -> list[str]:
 def main(argv: list[str] | None = None) -> list[Row]:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--joints", type=int, nargs="+", default=[3, 6], choices=[3, 4, 5, 6])
-    parser.add_argument("--seeds", type=int, default=3, help="paired seeds 0..N-1")
+    parser.add_argument("--seeds", type=int, default=3, help="how many paired seeds")
+    parser.add_argument("--first-seed", type=int, default=0, help="seeds from this one on")
     parser.add_argument("--budget", type=int, default=None, help="real steps per run")
     parser.add_argument(
         "--quick", action="store_true", help="3 joints, 1 seed, 6,000 steps, two studio rows"
@@ -426,12 +445,13 @@ def main(argv: list[str] | None = None) -> list[Row]:
         print(f"Stable-Baselines3 is not installed: measuring the studio only ({INSTALL} adds it).")
         peers = {}
     all_rows = []
+    seeds = range(args.first_seed, args.first_seed + args.seeds)
     for joints in args.joints:
         budget = args.budget or (QUICK_BUDGET if args.quick else BUDGET.get(joints, 300_000))
         print(
             f"\nArmReach-v0, {joints} joints, default shaping; greedy success from {STARTS} "
             f"held-out starts every {RHYTHM.get(joints, 5_000):,} real steps; budget "
-            f"{budget:,} steps; seeds 0..{args.seeds - 1}\n",
+            f"{budget:,} steps; seeds {seeds.start}..{seeds.stop - 1}\n",
             flush=True,
         )
         RHYTHM.setdefault(joints, 5_000)
@@ -439,15 +459,12 @@ def main(argv: list[str] | None = None) -> list[Row]:
         rows = []
         for name, (config, coding) in studio.items():
             traces = [
-                studio_trace(joints, config, s, budget, coding, args.stop_at_target)
-                for s in range(args.seeds)
+                studio_trace(joints, config, s, budget, coding, args.stop_at_target) for s in seeds
             ]
             rows.append(Row(name, traces))
             print(rows[-1].line(), flush=True)
         for name, peer in peers.items():
-            traces = [
-                peer_trace(joints, peer, s, budget, args.stop_at_target) for s in range(args.seeds)
-            ]
+            traces = [peer_trace(joints, peer, s, budget, args.stop_at_target) for s in seeds]
             rows.append(Row(name, traces))
             print(rows[-1].line(), flush=True)
         print(
