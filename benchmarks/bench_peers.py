@@ -85,6 +85,7 @@ STUDIO: dict[str, tuple[DynaQConfig, dict | None]] = {
     "studio, 10 planning steps": (DynaQConfig(planning_steps=10), None),
     "studio, no planning": (DynaQConfig(planning="zero"), None),
     "studio, 32 tilings x 8 tiles": (DynaQConfig(), WIDE_TILES),
+    "studio, 32 tilings x 8 tiles, 30 planning steps": (DynaQConfig(planning_steps=30), WIDE_TILES),
 }
 
 
