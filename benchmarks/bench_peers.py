@@ -40,7 +40,7 @@ closing lines compare the studio's defaults with the best peer (fewest mean step
 joint count: the steps ratio (goal < 1) and the CPU ratio (goal >= 10).
 
 Without SB3 installed it measures the studio side only and says how to install the extra.
-``--quick`` runs 6,000 steps at 3 joints, one seed, the studio's defaults and the wider tiling.
+``--quick`` runs 6,000 steps at 3 joints, one seed, the studio's defaults and the wider tilings.
 ``--learners`` keeps the rows whose names contain any of the words given (``--learners "studio
 defaults" "DQN (zoo MountainCar)"``); ``--first-seed`` lets seeds run in separate processes.
 """
@@ -421,7 +421,9 @@ def main(argv: list[str] | None = None) -> list[Row]:
     parser.add_argument("--first-seed", type=int, default=0, help="seeds from this one on")
     parser.add_argument("--budget", type=int, default=None, help="real steps per run")
     parser.add_argument(
-        "--quick", action="store_true", help="3 joints, 1 seed, 6,000 steps, two studio rows"
+        "--quick",
+        action="store_true",
+        help="3 joints, 1 seed, 6,000 steps, the studio defaults and wider tilings",
     )
     parser.add_argument("--studio-only", action="store_true", help="skip the SB3 learners")
     parser.add_argument(

@@ -84,12 +84,13 @@ def test_studio_side_runs_without_sb3(bench, monkeypatch, capsys):
     studio's learner is evaluated on the rhythm and checked against the compiled kernel."""
     monkeypatch.setitem(sys.modules, "stable_baselines3", None)  # as if not installed
     rows = bench.main(
-        ["--joints", "3", "--seeds", "1", "--budget", "3000", "--learners", "32 tilings", "DQN"]
+        ["--joints", "3", "--seeds", "1", "--budget", "3000", "--learners", "30 planning", "DQN"]
     )
     out = capsys.readouterr().out
     assert 'pip install -e ".[peers]"' in out
-    assert [r.name for r in rows] == ["studio, 32 tilings x 8 tiles"]
+    name = "studio, 32 tilings x 8 tiles, 30 planning steps"
+    assert [r.name for r in rows] == [name]
     (trace,) = rows[0].traces
     assert trace.steps == [1000, 2000, 3000]
     assert all(0.0 <= s <= 1.0 for s in trace.success)
-    assert "| studio, 32 tilings x 8 tiles |" in out
+    assert f"| {name} |" in out
