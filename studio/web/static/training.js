@@ -150,11 +150,13 @@ export async function startRun(ev) {
     const pair = $("train-form").elements.baseline.checked;
     // with "also train without demonstrations": the run and its twin, plotted alone and compared
     const runs = pair ? await api("POST", "/api/runs/pair", body) : [await api("POST", "/api/runs", body)];
-    if (pair) S.shown = new Set();
+    // the user's choice of plotted runs: a runs list reloaded meanwhile keeps it (not the newest four)
+    if (pair) { S.shown = new Set(); S.shownTouched = true; }
     for (const run of runs) {
-      upsertRun(run);
+      // the run's events may have come first (a short run can even be done): keep what they brought
+      if (!S.runs.some((r) => r.id === run.id)) upsertRun(run);
       S.shown.add(run.id);
-      S.curves.set(run.id, emptyCurve());
+      if (!S.curves.has(run.id)) S.curves.set(run.id, emptyCurve());
     }
     renderRuns();
     markCurvesDirty();

@@ -56,10 +56,10 @@ function build() {
     ),
     el("div", { class: "err", id: "rollout-error", testid: "rollout-error", hidden: true }),
   );
-  $("rollout-back").addEventListener("click", () => change({ step: -1 }));
-  $("rollout-forward").addEventListener("click", () => change({ step: 1 }));
-  $("rollout-play").addEventListener("click", () => change({ paused: !(S.rollout && S.rollout.paused) && !finished() }));
-  $("rollout-speed").addEventListener("change", () => change({ speed: Number($("rollout-speed").value) }));
+  $("rollout-back").addEventListener("click", () => act({ step: -1 }));
+  $("rollout-forward").addEventListener("click", () => act({ step: 1 }));
+  $("rollout-play").addEventListener("click", () => act({ paused: !(S.rollout && S.rollout.paused) && !finished() }));
+  $("rollout-speed").addEventListener("change", () => act({ speed: Number($("rollout-speed").value) }));
   const slider = $("rollout-time");
   slider.addEventListener("input", () => { slider.dataset.dragging = "1"; scrubTo(Number(slider.value)); });
   slider.addEventListener("change", () => { delete slider.dataset.dragging; scrubTo(Number(slider.value)); });
@@ -118,6 +118,13 @@ async function change(body) {
 // Scrubbing sends the newest position only, one request at a time, and pauses the rollout there.
 let scrubBusy = false;
 let scrubNext = null;
+
+/** A step, play or pause, or speed: it comes after any scrub still waiting to be sent (the slider's
+ * ``change`` that follows its last ``input``), which is dropped so it cannot undo this. */
+async function act(body) {
+  scrubNext = null;
+  await change(body);
+}
 async function scrubTo(t) {
   scrubNext = t;
   if (scrubBusy) return;
@@ -154,9 +161,9 @@ function onKey(ev) {
   if (!S.rollout || ev.altKey || ev.ctrlKey || ev.metaKey || keyTakenElsewhere(ev)) return;
   const n = ev.shiftKey ? BIG_STEP : 1;
   const action = {
-    " ": () => change({ paused: !S.rollout.paused && !finished() }),
-    ArrowLeft: () => change({ step: -n }),
-    ArrowRight: () => change({ step: n }),
+    " ": () => act({ paused: !S.rollout.paused && !finished() }),
+    ArrowLeft: () => act({ step: -n }),
+    ArrowRight: () => act({ step: n }),
     Home: () => scrubTo(0),
     End: () => scrubTo(S.rollout.duration),
   }[ev.key];
