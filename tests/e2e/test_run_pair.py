@@ -45,6 +45,12 @@ def test_one_click_trains_with_and_without_demonstrations_and_compares_them(
     by_name = {r["name"]: r for r in new}
     assert set(by_name) == {"pair", "pair · no demos"}
     ids = sorted(r["id"] for r in new)
+    # the pair may wait in the queue behind runs of earlier stories: a run is plotted once it has
+    # an episode, so let both finish first
+    for r in new:
+        assert wait_for(
+            lambda r=r: studio_server.get(f"/api/runs/{r['id']}")["status"] == "done", 180
+        )
     page.wait_for_function(
         "ids => JSON.stringify([...window.studio.plottedRuns()].sort()) === JSON.stringify(ids)",
         arg=ids,
@@ -64,10 +70,6 @@ def test_one_click_trains_with_and_without_demonstrations_and_compares_them(
     assert wait_for(lambda: row.count() == 1, T)
     cell = row.locator("td[data-key='demonstrations']")
     assert "differs" in (cell.get_attribute("class") or "")
-    for r in new:
-        assert wait_for(
-            lambda r=r: studio_server.get(f"/api/runs/{r['id']}")["status"] == "done", 180
-        )
     ARTIFACTS.mkdir(parents=True, exist_ok=True)
     page.screenshot(path=str(ARTIFACTS / "21-pair-compare-1280x720.png"))
     page.set_viewport_size({"width": 1920, "height": 1080})
