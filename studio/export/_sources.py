@@ -144,7 +144,7 @@ def retarget(
                 robot.spec.tool,
                 f"frame {i} (t = {times[i]:.3f} s of the source): the hand's target is "
                 f"{path.position_error[i] * 100:.1f} cm out of the {robot.spec.title}'s reach "
-                f"(tolerance {RetargetConfig().reach_tolerance * 100:.0f} cm)",
+                f"(tolerance {(config or RetargetConfig()).reach_tolerance * 100:.0f} cm)",
             )
         )
     return path.q, findings
