@@ -93,12 +93,13 @@ def time_path(
         )
     if not 0 < fraction <= 1:
         raise ExportError(f"The limit fraction is {fraction!r}; give a number in (0, 1].")
-    q = np.asarray(q, dtype=float)
-    moves = np.r_[True, np.abs(np.diff(q, axis=0)).max(axis=1) > 1e-9]
-    q = q[moves]
+    q = _moving(np.asarray(q, dtype=float))
     if len(q) < 2:
         return np.zeros(1), q[:1].copy()
-    q = q[_thin(q, tolerance)]
+    # thinning can leave a path that comes back to a waypoint with a step of zero length
+    q = _moving(q[_thin(q, tolerance)])
+    if len(q) < 2:
+        return np.zeros(1), q[:1].copy()
     times, samples = _toppra(robot, q, rate_hz, fraction)
     for _ in range(RETIME_TRIES - 1):
         if within_limits(robot, times, samples):
@@ -106,6 +107,11 @@ def time_path(
         fraction *= RETIME_FACTOR
         times, samples = _toppra(robot, q, rate_hz, fraction)
     return times, samples
+
+
+def _moving(q: np.ndarray) -> np.ndarray:
+    """``q`` without the samples that repeat the one before (a path's length must grow)."""
+    return q[np.r_[True, np.abs(np.diff(q, axis=0)).max(axis=1) > 1e-9]] if len(q) else q
 
 
 def within_limits(robot: RobotArm, times: np.ndarray, q: np.ndarray) -> bool:

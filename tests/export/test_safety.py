@@ -131,3 +131,15 @@ def test_a_path_along_a_joint_limit_never_overshoots_it(tmp_path):
     done = export_motion(motion, "csv", tmp_path / "edge.csv")
     assert not done.findings and done.q[:, 0].max() <= up
     _within_limits(PUMA, read_csv(tmp_path / "edge.csv")[1])
+
+
+def test_a_path_that_comes_back_to_where_it_started_is_timed(tmp_path):
+    """Thinning such a path (its turn within the path tolerance) can leave a step of zero
+    length, which the spline cannot take."""
+    a, b = np.zeros(6), np.full(6, 1e-3)
+    q = np.array([a, b, a])
+    done = export_motion(
+        Motion("policy", "p", PUMA, np.zeros(len(q)), q, False, 50.0), "csv", tmp_path / "t.csv"
+    )
+    _within_limits(PUMA, read_csv(tmp_path / "t.csv")[1])
+    assert np.allclose(done.q[0], a) and np.allclose(done.q[-1], a)
