@@ -74,3 +74,40 @@ def test_one_click_trains_with_and_without_demonstrations_and_compares_them(
     page.screenshot(path=str(ARTIFACTS / "21-pair-compare-1280x720.png"))
     page.set_viewport_size({"width": 1920, "height": 1080})
     page.screenshot(path=str(ARTIFACTS / "21-pair-compare-1920x1080.png"))
+
+
+
+def test_a_run_that_finished_unseen_is_plotted_when_the_runs_list_reloads(
+    browser: Any, studio_server: Studio
+) -> None:
+    """A short run can go from queued to done between two ticks of the event stream, so no event
+    of its own tells the page; a stream that reconnected misses them too. The runs list reloads on
+    the "lists" event its end sends, and must then fetch the curve the page holds empty.
+
+    The page here has no event stream, so nothing else brings the curve."""
+    run = studio_server.send(
+        "POST", "/api/runs", {"name": "unseen", "episodes": 4, "experiments": 1, "seed": 3}
+    )
+    assert wait_for(lambda: studio_server.get(f"/api/runs/{run['id']}")["status"] == "done", 180)
+    context = browser.new_context(viewport={"width": 1280, "height": 720})
+    try:
+        context.route("**/api/events*", lambda route: route.abort())
+        page = context.new_page()
+        page.goto(studio_server.base + "/")
+        page.wait_for_selector("body[data-ready='1']", timeout=60_000)
+        plotted = page.evaluate(
+            """async (id) => {
+                const S = window.studio;
+                const empty = Object.fromEntries(Object.keys(S.curves.values().next().value || { episodes: 0 }).map((k) => [k, []]));
+                S.shownTouched = true;
+                S.shown = new Set([id]);
+                S.runs.find((r) => r.id === id).status = "queued"; // as the page last saw it
+                S.curves.set(id, empty); // as the page holds a run it just queued
+                await loadRuns();
+                return plottedRuns().map((r) => r.id);
+            }""",
+            run["id"],
+        )
+    finally:
+        context.close()
+    assert plotted == [run["id"]]

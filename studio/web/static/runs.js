@@ -19,7 +19,13 @@ export function upsertRun(run) {
 export async function loadRuns() {
   await guarded("runs-error", async () => {
     const notes = api("GET", "/api/run-notes").catch(() => null); // tags and notes (compare.js)
+    const was = new Map(S.runs.map((r) => [r.id, r.status]));
     S.runs = await api("GET", "/api/runs");
+    // A run that finished since we last saw it: its curve as saved. A short run can go from queued
+    // to done between two ticks of the event stream and send no event of its own, and a stream
+    // that reconnected missed the events it would have sent.
+    const stale = (r) => !["running", "queued"].includes(r.status) && (was.get(r.id) !== r.status || !S.curves.get(r.id)?.episodes.length);
+    const finished = new Set(S.runs.filter((r) => S.curves.has(r.id) && stale(r)).map((r) => r.id));
     const all = await notes;
     if (all) S.notes = new Map(Object.entries(all));
     S.sweeps = S.runs.some(sweepOf) ? await api("GET", "/api/sweeps") : [];
@@ -28,7 +34,7 @@ export async function loadRuns() {
       S.shown = new Set(S.runs.filter((r) => !r.damaged).slice(0, 4).map((r) => r.id));
     }
     renderRuns();
-    await Promise.all([...S.shown].filter((id) => !S.curves.has(id)).map(loadCurve));
+    await Promise.all([...S.shown].filter((id) => !S.curves.has(id) || finished.has(id)).map(loadCurve));
     renderWatchChoices();
     renderPolicies(); // a run's policy is listed under the run's name
   });
