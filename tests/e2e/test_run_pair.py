@@ -76,7 +76,6 @@ def test_one_click_trains_with_and_without_demonstrations_and_compares_them(
     page.screenshot(path=str(ARTIFACTS / "21-pair-compare-1920x1080.png"))
 
 
-
 def test_a_run_that_finished_unseen_is_plotted_when_the_runs_list_reloads(
     browser: Any, studio_server: Studio
 ) -> None:
