@@ -101,3 +101,43 @@ def test_redrawing_the_run_list_keeps_unchanged_rows(
     )
     assert same, "an unchanged run row was rebuilt"
     assert updated, "a changed run row was not redrawn"
+
+
+def test_a_training_run_redraws_its_row_less_often_than_the_chart(
+    quiet_page: Any, studio_server: Studio
+) -> None:
+    """The run list follows a training run's progress, but at a third of the chart's frames
+    (events.js, RUNS_EVERY_FRAMES): rebuilding the list with every frame of the chart was most of
+    the page's own work while a run trained."""
+    page = quiet_page
+    page.evaluate(
+        """() => {
+            window.__rowRedraws = {};
+            window.__chartFrames0 = window.studio.curveRenders || 0;
+            new MutationObserver((records) => {
+                for (const m of records) {
+                    for (const n of m.addedNodes) {
+                        const id = n.dataset && n.dataset.id;
+                        if (id) window.__rowRedraws[id] = (window.__rowRedraws[id] || 0) + 1;
+                    }
+                }
+            }).observe(document.getElementById("runs-body"), { childList: true });
+        }"""
+    )
+    run = studio_server.send(
+        "POST",
+        "/api/runs",
+        {"name": "row-rate", "planning": "full", "episodes": 400, "experiments": 4, "bins": 31},
+    )
+    row = f"tr[data-id='{run['id']}']"
+    page.wait_for_selector(f"{row}[data-status='done']", timeout=EVENTS_TIMEOUT_MS * 6)
+    redraws, frames = page.evaluate(
+        "(id) => [window.__rowRedraws[id] || 0, (window.studio.curveRenders || 0) - window.__chartFrames0]",
+        run["id"],
+    )
+    every = page.evaluate("async () => (await import('/static/events.js')).RUNS_EVERY_FRAMES")
+    assert every >= 2
+    assert frames >= 6, "the run trained too briefly to tell"
+    # each status (queued, running, done) draws at once (and a list reloaded on a status change
+    # may draw it again); the progress on every third frame
+    assert 2 <= redraws <= frames / every + 6, (redraws, frames)

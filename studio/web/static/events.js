@@ -33,7 +33,7 @@ export function connectEvents() {
     if (!before && !S.shownTouched) S.shown.add(d.run.id);
     if (d.curve) mergeCurve(d.run.id, d.curve, d.from);
     for (const p of d.pieces || []) mergeCurve(d.run.id, p.curve, p.from, p.to);
-    scheduleRunsRender();
+    scheduleRunsRender(!before || before.status !== d.run.status);
     if (before && before.status !== d.run.status && !["running", "queued"].includes(d.run.status)) {
       loadCurve(d.run.id);
       renderWatchChoices();
@@ -46,13 +46,24 @@ export function connectEvents() {
   });
 }
 
+// A running run's row (its progress bar and CPU time) is redrawn every RUNS_EVERY_FRAMES live
+// frames, not with every frame of the chart: rebuilding and laying out the list was most of the
+// page's own work while a run trained, for a bar that moves a pixel. A run that appears or changes
+// status is drawn with the next frame.
+export const RUNS_EVERY_FRAMES = 3;
 let runsRenderPending = false;
-function scheduleRunsRender() { // drawn by the next renderLive, in the same frame as the chart
+let runsRenderUrgent = false;
+let framesSinceRuns = 0;
+function scheduleRunsRender(urgent) { // drawn by a coming renderLive, in the same frame as the chart
   runsRenderPending = true;
+  runsRenderUrgent ||= urgent;
 }
 export function renderLive() {
-  if (runsRenderPending) {
+  framesSinceRuns++;
+  if (runsRenderPending && (runsRenderUrgent || framesSinceRuns >= RUNS_EVERY_FRAMES)) {
     runsRenderPending = false;
+    runsRenderUrgent = false;
+    framesSinceRuns = 0;
     renderRuns();
   }
   renderCurves();
