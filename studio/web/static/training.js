@@ -19,10 +19,31 @@ export function resetTrainForm() {
   const planners = S.config.planners || [defaults.planning];
   f.elements.planning.replaceChildren(...planners.map((p) => el("option", { value: p, text: p })));
   for (const [k, v] of Object.entries(defaults)) {
-    if (k === "goal_deg") v.forEach((g, i) => { f.elements[`goal${i}`].value = String(g); });
+    if (k === "goal_deg") fillGoal(robotGoal() || v);
     else if (f.elements[k] && !(f.elements[k] instanceof RadioNodeList)) f.elements[k].value = v == null ? "" : String(v);
   }
 }
+
+/** The default goal of the robot chosen under Source (joints 1-3, degrees, as GET /api/robots
+ * serves it from the learning package): the goal `studio train --robot NAME` trains towards. */
+function robotGoal() {
+  const robot = (S.robots || []).find((r) => r.name === S.robot);
+  return robot && robot.goal_deg && robot.goal_deg.length ? robot.goal_deg : null;
+}
+
+function fillGoal(goal) {
+  const f = $("train-form");
+  goal.forEach((g, i) => { f.elements[`goal${i}`].value = String(g); });
+}
+
+// Another robot chosen: the form's goal becomes that robot's default (the Puma560's would be
+// another arm's pose, often beyond its limits), and the picked demonstrations are checked again.
+document.addEventListener("studio:robot", () => {
+  const goal = robotGoal();
+  if (!goal) return;
+  fillGoal(goal);
+  checkTrainForm();
+});
 
 /** Show every problem of a refused run beside the form, and mark each bad field (null clears). */
 function showTrainErrors(err) {

@@ -49,6 +49,7 @@ function build() {
     ),
     el("details", { id: "jog", testid: "jog", ontoggle: (e) => { if (e.target.open) loadJog(); } },
       el("summary", { text: "Pose by hand" }),
+      el("p", { class: "muted small", id: "jog-robot", testid: "jog-robot" }),
       el("div", { id: "jog-joints", testid: "jog-joints" }),
       el("div", { class: "row" },
         el("button", { id: "jog-goal", testid: "jog-goal", text: "Use this pose as the goal", title: "fill Train → goal with joints 1–3 of this pose", onclick: useAsGoal }),
@@ -191,17 +192,20 @@ async function loadJog() {
   await guarded("rollout-error", async () => {
     const jog = await api("GET", "/api/scene/jog");
     $("jog-joints").replaceChildren(...jog.joints.map((j, i) => jointRow(j, jog.q_deg[i])));
+    $("jog").dataset.robot = jog.robot;
+    setText("jog-robot", `${jog.title}: ${jog.joints.length} joints, each between its own limits`);
   });
 }
 
 function jointRow(j, value) {
   const label = j.name[0].toUpperCase() + j.name.slice(1);
   const v = Math.min(Math.max(value, j.lower_deg), j.upper_deg);
-  const input = el("input", { type: "range", class: "grow", min: String(j.lower_deg), max: String(j.upper_deg), step: "0.5", value: String(v), "aria-label": label, testid: "jog-joint" });
+  const input = el("input", { type: "range", class: "grow", min: String(j.lower_deg), max: String(j.upper_deg), step: "0.5", value: String(v), "aria-label": label, title: j.joint, testid: "jog-joint" });
   const shown = el("span", { class: "mono w5", testid: "jog-value", text: `${fmt(v, 1)}°` });
   input.addEventListener("input", () => { setText(shown, `${fmt(Number(input.value), 1)}°`); jog(); });
   return el("div", { class: "row jog-row" },
-    el("span", { class: "w5", text: label }),
+    el("span", { class: "w5", text: label, title: j.joint }),
+    el("span", { class: "muted small mono jog-name", testid: "jog-name", title: j.joint, text: j.joint }),
     el("span", { class: "muted small mono", testid: "jog-min", title: `${label}'s lower limit`, text: `${fmt(j.lower_deg, 0)}°` }),
     input,
     el("span", { class: "muted small mono", testid: "jog-max", title: `${label}'s upper limit`, text: `${fmt(j.upper_deg, 0)}°` }),
@@ -244,5 +248,7 @@ function useAsGoal() {
 
 build();
 document.addEventListener("studio:watch", loadRollout);
+// Another robot chosen under Source: the sliders become its joints, between its limits.
+document.addEventListener("studio:robot", () => { if ($("jog").open) loadJog(); else $("jog-joints").replaceChildren(); });
 $("watch-stop").addEventListener("click", () => showRollout(null)); // the robot goes back to live
 loadRollout();
