@@ -5,6 +5,7 @@ Panda can take; back on the Puma560, all of it is the Puma560's again."""
 
 from __future__ import annotations
 
+import urllib.error
 from typing import Any
 
 import numpy as np
@@ -28,6 +29,17 @@ def _timeline_robot(page: Any, name: str) -> None:
         f"() => ((window.studio.timeline || {{}}).data || {{}}).robot_name === '{name}'",
         timeout=LOAD_MS,
     )
+
+
+def _deleted(studio_server: Studio, policy: str) -> bool:
+    """Delete an uploaded policy; False while the studio still holds it in use (409)."""
+    try:
+        studio_server.send("DELETE", f"/api/policies/{policy}")
+    except urllib.error.HTTPError as err:
+        if err.code != 409:
+            raise
+        return False
+    return True
 
 
 def _goal(page: Any) -> list[float]:
@@ -93,8 +105,32 @@ def test_the_timeline_goal_and_jog_sliders_follow_the_robot_chosen(
         shot(page, "chosen-robot-panda-jog", "jog")
         page.locator("#timeline").scroll_into_view_if_needed()
         shot(page, "chosen-robot-panda-timeline", "sec-demos")
+
+        # a movement primitive fitted on the Panda: listed, watched on it, scored
+        page.get_by_role("button", name=f"Fit a movement primitive to {RECORDING}").click()
+        made = "reach-1-dmp-panda"  # a user's policy: the sample's prefix dropped
+        page.wait_for_function(
+            f"() => document.getElementById('watch-policy').value === 'policy:{made}'",
+            timeout=LOAD_MS,
+        )
+        page.click("[data-testid='watch-go']")
+        card = page.get_by_test_id("likeness-card")
+        card.get_by_test_id("likeness-row").first.wait_for(timeout=LOAD_MS)
+        assert "its demonstration" in card.inner_text()
+        assert wait_for(
+            lambda: (
+                studio_server.get("/api/scene/playback")["robot"] == "panda"
+                and studio_server.get("/api/scene/playback")["samples"] > 2
+            ),
+            timeout=LOAD_MS / 1000,
+        )
+        shot(page, "chosen-robot-panda-dmp", "sec-watch")
     finally:
         robot.select_option("puma560")
+        studio_server.send("POST", "/api/watch/stop")
+        made = "reach-1-dmp-panda"  # a user's policy: the sample's prefix dropped
+        if made in [p["name"] for p in studio_server.get("/api/policies")]:
+            assert wait_for(lambda: _deleted(studio_server, made), timeout=30)  # the next stories'
 
     # back on the Puma560: its joints, its goal, its six sliders
     _timeline_robot(page, "puma560")

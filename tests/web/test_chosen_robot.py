@@ -117,3 +117,53 @@ def test_the_jog_sliders_are_the_chosen_robots_joints_within_its_limits(
     assert r.status_code == 422 and "Panda has 7 joints" in r.json()["detail"]
     r = client.post("/api/scene/jog", json={"q_deg": [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]})
     assert r.status_code == 422 and "joint 4 is 0°" in r.json()["detail"]  # -176 to -4
+
+
+# ---------------------------------------------------------------------- movement primitives
+
+
+def test_a_movement_primitive_is_fitted_watched_scored_and_exported_on_the_chosen_robot(
+    client: TestClient,
+) -> None:
+    assert client.put("/api/robot", json={"name": "panda"}).status_code == 200
+    r = client.post("/api/demonstrations/sample-reach-1/dmp")
+    assert r.status_code == 201, r.text
+    made = r.json()
+    name = made["name"]
+    assert name == "reach-1-dmp-panda"  # the user's own, not a sample
+    assert made["task"]["kind"] == "dmp" and made["task"]["robot"] == "panda"
+    assert made["joints"] == 7 and made["error"] is None
+    assert name in [p["name"] for p in client.get("/api/policies").json()]
+    # watched on the Panda: its seven joints, to its goal, with its likeness card
+    w = client.post("/api/watch", json={"policy": name})
+    assert w.status_code == 200, w.text
+    watched = w.json()
+    q = np.array(watched["q_robot"])
+    panda = load_robot("panda", geometry=False)
+    assert q.shape[1] == 7 and watched["reached_goal"]
+    assert np.all(q >= panda.lower - 0.02) and np.all(q <= panda.upper + 0.02)
+    assert watched["likeness"] is not None and watched["likeness"]["name"] == "its demonstration"
+    # scored against another demonstration: retargeted onto the Panda as the policy's own was
+    other = client.post("/api/watch", json={"policy": name, "demonstration": "sample-reach-3"})
+    assert other.status_code == 200, other.text
+    assert other.json()["likeness"]["name"] == "sample-reach-3", other.json()["likeness_note"]
+    # its rollout exports for the Panda: checked against the Panda's limits (at the pace it was
+    # watched, a human reach's, its wrist may accelerate faster than the Panda's allows: then
+    # refused naming the Panda's joint, and written anyway on request with the findings in it)
+    r = client.get(f"/api/robot/export/rollout.mcap?policy={name}")
+    if r.status_code == 422:
+        assert r.json()["reason"] == "safety" and "panda_joint" in r.json()["detail"]
+        r = client.get(f"/api/robot/export/rollout.mcap?policy={name}&unchecked=true")
+    assert r.status_code == 200 and r.content[:5] == b"\x89MCAP"
+    # a second fit takes the next free name
+    again = client.post("/api/demonstrations/sample-reach-1/dmp").json()
+    assert again["name"] == "reach-1-dmp-panda-2"
+    assert client.delete(f"/api/policies/{again['name']}").status_code == 204
+    # back on the Puma560 the Panda's primitive is refused in one sentence naming both
+    client.put("/api/robot", json={"name": "puma560"})
+    refused = client.post("/api/watch", json={"policy": name})
+    assert refused.status_code == 409
+    assert "Franka Emika Panda" in refused.json()["detail"]
+    puma = client.post("/api/demonstrations/sample-reach-1/dmp").json()
+    assert puma["name"] == "reach-1-dmp-puma560" and puma["joints"] == 6
+    assert client.post("/api/demonstrations/nothing/dmp").status_code == 404

@@ -29,6 +29,7 @@ function policyTask(p) {
   const t = p.task || {};
   if (t.kind === "arm-grid") return `grid ${t.joints}×${t.bins}`;
   if (t.kind === "arm-reach") return `continuous ${t.joints} joints`;
+  if (t.kind === "dmp") return `movement primitive, ${p.joints} joints`;
   return t.kind || "";
 }
 
@@ -142,10 +143,13 @@ async function deletePolicy(name) {
 }
 
 export async function uploadPolicy(input) {
-  await uploadChosen(input, "/api/policies", "policies-error", async (p) => {
-    await loadPolicies();
-    if (p) { selectWatch(p); flashRow("policies-body", p.name); }
-  });
+  await uploadChosen(input, "/api/policies", "policies-error", showNewPolicy);
+}
+
+/** A policy just made (uploaded, or fitted to a demonstration): listed, chosen to watch, flashed. */
+export async function showNewPolicy(p) {
+  await loadPolicies();
+  if (p) { selectWatch(p); flashRow("policies-body", p.name); }
 }
 
 export function exportFile(kind) {
