@@ -11,7 +11,6 @@ import pytest
 from fastapi.testclient import TestClient
 
 from studio.capture import recording_series
-from studio.export import series_motion
 from studio.kinematics import load_robot, robot_names
 from studio.learning import ArmGrid, RunRequest, check_goal_deg, default_goal, resolve_run
 from studio.samples import SAMPLES_DIR
@@ -66,6 +65,8 @@ def test_the_timeline_plots_the_chosen_robots_joints_by_their_own_names(
     assert np.all(q >= panda.lower - 1e-3) and np.all(q <= panda.upper + 1e-3)
     assert timeline["human"] == puma["human"]  # the same arm, on another robot
     # retargeted as an export retargets a recording: the one path onto a robot
+    from studio.export import series_motion
+
     path = client.app.state.studio.recordings.path(recording)
     expected = series_motion(recording_series(path, 60), "panda").q
     assert np.allclose(q, expected, atol=np.radians(0.01))
