@@ -104,7 +104,8 @@ def test_the_timeline_goal_and_jog_sliders_follow_the_robot_chosen(
         ), studio_server.get("/api/scene/playback")
         page.get_by_role("button", name="Use this pose as the goal").click()
         goal = _goal(page)
-        assert goal[1] == pytest.approx(np.degrees(panda.lower[1]), abs=0.5)
+        assert goal[1] == pytest.approx(np.degrees(panda.lower[1]), abs=0.01)
+        assert all(round(g, 2) == g for g in goal)  # as a person types it, not -101.001061
         check_goal_deg(goal, "panda")  # a goal the Panda can take
         assert not page.get_by_test_id("train-problem").count()
         shot(page, "chosen-robot-panda-jog", "jog")
@@ -147,4 +148,14 @@ def test_the_timeline_goal_and_jog_sliders_follow_the_robot_chosen(
     assert _goal(page) == pytest.approx(_default_goal_deg("puma560"), abs=0.005)
     page.get_by_role("slider", name="Joint 6").wait_for(state="visible", timeout=LOAD_MS)
     assert page.locator("#jog-joints .jog-row").count() == 6
+    # a pose within the limits whose grid bin is not: the form says so at once, not at Start
+    joint1 = page.get_by_role("slider", name="Joint 1")
+    joint1.focus()
+    joint1.press("End")  # 160°: its bin of the paper's grid is centred at 163.6°
+    page.get_by_role("button", name="Use this pose as the goal").click()
+    problem = page.get_by_test_id("train-problem")
+    problem.first.wait_for(timeout=LOAD_MS)
+    assert "joint 1 falls in the bin centred at 163.6 degrees" in problem.first.inner_text()
+    page.get_by_test_id("train-defaults").click()  # the next stories start from the defaults
+    assert _goal(page) == pytest.approx(_default_goal_deg("puma560"), abs=0.005)
     assert not page.errors  # type: ignore[attr-defined]

@@ -38,6 +38,10 @@ function fillGoal(goal) {
 
 // Another robot chosen: the form's goal becomes that robot's default (the Puma560's would be
 // another arm's pose, often beyond its limits), and the picked demonstrations are checked again.
+// A goal taken from a pose by hand (watch.js) is checked at once, as Start would check it: a
+// joint within the robot's limits may still fall in a grid bin whose centre lies beyond them.
+document.addEventListener("studio:goal", () => checkTrainForm(true));
+
 document.addEventListener("studio:robot", () => {
   const goal = robotGoal();
   if (!goal) return;
@@ -136,12 +140,13 @@ function clearCheck() {
 }
 
 /** Check the picked demonstrations against the form's goal and task now, before Start, with the
- * learning package's own resolver (/api/demonstrations/check); show its sentences by field. */
-export async function checkTrainForm() {
+ * learning package's own resolver (/api/demonstrations/check); show its sentences by field.
+ * ``always``: check the goal even with no demonstration picked (a goal taken from a pose). */
+export async function checkTrainForm(always = false) {
   const seq = ++checkSeq;
   let body;
   try { body = readTrainForm(); } catch { return; } // an empty number: Start will say which
-  if (!body.demonstrations.length) { clearCheck(); return; }
+  if (!body.demonstrations.length && always !== true) { clearCheck(); return; }
   let data = {};
   try {
     await api("POST", "/api/demonstrations/check", body); // 204: it would start

@@ -234,16 +234,25 @@ async function jog() {
   showRollout(null); // a pose by hand replaces the rollout being scrubbed
 }
 
+/** A slider's angle to a hundredth of a degree, as a person types a goal, kept within its limits
+ * (a slider's values step from its lower limit, so they carry its decimals). */
+function goalAngle(input) {
+  const lo = Math.ceil(Number(input.min) * 100) / 100;
+  const hi = Math.floor(Number(input.max) * 100) / 100;
+  return Math.min(hi, Math.max(lo, Math.round(Number(input.value) * 100) / 100));
+}
+
 function useAsGoal() {
-  const q = jogValues();
-  if (q.length < GOAL_JOINTS) { showError("rollout-error", "Open Pose by hand and set the joints first."); return; }
+  const sliders = [...$("jog-joints").querySelectorAll("input[type=range]")];
+  if (sliders.length < GOAL_JOINTS) { showError("rollout-error", "Open Pose by hand and set the joints first."); return; }
   const f = $("train-form");
   for (let i = 0; i < GOAL_JOINTS; i++) {
     const input = f.elements[`goal${i}`];
-    input.value = String(q[i]);
+    input.value = String(goalAngle(sliders[i]));
     input.dispatchEvent(new Event("change", { bubbles: true }));
   }
   showError("rollout-error", null);
+  document.dispatchEvent(new CustomEvent("studio:goal")); // the train form checks it now
 }
 
 build();
