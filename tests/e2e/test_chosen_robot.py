@@ -108,9 +108,12 @@ def test_the_timeline_goal_and_jog_sliders_follow_the_robot_chosen(
         assert all(round(g, 2) == g for g in goal)  # as a person types it, not -101.001061
         check_goal_deg(goal, "panda")  # a goal the Panda can take
         assert not page.get_by_test_id("train-problem").count()
-        shot(page, "chosen-robot-panda-jog", "jog")
-        page.locator("#timeline").scroll_into_view_if_needed()
-        shot(page, "chosen-robot-panda-timeline", "sec-demos")
+        for width, height in ((1280, 720), (1920, 1080)):
+            page.set_viewport_size({"width": width, "height": height})
+            shot(page, f"chosen-robot-panda-jog-{width}x{height}", "jog")
+            page.locator("#timeline").scroll_into_view_if_needed()
+            shot(page, f"chosen-robot-panda-timeline-{width}x{height}", "timeline")
+        page.set_viewport_size({"width": 1440, "height": 900})
 
         # a movement primitive fitted on the Panda: listed, watched on it, scored
         page.get_by_role("button", name=f"Fit a movement primitive to {RECORDING}").click()
@@ -123,6 +126,8 @@ def test_the_timeline_goal_and_jog_sliders_follow_the_robot_chosen(
         card = page.get_by_test_id("likeness-card")
         card.get_by_test_id("likeness-row").first.wait_for(timeout=LOAD_MS)
         assert "its demonstration" in card.inner_text()
+        result = page.get_by_test_id("watch-result").inner_text()
+        assert "from its demonstration's start" in result and "reaches the goal" in result
         assert wait_for(
             lambda: (
                 studio_server.get("/api/scene/playback")["robot"] == "panda"

@@ -92,7 +92,8 @@ export async function watch() {
   await guarded("watch-error", async () => {
     const w = await api("POST", "/api/watch", body);
     const secs = w.times && w.times.length ? w.times[w.times.length - 1] : 0;
-    const from = w.seed == null ? "from the current pose" : `from a random start (seed ${w.seed})`;
+    // a movement primitive has no random start: it starts where its demonstration did
+    const from = w.seed != null ? `from a random start (seed ${w.seed})` : body.start === "current" ? "from the current pose" : "from its demonstration's start";
     setText("watch-result", `${w.steps} steps, ${secs.toFixed(1)} s ${from} — ${w.reached_goal ? "reaches the goal" : "does not reach the goal"}`);
     renderLikeness(w.likeness, w.likeness_note);
     S.watchedRun = t;
