@@ -161,6 +161,10 @@ def test_the_timeline_goal_and_jog_sliders_follow_the_robot_chosen(
     problem = page.get_by_test_id("train-problem")
     problem.first.wait_for(timeout=LOAD_MS)
     assert "joint 1 falls in the bin centred at 163.6 degrees" in problem.first.inner_text()
-    page.get_by_test_id("train-defaults").click()  # the next stories start from the defaults
+    # the next stories start from the defaults, the robot following the live source
+    page.get_by_test_id("train-defaults").click()
     assert _goal(page) == pytest.approx(_default_goal_deg("puma560"), abs=0.005)
+    page.get_by_text("Pose by hand").click()  # folded again
+    studio_server.send("POST", "/api/watch/stop")
+    assert not studio_server.get("/api/scene/playback")["active"]
     assert not page.errors  # type: ignore[attr-defined]
