@@ -23,7 +23,7 @@ const STEP_S = 0.1;
 
 const UNITS = { deg: (x) => `${x}°`, cm: (x) => `${x} cm` };
 
-const T = { name: null, show: "joints", data: null, chart: null, playhead: 0, playing: false, last: 0, want: null, sending: false };
+const T = { asked: 0, name: null, show: "joints", data: null, chart: null, playhead: 0, playing: false, last: 0, want: null, sending: false };
 S.timeline = T; // for the browser tests and the console
 
 function duration() { return T.data ? T.data.duration : 0; }
@@ -40,9 +40,10 @@ export async function showTimeline(name) {
   const box = $("timeline-plot");
   const points = Math.max(100, Math.min(600, box.clientWidth || 400));
   setText("timeline-time", "fitting the arm to the recording…");
+  const asked = ++T.asked;
   await guarded("timeline-error", async () => {
     const data = await api("GET", `/api/recordings/${enc(name)}/timeline?points=${points}`);
-    if (T.name !== name) return; // another recording was chosen meanwhile
+    if (asked !== T.asked || T.name !== name) return; // another recording or robot was chosen meanwhile
     T.data = data;
     T.playhead = 0;
     showChoices();
@@ -67,7 +68,7 @@ function showLegend() {
   setProp(box, "hidden", !joints.length);
   if (!joints.length) { box.replaceChildren(); return; }
   box.replaceChildren(
-    el("span", { text: `solid: the ${d.robot_title}'s joints ` }),
+    el("span", { text: `solid: joints of the ${d.robot_title}: ` }),
     ...joints.map((name, j) => el("span", { class: "mono", style: `color: ${ROBOT[j % ROBOT.length]}`, text: `${name} ` })),
     el("span", { text: "· dashed: the human arm's" }),
     ...(d.robot_notes || []).map((note) => el("span", { class: "warn", text: ` · ${note}` })),
