@@ -16,7 +16,7 @@ from studio.learning import ArmGrid, RunRequest, check_goal_deg, default_goal, r
 from studio.samples import SAMPLES_DIR
 from studio.web._scene import StudioScene
 from studio.web._scene_model import Mode
-from tests.web.conftest import wait_for
+from tests.web.conftest import wait_for, wait_run
 from tests.web.test_robot_playback import studio  # noqa: F401  (a studio with a scene)
 
 LOAD_S = 120.0
@@ -168,3 +168,39 @@ def test_a_movement_primitive_is_fitted_watched_scored_and_exported_on_the_chose
     puma = client.post("/api/demonstrations/sample-reach-1/dmp").json()
     assert puma["name"] == "reach-1-dmp-puma560" and puma["joints"] == 6
     assert client.post("/api/demonstrations/nothing/dmp").status_code == 404
+
+
+def test_a_movement_primitive_plays_on_its_robot_beside_its_demonstration_and_goal(
+    studio: tuple[TestClient, StudioScene],  # noqa: F811  (the fixture imported above)
+) -> None:
+    client, scene = studio
+    client.put("/api/robot", json={"name": "panda"})
+    assert wait_for(lambda: scene.robot_name == "panda", timeout=LOAD_S)
+    name = client.post("/api/demonstrations/sample-reach-2/dmp").json()["name"]
+    assert client.post("/api/watch", json={"policy": name}).status_code == 200
+    assert wait_for(lambda: "demonstration" in scene.path_names(), timeout=10)
+    assert wait_for(lambda: scene.goal_shown, timeout=10)
+    playback = scene.scrub()
+    assert playback is not None and playback[0].robot == "panda" and playback[0].q.shape[1] == 7
+
+
+def test_a_continuous_run_on_the_panda_plays_beside_its_demonstration(
+    studio: tuple[TestClient, StudioScene],  # noqa: F811  (the fixture imported above)
+) -> None:
+    client, scene = studio
+    client.put("/api/robot", json={"name": "panda"})
+    assert wait_for(lambda: scene.robot_name == "panda", timeout=LOAD_S)
+    body = {
+        "task": "arm-reach",
+        "joints": 3,
+        "planning": "zero",
+        "episodes": 3,
+        "experiments": 1,
+        "demonstrations": ["sample-reach-1"],
+    }
+    run = client.post("/api/runs", json=body)
+    assert run.status_code == 201, run.text
+    assert wait_run(client, run.json()["id"])["status"] == "done"
+    assert client.post("/api/watch", json={"run": run.json()["id"]}).status_code == 200
+    # its demonstration's path, on the Panda (its joints were drawn only for the Puma560 before)
+    assert wait_for(lambda: "demonstration" in scene.path_names(), timeout=10)

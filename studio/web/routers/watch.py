@@ -41,7 +41,8 @@ ROLLOUT_RATE_HZ = 50.0
 ROUND_DECIMALS = 6
 """Seconds and radians are sent to a micro-unit: far below what the scene can show."""
 TILE_DEMONSTRATION_PATH = "demonstration"
-"""Name of the scene path showing a continuous run's demonstration beside the watched robot."""
+"""Name of the scene path showing a continuous run's (or a movement primitive's) demonstration
+beside the watched robot."""
 TILE_WATCH_MAX_STEPS = 1_500
 """Most joint steps of a watched continuous rollout (a minute of motion at 0.04 s per step)."""
 
@@ -184,10 +185,10 @@ def _watch_tile_policy(
             if key.startswith("run:")
             else []
         )
-        if demos and task.robot == "puma560":  # the scene draws paths of the Puma560's joints
+        if demos:  # its joints on the task's robot, the others at the goal's
             path = np.tile(np.asarray(task.goal), (len(demos[0]), 1))
             path[:, : task.joints] = np.asarray(demos[0])[:, : task.joints]
-            studio.scene.show_path(TILE_DEMONSTRATION_PATH, path)
+            studio.scene.show_path(TILE_DEMONSTRATION_PATH, path, robot=task.robot)
         studio.scene.play_trajectory(times, q, robot=task.robot)
     return WatchPublic(
         steps=len(path) - 1,
@@ -212,6 +213,8 @@ def _watch_dmp_policy(
     studio.keep_rollout(key, times, q)
     if studio.scene is not None:
         studio.scene.set_goal(policy.goal, robot=policy.robot)
+        # the demonstration it was fitted to, beside it, as a continuous run's
+        studio.scene.show_path(TILE_DEMONSTRATION_PATH, policy.demo_q, robot=policy.robot)
         studio.scene.play_trajectory(times, q, robot=policy.robot)
     return WatchPublic(
         steps=len(times) - 1,
