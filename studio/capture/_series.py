@@ -11,7 +11,7 @@ of the arm's landmarks, a hand guide's hand position.
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -82,6 +82,9 @@ class RecordingSeries:
         duration: the whole recording's length, s.
         kind: ``"tape"``, ``"pose"`` or ``"hand"``.
         signals: the recording's own values at the same times (:func:`recording_signals`).
+        frames: the recording's frame index of each sample ``(N,)`` (how many frames lie
+            between two samples: a robot path retargeted from ``q_human`` moves that many
+            frames' worth between them).
     """
 
     times: np.ndarray
@@ -91,6 +94,7 @@ class RecordingSeries:
     duration: float
     kind: str
     signals: tuple[Signal, ...] = ()
+    frames: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
 
 
 def human_angles(
@@ -161,4 +165,5 @@ def recording_series(
         duration=rec.duration,
         kind=rec.kind_name,
         signals=recording_signals(rec, rows),
+        frames=rows,
     )

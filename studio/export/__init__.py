@@ -27,6 +27,7 @@ from ._sources import check_policy_robot as check_policy_robot
 from ._sources import demonstration_motion as demonstration_motion
 from ._sources import find_source as find_source
 from ._sources import recording_motion as recording_motion
+from ._sources import series_motion as series_motion
 from ._sources import source_kind as source_kind
 from ._sources import training_demonstration as training_demonstration
 from ._timing import LIMIT_FRACTION as LIMIT_FRACTION

@@ -1,6 +1,7 @@
 """Which demonstrations an exported policy is scored against, for its likeness card.
 
-``studio export POLICY`` prints the policy's likeness card against each of them, rolled out from
+``studio export POLICY`` prints the policy's likeness card against each of them on the policy's
+robot (a demonstration retargeted onto it as a training run replays it), rolled out from
 that demonstration's own start (:func:`studio.learning.likeness_cards`): the one ``--demo``
 names, else the run's own (kept in its ``config.json``; by name for a run recorded before the
 motions were kept), else a movement primitive's own demonstration.
@@ -10,8 +11,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
+
 from studio import StudioError, read_json
-from studio.capture import DEMO_SUFFIX, load_demonstration
+from studio.capture import DEMO_SUFFIX
 from studio.learning import (
     DemonstrationMotion,
     DmpPolicyFile,
@@ -22,28 +25,32 @@ from studio.learning import (
 )
 
 from ._errors import ExportError
-from ._sources import find_source, source_kind
+from ._sources import PUMA560, find_source, source_kind, training_demonstration
 
 RUN_CONFIG = "config.json"
 """A run folder's record, beside its policy."""
 
 
-def demonstration_of(given: str | Path, data_dir: str | Path = ".") -> DemonstrationMotion:
-    """The motion of the demonstration ``given`` names (a path, or a name as :func:`find_source`
-    looks it up).
+def demonstration_of(
+    given: str | Path, data_dir: str | Path = ".", robot: str = PUMA560
+) -> DemonstrationMotion:
+    """The motion on ``robot`` of the demonstration ``given`` names (a path, or a name as
+    :func:`find_source` looks it up): its stored Puma560 path, or for another robot its
+    recording's segment retargeted onto it (:func:`training_demonstration`).
 
     Raises:
-        ExportError: nothing of that name, not a demonstration, or a motion learning refuses.
+        ExportError: nothing of that name, not a demonstration, its recording missing for
+            another robot, or a motion learning refuses.
     """
     path = find_source(given, data_dir)
     if source_kind(path) != "demonstration":
         raise ExportError(f"--demo names {path.name}, which is not a demonstration (*.demo.json).")
-    demo = load_demonstration(path)
     name = path.name.removesuffix(DEMO_SUFFIX)
+    label = f"The demonstration {path}"
+    demo = training_demonstration(path, robot, label, name)
+    times = demo.times if demo.times is not None else np.zeros(0)
     try:
-        return DemonstrationMotion.checked(
-            name, demo.times, demo.q_robot, f"The demonstration {path}"
-        )
+        return DemonstrationMotion.checked(name, times, demo.q_robot, label)
     except LearningError as err:
         raise ExportError(str(err)) from None
 
@@ -55,8 +62,9 @@ def likeness_motions(
     data_dir: str | Path = ".",
 ) -> list[DemonstrationMotion]:
     """The demonstrations to score ``policy`` (read from ``policy_path``) against (module doc)."""
+    robot = policy.robot or PUMA560
     if demo is not None:
-        return [demonstration_of(demo, data_dir)]
+        return [demonstration_of(demo, data_dir, robot)]
     config = Path(policy_path).parent / RUN_CONFIG
     if config.is_file():
         try:
@@ -66,7 +74,7 @@ def likeness_motions(
         if record is not None and record.demonstration_motions:
             return list(record.demonstration_motions)
         if record is not None and record.demonstration_names:
-            return [demonstration_of(n, data_dir) for n in record.demonstration_names]
+            return [demonstration_of(n, data_dir, robot) for n in record.demonstration_names]
     if isinstance(policy, DmpPolicyFile):
         return [DemonstrationMotion("its demonstration", policy.demo_times, policy.demo_q)]
     return []

@@ -25,6 +25,7 @@ from studio.capture import (
     RECORDING_SUFFIXES,
     ObservationRecording,
     Recording,
+    RecordingSeries,
     human_angles,
     load_demonstration,
     read_any_recording,
@@ -182,14 +183,42 @@ def recording_motion(
         )
     stride = 1 if most_frames is None else max(1, -(-(stop - start) // max(int(most_frames), 2)))
     rows = slice(start, stop, stride)
-    config = None
-    if stride > 1:
-        default = RetargetConfig()
-        config = replace(default, max_joint_step=default.max_joint_step * stride)
     times = np.asarray(rec.t[rows] - rec.t[start], dtype=float)
-    q, findings = retarget(robot, times, human_angles(rec, rows), config)
+    q, findings = retarget(robot, times, human_angles(rec, rows), _strided(stride))
     rate = _capture_rate(rec, times) / stride
     return Motion("recording", path.name, robot, times, q, True, rate, tuple(findings))
+
+
+def _strided(stride: int) -> RetargetConfig | None:
+    """The retargeting of every ``stride``-th frame: each step may move ``stride`` frames' worth
+    (None: every frame, the default config)."""
+    if stride <= 1:
+        return None
+    default = RetargetConfig()
+    return replace(default, max_joint_step=default.max_joint_step * stride)
+
+
+def series_motion(series: RecordingSeries, robot_name: str, name: str = "") -> Motion:
+    """A recording's timeline on ``robot_name``: the human arm's angles of
+    :func:`studio.capture.recording_series` retargeted onto it as :func:`recording_motion`
+    retargets a recording (the step cap grown by the frames between two samples); the Puma560's
+    are the series' own ``q_robot``, as a demonstration keeps them.
+
+    Args:
+        series: the recording's series (its ``frames`` say how far apart its samples are).
+        robot_name: the robot to show it on.
+        name: the recording's name, for messages.
+    """
+    robot = load_robot(robot_name).scratch_copy()  # its own scratch data: any thread
+    times = np.asarray(series.times, dtype=float)
+    rate = float(1.0 / np.median(np.diff(times))) if len(times) > 1 else 1.0
+    if robot.name == PUMA560 or not len(times):
+        q = series.q_robot if robot.name == PUMA560 else np.zeros((0, robot.nq))
+        return Motion("recording", name, robot, times, q, True, rate)
+    gaps = np.diff(np.asarray(series.frames))
+    stride = int(gaps.max()) if len(gaps) else 1
+    q, findings = retarget(robot, times, series.q_human, _strided(stride))
+    return Motion("recording", name, robot, times, q, True, rate, tuple(findings))
 
 
 def demonstration_motion(path: Path, robot_name: str, rate_hz: float) -> Motion:

@@ -6,16 +6,21 @@ tabular and tile-coded formats, holding
 - ``header``: a 0-d unicode array with a JSON object::
 
       {"format": "teach-studio-dmp-policy", "version": 1,
-       "primitive": {"joints": 6, "basis": 50, "duration_s": 2.49, "alpha_z": 25.0,
-                     "alpha_x": 4.0, "start": [...6 rad...], "goal": [...6 rad...]},
-       "goal": [...6 rad...],          (where rollouts go; the demonstration's end by default)
+       "robot": "panda",               (the robot whose joints it moves; absent: the Puma560)
+       "primitive": {"joints": 7, "basis": 50, "duration_s": 2.49, "alpha_z": 25.0,
+                     "alpha_x": 4.0, "start": [...nq rad...], "goal": [...nq rad...]},
+       "goal": [...nq rad...],         (where rollouts go; the demonstration's end by default)
        "learned_joints": 3,            (the joints the likeness card compares)
        "likeness": {...},              (LikenessCard.to_dict() from the demonstration's start)
        "created": "...", "notes": ""}
 
 - ``weights``: float64 ``(joints, basis)``, the forcing terms (see :mod:`._dmp`);
-- ``demo_times``: float64 ``(N,)`` and ``demo_q``: float64 ``(N, 6)``, the demonstration it was
+- ``demo_times``: float64 ``(N,)`` and ``demo_q``: float64 ``(N, nq)``, the demonstration it was
   fitted to, so its likeness card can be computed from the file alone.
+
+``joints`` is the robot's joint count (``nq``: six for the Puma560, seven for the Panda): a
+primitive is fitted in its robot's joint space, to a demonstration retargeted onto that robot
+(``studio.export.training_demonstration``, the path a training run replays).
 """
 
 from __future__ import annotations
@@ -34,10 +39,10 @@ from ._dmp import (
     fit_movement_primitive,
     roll_out_primitive,
 )
-from ._errors import LearningError, PolicyFileError
-from ._likeness import LikenessCard, likeness_card, puma_tool_positions
-from ._policy import MAX_NPZ_BYTES, ROBOT_JOINTS, ROLLOUT_RATE_HZ, BoundedNpz, read_header
-from ._robot import PUMA560
+from ._errors import ConfigError, LearningError, PolicyFileError
+from ._likeness import LikenessCard, likeness_card, robot_tool_positions
+from ._policy import MAX_NPZ_BYTES, ROLLOUT_RATE_HZ, BoundedNpz, read_header
+from ._robot import PUMA560, check_robot, robot_title, task_arm
 
 FORMAT_NAME = "teach-studio-dmp-policy"
 FORMAT_VERSION = 1
@@ -50,31 +55,28 @@ class DmpPolicyFile:
     """A movement-primitive baseline policy: a DMP and the demonstration it was fitted to.
 
     Attributes:
-        primitive: the fitted DMP over the Puma560's six joints.
-        goal: where rollouts go ``(6,)`` (rad).
+        primitive: the fitted DMP over the robot's joints.
+        goal: where rollouts go ``(nq,)`` (rad).
         demo_times: the demonstration's sample times ``(N,)`` (s).
-        demo_q: the demonstration's joints ``(N, 6)`` (rad).
+        demo_q: the demonstration's joints on the robot ``(N, nq)`` (rad).
         learned_joints: joints the likeness card compares (the demonstration's task joints).
         created: ISO 8601 time of writing.
         notes: free text.
         mean_steps: empty (a primitive has no learning curve; kept so listings read all kinds alike).
         experiments: 1.
+        robot: the robot it drives (a registry name; the Puma560 for a file that names none).
     """
 
     primitive: MovementPrimitive
     goal: np.ndarray
     demo_times: np.ndarray
     demo_q: np.ndarray
-    learned_joints: int = ROBOT_JOINTS
+    learned_joints: int = 6
     created: str = ""
     notes: str = ""
     mean_steps: np.ndarray = field(default_factory=lambda: np.zeros(0))
     experiments: int = 1
-
-    @property
-    def robot(self) -> str:
-        """The robot it drives: the Puma560, whose joints its demonstration holds."""
-        return PUMA560
+    robot: str = PUMA560
 
     def header(self, likeness: LikenessCard | None = None) -> dict[str, object]:
         """The JSON header written to the file."""
@@ -82,6 +84,7 @@ class DmpPolicyFile:
         return {
             "format": FORMAT_NAME,
             "version": FORMAT_VERSION,
+            "robot": self.robot,
             "primitive": {
                 "joints": p.joints,
                 "basis": p.basis,
@@ -104,42 +107,57 @@ def fit_dmp_policy(
     q_robot: np.ndarray,
     *,
     goal: np.ndarray | None = None,
-    learned_joints: int = ROBOT_JOINTS,
+    learned_joints: int | None = None,
     basis: int = DMP_BASIS,
     notes: str = "",
+    robot: str = PUMA560,
 ) -> DmpPolicyFile:
-    """Fit the movement-primitive baseline to a demonstration's Puma560 joint path.
+    """Fit the movement-primitive baseline to a demonstration's joint path on ``robot``.
 
     Args:
         times: the demonstration's sample times ``(N,)`` (s).
-        q_robot: its joints ``(N, 6)`` (rad): a demonstration's ``q_robot``.
+        q_robot: its joints on the robot ``(N, nq)`` (rad): a demonstration's ``q_robot`` for
+            the Puma560; for another robot, the demonstration retargeted onto it
+            (``studio.export.training_demonstration(path, robot, label).q_robot``).
         goal: where rollouts go (default: where the demonstration ends).
-        learned_joints: the joints its likeness card compares (a demonstration's grid joints).
+        learned_joints: the joints its likeness card compares (a demonstration's grid joints;
+            default: all the robot's).
         basis: basis functions per joint.
         notes: free text.
+        robot: the robot whose joints these are (``studio robots``; the Puma560 by default).
 
     Raises:
-        LearningError: a path that is not ``(N, 6)`` finite angles, or a bad goal or count.
+        LearningError: an unknown robot, a path that is not ``(N, nq)`` finite angles of it, or
+            a bad goal or count.
     """
+    try:
+        arm = task_arm(check_robot(robot))
+    except ConfigError as err:
+        raise LearningError(str(err)) from None
+    width, title = arm.nq, robot_title(arm.name)
     q = np.asarray(q_robot, dtype=np.float64)
-    if q.ndim != 2 or q.shape[1] != ROBOT_JOINTS:
+    if q.ndim != 2 or q.shape[1] != width:
         raise LearningError(
-            f"The demonstration's joints have shape {q.shape}; give (N, {ROBOT_JOINTS}) Puma560 angles in radians."
+            f"The demonstration's joints have shape {q.shape}; give (N, {width}) {title} angles in radians (a demonstration retargeted onto it)."
         )
-    if not isinstance(learned_joints, int) or not 1 <= learned_joints <= ROBOT_JOINTS:
-        raise LearningError(f"learned_joints is {learned_joints!r}; give 1 to {ROBOT_JOINTS}.")
+    learned = width if learned_joints is None else learned_joints
+    if not isinstance(learned, int) or not 1 <= learned <= width:
+        raise LearningError(f"learned_joints is {learned_joints!r}; give 1 to {width}.")
     primitive = fit_movement_primitive(times, q, basis)
     target = primitive.goal if goal is None else np.asarray(goal, dtype=np.float64).reshape(-1)
-    if target.shape != (ROBOT_JOINTS,) or not np.all(np.isfinite(target)):
-        raise LearningError(f"The goal has {target.size} angles; give {ROBOT_JOINTS} in radians.")
+    if target.shape != (width,) or not np.all(np.isfinite(target)):
+        raise LearningError(
+            f"The goal has {target.size} angles; give {width} in radians, one per {title} joint."
+        )
     return DmpPolicyFile(
         primitive=primitive,
         goal=target.copy(),
         demo_times=np.asarray(times, dtype=np.float64).reshape(-1).copy(),
         demo_q=q.copy(),
-        learned_joints=learned_joints,
+        learned_joints=learned,
         created=datetime.now(UTC).isoformat(timespec="seconds"),
         notes=notes,
+        robot=arm.name,
     )
 
 
@@ -149,7 +167,7 @@ def rollout_dmp_policy(
     """The primitive from ``start_q`` (default: the demonstration's start) to the policy's goal.
 
     Returns:
-        ``(times (N,), q (N, 6), reached)``: ``reached`` when every joint ends within
+        ``(times (N,), q (N, nq), reached)``: ``reached`` when every joint ends within
         :data:`._dmp.DMP_SETTLE_RAD` of the goal.
     """
     times, q = roll_out_primitive(policy.primitive, start_q, policy.goal, rate_hz)
@@ -161,7 +179,11 @@ def dmp_likeness_card(policy: DmpPolicyFile, rate_hz: float = ROLLOUT_RATE_HZ) -
     """The likeness card of the primitive's rollout from the demonstration's own start."""
     times, q, _ = rollout_dmp_policy(policy, policy.demo_q[0], rate_hz)
     k = policy.learned_joints
-    return likeness_card(times, q, policy.demo_times, policy.demo_q, puma_tool_positions, joints=k)
+
+    def tool(q: np.ndarray) -> np.ndarray:
+        return robot_tool_positions(policy.robot, q)
+
+    return likeness_card(times, q, policy.demo_times, policy.demo_q, tool, joints=k)
 
 
 def save_dmp_policy(
@@ -208,11 +230,17 @@ def load_dmp_policy(path: str | Path) -> DmpPolicyFile:
             raise PolicyFileError(
                 f"{name} uses DMP policy format version {version!r}, not one this studio reads ({FORMAT_VERSION}); upgrade Teach Studio to read it."
             )
+        robot = _robot_of(header, name)
         try:
             spec = header["primitive"]
             joints, basis = int(spec["joints"]), int(spec["basis"])
-            if joints != ROBOT_JOINTS or basis < 2:
-                raise ValueError(f"it has {joints} joints and {basis} basis functions")
+            width = task_arm(robot).nq
+            if joints != width:
+                raise ValueError(
+                    f"it moves {joints} joints where the {robot_title(robot)} has {width}"
+                )
+            if basis < 2:
+                raise ValueError(f"it has {basis} basis functions")
             weights = archive.read("weights", (joints, basis), "f").astype(np.float64)
             demo_times = archive.read("demo_times", None, "f").astype(np.float64)
             demo_q = archive.read("demo_q", (demo_times.shape[0], joints), "f").astype(np.float64)
@@ -246,4 +274,18 @@ def load_dmp_policy(path: str | Path) -> DmpPolicyFile:
         learned_joints=learned,
         created=str(header.get("created", "")),
         notes=str(header.get("notes", "")),
+        robot=robot,
+    )
+
+
+def _robot_of(header: dict[str, object], name: str) -> str:
+    """The robot a DMP file names (the Puma560 when it names none), or a PolicyFileError."""
+    robot = header.get("robot", PUMA560)
+    try:
+        if isinstance(robot, str):
+            return check_robot(robot)
+    except ConfigError:
+        pass
+    raise PolicyFileError(
+        f"{name} names the robot {robot!r}, which this studio does not offer; fit the primitive again for a robot `studio robots` lists."
     )

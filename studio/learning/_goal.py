@@ -17,13 +17,27 @@ import numpy as np
 
 from ._arm import ArmGrid
 from ._errors import ConfigError, LearningError
-from ._robot import DEFAULT_GOAL_DEG, PUMA560, robot_title, task_arm
+from ._robot import DEFAULT_GOAL_DEG, PUMA560, default_goal, robot_title, task_arm
 
 GOAL_JOINTS = 3
 """A goal names joints 1-3 of the robot: the paper's task (the Puma560's joints 4-6 rest at 0,
 another robot's other joints at its default goal's)."""
 DEFAULT_GOAL_JOINTS_DEG: tuple[float, ...] = tuple(DEFAULT_GOAL_DEG[:GOAL_JOINTS])
 """The Puma560's default goal for joints 1-3, degrees (the one default: :data:`DEFAULT_GOAL_DEG`)."""
+
+
+FORM_GOAL_DECIMALS = 2
+"""A goal in degrees is shown to a hundredth of a degree, as a person would type it."""
+
+
+def default_goal_deg(robot: str = PUMA560) -> tuple[float, ...]:
+    """Robot ``robot``'s default goal for joints 1-3 in degrees, as the run form and
+    ``--goal-deg`` take a goal: joints 1-3 of :func:`default_goal`, the goal ``studio train
+    --robot NAME`` trains towards when given none (the same grid bins; the same reach goal to
+    within :data:`FORM_GOAL_DECIMALS`), kept within the robot's limits."""
+    lower, upper = robot_limits_deg(robot)
+    goal = np.degrees(default_goal(robot)[:GOAL_JOINTS]).round(FORM_GOAL_DECIMALS)
+    return tuple(float(v) for v in np.clip(goal, lower, upper))
 
 
 @cache

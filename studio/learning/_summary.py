@@ -71,11 +71,12 @@ def policy_summary(policy: PolicyFile | TilePolicyFile | DmpPolicyFile) -> Polic
         :func:`goal_degrees`, or the continuous task's goal angles), ``planning`` (the planner
         it was trained with), ``episodes`` (length of its learning curve), ``experiments`` (how
         many the curve averages), ``created`` and ``notes``. A movement primitive's task is
-        ``{"kind": "dmp", "basis": ...}`` and its planning ``"none"``.
+        ``{"kind": "dmp", "basis": ..., "robot": ...}`` and its planning ``"none"``.
     """
     task: dict[str, object]
     if isinstance(policy, DmpPolicyFile):
-        task, grid, joints = {"kind": "dmp", "basis": policy.primitive.basis}, {}, len(policy.goal)
+        task = {"kind": "dmp", "basis": policy.primitive.basis, "robot": policy.robot}
+        grid, joints = {}, len(policy.goal)
         goal = [round(float(x), GOAL_DECIMALS) for x in np.degrees(policy.goal)]
     elif isinstance(policy, TilePolicyFile):
         reach = policy.task

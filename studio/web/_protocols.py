@@ -122,8 +122,8 @@ class Scene(LiveScene, Protocol):
     ) -> tuple[Playback, float] | None:
         """Reschedule the playback (or only read it); None when nothing was played."""
 
-    def hold_pose(self, q_robot: np.ndarray) -> None:
-        """Show the robot at a pose posed by hand."""
+    def hold_pose(self, q_robot: np.ndarray, robot: str | None = None) -> None:
+        """Show ``robot`` (the Puma560 when None) at a pose posed by hand."""
 
     def show_hand_handle(self, side: str | None, on_move: HandMoved | None) -> None:
         """Show the hand guide's handle on ``side``'s hand (None hides it)."""

@@ -3,8 +3,9 @@ timeline's cursor, and a segment's robot path drawn and played in the scene.
 
 The joints come from :func:`studio.capture.recording_series` (the capture package's fitters);
 this module only caches them per file and hands them to the scene. On a robot other than the
-Puma560 the human arm's joints are retargeted onto it: the cursor's pose at once (one IK solve,
-warm-started from the pose before), a played stretch in the background by the studio's
+Puma560 the human arm's joints are retargeted onto it by :func:`studio.export.series_motion` (the
+path an export takes): the timeline plots that robot's joints and its cursor holds the robot at
+them; a played stretch is retargeted in the background by the studio's
 :class:`~._robot_playback.RobotPlayer`.
 """
 
@@ -18,8 +19,8 @@ import numpy as np
 from fastapi import Depends, Request
 
 from studio.capture import RecordingSeries, recording_series
-from studio.export import recording_motion
-from studio.kinematics import RetargetConfig, Retargeter, load_robot
+from studio.export import Motion, recording_motion, series_motion
+from studio.kinematics import load_robot
 
 from ._robot_playback import PREVIEW_FRAMES
 from ._state import Studio
@@ -28,8 +29,6 @@ REVIEW_PATH = "review"
 """The scene path that shows the segment under review (one at a time, replaced by the next)."""
 CACHED_SERIES = 8
 """How many series are kept (a timeline's pose lookups read the one it plotted)."""
-CURSOR_RETARGET = RetargetConfig(max_joint_step=float(np.pi))
-"""The timeline's cursor jumps anywhere: its pose on a robot is not held to a frame's step."""
 
 
 class Reviewer:
@@ -40,7 +39,7 @@ class Reviewer:
         self._lock = threading.Lock()
         self._cache: OrderedDict[tuple[object, ...], RecordingSeries] = OrderedDict()
         self._plotted: dict[str, RecordingSeries] = {}
-        self._cursor: dict[str, Retargeter] = {}  # per robot, warm from the last cursor pose
+        self._on_robot: dict[tuple[str, str], tuple[RecordingSeries, Motion]] = {}
 
     def series(
         self, name: str, points: int, t0: float | None = None, t1: float | None = None
@@ -69,8 +68,28 @@ class Reviewer:
             self._plotted[name] = series
         return series
 
+    def timeline(self, name: str, points: int) -> tuple[RecordingSeries, Motion]:
+        """The series a timeline plots and its joints on the robot taught
+        (:func:`studio.export.series_motion`), kept while the series is."""
+        series = self.plotted(name, points)
+        return series, self._robot_path(name, series)
+
+    def _robot_path(self, name: str, series: RecordingSeries) -> Motion:
+        robot = self.studio.pipeline.robot_name
+        with self._lock:
+            kept = self._on_robot.get((name, robot))
+        if kept is not None and kept[0] is series:
+            return kept[1]
+        motion = series_motion(series, robot, name)
+        with self._lock:
+            self._on_robot[(name, robot)] = (series, motion)
+            while len(self._on_robot) > CACHED_SERIES:
+                self._on_robot.pop(next(iter(self._on_robot)))
+        return motion
+
     def hold(self, name: str, t: float) -> np.ndarray:
-        """Hold the robot at the pose of recording ``name`` at ``t`` s (the timeline's cursor).
+        """Hold the robot at the pose of recording ``name`` at ``t`` s (the timeline's cursor):
+        the robot's joints the timeline plots, between its samples.
 
         Returns:
             The robot joints shown (rad, (nq,) of the robot taught).
@@ -79,20 +98,11 @@ class Reviewer:
             series = self._plotted.get(name)
         if series is None or not len(series.times):
             series = self.plotted(name, 400)
-        robot = self.studio.pipeline.robot_name
+        motion = self._robot_path(name, series)
+        robot = motion.robot.name
         if not len(series.times):
             return np.zeros(load_robot(robot, geometry=False).nq)
-        if robot == "puma560":
-            q = np.array([np.interp(t, series.times, col) for col in series.q_robot.T])
-        else:
-            q_human = np.array([np.interp(t, series.times, col) for col in series.q_human.T])
-            with self._lock:
-                retargeter = self._cursor.get(robot)
-                if retargeter is None:
-                    arm = load_robot(robot).scratch_copy()  # the live thread has its own
-                    retargeter = Retargeter(robot=arm, config=CURSOR_RETARGET)
-                    self._cursor = {robot: retargeter}
-                q = retargeter.robot_from_human(q_human)
+        q = np.array([np.interp(t, motion.times, col) for col in motion.q.T])
         scene = self.studio.scene
         if scene is not None:
             scene.play_trajectory(np.zeros(1), q[None, :], robot=robot)

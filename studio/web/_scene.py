@@ -614,13 +614,15 @@ class StudioScene(ScenePaths, SceneRobot):
         self._wake.set()
         return playback, playback_time(playback, now)
 
-    def hold_pose(self, q_robot: np.ndarray) -> None:
-        """Show the robot at ``q_robot`` (rad) until the next playback or stop: a jogged pose,
-        a paused playback of one pose."""
+    def hold_pose(self, q_robot: np.ndarray, robot: str | None = None) -> None:
+        """Show ``robot`` (the Puma560 when None) at ``q_robot`` (rad, its joints) until the
+        next playback or stop: a jogged pose, a paused playback of one pose."""
         q = np.repeat(np.asarray(q_robot, dtype=float).reshape(1, -1), 2, axis=0)
         t = np.array([0.0, 1e-3])
         marks = np.zeros(0, dtype=int)
-        playback = Playback(t, q, self.tool_positions(q), marks, time.perf_counter(), paused=True)
+        name = robot or PUMA
+        tool = self.tool_positions(q, name)
+        playback = Playback(t, q, tool, marks, time.perf_counter(), paused=True, robot=name)
         with self._lock:
             self._playback = playback
         self._wake.set()

@@ -306,7 +306,18 @@ class TimelinePublic(BaseModel):
     duration: float = Field(description="the whole recording's length, s")
     times: list[float] = Field(description="s after the first frame")
     human: list[list[float]] = Field(description="the human arm's 7 joints per time, degrees")
-    robot: list[list[float]] = Field(description="the Puma560's 6 joints per time, degrees")
+    robot: list[list[float]] = Field(
+        description="the taught robot's joints per time, degrees (one per `robot_joints`)"
+    )
+    robot_name: str = Field("puma560", description="the robot taught, whose joints `robot` holds")
+    robot_title: str = Field("", description="its name as people read it")
+    robot_joints: list[str] = Field(
+        default_factory=list, description="its own joint names (its URDF's), in order"
+    )
+    robot_notes: list[str] = Field(
+        default_factory=list,
+        description="what retargeting onto it met: the first frame out of its reach, in one sentence",
+    )
     residual_mm: list[float] = Field(description="how far the fitted arm misses, mm")
     signals: list[TimelineSignal] = Field(
         default_factory=list,
@@ -658,6 +669,10 @@ class RobotInfo(BaseModel):
     name: str
     title: str
     joints: list[str]
+    goal_deg: list[float] = Field(
+        default_factory=list,
+        description="its default goal, joints 1-3 in degrees: the train form's goal for it, the goal `studio train --robot NAME` trains towards",
+    )
 
 
 class RobotsPublic(BaseModel):

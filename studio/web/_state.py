@@ -45,6 +45,7 @@ from studio.learning import (
     PolicyFile,
     TilePolicyFile,
     check_goal_deg,
+    default_goal_deg,
 )
 
 from ._errors import ConflictError, InvalidError, NotFoundError, TooManyRequestsError
@@ -384,12 +385,14 @@ class Studio:
         }
 
     def robots_public(self) -> dict[str, object]:
-        """``RobotsPublic``: every offered robot with its joints, and the one taught now."""
+        """``RobotsPublic``: every offered robot with its joints and default goal, and the one
+        taught now."""
         robots = [
             {
                 "name": name,
                 "title": robot_spec(name).title,
                 "joints": list(load_robot(name, geometry=False).joint_names),
+                "goal_deg": list(default_goal_deg(name)),
             }
             for name in robot_names()
         ]

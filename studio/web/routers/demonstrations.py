@@ -7,12 +7,24 @@ deleted.
 
 from __future__ import annotations
 
+import uuid
+
+import numpy as np
 from fastapi import APIRouter, Response
 
 from studio.capture import RECORDING_SUFFIX, RECORDING_SUFFIXES, Demonstration
-from studio.learning import goal_degrees, has_default_goal
+from studio.kinematics import robot_spec
+from studio.learning import (
+    POLICY_SUFFIX,
+    LearningError,
+    fit_dmp_policy,
+    goal_degrees,
+    has_default_goal,
+    save_dmp_policy,
+)
 
 from .._deps import StudioDep
+from .._errors import InvalidError
 from .._runs import prepare_run
 from .._schemas import (
     DemonstrationCreate,
@@ -20,10 +32,12 @@ from .._schemas import (
     DemonstrationMark,
     DemonstrationPublic,
     MarkPublic,
+    PolicyPublic,
     RunCreate,
 )
 from .._state import Studio
 from .._store import StoredFile
+from .policies import policy_public
 
 router = APIRouter(prefix="/api/demonstrations", tags=["demonstrations"])
 
@@ -127,6 +141,37 @@ def read_demonstration(name: str, studio: StudioDep) -> DemonstrationDetail:
         q_robot=demo.q_robot.tolist(),
         grid_path=[int(s) for s in demo.grid_path],
     )
+
+
+@router.post("/{name}/dmp", status_code=201)
+def fit_demonstration_primitive(name: str, studio: StudioDep) -> PolicyPublic:
+    """Fit the movement-primitive baseline (a DMP) to the demonstration on the robot taught, in
+    that robot's joint space (the demonstration retargeted onto it, as a training run replays
+    it), and keep it among the policies as ``<name>-dmp-<robot>`` (a sample's name without its
+    ``sample-`` prefix; ``-2``, ... when taken): it
+    is watched, scored and exported like the others. 404 for no such demonstration; 422 when it
+    cannot be retargeted (its recording gone) or fitted."""
+    studio.demonstrations.load(name)  # 404 with the store's sentence
+    robot = studio.pipeline.robot_name
+    demo = studio.demonstration_path(name, robot)
+    try:
+        policy = fit_dmp_policy(
+            demo.times if demo.times is not None else np.zeros(0),
+            demo.q_robot,
+            robot=robot,
+            notes=f"fitted to the demonstration {name} on the {robot_spec(robot).title}",
+        )
+    except LearningError as err:
+        raise InvalidError(str(err)) from None
+    tmp = studio.policies.folder / f".dmp-{uuid.uuid4().hex}.tmp"
+    try:
+        save_dmp_policy(tmp, policy)
+        taken = studio.policy_names()
+        base = studio.policies.new_name(f"{name}-dmp-{robot}")  # a user's, not a sample's, name
+        new = studio.policies.claim(tmp, base, lambda n: n in taken, suffix=POLICY_SUFFIX)
+    finally:
+        tmp.unlink(missing_ok=True)
+    return policy_public(studio.policies.entry(new))
 
 
 @router.post("/{name}/preview", status_code=202, response_class=Response)

@@ -178,18 +178,24 @@ def read_timeline(
     reviewer: ReviewerDep,
     points: Annotated[int, Query(ge=2, le=MAX_SERIES_POINTS)] = DEFAULT_SERIES_POINTS,
 ) -> TimelinePublic:
-    """The human arm's and the robot's joints over the whole recording, at about ``points``
-    evenly spaced frames (degrees), fitted as a demonstration cut from it would be; and the
-    recording's own values at the same frames (``signals``)."""
+    """The human arm's joints and the taught robot's over the whole recording, at about
+    ``points`` evenly spaced frames (degrees), fitted as a demonstration cut from it would be and
+    retargeted onto that robot as an export would be; and the recording's own values at the same
+    frames (``signals``)."""
 
-    series = reviewer.plotted(name, points)
+    series, on_robot = reviewer.timeline(name, points)
+    arm = on_robot.robot
     return TimelinePublic(
         name=name,
         kind=series.kind,
         duration=series.duration,
         times=series.times.round(4).tolist(),
         human=np.degrees(series.q_human).round(2).tolist(),
-        robot=np.degrees(series.q_robot).round(2).tolist(),
+        robot=np.degrees(on_robot.q).round(2).tolist(),
+        robot_name=arm.name,
+        robot_title=arm.spec.title,
+        robot_joints=list(arm.joint_names),
+        robot_notes=[f.sentence for f in on_robot.findings],
         residual_mm=(series.residual * 1000).round(2).tolist(),
         signals=[
             TimelineSignal(

@@ -13,6 +13,8 @@ import numpy as np
 from fastapi import APIRouter
 from pydantic import BaseModel, Field
 
+from studio.kinematics import RobotArm, load_robot
+
 from .._deps import StudioDep
 from .._errors import ConflictError, InvalidError
 from .._protocols import Scene
@@ -96,7 +98,8 @@ class JogChange(_Body):
 class JointPublic(BaseModel):
     """One joint of the robot and its limits."""
 
-    name: str
+    name: str = Field(description='"joint 1", "joint 2", ...: the slider\'s name on the page')
+    joint: str = Field("", description="the robot's own name for it (its URDF's, `panda_joint1`)")
     lower_deg: float
     upper_deg: float
 
@@ -106,6 +109,8 @@ class JogPublic(BaseModel):
 
     joints: list[JointPublic]
     q_deg: list[float]
+    robot: str = Field("puma560", description="the robot posed: the one taught (`/api/robot`)")
+    title: str = Field("", description="its name as people read it")
 
 
 def _scene(studio: StudioDep) -> Scene:
@@ -195,31 +200,45 @@ def change_follow(body: FollowChange, studio: StudioDep) -> ViewsPublic:
     return read_views(studio)
 
 
-def _joints(scene: Scene) -> list[JointPublic]:
-    lower, upper = np.degrees(scene.robot.lower), np.degrees(scene.robot.upper)
+def _joints(arm: RobotArm) -> list[JointPublic]:
+    """The arm's joints with their limits in degrees, rounded inwards (a slider's end is a pose
+    the arm may take, and joints 1-3 there a goal the learning package accepts)."""
+    lower = np.ceil(np.degrees(arm.lower) * 1e6) / 1e6
+    upper = np.floor(np.degrees(arm.upper) * 1e6) / 1e6
     return [
-        JointPublic(name=f"joint {i + 1}", lower_deg=round(float(lo), 6), upper_deg=round(float(hi), 6))
-        for i, (lo, hi) in enumerate(zip(lower, upper, strict=True))
-    ]  # fmt: skip
+        JointPublic(name=f"joint {i + 1}", joint=joint, lower_deg=float(lo), upper_deg=float(hi))
+        for i, (joint, lo, hi) in enumerate(zip(arm.joint_names, lower, upper, strict=True))
+    ]
+
+
+def _posed(studio: StudioDep) -> RobotArm:
+    """The arm posed by hand: the robot taught (the scene draws it, once its meshes are read)."""
+    return load_robot(studio.pipeline.robot_name, geometry=False)
 
 
 @router.get("/jog")
 def read_jog(studio: StudioDep) -> JogPublic:
-    """The robot's joints with their limits (deg), and the joints the scene shows."""
+    """The taught robot's joints with their limits (deg), and the joints the scene shows (its
+    home pose while the scene still draws another robot)."""
     scene = _scene(studio)
-    q = np.degrees(scene.current_q_robot()).round(6).tolist()
-    return JogPublic(joints=_joints(scene), q_deg=q)
+    arm = _posed(studio)
+    q = scene.current_q_robot()
+    if scene.robot_name != arm.name or len(q) != arm.nq:
+        q = np.asarray(arm.home, dtype=float)
+    q_deg = np.degrees(np.clip(q, arm.lower, arm.upper)).round(6).tolist()
+    return JogPublic(joints=_joints(arm), q_deg=q_deg, robot=arm.name, title=arm.spec.title)
 
 
 @router.post("/jog")
 def jog(body: JogChange, studio: StudioDep) -> JogPublic:
-    """Show the robot at the given joints (deg, each within its limits; 422 otherwise) until
-    the next watch or Stop."""
+    """Show the taught robot at the given joints (deg, one per joint of that robot, each within
+    its limits; 422 otherwise) until the next watch or Stop."""
     scene = _scene(studio)
-    joints = _joints(scene)
+    arm = _posed(studio)
+    joints = _joints(arm)
     if len(body.q_deg) != len(joints):
         raise InvalidError(
-            f"q_deg has {len(body.q_deg)} angles but the robot has {len(joints)} joints; give one angle per joint."
+            f"q_deg has {len(body.q_deg)} angles but the {arm.spec.title} has {len(joints)} joints; give one angle per joint."
         )
     for j, value in zip(joints, body.q_deg, strict=True):
         if not j.lower_deg <= value <= j.upper_deg:
@@ -228,5 +247,5 @@ def jog(body: JogChange, studio: StudioDep) -> JogPublic:
             )
     with studio.watch_lock:
         studio.watching = None  # a pose by hand replaces the policy being watched
-    scene.hold_pose(np.radians(body.q_deg))
-    return JogPublic(joints=joints, q_deg=list(body.q_deg))
+    scene.hold_pose(np.radians(body.q_deg), robot=arm.name)
+    return JogPublic(joints=joints, q_deg=list(body.q_deg), robot=arm.name, title=arm.spec.title)

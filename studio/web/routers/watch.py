@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 from fastapi import APIRouter, Response
 
+from studio.kinematics import DEFAULT_ROBOT
 from studio.learning import (
     DemonstrationMotion,
     DmpPolicyFile,
@@ -40,7 +41,8 @@ ROLLOUT_RATE_HZ = 50.0
 ROUND_DECIMALS = 6
 """Seconds and radians are sent to a micro-unit: far below what the scene can show."""
 TILE_DEMONSTRATION_PATH = "demonstration"
-"""Name of the scene path showing a continuous run's demonstration beside the watched robot."""
+"""Name of the scene path showing a continuous run's (or a movement primitive's) demonstration
+beside the watched robot."""
 TILE_WATCH_MAX_STEPS = 1_500
 """Most joint steps of a watched continuous rollout (a minute of motion at 0.04 s per step)."""
 
@@ -84,11 +86,15 @@ def _demonstration_motions(
         names = list(record.demonstration_names)
     if not names and isinstance(policy, DmpPolicyFile):
         return [DemonstrationMotion("its demonstration", policy.demo_times, policy.demo_q)]
+    robot = policy.robot or DEFAULT_ROBOT
     motions = []
     for name in names:
-        demo = studio.demonstrations.load(name)  # 404 with the store's sentence
+        studio.demonstrations.load(name)  # 404 with the store's sentence
+        # on the policy's robot: the Puma560's stored path, another's retargeted (422 if not)
+        demo = studio.demonstration_path(name, robot)
+        times = demo.times if demo.times is not None else np.zeros(0)
         try:
-            motions.append(DemonstrationMotion.checked(name, demo.times, demo.q_robot))
+            motions.append(DemonstrationMotion.checked(name, times, demo.q_robot))
         except LearningError as err:
             raise InvalidError(str(err)) from None
     return motions
@@ -179,10 +185,10 @@ def _watch_tile_policy(
             if key.startswith("run:")
             else []
         )
-        if demos and task.robot == "puma560":  # the scene draws paths of the Puma560's joints
+        if demos:  # its joints on the task's robot, the others at the goal's
             path = np.tile(np.asarray(task.goal), (len(demos[0]), 1))
             path[:, : task.joints] = np.asarray(demos[0])[:, : task.joints]
-            studio.scene.show_path(TILE_DEMONSTRATION_PATH, path)
+            studio.scene.show_path(TILE_DEMONSTRATION_PATH, path, robot=task.robot)
         studio.scene.play_trajectory(times, q, robot=task.robot)
     return WatchPublic(
         steps=len(path) - 1,
@@ -201,12 +207,15 @@ def _watch_dmp_policy(
     start = None
     if body.start == "current":
         scene = studio.scene
-        start = np.asarray(scene.current_q_robot() if scene else studio.pipeline.q_robot())
+        now = np.asarray(scene.current_q_robot() if scene else studio.pipeline.q_robot())
+        start = now if len(now) == len(policy.goal) else None  # another robot's: its own start
     times, q, reached = rollout_dmp_policy(policy, start, ROLLOUT_RATE_HZ)
     studio.keep_rollout(key, times, q)
     if studio.scene is not None:
-        studio.scene.set_goal(policy.goal)
-        studio.scene.play_trajectory(times, q)
+        studio.scene.set_goal(policy.goal, robot=policy.robot)
+        # the demonstration it was fitted to, beside it, as a continuous run's
+        studio.scene.show_path(TILE_DEMONSTRATION_PATH, policy.demo_q, robot=policy.robot)
+        studio.scene.play_trajectory(times, q, robot=policy.robot)
     return WatchPublic(
         steps=len(times) - 1,
         seed=None,

@@ -3,7 +3,7 @@
 import { api, guarded } from "./api.js";
 import { $, confirmDialog, el, emptyRow, enc, flashRow, fmt, groupRow, setProp, setText, showError } from "./dom.js";
 import { fillExportItems } from "./exports.js";
-import { renderWatchDemos } from "./policies.js";
+import { renderWatchDemos, showNewPolicy } from "./policies.js";
 import { S } from "./state.js";
 
 function currentDemoRecording() {
@@ -101,6 +101,7 @@ function demoRow(d) {
     : el("span", { class: d.reaches_goal ? "badge done" : "badge warn", text: d.reaches_goal ? "reached" : "not reached", title: `goal ${(d.goal || []).map((g) => fmt(g, 0)).join(", ")}°` });
   const actions = [];
   if (!d.error) actions.push(el("button", { class: "icon", title: "preview on the robot", "aria-label": `Preview ${d.name} on the robot`, testid: "demo-preview", onclick: () => previewDemo(d.name) }, "▶"));
+  if (!d.error) actions.push(el("button", { class: "icon", title: "fit a movement primitive (DMP) to it on the robot chosen under Source: a policy to watch, score and export", "aria-label": `Fit a movement primitive to ${d.name}`, testid: "demo-dmp", onclick: (e) => fitPrimitive(d.name, e.currentTarget) }, "≈"));
   if (!d.sample) actions.push(el("button", { class: "icon", title: "delete", testid: "demo-delete", onclick: () => deleteDemo(d.name) }, "✕"));
   return el("tr", { "data-name": d.name, testid: "demo-row", title: d.error || "" },
     el("td", { class: "name", title: d.name }, d.name, d.sample ? " " : null, d.sample ? el("span", { class: "badge", text: "sample", title: "shipped with the studio: read-only" }) : null),
@@ -138,6 +139,15 @@ function renderDemos() {
 
 async function previewDemo(name) {
   await guarded("demo-error", () => api("POST", `/api/demonstrations/${enc(name)}/preview`));
+}
+
+/** Fit the movement-primitive baseline to a demonstration on the robot taught; it joins the
+ * policies, chosen to watch. */
+async function fitPrimitive(name, button) {
+  await guarded("demo-error", async () => {
+    const policy = await api("POST", `/api/demonstrations/${enc(name)}/dmp`);
+    await showNewPolicy(policy);
+  }, button);
 }
 
 async function deleteDemo(name) {

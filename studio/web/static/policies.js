@@ -29,6 +29,7 @@ function policyTask(p) {
   const t = p.task || {};
   if (t.kind === "arm-grid") return `grid ${t.joints}×${t.bins}`;
   if (t.kind === "arm-reach") return `continuous ${t.joints} joints`;
+  if (t.kind === "dmp") return `movement primitive, ${p.joints} joints`;
   return t.kind || "";
 }
 
@@ -91,7 +92,8 @@ export async function watch() {
   await guarded("watch-error", async () => {
     const w = await api("POST", "/api/watch", body);
     const secs = w.times && w.times.length ? w.times[w.times.length - 1] : 0;
-    const from = w.seed == null ? "from the current pose" : `from a random start (seed ${w.seed})`;
+    // a movement primitive has no random start: it starts where its demonstration did
+    const from = w.seed != null ? `from a random start (seed ${w.seed})` : body.start === "current" ? "from the current pose" : "from its demonstration's start";
     setText("watch-result", `${w.steps} steps, ${secs.toFixed(1)} s ${from} — ${w.reached_goal ? "reaches the goal" : "does not reach the goal"}`);
     renderLikeness(w.likeness, w.likeness_note);
     S.watchedRun = t;
@@ -142,10 +144,13 @@ async function deletePolicy(name) {
 }
 
 export async function uploadPolicy(input) {
-  await uploadChosen(input, "/api/policies", "policies-error", async (p) => {
-    await loadPolicies();
-    if (p) { selectWatch(p); flashRow("policies-body", p.name); }
-  });
+  await uploadChosen(input, "/api/policies", "policies-error", showNewPolicy);
+}
+
+/** A policy just made (uploaded, or fitted to a demonstration): listed, chosen to watch, flashed. */
+export async function showNewPolicy(p) {
+  await loadPolicies();
+  if (p) { selectWatch(p); flashRow("policies-body", p.name); }
 }
 
 export function exportFile(kind) {

@@ -115,6 +115,7 @@ function renderRobot(s) {
   const select = $("robot-name");
   if (s.robot && !select.dataset.pending && document.activeElement !== select && select.querySelector(`option[value="${s.robot}"]`)) {
     setProp(select, "value", s.robot);
+    announceRobot(s.robot);
   }
   showTrainedRobot();
   // Joint mode maps the arm onto the Puma560's joints; any other robot follows the hand.
@@ -157,8 +158,18 @@ export async function loadRobots() {
       return o;
     }));
     select.value = body.robot;
+    S.robots = body.robots;
     showTrainedRobot();
+    announceRobot(body.robot);
   });
+}
+
+/** Tell the page's other parts (the train form's goal, the timeline, the jog sliders) that the
+ * robot taught is now ``name``: the `studio:robot` event, once per change. */
+function announceRobot(name) {
+  if (!S.robots || S.robot === name) return;
+  S.robot = name;
+  document.dispatchEvent(new CustomEvent("studio:robot", { detail: name }));
 }
 
 /** The train form says which robot a run trains: the one chosen here. */
@@ -176,6 +187,7 @@ export async function setRobot() {
       const body = await api("PUT", "/api/robot", { name: select.value });
       select.value = body.robot;
       showTrainedRobot();
+      announceRobot(body.robot);
       return true;
     }, select);
     if (!chosen && S.source && S.source.robot) select.value = S.source.robot;

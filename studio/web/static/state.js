@@ -10,6 +10,8 @@ export const S = {
   sweeps: [], // `studio sweep` summaries (GET /api/sweeps); their trials are runs of a group
   openSweeps: new Set(), // sweep ids unfolded in the run list (table, figure, runs)
   policies: [],
+  robots: null, // the offered robots with their joints and default goals (GET /api/robots)
+  robot: null, // the robot taught, as the page last announced it (`studio:robot`, sources.js)
   curves: new Map(), // run id -> {episodes, mean, std, min, max, count}
   shown: new Set(), // run ids plotted
   shownTouched: false, // the user changed which runs are plotted

@@ -1,8 +1,10 @@
 /* Teach Studio page: a recording's timeline, to cut demonstrations seeing the signal.
  *
- * Choosing a recording to cut from (or its row's timeline button) plots the robot's joints (solid)
- * and the human arm's (dashed) over the whole recording, served downsampled by
- * GET /api/recordings/{name}/timeline (uPlot, as the curve chart). "Timeline shows" plots the
+ * Choosing a recording to cut from (or its row's timeline button) plots the joints of the robot
+ * chosen under Source (solid, by its own joint names, retargeted by the server as an export is) and
+ * the human arm's (dashed) over the whole recording, served downsampled by
+ * GET /api/recordings/{name}/timeline (uPlot, as the curve chart); choosing another robot plots
+ * its joints instead. "Timeline shows" plots the
  * recording's own values instead, as the server serves them (``signals``): a tape's bend or twist
  * per region, a camera's landmark visibility, a hand guide's hand position. The robot in the scene follows
  * the playhead: hovering the plot moves it, as do the arrow keys. Dragging selects the segment to
@@ -15,13 +17,13 @@ import { setDemoRange } from "./demos.js";
 import { $, el, enc, fmt, setProp, setText } from "./dom.js";
 import { S } from "./state.js";
 
-const ROBOT = ["#1f4e9c", "#2a7bd8", "#0f8b8d", "#23874b", "#6b4fbb", "#b83280"];
+const ROBOT = ["#1f4e9c", "#2a7bd8", "#0f8b8d", "#23874b", "#6b4fbb", "#b83280", "#5c6b7a"];
 const HUMAN = ["#d9822b", "#b8661f", "#a0522d", "#c9a227", "#e05a47", "#8c6d46", "#7a7a7a"];
 const STEP_S = 0.1;
 
 const UNITS = { deg: (x) => `${x}°`, cm: (x) => `${x} cm` };
 
-const T = { name: null, show: "joints", data: null, chart: null, playhead: 0, playing: false, last: 0, want: null, sending: false };
+const T = { asked: 0, name: null, show: "joints", data: null, chart: null, playhead: 0, playing: false, last: 0, want: null, sending: false };
 S.timeline = T; // for the browser tests and the console
 
 function duration() { return T.data ? T.data.duration : 0; }
@@ -38,9 +40,10 @@ export async function showTimeline(name) {
   const box = $("timeline-plot");
   const points = Math.max(100, Math.min(600, box.clientWidth || 400));
   setText("timeline-time", "fitting the arm to the recording…");
+  const asked = ++T.asked;
   await guarded("timeline-error", async () => {
     const data = await api("GET", `/api/recordings/${enc(name)}/timeline?points=${points}`);
-    if (T.name !== name) return; // another recording was chosen meanwhile
+    if (asked !== T.asked || T.name !== name) return; // another recording or robot was chosen meanwhile
     T.data = data;
     T.playhead = 0;
     showChoices();
@@ -57,6 +60,21 @@ function showChoices() {
   select.replaceChildren(...names.map((n) => el("option", { value: n, text: n === "joints" ? "joints (robot and human arm)" : n, selected: n === T.show })));
 }
 
+/** Say whose joints the solid lines are: the robot's name, then each joint's own, in its colour. */
+function showLegend() {
+  const d = T.data;
+  const box = $("timeline-robot");
+  const joints = T.show === "joints" && d ? d.robot_joints || [] : [];
+  setProp(box, "hidden", !joints.length);
+  if (!joints.length) { box.replaceChildren(); return; }
+  box.replaceChildren(
+    el("span", { text: `solid: joints of the ${d.robot_title}: ` }),
+    ...joints.map((name, j) => el("span", { class: "mono", style: `color: ${ROBOT[j % ROBOT.length]}`, text: `${name} ` })),
+    el("span", { text: "· dashed: the human arm's" }),
+    ...(d.robot_notes || []).map((note) => el("span", { class: "warn", text: ` · ${note}` })),
+  );
+}
+
 /** The plotted columns and their series: the joints, or one group of the recording's values. */
 function plotted(d) {
   const cols = [d.times];
@@ -70,10 +88,11 @@ function plotted(d) {
     });
     return { cols, series, unit: UNITS[group.unit] || String };
   }
-  for (let j = 0; j < 6; j++) {
+  const joints = d.robot_joints || (d.robot[0] || []).map((_, j) => `robot ${j + 1}`);
+  joints.forEach((name, j) => {
     cols.push(d.robot.map((q) => q[j]));
-    series.push({ label: `robot ${j + 1}`, stroke: ROBOT[j], width: 1.5 });
-  }
+    series.push({ label: name, stroke: ROBOT[j % ROBOT.length], width: 1.5 });
+  });
   for (let j = 0; j < 7; j++) {
     cols.push(d.human.map((q) => q[j]));
     series.push({ label: `human ${j + 1}`, stroke: HUMAN[j], width: 1, dash: [4, 3] });
@@ -87,6 +106,7 @@ function draw() {
   const d = T.data;
   const { cols, series, unit } = plotted(d);
   S.timelineShown = series.slice(1).map((s) => s.label); // for the browser tests
+  showLegend();
   const box = $("timeline-plot");
   T.chart = new uPlot({
     width: Math.max(200, box.clientWidth),
@@ -222,6 +242,8 @@ function onKey(ev) {
 }
 
 function wire() {
+  // another robot chosen under Source: plot its joints (the server retargets the recording onto it)
+  document.addEventListener("studio:robot", () => { if (T.name) showTimeline(T.name); });
   $("timeline").addEventListener("keydown", onKey);
   $("timeline-show").addEventListener("change", (e) => { T.show = e.target.value; draw(); });
   $("demo-recording").addEventListener("change", () => showTimeline($("demo-recording").value));

@@ -19,10 +19,35 @@ export function resetTrainForm() {
   const planners = S.config.planners || [defaults.planning];
   f.elements.planning.replaceChildren(...planners.map((p) => el("option", { value: p, text: p })));
   for (const [k, v] of Object.entries(defaults)) {
-    if (k === "goal_deg") v.forEach((g, i) => { f.elements[`goal${i}`].value = String(g); });
+    if (k === "goal_deg") fillGoal(robotGoal() || v);
     else if (f.elements[k] && !(f.elements[k] instanceof RadioNodeList)) f.elements[k].value = v == null ? "" : String(v);
   }
 }
+
+/** The default goal of the robot chosen under Source (joints 1-3, degrees, as GET /api/robots
+ * serves it from the learning package): the goal `studio train --robot NAME` trains towards. */
+function robotGoal() {
+  const robot = (S.robots || []).find((r) => r.name === S.robot);
+  return robot && robot.goal_deg && robot.goal_deg.length ? robot.goal_deg : null;
+}
+
+function fillGoal(goal) {
+  const f = $("train-form");
+  goal.forEach((g, i) => { f.elements[`goal${i}`].value = String(g); });
+}
+
+// Another robot chosen: the form's goal becomes that robot's default (the Puma560's would be
+// another arm's pose, often beyond its limits), and the picked demonstrations are checked again.
+// A goal taken from a pose by hand (watch.js) is checked at once, as Start would check it: a
+// joint within the robot's limits may still fall in a grid bin whose centre lies beyond them.
+document.addEventListener("studio:goal", () => checkTrainForm(true));
+
+document.addEventListener("studio:robot", () => {
+  const goal = robotGoal();
+  if (!goal) return;
+  fillGoal(goal);
+  checkTrainForm();
+});
 
 /** Show every problem of a refused run beside the form, and mark each bad field (null clears). */
 function showTrainErrors(err) {
@@ -115,12 +140,13 @@ function clearCheck() {
 }
 
 /** Check the picked demonstrations against the form's goal and task now, before Start, with the
- * learning package's own resolver (/api/demonstrations/check); show its sentences by field. */
-export async function checkTrainForm() {
+ * learning package's own resolver (/api/demonstrations/check); show its sentences by field.
+ * ``always``: check the goal even with no demonstration picked (a goal taken from a pose). */
+export async function checkTrainForm(always = false) {
   const seq = ++checkSeq;
   let body;
   try { body = readTrainForm(); } catch { return; } // an empty number: Start will say which
-  if (!body.demonstrations.length) { clearCheck(); return; }
+  if (!body.demonstrations.length && always !== true) { clearCheck(); return; }
   let data = {};
   try {
     await api("POST", "/api/demonstrations/check", body); // 204: it would start

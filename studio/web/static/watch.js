@@ -49,6 +49,7 @@ function build() {
     ),
     el("details", { id: "jog", testid: "jog", ontoggle: (e) => { if (e.target.open) loadJog(); } },
       el("summary", { text: "Pose by hand" }),
+      el("p", { class: "muted small", id: "jog-robot", testid: "jog-robot" }),
       el("div", { id: "jog-joints", testid: "jog-joints" }),
       el("div", { class: "row" },
         el("button", { id: "jog-goal", testid: "jog-goal", text: "Use this pose as the goal", title: "fill Train → goal with joints 1–3 of this pose", onclick: useAsGoal }),
@@ -191,17 +192,20 @@ async function loadJog() {
   await guarded("rollout-error", async () => {
     const jog = await api("GET", "/api/scene/jog");
     $("jog-joints").replaceChildren(...jog.joints.map((j, i) => jointRow(j, jog.q_deg[i])));
+    $("jog").dataset.robot = jog.robot;
+    setText("jog-robot", `${jog.title}: ${jog.joints.length} joints, each between its own limits`);
   });
 }
 
 function jointRow(j, value) {
   const label = j.name[0].toUpperCase() + j.name.slice(1);
   const v = Math.min(Math.max(value, j.lower_deg), j.upper_deg);
-  const input = el("input", { type: "range", class: "grow", min: String(j.lower_deg), max: String(j.upper_deg), step: "0.5", value: String(v), "aria-label": label, testid: "jog-joint" });
+  const input = el("input", { type: "range", class: "grow", min: String(j.lower_deg), max: String(j.upper_deg), step: "0.5", value: String(v), "aria-label": label, title: j.joint, testid: "jog-joint" });
   const shown = el("span", { class: "mono w5", testid: "jog-value", text: `${fmt(v, 1)}°` });
   input.addEventListener("input", () => { setText(shown, `${fmt(Number(input.value), 1)}°`); jog(); });
   return el("div", { class: "row jog-row" },
-    el("span", { class: "w5", text: label }),
+    el("span", { class: "w5", text: label, title: j.joint }),
+    el("span", { class: "muted small mono jog-name", testid: "jog-name", title: j.joint, text: j.joint }),
     el("span", { class: "muted small mono", testid: "jog-min", title: `${label}'s lower limit`, text: `${fmt(j.lower_deg, 0)}°` }),
     input,
     el("span", { class: "muted small mono", testid: "jog-max", title: `${label}'s upper limit`, text: `${fmt(j.upper_deg, 0)}°` }),
@@ -230,19 +234,30 @@ async function jog() {
   showRollout(null); // a pose by hand replaces the rollout being scrubbed
 }
 
+/** A slider's angle to a hundredth of a degree, as a person types a goal, kept within its limits
+ * (a slider's values step from its lower limit, so they carry its decimals). */
+function goalAngle(input) {
+  const lo = Math.ceil(Number(input.min) * 100) / 100;
+  const hi = Math.floor(Number(input.max) * 100) / 100;
+  return Math.min(hi, Math.max(lo, Math.round(Number(input.value) * 100) / 100));
+}
+
 function useAsGoal() {
-  const q = jogValues();
-  if (q.length < GOAL_JOINTS) { showError("rollout-error", "Open Pose by hand and set the joints first."); return; }
+  const sliders = [...$("jog-joints").querySelectorAll("input[type=range]")];
+  if (sliders.length < GOAL_JOINTS) { showError("rollout-error", "Open Pose by hand and set the joints first."); return; }
   const f = $("train-form");
   for (let i = 0; i < GOAL_JOINTS; i++) {
     const input = f.elements[`goal${i}`];
-    input.value = String(q[i]);
+    input.value = String(goalAngle(sliders[i]));
     input.dispatchEvent(new Event("change", { bubbles: true }));
   }
   showError("rollout-error", null);
+  document.dispatchEvent(new CustomEvent("studio:goal")); // the train form checks it now
 }
 
 build();
 document.addEventListener("studio:watch", loadRollout);
+// Another robot chosen under Source: the sliders become its joints, between its limits.
+document.addEventListener("studio:robot", () => { if ($("jog").open) loadJog(); else $("jog-joints").replaceChildren(); });
 $("watch-stop").addEventListener("click", () => showRollout(null)); // the robot goes back to live
 loadRollout();
