@@ -190,3 +190,11 @@ def shot(page: Any, name: str, section: str | None = None) -> Path:
     path = ARTIFACTS / f"{name}.png"
     page.screenshot(path=str(path))
     return path
+
+
+def pose_by_hand(page: Any, unfolded: bool = True) -> None:
+    """Unfold (or fold) the Watch panel's "Pose by hand" as a person would: by clicking its title,
+    only when it is not so already (stories share one page, and one may leave it open)."""
+    details = page.get_by_test_id("jog")
+    if (details.get_attribute("open") is not None) != unfolded:
+        page.get_by_text("Pose by hand").click()

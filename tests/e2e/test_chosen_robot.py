@@ -13,7 +13,7 @@ import pytest
 
 from studio.kinematics import load_robot
 from studio.learning import check_goal_deg, default_goal
-from tests.e2e.conftest import Studio, shot
+from tests.e2e.conftest import Studio, pose_by_hand, shot
 from tests.web.conftest import wait_for
 
 pytestmark = pytest.mark.e2e
@@ -82,7 +82,7 @@ def test_the_timeline_goal_and_jog_sliders_follow_the_robot_chosen(
         assert _goal(page) == pytest.approx(_default_goal_deg("panda"), abs=0.005)
 
         # the jog sliders: one per Panda joint, between its own limits, drawn at both ends
-        page.get_by_text("Pose by hand").click()
+        pose_by_hand(page)
         page.get_by_role("slider", name="Joint 7").wait_for(state="visible", timeout=LOAD_MS)
         rows = page.locator("#jog-joints .jog-row")
         assert rows.count() == 7
@@ -164,7 +164,7 @@ def test_the_timeline_goal_and_jog_sliders_follow_the_robot_chosen(
     # the next stories start from the defaults, the robot following the live source
     page.get_by_test_id("train-defaults").click()
     assert _goal(page) == pytest.approx(_default_goal_deg("puma560"), abs=0.005)
-    page.get_by_text("Pose by hand").click()  # folded again
+    pose_by_hand(page, unfolded=False)  # folded again
     studio_server.send("POST", "/api/watch/stop")
     assert not studio_server.get("/api/scene/playback")["active"]
     assert not page.errors  # type: ignore[attr-defined]

@@ -16,7 +16,7 @@ import pytest
 
 from tests.web.test_policies import policy_bytes
 
-from .conftest import Studio, shot
+from .conftest import Studio, pose_by_hand, shot
 from .test_stories import _pixels, _scene_png, _wait
 
 pytestmark = pytest.mark.e2e
@@ -173,7 +173,7 @@ def test_camera_presets_move_the_scene_camera(page: Any, studio_server: Studio) 
 
 
 def test_pose_the_robot_by_hand_and_use_it_as_the_goal(page: Any, studio_server: Studio) -> None:
-    page.get_by_text("Pose by hand").click()
+    pose_by_hand(page)
     joint1 = page.get_by_role("slider", name="Joint 1")
     joint1.wait_for(state="visible", timeout=T)
     rows = page.locator("#jog-joints .jog-row")
