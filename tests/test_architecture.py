@@ -105,6 +105,7 @@ FOR_USERS = {
             "studio.learning.curve_statistics",
             "studio.learning.downsample_curve",
             "studio.learning.grid_for_goal",
+            "studio.learning.check_goal_deg",
             "studio.learning.TabularMDP",
             "studio.learning.load_dmp_policy",
             "studio.learning.save_dmp_policy",

@@ -132,7 +132,12 @@ class OperatorMotion:
 
     def reach(self, q_robot_goal: np.ndarray) -> None:
         """Start a movement from the current pose that ends (and holds) at the robot goal."""
-        goal = self.human_of(q_robot_goal)
+        self.reach_human(self.human_of(q_robot_goal))
+
+    def reach_human(self, q_human_goal: np.ndarray) -> None:
+        """Start a movement from the current pose that ends (and holds) at this arm pose (rad,
+        (7,), kept within the arm's limits)."""
+        goal = np.clip(np.asarray(q_human_goal, dtype=float), self.arm.lower, self.arm.upper)
         with self._lock:
             current = self._pose_at(self.k)
             frames = self._movement_frames()
@@ -357,6 +362,12 @@ class SimulatorSource(ThreadedSource[TapeFrame]):
         now until :meth:`wander`, marking the demonstration in the recording.
         """
         self._sim.motion.reach(np.asarray(q_robot_goal, dtype=float))
+
+    def reach_human(self, q_human_goal: np.ndarray) -> None:
+        """Make the operator reach (and hold) this arm pose (rad, (7,)): a goal of another robot
+        than the Puma560, turned into the arm that puts the hand where that robot's tool goes
+        (:meth:`studio.kinematics.Retargeter.human_reaching`). Marked like :meth:`reach`."""
+        self._sim.motion.reach_human(np.asarray(q_human_goal, dtype=float))
 
     def wander(self) -> None:
         """Return to random reaching after :meth:`reach`."""

@@ -153,6 +153,19 @@ def _soft_ceiling(r: float, ceiling: float, width: float) -> float:
     return r if r <= knee else knee + width * math.tanh((r - knee) / width)
 
 
+def _unfloored(z: float, floor: float, width: float) -> float:
+    """The ``z`` that :func:`_soft_floor` keeps at ``z`` (a height at the floor or below: as far
+    below it as the softplus allows, ``width`` times the float's smallest log)."""
+    y = max((z - floor) / width, 1e-300)
+    return floor + width * (y + math.log(-math.expm1(-y)) if y > 30.0 else math.log(math.expm1(y)))
+
+
+def _unbent(r: float, ceiling: float, width: float) -> float:
+    """The ``r`` that :func:`_soft_ceiling` bends to ``r`` (one at the ceiling or beyond: far out)."""
+    knee = ceiling - width
+    return r if r <= knee else knee + width * math.atanh(min((r - knee) / width, 1.0 - 1e-12))
+
+
 PINNED = 0.01
 """A joint within this share of its range from a limit counts as pinned there."""
 
@@ -429,6 +442,51 @@ class Retargeter:
         for j, (i, _, offset, _) in enumerate(JOINT_MAP):
             q_human[i] = (q[j] - offset) * signs[j]
         return np.minimum(np.maximum(q_human, self.arm.lower), self.arm.upper)
+
+    def human_reaching(self, q_robot: object, q_seed: object = None) -> np.ndarray:
+        """Operator arm angles whose retargeting puts the robot at ``q_robot``, in either mode.
+
+        Joint mode (the Puma560): :meth:`human_from_robot`, exact. Cartesian mode: the hand pose
+        whose target (:meth:`hand_target`) is the robot's tool pose at ``q_robot``, undoing the
+        soft limits of the reach and the table, the placement, the scale and the mirror, then
+        the arm that holds the hand there (:func:`fit_hand_pose`, within the arm's limits; where
+        the arm cannot, the closest it can). The simulator uses it to reach a goal of any robot.
+
+        Args:
+            q_robot: the robot's angles (rad), its ``nq``.
+            q_seed: where the hand guide's solver starts (rad, (7,)); default: the neutral arm.
+
+        Returns:
+            ``q_human`` (rad, shape (7,)), within the arm's limits.
+
+        Raises:
+            KinematicsError: wrong shape or non-finite angles.
+        """
+        robot = self.robot
+        if self.mode == "joint" or not isinstance(robot, RobotArm):
+            return self.human_from_robot(q_robot)
+        from ._hand_ik import fit_hand_pose
+
+        tool = robot.forward(robot.check_q(q_robot, "q_robot"))
+        R = tool[:3, :3] @ robot.tool_axes.T @ HAND_TO_TOOL.T
+        # undo the target's soft limits, the reach's (applied last) first, then the table's
+        config, t = self.config, tool[:3, 3].copy()
+        offset = t - robot.shoulder
+        distance = float(np.linalg.norm(offset))
+        if distance > 0.0:
+            ceiling = config.reach_fraction * robot.reach
+            t = robot.shoulder + offset * (
+                _unbent(distance, ceiling, config.reach_softness) / distance
+            )
+        t[2] = _unfloored(float(t[2]), config.floor_height, config.floor_softness)
+        p = (t - self._shoulder()) / self._scale()
+        if self._mirror:  # both mirrors are their own inverses
+            R = SAGITTAL_MIRROR @ R @ URDF_LATERAL_MIRROR
+        oMhand = np.eye(4)
+        oMhand[:3, :3] = R
+        oMhand[:3, 3] = self._mirrored(p)
+        q = fit_hand_pose(oMhand, self.arm.side, q_seed).q_human
+        return np.minimum(np.maximum(q, self.arm.lower), self.arm.upper)
 
 
 @dataclass(frozen=True)

@@ -46,9 +46,9 @@ from ._errors import LearningError as LearningError
 from ._errors import PolicyFileError as PolicyFileError
 from ._experiments import run_experiments as run_experiments
 from ._goal import DEFAULT_GOAL_JOINTS_DEG as DEFAULT_GOAL_JOINTS_DEG
-from ._goal import GOAL_JOINTS as GOAL_JOINTS
 from ._goal import check_goal_deg as check_goal_deg
 from ._goal import default_goal_deg as default_goal_deg
+from ._goal import goal_pose as goal_pose
 from ._goal import grid_for_goal as grid_for_goal
 from ._gym import register as _register_environments
 from ._learner import LiveProgress as LiveProgress

@@ -40,6 +40,19 @@ def default_goal_deg(robot: str = PUMA560) -> tuple[float, ...]:
     return tuple(float(v) for v in np.clip(goal, lower, upper))
 
 
+def goal_pose(goal_deg: Sequence[float] | np.ndarray, robot: str = PUMA560) -> np.ndarray:
+    """Robot ``robot``'s whole pose for a goal of its first joints (degrees), radians ``(nq,)``:
+    those joints at ``goal_deg``, the others at :func:`default_goal` (the Puma560's wrist at zero).
+    The pose a run, the simulator's reach and the scene's goal take for a goal of joints 1-3.
+
+    Raises:
+        ConfigError: not three finite angles within the robot's limits (field ``goal_deg``).
+    """
+    full = default_goal(robot).copy()
+    full[:GOAL_JOINTS] = np.radians(check_goal_deg(goal_deg, robot))
+    return full
+
+
 @cache
 def robot_limits_deg(robot: str = PUMA560) -> tuple[np.ndarray, np.ndarray]:
     """The robot's joint limits for joints 1-3, degrees ``(lower, upper)``."""

@@ -27,10 +27,10 @@ from ._arm import ArmGrid
 from ._config import DEFAULT_EPISODES, DEFAULT_EXPERIMENTS, DEFAULT_SEED, DynaQConfig
 from ._demo_motion import DemonstrationMotion, demonstration_grid_path
 from ._errors import ConfigError, LearningError
-from ._goal import goal_problems, grid_for_goal
+from ._goal import goal_pose, goal_problems, grid_for_goal
 from ._reach import ArmReach
 from ._reproduce import generate_demonstrations
-from ._robot import PUMA560, check_robot, default_goal, robot_title, task_arm
+from ._robot import PUMA560, check_robot, robot_title, task_arm
 from ._run_record import (
     CONFIG_FORM_FIELDS,
     TASK_ARM_GRID,
@@ -362,7 +362,7 @@ def _reach_record(
     request: RunRequest, config: DynaQConfig | None, problems: list[tuple[str, str]]
 ) -> RunRecord:
     """:func:`resolve_run` for the continuous task. Its goal is the first demonstration's final
-    pose, else ``goal_deg`` for joints 1-3 with the wrist at zero, else the task's default."""
+    pose, else ``goal_deg`` for joints 1-3 (:func:`goal_pose`), else the task's default."""
     paths = [np.asarray(d.q_robot, dtype=np.float64) for d in request.demonstrations]
     goal: tuple[float, ...] | None = None
     robot = request.robot
@@ -372,9 +372,7 @@ def _reach_record(
         wrong = goal_problems(request.goal_deg, robot)
         problems += [("goal_deg", text) for text in wrong]
         if not wrong:
-            full = default_goal(robot)  # the joints beyond the goal's at the robot's default
-            full[: len(request.goal_deg)] = np.radians(request.goal_deg)
-            goal = tuple(full)
+            goal = tuple(goal_pose(request.goal_deg, robot))
     built = _reach_task(request, goal, problems)
     if built is None or config is None:
         raise_problems(

@@ -227,6 +227,16 @@ class Pipeline:
             self._robot_note = None
             self._q_robot = np.zeros(ROBOT_JOINTS) if arm is None else np.array(arm.home)
 
+    def human_reaching(self, q_robot: np.ndarray) -> np.ndarray:
+        """The operator's arm pose whose retargeting puts the robot taught at ``q_robot``
+        (:meth:`~studio.kinematics.Retargeter.human_reaching`, on a copy of the robot's model so
+        the live retargeting is not disturbed)."""
+        with self._lock:
+            arm, mirror = self._arm, self._mirror
+        robot = None if arm is None else arm.scratch_copy()
+        retargeter = Retargeter(robot=robot, arm=HumanArm(side=self.side()), mirror=mirror)
+        return retargeter.human_reaching(q_robot)
+
     @property
     def robot_name(self) -> str:
         """The robot taught (``puma560`` unless another was chosen)."""

@@ -209,7 +209,8 @@ class ReachAction(_Body):
     """Tell the simulated operator to reach a robot goal (or to go back to random reaching)."""
 
     action: Literal["reach", "wander"] = "reach"
-    goal_deg: list[float] = Field(default_factory=lambda: list(DEFAULT_GOAL_DEG))
+    goal_deg: list[float] | None = None
+    """Joints 1-3 of the goal in degrees; None: the default goal of the robot taught."""
 
 
 class RetargetUpdate(_Body):

@@ -40,12 +40,11 @@ from studio.kinematics import (
     robot_spec,
 )
 from studio.learning import (
-    GOAL_JOINTS,
     DemonstrationPath,
     PolicyFile,
     TilePolicyFile,
-    check_goal_deg,
     default_goal_deg,
+    goal_pose,
 )
 
 from ._errors import ConflictError, InvalidError, NotFoundError, TooManyRequestsError
@@ -242,12 +241,14 @@ class Studio:
             current.loop = loop
         return True
 
-    def simulator_reach(self, action: str, goal_deg: list[float]) -> None:
-        """Make the simulator reach a robot goal (``goal_deg``, joints 1-3) or wander again.
+    def simulator_reach(self, action: str, goal_deg: list[float] | None = None) -> None:
+        """Make the simulator reach a goal of the robot taught (``goal_deg``, joints 1-3) or
+        wander again; no goal: the robot's default goal. The Puma560's goal is mirrored joint by
+        joint; another robot's is the arm that puts the hand where that robot's tool goes at it.
 
         Raises:
             ConflictError: the live source is not the simulator.
-            ConfigError: the goal is not 3 angles within the Puma560's limits.
+            ConfigError: the goal is not 3 angles within the robot's limits.
         """
         source = self.pipeline.source
         if self.pipeline.kind != "simulator" or not isinstance(source, SimulatorSource):
@@ -257,10 +258,14 @@ class Studio:
         if action == "wander":
             source.wander()
             return
-        q = goal_q_robot(goal_deg)
-        source.reach(q)
+        robot = self.pipeline.robot_name
+        q = goal_pose(default_goal_deg(robot) if goal_deg is None else goal_deg, robot)
+        if robot == DEFAULT_ROBOT:  # the Puma560: its joints mirror the arm's one by one
+            source.reach(q)
+        else:
+            source.reach_human(self.pipeline.human_reaching(q))
         if self.scene is not None:
-            self.scene.set_goal(q)
+            self.scene.set_goal(q, robot)
 
     def _fed_source(self, kind: str) -> CameraSource | HandSource:
         """The live fed source ``kind`` (camera or hand).
@@ -703,15 +708,3 @@ def _playback_state(source: PlaybackSource) -> dict[str, object]:
         "duration": float(source.duration),
         "loop": bool(source.loop),
     }
-
-
-def goal_q_robot(goal_deg: list[float]) -> np.ndarray:
-    """A Puma560 pose (rad, (6,)) with joints 1-3 at ``goal_deg`` and the wrist at zero.
-
-    Raises:
-        ConfigError: not three finite angles within the robot's limits (the learning package's
-            one goal check, as for a run).
-    """
-    q = np.zeros(6)
-    q[:GOAL_JOINTS] = np.radians(check_goal_deg(goal_deg))
-    return q

@@ -107,3 +107,43 @@ def test_the_shipped_samples_are_listed_and_train(open_client, tmp_path):
     assert client.app.state.studio.runs.wait_idle(60)
     done = client.get(f"/api/runs/{run.json()['id']}").json()
     assert done["status"] == "done"
+
+
+def test_the_simulator_reaches_a_goal_of_the_robot_chosen(open_client):
+    """With the Panda chosen, "reach" takes the Panda's goal (joints 1-3, the others at its
+    default): the simulated operator moves until the Panda, retargeted from the fitted arm, holds
+    its tool where the goal puts it, and the scene's goal is the Panda's."""
+    from studio.kinematics import load_robot
+    from studio.learning import default_goal_deg, goal_pose
+
+    client = open_client(source="simulator")
+    assert wait_for(lambda: client.get("/api/source").json()["fit_residual_mm"] is not None)
+    assert client.put("/api/robot", json={"name": "panda"}).status_code == 200
+    goal_deg = list(default_goal_deg("panda"))
+    goal_deg[0] += 20.0  # off the default, so a Puma560 reading of it would land elsewhere
+    r = client.post("/api/source/reach", json={"goal_deg": goal_deg})
+    assert r.status_code == 200, r.text
+    simulator = client.app.state.studio.pipeline.source
+    assert wait_for(lambda: simulator._sim.motion.frames_to_goal() == 0, timeout=20)
+    panda = load_robot("panda", geometry=False)
+    wanted = panda.forward(goal_pose(goal_deg, "panda"))[:3, 3]
+
+    def tool_error() -> float:
+        q = np.asarray(client.app.state.studio.pipeline.q_robot())
+        return float(np.linalg.norm(panda.forward(q)[:3, 3] - wanted))
+
+    # the simulator's tremor and the tape's noise stay: within 2 cm of the goal's tool
+    assert wait_for(lambda: tool_error() < 0.02, timeout=20), tool_error()
+    # no goal given: the Panda's default goal (not the Puma560's angles read as the Panda's)
+    assert client.post("/api/source/reach", json={}).status_code == 200
+    wanted = panda.forward(goal_pose(default_goal_deg("panda"), "panda"))[:3, 3]
+    assert wait_for(lambda: simulator._sim.motion.frames_to_goal() == 0, timeout=20)
+    assert wait_for(lambda: tool_error() < 0.02, timeout=20), tool_error()
+
+
+def test_a_goal_beyond_the_chosen_robots_limits_is_refused_naming_it(open_client):
+    client = open_client(source="simulator")
+    assert client.put("/api/robot", json={"name": "panda"}).status_code == 200
+    r = client.post("/api/source/reach", json={"goal_deg": [0.0, 120.0, 0.0]})  # joint 2: ±101°
+    assert r.status_code == 422
+    assert "joint 2" in r.text

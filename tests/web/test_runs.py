@@ -553,12 +553,11 @@ def test_the_page_marks_where_a_run_averages_fewer_experiments(page_server, brow
     "goal", [[170.0, 0.0, 0.0], [0.0, 120.0, -150.0], [0.0, 0.0], [1, "up", 2]]
 )
 def test_the_simulators_reach_and_a_run_check_a_goal_with_one_function(client, goal):
-    from studio.learning import ConfigError
+    from studio.learning import ConfigError, goal_pose
     from studio.learning._goal import goal_problems
-    from studio.web._state import goal_q_robot
 
     with pytest.raises(ConfigError) as err:
-        goal_q_robot(goal)
+        goal_pose(goal)
     assert err.value.problems == goal_problems(goal)
     r = client.post("/api/runs", json={**TINY_RUN, "goal_deg": goal})
     if r.status_code == 422 and "problems" in r.json():

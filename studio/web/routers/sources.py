@@ -56,8 +56,8 @@ def set_retarget(body: RetargetUpdate, studio: StudioDep) -> SourcePublic:
 
 @router.post("/reach")
 def simulator_reach(body: ReachAction, studio: StudioDep) -> SourcePublic:
-    """Make the simulated operator reach the pose that mirrors onto a robot goal (joints 1-3,
-    degrees; the default goal when omitted), or go back to random reaching (409 if the source is
+    """Make the simulated operator reach the pose that retargets onto a goal of the robot taught
+    (joints 1-3, degrees; its default goal when omitted), or go back to random reaching (409 if the source is
     not the simulator). Handy for recording demonstrations that end at the goal."""
     studio.simulator_reach(body.action, body.goal_deg)
     return SourcePublic.model_validate(studio.source_public())
