@@ -9,6 +9,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from studio.export import (
+    ExportError,
     Motion,
     SafetyError,
     check_trajectory,
@@ -237,3 +238,40 @@ def test_a_path_that_comes_back_to_where_it_started_is_timed(tmp_path):
     )
     _within_limits(PUMA, read_csv(tmp_path / "t.csv")[1])
     assert np.allclose(done.q[0], a) and np.allclose(done.q[-1], a)
+
+
+def _toppra_fails(monkeypatch, when) -> None:
+    """Make TOPP-RA find no timing for a path of waypoints ``q`` where ``when(q)``."""
+    import toppra.algorithm
+
+    compute = toppra.algorithm.TOPPRA.compute_trajectory
+
+    def failing(self, *args, **kwargs):
+        return None if when(self.path.waypoints[1]) else compute(self, *args, **kwargs)
+
+    monkeypatch.setattr(toppra.algorithm.TOPPRA, "compute_trajectory", failing)
+
+
+def test_where_toppra_fails_the_path_is_timed_in_parts_stopping_between_them(monkeypatch, tmp_path):
+    _toppra_fails(monkeypatch, lambda q: len(q) > 2)  # only single steps get a timing
+    q = _across_range(PUMA, [[0, 0, 0, 0, 0, 0], [0.5, 0.2, 0, 0, 0, 0], [0.5, 0.6, 0.3, 0, 0, 0]])
+    rows = _export_exactly(q, 50.0, 0.8, tmp_path / "t.csv")
+    t, samples = rows[:, 0], rows[:, 1:]
+    nearest = int(np.argmin(np.abs(samples - q[1]).max(axis=1)))
+    # it comes to rest at the middle waypoint, between two samples of the rate's grid
+    assert np.abs(samples[nearest] - q[1]).max() < 1e-3
+    speed = np.abs(np.diff(samples, axis=0)).max(axis=1) / np.diff(t)
+    assert speed[nearest - 1 : nearest + 1].max() < 0.05 < speed.max()
+
+
+def test_a_step_toppra_cannot_time_is_refused_naming_its_samples(monkeypatch, tmp_path):
+    _toppra_fails(monkeypatch, lambda q: True)
+    q = _across_range(PUMA, [[0, 0, 0, 0, 0, 0], [0, 0, 0, 0, 0, 0], [0.5, 0, 0, 0, 0, 0]])
+    motion = Motion("policy", "p", PUMA, np.zeros(len(q)), q, False, 50.0)
+    with pytest.raises(ExportError) as err:
+        export_motion(motion, "csv", tmp_path / "t.csv")
+    message = str(err.value)
+    assert "\n" not in message and message.endswith(".")
+    assert "from its sample 0 to its sample 2" in message  # sample 1 repeats sample 0
+    assert "smooth the path there" in message
+    assert not (tmp_path / "t.csv").exists()
