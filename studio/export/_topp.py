@@ -3,8 +3,8 @@
 :func:`studio.export.time_path` thins a path to its waypoints; this times the curve through
 them. Imported only when a path is timed: ``toppra`` takes seconds to import.
 
-Three things make TOPP-RA time every path within the limits, where a plain call failed on some
-(found by ``tests/export/test_safety.py``'s property test):
+What makes TOPP-RA time every path within the limits, where a plain call failed on one random
+path in a hundred (found by ``tests/export/test_safety.py``'s property test):
 
 - **The path parameter is the joint-space arc length** (rad), not a share of the path in [0, 1]:
   on a path of a fraction of a degree, the share's derivatives are tiny and the path speed's
@@ -20,6 +20,10 @@ Three things make TOPP-RA time every path within the limits, where a plain call 
   puts a point on every waypoint (where a shape-preserving curve's second derivative jumps) and
   halves its steps where the path turns sharply, so the samples between grid points stay within
   the limits too.
+- **The curve's range is found exactly** (:func:`curve_range`), so a spline that bulges past a
+  position limit between waypoints is always replaced by one that cannot.
+- **A last resort:** where TOPP-RA still finds no timing, the path is timed in parts that stop at
+  its slowest waypoint (:func:`topp`); no random path has needed it since the above.
 """
 
 from __future__ import annotations
