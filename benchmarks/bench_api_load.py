@@ -87,13 +87,21 @@ def free_port() -> int:
 class Studio:
     """A studio in a child process on loopback, and a small JSON client for it."""
 
-    def __init__(self, niceness: int, data: Path, background_prepare: bool = True) -> None:
+    def __init__(
+        self,
+        niceness: int,
+        data: Path,
+        background_prepare: bool = True,
+        code: str = SERVER,
+        **extra: object,
+    ) -> None:
+        """Start ``code`` (default :data:`SERVER`) with its arguments, and ``extra`` ones."""
         self.port = free_port()
-        args = {"niceness": niceness, "data": str(data), "port": self.port}
+        args = {"niceness": niceness, "data": str(data), "port": self.port, **extra}
         args["background_prepare"] = background_prepare
         args["viser_port"] = free_port()
         self.process = subprocess.Popen(
-            [sys.executable, "-c", SERVER, json.dumps(args)],
+            [sys.executable, "-c", code, json.dumps(args)],
             stdout=subprocess.DEVNULL,
             stderr=subprocess.PIPE,
             text=True,

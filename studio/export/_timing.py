@@ -3,14 +3,11 @@
 A policy rollout or a demonstration is a *path* (where the joints go); how fast it is run is set
 here with TOPP-RA (``toppra``): the time-optimal timing along the path that keeps every joint's
 velocity and acceleration within a fraction of the URDF's limits. The path is first cleared of
-repeated samples and thinned to the waypoints that matter (no sample of the original path is
-further than :data:`PATH_TOLERANCE_RAD` from the thinned one, joint by joint), so the capture
-noise of a demonstration does not force the arm to crawl. The path through the waypoints (by
-arc length) is a cubic spline; where that overshoots a position limit (it did past the Panda's
-joint 6 on a sample demonstration), a shape-preserving cubic (PCHIP), which never goes beyond
-two consecutive waypoints, is used instead: slower to run (its second derivative jumps at the
-waypoints), but within the limits wherever the waypoints are. The timing starts and ends at
-rest.
+steps shorter than :data:`STILL_RAD` and thinned to the waypoints that matter (no sample of the
+original path is further than :data:`PATH_TOLERANCE_RAD` from the thinned one, joint by joint),
+so the capture noise of a demonstration does not force the arm to crawl. The curve through the
+waypoints and how TOPP-RA is set up to time every such path are ``_topp.py``'s. The timing
+starts and ends at rest, and ends where the path does.
 
 Why TOPP-RA rather than Ruckig: Ruckig's open-source edition plans from one state to one target
 and does not pass through intermediate waypoints, so a path of many waypoints would stop at each
@@ -33,10 +30,11 @@ PATH_TOLERANCE_RAD = np.radians(0.5)
 LIMIT_FRACTION = 0.8
 """The share of each velocity and acceleration limit the timing uses by default: headroom for
 the controller's tracking and the spline's sampling, checked afterwards against the full limits."""
-GRID_PER_WAYPOINT = 20
-"""TOPP-RA grid points per waypoint: it bounds the limits at its grid points only, and 20 keeps
-the samples between them within the limits on the first pass for the sample demonstrations (8
-did not, and the retiming below then cost a quarter more time)."""
+STILL_RAD = 1e-6
+"""A step of the path shorter than this on every joint (rad) is no motion: a sixth of a 20-bit
+encoder's count (6e-6 rad), and TOPP-RA's LP solver, whose tolerances are absolute, fails on
+steps of a ten-millionth of a radian. A path that never leaves its first sample by this much is
+held still there."""
 RETIME_FACTOR = 0.8
 """TOPP-RA bounds the limits at its grid points only; when the sampled trajectory still exceeds
 a limit between them, the timing is run again with the limits scaled by this factor."""
@@ -93,25 +91,40 @@ def time_path(
         )
     if not 0 < fraction <= 1:
         raise ExportError(f"The limit fraction is {fraction!r}; give a number in (0, 1].")
-    q = _moving(np.asarray(q, dtype=float))
-    if len(q) < 2:
-        return np.zeros(1), q[:1].copy()
-    # thinning can leave a path that comes back to a waypoint with a step of zero length
-    q = _moving(q[_thin(q, tolerance)])
-    if len(q) < 2:
-        return np.zeros(1), q[:1].copy()
-    times, samples = _toppra(robot, q, rate_hz, fraction)
+    q = np.asarray(q, dtype=float)
+    kept = _moving(q, np.arange(len(q)))
+    # thinned, a path that comes back within the tolerance can leave a step of zero length
+    kept = _moving(q, kept[_thin(q[kept], tolerance)])
+    if len(kept) < 2:  # it never leaves its start by more than STILL_RAD: held still there
+        return np.zeros(1), q[kept[:1]].copy()
+    from ._topp import GRID_TURN_RAD, topp  # imports toppra: seconds, so only when timing
+
+    turn = GRID_TURN_RAD
+    times, samples = topp(robot, q[kept], rate_hz, fraction, turn, kept)
     for _ in range(RETIME_TRIES - 1):
         if within_limits(robot, times, samples):
             break
         fraction *= RETIME_FACTOR
-        times, samples = _toppra(robot, q, rate_hz, fraction)
+        turn /= 4
+        times, samples = topp(robot, q[kept], rate_hz, fraction, turn, kept)
     return times, samples
 
 
-def _moving(q: np.ndarray) -> np.ndarray:
-    """``q`` without the samples that repeat the one before (a path's length must grow)."""
-    return q[np.r_[True, np.abs(np.diff(q, axis=0)).max(axis=1) > 1e-9]] if len(q) else q
+def _moving(q: np.ndarray, rows: np.ndarray) -> np.ndarray:
+    """The ``rows`` of ``q`` that move on from the last one kept by more than
+    :data:`STILL_RAD` (a path's length must grow by a step TOPP-RA can time). The last row
+    stays (in place of the one kept before it, when that is nearer): the path ends where given."""
+    if len(rows) == 0:
+        return rows
+    kept = [rows[0]]
+    for row in rows[1:]:
+        if np.abs(q[row] - q[kept[-1]]).max() > STILL_RAD:
+            kept.append(row)
+    if len(kept) > 1 and kept[-1] != rows[-1]:  # end where given, not a step short of it
+        kept[-1] = rows[-1]
+        while len(kept) > 2 and np.abs(q[kept[-1]] - q[kept[-2]]).max() <= STILL_RAD:
+            del kept[-2]
+    return np.asarray(kept)
 
 
 def within_limits(robot: RobotArm, times: np.ndarray, q: np.ndarray) -> bool:
@@ -123,71 +136,3 @@ def within_limits(robot: RobotArm, times: np.ndarray, q: np.ndarray) -> bool:
         (np.abs(velocity) <= robot.velocity).all()
         and (np.abs(acceleration) <= robot.acceleration).all()
     )
-
-
-def _toppra(
-    robot: RobotArm, q: np.ndarray, rate_hz: float, fraction: float
-) -> tuple[np.ndarray, np.ndarray]:
-    import toppra
-    import toppra.algorithm
-    import toppra.constraint
-
-    s = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(q, axis=0), axis=1))]
-    s /= s[-1]
-    toppra.setup_logging("WARNING")
-    path = toppra.SplineInterpolator(s, q, bc_type="clamped")
-    dense = path(np.linspace(0.0, 1.0, max(400, GRID_PER_WAYPOINT * len(q))))
-    if (dense < robot.lower).any() or (dense > robot.upper).any():
-        path = _shape_preserving_path(s, q)
-    velocity = fraction * robot.velocity
-    acceleration = fraction * robot.acceleration
-    instance = toppra.algorithm.TOPPRA(
-        [
-            toppra.constraint.JointVelocityConstraint(np.column_stack([-velocity, velocity])),
-            toppra.constraint.JointAccelerationConstraint(
-                np.column_stack([-acceleration, acceleration])
-            ),
-        ],
-        path,
-        gridpoints=np.linspace(0.0, 1.0, max(400, GRID_PER_WAYPOINT * len(q))),
-        parametrizer="ParametrizeConstAccel",
-    )
-    trajectory = instance.compute_trajectory()
-    if trajectory is None:
-        raise ExportError(
-            f"The path cannot be timed within the {robot.spec.title}'s limits (TOPP-RA found no "
-            "feasible timing); export it with --unchecked to inspect it."
-        )
-    duration = float(trajectory.duration)
-    # whole sample periods, the last one held at the end (at rest): the samples stay on the
-    # rate's grid, which players and LeRobot's timestamp checks expect
-    times = np.arange(int(np.ceil(duration * rate_hz - 1e-9)) + 1) / rate_hz
-    return times, np.asarray(trajectory(np.minimum(times, duration)), dtype=float)
-
-
-def _shape_preserving_path(s: np.ndarray, q: np.ndarray) -> object:  # a toppra path
-    """A TOPP-RA geometric path through ``q`` at ``s`` that stays between its waypoints."""
-    from scipy.interpolate import PchipInterpolator
-    from toppra.interpolator import AbstractGeometricPath
-
-    class ShapePreservingPath(AbstractGeometricPath):  # type: ignore[misc]
-        def __init__(self) -> None:
-            self.curves = [PchipInterpolator(s, q, axis=0)]
-            self.curves += [self.curves[0].derivative(1), self.curves[0].derivative(2)]
-
-        def __call__(self, path_positions: object, order: int = 0) -> np.ndarray:
-            return self.curves[order](path_positions)
-
-        @property
-        def dof(self) -> int:
-            return int(q.shape[1])
-
-        @property
-        def path_interval(self) -> np.ndarray:
-            return np.array([s[0], s[-1]])
-
-        @property
-        def waypoints(self) -> tuple[np.ndarray, np.ndarray]:
-            return s, q
-
-    return ShapePreservingPath()

@@ -24,10 +24,11 @@ from ._puma import Puma560 as Puma560
 from ._retarget import RetargetConfig as RetargetConfig
 from ._retarget import Retargeter as Retargeter
 from ._retarget import retarget_path as retarget_path
+from ._robot_load import isolate_robot_loading as isolate_robot_loading
+from ._robot_load import load_robot as load_robot
+from ._robot_load import prepare_arm_ik_in_background as prepare_arm_ik_in_background
 from ._robots import DEFAULT_ROBOT as DEFAULT_ROBOT
 from ._robots import RobotArm as RobotArm
-from ._robots import load_robot as load_robot
-from ._robots import prepare_arm_ik_in_background as prepare_arm_ik_in_background
 from ._robots import robot_names as robot_names
 from ._robots import robot_spec as robot_spec
 from ._sleeve import SLEEVE_LIFT_M as SLEEVE_LIFT_M

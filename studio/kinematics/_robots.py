@@ -19,17 +19,11 @@ published (Panda) and otherwise twice the velocity limit per second, a conservat
 
 from __future__ import annotations
 
-import contextlib
 import copy
-import functools
 import importlib.metadata
 import math
 import re
-import subprocess
-import sys
 import sysconfig
-import threading
-import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -544,35 +538,6 @@ class RobotArm:
         return self._collision_data is not None
 
 
-def _visual_mesh_loader() -> object:
-    """The mesh loader of the visual meshes: axis-aligned boxes around their triangles.
-
-    The visual meshes are only drawn and exported, never queried for distances, so the tree
-    built around their triangles can be the cheapest; Coal's default (oriented boxes and swept
-    spheres) takes about twice as long on the finely meshed arms (SO-101: 4.4 s -> 1.7 s).
-    """
-    import coal  # Pinocchio's collision library, installed with it
-
-    return coal.MeshLoader(coal.BV_AABB)
-
-
-def _convex(geom: pin.GeometryModel) -> None:
-    """Replace each collision mesh by its convex hull (qhull, through coal).
-
-    Distances between hulls cost a fraction of mesh-to-mesh ones (a 5-joint SO-101 check drops
-    from about a second to milliseconds), and a hull contains its mesh, so a clearance found on
-    hulls holds for the meshes: the check errs on the safe side. The hull is computed, not
-    assumed: coal's GJK walks a convex shape's vertex graph to find support points, and on a
-    mesh taken as its own hull that walk stops at local extremes, so distances came out
-    centimetres too large and changed from one query to the next.
-    """
-    for obj in geom.geometryObjects:
-        shape = obj.geometry
-        if hasattr(shape, "buildConvexHull"):
-            shape.buildConvexHull(True, "Qt")
-            obj.geometry = shape.convex
-
-
 def _shoulder(model: pin.Model, data: pin.Data, axis: np.ndarray) -> np.ndarray:
     """The point of joint 1's axis nearest joint 2's origin (``data`` holds a forward pass)."""
     base = data.oMi[1]
@@ -616,107 +581,3 @@ def _link_of(geometry_name: str) -> str:
     """A geometry object's link (Pinocchio names them ``<link>_<index>``)."""
     head, _, tail = geometry_name.rpartition("_")
     return head if head and tail.isdigit() else geometry_name
-
-
-def _reduce(
-    model: pin.Model, geoms: list[pin.GeometryModel], keep: int
-) -> tuple[pin.Model, list[pin.GeometryModel]]:
-    """The model with only its first ``keep`` joints free; the rest locked at a valid angle."""
-    locked = list(range(keep + 1, model.njoints))
-    if not locked:
-        return model, geoms
-    q_ref = np.clip(np.zeros(model.nq), model.lowerPositionLimit, model.upperPositionLimit)
-    reduced, reduced_geoms = pin.buildReducedModel(model, geoms, locked, q_ref)
-    return reduced, list(reduced_geoms)
-
-
-@functools.cache
-def load_robot(name: str, geometry: bool = True) -> RobotArm:
-    """The :class:`RobotArm` for ``name``, loaded once per process.
-
-    Args:
-        name: one of :func:`robot_names`.
-        geometry: load the meshes too (a second or more per robot; needed for drawing and for
-            :meth:`RobotArm.self_collisions`). Without them the model is ready in milliseconds,
-            enough for limits, FK and IK.
-
-    Raises:
-        KinematicsError: an unknown name, or a model whose files are missing or unreadable.
-    """
-    spec = robot_spec(name)
-    if spec.name == "puma560":
-        return _puma_arm(spec)
-    root = robots_folder()
-    urdf_path = root / spec.urdf
-    try:
-        text = _bounded_urdf(urdf_path.read_text())
-    except OSError as err:
-        raise KinematicsError(
-            f"The {spec.title} URDF {urdf_path} cannot be read ({err.strerror}); reinstall "
-            "example-robot-data."
-        ) from None
-    package_dirs = [str(root.parent.parent)]
-    try:
-        model = pin.buildModelFromXML(text)
-        if geometry:
-            geoms = [
-                pin.buildGeomFromUrdfString(model, text, kind, None, package_dirs, loader)
-                for kind, loader in (
-                    (pin.GeometryType.VISUAL, _visual_mesh_loader()),
-                    (pin.GeometryType.COLLISION, None),
-                )
-            ]
-        else:
-            geoms = [pin.GeometryModel(), pin.GeometryModel()]
-    except (RuntimeError, ValueError) as err:
-        raise KinematicsError(
-            f"The {spec.title} model cannot be built ({err}); its URDF or meshes are missing: "
-            "reinstall example-robot-data."
-        ) from None
-    model, (visual, collision) = _reduce(model, geoms, spec.arm_joints)
-    _convex(collision)
-    srdf = root / spec.srdf if spec.srdf else None
-    return RobotArm(spec, model, visual, collision, text, srdf)
-
-
-def _puma_arm(spec: RobotSpec) -> RobotArm:
-    from ._puma import Puma560
-
-    puma = Puma560()
-    empty = pin.GeometryModel()
-    model = puma.model.copy()
-    model.velocityLimit = np.full(6, PUMA_VELOCITY)
-    return RobotArm(spec, model, empty, pin.GeometryModel(), puma.urdf())
-
-
-def prepare_arm_ik() -> float:
-    """Load (or, the first time on this machine, compile) the IK kernel; returns the seconds.
-
-    The kernel is cached on disk: compiling it takes seconds (tens on a loaded machine), which
-    would otherwise stall the first frame of the first arm chosen in the studio.
-    """
-    start = time.perf_counter()
-    arm = load_robot("puma560", geometry=False)
-    arm.inverse(arm.forward(arm.home), arm.home, iterations=2)
-    return time.perf_counter() - start
-
-
-def prepare_arm_ik_in_background() -> threading.Thread:
-    """Run :func:`prepare_arm_ik` in a child process (a compile holds its interpreter's GIL),
-    waited for by the returned daemon thread. If the child cannot start, the first arm chosen
-    compiles the kernel itself."""
-    code = "from studio.kinematics._robots import prepare_arm_ik; prepare_arm_ik()"
-
-    def child() -> None:
-        with contextlib.suppress(OSError):
-            subprocess.run(
-                [sys.executable, "-c", code],
-                stdin=subprocess.DEVNULL,
-                stdout=subprocess.DEVNULL,
-                stderr=subprocess.DEVNULL,
-                check=False,
-            )
-
-    thread = threading.Thread(target=child, name="studio-prepare-ik", daemon=True)
-    thread.start()
-    return thread

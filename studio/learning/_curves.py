@@ -41,7 +41,7 @@ TIME_COLUMNS = ("wall_seconds", "cpu_seconds")
 """Two more ``curves.csv`` columns, after :data:`CURVE_COLUMNS`, in a run trained since they were
 added: per episode, the mean over the experiments that finished it of each experiment's own wall
 and CPU seconds from its start to that episode's end (:func:`episode_seconds`). A file without
-them (an older run, a run recovered after a crash) still reads: its curve has no times."""
+them (an older run) still reads: its curve has no times."""
 MAX_CURVES_BYTES_PER_EPISODE = 256
 """Largest ``curves.csv`` row read back (the studio writes under 120 bytes)."""
 

@@ -22,9 +22,10 @@ A run folder ``<parent>/<id>/`` holds:
   atomically every :data:`CHECKPOINT_SECONDS` while training (less often only when one write
   takes over a tenth of that), so a killed process loses about that much of its curve;
 - ``curves.csv``: the :func:`curve_statistics` of ``steps.csv`` in the layout
-  :data:`CURVE_COLUMNS`, written when the run ends (or by :meth:`RunFolder.recover` after a
-  crash), with each episode's wall and CPU time (:data:`TIME_COLUMNS`, measured while it trained;
-  a run recovered after a crash has none);
+  :data:`CURVE_COLUMNS`, with each episode's wall and CPU time (:data:`TIME_COLUMNS`, measured
+  while it trained), rewritten with every checkpoint of ``steps.csv`` and when the run ends: a
+  run recovered after a crash (:meth:`RunFolder.recover`) keeps the times of its last
+  checkpoint;
 - ``policy.policy.npz``: the best experiment's Q table (see ``_policy.py``), saved with every
   ``steps.csv`` checkpoint from the tables the kernels are filling (:attr:`LiveProgress.snapshot`)
   and again when the run ends, also when it was stopped (Stop, Ctrl-C). A process killed with
@@ -448,30 +449,26 @@ class RunFolder:
             self._owner.release()  # the final status is written: nobody owns a finished run
             self._owner = None
 
-    def save_steps(
-        self, steps: np.ndarray, curves: bool = True, seconds: np.ndarray | None = None
-    ) -> None:
-        """Write ``steps.csv`` and, unless ``curves`` is false (a checkpoint), ``curves.csv``,
-        each atomically. ``steps.csv`` is the truth; ``curves.csv`` is derived from it, with the
-        episodes' times from ``seconds`` (:attr:`LiveProgress.episode_seconds`) when given, else
-        the ones saved before."""
+    def save_steps(self, steps: np.ndarray, seconds: np.ndarray | None = None) -> None:
+        """Write ``steps.csv`` and then ``curves.csv``, each atomically. ``steps.csv`` is the
+        truth; ``curves.csv`` is derived from it, with the episodes' times from ``seconds``
+        (:attr:`LiveProgress.episode_seconds`) when given, else the ones saved before."""
         steps = np.asarray(steps, dtype=np.int64).copy()
         times = self._times if seconds is None else episode_seconds(steps, seconds)
         try:
             atomic_write_text(self.path / STEPS_FILE, steps_text(steps))
-            if curves:
-                text = curves_csv(curve_statistics(steps, times=times))
-                atomic_write_text(self.path / CURVES_FILE, text)
+            text = curves_csv(curve_statistics(steps, times=times))
+            atomic_write_text(self.path / CURVES_FILE, text)
         except OSError as err:
             raise _disk_error(err, "the run's curve", self.path) from None
         self._steps = steps
-        if curves:
-            self._times = times
+        self._times = times
 
     def recover(self) -> None:
         """Write down what :meth:`load` found for a run whose process died: its ``stopped``
-        status and a ``curves.csv`` of its last checkpoint (no-op for other runs, and for a run
-        whose owner turns out to be alive). The run's lock is held while it is written."""
+        status and a ``curves.csv`` of its last checkpoint, with the episodes' times that
+        checkpoint saved (no-op for other runs, and for a run whose owner turns out to be
+        alive). The run's lock is held while it is written."""
         if not self.interrupted:
             return
         locked = (self.path / OWNER_FILE).exists()  # else a folder from before owner locks
@@ -594,8 +591,8 @@ class RunFolder:
             return self._finish(live, None, None)
         thread = TrainingThread(self.id, record, live, workers).start()
 
-        def checkpoint() -> None:
-            self.save_steps(live.steps, curves=False)
+        def checkpoint() -> None:  # with the times so far: a crash keeps them (recover)
+            self.save_steps(live.steps, seconds=live.episode_seconds)
             self._checkpoint_policy(live)
 
         interrupted, disk = watch_training(thread, live, checkpoint, on_checkpoint, poll_seconds)

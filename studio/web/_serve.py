@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING
 from urllib.parse import urlsplit
 
 from studio import StudioError, is_loopback
-from studio.kinematics import prepare_arm_ik_in_background
+from studio.kinematics import isolate_robot_loading, prepare_arm_ik_in_background
 from studio.learning import prepare_in_background
 
 from ._guard import SiteRule
@@ -331,6 +331,9 @@ def serve(settings: Settings, open_browser: bool = True) -> None:
     # switch interval (5 ms by default) while a request or the run list holds it. 1 ms keeps
     # the hops short (issue 10's motion-to-scene latency) at a negligible cost in throughput.
     sys.setswitchinterval(GIL_SWITCH_INTERVAL_S)
+    # A robot's first load reads its meshes for seconds holding the GIL: in a child process,
+    # so that a robot switch does not freeze the API and the scene meanwhile.
+    isolate_robot_loading()
     sock = bind_port(settings.host, settings.port)
     try:
         server, scene, guard = start_scene(settings)

@@ -15,7 +15,7 @@ from studio.kinematics import HumanArm, Retargeter, arm_motion, load_robot, robo
 from studio.kinematics._chain_ik import _log3, _solve
 from studio.kinematics._clearance import ClearanceGuard
 from studio.kinematics._puma import closed_form_solutions
-from studio.kinematics._robots import prepare_arm_ik
+from studio.kinematics._robot_load import prepare_arm_ik
 
 RIGHT = HumanArm("right")
 MAX_STEP_DEG = 5.0

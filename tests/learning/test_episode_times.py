@@ -5,12 +5,23 @@ from __future__ import annotations
 
 import csv
 import io
+import shutil
 import threading
 
 import numpy as np
 import pytest
 
-from studio.learning import LiveCurve, LiveProgress, RunFolder, curve_statistics, curves_csv
+from studio.learning import (
+    ArmGrid,
+    DynaQConfig,
+    LiveCurve,
+    LiveProgress,
+    RunFolder,
+    RunRecord,
+    _run_train,
+    curve_statistics,
+    curves_csv,
+)
 from studio.learning._curves import (
     CURVE_COLUMNS,
     TIME_COLUMNS,
@@ -139,3 +150,37 @@ def test_a_trained_run_saves_times_and_an_older_one_loads_without(tmp_path):
     old = RunFolder.load(run.path)
     assert old.episode_times() is None and "wall_seconds" not in old.curve()
     assert old.curve() == curve_statistics(result.steps)
+
+
+def test_a_run_recovered_after_a_crash_keeps_its_episodes_times(tmp_path, monkeypatch):
+    """A killed process leaves its folder as of its last checkpoint: ``running``, nobody holding
+    its lock. Recovered, its curve keeps the wall and CPU time of each checkpointed episode."""
+    monkeypatch.setattr(_run_train, "CHECKPOINT_SECONDS", 0.0)  # a checkpoint at every poll
+    grid = ArmGrid(joints=3, bins=11, goal=(5, 5, 5))
+    config = DynaQConfig(planning="full", planning_steps=2000)  # slow: stopped long before
+    record = RunRecord.for_arm_grid(grid, config, 1, 100_000, seed=3, origin="cli")
+    run = RunFolder.create(tmp_path / "runs", record, name="crashing")
+    crashed = tmp_path / "crashed"
+
+    def crash_after_a_checkpoint(live: LiveProgress) -> None:
+        if not crashed.exists() and (run.path / "steps.csv").exists():
+            shutil.copytree(run.path, crashed)  # what kill -9 would leave at this moment
+            live.stop()
+
+    run.train(workers=1, on_checkpoint=crash_after_a_checkpoint)
+    left = RunFolder.load(crashed)
+    assert left.status == "stopped" and left.interrupted
+    left.recover()
+    again = RunFolder.load(crashed)
+    assert not again.interrupted and again.status == "stopped"
+    curve = again.curve()
+    done = len(curve["episodes"])
+    assert 0 < done < 100_000
+    wall = [v for v in curve["wall_seconds"] if v is not None]
+    cpu = [v for v in curve["cpu_seconds"] if v is not None]
+    # an episode that ended between the poll's stamp and the checkpoint may have none
+    assert len(wall) == len(cpu) >= done - 2 and len(wall) >= 1
+    assert np.all(np.diff(wall) >= 0) and np.all(np.diff(cpu) >= 0)
+    assert all(v > 0 for v in wall + cpu)
+    rows = list(csv.reader(io.StringIO((crashed / "curves.csv").read_text())))
+    assert rows[0][-2:] == list(TIME_COLUMNS) and len(rows) == done + 1

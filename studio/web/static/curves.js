@@ -15,8 +15,8 @@ export const CURVE_KEYS = ["episodes", "mean", "std", "min", "max", "count", "wa
  * over the experiments that finished the episode of each one's own seconds up to its end. */
 export const TIME_KEYS = { wall: "wall_seconds", cpu: "cpu_seconds" };
 
-/** The curve's measured seconds for a time axis, or null when its run saved none (an older run,
- * one recovered after a crash): that axis is then an estimate. */
+/** The curve's measured seconds for a time axis, or null when its run saved none (a run from
+ * before they were measured): that axis is then an estimate. */
 export function measuredSeconds(curve, xMode) {
   const t = curve[TIME_KEYS[xMode]];
   return t && t.length === curve.episodes.length && t.some((v) => v !== null) ? t : null;

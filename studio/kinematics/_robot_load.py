@@ -1,0 +1,282 @@
+"""Loading a robot: its model and geometry, once per process, and off the process's lock when
+other threads must keep running.
+
+:func:`load_robot` builds a :class:`RobotArm` from the robot's URDF (Pinocchio), reads its meshes
+(visual and collision) and computes the collision meshes' convex hulls (coal), then keeps it for
+the rest of the process. Pinocchio and coal keep Python's lock (the GIL) while they read meshes
+and compute hulls: 0.5-3 s for one robot, during which no other thread of the process runs. In a
+server that froze the API and the scene at every first switch to a robot. After
+:func:`isolate_robot_loading` (``studio serve`` calls it), the geometry is built in a child
+process and handed back in Pinocchio's binary archives: this process waits without the lock and
+holds it only to read them and set up the arm (a few tenths of a second at most;
+``benchmarks/bench_robot_switch.py`` measures the API's latency during a switch both ways).
+
+The visual meshes are read from their files when the scene draws them or a URDF is exported
+(``GeometryObject.meshPath``); the triangles Pinocchio loaded for them are never queried, so they
+are dropped once the model is built, which also keeps the archives small.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import logging
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+
+from ._errors import KinematicsError
+from ._robots import PUMA_VELOCITY, RobotArm, RobotSpec, _bounded_urdf, robot_spec, robots_folder
+
+log = logging.getLogger(__name__)
+
+LOAD_TIMEOUT_S = 600.0
+"""The longest a child process may take to build a robot's geometry (a first load takes seconds)."""
+
+_arms: dict[tuple[str, bool], RobotArm] = {}
+_locks: dict[tuple[str, bool], threading.Lock] = {}
+_guard = threading.Lock()
+_isolated = threading.Event()
+
+_CHILD = "from studio.kinematics._robot_load import _build_for_parent; _build_for_parent()"
+_PARTS = ("model", "visual", "collision")
+"""The files a child writes, one Pinocchio binary archive each."""
+_REFUSED = "refused.txt"
+"""The file a child writes instead: the sentence of the error that refused the robot."""
+
+
+def isolate_robot_loading() -> None:
+    """From now on in this process, build a robot's geometry in a child process (see the module
+    docstring): for a process whose other threads must not stall, such as a server's."""
+    _isolated.set()
+
+
+def load_robot(name: str, geometry: bool = True) -> RobotArm:
+    """The :class:`RobotArm` for ``name``, loaded once per process.
+
+    Args:
+        name: one of :func:`robot_names`.
+        geometry: load the meshes too (a second or more per robot; needed for drawing and for
+            :meth:`RobotArm.self_collisions`). Without them the model is ready in milliseconds,
+            enough for limits, FK and IK.
+
+    Raises:
+        KinematicsError: an unknown name, or a model whose files are missing or unreadable.
+    """
+    spec = robot_spec(name)
+    key = (spec.name, geometry)
+    with _guard:
+        arm = _arms.get(key)
+        if arm is not None:
+            return arm
+        lock = _locks.setdefault(key, threading.Lock())
+    with lock:  # a second thread asking meanwhile waits for this load, not another
+        arm = _arms.get(key)
+        if arm is None:
+            arm = _load(spec, geometry)
+            with _guard:
+                _arms[key] = arm
+    return arm
+
+
+def _load(spec: RobotSpec, geometry: bool) -> RobotArm:
+    if spec.name == "puma560":
+        return _puma_arm(spec)
+    text = _urdf_text(spec)
+    if geometry and _isolated.is_set():
+        model, visual, collision = _built_in_child(spec)
+    else:
+        model, visual, collision = _built(spec, text, geometry)
+    srdf = robots_folder() / spec.srdf if spec.srdf else None
+    return RobotArm(spec, model, visual, collision, text, srdf)
+
+
+def _urdf_text(spec: RobotSpec) -> str:
+    urdf_path = robots_folder() / spec.urdf
+    try:
+        return _bounded_urdf(urdf_path.read_text())
+    except OSError as err:
+        raise KinematicsError(
+            f"The {spec.title} URDF {urdf_path} cannot be read ({err.strerror}); reinstall "
+            "example-robot-data."
+        ) from None
+
+
+def _built(
+    spec: RobotSpec, text: str, geometry: bool
+) -> tuple[pin.Model, pin.GeometryModel, pin.GeometryModel]:
+    """The arm's reduced model, its visual geometry (mesh files, no triangles) and its collision
+    geometry (convex hulls), from the URDF ``text``."""
+    package_dirs = [str(robots_folder().parent.parent)]
+    try:
+        model = pin.buildModelFromXML(text)
+        if geometry:
+            geoms = [
+                pin.buildGeomFromUrdfString(model, text, kind, None, package_dirs, loader)
+                for kind, loader in (
+                    (pin.GeometryType.VISUAL, _visual_mesh_loader()),
+                    (pin.GeometryType.COLLISION, None),
+                )
+            ]
+        else:
+            geoms = [pin.GeometryModel(), pin.GeometryModel()]
+    except (RuntimeError, ValueError) as err:
+        raise KinematicsError(
+            f"The {spec.title} model cannot be built ({err}); its URDF or meshes are missing: "
+            "reinstall example-robot-data."
+        ) from None
+    model, (visual, collision) = _reduce(model, geoms, spec.arm_joints)
+    _convex(collision)
+    _drop_triangles(visual)
+    return model, visual, collision
+
+
+def _built_in_child(spec: RobotSpec) -> tuple[pin.Model, pin.GeometryModel, pin.GeometryModel]:
+    """:func:`_built` in a child process, handed back in Pinocchio's binary archives (read in
+    tens of milliseconds, a tenth of its pickles' text archives); this thread waits without
+    Python's lock. In this process after all when no child can be started."""
+    with tempfile.TemporaryDirectory(prefix="studio-robot-") as folder:
+        try:
+            done = subprocess.run(
+                [sys.executable, "-c", _CHILD, spec.name, folder],
+                stdin=subprocess.DEVNULL,
+                stdout=subprocess.DEVNULL,
+                stderr=subprocess.PIPE,
+                timeout=LOAD_TIMEOUT_S,
+                check=False,
+            )
+        except subprocess.TimeoutExpired:
+            raise KinematicsError(
+                f"Loading the {spec.title} model took over {LOAD_TIMEOUT_S:.0f} s and was given "
+                "up; try again, or reinstall example-robot-data if it stays so."
+            ) from None
+        except OSError as err:  # no child process here: load it in this one, holding the lock
+            log.warning("the %s model loads in this process: %s", spec.name, err)
+            return _built(spec, _urdf_text(spec), True)
+        files = [Path(folder) / f"{part}.bin" for part in _PARTS]
+        refused = Path(folder) / _REFUSED
+        if done.returncode == 0 and refused.is_file():
+            raise KinematicsError(refused.read_text())
+        if done.returncode != 0 or not all(f.is_file() for f in files):
+            last = done.stderr.decode(errors="replace").strip().splitlines()[-1:] or ["no message"]
+            raise KinematicsError(
+                f"The {spec.title} model could not be built: its loading process ended with "
+                f"code {done.returncode} ({last[0]}); reinstall example-robot-data."
+            )
+        model, visual, collision = pin.Model(), pin.GeometryModel(), pin.GeometryModel()
+        for part, file in zip((model, visual, collision), files, strict=True):
+            part.loadFromBinary(str(file))
+    return model, visual, collision
+
+
+def _build_for_parent() -> None:
+    """A child process's work: build the geometry of the robot ``sys.argv[1]`` and write it in
+    the folder ``sys.argv[2]`` (:data:`_PARTS`, Pinocchio's binary archives), or there the
+    sentence of the :class:`KinematicsError` that refused it (:data:`_REFUSED`)."""
+    spec, folder = robot_spec(sys.argv[1]), Path(sys.argv[2])
+    try:
+        parts = _built(spec, _urdf_text(spec), True)
+    except KinematicsError as err:
+        (folder / _REFUSED).write_text(str(err))
+        return
+    for name, part in zip(_PARTS, parts, strict=True):
+        part.saveToBinary(str(folder / f"{name}.bin"))
+
+
+def _drop_triangles(visual: pin.GeometryModel) -> None:
+    """Replace the visual meshes' loaded triangles by an empty shape: they are drawn and
+    exported from their files, never queried (a finely meshed link holds megabytes)."""
+    import coal  # Pinocchio's collision library, installed with it
+
+    for obj in visual.geometryObjects:
+        if obj.meshPath:
+            obj.geometry = coal.Sphere(0.0)
+
+
+def _visual_mesh_loader() -> object:
+    """The mesh loader of the visual meshes: axis-aligned boxes around their triangles.
+
+    The visual meshes are only drawn and exported, never queried for distances, so the tree
+    built around their triangles can be the cheapest; Coal's default (oriented boxes and swept
+    spheres) takes about twice as long on the finely meshed arms (SO-101: 4.4 s -> 1.7 s).
+    """
+    import coal  # Pinocchio's collision library, installed with it
+
+    return coal.MeshLoader(coal.BV_AABB)
+
+
+def _convex(geom: pin.GeometryModel) -> None:
+    """Replace each collision mesh by its convex hull (qhull, through coal).
+
+    Distances between hulls cost a fraction of mesh-to-mesh ones (a 5-joint SO-101 check drops
+    from about a second to milliseconds), and a hull contains its mesh, so a clearance found on
+    hulls holds for the meshes: the check errs on the safe side. The hull is computed, not
+    assumed: coal's GJK walks a convex shape's vertex graph to find support points, and on a
+    mesh taken as its own hull that walk stops at local extremes, so distances came out
+    centimetres too large and changed from one query to the next.
+    """
+    for obj in geom.geometryObjects:
+        shape = obj.geometry
+        if hasattr(shape, "buildConvexHull"):
+            shape.buildConvexHull(True, "Qt")
+            obj.geometry = shape.convex
+
+
+def _reduce(
+    model: pin.Model, geoms: list[pin.GeometryModel], keep: int
+) -> tuple[pin.Model, list[pin.GeometryModel]]:
+    """The model with only its first ``keep`` joints free; the rest locked at a valid angle."""
+    locked = list(range(keep + 1, model.njoints))
+    if not locked:
+        return model, geoms
+    q_ref = np.clip(np.zeros(model.nq), model.lowerPositionLimit, model.upperPositionLimit)
+    reduced, reduced_geoms = pin.buildReducedModel(model, geoms, locked, q_ref)
+    return reduced, list(reduced_geoms)
+
+
+def _puma_arm(spec: RobotSpec) -> RobotArm:
+    from ._puma import Puma560
+
+    puma = Puma560()
+    empty = pin.GeometryModel()
+    model = puma.model.copy()
+    model.velocityLimit = np.full(6, PUMA_VELOCITY)
+    return RobotArm(spec, model, empty, pin.GeometryModel(), puma.urdf())
+
+
+def prepare_arm_ik() -> float:
+    """Load (or, the first time on this machine, compile) the IK kernel; returns the seconds.
+
+    The kernel is cached on disk: compiling it takes seconds (tens on a loaded machine), which
+    would otherwise stall the first frame of the first arm chosen in the studio.
+    """
+    start = time.perf_counter()
+    arm = load_robot("puma560", geometry=False)
+    arm.inverse(arm.forward(arm.home), arm.home, iterations=2)
+    return time.perf_counter() - start
+
+
+def prepare_arm_ik_in_background() -> threading.Thread:
+    """Run :func:`prepare_arm_ik` in a child process (a compile holds its interpreter's GIL),
+    waited for by the returned daemon thread. If the child cannot start, the first arm chosen
+    compiles the kernel itself."""
+    code = "from studio.kinematics._robot_load import prepare_arm_ik; prepare_arm_ik()"
+
+    def child() -> None:
+        with contextlib.suppress(OSError):
+            subprocess.run(
+                [sys.executable, "-c", code],
+                stdin=subprocess.DEVNULL,
+                stdout=subprocess.DEVNULL,
+                stderr=subprocess.DEVNULL,
+                check=False,
+            )
+
+    thread = threading.Thread(target=child, name="studio-prepare-ik", daemon=True)
+    thread.start()
+    return thread

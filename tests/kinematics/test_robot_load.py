@@ -1,0 +1,117 @@
+"""Loading a robot once per process, and in a child process after ``isolate_robot_loading``:
+the same robot either way, and every way the child can fail is one sentence or a fallback."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import threading
+
+import numpy as np
+import pytest
+
+from studio.kinematics import KinematicsError, load_robot
+from studio.kinematics import _robot_load as robot_load
+from studio.kinematics._robots import RobotArm, robot_spec
+
+SPEC = robot_spec("so100")  # meshes for both geometries, and quick to build
+
+
+def _arm(parts: tuple) -> RobotArm:
+    return RobotArm(SPEC, *parts, robot_load._urdf_text(SPEC))
+
+
+def test_a_robot_built_in_a_child_process_is_the_robot_built_here():
+    here = _arm(robot_load._built(SPEC, robot_load._urdf_text(SPEC), True))
+    child = _arm(robot_load._built_in_child(SPEC))
+    assert child.joint_names == here.joint_names
+    for name in ("lower", "upper", "velocity", "home"):
+        np.testing.assert_array_equal(getattr(child, name), getattr(here, name))
+    drawn = [(g.name, g.meshPath, g.parentJoint) for g in here.visual_model.geometryObjects]
+    assert [
+        (g.name, g.meshPath, g.parentJoint) for g in child.visual_model.geometryObjects
+    ] == drawn
+    for a, b in zip(
+        here.visual_model.geometryObjects, child.visual_model.geometryObjects, strict=True
+    ):
+        np.testing.assert_array_equal(a.placement.homogeneous, b.placement.homogeneous)
+        np.testing.assert_array_equal(a.meshScale, b.meshScale)
+    rng = np.random.default_rng(4)
+    for q in rng.uniform(here.lower, here.upper, size=(8, here.nq)):
+        np.testing.assert_allclose(child.forward(q), here.forward(q))
+        near = [(c.link_a, c.link_b, c.distance) for c in here.self_collisions(q, 0.05)]
+        found = [(c.link_a, c.link_b, c.distance) for c in child.self_collisions(q, 0.05)]
+        assert [(a, b) for a, b, _ in found] == [(a, b) for a, b, _ in near]
+        np.testing.assert_allclose([d for *_, d in found], [d for *_, d in near], atol=1e-9)
+
+
+def test_the_visual_meshes_are_kept_as_files_not_triangles():
+    _, visual, _ = robot_load._built(SPEC, robot_load._urdf_text(SPEC), True)
+    assert visual.ngeoms > 0
+    for obj in visual.geometryObjects:
+        assert obj.meshPath.endswith((".stl", ".STL", ".dae"))  # drawn from its file
+        assert type(obj.geometry).__name__ == "Sphere" and obj.geometry.radius == 0.0
+
+
+def test_without_a_child_process_the_robot_loads_here(monkeypatch):
+    monkeypatch.setattr(robot_load.sys, "executable", "/nonexistent/python")
+    arm = _arm(robot_load._built_in_child(SPEC))
+    assert arm.checks_collisions and len(arm.visual_model.geometryObjects) > 0
+
+
+def test_a_child_that_dies_is_one_sentence(monkeypatch):
+    monkeypatch.setattr(robot_load, "_CHILD", "import sys; print('assimp crashed', file=sys.stderr); sys.exit(3)")  # fmt: skip
+    with pytest.raises(KinematicsError) as err:
+        robot_load._built_in_child(SPEC)
+    message = str(err.value)
+    assert "\n" not in message and message.endswith("reinstall example-robot-data.")
+    assert "ended with code 3 (assimp crashed)" in message
+
+
+def test_a_robot_the_child_refuses_is_refused_in_its_sentence(monkeypatch):
+    code = "import pathlib, sys; (pathlib.Path(sys.argv[2]) / 'refused.txt').write_text('The SO-100 URDF is gone; reinstall example-robot-data.')"  # fmt: skip
+    monkeypatch.setattr(robot_load, "_CHILD", code)
+    with pytest.raises(KinematicsError, match=r"^The SO-100 URDF is gone; reinstall"):
+        robot_load._built_in_child(SPEC)
+
+
+def test_a_child_that_hangs_is_given_up_in_one_sentence(monkeypatch):
+    monkeypatch.setattr(robot_load, "_CHILD", "import time; time.sleep(60)")
+    monkeypatch.setattr(robot_load, "LOAD_TIMEOUT_S", 0.5)
+    with pytest.raises(KinematicsError, match=r"took over 0 s and was given up; try again"):
+        robot_load._built_in_child(SPEC)
+
+
+def test_threads_asking_for_one_robot_together_get_one_arm():
+    arms: list[RobotArm] = []
+    threads = [
+        threading.Thread(target=lambda: arms.append(load_robot("ur3", geometry=False)))
+        for _ in range(4)
+    ]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join()
+    assert len(arms) == 4 and all(arm is arms[0] for arm in arms)
+
+
+def test_a_server_process_loads_robots_in_a_child_process():
+    """``isolate_robot_loading`` then ``load_robot``, in a fresh process: the geometry comes
+    from a child process (seen as one), and the arm works."""
+    code = (
+        "import subprocess, sys\n"
+        "from studio.kinematics import isolate_robot_loading, load_robot\n"
+        "from studio.kinematics import _robot_load\n"
+        "children = []\n"
+        "run = subprocess.run\n"
+        "def counted(*a, **k):\n"
+        "    children.append(a[0][3])\n"
+        "    return run(*a, **k)\n"
+        "_robot_load.subprocess.run = counted\n"
+        "isolate_robot_loading()\n"
+        "arm = load_robot('so100')\n"
+        "assert load_robot('so100') is arm\n"
+        "print(children, arm.checks_collisions, len(arm.self_collisions(arm.home, 1.0)) > 0)\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.split() == ["['so100']", "True", "True"]
