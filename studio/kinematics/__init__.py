@@ -21,6 +21,8 @@ from ._pose_stream import PoseStreamFitter as PoseStreamFitter
 from ._pose_stream import StreamConfig as StreamConfig
 from ._puma import IKConfig as IKConfig
 from ._puma import Puma560 as Puma560
+from ._reach import reachable as reachable
+from ._reach import tool_reaches as tool_reaches
 from ._retarget import RetargetConfig as RetargetConfig
 from ._retarget import Retargeter as Retargeter
 from ._retarget import retarget_path as retarget_path

@@ -318,6 +318,46 @@ def _elbow_pull(R, p, axes, elbow_joint, elbow):  # pragma: no cover - compiled
 
 
 @njit(nogil=True, cache=True)
+def _clamped_step(J, e, pull, secondary_task, q, lower, upper, damping, A):  # pragma: no cover
+    """The DLS step ``J^T (J J^T + damping^2 I)^-1 e`` plus ``pull`` projected into the tool
+    task's null space, with the joints held at a limit they would be pushed beyond taken out.
+
+    A joint at a limit that the step would push further is locked (its column of ``J`` and its
+    ``pull`` zeroed) and the step solved again by the others, until none is pushed beyond:
+    clipping it afterwards instead left the rest of the step aimed at a motion that does not
+    happen, and the solve stalled with the tool short of a target the other joints could reach.
+    Returns (step, its null-space part); ``J`` and ``pull`` are overwritten.
+    """
+    rows, n = J.shape
+    locked = np.zeros(n, dtype=np.bool_)
+    dq = np.zeros(n)
+    secondary = np.zeros(n)
+    for _ in range(n):
+        for k in range(n):
+            if locked[k]:
+                J[:, k] = 0.0
+                pull[k] = 0.0
+        _damped_gram(J, damping, A)
+        dq = _transpose_times(J, _spd_solve(A, e))
+        if secondary_task:
+            Jpull = np.zeros(rows)
+            for i in range(rows):
+                for k in range(n):
+                    Jpull[i] += J[i, k] * pull[k]
+            secondary = pull - _transpose_times(J, _spd_solve(A, Jpull))
+            dq += secondary
+        more = False
+        for k in range(n):
+            pushed = (q[k] <= lower[k] and dq[k] < 0.0) or (q[k] >= upper[k] and dq[k] > 0.0)
+            if pushed and not locked[k]:
+                locked[k] = True
+                more = True
+        if not more:
+            break
+    return dq, secondary
+
+
+@njit(nogil=True, cache=True)
 def _solve(  # noqa: PLR0913 - the kernel's flat arguments  # pragma: no cover - compiled
     rotations,
     translations,
@@ -378,22 +418,16 @@ def _solve(  # noqa: PLR0913 - the kernel's flat arguments  # pragma: no cover -
         if it == iterations or (reached and not use_elbow):
             break
         _jacobian(R, p, axes, tool_p, min(n, tool_joint + 1), J)
-        _damped_gram(J, damping, A)
-        dq = _transpose_times(J, _spd_solve(A, e))
-        if use_elbow and n > rows:
-            # the elbow's pull, J_e^T (target - elbow), projected into the tool task's null space
-            pull = _elbow_pull(R, p, axes, elbow_joint, elbow)
-            Jpull = np.zeros(rows)
-            for i in range(rows):
-                for k in range(n):
-                    Jpull[i] += J[i, k] * pull[k]
-            secondary = 0.5 * (pull - _transpose_times(J, _spd_solve(A, Jpull)))
+        secondary_task = use_elbow and n > rows
+        # the elbow's pull, J_e^T (target - elbow)
+        pull = 0.5 * _elbow_pull(R, p, axes, elbow_joint, elbow) if secondary_task else np.zeros(n)
+        dq, secondary = _clamped_step(J, e, pull, secondary_task, q, lower, upper, damping, A)
+        if secondary_task:
             biggest_secondary = np.abs(secondary).max()
             if reached and (elbow_steps <= 0 or biggest_secondary < 1e-4):
                 break  # the elbow is as near as the tool lets it be, or left to next time
             if reached:
                 elbow_steps -= 1
-            dq += secondary
         biggest = np.abs(dq).max()
         if biggest > max_step:
             dq *= max_step / biggest

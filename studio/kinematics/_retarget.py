@@ -30,9 +30,13 @@ dropped; :meth:`Retargeter.human_from_robot` sets it to zero.
 the robot's reach to the arm's (times ``reach_fraction``), placed at the robot's shoulder and
 solved by the robot's IK, warm-started from the previous solution; when the full pose is out of
 reach of the wrist, the position alone is solved. While the arm moves, no joint turns more than
-``max_joint_step`` a frame (a change of IK branch is walked over several frames).
+``max_joint_step`` a frame: a pose within that step that reaches the target (1 cm and 5 deg,
+:meth:`RetargetConfig.within_reach`) is looked for first, and only when there is none does the
+IK look on other branches, whose answer is then walked to over several frames.
 
-Any robot of :func:`load_robot` (a :class:`RobotArm`) is driven in cartesian mode, the only one
+The hand's target is placed in the robot's base frame turned by ``RobotArm.base_rotation``,
+so an arm whose URDF faces elsewhere than +x (the SO-100's faces -y) faces the operator, as the
+scene draws it. Any robot of :func:`load_robot` (a :class:`RobotArm`) is driven in cartesian mode, the only one
 that means something for an arm whose joints are not the human arm's; on a redundant arm (Panda,
 xArm7) the IK's null-space task keeps the robot's elbow at the operator's elbow, mirrored and
 scaled like the hand. Joint mode is the Puma560's alone.
@@ -41,7 +45,7 @@ scaled like the hand. Joint mode is the Puma560's alone.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Literal
 
 import numpy as np
@@ -51,7 +55,7 @@ from ._clearance import ClearanceGuard
 from ._errors import KinematicsError
 from ._human import SAGITTAL_MIRROR, HumanArm, _as_q
 from ._puma import IKConfig, IKResult, Puma560
-from ._robots import RobotArm, RobotIK
+from ._robots import RobotArm, RobotIK, load_robot
 
 Mode = Literal["joint", "cartesian"]
 
@@ -110,6 +114,17 @@ class RetargetConfig:
         reach_tolerance: a tool further than this from the hand's target is out of reach (m):
             the page says so live, a path counts the frame (:func:`retarget_path`) and an
             export names it.
+        reach_angle: ... and a tool turned further than this from the target's orientation
+            has not reached it (rad; arms that follow the position only are not held to it).
+            With ``reach_tolerance``, what "reached" means (:meth:`within_reach`): the
+            retargeting looks further (other IK branches) only for a pose it misses by more.
+        restart_starts: when neither the last frame's pose nor its neighbourhood reaches the
+            target, the IK starts again from this many fixed poses spread over the joint ranges
+            (drawn once per robot, seeded), besides home.
+        near_starts: a frame's IK first looks for a pose within ``max_joint_step`` of the last
+            frame's, from the last pose and, when that misses, from this many fixed points
+            around it (the step's bounds leave local minima a single start can stall in), then
+            ``restart_iterations`` more from the nearest answer.
         settle_tries: IK passes on a path's first frame (each warm-started from the last)
             before the path starts, as a live session settles before it moves.
     """
@@ -124,6 +139,9 @@ class RetargetConfig:
     input_jump: float = 0.15
     clearance: float = 0.005
     reach_tolerance: float = 0.01
+    reach_angle: float = math.radians(5.0)
+    restart_starts: int = 16
+    near_starts: int = 4
     settle_tries: int = 5
 
     def __post_init__(self) -> None:
@@ -137,7 +155,14 @@ class RetargetConfig:
         positive_number(self.input_jump, "RetargetConfig.input_jump")
         positive_number(self.clearance, "RetargetConfig.clearance")
         positive_number(self.reach_tolerance, "RetargetConfig.reach_tolerance")
+        positive_number(self.reach_angle, "RetargetConfig.reach_angle")
+        whole_number(self.restart_starts, "RetargetConfig.restart_starts", 0)
+        whole_number(self.near_starts, "RetargetConfig.near_starts", 0)
         whole_number(self.settle_tries, "RetargetConfig.settle_tries", 1)
+
+    def within_reach(self, position_error: float, rotation_error: float) -> bool:
+        """Whether a tool this far (m) and this turned (rad) from its target has reached it."""
+        return position_error <= self.reach_tolerance and rotation_error <= self.reach_angle
 
 
 def _soft_floor(z: float, floor: float, width: float) -> float:
@@ -168,6 +193,20 @@ def _unbent(r: float, ceiling: float, width: float) -> float:
 
 PINNED = 0.01
 """A joint within this share of its range from a limit counts as pinned there."""
+
+
+RESTART_SEED = 0
+"""Seed of the fixed IK starts (:attr:`RetargetConfig.restart_starts` and ``near_starts``)."""
+
+
+def _turned_near(robot: RobotArm, q: np.ndarray, reference: np.ndarray) -> np.ndarray:
+    """``q`` with each joint turned by whole turns to the angle nearest ``reference`` that its
+    limits allow (the same pose: a joint with limits of +-2 pi reaches most angles two ways)."""
+    turns = np.round((reference - q) / (2 * math.pi))
+    turned = q + 2 * math.pi * turns
+    turned = np.where(turned > robot.upper, turned - 2 * math.pi, turned)
+    turned = np.where(turned < robot.lower, turned + 2 * math.pi, turned)
+    return np.where((turned >= robot.lower) & (turned <= robot.upper), turned, q)
 
 
 def _unpinned(robot: RobotArm, q: np.ndarray) -> np.ndarray:
@@ -216,6 +255,7 @@ class Retargeter:
         unreachable hand pose is reported here, while ``robot_from_human`` returns the closest
         configuration within the limits."""
         self._guard: ClearanceGuard | None = None
+        self._draws: dict[str, np.ndarray] = {}
         self.pulled_in = 0.0
         """How far (m) the last cartesian-mode hand target was drawn back into the robot's reach
         (0 while the scaled hand lies within it; see ``RetargetConfig.reach_softness``)."""
@@ -310,8 +350,10 @@ class Retargeter:
     def elbow_target(self, q_human: object) -> np.ndarray:
         """Where the robot's elbow should be (m, robot base frame): the operator's, mirrored and
         scaled like the hand."""
-        elbow = self.arm.forward(q_human).elbow[:3, 3]
-        return self._shoulder() + self._scale() * self._mirrored(elbow)
+        elbow = self._mirrored(self.arm.forward(q_human).elbow[:3, 3])
+        if isinstance(self.robot, RobotArm):
+            elbow = self.robot.base_rotation.T @ elbow
+        return self._shoulder() + self._scale() * elbow
 
     def hand_target(self, q_human: object) -> np.ndarray:
         """The robot tool pose (4x4, robot base frame) that cartesian mode aims at.
@@ -333,13 +375,16 @@ class Retargeter:
         p, R = self._mirrored(pose[:3, 3]), pose[:3, :3]
         if self._mirror:
             R = SAGITTAL_MIRROR @ R @ URDF_LATERAL_MIRROR
-        oMdes = np.eye(4)
-        oMdes[:3, :3] = R @ HAND_TO_TOOL
-        oMdes[:3, 3] = self._shoulder() + self._scale() * p
+        R = R @ HAND_TO_TOOL
         robot, config = self.robot, self.config
+        if isinstance(robot, RobotArm):
+            # into the URDF's base frame, which may face elsewhere than the studio's x (SO-100)
+            p, R = robot.base_rotation.T @ p, robot.base_rotation.T @ R @ robot.tool_axes
+        oMdes = np.eye(4)
+        oMdes[:3, :3] = R
+        oMdes[:3, 3] = self._shoulder() + self._scale() * p
         if not isinstance(robot, RobotArm):
             return oMdes, 0.0
-        oMdes[:3, :3] = oMdes[:3, :3] @ robot.tool_axes
         oMdes[2, 3] = _soft_floor(float(oMdes[2, 3]), config.floor_height, config.floor_softness)
         # Between two points above the table, so the drawn-back target stays above it too.
         offset = oMdes[:3, 3] - robot.shoulder
@@ -355,12 +400,7 @@ class Retargeter:
         if isinstance(robot, RobotArm):
             found: IKResult | RobotIK = self._solve_arm(robot, oMdes, q_human)
         else:
-            found = robot.inverse(oMdes, q0=self._q_prev)
-            if not found.success:
-                start = found.q if self._q_prev is None else self._q_prev
-                position = robot.inverse(oMdes[:3, 3], q0=start, position_only=True)
-                if position.success or position.error < found.error:
-                    found = position
+            found = self._solve_puma(robot, oMdes, q_human)
         self.last_ik = found
         q = found.q
         if self._q_prev is not None and (isinstance(robot, RobotArm) or self._smooth(q_human)):
@@ -387,36 +427,118 @@ class Retargeter:
             self._guard = ClearanceGuard(robot, self.config.clearance)
         return self._guard
 
+    def _solve_puma(
+        self, puma: Puma560, oMdes: np.ndarray, q_human: np.ndarray
+    ) -> IKResult | RobotIK:
+        """The Puma560's IK for one frame: while the arm moves, first within the joint motion
+        one frame allows (as for any arm, by the compiled IK on its chain); else its own IK
+        from the last pose, the pose or else the position."""
+        if self._q_prev is not None and self._smooth(q_human):
+            chain_arm = load_robot("puma560", geometry=False)  # the same DH model, compiled
+            near = self._within_a_step(chain_arm, oMdes, {"iterations": self.config.ik_iterations})
+            if near is not None:
+                return near
+        found = puma.inverse(oMdes, q0=self._q_prev)
+        if not found.success:
+            start = found.q if self._q_prev is None else self._q_prev
+            position = puma.inverse(oMdes[:3, 3], q0=start, position_only=True)
+            if position.success or position.error < found.error:
+                found = position
+        return found
+
     def _solve_arm(self, robot: RobotArm, oMdes: np.ndarray, q_human: np.ndarray) -> RobotIK:
         """The arm's IK for one frame: the pose, else the position; one elbow step a frame.
 
-        The solve starts from the last frame's pose, and goes on from where it stopped if
-        it falls short. When that fails too, a joint is often pinned at a limit in a basin
-        that no longer holds the pose; the solve is tried again from that answer with its
-        pinned joints moved home, and from home, and the answer nearest the last one that
-        reaches the pose is taken (the step cap then walks the robot there over as many frames
-        as it needs).
+        First within the joint motion one frame allows around the last frame's pose: a pose
+        there that reaches the target (:meth:`RetargetConfig.within_reach`) is taken, so the
+        robot never leaves a branch that still reaches for one that reaches more exactly.
+        Otherwise the solve goes on unbounded from the last pose, and then, as a joint is often
+        pinned at a limit in a basin that no longer holds the pose, from that answer with its
+        pinned joints moved home, from home and from ``config.restart_starts`` fixed poses; of
+        the answers that reach the target, the one nearest the last pose is taken (a joint with
+        a turn to spare counted the short way round), and the step cap walks the robot there
+        over as many frames as it needs.
         """
+        config = self.config
         elbow = self.elbow_target(q_human) if robot.nq > 6 else None
-        settings = {"elbow": elbow, "iterations": self.config.ik_iterations, "elbow_iterations": 1}
+        settings = {"elbow": elbow, "iterations": config.ik_iterations, "elbow_iterations": 1}
         start = robot.home if self._q_prev is None else self._q_prev
+        if self._q_prev is not None:
+            near = self._within_a_step(robot, oMdes, settings)
+            if near is not None:
+                return near
         found = robot.inverse(oMdes, q0=start, **settings)
-        settings["iterations"] = self.config.restart_iterations
-        if not found.success:  # the pose may have moved further than a few iterations go
+        settings["iterations"] = config.restart_iterations
+        if not self._reached(found):  # the pose may have moved further than a few iterations go
             found = robot.inverse(oMdes, q0=found.q, **settings)
-        if not found.success:
+        if not self._reached(found):
             nearest = math.inf
-            for seed in (_unpinned(robot, found.q), robot.home):
+            for seed in (_unpinned(robot, found.q), robot.home, *self._starts(robot)):
                 other = robot.inverse(oMdes, q0=seed, **settings)
-                distance = float(np.abs(other.q - start).max())
-                if other.success and distance < nearest:
-                    found, nearest = other, distance
-            settings["iterations"] = self.config.ik_iterations
-        if not found.success and robot.spec.orientation:
+                q = _turned_near(robot, other.q, start)
+                distance = float(np.abs(q - start).max())
+                if self._reached(other) and distance < nearest:
+                    found, nearest = replace(other, q=q), distance
+            settings["iterations"] = config.ik_iterations
+        if not self._reached(found) and robot.spec.orientation:
             position = robot.inverse(oMdes[:3, 3], q0=found.q, **settings)
             if position.success or position.position_error < found.position_error:
                 found = position
         return found
+
+    def _reached(self, found: RobotIK) -> bool:
+        return self.config.within_reach(found.position_error, found.rotation_error)
+
+    def _within_a_step(self, arm: RobotArm, oMdes: np.ndarray, settings: dict) -> RobotIK | None:
+        """A pose within one frame's joint motion of the last that reaches ``oMdes``, searched
+        from the last pose and from ``config.near_starts`` fixed points around it; or None."""
+        q_prev = self._q_prev
+        assert q_prev is not None
+        step = self.config.max_joint_step
+        lower, upper = q_prev - step, q_prev + step
+        offsets = self._fixed_draws("near", -np.ones(arm.nq), np.ones(arm.nq))
+        best: RobotIK | None = None
+        for offset in (np.zeros(arm.nq), *offsets):
+            near = arm.inverse(oMdes, q_prev + step * offset, lower=lower, upper=upper, **settings)
+            if self._reached(near):
+                return near
+            if best is None or near.position_error < best.position_error:
+                best = near
+        assert best is not None
+        # the nearest may only need more iterations (a target that moved fast)
+        more = {**settings, "iterations": self.config.restart_iterations}
+        near = arm.inverse(oMdes, best.q, lower=lower, upper=upper, **more)
+        if self._reached(near):
+            return near
+        # the last pose itself may be within reach of the target, where the solves, aiming at
+        # it exactly, stalled against the step's bounds further off
+        stay = self._reached_at(arm, q_prev, oMdes)
+        return stay
+
+    def _reached_at(self, arm: RobotArm, q: np.ndarray, oMdes: np.ndarray) -> RobotIK | None:
+        """``q`` as an IK answer if its tool reaches ``oMdes``, else None."""
+        got = arm.chain.forward(q)
+        position_error = float(np.linalg.norm(got[:3, 3] - oMdes[:3, 3]))
+        rotation_error = 0.0
+        if arm.spec.orientation:
+            cos = (np.trace(got[:3, :3].T @ oMdes[:3, :3]) - 1.0) / 2.0
+            rotation_error = math.acos(float(np.clip(cos, -1.0, 1.0)))
+        found = RobotIK(q.copy(), False, position_error, rotation_error, 0)
+        return found if self._reached(found) else None
+
+    def _starts(self, robot: RobotArm) -> np.ndarray:
+        """The fixed restart poses of ``robot`` (drawn once, seeded)."""
+        return self._fixed_draws("restart", robot.lower, robot.upper)
+
+    def _fixed_draws(self, what: str, lower: np.ndarray, upper: np.ndarray) -> np.ndarray:
+        """Points drawn once (seeded) between ``lower`` and ``upper``: ``config.near_starts``
+        of them for ``"near"``, ``config.restart_starts`` for ``"restart"``."""
+        drawn = self._draws.get(what)
+        if drawn is None or drawn.shape[1] != len(lower):
+            count = self.config.near_starts if what == "near" else self.config.restart_starts
+            drawn = np.random.default_rng(RESTART_SEED).uniform(lower, upper, (count, len(lower)))
+            self._draws[what] = drawn
+        return drawn
 
     def human_from_robot(self, q_robot: object) -> np.ndarray:
         """Operator arm angles that joint mode maps onto ``q_robot``: its inverse.

@@ -57,6 +57,9 @@ class RobotSpec:
             where :attr:`RobotArm.home` is a poor aim; empty: ``home``.
         approach: the tool frame's axis that points out of the tool, along its fingers
             (``"z"``, the ROS convention, or ``"x"`` where the URDF's tool frame has it so).
+        facing: the direction the arm faces in its URDF's base frame, as an angle about z from
+            +x (rad): the studio turns its targets and its drawing by it, so that every arm
+            faces the operator (the SO-100's URDF faces -y).
     """
 
     name: str
@@ -70,6 +73,7 @@ class RobotSpec:
     elbow: int = 3
     ready: tuple[float, ...] = field(default=())
     approach: str = "z"
+    facing: float = 0.0
 
 
 UR_READY_DEG = (0.0, -90.0, 90.0, -90.0, -90.0, 0.0)
@@ -133,6 +137,7 @@ ROBOT_SPECS: dict[str, RobotSpec] = {
             "wrist",
             5,
             orientation=False,
+            facing=-math.pi / 2,
         ),
         RobotSpec(
             "so101",
@@ -306,6 +311,9 @@ class RobotArm:
         reach: the largest distance from ``shoulder`` to the tool over the limits (sampled, m).
         tool_axes: the tool frame's axes in the studio's tool frame, whose z points along the
             fingers (:data:`TOOL_AXES`).
+        base_rotation: the URDF's base frame in the studio's robot frame (x where the arm faces,
+            z up): a turn about z by ``-spec.facing``. Targets go into the base frame through
+            its transpose, and the scene draws the arm turned by it.
         chain: the arm's joints as the compiled IK reads them (:class:`SerialChain`).
         urdf_text: the URDF the model was built from (for export).
     """
@@ -345,6 +353,9 @@ class RobotArm:
         self.chain = SerialChain.from_model(model, self._tool, self._elbow_joint)
         self.shoulder = _shoulder(model, self.data, self.chain.axes[0])
         self.tool_axes = TOOL_AXES[spec.approach]
+        c, s = math.cos(-spec.facing), math.sin(-spec.facing)
+        self.base_rotation = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+        self.base_rotation.setflags(write=False)
         self.reach = self._sampled_reach()
         self._collision_data: pin.GeometryData | None = None
         if len(collision_model.geometryObjects):
@@ -419,12 +430,15 @@ class RobotArm:
         rotation_tolerance: float = math.radians(1.0),
         damping: float = 1e-2,
         max_step: float = 0.2,
+        lower: np.ndarray | None = None,
+        upper: np.ndarray | None = None,
     ) -> RobotIK:
         """Joint angles that put the tool at ``oMdes``, by damped least squares within the limits.
 
         Each iteration takes ``dq = J^T (J J^T + lambda^2 I)^-1 e`` and, for arms with joints to
-        spare, a null-space step moving the elbow towards ``elbow``; the result is projected
-        onto the limits, so every returned ``q`` is within them.
+        spare, a null-space step moving the elbow towards ``elbow``; a joint held at a limit
+        that the step would push beyond is left out of it (the others make up for it), and the
+        result is projected onto the limits, so every returned ``q`` is within them.
 
         Args:
             oMdes: the tool's target pose (4x4) in the base frame, or its position (3,).
@@ -437,6 +451,8 @@ class RobotArm:
                 caller takes one per frame and lets the elbow settle over frames).
             iterations, position_tolerance, rotation_tolerance, damping, max_step: the solver's
                 settings (max_step in rad per iteration, infinity norm).
+            lower, upper: bounds tighter than the limits for this solve (rad, within
+                :attr:`lower`..:attr:`upper`), such as the joint motion one frame allows.
 
         Returns:
             A :class:`RobotIK`.
@@ -453,7 +469,9 @@ class RobotArm:
             )
         if position_only:
             pos_only = True
-        q = np.clip(self.home if q0 is None else self.check_q(q0, "q0"), self.lower, self.upper)
+        lower = self.lower if lower is None else np.maximum(self.lower, lower)
+        upper = self.upper if upper is None else np.minimum(self.upper, upper)
+        q = np.clip(self.home if q0 is None else self.check_q(q0, "q0"), lower, upper)
         elbow_target = None if elbow is None else real_array(elbow, "elbow").reshape(3)
         settings = ChainSolve(
             iterations=iterations,
@@ -465,8 +483,8 @@ class RobotArm:
         )
         q, pos_err, rot_err, it = solve(
             self.chain,
-            self.lower,
-            self.upper,
+            lower,
+            upper,
             q,
             target_R,
             target_p,

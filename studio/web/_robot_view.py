@@ -3,7 +3,8 @@
 The Puma560 is drawn from the Toolbox's link meshes on its DH frames, at the origin, as ever.
 Any other robot of :func:`studio.kinematics.load_robot` is drawn from its URDF's own meshes
 (:func:`studio.kinematics.robot_meshes`), posed by Pinocchio, and framed where the Puma560
-stands: its base at the origin facing +X, raised on a pedestal so its shoulder is at the
+stands: its base at the origin facing +X (turned by ``RobotArm.base_rotation`` where its URDF
+faces elsewhere, as the retargeting turns its targets), raised on a pedestal so its shoulder is at the
 Puma560's, and enlarged (never shrunk) to the Puma560's reach, so a small arm such as the SO-100
 reads at the scene's distance from the operator beside it.
 """
@@ -101,11 +102,12 @@ def arm_tool(arm: RobotArm) -> Callable[[np.ndarray], np.ndarray]:
     data = arm.model.createData()  # its own scratch data, as the retargeting has its own
     lock = threading.Lock()
     lift = np.array([0.0, 0.0, pedestal])
+    turn = arm.base_rotation  # facing the operator, as its targets do
 
     def tool(q: np.ndarray) -> np.ndarray:
         with lock:
             pin.framesForwardKinematics(arm.model, data, np.asarray(q, dtype=float))
-            return data.oMf[arm.tool_frame].translation * scale + lift
+            return turn @ data.oMf[arm.tool_frame].translation * scale + lift
 
     return tool
 
@@ -133,6 +135,7 @@ def arm_view(arm: RobotArm, config: MeshConfig, cache: Path | None = None) -> Ro
     data, geometry_data = arm.model.createData(), arm.visual_model.createData()
     lock = threading.Lock()
     lift = np.array([0.0, 0.0, pedestal])
+    turn = arm.base_rotation  # facing the operator, as its targets do
     tool = arm_tool(arm)
 
     def poses(q: np.ndarray) -> np.ndarray:
@@ -141,7 +144,8 @@ def arm_view(arm: RobotArm, config: MeshConfig, cache: Path | None = None) -> Ro
                 arm.model, data, arm.visual_model, geometry_data, np.asarray(q, dtype=float)
             )
             out = np.stack([geometry_data.oMg[int(p.frame)].homogeneous for p in parts])
-        out[:, :3, 3] = out[:, :3, 3] * scale + lift
+        out[:, :3, :3] = turn @ out[:, :3, :3]
+        out[:, :3, 3] = out[:, :3, 3] * scale @ turn.T + lift
         return out
 
     return RobotView(

@@ -207,7 +207,8 @@ def test_a_colliding_pose_is_refused_naming_the_link_pair_and_the_margin(tmp_pat
 
 def test_a_target_out_of_reach_is_refused_naming_the_sample(tmp_path):
     arm = HumanArm()
-    pose = np.random.default_rng(0).uniform(arm.lower, arm.upper, size=(5, 7))[4]
+    # a pose whose scaled hand the SO-100, facing the operator, cannot reach (12.8 cm off)
+    pose = np.random.default_rng(0).uniform(arm.lower, arm.upper, size=(24, 7))[23]
     rec = write_arm_recording(tmp_path / "far.tape.csv", np.repeat(pose[None], 12, axis=0))
     motion = recording_motion(rec, "so100")
     with pytest.raises(SafetyError, match=r"frame \d+ \(t = [\d.]+ s of the source\): the hand's target is "

@@ -1,0 +1,95 @@
+"""Whether a robot's tool has reached a target, and whether any pose of the robot could.
+
+The retargeting's goal is the tool within ``RetargetConfig.reach_tolerance`` (1 cm) and
+``RetargetConfig.reach_angle`` (5 deg) of the hand's target wherever the target is reachable.
+This module is the one definition of both halves, used by the retargeting's tests and
+benchmarks:
+
+- :func:`tool_reaches`: the tool at ``q`` is within those tolerances of the target (the angle is
+  not asked of an arm that follows the position only).
+- :func:`reachable`: some pose of the arm reaches the target: within its joint limits, its links
+  at least ``RetargetConfig.clearance`` apart, and, given ``near``, no joint further than
+  ``RetargetConfig.max_joint_step`` from ``near`` (the target can be reached in the one frame the
+  step cap allows from there). It is a search: the IK, run to convergence from ``near`` (or
+  home) and from :data:`REACHABLE_STARTS` (:data:`NEAR_STARTS` given ``near``) starts drawn at
+  random (seeded) within those bounds;
+  "not reachable" means none of those starts found a pose.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ._puma import Puma560
+from ._retarget import RetargetConfig
+from ._robots import RobotArm
+
+REACHABLE_STARTS = 24
+"""Random starts of :func:`reachable`'s search over the joint ranges, besides home."""
+
+NEAR_STARTS = 8
+"""Random starts of :func:`reachable`'s search within one frame's joint motion of ``near``,
+besides ``near`` itself (a small box: fewer starts cover it)."""
+
+REACHABLE_ITERATIONS = 200
+"""IK iterations from each start of :func:`reachable`'s search (enough to converge)."""
+
+
+def reach_errors(
+    robot: RobotArm | Puma560, q: np.ndarray, oMdes: np.ndarray
+) -> tuple[float, float]:
+    """How far (m) and how turned (rad) the tool at ``q`` is from ``oMdes`` (4x4); the angle is
+    0 for an arm that follows the position only."""
+    got = robot.forward(q)
+    distance = float(np.linalg.norm(got[:3, 3] - oMdes[:3, 3]))
+    if isinstance(robot, RobotArm) and not robot.spec.orientation:
+        return distance, 0.0
+    cos = (np.trace(got[:3, :3].T @ oMdes[:3, :3]) - 1.0) / 2.0
+    return distance, math.acos(float(np.clip(cos, -1.0, 1.0)))
+
+
+def tool_reaches(
+    robot: RobotArm | Puma560,
+    q: np.ndarray,
+    oMdes: np.ndarray,
+    config: RetargetConfig | None = None,
+) -> bool:
+    """Whether the tool at ``q`` has reached ``oMdes`` (:meth:`RetargetConfig.within_reach`)."""
+    return (config or RetargetConfig()).within_reach(*reach_errors(robot, q, oMdes))
+
+
+def reachable(
+    arm: RobotArm,
+    oMdes: np.ndarray,
+    config: RetargetConfig | None = None,
+    near: np.ndarray | None = None,
+) -> bool:
+    """Whether some pose of ``arm`` reaches ``oMdes`` (see the module docstring).
+
+    Args:
+        arm: the robot (the Puma560 too, as ``load_robot("puma560")``).
+        oMdes: the tool's target (4x4, the arm's base frame).
+        config: the tolerances, the clearance and the step cap.
+        near: a pose: only poses within one frame's joint motion of it count.
+    """
+    config = config or RetargetConfig()
+    lower, upper = arm.lower, arm.upper
+    if near is not None:
+        lower = np.maximum(lower, near - config.max_joint_step)
+        upper = np.minimum(upper, near + config.max_joint_step)
+    rng = np.random.default_rng(0)
+    first = arm.home if near is None else near
+    starts = REACHABLE_STARTS if near is None else NEAR_STARTS
+    for start in (first, *rng.uniform(lower, upper, (starts, arm.nq))):
+        q = arm.inverse(
+            oMdes,
+            np.clip(start, lower, upper),
+            iterations=REACHABLE_ITERATIONS,
+            lower=lower,
+            upper=upper,
+        ).q
+        if tool_reaches(arm, q, oMdes, config) and not arm.self_collisions(q, config.clearance):
+            return True
+    return False
