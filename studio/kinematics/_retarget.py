@@ -55,7 +55,8 @@ from ._clearance import ClearanceGuard
 from ._errors import KinematicsError
 from ._human import SAGITTAL_MIRROR, HumanArm, _as_q
 from ._puma import IKConfig, IKResult, Puma560
-from ._robots import RobotArm, RobotIK, load_robot
+from ._robot_load import load_robot
+from ._robots import RobotArm, RobotIK
 
 Mode = Literal["joint", "cartesian"]
 
@@ -570,7 +571,8 @@ class Retargeter:
 
         Joint mode (the Puma560): :meth:`human_from_robot`, exact. Cartesian mode: the hand pose
         whose target (:meth:`hand_target`) is the robot's tool pose at ``q_robot``, undoing the
-        soft limits of the reach and the table, the placement, the scale and the mirror, then
+        soft limits of the reach and the table, the placement, the scale, the base's turn and
+        the mirror, then
         the arm that holds the hand there (:func:`fit_hand_pose`, within the arm's limits; where
         the arm cannot, the closest it can). The simulator uses it to reach a goal of any robot.
 
@@ -590,7 +592,8 @@ class Retargeter:
         from ._hand_ik import fit_hand_pose
 
         tool = robot.forward(robot.check_q(q_robot, "q_robot"))
-        R = tool[:3, :3] @ robot.tool_axes.T @ HAND_TO_TOOL.T
+        turn = robot.base_rotation  # out of the URDF's base frame (the SO-100 faces -y)
+        R = turn @ tool[:3, :3] @ robot.tool_axes.T @ HAND_TO_TOOL.T
         # undo the target's soft limits, the reach's (applied last) first, then the table's
         config, t = self.config, tool[:3, 3].copy()
         offset = t - robot.shoulder
@@ -601,7 +604,7 @@ class Retargeter:
                 _unbent(distance, ceiling, config.reach_softness) / distance
             )
         t[2] = _unfloored(float(t[2]), config.floor_height, config.floor_softness)
-        p = (t - self._shoulder()) / self._scale()
+        p = turn @ (t - self._shoulder()) / self._scale()
         if self._mirror:  # both mirrors are their own inverses
             R = SAGITTAL_MIRROR @ R @ URDF_LATERAL_MIRROR
         oMhand = np.eye(4)
