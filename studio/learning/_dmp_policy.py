@@ -166,11 +166,18 @@ def rollout_dmp_policy(
 ) -> tuple[np.ndarray, np.ndarray, bool]:
     """The primitive from ``start_q`` (default: the demonstration's start) to the policy's goal.
 
+    The primitive knows nothing of the robot's joint limits: a demonstration that runs along a
+    limit (the Panda's fourth joint near -4 degrees) comes back a hair beyond it, so the rollout
+    is kept within the robot's limits, as every motion the studio plays or exports is.
+
     Returns:
         ``(times (N,), q (N, nq), reached)``: ``reached`` when every joint ends within
         :data:`._dmp.DMP_SETTLE_RAD` of the goal.
     """
     times, q = roll_out_primitive(policy.primitive, start_q, policy.goal, rate_hz)
+    arm = task_arm(policy.robot)
+    width = q.shape[1]
+    q = np.clip(q, arm.lower[:width], arm.upper[:width])
     reached = bool(np.all(np.abs(q[-1] - policy.goal) <= DMP_SETTLE_RAD))
     return times, q, reached
 

@@ -129,3 +129,12 @@ def test_a_primitive_is_refused_angles_of_another_robot_and_a_file_naming_no_off
         np.savez(bad, **members)
         with pytest.raises(PolicyFileError, match=why):
             load_dmp_policy(bad)
+
+
+def test_a_primitive_rolls_out_within_its_robots_limits(panda_policy) -> None:
+    """The Panda's sample demonstration runs along joint 4's upper limit (-4 degrees); the
+    primitive, which knows no limits, must not carry the rollout past it."""
+    _, policy = panda_policy
+    panda = load_robot("panda", geometry=False)
+    _, q, _ = rollout_dmp_policy(policy)
+    assert np.all(q >= panda.lower) and np.all(q <= panda.upper)
