@@ -33,6 +33,11 @@ def test_cut_on_the_timeline(page: Any, studio_server: Studio) -> None:
     timeline = page.get_by_role("slider", name="Timeline")
     timeline.wait_for(state="visible", timeout=T)
     page.wait_for_selector("[data-testid='timeline-plot'] canvas", timeout=60_000)
+    # the answer to this click drawn (an earlier story's plot of the same recording may be up)
+    page.wait_for_function(
+        "() => { const t = window.studio.timeline; return t.data && t.drawn === t.asked; }",
+        timeout=60_000,
+    )
     duration = float(timeline.get_attribute("aria-valuemax"))
     assert duration > 3
     assert page.input_value("[data-testid='demo-recording']") == "sample-reach-1"

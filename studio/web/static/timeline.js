@@ -23,7 +23,7 @@ const STEP_S = 0.1;
 
 const UNITS = { deg: (x) => `${x}°`, cm: (x) => `${x} cm` };
 
-const T = { asked: 0, name: null, show: "joints", data: null, chart: null, playhead: 0, playing: false, last: 0, want: null, sending: false };
+const T = { asked: 0, drawn: 0, name: null, show: "joints", data: null, chart: null, playhead: 0, playing: false, last: 0, want: null, sending: false };
 S.timeline = T; // for the browser tests and the console
 
 function duration() { return T.data ? T.data.duration : 0; }
@@ -48,6 +48,7 @@ export async function showTimeline(name) {
     T.playhead = 0;
     showChoices();
     draw();
+    T.drawn = asked; // the answer to the latest request is on screen (the browser tests wait for it)
   });
 }
 
