@@ -227,11 +227,16 @@ class _Simulation:
         self.rate_hz = float(rate_hz)
         self._noise_rng = np.random.default_rng(seeds[1])
         self._tape_from_arm = tape_from_arm
+        self._last_reading: tuple[np.ndarray, np.ndarray] | None = None  # noiseless, last frame
         self.k = 0
 
     def next(self, n: int) -> tuple[list[TapeFrame], np.ndarray]:
         q, reaching = self.motion.sample(n)
-        bend, twist = self._tape_from_arm(self.motion.arm, q, self.config)
+        # a stream: each region's reading continuous from the last chunk's last frame on
+        bend, twist = self._tape_from_arm(
+            self.motion.arm, q, self.config, in_time=True, previous=self._last_reading
+        )
+        self._last_reading = (bend[-1].copy(), twist[-1].copy())
         # noise drawn frame by frame (bend then twist), so any chunking gives the same frames
         shape = (n, 2, self.config.regions)
         noise = self._noise_rng.normal(0.0, self.motion.operator.noise_rad, shape)

@@ -429,12 +429,50 @@ def _angles_along(
     return bend, twist
 
 
+def _in_time(
+    bend: np.ndarray,
+    twist: np.ndarray,
+    first: int,
+    previous: tuple[np.ndarray, np.ndarray] | None,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Readings ``(N, regions)`` of frames in time order, each region's chosen continuous with the
+    frame before (``previous``: the readings of the frame before the first, if any).
+
+    A region whose twist sits at +-90 degrees reads (b, 90) or (-b, -90) with the next frame's
+    slightest change, and every region after it flips its bend's sign with it: the same shape,
+    two readings. A real tape twists continuously. So from region ``first`` on, each region takes
+    whichever of its reading and the other one (bend negated, twist turned by 180 degrees; the
+    regions after it then read with their bends negated) lies nearer its reading in the frame
+    before. (A region passing through straight, where the twist says little of the shape, may
+    still choose the reading that flips the small bends after it: tenths of a radian, where the
+    canonical readings jump by up to 190 degrees.)
+    """
+    bend, twist = bend.copy(), twist.copy()
+    last = None if previous is None else (np.asarray(previous[0]), np.asarray(previous[1]))
+    for n in range(bend.shape[0]):
+        if last is not None:
+            sign = 1.0  # the bends' sign from the regions chosen so far in this frame
+            for r in range(first, bend.shape[1]):
+                b, t = sign * bend[n, r], twist[n, r]
+                other_t = t - math.pi if t > last[1][r] else t + math.pi
+                here = (b - last[0][r]) ** 2 + (t - last[1][r]) ** 2
+                there = (b + last[0][r]) ** 2 + (other_t - last[1][r]) ** 2
+                if there < here:
+                    sign, b, t = -sign, -b, other_t
+                bend[n, r], twist[n, r] = b, t
+        last = (bend[n], twist[n])
+    return bend, twist
+
+
 def tape_from_arm(
     arm: HumanArm,
     q_human: object,
     config: TapeConfig,
     rng: np.random.Generator | None = None,
     noise: float | None = None,
+    *,
+    in_time: bool = False,
+    previous: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Bend and twist of a tape strapped on ``arm`` at pose ``q_human``: the forward model.
 
@@ -461,6 +499,13 @@ def tape_from_arm(
         rng: random generator for ``noise`` (required when ``noise > 0``).
         noise: standard deviation of Gaussian sensor noise added to every angle (rad); None
             or 0 for none.
+        in_time: the poses are consecutive frames (``q_human`` of shape ``(N, 7)``): each
+            region's reading stays continuous from frame to frame, as a real tape's does, where
+            a region at +-90 degrees of twist would otherwise jump between its two readings of
+            the same shape (see ``_in_time``). Default: each pose on its own, its twist in
+            (-90, 90] degrees.
+        previous: with ``in_time``, the noiseless ``(bend, twist)`` of the frame before the
+            first, to continue from (a stream made in chunks).
 
     Returns:
         ``(bend, twist)``, each of shape ``(..., regions)``.
@@ -497,6 +542,8 @@ def tape_from_arm(
 
     bend = np.concatenate([np.broadcast_to(back_bend, (flat.shape[0], s)), arm_bend], axis=1)
     twist = np.concatenate([np.broadcast_to(back_twist, (flat.shape[0], s)), arm_twist], axis=1)
+    if in_time:
+        bend, twist = _in_time(bend, twist, s, previous)
     if noise:
         if not isinstance(rng, np.random.Generator):
             raise KinematicsError("tape_from_arm with noise needs rng=np.random.default_rng(seed).")
