@@ -80,7 +80,9 @@ def test_the_timeline_cursor_holds_the_chosen_robot_where_its_timeline_says(
     reviewer = client.app.state.reviewer
     k = len(timeline["times"]) // 2
     held = reviewer.hold(recording, timeline["times"][k])
-    assert np.allclose(np.degrees(held), timeline["robot"][k], atol=0.01)
+    # the plot's points are downsampled and served to 0.01 degree; the cursor interpolates the
+    # same retargeted path
+    assert np.allclose(np.degrees(held), timeline["robot"][k], atol=0.05)
 
 
 # ---------------------------------------------------------------------- the jog sliders
