@@ -53,6 +53,7 @@ import numpy as np
 from ._checks import instance_of, positive_number, whole_number
 from ._clearance import ClearanceGuard
 from ._errors import KinematicsError
+from ._hand_ik import fit_hand_pose
 from ._human import SAGITTAL_MIRROR, HumanArm, _as_q
 from ._puma import IKConfig, IKResult, Puma560
 from ._robot_load import load_robot
@@ -589,8 +590,6 @@ class Retargeter:
         robot = self.robot
         if self.mode == "joint" or not isinstance(robot, RobotArm):
             return self.human_from_robot(q_robot)
-        from ._hand_ik import fit_hand_pose
-
         tool = robot.forward(robot.check_q(q_robot, "q_robot"))
         turn = robot.base_rotation  # out of the URDF's base frame (the SO-100 faces -y)
         R = turn @ tool[:3, :3] @ robot.tool_axes.T @ HAND_TO_TOOL.T
