@@ -195,6 +195,17 @@ def wait_until_browser_settles() -> None:
             return
 
 
+def wait_until_scene_still(page: Any) -> None:
+    """Wait until the scene's page has been told its scene is still (``_scene_frames.py``): a page
+    left open, as a user's is while training runs, draws its still scene rarely; one opened a
+    second ago is still loading it and draws freely."""
+    still = "() => !!window.__studioFramePacing && window.__studioFramePacing.gapMs >= 1000"
+    scene = next(f for f in page.frames if f != page.main_frame)
+    end = time.monotonic() + SETTLE_TIMEOUT_S
+    while time.monotonic() < end and not scene.evaluate(still):
+        time.sleep(0.25)
+
+
 def process_cpu_seconds(pid: int) -> float:
     """CPU seconds (user + system) used so far by process ``pid`` and its threads (Linux /proc)."""
     with open(f"/proc/{pid}/stat") as f:
@@ -394,6 +405,7 @@ def measure_with_page(
         page.goto(base + "/")
         page.wait_for_selector("body[data-ready='1']", timeout=30_000)
         wait_until_browser_settles()
+        wait_until_scene_still(page)
         before = page.evaluate("() => window.studio.curveRenders || 0")
         cpu = chromium_cpu_seconds()
         cpu0 = process_cpu_seconds(studio_pid)

@@ -165,7 +165,7 @@ class StudioScene(ScenePaths, SceneRobot):
         self._closed = threading.Event()
 
         self._build()
-        self.frames = FramePacer(server)  # viser's page draws less while a slow stream drives it
+        self.frames = FramePacer(server)  # viser's page draws less: a slow stream, a still scene
         self.hand_handle = HandHandle(server)
         self.camera = SceneCamera(server, self.layout)  # presets, following the tool
         self._arms: dict[str, HumanArm] = {}  # the hand guide's arm model per side
@@ -683,6 +683,7 @@ class StudioScene(ScenePaths, SceneRobot):
         self._closed.set()
         self._wake.set()
         self._thread.join(timeout=2.0)
+        self.frames.close()
 
 
 @dataclass

@@ -1,18 +1,31 @@
-"""How often viser's page may draw the scene while a slow live stream drives it.
+"""How often viser's page may draw the scene: while a slow live stream drives it, and while
+nothing in it changes.
 
 viser's page draws on demand, but after every update it receives it keeps drawing for a quarter
-of a second (``RENDER_SETTLE_MS`` in its ``App.tsx``), as fast as the browser allows. Without a
-GPU every one of those frames is drawn by SwiftShader in the browser's GPU process: about 50 ms
-of CPU a frame for this scene, 4 to 7 frames an update, in the very process where the camera's
-pose model runs its WebGL. The pose model then waits behind the scene.
+of a second (``RENDER_SETTLE_MS`` in its ``App.tsx``), as fast as the browser allows, and it
+draws one frame a second besides, changed or not (``RENDER_HEARTBEAT_MS``, a safety net for
+changes that never ask for a frame). Without a GPU every one of those frames is drawn by
+SwiftShader in the browser's GPU process: about 50 ms of CPU a frame for this scene.
 
-A slow live stream (pose estimation without a GPU, see ``SceneLayout.slow_live_s``) brings a new
-pose at most once a second, and the frames after the first show the same pose again. So while
-one drives the scene, :class:`FramePacer` asks every browser showing the scene to start a frame
-at most every :data:`SLOW_FRAME_GAP_MS`: the update is drawn, and one frame after it (for what
-viser finishes after a commit, such as a texture upload), instead of a burst. Anything the user
-does in the scene (a pointer, the wheel, a key) lifts the limit for
-:data:`INPUT_LIFTS_MS`, so orbiting stays as smooth as the browser can draw it.
+- **A slow live stream** (pose estimation without a GPU, see ``SceneLayout.slow_live_s``) brings
+  a new pose at most once a second, and the frames after the first show the same pose again,
+  in the very process where the camera's pose model runs its WebGL. So while one drives the
+  scene, :class:`FramePacer` asks every browser showing the scene to start a frame at most every
+  :data:`SLOW_FRAME_GAP_MS`: the update is drawn, and one frame after it (for what viser
+  finishes after a commit, such as a texture upload), instead of a burst.
+- **A still scene**: when nothing has been sent to the page for :data:`STILL_AFTER_S`, a page
+  that has finished loading (:data:`LOADING_S`) is asked to draw at most every
+  :data:`STILL_FRAME_GAP_MS`. The once-a-second frame then costs a quarter of what it did: a
+  still page beside a training run took 0.08 of this machine's two cores, most of it that frame.
+  The first message sent to the page afterwards (any update of the scene, or of the page's
+  camera) first lifts the limit, and the frames a page was holding back are drawn at once.
+  viser's page applies what it receives in its next frame, so the page must not wait for a
+  frame to read the message that lifts the limit: while still, the page reads as hidden
+  (``document.hidden``), for which viser applies each message as it comes.
+
+Anything the user does in the scene (a pointer, the wheel, a key) or a resize of its window lifts
+the limit for :data:`INPUT_LIFTS_MS` and draws any frame held back, so orbiting stays as smooth
+as the browser can draw it.
 
 The limit is a wrapper of the page's ``requestAnimationFrame`` (the clock of three.js and of
 React Three Fiber, which viser draws with), installed through viser's ``RunJavascriptMessage``.
@@ -23,14 +36,27 @@ browser. ``window.__studioFramePacing.frames`` counts the frames it let through.
 from __future__ import annotations
 
 import threading
+import time
+from collections.abc import Callable
 
 import viser
 
 SLOW_FRAME_GAP_MS = 250.0
 """Least time between two frames of viser's page while a slow live stream drives the scene: as
 long as viser's settle window, so an update is drawn in one frame and settled in one more."""
+STILL_FRAME_GAP_MS = 4000.0
+"""Least time between two frames of a page whose scene is still: viser's safety-net frame, once
+every 4 s instead of every second."""
+STILL_AFTER_S = 1.5
+"""Nothing sent to the page for this long: its scene is still (viser's settle window after the
+last update, a quarter of a second, is long over)."""
+LOADING_S = 5.0
+"""A page that connected less than this long ago is still loading the scene (meshes, shaders):
+it draws freely."""
 INPUT_LIFTS_MS = 1500.0
-"""How long a pointer, wheel or key event in the scene lifts the limit."""
+"""How long a pointer, wheel or key event in the scene, or a resize, lifts the limit."""
+WATCH_EVERY_S = 0.25
+"""How often the pacer looks whether the scene has become still."""
 
 _PACING_JS = """
 (() => {
@@ -39,7 +65,7 @@ _PACING_JS = """
     p = window.__studioFramePacing = { gapMs: 0, inputUntil: 0, next: 0, lastT: -1, frames: 0 };
     const raf = window.requestAnimationFrame.bind(window);
     const caf = window.cancelAnimationFrame.bind(window);
-    const waiting = new Map(); // our id -> [timeout, the browser's frame id]
+    const waiting = new Map(); // our id -> [timeout, the browser's frame id, callback]
     let seq = 0x40000000; // apart from the browser's own ids (a request made before this ran)
     const hand = (id, cb) => {
       waiting.get(id)[1] = raf((t) => {
@@ -48,12 +74,20 @@ _PACING_JS = """
         cb(t);
       });
     };
+    p.release = () => { // hand every frame held back to the browser now
+      for (const [id, entry] of waiting) {
+        if (!entry[0]) continue;
+        clearTimeout(entry[0]);
+        entry[0] = 0;
+        hand(id, entry[2]);
+      }
+    };
     window.requestAnimationFrame = (cb) => {
       const id = ++seq;
       const now = performance.now();
       const wait = p.gapMs > 0 && now >= p.inputUntil ? p.next - now : 0;
-      waiting.set(id, [0, 0]);
-      if (wait > 0) waiting.get(id)[0] = setTimeout(() => hand(id, cb), wait);
+      waiting.set(id, [0, 0, cb]);
+      if (wait > 0) waiting.get(id)[0] = setTimeout(() => { waiting.get(id)[0] = 0; hand(id, cb); }, wait);
       else hand(id, cb);
       return id;
     };
@@ -64,29 +98,69 @@ _PACING_JS = """
       if (entry[1]) caf(entry[1]);
       waiting.delete(id);
     };
-    const lift = () => { p.inputUntil = performance.now() + %(lift)s; };
-    for (const type of ["pointerdown", "pointermove", "wheel", "keydown"]) {
+    const lift = () => { p.inputUntil = performance.now() + %(lift)s; p.release(); };
+    for (const type of ["pointerdown", "pointermove", "wheel", "keydown", "resize"]) {
       window.addEventListener(type, lift, { capture: true, passive: true });
     }
   }
+  if (!p.hides) {
+    // viser applies what it receives in its next frame, or at once while the page is hidden
+    // (its messageQueue.ts); a still page reads as hidden, so that an update (and the script
+    // waking the page, above all) is applied as it comes rather than in a frame held back.
+    const hidden = Object.getOwnPropertyDescriptor(Document.prototype, "hidden").get;
+    Object.defineProperty(document, "hidden", { configurable: true, get: () => p.still || hidden.call(document) });
+    p.hides = true;
+  }
+  const before = p.gapMs;
   p.gapMs = %(gap)s;
+  p.still = %(still)s;
+  if (p.gapMs < before) { p.next = 0; p.release(); }
 })();
 """
 
 
-def pacing_js(gap_ms: float) -> str:
-    """The script that sets the least time between frames of viser's page (0: no limit)."""
-    return _PACING_JS % {"gap": float(gap_ms), "lift": INPUT_LIFTS_MS}
+def pacing_js(gap_ms: float, still: bool = False) -> str:
+    """The script that sets the least time between frames of viser's page (0: no limit), and
+    whether its scene is still (viser then applies each update as it comes, see above)."""
+    return _PACING_JS % {
+        "gap": float(gap_ms),
+        "lift": INPUT_LIFTS_MS,
+        "still": "true" if still else "false",
+    }
+
+
+class _Page:
+    """One browser showing the scene: how to send it a script, and what it was told."""
+
+    def __init__(self, send: Callable[[object], None]) -> None:
+        self.send = send  # its connection's own queue_message, before the pacer wrapped it
+        self.connected_at = time.monotonic()
+        self.gap_ms = 0.0  # the gap it was told last (0 before any script)
 
 
 class FramePacer:
-    """Tells every browser showing the scene, and each one that connects, the frame gap."""
+    """Tells every browser showing the scene, and each one that connects, the frame gap.
+
+    Every message viser sends to a page passes through the pacer (it wraps the ``queue_message``
+    of the server and of each client's connection), which is how it knows the scene is still,
+    and wakes a still page before the message that changes it.
+    """
 
     def __init__(self, server: viser.ViserServer) -> None:
         self.server = server
         self.gap_ms = 0.0
+        """The gap while the scene changes: :data:`SLOW_FRAME_GAP_MS` while a slow stream
+        drives it, else 0."""
         self._lock = threading.Lock()
+        self._pages: dict[int, _Page] = {}
+        self._still: set[int] = set()  # pages told the still gap
+        self._last_sent = time.monotonic()
+        self._closed = threading.Event()
+        self._wrap(server._websock_server)
         server.on_client_connect(self._connected)
+        server.on_client_disconnect(self._disconnected)
+        self._thread = threading.Thread(target=self._watch, name="frame-pacer", daemon=True)
+        self._thread.start()
 
     def slow(self, slow: bool) -> None:
         """Limit the frames while a slow live stream drives the scene; lift it otherwise."""
@@ -95,17 +169,73 @@ class FramePacer:
             if gap == self.gap_ms:
                 return
             self.gap_ms = gap
-        for client in list(self.server.get_clients().values()):
-            self._send(client)
+            for client_id, page in self._pages.items():
+                if client_id not in self._still:
+                    self._tell(page, gap)
+
+    def still_pages(self) -> int:
+        """How many pages are drawing at the still gap now (tests, benchmarks)."""
+        with self._lock:
+            return len(self._still)
+
+    def close(self) -> None:
+        """Stop watching for a still scene."""
+        self._closed.set()
+        self._thread.join(timeout=2.0)
+
+    def _wrap(self, handler: object) -> Callable[[object], None]:
+        """Route ``handler``'s outgoing messages through :meth:`_sent`; its original sender."""
+        send = handler.queue_message  # type: ignore[attr-defined]
+
+        def queue_message(message: object) -> None:
+            self._sent()
+            send(message)
+
+        handler.queue_message = queue_message  # type: ignore[attr-defined]
+        return send
+
+    def _sent(self) -> None:
+        """A message is about to go to the pages: wake the still ones first."""
+        with self._lock:
+            self._last_sent = time.monotonic()
+            if not self._still:
+                return
+            for client_id in self._still:
+                page = self._pages.get(client_id)
+                if page is not None:
+                    self._tell(page, self.gap_ms)
+            self._still.clear()
 
     def _connected(self, client: viser.ClientHandle) -> None:
-        if self.gap_ms > 0:  # else the page draws as viser made it, without the wrapper
-            self._send(client)
+        # viser has no public call to run a script in one browser, nor to see what it sends;
+        # its plotly support sends scripts through the connection the same way.
+        page = _Page(self._wrap(client._websock_connection))
+        with self._lock:
+            self._pages[client.client_id] = page
+            if self.gap_ms > 0:  # else the page draws as viser made it, without the wrapper
+                self._tell(page, self.gap_ms)
 
-    def _send(self, client: viser.ClientHandle) -> None:
-        # viser has no public call to run a script in one browser; its plotly support sends
-        # this message the same way.
+    def _disconnected(self, client: viser.ClientHandle) -> None:
+        with self._lock:
+            self._pages.pop(client.client_id, None)
+            self._still.discard(client.client_id)
+
+    def _tell(self, page: _Page, gap_ms: float, still: bool = False) -> None:
+        """Send ``page`` the gap (the caller holds the lock)."""
         from viser import _messages
 
-        message = _messages.RunJavascriptMessage(pacing_js(self.gap_ms))
-        client._websock_connection.queue_message(message)
+        page.gap_ms = gap_ms
+        page.send(_messages.RunJavascriptMessage(pacing_js(gap_ms, still)))
+
+    def _watch(self) -> None:
+        """Tell each loaded page the still gap once nothing was sent for STILL_AFTER_S."""
+        while not self._closed.wait(WATCH_EVERY_S):
+            now = time.monotonic()
+            with self._lock:
+                if now - self._last_sent < STILL_AFTER_S:
+                    continue
+                for client_id, page in self._pages.items():
+                    if client_id in self._still or now - page.connected_at < LOADING_S:
+                        continue
+                    self._tell(page, max(STILL_FRAME_GAP_MS, self.gap_ms), still=True)
+                    self._still.add(client_id)

@@ -1,4 +1,5 @@
-"""viser's page draws fewer frames while a slow live stream drives the scene, and still shows it.
+"""viser's page draws fewer frames while a slow live stream drives the scene, or while the scene
+is still, and still shows every change.
 
 ``studio/web/_scene_frames.py`` wraps the page's ``requestAnimationFrame`` so that frames start
 at least ``SLOW_FRAME_GAP_MS`` apart while a slow stream (pose estimation without a GPU) drives
@@ -9,6 +10,7 @@ drawn, in a few frames instead of a burst, and a fast stream lifts the limit).
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import time
 from collections.abc import Iterator
@@ -17,8 +19,10 @@ from typing import Any
 import numpy as np
 import pytest
 import viser
+from playwright.sync_api import TimeoutError as PlaywrightTimeout
 
 from studio.kinematics import HumanBody
+from studio.web import _scene_frames
 from studio.web._scene import SceneLayout, StudioScene
 from studio.web._scene_frames import SLOW_FRAME_GAP_MS, pacing_js
 from tests.conftest import free_port
@@ -36,6 +40,11 @@ FRAMES_JS = """(n) => new Promise((resolve) => {
 def blank(browser: Any) -> Iterator[Any]:
     page = browser.new_page()
     page.set_content("<!doctype html><title>frames</title><p>frames</p>")
+    # A new page beside others gets its viewport a moment later, as a resize, which would lift
+    # the limit under test for INPUT_LIFTS_MS: let it come first (it may not come at all).
+    page.evaluate("() => addEventListener('resize', () => { window.__resized = true; })")
+    with contextlib.suppress(PlaywrightTimeout):
+        page.wait_for_function("() => window.__resized === true", timeout=1000)
     yield page
     page.close()
 
@@ -64,6 +73,35 @@ def test_a_cancelled_frame_never_runs_and_no_limit_passes_frames_through(blank: 
     assert ran is False
     blank.evaluate(f"() => {{ {pacing_js(0)} }}")  # the same page, the limit lifted
     assert len(blank.evaluate(FRAMES_JS, 5)) == 5
+
+
+HELD_JS = """() => { window.__held = false;
+  requestAnimationFrame(() => { window.__held = true; }); }"""
+"""Request a frame; ``window.__held`` turns true when it runs."""
+
+
+@pytest.mark.parametrize("how", ["gap lowered", "resize", "pointer"])
+def test_a_frame_held_back_runs_at_once_when_the_gap_drops_or_the_user_acts(
+    blank: Any, how: str
+) -> None:
+    """A still page holds a frame back for seconds; lowering the gap (an update woke the page),
+    or a pointer or resize in the page, hands it to the browser at once."""
+    blank.evaluate(f"() => {{ {pacing_js(1e9)} }}")  # a gap no frame would ever outwait
+    for _ in range(5):  # (a new page may get a resize of its own, which lifts the limit)
+        blank.evaluate(FRAMES_JS, 1)  # a frame just ran: the next one waits for the gap
+        blank.evaluate(HELD_JS)
+        blank.wait_for_timeout(300)
+        if blank.evaluate("() => window.__held") is False:
+            break
+    assert blank.evaluate("() => window.__held") is False, "the frame is held back"
+    if how == "gap lowered":
+        blank.evaluate(f"() => {{ {pacing_js(0)} }}")
+    elif how == "resize":
+        blank.evaluate("() => window.dispatchEvent(new Event('resize'))")
+    else:
+        blank.mouse.move(20, 20)
+        blank.mouse.move(40, 30)
+    blank.wait_for_function("() => window.__held === true", timeout=10_000)
 
 
 @pytest.fixture
@@ -123,3 +161,22 @@ def test_a_slow_stream_is_drawn_in_few_frames_each_pose_shown(scene_page) -> Non
         _pose(scene, k % 7)
         time.sleep(0.005)
     assert wait_for(lambda: _pacing(page)["gap"] == 0)
+
+
+def test_a_still_scene_draws_rarely_and_shows_the_next_pose_at_once(scene_page, monkeypatch):
+    """Nothing sent to a loaded page for a while: it draws at most every STILL_FRAME_GAP_MS (here
+    never). A pose sent then is drawn at once, in viser's usual burst: the page applies the
+    message lifting the limit without waiting for a frame."""
+    monkeypatch.setattr(_scene_frames, "LOADING_S", 1.0)
+    monkeypatch.setattr(_scene_frames, "STILL_AFTER_S", 0.5)
+    monkeypatch.setattr(_scene_frames, "STILL_FRAME_GAP_MS", 1e9)  # no safety-net frame at all
+    scene, page = scene_page
+    assert wait_for(lambda: (_pacing(page) or {}).get("gap") == 1e9)
+    start = _pacing(page)["frames"]
+    page.wait_for_timeout(2000)
+    assert _pacing(page)["frames"] - start <= 1, "no frame while still (but one in flight)"
+    before = _picture(page)
+    start = _pacing(page)["frames"]
+    _pose(scene, 3)
+    assert wait_for(lambda: _picture(page) != before), "the pose never showed"
+    assert wait_for(lambda: _pacing(page)["frames"] - start >= 2), "drawn as a burst"

@@ -1,4 +1,5 @@
-"""A slow live stream (pose estimation without a GPU) reaches the scene at a bounded rate.
+"""A slow live stream (pose estimation without a GPU) reaches the scene at a bounded rate, and a
+still scene is drawn rarely.
 
 viser's page redraws for a quarter of a second after every push. A camera whose pose model runs
 at a few frames a second in software WebGL would make the page redraw most of the time, in the
@@ -22,8 +23,9 @@ import websockets
 import zstandard
 
 from studio.kinematics import HumanBody
+from studio.web import _scene_frames
 from studio.web._scene import STREAM_STOPPED_S, SceneLayout, StudioScene
-from studio.web._scene_frames import SLOW_FRAME_GAP_MS
+from studio.web._scene_frames import SLOW_FRAME_GAP_MS, STILL_FRAME_GAP_MS
 from tests.conftest import free_port
 from tests.web.conftest import wait_for
 
@@ -123,11 +125,13 @@ class _ScriptWatch:
                     if m.get("type") == "RunJavascriptMessage":
                         self.scripts.append(m["source"])
 
+    def gaps(self) -> list[float]:
+        """The frame gap each script set, in order."""
+        return [float(s.split("p.gapMs = ")[1].split(";")[0]) for s in self.scripts]
+
     def gap(self) -> float | None:
         """The frame gap the last script set, or None before any script."""
-        return (
-            float(self.scripts[-1].split("p.gapMs = ")[1].split(";")[0]) if self.scripts else None
-        )
+        return self.gaps()[-1] if self.scripts else None
 
 
 def test_a_slow_stream_limits_the_browsers_frames_and_a_fast_one_lifts_the_limit():
@@ -151,10 +155,48 @@ def test_a_slow_stream_limits_the_browsers_frames_and_a_fast_one_lifts_the_limit
         assert wait_for(lambda: early.gap() == 0.0 and late.gap() == 0.0)
         _stream(sc, count=12, gap_s=0.06)
         assert wait_for(lambda: early.gap() == SLOW_FRAME_GAP_MS)
-        # the slow stream stops: its last pose stays, the frames are free again
-        assert wait_for(lambda: early.gap() == 0.0, timeout=STREAM_STOPPED_S + 5)
+        # the slow stream stops: its last pose stays, the slow limit goes (the scene, still by
+        # then, may already have been given the still gap instead)
+        assert wait_for(
+            lambda: early.gap() in (0.0, STILL_FRAME_GAP_MS), timeout=STREAM_STOPPED_S + 5
+        )
+        _stream(sc, count=5, gap_s=0.002)  # (after a pause it starts as a slow stream)
+        assert wait_for(lambda: early.gap() in (0.0, SLOW_FRAME_GAP_MS)), "the next pose wakes it"
         late.stop.set()
     finally:
         early.stop.set()
+        sc.close()
+        server.stop()
+
+
+def test_a_still_scene_is_drawn_rarely_and_the_next_update_frees_the_frames(monkeypatch):
+    """Once nothing was sent to a loaded page for STILL_AFTER_S it is told the still gap; a page
+    still loading is not; the next update (of the scene, or of one page's camera) first tells
+    every still page the gap back, before the update itself reaches it."""
+    monkeypatch.setattr(_scene_frames, "LOADING_S", 1.0)
+    monkeypatch.setattr(_scene_frames, "STILL_AFTER_S", 0.5)
+    port = free_port()
+    server = viser.ViserServer(host="127.0.0.1", port=port, verbose=False)
+    sc = StudioScene(server, body=HumanBody("right"), layout=SceneLayout(**SLOW))
+    page = _ScriptWatch(port)
+    try:
+        assert wait_for(lambda: page.gap() == STILL_FRAME_GAP_MS), page.scripts[-1:]
+        assert sc.frames.still_pages() == 1
+        monkeypatch.setattr(_scene_frames, "LOADING_S", 60.0)
+        loading = _ScriptWatch(port)  # connects to the still scene: it loads, drawing freely
+        time.sleep(3 * _scene_frames.STILL_AFTER_S)
+        assert loading.gap() is None, loading.scripts
+        _stream(sc, count=3, gap_s=0.002)  # a pose
+        awake = (0.0, SLOW_FRAME_GAP_MS)  # (after a pause a stream starts as a slow one)
+        assert wait_for(lambda: page.gap() in awake), "the update woke the still page"
+        assert STILL_FRAME_GAP_MS not in loading.gaps(), "a loading page is never still"
+        loading.stop.set()
+        monkeypatch.setattr(_scene_frames, "LOADING_S", 1.0)
+        assert wait_for(lambda: page.gap() == STILL_FRAME_GAP_MS), "still again after"
+        for client in server.get_clients().values():  # one page's camera moves
+            client.camera.position = (3.0, -1.0, 2.0)
+        assert wait_for(lambda: page.gap() in awake), "a camera update wakes it too"
+    finally:
+        page.stop.set()
         sc.close()
         server.stop()
