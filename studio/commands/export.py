@@ -318,6 +318,8 @@ def run(args: argparse.Namespace) -> int:
         f"{summary}: {len(done.times)} samples over {done.times[-1]:.2f} s for the "
         f"{motion.robot.spec.title}, {timing}, {checks}; wrote {fmt} to {out}"
     )
+    for note in motion.notes:
+        print(f"  note: {note}")
     for finding in done.findings:
         print(f"  {finding.sentence}", file=sys.stderr)
     if motion.kind == "policy":

@@ -3,7 +3,9 @@
 The checks run on the very samples that are written and before a byte is written; a refusal is
 a :class:`SafetyError` and leaves any earlier file at ``out`` untouched. ``unchecked=True`` writes
 anyway, with every finding stated in the file (CSV comment lines, the MCAP ``teach_studio``
-metadata, ``info.json``'s ``teach_studio`` key).
+metadata, ``info.json``'s ``teach_studio`` key). A motion's notes (the hand went beyond the
+robot's reach while retargeting) are stated in the MCAP and LeRobot files whether checked or not,
+and in an unchecked CSV's comment lines (a checked CSV has none, as its readers expect).
 """
 
 from __future__ import annotations
@@ -54,11 +56,12 @@ def _notes(motion: Motion, findings: list[Finding], checked: bool) -> list[str]:
         f"Teach Studio export of {motion.kind} {motion.name} for the {robot.spec.title} "
         f"({robot.name}), {now_iso()}"
     )
+    notes = [f"note: {note}" for note in motion.notes]
     if not findings:
-        return [head, "safety checks: passed (joint positions, velocities, accelerations, "
-                f"self-collision margin {COLLISION_MARGIN_M * 100:.1f} cm)"]  # fmt: skip
+        return [head, *notes, "safety checks: passed (joint positions, velocities, "
+                f"accelerations, self-collision margin {COLLISION_MARGIN_M * 100:.1f} cm)"]  # fmt: skip
     state = "NOT checked (--unchecked)" if not checked else "failed"
-    return [head, f"safety checks: {state}; {len(findings)} finding(s):"] + [
+    return [head, *notes, f"safety checks: {state}; {len(findings)} finding(s):"] + [
         f.sentence for f in findings
     ]
 
@@ -99,7 +102,7 @@ def export_motion(
     notes = _notes(motion, findings, checked=not unchecked)
     names = robot.joint_names
     if fmt == "csv":
-        write_csv(out, names, times, q, notes if findings else ())
+        write_csv(out, names, times, q, notes if findings else ())  # a checked file: no # lines
     elif fmt == "mcap":
         metadata = {
             "source": motion.name,
@@ -108,6 +111,7 @@ def export_motion(
             "timed_by": timed_by,
             "checked": "passed" if not findings else "no (--unchecked)",
             "findings": "\n".join(f.sentence for f in findings),
+            "notes": "\n".join(motion.notes),
         }
         write_mcap(out, names, times, q, states=motion.kind == "recording", metadata=metadata)
     else:
@@ -119,6 +123,7 @@ def export_motion(
                 "timed_by": timed_by,
                 "checked": not findings,
                 "findings": [f.sentence for f in findings],
+                "notes": list(motion.notes),
             }
         }
         task = task or f"Move as in {motion.name}"

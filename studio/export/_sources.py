@@ -64,6 +64,8 @@ class Motion:
             otherwise ``q`` is a path that :func:`time_path` times.
         rate_hz: the capture rate (recordings) or the wanted sample rate.
         findings: problems met while retargeting (targets out of reach).
+        notes: what the retargeting did that is no problem but the file should say (the hand
+            went beyond the robot's reach and its target was drawn back into it).
     """
 
     kind: SourceKind
@@ -74,6 +76,7 @@ class Motion:
     timed: bool
     rate_hz: float
     findings: tuple[Finding, ...] = field(default=())
+    notes: tuple[str, ...] = field(default=())
 
 
 def source_kind(path: Path) -> SourceKind:
@@ -131,10 +134,23 @@ def find_source(given: str | Path, data_dir: str | Path = ".") -> Path:
 
 def retarget(
     robot: RobotArm, times: np.ndarray, q_human: np.ndarray, config: RetargetConfig | None = None
-) -> tuple[np.ndarray, list[Finding]]:
+) -> tuple[np.ndarray, list[Finding], tuple[str, ...]]:
     """The robot's joints (N, nq) for human-arm angles (N, 7)
-    (:func:`studio.kinematics.retarget_path`), and the first frame out of reach as a finding."""
+    (:func:`studio.kinematics.retarget_path`), the first frame out of reach as a finding, and a
+    note when the hand went beyond the robot's reach (its target drawn back into it, as the page
+    says live): the motion is the robot's own and safe, but it is not the hand's there."""
     path = retarget_path(robot, q_human, config)
+    tolerance = (config or RetargetConfig()).reach_tolerance
+    beyond = np.flatnonzero(path.pulled_in > tolerance)
+    notes: tuple[str, ...] = ()
+    if len(beyond):
+        i = int(beyond[0])
+        notes = (
+            f"the hand went beyond the {robot.spec.title}'s reach in {len(beyond)} of "
+            f"{len(times)} frames (first at frame {i}, t = {times[i]:.3f} s; at most "
+            f"{path.pulled_in.max() * 100:.1f} cm): there the robot follows the hand's target "
+            "drawn back into its reach",
+        )
     findings: list[Finding] = []
     for i in np.flatnonzero(path.out_of_reach)[:1]:
         findings.append(
@@ -145,10 +161,10 @@ def retarget(
                 robot.spec.tool,
                 f"frame {i} (t = {times[i]:.3f} s of the source): the hand's target is "
                 f"{path.position_error[i] * 100:.1f} cm out of the {robot.spec.title}'s reach "
-                f"(tolerance {(config or RetargetConfig()).reach_tolerance * 100:.0f} cm)",
+                f"(tolerance {tolerance * 100:.0f} cm)",
             )
         )
-    return path.q, findings
+    return path.q, findings, notes
 
 
 def _capture_rate(rec: Recording | ObservationRecording, times: np.ndarray) -> float:
@@ -184,9 +200,9 @@ def recording_motion(
     stride = 1 if most_frames is None else max(1, -(-(stop - start) // max(int(most_frames), 2)))
     rows = slice(start, stop, stride)
     times = np.asarray(rec.t[rows] - rec.t[start], dtype=float)
-    q, findings = retarget(robot, times, human_angles(rec, rows), _strided(stride))
+    q, findings, notes = retarget(robot, times, human_angles(rec, rows), _strided(stride))
     rate = _capture_rate(rec, times) / stride
-    return Motion("recording", path.name, robot, times, q, True, rate, tuple(findings))
+    return Motion("recording", path.name, robot, times, q, True, rate, tuple(findings), notes)
 
 
 def _strided(stride: int) -> RetargetConfig | None:
@@ -217,8 +233,8 @@ def series_motion(series: RecordingSeries, robot_name: str, name: str = "") -> M
         return Motion("recording", name, robot, times, q, True, rate)
     gaps = np.diff(np.asarray(series.frames))
     stride = int(gaps.max()) if len(gaps) else 1
-    q, findings = retarget(robot, times, series.q_human, _strided(stride))
-    return Motion("recording", name, robot, times, q, True, rate, tuple(findings))
+    q, findings, notes = retarget(robot, times, series.q_human, _strided(stride))
+    return Motion("recording", name, robot, times, q, True, rate, tuple(findings), notes)
 
 
 def demonstration_motion(path: Path, robot_name: str, rate_hz: float) -> Motion:
@@ -239,8 +255,10 @@ def demonstration_motion(path: Path, robot_name: str, rate_hz: float) -> Motion:
     rec = read_any_recording(recording)
     rows = rec.segment(demo.t0, demo.t1)
     times = np.asarray(rec.t[rows] - rec.t[rows][0], dtype=float)
-    q, findings = retarget(robot, times, human_angles(rec, rows))
-    return Motion("demonstration", path.name, robot, times, q, False, rate_hz, tuple(findings))
+    q, findings, notes = retarget(robot, times, human_angles(rec, rows))
+    return Motion(
+        "demonstration", path.name, robot, times, q, False, rate_hz, tuple(findings), notes
+    )
 
 
 def training_demonstration(

@@ -622,11 +622,15 @@ class RetargetedPath:
         position_error: how far the tool stays from the hand's target per frame (m; 0 in joint
             mode, which has no target).
         out_of_reach: the frames whose target is out of reach (``RetargetConfig.reach_tolerance``).
+        pulled_in: per frame, how far the hand's target was drawn back into the robot's reach
+            (m; the hand went beyond it, and the robot followed the drawn-back target; 0 in
+            joint mode).
     """
 
     q: np.ndarray
     position_error: np.ndarray
     out_of_reach: np.ndarray
+    pulled_in: np.ndarray
 
 
 def retarget_path(
@@ -653,14 +657,16 @@ def retarget_path(
     q = np.empty((len(q_h), robot.nq))
     error = np.zeros(len(q_h))
     out = np.zeros(len(q_h), dtype=bool)
+    pulled = np.zeros(len(q_h))
     for _ in range(config.settle_tries if len(q_h) else 0):
         retargeter.robot_from_human(q_h[0])
         if not isinstance(retargeter.last_ik, RobotIK) or retargeter.last_ik.success:
             break
     for i, q_frame in enumerate(q_h):
         q[i] = retargeter.robot_from_human(q_frame)
+        pulled[i] = retargeter.pulled_in
         ik = retargeter.last_ik
         if isinstance(ik, RobotIK):
             error[i] = ik.position_error
             out[i] = not ik.success and ik.position_error > config.reach_tolerance
-    return RetargetedPath(q, error, out)
+    return RetargetedPath(q, error, out, pulled)

@@ -317,7 +317,8 @@ class TimelinePublic(BaseModel):
     )
     robot_notes: list[str] = Field(
         default_factory=list,
-        description="what retargeting onto it met: the first frame out of its reach, in one sentence",
+        description="what retargeting onto it met, one sentence each: the first frame out of "
+        "its reach, and the frames where the hand went beyond its reach",
     )
     residual_mm: list[float] = Field(description="how far the fitted arm misses, mm")
     signals: list[TimelineSignal] = Field(

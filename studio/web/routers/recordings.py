@@ -195,7 +195,7 @@ def read_timeline(
         robot_name=arm.name,
         robot_title=arm.spec.title,
         robot_joints=list(arm.joint_names),
-        robot_notes=[f.sentence for f in on_robot.findings],
+        robot_notes=[*(f.sentence for f in on_robot.findings), *on_robot.notes],
         residual_mm=(series.residual * 1000).round(2).tolist(),
         signals=[
             TimelineSignal(

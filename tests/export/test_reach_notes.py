@@ -1,0 +1,68 @@
+"""A hand beyond the robot's reach is stated in the export, not only on the page.
+
+Cartesian retargeting draws a hand target beyond the robot's reach back into it (the page says so
+live). The motion the robot makes there is its own and safe, so the export is not refused, but it
+is not the hand's: the export says how many frames, the first one and how far, in the MCAP
+metadata, the LeRobot ``info.json`` and the CLI's output. A checked CSV keeps no comment lines.
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from mcap.reader import make_reader
+
+from studio.capture import human_angles, read_any_recording
+from studio.cli import main
+from studio.export import recording_motion
+from studio.kinematics import RetargetConfig, load_robot, retarget_path
+from studio.samples import SAMPLES_DIR
+
+RECORDING = SAMPLES_DIR / "sample-reach-1.tape.csv"
+BEYOND = "the hand went beyond the Universal Robots UR5's reach in"
+
+
+def test_the_retargeted_path_says_where_the_target_was_drawn_in():
+    motion = recording_motion(RECORDING, "ur5")
+    assert len(motion.notes) == 1 and motion.notes[0].startswith(BEYOND)
+    rec = read_any_recording(RECORDING)
+    path = retarget_path(load_robot("ur5"), human_angles(rec, slice(None)))
+    beyond = path.pulled_in > RetargetConfig().reach_tolerance
+    assert beyond.any() and np.all(path.pulled_in >= 0)
+    assert f"in {beyond.sum()} of {len(rec)} frames" in motion.notes[0]
+    assert f"first at frame {np.flatnonzero(beyond)[0]}," in motion.notes[0]
+    puma = retarget_path(load_robot("puma560"), human_angles(rec, slice(None)))
+    assert not puma.pulled_in.any(), "joint mode has no target to draw in"
+    assert recording_motion(RECORDING, "puma560").notes == ()
+
+
+@pytest.mark.parametrize("fmt", ["csv", "mcap", "lerobot"])
+def test_a_checked_export_states_the_hand_beyond_reach(fmt, tmp_path, capsys):
+    out = tmp_path / f"demo.{fmt}"
+    args = ["export", "sample-reach-1", "--robot", "ur5", "--format", fmt, "--out", str(out)]
+    assert main(args) == 0
+    printed = capsys.readouterr().out
+    assert "passed the safety checks" in printed
+    assert f"note: {BEYOND}" in printed
+    if fmt == "csv":
+        assert out.read_text().startswith("time,"), "a checked CSV has no comment lines"
+    elif fmt == "mcap":
+        with out.open("rb") as f:
+            meta = {m.name: m.metadata for m in make_reader(f).iter_metadata()}
+        assert meta["teach_studio"]["checked"] == "passed"
+        assert meta["teach_studio"]["notes"].startswith(BEYOND)
+    else:
+        info = json.loads((out / "meta/info.json").read_text())
+        assert info["teach_studio"]["checked"] is True
+        assert info["teach_studio"]["notes"][0].startswith(BEYOND)
+
+
+def test_the_puma560s_export_has_no_note(tmp_path, capsys):
+    out = tmp_path / "demo.mcap"
+    assert main(["export", "sample-reach-1", "--format", "mcap", "--out", str(out)]) == 0
+    assert "note:" not in capsys.readouterr().out
+    with out.open("rb") as f:
+        meta = {m.name: m.metadata for m in make_reader(f).iter_metadata()}
+    assert meta["teach_studio"]["notes"] == ""
