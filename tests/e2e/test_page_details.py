@@ -231,3 +231,43 @@ def test_run_names_are_never_cut_without_a_tooltip_and_name_their_task(
         assert wait_for(
             lambda r=run: studio_server.get(f"/api/runs/{r['id']}")["status"] in ENDED, 120
         )
+
+
+CUT_CONTROLS_JS = """() => {
+  const side = document.querySelector('aside.panel').getBoundingClientRect();
+  const out = [];
+  for (const el of document.querySelectorAll('aside.panel details[open] select, aside.panel details[open] input, aside.panel details[open] button')) {
+    if (el.offsetParent === null || el.type === 'checkbox' || el.type === 'radio' || el.type === 'file') continue;
+    const r = el.getBoundingClientRect();
+    if (r.width < 14 || r.right > side.right + 0.5 || r.left < side.left - 0.5) out.push([el.id || el.textContent.trim(), Math.round(r.left), Math.round(r.width)]);
+  }
+  return out;
+}"""
+"""Controls of the side panel's open sections that are squeezed to nothing or stick out of it."""
+
+
+@pytest.mark.parametrize("size", [(1280, 720), (1920, 1080)])
+def test_every_control_of_the_side_panel_fits_it(
+    browser: Any, studio_server: Studio, size: tuple[int, int]
+) -> None:
+    """No control of the side panel is squeezed out of sight or reaches past its edge (the Watch
+    row once squeezed the policy list to nothing and pushed "compare with" past the edge)."""
+    long_name = "a-demonstration-named-at-length-to-widen-the-lists-it-is-in"
+    if not any(d["name"] == long_name for d in studio_server.get("/api/demonstrations")):
+        studio_server.send(
+            "POST",
+            "/api/demonstrations",
+            {"recording": "sample-reach-1", "t0": 0.2, "t1": 2.5, "name": long_name},
+        )
+    context = browser.new_context(viewport={"width": size[0], "height": size[1]})
+    page = context.new_page()
+    try:
+        page.goto(studio_server.base + "/")
+        page.wait_for_selector("body[data-ready='1']", timeout=READY_TIMEOUT_MS)
+        page.wait_for_selector(f"#watch-demo option[value*='{long_name}']", state="attached")
+        page.locator("#sec-watch").scroll_into_view_if_needed()
+        shot(page, f"side-panel-watch-{size[0]}x{size[1]}", "sec-watch")
+        assert page.evaluate(CUT_CONTROLS_JS) == []
+    finally:
+        context.close()
+        studio_server.send("DELETE", f"/api/demonstrations/{long_name}")  # the others' lists
