@@ -175,14 +175,14 @@ function chartOptions(runs, band, log, width, height, xMode = "episode", smoothi
     const meanIdx = series.length;
     series.push(smoothing > 0
       ? { label: `${runLabel(r)} raw`, class: "band-edge", stroke: hexAlpha(color, 0.3), width: 1, spanGaps: gaps, points: { show: false } }
-      : { label: runLabel(r), stroke: color, width: 1.8, spanGaps: gaps, value: valueOf(i, "") });
+      : { label: runLabel(r), stroke: color, width: 1, spanGaps: gaps, value: valueOf(i, "") });
     if (band !== "none") {
       for (const edge of ["low", "high"]) {
         series.push({ label: `${runLabel(r)} ${edge}`, class: "band-edge", stroke: "transparent", width: 0, spanGaps: gaps, points: { show: false } });
       }
       bands.push({ series: [meanIdx + 2, meanIdx + 1], fill: hexAlpha(color, smoothing > 0 ? 0.1 : 0.16) });
     }
-    if (smoothing > 0) series.push({ label: runLabel(r), stroke: color, width: 1.8, spanGaps: gaps, value: valueOf(i, " smoothed") });
+    if (smoothing > 0) series.push({ label: runLabel(r), stroke: color, width: 1, spanGaps: gaps, value: valueOf(i, " smoothed") });
   });
   const axis = { stroke: "#555", grid: { stroke: "#eceef1", width: 1 }, ticks: { stroke: "#d6d9de", width: 1 }, font: "11px system-ui, sans-serif", labelFont: "11px system-ui, sans-serif" };
   return {
