@@ -199,7 +199,7 @@ def wait_until_scene_still(page: Any) -> None:
     """Wait until the scene's page has been told its scene is still (``_scene_frames.py``): a page
     left open, as a user's is while training runs, draws its still scene rarely; one opened a
     second ago is still loading it and draws freely."""
-    still = "() => !!window.__studioFramePacing && window.__studioFramePacing.gapMs >= 1000"
+    still = "() => !!window.__studioFramePacing && window.__studioFramePacing.still === true"
     scene = next(f for f in page.frames if f != page.main_frame)
     end = time.monotonic() + SETTLE_TIMEOUT_S
     while time.monotonic() < end and not scene.evaluate(still):

@@ -18,13 +18,11 @@ benchmarks:
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from ._puma import Puma560
 from ._retarget import RetargetConfig
-from ._robots import RobotArm
+from ._robots import RobotArm, tool_errors
 
 REACHABLE_STARTS = 24
 """Random starts of :func:`reachable`'s search over the joint ranges, besides home."""
@@ -42,12 +40,8 @@ def reach_errors(
 ) -> tuple[float, float]:
     """How far (m) and how turned (rad) the tool at ``q`` is from ``oMdes`` (4x4); the angle is
     0 for an arm that follows the position only."""
-    got = robot.forward(q)
-    distance = float(np.linalg.norm(got[:3, 3] - oMdes[:3, 3]))
-    if isinstance(robot, RobotArm) and not robot.spec.orientation:
-        return distance, 0.0
-    cos = (np.trace(got[:3, :3].T @ oMdes[:3, :3]) - 1.0) / 2.0
-    return distance, math.acos(float(np.clip(cos, -1.0, 1.0)))
+    orientation = not isinstance(robot, RobotArm) or robot.spec.orientation
+    return tool_errors(robot.forward(q), oMdes, orientation)
 
 
 def tool_reaches(

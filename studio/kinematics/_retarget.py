@@ -57,7 +57,7 @@ from ._hand_ik import fit_hand_pose
 from ._human import SAGITTAL_MIRROR, HumanArm, _as_q
 from ._puma import IKConfig, IKResult, Puma560
 from ._robot_load import load_robot
-from ._robots import RobotArm, RobotIK
+from ._robots import RobotArm, RobotIK, tool_errors
 
 Mode = Literal["joint", "cartesian"]
 
@@ -514,18 +514,12 @@ class Retargeter:
             return near
         # the last pose itself may be within reach of the target, where the solves, aiming at
         # it exactly, stalled against the step's bounds further off
-        stay = self._reached_at(arm, q_prev, oMdes)
-        return stay
+        return self._reached_at(arm, q_prev, oMdes)
 
     def _reached_at(self, arm: RobotArm, q: np.ndarray, oMdes: np.ndarray) -> RobotIK | None:
         """``q`` as an IK answer if its tool reaches ``oMdes``, else None."""
-        got = arm.chain.forward(q)
-        position_error = float(np.linalg.norm(got[:3, 3] - oMdes[:3, 3]))
-        rotation_error = 0.0
-        if arm.spec.orientation:
-            cos = (np.trace(got[:3, :3].T @ oMdes[:3, :3]) - 1.0) / 2.0
-            rotation_error = math.acos(float(np.clip(cos, -1.0, 1.0)))
-        found = RobotIK(q.copy(), False, position_error, rotation_error, 0)
+        errors = tool_errors(arm.chain.forward(q), oMdes, arm.spec.orientation)
+        found = RobotIK(q.copy(), False, *errors, 0)
         return found if self._reached(found) else None
 
     def _starts(self, robot: RobotArm) -> np.ndarray:

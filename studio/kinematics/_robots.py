@@ -257,6 +257,18 @@ def _bounded_urdf(text: str) -> str:
     return re.sub(r"<joint\b.*?</joint>", add_limit, text, flags=re.S)
 
 
+def tool_errors(
+    got: np.ndarray, oMdes: np.ndarray, orientation: bool = True
+) -> tuple[float, float]:
+    """How far (m) and how turned (rad) a tool pose ``got`` (4x4) is from ``oMdes`` (4x4); the
+    angle is 0 when ``orientation`` is not asked (an arm that follows the position only)."""
+    distance = float(np.linalg.norm(got[:3, 3] - oMdes[:3, 3]))
+    if not orientation:
+        return distance, 0.0
+    cos = (np.trace(got[:3, :3].T @ oMdes[:3, :3]) - 1.0) / 2.0
+    return distance, math.acos(float(np.clip(cos, -1.0, 1.0)))
+
+
 @dataclass(frozen=True)
 class RobotIK:
     """The outcome of :meth:`RobotArm.inverse`.

@@ -130,12 +130,11 @@ def pacing_js(gap_ms: float, still: bool = False) -> str:
 
 
 class _Page:
-    """One browser showing the scene: how to send it a script, and what it was told."""
+    """One browser showing the scene: how to send it a script, and when it connected."""
 
     def __init__(self, send: Callable[[object], None]) -> None:
         self.send = send  # its connection's own queue_message, before the pacer wrapped it
         self.connected_at = time.monotonic()
-        self.gap_ms = 0.0  # the gap it was told last (0 before any script)
 
 
 class FramePacer:
@@ -224,7 +223,6 @@ class FramePacer:
         """Send ``page`` the gap (the caller holds the lock)."""
         from viser import _messages
 
-        page.gap_ms = gap_ms
         page.send(_messages.RunJavascriptMessage(pacing_js(gap_ms, still)))
 
     def _watch(self) -> None:
