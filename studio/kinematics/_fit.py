@@ -372,7 +372,9 @@ class ArmFitter:
         on a cold start the anatomical one, abduction within 90 degrees) are kept unless the other
         branch meets the landmarks better by more than ``branch_slack``: near a straight elbow, or
         at the elbow's limit, sensor noise alone can make the other branch fit a few millimetres
-        better. Within the chosen branch, the candidates that meet the landmarks as well as the
+        better. On a cold start the other branch is also taken when it meets the landmarks exactly
+        (to ``equivalent_error``) where the anatomical one cannot: an arm raised overhead with a
+        slightly bent elbow, which the anatomical branch cannot bend that way within the limits. Within the chosen branch, the candidates that meet the landmarks as well as the
         best one (to ``equivalent_error``) are equivalent, and the one nearest the previous frame
         (or the neutral arm) wins, so the unobservable directions move least.
 
@@ -416,9 +418,16 @@ class ArmFitter:
 
         pool = settle(same) if same else []
         best_same = min((c[1] for c in pool), default=math.inf)
-        if best_same > cfg.branch_slack and other:  # the other branch may be needed
+        # the other branch may be needed: it must meet the landmarks better by branch_slack,
+        # or, on a cold start (no frame to stay continuous with), meet them exactly where this
+        # one cannot (noisy landmarks are met exactly by neither)
+        cold_miss = previous is None and best_same > cfg.equivalent_error
+        if (best_same > cfg.branch_slack or cold_miss) and other:
             other = settle(other)
-            if min(c[1] for c in other) < best_same - cfg.branch_slack:
+            best_other = min(c[1] for c in other)
+            if best_other < best_same - cfg.branch_slack or (
+                cold_miss and best_other <= cfg.equivalent_error
+            ):
                 pool = other
         best = min(c[1] for c in pool)
         equivalent = [c for c in pool if c[1] <= best + cfg.equivalent_error]
