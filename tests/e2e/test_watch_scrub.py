@@ -40,6 +40,21 @@ def _watch_uploaded_policy(page: Any, tmp_path: Any) -> None:
     page.wait_for_selector("[data-testid='watch-result']:has-text('steps')", timeout=T)
 
 
+def _slowest_rollout_shown(page: Any, studio_server: Studio, tmp_path: Any) -> Any:
+    """A watched rollout in view (watching one if an earlier story has not), at 0.25x; returns
+    a function reading the scene's playback back."""
+    if not page.get_by_role("slider", name="Rollout time").is_visible():
+        _watch_uploaded_policy(page, tmp_path)
+    page.locator("#sec-watch").scroll_into_view_if_needed()
+
+    def scene() -> dict:
+        return studio_server.get("/api/scene/playback")
+
+    page.get_by_role("combobox", name="Rollout speed").select_option("0.25")
+    assert _until(lambda: scene()["speed"] == 0.25)
+    return scene
+
+
 def test_scrub_a_rollout_change_its_speed_and_step_it(
     page: Any, studio_server: Studio, tmp_path: Any
 ) -> None:
@@ -90,17 +105,9 @@ def test_keyboard_shortcuts_scrub_the_rollout_but_not_while_typing(
 ) -> None:
     """Space plays and pauses, ←/→ step one sample, Shift+←/→ ten, Home/End go to the ends; the
     keys are listed beside the controls and in their tooltips, and do nothing in a text field."""
-    if not page.get_by_role("slider", name="Rollout time").is_visible():
-        _watch_uploaded_policy(page, tmp_path)
-    page.locator("#sec-watch").scroll_into_view_if_needed()
-
-    def scene() -> dict:
-        return studio_server.get("/api/scene/playback")
-
     # the slowest speed, so the rollout still plays when the second space comes however busy the
     # machine is (at the 4x the story above left, it can end first: space then plays it again)
-    page.get_by_role("combobox", name="Rollout speed").select_option("0.25")
-    assert _until(lambda: scene()["speed"] == 0.25)
+    scene = _slowest_rollout_shown(page, studio_server, tmp_path)
 
     keys = page.get_by_test_id("rollout-keys")
     assert "Shift+←/→" in keys.inner_text() and "Home/End" in keys.inner_text()
@@ -144,6 +151,45 @@ def test_keyboard_shortcuts_scrub_the_rollout_but_not_while_typing(
         seed.press(key)
     time.sleep(0.5)  # nothing to wait for: a request the keys would send would be back by now
     assert scene()["sample"] == paused_at and scene()["paused"]
+    assert not page.errors  # type: ignore[attr-defined]
+
+
+def test_play_clicked_while_a_scrub_is_on_its_way_plays(
+    page: Any, studio_server: Studio, tmp_path: Any
+) -> None:
+    """The page sends the scene's changes in the order the user made them. A scrub pauses the
+    rollout; a Play clicked while that scrub is still on its way must land after it, or the
+    rollout stays paused with the button saying it plays (seen in CI on a busy machine)."""
+    scene = _slowest_rollout_shown(page, studio_server, tmp_path)
+    slider = page.get_by_role("slider", name="Rollout time")
+    slider.focus()
+    slider.press("End")
+    assert _until(lambda: scene()["paused"] and scene()["sample"] == scene()["samples"] - 1)
+    assert _until(lambda: page.get_by_role("button", name="Play").count() == 1)
+
+    # hold the scrubs (they pause) in the browser; let anything else through
+    held: list[Any] = []
+
+    def hold_scrubs(route: Any) -> None:
+        if '"paused":true' in (route.request.post_data or "").replace(" ", ""):
+            held.append(route)
+        else:
+            route.continue_()
+
+    pattern = "**/api/scene/playback"
+    page.route(pattern, hold_scrubs)
+    try:
+        slider.press("Home")
+        page.wait_for_timeout(300)
+        assert held, "the scrub to the start never left the page"
+        page.get_by_role("button", name="Play").click()
+        page.wait_for_timeout(1000)  # a Play sent now would reach the scene before the scrub
+    finally:
+        for route in held:
+            route.continue_()
+        page.unroute(pattern)
+    assert _until(lambda: not scene()["paused"] and scene()["sample"] > 0)
+    assert _until(lambda: float(slider.input_value()) > 0)
     assert not page.errors  # type: ignore[attr-defined]
 
 

@@ -92,11 +92,15 @@ export async function simulatorReach(action) {
   }, $(action === "reach" ? "source-reach" : "source-wander"));
 }
 
-export async function playback(action, extra = {}) {
-  await guarded("source-error", async () => {
+// Playback changes go one at a time, in the order the user made them (a seek, then play).
+let playbackSending = Promise.resolve();
+
+export function playback(action, extra = {}) {
+  playbackSending = playbackSending.then(() => guarded("source-error", async () => {
     S.source = await api("POST", "/api/source/playback", { action, ...extra });
     renderSource();
-  });
+  }));
+  return playbackSending;
 }
 
 export async function setRetarget() {

@@ -112,8 +112,13 @@ function render() {
   if (!playing) stopTicker();
 }
 
-async function change(body) {
-  await guarded("rollout-error", async () => showRollout(await api("POST", "/api/scene/playback", body)));
+// The scene's changes go one at a time, in the order the user made them: a play sent while a scrub
+// is still on its way would otherwise race it, and the scrub (which pauses) could land second.
+let sending = Promise.resolve();
+
+function change(body) {
+  sending = sending.then(() => guarded("rollout-error", async () => showRollout(await api("POST", "/api/scene/playback", body))));
+  return sending;
 }
 
 // Scrubbing sends the newest position only, one request at a time, and pauses the rollout there.
