@@ -50,6 +50,7 @@ from ._tape import TapeConfig, TapeShape, reconstruct
 
 _SEEN = 1e-6  # sine of a bend below which the rotation about the limb is not observable
 _DEGENERATE = 1e-12  # m: two tape points closer than this give no direction
+_AT_LIMIT = 1e-9  # rad: a closed-form angle this far past a limit is on it (rounding), not beyond
 
 
 @dataclass(frozen=True)
@@ -323,8 +324,9 @@ class ArmFitter:
         q5 = math.acos(float(np.clip(-h[1], -1.0, 1.0)))
         # A straight wrist leaves forearm rotation unseen: keep it at zero then.
         q4 = math.atan2(sign * h[2], h[0]) if math.sin(q5) > _SEEN else 0.0
+        lo, hi = lower - _AT_LIMIT, upper + _AT_LIMIT
         for q4_try, q5_try in ((q4, q5), (q4 + math.pi, -q5), (q4 - math.pi, -q5)):
-            if lower[4] <= q4_try <= upper[4] and lower[5] <= q5_try <= upper[5]:
+            if lo[4] <= q4_try <= hi[4] and lo[5] <= q5_try <= hi[5]:
                 q[4], q[5] = q4_try, q5_try
                 break
         return np.minimum(np.maximum(q, lower), upper)

@@ -11,6 +11,13 @@ process and handed back in Pinocchio's binary archives: this process waits witho
 holds it only to read them and set up the arm (a few tenths of a second at most;
 ``benchmarks/bench_robot_switch.py`` measures the API's latency during a switch both ways).
 
+Given a cache folder (``studio serve`` keeps one under its data folder), the archives a child
+wrote are kept there, one folder per robot, under a key of what they are built from (the URDF's
+text, the versions of Pinocchio, Coal and example-robot-data); a robot is then built once per
+machine, and later switches to it (in this process or another) read the archives in tens of
+milliseconds without a child. A kept archive is read only when its SHA-256 matches the one
+written beside it; anything else in the cache is ignored and built afresh.
+
 The visual meshes are read from their files when the scene draws them or a URDF is exported
 (``GeometryObject.meshPath``); the triangles Pinocchio loaded for them are never queried, so they
 are dropped once the model is built, which also keeps the archives small.
@@ -19,7 +26,11 @@ are dropped once the model is built, which also keeps the archives small.
 from __future__ import annotations
 
 import contextlib
+import hashlib
+import json
 import logging
+import os
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -42,6 +53,12 @@ _arms: dict[tuple[str, bool], RobotArm] = {}
 _locks: dict[tuple[str, bool], threading.Lock] = {}
 _guard = threading.Lock()
 _isolated = threading.Event()
+_cache: list[Path] = []  # the cache folder isolate_robot_loading was given (none: no cache)
+CACHE_VERSION = 1
+"""Bumped when what a cache folder holds changes."""
+_MANIFEST = "sha256.json"
+"""The file of a kept robot naming each archive's SHA-256; written last, so its presence means the
+archives beside it were complete."""
 
 _CHILD = "from studio.kinematics._robot_load import _build_for_parent; _build_for_parent()"
 _PARTS = ("model", "visual", "collision")
@@ -50,9 +67,15 @@ _REFUSED = "refused.txt"
 """The file a child writes instead: the sentence of the error that refused the robot."""
 
 
-def isolate_robot_loading() -> None:
+def isolate_robot_loading(cache: Path | None = None) -> None:
     """From now on in this process, build a robot's geometry in a child process (see the module
-    docstring): for a process whose other threads must not stall, such as a server's."""
+    docstring): for a process whose other threads must not stall, such as a server's.
+
+    Args:
+        cache: a folder where each robot's built geometry is kept, so that it is built once per
+            machine (safe to delete; None: nothing kept).
+    """
+    _cache[:] = [] if cache is None else [Path(cache)]
     _isolated.set()
 
 
@@ -136,10 +159,19 @@ def _built(
     return model, visual, collision
 
 
-def _built_in_child(spec: RobotSpec) -> tuple[pin.Model, pin.GeometryModel, pin.GeometryModel]:
+Parts = tuple[pin.Model, pin.GeometryModel, pin.GeometryModel]
+
+
+def _built_in_child(spec: RobotSpec) -> Parts:
     """:func:`_built` in a child process, handed back in Pinocchio's binary archives (read in
     tens of milliseconds, a tenth of its pickles' text archives); this thread waits without
-    Python's lock. In this process after all when no child can be started."""
+    Python's lock. In this process after all when no child can be started. Read from the cache
+    folder instead when it keeps this robot, and kept there after a build."""
+    kept = _cache_entry(spec)
+    if kept is not None:
+        parts = _read_kept(kept)
+        if parts is not None:
+            return parts
     with tempfile.TemporaryDirectory(prefix="studio-robot-") as folder:
         try:
             done = subprocess.run(
@@ -168,10 +200,78 @@ def _built_in_child(spec: RobotSpec) -> tuple[pin.Model, pin.GeometryModel, pin.
                 f"The {spec.title} model could not be built: its loading process ended with "
                 f"code {done.returncode} ({last[0]}); reinstall example-robot-data."
             )
-        model, visual, collision = pin.Model(), pin.GeometryModel(), pin.GeometryModel()
-        for part, file in zip((model, visual, collision), files, strict=True):
-            part.loadFromBinary(str(file))
+        parts = _read_archives(files)
+        if kept is not None:
+            _keep(kept, files)
+    return parts
+
+
+def _read_archives(files: list[Path]) -> Parts:
+    model, visual, collision = pin.Model(), pin.GeometryModel(), pin.GeometryModel()
+    for part, file in zip((model, visual, collision), files, strict=True):
+        part.loadFromBinary(str(file))
     return model, visual, collision
+
+
+def _cache_entry(spec: RobotSpec) -> Path | None:
+    """The cache folder's place for ``spec``'s built geometry (None: no cache)."""
+    if not _cache:
+        return None
+    from importlib import metadata
+
+    import coal
+
+    try:
+        robots_version = metadata.version("example-robot-data")
+    except metadata.PackageNotFoundError:
+        robots_version = None
+    stamp = [CACHE_VERSION, pin.__version__, coal.__version__, robots_version, spec.arm_joints]
+    digest = hashlib.sha256(json.dumps(stamp).encode())
+    digest.update(_urdf_text(spec).encode())
+    return _cache[0] / f"{spec.name}-{digest.hexdigest()[:20]}"
+
+
+def _sha256(path: Path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+def _read_kept(folder: Path) -> Parts | None:
+    """The geometry kept in ``folder``, or None when there is none or it does not match its
+    hashes (it is then built again and kept anew)."""
+    files = [folder / f"{part}.bin" for part in _PARTS]
+    try:
+        expected = json.loads((folder / _MANIFEST).read_text())
+        if not isinstance(expected, dict) or any(expected.get(f.name) != _sha256(f) for f in files):
+            raise ValueError("an archive does not match its SHA-256")
+        return _read_archives(files)
+    except FileNotFoundError:
+        return None
+    except (OSError, ValueError, RuntimeError) as err:
+        log.warning("the kept geometry in %s is ignored and built again: %s", folder, err)
+        return None
+
+
+def _keep(folder: Path, files: list[Path]) -> None:
+    """Copy the archives a child wrote into ``folder`` of the cache, the manifest last; a cache
+    that cannot be written (a full disk, no permission) is logged and skipped."""
+    temporary = folder.with_name(f".{folder.name}.{os.getpid()}.{threading.get_ident()}")
+    try:
+        temporary.mkdir(parents=True, exist_ok=True)
+        for file in files:
+            shutil.copyfile(file, temporary / file.name)
+        hashes = {file.name: _sha256(temporary / file.name) for file in files}
+        (temporary / _MANIFEST).write_text(json.dumps(hashes))
+        if folder.exists():
+            shutil.rmtree(folder)  # a damaged one, read and refused above
+        os.replace(temporary, folder)
+    except OSError as err:
+        log.warning(
+            "the built geometry of %s is not kept (%s): it is built again next time",
+            folder.name,
+            err,
+        )
+    finally:
+        shutil.rmtree(temporary, ignore_errors=True)
 
 
 def _build_for_parent() -> None:

@@ -12,10 +12,13 @@ SwiftShader in the browser's GPU process: about 50 ms of CPU a frame for this sc
   in the very process where the camera's pose model runs its WebGL. So while one drives the
   scene, :class:`FramePacer` asks every browser showing the scene to start a frame at most every
   :data:`SLOW_FRAME_GAP_MS`: the update is drawn, and one frame after it (for what viser
-  finishes after a commit, such as a texture upload), instead of a burst.
+  finishes after a commit, such as a texture upload), instead of a burst. Between its poses the
+  scene counts as still once nothing was sent for :data:`SLOW_STILL_AFTER_S`, so viser's
+  once-a-second frame is not drawn between them either.
 - **A still scene**: when nothing has been sent to the page for :data:`STILL_AFTER_S`, a page
   that has finished loading (:data:`LOADING_S`) is asked to draw at most every
-  :data:`STILL_FRAME_GAP_MS`. The once-a-second frame then costs a quarter of what it did: a
+  :data:`STILL_FRAME_GAP_MS`, counted from the frame it drew last. The once-a-second frame then
+  costs a quarter of what it did: a
   still page beside a training run took 0.08 of this machine's two cores, most of it that frame.
   The first message sent to the page afterwards (any update of the scene, or of the page's
   camera) first lifts the limit, and the frames a page was holding back are drawn at once.
@@ -50,19 +53,23 @@ every 4 s instead of every second."""
 STILL_AFTER_S = 1.5
 """Nothing sent to the page for this long: its scene is still (viser's settle window after the
 last update, a quarter of a second, is long over)."""
+SLOW_STILL_AFTER_S = 0.3
+"""While a slow stream drives the scene: nothing sent for this long, and its last pose is drawn
+and settled (a frame, and one more :data:`SLOW_FRAME_GAP_MS` later); the scene is still until the
+next pose."""
 LOADING_S = 5.0
 """A page that connected less than this long ago is still loading the scene (meshes, shaders):
 it draws freely."""
 INPUT_LIFTS_MS = 1500.0
 """How long a pointer, wheel or key event in the scene, or a resize, lifts the limit."""
-WATCH_EVERY_S = 0.25
+WATCH_EVERY_S = 0.1
 """How often the pacer looks whether the scene has become still."""
 
 _PACING_JS = """
 (() => {
   let p = window.__studioFramePacing;
   if (!p) {
-    p = window.__studioFramePacing = { gapMs: 0, inputUntil: 0, next: 0, lastT: -1, frames: 0 };
+    p = window.__studioFramePacing = { gapMs: 0, inputUntil: 0, next: 0, at: 0, lastT: -1, frames: 0 };
     const raf = window.requestAnimationFrame.bind(window);
     const caf = window.cancelAnimationFrame.bind(window);
     const waiting = new Map(); // our id -> [timeout, the browser's frame id, callback]
@@ -70,7 +77,7 @@ _PACING_JS = """
     const hand = (id, cb) => {
       waiting.get(id)[1] = raf((t) => {
         waiting.delete(id);
-        if (t !== p.lastT) { p.lastT = t; p.frames += 1; p.next = performance.now() + p.gapMs; }
+        if (t !== p.lastT) { p.lastT = t; p.frames += 1; p.at = performance.now(); p.next = p.at + p.gapMs; }
         cb(t);
       });
     };
@@ -108,24 +115,28 @@ _PACING_JS = """
     // (its messageQueue.ts); a still page reads as hidden, so that an update (and the script
     // waking the page, above all) is applied as it comes rather than in a frame held back.
     const hidden = Object.getOwnPropertyDescriptor(Document.prototype, "hidden").get;
-    Object.defineProperty(document, "hidden", { configurable: true, get: () => p.still || hidden.call(document) });
+    Object.defineProperty(document, "hidden", { configurable: true, get: () => p.still || p.atOnce || hidden.call(document) });
     p.hides = true;
   }
   const before = p.gapMs;
   p.gapMs = %(gap)s;
   p.still = %(still)s;
-  if (p.gapMs < before) { p.next = 0; p.release(); }
+  p.atOnce = %(at_once)s;
+  if (p.gapMs !== before) p.next = p.at ? p.at + p.gapMs : 0; // from the last frame drawn
+  if (p.gapMs < before) p.release();
 })();
 """
 
 
-def pacing_js(gap_ms: float, still: bool = False) -> str:
-    """The script that sets the least time between frames of viser's page (0: no limit), and
-    whether its scene is still (viser then applies each update as it comes, see above)."""
+def pacing_js(gap_ms: float, still: bool = False, at_once: bool = False) -> str:
+    """The script that sets the least time between frames of viser's page (0: no limit),
+    whether its scene is still, and whether a slow stream drives it (in both viser applies each
+    update as it comes, see above: the frame that draws it is then the only one it needs)."""
     return _PACING_JS % {
         "gap": float(gap_ms),
         "lift": INPUT_LIFTS_MS,
         "still": "true" if still else "false",
+        "at_once": "true" if at_once else "false",
     }
 
 
@@ -223,14 +234,16 @@ class FramePacer:
         """Send ``page`` the gap (the caller holds the lock)."""
         from viser import _messages
 
-        page.send(_messages.RunJavascriptMessage(pacing_js(gap_ms, still)))
+        page.send(_messages.RunJavascriptMessage(pacing_js(gap_ms, still, self.gap_ms > 0)))
 
     def _watch(self) -> None:
-        """Tell each loaded page the still gap once nothing was sent for STILL_AFTER_S."""
+        """Tell each loaded page the still gap once nothing was sent for STILL_AFTER_S (for
+        SLOW_STILL_AFTER_S while a slow stream drives the scene)."""
         while not self._closed.wait(WATCH_EVERY_S):
             now = time.monotonic()
             with self._lock:
-                if now - self._last_sent < STILL_AFTER_S:
+                quiet = SLOW_STILL_AFTER_S if self.gap_ms > 0 else STILL_AFTER_S
+                if now - self._last_sent < quiet:
                     continue
                 for client_id, page in self._pages.items():
                     if client_id in self._still or now - page.connected_at < LOADING_S:

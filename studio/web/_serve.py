@@ -332,8 +332,9 @@ def serve(settings: Settings, open_browser: bool = True) -> None:
     # the hops short (issue 10's motion-to-scene latency) at a negligible cost in throughput.
     sys.setswitchinterval(GIL_SWITCH_INTERVAL_S)
     # A robot's first load reads its meshes for seconds holding the GIL: in a child process,
-    # so that a robot switch does not freeze the API and the scene meanwhile.
-    isolate_robot_loading()
+    # so that a robot switch does not freeze the API and the scene meanwhile; and once per
+    # machine, kept in the data folder's cache.
+    isolate_robot_loading(settings.robot_cache_dir)
     sock = bind_port(settings.host, settings.port)
     try:
         server, scene, guard = start_scene(settings)

@@ -82,6 +82,11 @@ class Settings(BaseModel):
         return self.data_dir / "cache" / "meshes"
 
     @property
+    def robot_cache_dir(self) -> Path:
+        """Where the robots' built models and collision hulls are kept (a cache: safe to delete)."""
+        return self.data_dir / "cache" / "robots"
+
+    @property
     def is_loopback(self) -> bool:
         """Whether ``host`` only accepts connections from this machine."""
         return is_loopback(self.host)

@@ -67,6 +67,8 @@ def test_the_timeline_goal_and_jog_sliders_follow_the_robot_chosen(
         _timeline_robot(page, "panda")
         shown = page.evaluate("window.studio.timelineShown")
         assert shown[:7] == list(panda.joint_names) and len(shown) == 7 + 7
+        # built once per machine: kept in the data folder's cache for the next studio
+        assert list((studio_server.data_dir / "cache" / "robots").glob("panda-*/sha256.json"))
         legend = page.get_by_test_id("timeline-robot")
         assert "Franka Emika Panda" in legend.inner_text()
         assert "panda_joint7" in legend.inner_text()

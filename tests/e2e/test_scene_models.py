@@ -151,7 +151,15 @@ def test_reset_view_returns_to_the_default_camera(scene: Any, scene_page: Any) -
     if not reset.is_visible():
         scene_page.get_by_role("button", name="Expand column").click()
     reset.click()
-    while not np.allclose(client.camera.position, scene.layout.camera_position, atol=1e-3):
-        assert time.monotonic() < deadline, "Reset view did not bring the camera back"
+
+    def back() -> bool:  # the page reports position and look-at as its camera moves: wait for both
+        return np.allclose(
+            client.camera.position, scene.layout.camera_position, atol=1e-3
+        ) and np.allclose(client.camera.look_at, scene.layout.camera_look_at, atol=1e-3)
+
+    while not back():
+        assert time.monotonic() < deadline, (
+            "Reset view did not bring the camera back: "
+            f"at {client.camera.position}, looking at {client.camera.look_at}"
+        )
         time.sleep(0.05)
-    np.testing.assert_allclose(client.camera.look_at, scene.layout.camera_look_at, atol=1e-3)

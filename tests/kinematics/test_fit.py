@@ -84,6 +84,18 @@ def test_cold_fit_meets_the_landmarks_anywhere_within_the_limits(q, side):
     assert fit.success
 
 
+@pytest.mark.parametrize("side", ["right", "left"])
+def test_cold_fit_meets_a_wrist_deviated_to_its_limit(side):
+    # Found by the property test above at 1,500 examples: the closed-form wrist came out a
+    # rounding error past the deviation's limit, no seed was taken, and the fit stalled with
+    # the wrist in the opposite corner, 0.9 mm off.
+    arm, config = ARMS[side], CONFIGS[side]
+    q = np.array([0.0, 0.0, 0.0, 0.5, 2.0, arm.upper[5], 0.0])
+    fit = ArmFitter(arm, config).fit(tape_from_arm(arm, q, config))
+    np.testing.assert_allclose(arm.points(fit.q_human), arm.points(q), atol=1e-9)
+    assert fit.success
+
+
 def test_warm_fit_follows_a_smooth_motion_with_few_iterations():
     arm, config = ARMS["right"], CONFIGS["right"]
     rng = np.random.default_rng(11)

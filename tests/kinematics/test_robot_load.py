@@ -115,3 +115,69 @@ def test_a_server_process_loads_robots_in_a_child_process():
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.split() == ["['so100']", "True", "True"]
+
+
+FAILING_CHILD = "import sys; sys.exit(3)"
+
+
+def _same_robot(a: tuple, b: tuple) -> None:
+    arm_a, arm_b = _arm(a), _arm(b)
+    assert arm_b.joint_names == arm_a.joint_names
+    assert [g.meshPath for g in arm_b.visual_model.geometryObjects] == [
+        g.meshPath for g in arm_a.visual_model.geometryObjects
+    ]
+    for q in np.random.default_rng(5).uniform(arm_a.lower, arm_a.upper, size=(4, arm_a.nq)):
+        np.testing.assert_allclose(arm_b.forward(q), arm_a.forward(q))
+        assert [(c.link_a, c.link_b) for c in arm_b.self_collisions(q, 0.05)] == [
+            (c.link_a, c.link_b) for c in arm_a.self_collisions(q, 0.05)
+        ]
+
+
+def test_a_built_robot_is_kept_in_the_cache_and_read_back_without_a_child(tmp_path, monkeypatch):
+    monkeypatch.setattr(robot_load, "_cache", [tmp_path])
+    built = robot_load._built_in_child(SPEC)
+    (kept,) = tmp_path.iterdir()
+    assert kept.name.startswith("so100-")
+    assert sorted(p.name for p in kept.iterdir()) == sorted(
+        [*(f"{part}.bin" for part in robot_load._PARTS), robot_load._MANIFEST]
+    )
+    monkeypatch.setattr(robot_load, "_CHILD", FAILING_CHILD)  # a child would fail: none runs
+    _same_robot(built, robot_load._built_in_child(SPEC))
+
+
+def test_a_damaged_kept_robot_is_built_again_and_kept_anew(tmp_path, monkeypatch, caplog):
+    monkeypatch.setattr(robot_load, "_cache", [tmp_path])
+    built = robot_load._built_in_child(SPEC)
+    (kept,) = tmp_path.iterdir()
+    archive = kept / "collision.bin"
+    data = bytearray(archive.read_bytes())
+    data[len(data) // 2] ^= 0xFF
+    archive.write_bytes(bytes(data))
+    again = robot_load._built_in_child(SPEC)
+    assert "ignored and built again" in caplog.text
+    _same_robot(built, again)
+    monkeypatch.setattr(robot_load, "_CHILD", FAILING_CHILD)
+    _same_robot(built, robot_load._built_in_child(SPEC))  # the new copy is read
+
+
+def test_a_cache_that_cannot_be_written_still_gives_the_robot(tmp_path, monkeypatch, caplog):
+    blocked = tmp_path / "not-a-folder"
+    blocked.write_text("a file where the cache folder should be")
+    monkeypatch.setattr(robot_load, "_cache", [blocked])
+    arm = _arm(robot_load._built_in_child(SPEC))
+    assert arm.checks_collisions
+    assert "is not kept" in caplog.text
+
+
+def test_another_pinocchio_or_urdf_is_another_cache_entry(tmp_path, monkeypatch):
+    monkeypatch.setattr(robot_load, "_cache", [tmp_path])
+    entry = robot_load._cache_entry(SPEC)
+    assert entry is not None and entry.parent == tmp_path
+    monkeypatch.setattr(robot_load.pin, "__version__", "0.0.0")
+    assert robot_load._cache_entry(SPEC) != entry
+    monkeypatch.undo()
+    monkeypatch.setattr(robot_load, "_cache", [tmp_path])
+    monkeypatch.setattr(robot_load, "_urdf_text", lambda spec: "<robot name='other'/>")
+    assert robot_load._cache_entry(SPEC) != entry
+    monkeypatch.setattr(robot_load, "_cache", [])
+    assert robot_load._cache_entry(SPEC) is None

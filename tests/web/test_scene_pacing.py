@@ -12,6 +12,7 @@ page is asked to draw fewer frames (``studio/web/_scene_frames.py``).
 from __future__ import annotations
 
 import asyncio
+import itertools
 import threading
 import time
 
@@ -196,6 +197,33 @@ def test_a_still_scene_is_drawn_rarely_and_the_next_update_frees_the_frames(monk
         for client in server.get_clients().values():  # one page's camera moves
             client.camera.position = (3.0, -1.0, 2.0)
         assert wait_for(lambda: page.gap() in awake), "a camera update wakes it too"
+    finally:
+        page.stop.set()
+        sc.close()
+        server.stop()
+
+
+def test_between_a_slow_streams_poses_the_scene_is_still(monkeypatch):
+    """A slow stream's poses 0.6 s apart: once a pose is drawn and settled (SLOW_STILL_AFTER_S
+    without a message) the page is told the still gap, so viser's idle frame is not drawn
+    between poses; each next pose wakes it to the slow gap first."""
+    monkeypatch.setattr(_scene_frames, "LOADING_S", 0.5)
+    monkeypatch.setattr(_scene_frames, "STILL_AFTER_S", 60.0)  # stills here come from the stream
+    port = free_port()
+    server = viser.ViserServer(host="127.0.0.1", port=port, verbose=False)
+    sc = StudioScene(server, body=HumanBody("right"), layout=SceneLayout(**SLOW))
+    page = _ScriptWatch(port)
+    try:
+        time.sleep(1.0)  # loaded
+        _stream(sc, count=8, gap_s=0.6)
+        gaps = page.gaps()
+        assert SLOW_FRAME_GAP_MS in gaps, gaps
+        during = gaps[gaps.index(SLOW_FRAME_GAP_MS) :]
+        assert during.count(STILL_FRAME_GAP_MS) >= 4, during
+        assert all(a != b for a, b in itertools.pairwise(during)), (
+            f"still, woken, in turn: {during}"
+        )
+        assert set(during) == {SLOW_FRAME_GAP_MS, STILL_FRAME_GAP_MS}, during
     finally:
         page.stop.set()
         sc.close()
