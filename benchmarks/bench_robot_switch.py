@@ -51,7 +51,7 @@ from pathlib import Path
 a = json.loads(sys.argv[1])
 if not a["isolate"]:  # the baseline: every robot's geometry built in the studio's own process
     import studio.kinematics
-    studio.kinematics.isolate_robot_loading = lambda: None
+    studio.kinematics.isolate_robot_loading = lambda cache=None: None
 import studio.web._serve as served
 served.prepare_in_background = lambda: None
 from studio.web import Settings, serve
