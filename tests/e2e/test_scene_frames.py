@@ -28,12 +28,14 @@ from studio.web._scene_frames import SLOW_FRAME_GAP_MS, pacing_js
 from tests.conftest import free_port
 from tests.web.conftest import wait_for
 
-FRAMES_JS = """(n) => new Promise((resolve) => {
+FRAMES_JS = """(n) => new Promise((resolve, reject) => {
   const times = [];
   const step = (t) => { times.push(performance.now()); if (times.length < n) requestAnimationFrame(step); else resolve(times); };
   requestAnimationFrame(step);
+  setTimeout(() => reject(new Error(`${times.length} of ${n} frames ran in 20 s`)), 20000);
 })"""
-"""A chain of ``n`` frames, each requested from the one before (as three.js does): their times."""
+"""A chain of ``n`` frames, each requested from the one before (as three.js does): their times
+(an error after 20 s, so that a frame held back for good fails the test rather than hangs it)."""
 
 
 @pytest.fixture
