@@ -1,4 +1,4 @@
-/* Teach Studio page: talking to the studio's API (docs/api.md): requests, their one-sentence errors, downloads. */
+/* Teach Studio page: talking to the studio's API (docs/api.md): requests, their one-sentence errors, sending in turn, downloads. */
 
 import { showError } from "./dom.js";
 import { S } from "./state.js";
@@ -56,6 +56,18 @@ export async function guarded(errId, fn, button) {
   } finally {
     if (button) button.disabled = false;
   }
+}
+
+/** A queue of actions that must reach the server one at a time, in the order the user made them
+ * (a seek, then play): ``queue(fn)`` runs ``fn`` once everything queued before it has settled,
+ * and returns its promise. */
+export function inTurn() {
+  let last = Promise.resolve();
+  return (fn) => {
+    const run = last.then(fn);
+    last = run.catch(() => {});
+    return run;
+  };
 }
 
 /** Fetch a file and save it, so that a refusal (409, 404) shows up as a message, not a page.

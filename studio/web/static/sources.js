@@ -1,6 +1,6 @@
 /* Teach Studio page: the live source: its status line, the source form, playback, the simulator's reach, the robot taught. */
 
-import { api, guarded } from "./api.js";
+import { api, guarded, inTurn } from "./api.js";
 import { $, fmt, setProp, setText, showError } from "./dom.js";
 import { S } from "./state.js";
 
@@ -92,15 +92,13 @@ export async function simulatorReach(action) {
   }, $(action === "reach" ? "source-reach" : "source-wander"));
 }
 
-// Playback changes go one at a time, in the order the user made them (a seek, then play).
-let playbackSending = Promise.resolve();
+const playbackInTurn = inTurn(); // a seek, then play: in that order
 
 export function playback(action, extra = {}) {
-  playbackSending = playbackSending.then(() => guarded("source-error", async () => {
+  return playbackInTurn(() => guarded("source-error", async () => {
     S.source = await api("POST", "/api/source/playback", { action, ...extra });
     renderSource();
   }));
-  return playbackSending;
 }
 
 export async function setRetarget() {

@@ -11,7 +11,7 @@
  * fills the train form's goal with joints 1-3 (degrees, as the form takes it).
  */
 
-import { api, guarded } from "./api.js";
+import { api, guarded, inTurn } from "./api.js";
 import { $, el, fmt, setProp, setText, showError } from "./dom.js";
 import { S } from "./state.js";
 
@@ -114,11 +114,10 @@ function render() {
 
 // The scene's changes go one at a time, in the order the user made them: a play sent while a scrub
 // is still on its way would otherwise race it, and the scrub (which pauses) could land second.
-let sending = Promise.resolve();
+const changeInTurn = inTurn();
 
 function change(body) {
-  sending = sending.then(() => guarded("rollout-error", async () => showRollout(await api("POST", "/api/scene/playback", body))));
-  return sending;
+  return changeInTurn(() => guarded("rollout-error", async () => showRollout(await api("POST", "/api/scene/playback", body))));
 }
 
 // Scrubbing sends the newest position only, one request at a time, and pauses the rollout there.
