@@ -376,9 +376,10 @@ class ArmFitter:
         at the elbow's limit, sensor noise alone can make the other branch fit a few millimetres
         better. On a cold start the other branch is also taken when it meets the landmarks exactly
         (to ``equivalent_error``) where the anatomical one cannot: an arm raised overhead with a
-        slightly bent elbow, which the anatomical branch cannot bend that way within the limits. Within the chosen branch, the candidates that meet the landmarks as well as the
-        best one (to ``equivalent_error``) are equivalent, and the one nearest the previous frame
-        (or the neutral arm) wins, so the unobservable directions move least.
+        slightly bent elbow, which the anatomical branch cannot bend that way within the limits.
+        Within the chosen branch, the candidates that meet the landmarks as well as the best one
+        (to ``equivalent_error``) are equivalent, and the one nearest the previous frame (or the
+        neutral arm) wins, so the unobservable directions move least.
 
         Args:
             relative: the landmarks relative to the tape's shoulder, (4, 3).

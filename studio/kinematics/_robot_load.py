@@ -57,8 +57,8 @@ _cache: list[Path] = []  # the cache folder isolate_robot_loading was given (non
 CACHE_VERSION = 1
 """Bumped when what a cache folder holds changes."""
 _MANIFEST = "sha256.json"
-"""The file of a kept robot naming each archive's SHA-256; written last, so its presence means the
-archives beside it were complete."""
+"""The file of a kept robot naming each archive's SHA-256 (a kept folder appears whole: it is
+written aside and renamed into place)."""
 
 _CHILD = "from studio.kinematics._robot_load import _build_for_parent; _build_for_parent()"
 _PARTS = ("model", "visual", "collision")
@@ -112,7 +112,7 @@ def _load(spec: RobotSpec, geometry: bool) -> RobotArm:
         return _puma_arm(spec)
     text = _urdf_text(spec)
     if geometry and _isolated.is_set():
-        model, visual, collision = _built_in_child(spec)
+        model, visual, collision = _built_in_child(spec, text)
     else:
         model, visual, collision = _built(spec, text, geometry)
     srdf = robots_folder() / spec.srdf if spec.srdf else None
@@ -162,12 +162,12 @@ def _built(
 Parts = tuple[pin.Model, pin.GeometryModel, pin.GeometryModel]
 
 
-def _built_in_child(spec: RobotSpec) -> Parts:
+def _built_in_child(spec: RobotSpec, text: str) -> Parts:
     """:func:`_built` in a child process, handed back in Pinocchio's binary archives (read in
     tens of milliseconds, a tenth of its pickles' text archives); this thread waits without
     Python's lock. In this process after all when no child can be started. Read from the cache
     folder instead when it keeps this robot, and kept there after a build."""
-    kept = _cache_entry(spec)
+    kept = _cache_entry(spec, text)
     if kept is not None:
         parts = _read_kept(kept)
         if parts is not None:
@@ -189,7 +189,7 @@ def _built_in_child(spec: RobotSpec) -> Parts:
             ) from None
         except OSError as err:  # no child process here: load it in this one, holding the lock
             log.warning("the %s model loads in this process: %s", spec.name, err)
-            return _built(spec, _urdf_text(spec), True)
+            return _built(spec, text, True)
         files = [Path(folder) / f"{part}.bin" for part in _PARTS]
         refused = Path(folder) / _REFUSED
         if done.returncode == 0 and refused.is_file():
@@ -213,8 +213,9 @@ def _read_archives(files: list[Path]) -> Parts:
     return model, visual, collision
 
 
-def _cache_entry(spec: RobotSpec) -> Path | None:
-    """The cache folder's place for ``spec``'s built geometry (None: no cache)."""
+def _cache_entry(spec: RobotSpec, text: str) -> Path | None:
+    """The cache folder's place for ``spec``'s built geometry from its URDF ``text`` (None: no
+    cache)."""
     if not _cache:
         return None
     from importlib import metadata
@@ -227,7 +228,7 @@ def _cache_entry(spec: RobotSpec) -> Path | None:
         robots_version = None
     stamp = [CACHE_VERSION, pin.__version__, coal.__version__, robots_version, spec.arm_joints]
     digest = hashlib.sha256(json.dumps(stamp).encode())
-    digest.update(_urdf_text(spec).encode())
+    digest.update(text.encode())
     return _cache[0] / f"{spec.name}-{digest.hexdigest()[:20]}"
 
 
@@ -252,8 +253,9 @@ def _read_kept(folder: Path) -> Parts | None:
 
 
 def _keep(folder: Path, files: list[Path]) -> None:
-    """Copy the archives a child wrote into ``folder`` of the cache, the manifest last; a cache
-    that cannot be written (a full disk, no permission) is logged and skipped."""
+    """Copy the archives a child wrote, and their hashes, into ``folder`` of the cache (written
+    aside, then renamed into place); a cache that cannot be written (a full disk, no permission)
+    is logged and skipped."""
     temporary = folder.with_name(f".{folder.name}.{os.getpid()}.{threading.get_ident()}")
     try:
         temporary.mkdir(parents=True, exist_ok=True)

@@ -15,15 +15,16 @@ from studio.kinematics import _robot_load as robot_load
 from studio.kinematics._robots import RobotArm, robot_spec
 
 SPEC = robot_spec("so100")  # meshes for both geometries, and quick to build
+TEXT = robot_load._urdf_text(SPEC)
 
 
 def _arm(parts: tuple) -> RobotArm:
-    return RobotArm(SPEC, *parts, robot_load._urdf_text(SPEC))
+    return RobotArm(SPEC, *parts, TEXT)
 
 
 def test_a_robot_built_in_a_child_process_is_the_robot_built_here():
-    here = _arm(robot_load._built(SPEC, robot_load._urdf_text(SPEC), True))
-    child = _arm(robot_load._built_in_child(SPEC))
+    here = _arm(robot_load._built(SPEC, TEXT, True))
+    child = _arm(robot_load._built_in_child(SPEC, TEXT))
     assert child.joint_names == here.joint_names
     for name in ("lower", "upper", "velocity", "home"):
         np.testing.assert_array_equal(getattr(child, name), getattr(here, name))
@@ -46,7 +47,7 @@ def test_a_robot_built_in_a_child_process_is_the_robot_built_here():
 
 
 def test_the_visual_meshes_are_kept_as_files_not_triangles():
-    _, visual, _ = robot_load._built(SPEC, robot_load._urdf_text(SPEC), True)
+    _, visual, _ = robot_load._built(SPEC, TEXT, True)
     assert visual.ngeoms > 0
     for obj in visual.geometryObjects:
         assert obj.meshPath.endswith((".stl", ".STL", ".dae"))  # drawn from its file
@@ -55,14 +56,14 @@ def test_the_visual_meshes_are_kept_as_files_not_triangles():
 
 def test_without_a_child_process_the_robot_loads_here(monkeypatch):
     monkeypatch.setattr(robot_load.sys, "executable", "/nonexistent/python")
-    arm = _arm(robot_load._built_in_child(SPEC))
+    arm = _arm(robot_load._built_in_child(SPEC, TEXT))
     assert arm.checks_collisions and len(arm.visual_model.geometryObjects) > 0
 
 
 def test_a_child_that_dies_is_one_sentence(monkeypatch):
     monkeypatch.setattr(robot_load, "_CHILD", "import sys; print('assimp crashed', file=sys.stderr); sys.exit(3)")  # fmt: skip
     with pytest.raises(KinematicsError) as err:
-        robot_load._built_in_child(SPEC)
+        robot_load._built_in_child(SPEC, TEXT)
     message = str(err.value)
     assert "\n" not in message and message.endswith("reinstall example-robot-data.")
     assert "ended with code 3 (assimp crashed)" in message
@@ -72,14 +73,14 @@ def test_a_robot_the_child_refuses_is_refused_in_its_sentence(monkeypatch):
     code = "import pathlib, sys; (pathlib.Path(sys.argv[2]) / 'refused.txt').write_text('The SO-100 URDF is gone; reinstall example-robot-data.')"  # fmt: skip
     monkeypatch.setattr(robot_load, "_CHILD", code)
     with pytest.raises(KinematicsError, match=r"^The SO-100 URDF is gone; reinstall"):
-        robot_load._built_in_child(SPEC)
+        robot_load._built_in_child(SPEC, TEXT)
 
 
 def test_a_child_that_hangs_is_given_up_in_one_sentence(monkeypatch):
     monkeypatch.setattr(robot_load, "_CHILD", "import time; time.sleep(60)")
     monkeypatch.setattr(robot_load, "LOAD_TIMEOUT_S", 0.5)
     with pytest.raises(KinematicsError, match=r"took over 0 s and was given up; try again"):
-        robot_load._built_in_child(SPEC)
+        robot_load._built_in_child(SPEC, TEXT)
 
 
 def test_threads_asking_for_one_robot_together_get_one_arm():
@@ -135,49 +136,48 @@ def _same_robot(a: tuple, b: tuple) -> None:
 
 def test_a_built_robot_is_kept_in_the_cache_and_read_back_without_a_child(tmp_path, monkeypatch):
     monkeypatch.setattr(robot_load, "_cache", [tmp_path])
-    built = robot_load._built_in_child(SPEC)
+    built = robot_load._built_in_child(SPEC, TEXT)
     (kept,) = tmp_path.iterdir()
     assert kept.name.startswith("so100-")
     assert sorted(p.name for p in kept.iterdir()) == sorted(
         [*(f"{part}.bin" for part in robot_load._PARTS), robot_load._MANIFEST]
     )
     monkeypatch.setattr(robot_load, "_CHILD", FAILING_CHILD)  # a child would fail: none runs
-    _same_robot(built, robot_load._built_in_child(SPEC))
+    _same_robot(built, robot_load._built_in_child(SPEC, TEXT))
 
 
 def test_a_damaged_kept_robot_is_built_again_and_kept_anew(tmp_path, monkeypatch, caplog):
     monkeypatch.setattr(robot_load, "_cache", [tmp_path])
-    built = robot_load._built_in_child(SPEC)
+    built = robot_load._built_in_child(SPEC, TEXT)
     (kept,) = tmp_path.iterdir()
     archive = kept / "collision.bin"
     data = bytearray(archive.read_bytes())
     data[len(data) // 2] ^= 0xFF
     archive.write_bytes(bytes(data))
-    again = robot_load._built_in_child(SPEC)
+    again = robot_load._built_in_child(SPEC, TEXT)
     assert "ignored and built again" in caplog.text
     _same_robot(built, again)
     monkeypatch.setattr(robot_load, "_CHILD", FAILING_CHILD)
-    _same_robot(built, robot_load._built_in_child(SPEC))  # the new copy is read
+    _same_robot(built, robot_load._built_in_child(SPEC, TEXT))  # the new copy is read
 
 
 def test_a_cache_that_cannot_be_written_still_gives_the_robot(tmp_path, monkeypatch, caplog):
     blocked = tmp_path / "not-a-folder"
     blocked.write_text("a file where the cache folder should be")
     monkeypatch.setattr(robot_load, "_cache", [blocked])
-    arm = _arm(robot_load._built_in_child(SPEC))
+    arm = _arm(robot_load._built_in_child(SPEC, TEXT))
     assert arm.checks_collisions
     assert "is not kept" in caplog.text
 
 
 def test_another_pinocchio_or_urdf_is_another_cache_entry(tmp_path, monkeypatch):
     monkeypatch.setattr(robot_load, "_cache", [tmp_path])
-    entry = robot_load._cache_entry(SPEC)
+    entry = robot_load._cache_entry(SPEC, TEXT)
     assert entry is not None and entry.parent == tmp_path
     monkeypatch.setattr(robot_load.pin, "__version__", "0.0.0")
-    assert robot_load._cache_entry(SPEC) != entry
+    assert robot_load._cache_entry(SPEC, TEXT) != entry
     monkeypatch.undo()
     monkeypatch.setattr(robot_load, "_cache", [tmp_path])
-    monkeypatch.setattr(robot_load, "_urdf_text", lambda spec: "<robot name='other'/>")
-    assert robot_load._cache_entry(SPEC) != entry
+    assert robot_load._cache_entry(SPEC, "<robot name='other'/>") != entry
     monkeypatch.setattr(robot_load, "_cache", [])
-    assert robot_load._cache_entry(SPEC) is None
+    assert robot_load._cache_entry(SPEC, TEXT) is None
