@@ -180,7 +180,9 @@ def test_play_clicked_while_a_scrub_is_on_its_way_plays(
     page.route(pattern, hold_scrubs)
     try:
         slider.press("Home")
-        page.wait_for_timeout(300)
+        deadline = time.monotonic() + T / 1000
+        while not held and time.monotonic() < deadline:  # (the route handler runs meanwhile)
+            page.wait_for_timeout(50)
         assert held, "the scrub to the start never left the page"
         page.get_by_role("button", name="Play").click()
         page.wait_for_timeout(1000)  # a Play sent now would reach the scene before the scrub
