@@ -33,7 +33,10 @@ as the browser can draw it.
 The limit is a wrapper of the page's ``requestAnimationFrame`` (the clock of three.js and of
 React Three Fiber, which viser draws with), installed through viser's ``RunJavascriptMessage``.
 It delays frames and never drops one; with a gap of 0 it hands every request straight to the
-browser. ``window.__studioFramePacing.frames`` counts the frames it let through.
+browser. A frame waiting for its turn counts its turn again when it comes, so a gap that grew
+meanwhile (the scene became still) holds it too: viser's once-a-second frame, asked for just
+before a slow stream's scene became still, waits for the next pose rather than being drawn
+between poses. ``window.__studioFramePacing.frames`` counts the frames it let through.
 """
 
 from __future__ import annotations
@@ -89,13 +92,19 @@ _PACING_JS = """
         hand(id, entry[2]);
       }
     };
+    const wait = () => { // how long a frame requested now waits for its turn
+      const now = performance.now();
+      return p.gapMs > 0 && now >= p.inputUntil ? p.next - now : 0;
+    };
+    const hold = (id, cb) => { // until its turn, counted again when it comes (the gap may have grown)
+      const ms = wait();
+      if (ms > 0) waiting.get(id)[0] = setTimeout(() => hold(id, cb), ms);
+      else { waiting.get(id)[0] = 0; hand(id, cb); }
+    };
     window.requestAnimationFrame = (cb) => {
       const id = ++seq;
-      const now = performance.now();
-      const wait = p.gapMs > 0 && now >= p.inputUntil ? p.next - now : 0;
       waiting.set(id, [0, 0, cb]);
-      if (wait > 0) waiting.get(id)[0] = setTimeout(() => { waiting.get(id)[0] = 0; hand(id, cb); }, wait);
-      else hand(id, cb);
+      hold(id, cb);
       return id;
     };
     window.cancelAnimationFrame = (id) => {

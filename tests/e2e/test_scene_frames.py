@@ -106,6 +106,22 @@ def test_a_frame_held_back_runs_at_once_when_the_gap_drops_or_the_user_acts(
     blank.wait_for_function("() => window.__held === true", timeout=10_000)
 
 
+def test_a_frame_waiting_for_its_turn_waits_longer_when_the_gap_grows(blank: Any) -> None:
+    """viser's once-a-second frame, asked for just before a slow stream's scene became still,
+    is held until the next pose rather than drawn between poses."""
+    blank.evaluate(f"() => {{ {pacing_js(SLOW_FRAME_GAP_MS)} }}")
+    for _ in range(5):  # (a new page may get a resize of its own, which lifts the limit)
+        blank.evaluate(FRAMES_JS, 1)  # a frame just ran: the next one waits for its turn
+        blank.evaluate(HELD_JS)
+        if blank.evaluate("() => window.__held") is False:
+            break
+    blank.evaluate(f"() => {{ {pacing_js(1e9, still=True)} }}")  # the scene became still
+    blank.wait_for_timeout(3 * SLOW_FRAME_GAP_MS)
+    assert blank.evaluate("() => window.__held") is False, "held past its old turn"
+    blank.evaluate(f"() => {{ {pacing_js(SLOW_FRAME_GAP_MS)} }}")  # the next pose woke the page
+    blank.wait_for_function("() => window.__held === true", timeout=10_000)
+
+
 @pytest.fixture
 def scene_page(browser: Any) -> Iterator[tuple[StudioScene, Any]]:
     port = free_port()
