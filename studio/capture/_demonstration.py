@@ -475,9 +475,9 @@ def _track_segment(
             )
         tracker.reset()
         tracker.mode = mode
-        bend, twist = rec.bend[rows], rec.twist[rows]
+        bend, twist, t = rec.bend[rows], rec.twist[rows], rec.t[rows]
         for i in range(n):
-            tracked = tracker.track(bend[i], twist[i])
+            tracked = tracker.track(bend[i], twist[i], t[i])
             q_robot[i] = tracked.q_robot
             # the residual (tape against the fitted arm) is the fit's quality; ``success`` also
             # asks for millimetre landmark agreement, which sensor noise alone can exceed

@@ -147,7 +147,7 @@ class TapeFitter:
 
     def fit(self, observation: Observation) -> Fitted:
         assert isinstance(observation, TapeFrame)
-        tracked = self.tracker.track(observation.bend, observation.twist)
+        tracked = self.tracker.track(observation.bend, observation.twist, observation.t)
         return Fitted(
             tracked.q_human,
             tracked.q_robot,
