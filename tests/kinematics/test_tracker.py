@@ -200,7 +200,10 @@ def test_the_smoothing_starts_afresh_at_a_reset_a_repeated_time_or_an_untimed_fr
 def test_bad_smoothing_settings_and_times_are_one_sentence():
     with pytest.raises(KinematicsError, match="smoothing_cutoff_hz"):
         TrackerConfig(smoothing_cutoff_hz=0.0)
+    with pytest.raises(KinematicsError, match="smoothing_cutoff_hz"):
+        TrackerConfig(smoothing_cutoff_hz=(1.0, 2.0))
     with pytest.raises(KinematicsError, match="beta"):
         TrackerConfig(smoothing_beta=-1.0)
-    with pytest.raises(KinematicsError, match="finite time"):
-        ArmTracker().track(np.zeros(16), np.zeros(16), float("nan"))
+    for t in (float("nan"), "1.0", True):
+        with pytest.raises(KinematicsError, match="finite time"):
+            ArmTracker().track(np.zeros(16), np.zeros(16), t)
