@@ -141,18 +141,11 @@ def arm_error(arm: HumanArm, fitted: np.ndarray, truth: np.ndarray) -> float:
     return float(np.abs(arm.points(fitted) - arm.points(truth)).max())
 
 
-def turns_back(q: np.ndarray, above_deg: float = 0.5) -> int:
-    """How often a joint turns back between frames, by more than ``above_deg`` each way."""
-    d = np.diff(q, axis=0)
-    big = np.abs(d) > np.radians(above_deg)
-    return int(((np.sign(d[1:]) * np.sign(d[:-1]) < 0) & big[1:] & big[:-1]).sum())
-
-
 def smoothing(seeds: tuple[int, ...] = (3, 4, 5), seconds: float = 7.0) -> None:
     """Section (c): the timed tracker against the one-frame-at-a-time baseline."""
     from studio.capture import simulate
     from studio.kinematics import load_robot, retarget_path
-    from studio.kinematics._filter import OneEuroFilter
+    from studio.kinematics._filter import OneEuroFilter, turn_backs
     from studio.kinematics._tracker import SMOOTHING_CUTOFF_HZ
 
     panda = load_robot("panda")
@@ -166,8 +159,8 @@ def smoothing(seeds: tuple[int, ...] = (3, 4, 5), seconds: float = 7.0) -> None:
             tracked = [tracker.track(f.bend, f.twist, f.t if timed else None) for f in sim.frames]
             q_human = np.array([x.q_human for x in tracked])
             counts[name] += (
-                turns_back(np.array([x.q_robot for x in tracked])),
-                turns_back(retarget_path(panda, q_human).q),
+                turn_backs(np.array([x.q_robot for x in tracked])),
+                turn_backs(retarget_path(panda, q_human).q),
                 np.degrees(np.abs(q_human - sim.q_human)[:, :4]).mean() / len(seeds),
             )
     lags = ", ".join(

@@ -12,7 +12,9 @@ step cap, as before).
 Prints per robot, ours against the baseline: the median and p99 time of a frame and their
 ratio, the share of frames whose tool is within 1 cm and 5 deg of the target
 (``studio.kinematics.tool_reaches``; 1 cm only where the robot follows the position), the share
-of frames whose target was reachable but missed, and the largest joint step between frames.
+of frames whose target was reachable but missed, the largest joint step between frames and how
+often a joint turns back between frames (``turn_backs``: jitter, or a pose flipping between two
+IK answers).
 Then, for ours, why frames were missed, judged on every 11th frame by
 ``studio.kinematics.reachable`` (the one definition the tests use too): the hand drawn back into
 the arm's reach sphere (the raised shoulder carries it beyond), targets no pose reaches (out of
@@ -45,6 +47,7 @@ from studio.kinematics import (
     robot_names,
     tool_reaches,
 )
+from studio.kinematics._filter import turn_backs
 
 
 def previous_inverse(
@@ -158,8 +161,11 @@ def bench(name: str, seconds: float) -> None:
     for label, ms, q in (("ours", ours_ms, ours_q), ("previous", previous_ms, previous_q)):
         reached = np.array([tool_reaches(arm, p, t) for p, t in zip(q, targets, strict=True)])
         step = float(np.degrees(np.abs(np.diff(q, axis=0))).max())
-        rows[label] = (np.median(ms), np.percentile(ms, 99), reached, step)
-    (m, p99, reached, step), (m0, p990, reached0, step0) = rows["ours"], rows["previous"]
+        rows[label] = (np.median(ms), np.percentile(ms, 99), reached, step, turn_backs(q))
+    (m, p99, reached, step, turns), (m0, p990, reached0, step0, turns0) = (
+        rows["ours"],
+        rows["previous"],
+    )
     sample = range(1, len(motion), 11)
     missed = [i for i in sample if not reached[i]]
     near = [i for i in missed if reachable(arm, targets[i], near=ours_q[i - 1])]
@@ -170,7 +176,8 @@ def bench(name: str, seconds: float) -> None:
         f"{name:8s} median {m:.2f} ms (previous {m0:.2f}, {m0 / m:.1f}x) | p99 {p99:.2f} "
         f"(previous {p990:.2f}) | reached {reached.mean():.0%} (previous {reached0.mean():.0%}) "
         f"| reachable but missed {(len(near) + len(walked)) / len(sample):.1%} "
-        f"| largest step {step:.1f} deg (previous {step0:.1f})",
+        f"| largest step {step:.1f} deg (previous {step0:.1f}) "
+        f"| joints turning back {turns} times (previous {turns0})",
         flush=True,
     )
     print(

@@ -98,6 +98,18 @@ class SerialChain:
         out[:3, :3], out[:3, 3] = tool_R, tool_p
         return out
 
+    def jacobian(self, q: np.ndarray, rows: int = 6) -> np.ndarray:
+        """The tool's geometric Jacobian at ``q`` (world axes), ``(rows, n)``: rows 0-2 its
+        velocity, rows 3-5 (``rows=6``) its angular velocity; computed by the kernel."""
+        n = len(self.axes)
+        R, p = np.empty((n, 3, 3)), np.empty((n, 3))
+        tool_R, tool_p = np.empty((3, 3)), np.empty(3)
+        _forward(self.rotations, self.translations, self.axes, np.asarray(q, float), R, p)
+        _tool(self, R, p, tool_R, tool_p)
+        J = np.empty((rows, n))
+        _jacobian(R, p, self.axes, tool_p, min(n, self.tool_joint + 1), J)
+        return J
+
 
 def _tool(chain: SerialChain, R: np.ndarray, p: np.ndarray, tool_R: np.ndarray, tool_p: np.ndarray):
     j = chain.tool_joint

@@ -195,3 +195,17 @@ class ConstantVelocityFilter:
         self._p = [(1.0 - k0) * p00, (1.0 - k0) * p01, p11 - k1 * p01]
         self._t = float(t)
         return self._x.copy()
+
+
+JITTER_RAD = math.radians(0.5)
+"""A joint step this large, followed by one as large the other way, is a turn back
+(:func:`turn_backs`): jitter rather than motion."""
+
+
+def turn_backs(path: object, above: float = JITTER_RAD) -> int:
+    """How often a joint of ``path`` ``(N, J)`` turns back between frames: a step larger than
+    ``above`` (rad) followed by one as large the other way. A smooth motion has none; a pose
+    that jitters or flips between two answers has one a frame."""
+    steps = np.diff(real_array(path, "The path", "pass joint angles (N, J)"), axis=0)
+    big = np.abs(steps) > above
+    return int(((np.sign(steps[1:]) * np.sign(steps[:-1]) < 0) & big[1:] & big[:-1]).sum())

@@ -57,7 +57,7 @@ from ._hand_ik import fit_hand_pose
 from ._human import SAGITTAL_MIRROR, HumanArm, _as_q
 from ._puma import IKConfig, IKResult, Puma560
 from ._robot_load import load_robot
-from ._robots import RobotArm, RobotIK, tool_errors
+from ._robots import IK_DAMPING, RobotArm, RobotIK, tool_errors
 
 Mode = Literal["joint", "cartesian"]
 
@@ -129,6 +129,15 @@ class RetargetConfig:
             ``restart_iterations`` more from the nearest answer.
         settle_tries: IK passes on a path's first frame (each warm-started from the last)
             before the path starts, as a live session settles before it moves.
+        singular_margin: an arm without joints to spare (six or fewer) whose last pose has a
+            Jacobian singular value below this (the tool's m/rad and rad/rad) is near a
+            singularity (the UR arms' shoulder and wrist), where the exact IK answer swings by
+            many degrees for a millimetre of the target: its solves that frame are damped more
+            (Chiaverini's damping, ``damping^2 = IK_DAMPING^2 + (1 - (s / margin)^2) *
+            singular_damping^2``), trading a little accuracy for a pose that does not flip
+            between two answers frame after frame. An arm with joints to spare keeps the plain
+            damping: its null space takes up such motion.
+        singular_damping: the largest extra damping there (at a singular value of 0).
     """
 
     reach_fraction: float = 0.95
@@ -145,6 +154,8 @@ class RetargetConfig:
     restart_starts: int = 16
     near_starts: int = 4
     settle_tries: int = 5
+    singular_margin: float = 0.1
+    singular_damping: float = 0.08
 
     def __post_init__(self) -> None:
         positive_number(self.reach_fraction, "RetargetConfig.reach_fraction")
@@ -161,6 +172,8 @@ class RetargetConfig:
         whole_number(self.restart_starts, "RetargetConfig.restart_starts", 0)
         whole_number(self.near_starts, "RetargetConfig.near_starts", 0)
         whole_number(self.settle_tries, "RetargetConfig.settle_tries", 1)
+        positive_number(self.singular_margin, "RetargetConfig.singular_margin")
+        positive_number(self.singular_damping, "RetargetConfig.singular_damping")
 
     def within_reach(self, position_error: float, rotation_error: float) -> bool:
         """Whether a tool this far (m) and this turned (rad) from its target has reached it."""
@@ -463,8 +476,13 @@ class Retargeter:
         """
         config = self.config
         elbow = self.elbow_target(q_human) if robot.nq > 6 else None
-        settings = {"elbow": elbow, "iterations": config.ik_iterations, "elbow_iterations": 1}
         start = robot.home if self._q_prev is None else self._q_prev
+        settings = {
+            "elbow": elbow,
+            "iterations": config.ik_iterations,
+            "elbow_iterations": 1,
+            "damping": self._damping(robot, start),
+        }
         if self._q_prev is not None:
             near = self._within_a_step(robot, oMdes, settings)
             if near is not None:
@@ -487,6 +505,19 @@ class Retargeter:
             if position.success or position.position_error < found.position_error:
                 found = position
         return found
+
+    def _damping(self, robot: RobotArm, q: np.ndarray) -> float:
+        """The IK's damping for a frame that starts at ``q`` (see
+        :attr:`RetargetConfig.singular_margin`)."""
+        config = self.config
+        rows = 6 if robot.spec.orientation else 3
+        if robot.nq > rows:  # joints to spare
+            return IK_DAMPING
+        smallest = float(np.linalg.svd(robot.chain.jacobian(q, rows), compute_uv=False)[-1])
+        if smallest >= config.singular_margin:
+            return IK_DAMPING
+        near = 1.0 - (smallest / config.singular_margin) ** 2
+        return math.sqrt(IK_DAMPING**2 + near * config.singular_damping**2)
 
     def _reached(self, found: RobotIK) -> bool:
         return self.config.within_reach(found.position_error, found.rotation_error)

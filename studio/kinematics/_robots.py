@@ -38,6 +38,10 @@ ROBOTS_RELATIVE = Path("cmeel.prefix/share/example-robot-data/robots")
 """Where the ``example-robot-data`` wheel installs its robots, relative to site-packages."""
 
 
+IK_DAMPING = 1e-2
+"""The damping (lambda, m) of :meth:`RobotArm.inverse`'s least-squares steps by default."""
+
+
 @dataclass(frozen=True)
 class RobotSpec:
     """One offered robot: where its files are and which of its joints form the arm.
@@ -440,7 +444,7 @@ class RobotArm:
         elbow_iterations: int = 200,
         position_tolerance: float = 1e-3,
         rotation_tolerance: float = math.radians(1.0),
-        damping: float = 1e-2,
+        damping: float = IK_DAMPING,
         max_step: float = 0.2,
         lower: np.ndarray | None = None,
         upper: np.ndarray | None = None,

@@ -20,6 +20,7 @@ from studio.kinematics import (
     load_robot,
     retarget_path,
 )
+from studio.kinematics._filter import turn_backs
 from studio.kinematics._retarget import DROPPED_HUMAN_JOINT, JOINT_MAP
 
 RIGHT = HumanArm("right")
@@ -283,3 +284,50 @@ def test_paths_retargeted_in_threads_at_once_are_each_the_one_retargeted_alone()
     copy = panda.scratch_copy()
     assert copy.model is panda.model and copy.data is not panda.data
     assert np.allclose(copy.forward(panda.home), panda.forward(panda.home))
+
+
+def test_near_a_singularity_a_ur_arm_does_not_flip_between_two_answers() -> None:
+    """Sample 2 takes the UR5 near its shoulder and wrist singularities, where the exact IK
+    answer swung between two poses about 12 degrees apart, frame after frame (about 530
+    turn-backs); damped more there, the arm moves through smoothly and reaches as often."""
+    from studio.capture import human_angles, read_any_recording
+    from studio.kinematics._reach import tool_reaches
+    from studio.samples import SAMPLES_DIR
+
+    ur5 = load_robot("ur5")
+    q_human = human_angles(read_any_recording(SAMPLES_DIR / "sample-reach-2.tape.csv"), slice(None))
+    path = retarget_path(ur5, q_human)
+    assert turn_backs(path.q) <= 60
+    targets = Retargeter(robot=ur5.scratch_copy())
+    reached = [
+        tool_reaches(ur5, q, targets.hand_target(h)) for q, h in zip(path.q, q_human, strict=True)
+    ]
+    assert np.mean(reached) >= 0.5  # (as before: the target is out of the UR5's reach early on)
+
+
+def test_the_ik_is_damped_more_only_near_a_singularity_of_an_arm_without_joints_to_spare() -> None:
+    from studio.kinematics._robots import IK_DAMPING
+
+    ur5, panda = load_robot("ur5"), load_robot("panda")
+    retargeter = Retargeter(robot=ur5.scratch_copy())
+    regular = ur5.home + np.array([0.3, -0.5, 1.0, -0.5, 0.8, 0.2])
+    wrist_singular = regular.copy()
+    wrist_singular[4] = 0.0  # the UR wrist's first and last axes in line
+    assert retargeter._damping(ur5, regular) == IK_DAMPING
+    assert retargeter._damping(ur5, wrist_singular) > 5 * IK_DAMPING
+    assert Retargeter(robot=panda.scratch_copy())._damping(panda, panda.home) == IK_DAMPING
+    with pytest.raises(KinematicsError, match="singular_margin"):
+        RetargetConfig(singular_margin=0.0)
+
+
+def test_the_chains_jacobian_is_pinocchios() -> None:
+    import pinocchio as pin
+
+    for name in ("ur5", "panda"):
+        arm = load_robot(name)
+        q = np.random.default_rng(1).uniform(arm.lower, arm.upper)
+        ours = arm.chain.jacobian(q)
+        theirs = pin.computeFrameJacobian(
+            arm.model, arm.model.createData(), q, arm.tool_frame, pin.LOCAL_WORLD_ALIGNED
+        )
+        np.testing.assert_allclose(ours, theirs, atol=1e-9, err_msg=name)

@@ -19,6 +19,7 @@ from studio.kinematics import (
     reconstruct,
     tape_from_arm,
 )
+from studio.kinematics._filter import turn_backs
 from studio.kinematics._tracker import Tracked
 from tests.kinematics.test_fit import observable_box, observable_q
 
@@ -138,13 +139,6 @@ def test_bad_input_is_one_sentence():
         TrackerConfig(tape=None)  # type: ignore[arg-type]
 
 
-def _turns_back(q: np.ndarray, above_deg: float = 0.5) -> int:
-    """How often a joint turns back between frames, by more than ``above_deg`` each way."""
-    d = np.diff(q, axis=0)
-    big = np.abs(d) > np.radians(above_deg)
-    return int(((np.sign(d[1:]) * np.sign(d[:-1]) < 0) & big[1:] & big[:-1]).sum())
-
-
 def test_frames_tracked_with_their_time_are_smoothed_and_the_robot_stops_shaking():
     """The tape's sensor noise reaches the joints a frame sees poorly (the turns about the
     forearm) as about a degree back and forth a frame, which the Puma560's wrist copied; timed
@@ -159,9 +153,9 @@ def test_frames_tracked_with_their_time_are_smoothed_and_the_robot_stops_shaking
         tracked = timed.track(frame.bend, frame.twist, frame.t)
         q_timed.append(tracked.q_robot)
         human.append(tracked.q_human)
-    assert _turns_back(sim.q_human) == 0, "the true arm moves smoothly"
-    assert _turns_back(np.array(q_raw)) > 100, "one frame at a time, the robot shakes"
-    assert _turns_back(np.array(q_timed)) <= 5
+    assert turn_backs(sim.q_human) == 0, "the true arm moves smoothly"
+    assert turn_backs(np.array(q_raw)) > 100, "one frame at a time, the robot shakes"
+    assert turn_backs(np.array(q_timed)) <= 5
     shoulder_elbow = np.degrees(np.abs(np.array(human) - sim.q_human)[:, :4])
     assert shoulder_elbow.mean() < 1.5, "smoothed, the seen joints stay on the arm"
 
