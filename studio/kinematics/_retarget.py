@@ -129,8 +129,9 @@ class RetargetConfig:
             ``restart_iterations`` more from the nearest answer.
         settle_tries: IK passes on a path's first frame (each warm-started from the last)
             before the path starts, as a live session settles before it moves.
-        singular_margin: an arm without joints to spare (six or fewer) whose last pose has a
-            Jacobian singular value below this (the tool's m/rad and rad/rad) is near a
+        singular_margin: an arm without joints to spare (no more joints than its tool's
+            target has numbers: six, or three for an arm that follows the position only) whose
+            last pose has a Jacobian singular value below this (the tool's m/rad and rad/rad) is near a
             singularity (the UR arms' shoulder and wrist), where the exact IK answer swings by
             many degrees for a millimetre of the target: its solves that frame are damped more
             (Chiaverini's damping, ``damping^2 = IK_DAMPING^2 + (1 - (s / margin)^2) *
