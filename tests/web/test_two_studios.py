@@ -66,7 +66,16 @@ def test_a_file_being_captured_is_never_deleted_by_the_store(tmp_path):
     assert not (folder / "live.tape.csv").exists()
 
 
-LONG_RUN = {"planning": "full", "experiments": 1, "episodes": 100_000, "seed": 1}
+LONG_RUN = {
+    "planning": "full",
+    "planning_steps": 2000,
+    "experiments": 1,
+    "episodes": 100_000,
+    "seed": 1,
+}
+"""Long enough (about 18 s of training here) to be stopped mid-training: with 100 planning updates
+the 100,000 episodes ended in about 2 s, and a loaded machine once took longer than that to reach
+the test's stop (the run then read "done", not "stopped")."""
 
 
 def test_a_second_studio_reads_the_first_ones_runs_and_never_rewrites_them(open_client, tmp_path):
