@@ -88,12 +88,17 @@ class SerialChain:
             int(elbow_joint) - 1,
         )
 
-    def forward(self, q: np.ndarray) -> np.ndarray:
-        """The tool pose (4x4) at ``q``, computed by the kernel (for tests and checks)."""
+    def _frames(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Each joint frame's rotation and origin at ``q``, and the tool's, by the kernel."""
         R, p = np.empty((len(self.axes), 3, 3)), np.empty((len(self.axes), 3))
         tool_R, tool_p = np.empty((3, 3)), np.empty(3)
         _forward(self.rotations, self.translations, self.axes, np.asarray(q, float), R, p)
         _tool(self, R, p, tool_R, tool_p)
+        return R, p, tool_R, tool_p
+
+    def forward(self, q: np.ndarray) -> np.ndarray:
+        """The tool pose (4x4) at ``q``, computed by the kernel (for tests and checks)."""
+        _, _, tool_R, tool_p = self._frames(q)
         out = np.eye(4)
         out[:3, :3], out[:3, 3] = tool_R, tool_p
         return out
@@ -101,13 +106,9 @@ class SerialChain:
     def jacobian(self, q: np.ndarray, rows: int = 6) -> np.ndarray:
         """The tool's geometric Jacobian at ``q`` (world axes), ``(rows, n)``: rows 0-2 its
         velocity, rows 3-5 (``rows=6``) its angular velocity; computed by the kernel."""
-        n = len(self.axes)
-        R, p = np.empty((n, 3, 3)), np.empty((n, 3))
-        tool_R, tool_p = np.empty((3, 3)), np.empty(3)
-        _forward(self.rotations, self.translations, self.axes, np.asarray(q, float), R, p)
-        _tool(self, R, p, tool_R, tool_p)
-        J = np.empty((rows, n))
-        _jacobian(R, p, self.axes, tool_p, min(n, self.tool_joint + 1), J)
+        R, p, _, tool_p = self._frames(q)
+        J = np.empty((rows, len(self.axes)))
+        _jacobian(R, p, self.axes, tool_p, min(len(self.axes), self.tool_joint + 1), J)
         return J
 
 

@@ -204,9 +204,10 @@ def test_a_still_scene_is_drawn_rarely_and_the_next_update_frees_the_frames(monk
 
 
 def test_between_a_slow_streams_poses_the_scene_is_still(monkeypatch):
-    """A slow stream's poses 0.8 s apart (a camera without a GPU: about one a second): once a pose is drawn and settled (SLOW_STILL_AFTER_S
-    without a message) the page is told the still gap, so viser's idle frame is not drawn
-    between poses; each next pose wakes it to the slow gap first."""
+    """A slow stream's poses 0.8 s apart (a camera without a GPU: about one a second): once a
+    pose is drawn and settled (SLOW_STILL_AFTER_S without a message) the page is told the still
+    gap, so viser's idle frame is not drawn between poses; each next pose wakes it to the slow
+    gap first."""
     monkeypatch.setattr(_scene_frames, "LOADING_S", 0.0)  # the page counts as loaded at once
     monkeypatch.setattr(_scene_frames, "STILL_AFTER_S", 60.0)  # stills here come from the stream
     port = free_port()

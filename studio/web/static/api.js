@@ -59,8 +59,8 @@ export async function guarded(errId, fn, button) {
 }
 
 /** A queue of actions that must reach the server one at a time, in the order the user made them
- * (a seek, then play): ``queue(fn)`` runs ``fn`` once everything queued before it has settled,
- * and returns its promise. */
+ * (a seek, then play). Returns the function that queues one: called with ``fn``, it runs ``fn``
+ * once everything queued before it has settled (a failed one too) and returns ``fn``'s promise. */
 export function inTurn() {
   let last = Promise.resolve();
   return (fn) => {
