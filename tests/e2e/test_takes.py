@@ -82,6 +82,7 @@ def test_record_in_takes(page: Any, studio_server: Studio) -> None:
     first = page.locator("[data-testid='take']").first.get_attribute("data-name")
     assert (studio_server.data_dir / "recordings" / f"{first}.tape.csv").is_file()
     shot(page, "takes-review", "sec-record")
+    assert page.get_by_role("button", name="Redo take").is_enabled()  # what ← does, by its name
     page.keyboard.press("ArrowLeft")
     _phase(page, "idle")
     assert not (studio_server.data_dir / "recordings" / f"{first}.tape.csv").exists()
