@@ -17,6 +17,9 @@ and the run without demonstrations share the seed ``k`` (the same start states, 
 4. Variants of the demonstrations' potential (``--variants``): its weight and kappa
    (:mod:`studio.learning._demo_shaping`), and the replay alone (weight 0, the earlier method).
 5. ``--long N``: greedy success with demonstrations under the paper's reward after N episodes.
+6. ``--actions SET``: every run with that action set (default: the task's default) and its
+   default features; with ``follow`` the demonstrations are also the paths its follow action
+   follows (without demonstrations it moves one joint per action, on the same features).
 
 Each figure is the mean over pairs with a 95% t interval of the paired difference or ratio. The
 machine may be shared: the figures are counts (steps, successes), not times, so load does not
@@ -35,7 +38,7 @@ import numpy as np
 from scipy import stats
 
 import studio.learning._linear as linear
-from studio.learning import ArmReach, DynaQConfig, LearningError, run_experiments
+from studio.learning import ACTION_SETS, ArmReach, DynaQConfig, LearningError, run_experiments
 from studio.learning._beyond import demonstration_paths
 from studio.learning._demo_shaping import demo_potential
 from studio.learning._linear import greedy_success
@@ -44,6 +47,7 @@ CAP = 3_000
 DEMOS = 3
 STARTS = 200
 FIRST_OWN = 20
+ACTIONS: dict[str, str] = {}  # the action set of every run, when --actions names one
 SECTIONS = ("paper", "other-goal", "default", "long")
 
 
@@ -90,7 +94,7 @@ _WITHOUT: dict[tuple, tuple] = {}
 
 def without(joints, shaping, episodes, seed):
     """The run without demonstrations (computed once per seed: every comparison pairs with it)."""
-    key = (joints, shaping, episodes, seed)
+    key = (joints, shaping, episodes, seed, tuple(ACTIONS.items()))
     if key not in _WITHOUT:
         _WITHOUT[key] = one_run(joints, shaping, episodes, seed, [])
     return _WITHOUT[key]
@@ -98,16 +102,16 @@ def without(joints, shaping, episodes, seed):
 
 def one_run(joints, shaping, episodes, seed, demos):
     """``(steps (episodes,), greedy success over the held-out starts)`` of one experiment."""
-    task = ArmReach(joints=joints, shaping=shaping)
+    task = ArmReach(joints=joints, shaping=shaping, **ACTIONS)
     result = run_experiments(
-        lambda: gymnasium.make("TeachStudio/ArmReach-v0", joints=joints, shaping=shaping),
+        lambda: gymnasium.make("TeachStudio/ArmReach-v0", joints=joints, shaping=shaping, **ACTIONS),
         DynaQConfig(planning="zero", max_steps_per_episode=CAP),
         1, episodes, seed, demos, task.features(), workers=1,
     )  # fmt: skip
     starts = np.random.default_rng([seed, joints, 7]).uniform(
         task.lower, task.upper, (STARTS, joints)
     )
-    success = greedy_success(task, result.coder, result.weights[0], starts, CAP).mean()
+    success = greedy_success(result.task, result.coder, result.weights[0], starts, CAP).mean()
     return result.steps[0], float(success)
 
 
@@ -175,9 +179,15 @@ def main() -> None:
     parser.add_argument(
         "--long", type=int, default=0, help="also greedy success with demonstrations after N"
     )
+    parser.add_argument("--actions", choices=ACTION_SETS, help="every run's action set")
     args = parser.parse_args()
+    if args.actions:
+        ACTIONS["actions"] = args.actions
     j, n, pairs = args.joints, args.episodes, range(args.first, args.first + args.pairs)
-    print(f"{j} joints, {n} episodes (demonstrations counted), {DEMOS} demonstrations, cap {CAP}")
+    print(
+        f"{j} joints, {n} episodes (demonstrations counted), {DEMOS} demonstrations, cap {CAP}, "
+        f"actions {args.actions or ArmReach().actions}"
+    )
     t0 = time.perf_counter()
     if "paper" in args.sections:
         rows = [pair(j, 0.0, n, k) for k in pairs]

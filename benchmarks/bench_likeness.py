@@ -20,10 +20,12 @@ each ``studio/samples/sample-reach-*.demo.json``:
 5. The learned policy (``--learned``, a few minutes): the continuous task with its defaults
    (six joints, the default action set and shaping, the default features), its goal the
    demonstration's last pose, trained on that one demonstration (zero planning,
-   :data:`LEARN_EPISODES` episodes, one experiment per seed in :data:`LEARN_SEEDS`), rolled out
-   from the demonstration's start and scored on the likeness card. Goals: DTW <= 0.05 rad per
-   sample on all six joints, LDLJ within 20% of the demonstration's. For comparison: the same
-   with the other action set (one joint per action beside the pairs), and (``--path-potential``) with the
+   ``--episodes`` episodes (:data:`LEARN_EPISODES`), one experiment per seed in
+   :data:`LEARN_SEEDS`), rolled out from the demonstration's start and scored on the likeness
+   card; also its greedy success from 200 random starts. Goals: DTW <= 0.05 rad per sample on
+   all six joints, LDLJ within 20% of the demonstration's. For comparison: the same with the
+   other action sets (the pairs, and ``follow``: one joint, or all of them along the
+   demonstration), and (``--path-potential``) with the
    demonstrations' potential over the whole demonstrated path (kappa 2, weight 5 on top of the
    task's shaping; :mod:`studio.learning._demo_shaping`), which pulls the greedy path along the
    demonstration rather than only to its end.
@@ -58,6 +60,7 @@ from studio.learning import (
     rollout_dmp_policy,
     run_experiments,
 )
+from studio.learning._linear import greedy_success
 
 SAMPLES = sorted((Path(__file__).resolve().parents[1] / "studio" / "samples").glob("*.demo.json"))
 GOAL_DTW_RAD = 0.02
@@ -66,7 +69,7 @@ START_SPREAD_RAD = 0.5
 REPEATS = 5
 GOAL_POLICY_DTW_RAD = 0.05
 GOAL_LDLJ_SHARE = 0.2
-LEARN_EPISODES = 1000
+LEARN_EPISODES = 3000
 LEARN_SEEDS = (0, 1, 2)
 CAP = 3_000
 
@@ -159,11 +162,12 @@ def path_potential() -> None:
     linear.demo_potential = functools.partial(demo_potential, weight=5.0 + shaping, kappa=2.0)
 
 
-def learned(path: Path, actions: str | None) -> tuple[int, int]:
+def learned(path: Path, actions: str | None, episodes: int) -> tuple[int, int]:
     """The learned policy's card figures against one sample; returns (seeds meeting both goals, seeds)."""
     demo = load_demonstration(path)
     settings = {} if actions is None else {"actions": actions}
     task = ArmReach(goal=tuple(demo.q_robot[-1]), **settings)
+    starts = np.array([task.random_start(np.random.default_rng([k, 7])) for k in range(200)])
     config = DynaQConfig(planning="zero", max_steps_per_episode=CAP)
     make = lambda: gymnasium.make(  # noqa: E731
         "TeachStudio/ArmReach-v0", goal=task.goal, **settings
@@ -172,11 +176,12 @@ def learned(path: Path, actions: str | None) -> tuple[int, int]:
     label = task.actions + (" (the default)" if actions is None else "")
     for seed in LEARN_SEEDS:
         result = run_experiments(
-            make, config, 1, LEARN_EPISODES, seed, [demo.q_robot], task.features(), workers=1
+            make, config, 1, episodes, seed, [demo.q_robot], task.features(), workers=1
         )
-        policy = TilePolicyFile(
-            coder=result.coder, weights=result.weights[0], config=config, task=task
+        policy = TilePolicyFile(  # result.task: with the demonstration when it follows it
+            coder=result.coder, weights=result.weights[0], config=config, task=result.task
         )
+        success = greedy_success(result.task, result.coder, result.weights[0], starts, CAP)
         card = policy_likeness_card(policy, demo.times, demo.q_robot)
         share = abs(card.policy.ldlj - card.demonstration.ldlj) / abs(card.demonstration.ldlj)
         ok = card.dtw_rad <= GOAL_POLICY_DTW_RAD and share <= GOAL_LDLJ_SHARE
@@ -186,7 +191,8 @@ def learned(path: Path, actions: str | None) -> tuple[int, int]:
             f"LDLJ {card.policy.ldlj:.2f} (demonstration {card.demonstration.ldlj:.2f}, "
             f"{100 * share:.0f}% off), together {100 * card.policy.together:.0f}% "
             f"(demonstration {100 * card.demonstration.together:.0f}%), duration "
-            f"{card.policy.duration_s:.1f} s ({card.demonstration.duration_s:.1f} s): "
+            f"{card.policy.duration_s:.1f} s ({card.demonstration.duration_s:.1f} s), greedy "
+            f"success {success.mean():.2f}, CPU {result.cpu_seconds[0]:.1f} s: "
             f"{'both goals met' if ok else 'goal missed'}",
             flush=True,
         )
@@ -199,18 +205,26 @@ def main() -> None:
     parser.add_argument(
         "--path-potential", action="store_true", help="(5) with the potential along the path"
     )
+    parser.add_argument("--episodes", type=int, default=LEARN_EPISODES, help="(5) episodes")
+    parser.add_argument(
+        "--actions",
+        nargs="*",
+        default=None,
+        help="(5) action sets (default: the default, pairs, follow)",
+    )
     args = parser.parse_args()
     if args.path_potential:
         path_potential()
         print("with the demonstrations' potential along the whole path (kappa 2, weight 5)")
     if args.learned or args.path_potential:
         print(
-            f"learned policies: {LEARN_EPISODES} episodes, one demonstration, from its start; "
+            f"learned policies: {args.episodes} episodes, one demonstration, from its start; "
             f"goals DTW <= {GOAL_POLICY_DTW_RAD} rad/sample (six joints), LDLJ within "
             f"{GOAL_LDLJ_SHARE:.0%} of the demonstration's"
         )
-        for actions in (None,) if args.path_potential else (None, "pairs"):
-            met = [learned(path, actions) for path in SAMPLES]
+        sets = args.actions or [None, "pairs", "follow"]
+        for actions in [None] if args.path_potential else sets:
+            met = [learned(path, actions, args.episodes) for path in SAMPLES]
             print(f"  met for {sum(m for m, _ in met)}/{sum(n for _, n in met)} policies\n")
         return
     fit_movement_primitive(np.arange(3.0), np.zeros((3, 1)))  # compile nothing, warm numpy

@@ -121,8 +121,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--actions",
         choices=ACTION_SETS,
-        help="arm-reach: what one action moves: one joint, also two joints together, or any "
-        f"joints at once (default: {REACH_DEFAULTS['actions']})",
+        help="arm-reach: what one action moves: one joint, also two joints together, any "
+        "joints at once, or one joint or all of them along the --demos (follow) "
+        f"(default: {REACH_DEFAULTS['actions']})",
     )
     parser.add_argument(
         "--tilings",

@@ -13,6 +13,7 @@ render nothing (no render modes), and pass ``gymnasium.utils.env_checker.check_e
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import Any, TypedDict, Unpack
 
 import gymnasium
@@ -52,6 +53,7 @@ class _ReachSettings(TypedDict, total=False):
     shaping: float
     actions: str
     robot: str
+    paths: tuple[tuple[tuple[float, ...], ...], ...]
 
 
 class ArmGridEnv(gymnasium.Env):
@@ -107,7 +109,9 @@ class ArmReachEnv(gymnasium.Env):
         angle_tolerance_deg: degrees.
         shaping: weight of the potential-based shaping reward.
         actions: what one action moves: ``"single"`` (one joint), ``"pairs"`` (also two
-            together) or ``"all"`` (any joints at once).
+            together), ``"all"`` (any joints at once) or ``"follow"`` (one joint, or all of them
+            along the demonstrated ``paths``; :meth:`follow`).
+        paths: the demonstrated joint paths ``"follow"`` follows (:class:`ArmReach`).
         robot: the robot's registry name (``studio robots``; default ``"puma560"``): its first
             ``joints`` joints, limits and forward kinematics.
     """
@@ -145,6 +149,14 @@ class ArmReachEnv(gymnasium.Env):
         else:
             self.q = np.ascontiguousarray(self.task.random_start(self.np_random))
         return self.q.copy(), {}
+
+    def follow(self, q_paths: Sequence[np.ndarray]) -> None:
+        """Follow the demonstrated joint paths ``q_paths`` when the task's actions are
+        ``"follow"`` and it has none yet (:meth:`ArmReach.with_paths`): the action space gains
+        the follow action. :func:`run_experiments` calls it with its demonstrations."""
+        self.task = self.task.with_paths(q_paths)
+        self._params = self.task.params
+        self.action_space = spaces.Discrete(self.task.n_actions)
 
     def step(self, action: int) -> tuple[NDArray[np.float64], float, bool, bool, dict[str, object]]:
         """Move the action's joints by one step each; ``terminated`` at the goal."""

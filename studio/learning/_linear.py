@@ -98,6 +98,7 @@ from ._learner import (
 from ._linear_env import (
     TASK_REACH,
     env_demonstrations,
+    follow_demonstrations,
     inspect_env,
     make_env,
     observe,
@@ -605,6 +606,7 @@ def run_linear_experiments(
     seed, workers, live = check_run_arguments(config, experiments, episodes, seed, workers, live)
     envs = [make_env(env, e) for e in range(experiments)]
     try:
+        follow_demonstrations(envs, demonstrations or [])
         task = inspect_env(envs[0], config)
         coder = features.bind(task.low, task.high)
         problem = weight_problem(experiments, coder, task.n_actions)

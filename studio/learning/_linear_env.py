@@ -176,6 +176,21 @@ def inspect_env(env: gymnasium.Env, config: DynaQConfig) -> EnvTask:
     )
 
 
+def follow_demonstrations(
+    envs: Sequence[gymnasium.Env], demonstrations: Sequence[Sequence[int] | np.ndarray]
+) -> None:
+    """Give every arm task whose actions follow the demonstrations (``actions="follow"``, no
+    paths yet) the joint-path demonstrations to follow (:meth:`._gym.ArmReachEnv.follow`)."""
+    from ._gym import ArmReachEnv
+
+    paths = [np.asarray(d) for d in demonstrations]
+    paths = [p for p in paths if p.ndim == 2 and np.issubdtype(p.dtype, np.floating)]
+    for env in envs:
+        if paths and type(env.unwrapped) is ArmReachEnv:
+            env.unwrapped.follow(paths)
+            env.action_space = env.unwrapped.action_space  # the wrappers read it at creation
+
+
 def _internal_state(env: gymnasium.Env, task: EnvTask, obs: np.ndarray) -> np.ndarray:
     """The state a compiled twin steps from, right after ``env.reset``."""
     raw = env.unwrapped

@@ -7,7 +7,9 @@ ONE joint by ``step_deg`` (2J actions: joint 1 up, joint 1 down, joint 2 up, ...
 ``actions="pairs"`` adds every two joints moving together, each up or down (the
 diagonals, 2J**2 actions), and
 ``actions="all"`` every joint -1/0/+1 at once (3**J - 1 actions); see :data:`ACTION_SETS` and
-:func:`action_directions`. A joint whose move would leave its limits stays where it is, as on
+:func:`action_directions`. ``actions="follow"`` adds to the single joints one action that moves
+every joint at once along the demonstrated paths (:attr:`ArmReach.paths`, :func:`_follow`), so a
+policy can move as its demonstrations did. A joint whose move would leave its limits stays where it is, as on
 the paper's grid (the action's other joints still move). Reaching the goal pays :data:`GOAL_REWARD` and ends the
 episode, every other step pays :data:`STEP_REWARD` (the paper's rewards), plus a potential-based
 shaping term (:data:`DEFAULT_SHAPING`). Episodes start uniformly across the limits (a start already
@@ -38,6 +40,7 @@ Dynamics are defined once, here, in numba functions (:func:`reach_step`, :func:`
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import math
 from collections.abc import Sequence
@@ -109,9 +112,19 @@ step away), which per-joint tilings represent exactly, and the +100 only settles
 (39 at gamma = 0.95)."""
 MAX_SHAPING = 100.0
 """Upper bound on ``shaping``."""
-ACTION_SETS = ("single", "pairs", "all")
-"""What one action may move: one joint (2J actions), one joint or two together (2J**2), or any
-joints at once (3**J - 1); each set begins with the one before it, in the same order."""
+ACTION_SETS = ("single", "pairs", "all", "follow")
+"""What one action may move: one joint (2J actions), one joint or two together (2J**2), any
+joints at once (3**J - 1), or one joint or all of them along the demonstrated paths (2J + 1, see
+:attr:`ArmReach.paths`); each of the first three begins with the one before it, in the same
+order, and ``"follow"`` with the singles."""
+FOLLOW_SIZE = 2**16
+"""Weight rows of the follow task's default features (:meth:`ArmReach.features`): the tiles of
+every joint together are hashed into them. 2**16, 2**18 and 2**20 rows gave the same likeness
+and greedy success (3 samples x 3 seeds, 3,000 episodes); 2**16 keeps a six-joint table of 13
+actions at 7 MB."""
+FOLLOW_SPACING_STEPS = 0.25
+"""A followed path keeps a demonstration's samples this many steps apart (max-norm over the
+joints), and always its last: closer samples add search work and no shape."""
 DEFAULT_ACTIONS = "single"
 """One joint per action. ``"pairs"``, learned with the factored action value (:mod:`._factored`),
 reaches 95% greedy success in fewer real steps (81 k against 321 k at six joints) and moves joints
@@ -143,8 +156,10 @@ _HOLD = 51  # MAX_CHAIN values: every joint's angle when not learned (the goal's
 _CHAIN = _HOLD + MAX_CHAIN  # per joint: placement rotation (9, row-major), translation, axis
 _LINK = 15
 _TOOL = _CHAIN + _LINK * MAX_CHAIN  # jointMtool: rotation (9, row-major), translation (3)
-_TABLE = _TOOL + 12  # per action, MAX_JOINTS directions -1/0/+1
+_COUNTS = _TOOL + 12  # the action table's rows, then the followed paths' points
+_TABLE = _COUNTS + 2  # per action, MAX_JOINTS directions -1/0/+1; then the followed points
 _N_PARAMS = _TABLE
+_POINT = MAX_JOINTS + 1  # a followed point: its joints, then the index of its path's last point
 
 
 @dataclass(frozen=True)
@@ -163,6 +178,12 @@ class ArmReach:
         shaping: weight of the potential-based shaping reward (:data:`DEFAULT_SHAPING`).
         actions: what one action moves, one of :data:`ACTION_SETS`.
         robot: the robot's registry name (``studio robots`` lists them).
+        paths: with ``actions="follow"``, the demonstrated joint paths (each ``(N, joints)``
+            radians, ending at the goal) that the last action follows: it moves every joint at
+            once, by at most one step, toward the first point of the nearest path that lies a
+            step ahead (pure pursuit), so a policy can move as the demonstrations did.
+            :func:`run_experiments` fills them from its demonstrations; without any the task
+            is one joint per action.
 
     Raises:
         LearningError: a bad value, or a goal outside the joint limits.
@@ -176,6 +197,7 @@ class ArmReach:
     shaping: float = DEFAULT_SHAPING
     actions: str = DEFAULT_ACTIONS
     robot: str = PUMA560
+    paths: tuple[tuple[tuple[float, ...], ...], ...] = ()
 
     def __post_init__(self) -> None:
         arm = task_arm(check_robot(self.robot))
@@ -240,17 +262,77 @@ class ArmReach:
                 ["goal"],
             )
         object.__setattr__(self, "goal", tuple(float(x) for x in np.clip(goal, lower, upper)))
+        object.__setattr__(self, "paths", self._checked_paths())
+
+    def _checked_paths(self) -> tuple[tuple[tuple[float, ...], ...], ...]:
+        if not self.paths:
+            return ()
+        if self.actions != "follow":
+            raise ConfigError(
+                [
+                    f'paths are given with actions={self.actions!r}; give actions="follow" to follow them, or no paths.'
+                ],
+                ["paths"],
+            )
+        checked = []
+        lower, upper = self.lower, self.upper
+        for i, path in enumerate(self.paths):
+            try:
+                q = np.asarray(path, dtype=np.float64)
+            except (TypeError, ValueError):
+                q = np.zeros((0, 0))
+            if (
+                q.ndim != 2
+                or q.shape[0] < 1
+                or q.shape[1] < self.joints
+                or not np.all(np.isfinite(q))
+            ):
+                raise ConfigError(
+                    [
+                        f"Path {i} has shape {q.shape}; give (N, {self.joints}) finite joint angles in radians."
+                    ],
+                    ["paths"],
+                )
+            q = np.clip(q[:, : self.joints], lower, upper)
+            checked.append(
+                tuple(
+                    tuple(float(x) for x in row)
+                    for row in _spaced(q, FOLLOW_SPACING_STEPS * self.step)
+                )
+            )
+        return tuple(checked)
+
+    def with_paths(self, q_paths: Sequence[np.ndarray]) -> ArmReach:
+        """This task following ``q_paths`` (joint paths, radians, ``(N, joints)`` or wider) when
+        its actions are ``"follow"`` and it has none yet; else this task unchanged."""
+        if self.actions != "follow" or self.paths or not q_paths:
+            return self
+        return dataclasses.replace(
+            self, paths=tuple(np.asarray(q)[:, : self.joints] for q in q_paths)
+        )
+
+    def _followed_points(self) -> np.ndarray:
+        """Every followed point: ``(M, joints + 1)``, its joints, then the index of its path's
+        last point."""
+        rows = []
+        for path in self.paths:
+            q = np.asarray(path, dtype=np.float64)
+            end = len(rows) + len(q) - 1
+            rows += [(*row, end) for row in q]
+        return np.asarray(rows, dtype=np.float64).reshape(-1, self.joints + 1)
 
     # ------------------------------------------------------------------ sizes
 
     @property
     def n_actions(self) -> int:
-        """2J (one joint up or down by one step), 2J**2 with the pairs, 3**J - 1 with all."""
-        return int(self.directions.shape[0])
+        """2J (one joint up or down by one step), 2J**2 with the pairs, 3**J - 1 with all, 2J + 1
+        when following paths."""
+        return int(self.directions.shape[0]) + (1 if self.paths else 0)
 
     @cached_property
     def directions(self) -> np.ndarray:
-        """Each action's move, in steps per joint: int8 ``(n_actions, joints)`` of -1/0/+1."""
+        """Each fixed action's move, in steps per joint: int8 ``(actions, joints)`` of -1/0/+1
+        (all but the follow action, which is last)."""
         return action_directions(self.joints, self.actions)
 
     @property
@@ -279,6 +361,7 @@ class ArmReach:
             "shaping": self.shaping,
             "actions": self.actions,
             "robot": self.robot,
+            "paths": [[list(row) for row in path] for path in self.paths],
         }
 
     @classmethod
@@ -286,7 +369,8 @@ class ArmReach:
         """Settings from :meth:`to_dict`'s form (one written before ``actions`` existed moves one
         joint per action; one written before ``robot`` existed is the Puma560's)."""
         goal = None if data.get("goal") is None else tuple(data["goal"])
-        return cls(**{"actions": STORED_ACTIONS, **data, "goal": goal})
+        paths = tuple(tuple(tuple(row) for row in path) for path in data.get("paths") or ())
+        return cls(**{"actions": STORED_ACTIONS, **data, "goal": goal, "paths": paths})
 
     @property
     def default_tiles(self) -> int:
@@ -313,18 +397,36 @@ class ArmReach:
         of joints (``J (J - 1) / 2 x (tiles + 1) ** 2`` tiles per tiling) at six joints, 4,000
         episodes: 100% greedy success for single joints against 77% for pairs and 94% for both
         (see the package README); pass ``TileCoding(groups=...)`` for other choices.
+
+        With ``actions="follow"`` the joints are also tiled all together, hashed into
+        :data:`FOLLOW_SIZE` weight rows: the follow action's worth depends on where the arm is
+        relative to the demonstrated paths, which no sum of per-joint terms holds, and with the
+        joints alone its estimate near the goal fell below the single joints' and the greedy
+        policy stepped one joint back and forth there (3 samples x 3 seeds, 3,000 episodes, the
+        paper's reward: 6 of 9 policies followed their demonstration with the joints alone, 9 of
+        9 with them together).
         """
         singles = tuple((j,) for j in range(self.joints))
         tiles = self.default_tiles if tiles is None else tiles
+        if self.actions == "follow":  # and every joint together, hashed (:data:`FOLLOW_SIZE`)
+            groups = (*singles, tuple(range(self.joints)))
+            size = FOLLOW_SIZE if size is None else size
+            return TileCoding(tilings=tilings, tiles=tiles, size=size, groups=groups)
         return TileCoding(tilings=tilings, tiles=tiles, size=size, groups=singles)
 
     @cached_property
     def params(self) -> np.ndarray:
         """The flat parameter array of :func:`reach_step` and friends (read-only)."""
-        table = self.directions
-        p = np.zeros(_N_PARAMS + MAX_JOINTS * table.shape[0], np.float64)
-        p[_MULTI] = 0.0 if self.actions == "single" else 1.0
-        p[_TABLE:].reshape(-1, MAX_JOINTS)[:, : self.joints] = table
+        table = action_directions(self.joints, self.actions)
+        points = self._followed_points()
+        p = np.zeros(_N_PARAMS + MAX_JOINTS * table.shape[0] + _POINT * points.shape[0], np.float64)
+        p[_MULTI] = 0.0 if table.shape[0] == self.n_actions == 2 * self.joints else 1.0
+        p[_COUNTS] = table.shape[0]
+        p[_COUNTS + 1] = points.shape[0]
+        followed = _TABLE + MAX_JOINTS * table.shape[0]
+        p[_TABLE:followed].reshape(-1, MAX_JOINTS)[:, : self.joints] = table
+        p[followed:].reshape(-1, _POINT)[:, : self.joints] = points[:, : self.joints]
+        p[followed:].reshape(-1, _POINT)[:, MAX_JOINTS] = points[:, self.joints]
         p[_J] = self.joints
         p[_STEP] = self.step
         p[_POS_TOL2] = self.position_tolerance**2
@@ -426,7 +528,9 @@ class ArmReach:
             )
         q = np.clip(q, lower, upper)
         actions = np.empty(_walk_capacity(q, self.step), np.int64)
-        n = _walk(self.params, q, actions)
+        n = _follow_walk(self.params, q[0], actions) if self.paths else -1
+        if n < 0:
+            n = _walk(self.params, q, actions)
         if n < 0:
             raise LearningError(
                 f"Demonstration {index} never brings the tool within {self.position_tolerance * 100:g} cm and {self.angle_tolerance_deg:g} deg of the goal; end it at the goal or make the goal its final pose."
@@ -452,6 +556,17 @@ def action_directions(joints: int, actions: str = DEFAULT_ACTIONS) -> np.ndarray
     if actions == "all":
         rows += [m for m in itertools.product((1, 0, -1), repeat=joints) if sum(map(abs, m)) > 2]
     return np.array(rows, dtype=np.int8).reshape(-1, joints)
+
+
+def _spaced(q: np.ndarray, spacing: float) -> np.ndarray:
+    """The rows of ``q`` at least ``spacing`` apart (max-norm) from the last kept, and the last."""
+    kept = [0]
+    for i in range(1, len(q)):
+        if np.abs(q[i] - q[kept[-1]]).max() >= spacing:
+            kept.append(i)
+    if kept[-1] != len(q) - 1:
+        kept.append(len(q) - 1)
+    return q[kept]
 
 
 def tool_positions(robot: str, q: np.ndarray) -> np.ndarray:
@@ -618,8 +733,9 @@ def reach_step(params, state, action):
     """Apply ``action`` to ``state`` (in place); returns ``(reward, terminated)``.
 
     Action ``2 j`` moves joint ``j`` up one step, ``2 j + 1`` down; a multi-joint task's other
-    actions move the joints of their row of the action table (:func:`action_directions`). A
-    joint whose move would leave its limits stays where it is. The reward is the paper's (+100 at
+    actions move the joints of their row of the action table (:func:`action_directions`), and
+    the one after the table follows the demonstrated paths (:func:`_follow`). A joint whose move
+    would leave its limits stays where it is. The reward is the paper's (+100 at
     the goal, -1 otherwise) plus ``shaping`` times the change of :func:`reach_potential`.
     """
     shaping = params[_SHAPING]
@@ -629,6 +745,8 @@ def reach_step(params, state, action):
         moved = state[j] + (params[_STEP] if action % 2 == 0 else -params[_STEP])
         if params[_LOWER + j] <= moved <= params[_UPPER + j]:
             state[j] = moved
+    elif action >= params[_COUNTS]:
+        _follow(params, state)
     else:
         row = _TABLE + MAX_JOINTS * action
         for j in range(state.shape[0]):
@@ -651,7 +769,7 @@ def _walk(params, path, actions):
     Returns -1 when the walk never reaches the goal. See :meth:`ArmReach.demonstration_actions`.
     """
     joints = path.shape[1]
-    n_actions = (params.shape[0] - _N_PARAMS) // MAX_JOINTS
+    n_actions = int(params[_COUNTS])  # the follow action is walked by _follow_walk
     step = params[_STEP]
     state = path[0].copy()
     if reach_success(params, state):
@@ -688,4 +806,67 @@ def _walk(params, path, actions):
             _, done = reach_step(params, state, best)
             if done:
                 return n
+    return -1
+
+
+@njit(nogil=True, cache=True)
+def _max_gap(params, row, state):
+    """The largest joint distance (rad) from ``state`` to the followed point at ``row``."""
+    gap = 0.0
+    for j in range(state.shape[0]):
+        gap = max(gap, abs(params[row + j] - state[j]))
+    return gap
+
+
+@njit(nogil=True, cache=True)
+def _follow(params, state):
+    """The follow action: ``state`` (in place) moves every joint at once, by at most one step
+    (max-norm), toward the first point of the nearest followed path (Euclidean) that lies a step
+    or more away, on the way to that path's end (pure pursuit): on a path it moves along it, off
+    one it cuts back to it. At a path's end it stays."""
+    base = _TABLE + MAX_JOINTS * int(params[_COUNTS])
+    joints = state.shape[0]
+    nearest, best = 0, np.inf
+    for i in range(int(params[_COUNTS + 1])):
+        row = base + _POINT * i
+        d = 0.0
+        for j in range(joints):
+            diff = params[row + j] - state[j]
+            d += diff * diff
+        if d < best:
+            best, nearest = d, i
+    step = params[_STEP]
+    end = int(params[base + _POINT * nearest + MAX_JOINTS])
+    target = nearest
+    while target < end and _max_gap(params, base + _POINT * target, state) < step:
+        target += 1
+    row = base + _POINT * target
+    gap = _max_gap(params, row, state)
+    scale = 1.0 if gap <= step else step / gap
+    for j in range(joints):
+        moved = state[j] + scale * (params[row + j] - state[j])
+        if params[_LOWER + j] <= moved <= params[_UPPER + j]:
+            state[j] = moved
+
+
+@njit(nogil=True, cache=True)
+def _follow_walk(params, start, actions):
+    """Fill ``actions`` with the follow action from ``start`` until the goal; returns their
+    number, or -1 when following stalls (a move under half a step) before it."""
+    state = start.copy()
+    if reach_success(params, state):
+        return 0
+    follow = int(params[_COUNTS])
+    before = np.empty_like(state)
+    for n in range(actions.shape[0]):
+        before[:] = state
+        actions[n] = follow
+        _, done = reach_step(params, state, follow)
+        if done:
+            return n + 1
+        moved = 0.0
+        for j in range(state.shape[0]):
+            moved = max(moved, abs(state[j] - before[j]))
+        if moved < 0.5 * params[_STEP]:
+            return -1
     return -1

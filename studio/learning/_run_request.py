@@ -381,6 +381,13 @@ def _reach_record(
         )
     assert built is not None and config is not None
     task, coding = built
+    if task.actions == "follow" and not paths:
+        problems.append(
+            (
+                "actions",
+                'actions is "follow" but no demonstration is picked; pick the demonstrations to follow, or choose another action set.',
+            )
+        )
     try:
         record = RunRecord.for_arm_reach(
             task,

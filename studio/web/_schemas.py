@@ -467,7 +467,8 @@ class ReachRunCreate(_RunCreateBase):
     step_deg: float = REACH_DEFAULTS["step_deg"]
     """Joint increment per action, degrees."""
     actions: str = REACH_DEFAULTS["actions"]
-    """What one action moves: "single" (one joint), "pairs" (also two together), "all"."""
+    """What one action moves: "single" (one joint), "pairs" (also two together), "all", or
+    "follow" (one joint, or all of them along the picked demonstrations)."""
     tilings: int = REACH_DEFAULTS["tilings"]
     """Offset tilings of each joint."""
     tiles: int | None = REACH_DEFAULTS["tiles"]

@@ -30,7 +30,13 @@ from studio.web._schemas import ReachRunCreate
 
 @pytest.mark.parametrize("joints", [3, 4, 5, 6])
 def test_each_action_set_has_its_size_and_begins_with_the_one_before(joints):
-    sizes = {"single": 2 * joints, "pairs": 2 * joints**2, "all": 3**joints - 1}
+    # "follow" without demonstrated paths to follow moves one joint per action
+    sizes = {
+        "single": 2 * joints,
+        "pairs": 2 * joints**2,
+        "all": 3**joints - 1,
+        "follow": 2 * joints,
+    }
     tables = {name: action_directions(joints, name) for name in ACTION_SETS}
     for name, table in tables.items():
         assert ArmReach(joints=joints, actions=name).n_actions == sizes[name] == table.shape[0]
@@ -38,6 +44,7 @@ def test_each_action_set_has_its_size_and_begins_with_the_one_before(joints):
         assert np.abs(table).sum(axis=1).min() == 1  # no "stay"
     assert np.array_equal(tables["pairs"][: 2 * joints], tables["single"])
     assert np.array_equal(tables["all"][: 2 * joints**2], tables["pairs"])
+    assert np.array_equal(tables["follow"], tables["single"])
     assert np.abs(tables["pairs"]).sum(axis=1).max() == 2
     single = tables["single"]  # action 2j moves joint j up, 2j + 1 down, as before
     for j in range(joints):

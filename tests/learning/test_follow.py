@@ -1,0 +1,145 @@
+"""The continuous task's follow action: every joint at once, along the demonstrated paths."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import gymnasium
+import numpy as np
+import pytest
+
+from studio.capture import load_demonstration
+from studio.learning import (
+    ArmReach,
+    ConfigError,
+    DynaQConfig,
+    RunRequest,
+    TilePolicyFile,
+    load_any_policy,
+    policy_likeness_card,
+    resolve_run,
+    run_experiments,
+)
+from studio.learning._gym import ARM_REACH_ID
+from studio.learning._linear_policy import save_tile_policy
+from studio.learning._reach import reach_step
+
+SAMPLES = Path(__file__).resolve().parents[2] / "studio" / "samples"
+
+
+def line_task(joints: int = 3, points: int = 200) -> tuple[ArmReach, np.ndarray]:
+    """A task whose one path runs straight, in joint space, from a start to its goal."""
+    goal = np.array(ArmReach(joints=joints).goal[:joints])
+    start = goal - np.radians([30.0, -20.0, 10.0, 5.0, -5.0, 5.0][:joints])
+    path = start + np.linspace(0.0, 1.0, points)[:, None] * (goal - start)
+    return ArmReach(joints=joints, goal=tuple(goal), actions="follow", paths=(path,)), path
+
+
+def test_the_follow_action_moves_every_joint_one_step_along_the_path_and_cuts_back_to_it():
+    task, path = line_task()
+    follow = task.n_actions - 1
+    assert task.n_actions == 2 * task.joints + 1
+    direction = (path[-1] - path[0]) / np.abs(path[-1] - path[0]).max()
+    q = path[0].copy()
+    reach_step(task.params, q, follow)
+    assert np.allclose(q - path[0], task.step * direction)  # one step, every joint, on the line
+    off = path[40] + np.radians([3.0, 3.0, -3.0])  # beside the path: back toward it
+    q = off.copy()
+    reach_step(task.params, q, follow)
+
+    def to_line(x):
+        along = path[0] + np.dot(x - path[0], direction) / direction.dot(direction) * direction
+        return np.linalg.norm(x - along)
+
+    assert to_line(q) < to_line(off) and np.abs(q - off).max() == pytest.approx(task.step)
+    q = path[-1].copy()  # at the path's end it stays
+    reward, done = reach_step(task.params, q, follow)
+    assert np.array_equal(q, path[-1]) and done
+
+
+def test_a_demonstration_is_walked_with_the_follow_action_in_fewer_steps():
+    task, path = line_task()
+    start, actions = task.demonstration_actions(path)
+    assert np.array_equal(start, path[0]) and set(actions.tolist()) == {task.n_actions - 1}
+    single = ArmReach(joints=3, goal=task.goal, actions="single")
+    _, staircase = single.demonstration_actions(path)
+    assert len(actions) <= 0.5 * len(staircase)
+
+
+def test_without_paths_follow_is_one_joint_per_action_bit_for_bit():
+    features = ArmReach(joints=3).features()
+    runs = [
+        run_experiments(
+            lambda a=actions: gymnasium.make(ARM_REACH_ID, joints=3, actions=a),
+            DynaQConfig(planning="zero", max_steps_per_episode=500),
+            1,
+            5,
+            3,
+            features=features,
+        )
+        for actions in ("single", "follow")
+    ]
+    assert np.array_equal(runs[0].weights, runs[1].weights)
+    assert runs[1].task.n_actions == 6 and runs[1].task.paths == ()
+
+
+def test_run_experiments_gives_the_task_its_demonstrations_and_the_policy_keeps_them(tmp_path):
+    task, path = line_task()
+    result = run_experiments(
+        lambda: gymnasium.make(ARM_REACH_ID, joints=3, goal=task.goal, actions="follow"),
+        DynaQConfig(planning="zero", max_steps_per_episode=500),
+        1,
+        20,
+        0,
+        [path],
+        task.features(),
+    )
+    assert result.task.n_actions == 7 and len(result.task.paths) == 1
+    assert result.weights.shape[-1] == 7
+    saved = tmp_path / "follow.policy.npz"
+    save_tile_policy(saved, result)
+    loaded = load_any_policy(saved)
+    assert loaded.task == result.task  # the followed points come back as they were
+    env = gymnasium.make(ARM_REACH_ID, **result.task.to_dict())
+    assert env.action_space.n == 7
+
+
+def test_a_policy_taught_to_follow_its_demonstration_moves_like_it():
+    """One sample demonstration, 3,000 episodes, no planning: the follow policy's rollout from
+    the demonstration's start lies within 0.05 rad a sample of it; one joint per action's, a
+    staircase, does not."""
+    demo = load_demonstration(SAMPLES / "sample-reach-3.demo.json")
+    cards = {}
+    goal = tuple(demo.q_robot[-1])
+    for actions in ("follow", "single"):
+        task = ArmReach(goal=goal, actions=actions)
+        config = DynaQConfig(planning="zero", max_steps_per_episode=3000)
+        result = run_experiments(
+            lambda a=actions: gymnasium.make(ARM_REACH_ID, goal=goal, actions=a),
+            config,
+            1,
+            3000,
+            0,
+            [demo.q_robot],
+            task.features(),
+            workers=1,
+        )
+        policy = TilePolicyFile(
+            coder=result.coder, weights=result.weights[0], config=config, task=result.task
+        )
+        cards[actions] = policy_likeness_card(policy, demo.times, demo.q_robot)
+    assert cards["follow"].dtw_rad <= 0.05 and cards["follow"].policy.together >= 0.5
+    assert cards["single"].dtw_rad > 0.1 and cards["single"].policy.together == 0.0
+
+
+def test_bad_paths_and_a_follow_run_without_demonstrations_are_refused_in_one_sentence():
+    _, path = line_task()
+    with pytest.raises(ConfigError, match='actions="follow"'):
+        ArmReach(joints=3, paths=(path,))
+    with pytest.raises(ConfigError, match=r"Path 0 has shape \(4,\)"):
+        ArmReach(joints=3, actions="follow", paths=((1.0, 2.0, 3.0, 4.0),))
+    with pytest.raises(ConfigError, match="Path 0 has shape"):
+        ArmReach(joints=3, actions="follow", paths=(np.full((5, 3), np.nan),))
+    with pytest.raises(ConfigError) as err:
+        resolve_run(RunRequest(task="arm-reach", reach={"actions": "follow"}, experiments=1))
+    assert "no demonstration is picked" in err.value.by_field["actions"]
