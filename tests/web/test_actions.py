@@ -16,3 +16,14 @@ def test_the_page_offers_the_action_set_and_a_run_keeps_it(client):
     r = client.post("/api/runs", json={**body, "actions": "diagonal"})
     assert r.status_code == 422
     assert r.json()["detail"].startswith("actions is 'diagonal'; give 'single', 'pairs', 'all'")
+
+
+def test_a_follow_run_follows_its_demonstrations_and_one_without_any_is_refused(client):
+    body = {**PAGE_REACH, "actions": "follow", "episodes": 3, "experiments": 1}
+    r = client.post("/api/runs", json={**body, "demonstrations": ["sample-reach-1"]})
+    assert r.status_code == 201, r.text
+    run = wait_run(client, r.json()["id"])
+    assert run["status"] == "done" and run["config"]["actions"] == "follow"
+    r = client.post("/api/runs", json=body)
+    assert r.status_code == 422
+    assert "no demonstration is picked" in r.json()["detail"]
