@@ -281,16 +281,16 @@ class ArmReach:
                 q = np.asarray(path, dtype=np.float64)
             except (TypeError, ValueError):
                 q = np.zeros((0, 0))
-            if (
-                q.ndim != 2
-                or q.shape[0] < 1
-                or q.shape[1] < self.joints
-                or not np.all(np.isfinite(q))
-            ):
+            if q.ndim != 2 or q.shape[0] < 1 or q.shape[1] < self.joints:
                 raise ConfigError(
                     [
-                        f"Path {i} has shape {q.shape}; give (N, {self.joints}) finite joint angles in radians."
+                        f"Path {i} has shape {q.shape}; give (N, {self.joints}) joint angles in radians."
                     ],
+                    ["paths"],
+                )
+            if not np.all(np.isfinite(q)):
+                raise ConfigError(
+                    [f"Path {i} holds NaN or infinite angles; re-record that demonstration."],
                     ["paths"],
                 )
             q = np.clip(q[:, : self.joints], lower, upper)

@@ -13,6 +13,7 @@ from studio.learning import (
     ArmReach,
     ConfigError,
     DynaQConfig,
+    LearningError,
     RunRequest,
     TilePolicyFile,
     load_any_policy,
@@ -138,8 +139,20 @@ def test_bad_paths_and_a_follow_run_without_demonstrations_are_refused_in_one_se
         ArmReach(joints=3, paths=(path,))
     with pytest.raises(ConfigError, match=r"Path 0 has shape \(4,\)"):
         ArmReach(joints=3, actions="follow", paths=((1.0, 2.0, 3.0, 4.0),))
-    with pytest.raises(ConfigError, match="Path 0 has shape"):
+    with pytest.raises(ConfigError, match="Path 0 holds NaN"):
         ArmReach(joints=3, actions="follow", paths=(np.full((5, 3), np.nan),))
+    nan_demo = path.copy()
+    nan_demo[7, 1] = np.nan
+    with pytest.raises(LearningError, match="NaN"):  # through run_experiments: one sentence
+        run_experiments(
+            lambda: gymnasium.make(ARM_REACH_ID, joints=3, actions="follow"),
+            DynaQConfig(planning="zero"),
+            1,
+            2,
+            0,
+            [nan_demo],
+            ArmReach(joints=3, actions="follow").features(),
+        )
     with pytest.raises(ConfigError) as err:
         resolve_run(RunRequest(task="arm-reach", reach={"actions": "follow"}, experiments=1))
     assert "no demonstration is picked" in err.value.by_field["actions"]
