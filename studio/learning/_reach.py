@@ -117,11 +117,14 @@ ACTION_SETS = ("single", "pairs", "all", "follow")
 joints at once (3**J - 1), or one joint or all of them along the demonstrated paths (2J + 1, see
 :attr:`ArmReach.paths`); each of the first three begins with the one before it, in the same
 order, and ``"follow"`` with the singles."""
-FOLLOW_SIZE = 2**16
-"""Weight rows of the follow task's default features (:meth:`ArmReach.features`): the tiles of
-every joint together are hashed into them. 2**16, 2**18 and 2**20 rows gave the same likeness
-and greedy success (3 samples x 3 seeds, 3,000 episodes); 2**16 keeps a six-joint table of 13
-actions at 7 MB."""
+FOLLOW_KAPPA = 2.0
+"""How much more a radian off the demonstrated paths costs the follow action than a radian along
+them (:func:`_follow`): joining a path is worth it where the path from there is shorter than
+twice the way straight to its end. With 1 the cheapest point is always a path's end (no path is
+shorter than the straight line), and the action would head straight for the goal's joints."""
+FOLLOW_LENGTH_STEPS = 2.0
+"""A followed path's length is measured along its samples this many steps apart
+(:func:`_path_left`)."""
 FOLLOW_SPACING_STEPS = 0.25
 """A followed path keeps a demonstration's samples this many steps apart (max-norm over the
 joints), and always its last: closer samples add search work and no shape."""
@@ -159,7 +162,7 @@ _TOOL = _CHAIN + _LINK * MAX_CHAIN  # jointMtool: rotation (9, row-major), trans
 _COUNTS = _TOOL + 12  # the action table's rows, then the followed paths' points
 _TABLE = _COUNTS + 2  # per action, MAX_JOINTS directions -1/0/+1; then the followed points
 _N_PARAMS = _TABLE
-_POINT = MAX_JOINTS + 1  # a followed point: its joints, then the index of its path's last point
+_POINT = MAX_JOINTS + 2  # a followed point: its joints, its path's last point, the path left (rad)
 
 
 @dataclass(frozen=True)
@@ -180,8 +183,8 @@ class ArmReach:
         robot: the robot's registry name (``studio robots`` lists them).
         paths: with ``actions="follow"``, the demonstrated joint paths (each ``(N, joints)``
             radians, ending at the goal) that the last action follows: it moves every joint at
-            once, by at most one step, toward the first point of the nearest path that lies a
-            step ahead (pure pursuit), so a policy can move as the demonstrations did.
+            once, by at most one step, along them to the goal (:func:`_follow`), so a policy
+            can move as the demonstrations did.
             :func:`run_experiments` fills them from its demonstrations; without any the task
             is one joint per action.
 
@@ -297,7 +300,7 @@ class ArmReach:
             checked.append(
                 tuple(
                     tuple(float(x) for x in row)
-                    for row in _spaced(q, FOLLOW_SPACING_STEPS * self.step)
+                    for row in q[_spaced(q, FOLLOW_SPACING_STEPS * self.step)]
                 )
             )
         return tuple(checked)
@@ -312,14 +315,16 @@ class ArmReach:
         )
 
     def _followed_points(self) -> np.ndarray:
-        """Every followed point: ``(M, joints + 1)``, its joints, then the index of its path's
-        last point."""
+        """Every followed point: ``(M, joints + 2)``, its joints, the index of its path's last
+        point, and the length of the path from it to that end (rad, Euclidean)."""
         rows = []
         for path in self.paths:
             q = np.asarray(path, dtype=np.float64)
             end = len(rows) + len(q) - 1
-            rows += [(*row, end) for row in q]
-        return np.asarray(rows, dtype=np.float64).reshape(-1, self.joints + 1)
+            rows += [
+                (*row, end, rest) for row, rest in zip(q, _path_left(q, self.step), strict=True)
+            ]
+        return np.asarray(rows, dtype=np.float64).reshape(-1, self.joints + 2)
 
     # ------------------------------------------------------------------ sizes
 
@@ -397,21 +402,9 @@ class ArmReach:
         of joints (``J (J - 1) / 2 x (tiles + 1) ** 2`` tiles per tiling) at six joints, 4,000
         episodes: 100% greedy success for single joints against 77% for pairs and 94% for both
         (see the package README); pass ``TileCoding(groups=...)`` for other choices.
-
-        With ``actions="follow"`` the joints are also tiled all together, hashed into
-        :data:`FOLLOW_SIZE` weight rows: the follow action's worth depends on where the arm is
-        relative to the demonstrated paths, which no sum of per-joint terms holds, and with the
-        joints alone its estimate near the goal fell below the single joints' and the greedy
-        policy stepped one joint back and forth there (3 samples x 3 seeds, 3,000 episodes, the
-        paper's reward: 6 of 9 policies followed their demonstration with the joints alone, 9 of
-        9 with them together).
         """
         singles = tuple((j,) for j in range(self.joints))
         tiles = self.default_tiles if tiles is None else tiles
-        if self.actions == "follow":  # and every joint together, hashed (:data:`FOLLOW_SIZE`)
-            groups = (*singles, tuple(range(self.joints)))
-            size = FOLLOW_SIZE if size is None else size
-            return TileCoding(tilings=tilings, tiles=tiles, size=size, groups=groups)
         return TileCoding(tilings=tilings, tiles=tiles, size=size, groups=singles)
 
     @cached_property
@@ -426,7 +419,7 @@ class ArmReach:
         followed = _TABLE + MAX_JOINTS * table.shape[0]
         p[_TABLE:followed].reshape(-1, MAX_JOINTS)[:, : self.joints] = table
         p[followed:].reshape(-1, _POINT)[:, : self.joints] = points[:, : self.joints]
-        p[followed:].reshape(-1, _POINT)[:, MAX_JOINTS] = points[:, self.joints]
+        p[followed:].reshape(-1, _POINT)[:, MAX_JOINTS:] = points[:, self.joints :]
         p[_J] = self.joints
         p[_STEP] = self.step
         p[_POS_TOL2] = self.position_tolerance**2
@@ -558,15 +551,28 @@ def action_directions(joints: int, actions: str = DEFAULT_ACTIONS) -> np.ndarray
     return np.array(rows, dtype=np.int8).reshape(-1, joints)
 
 
+def _path_left(q: np.ndarray, step: float) -> np.ndarray:
+    """Per sample of the path ``q``, the length of the path from it to its end (rad, Euclidean),
+    measured along the samples :data:`FOLLOW_LENGTH_STEPS` steps apart: along every sample, a
+    recorded wrist's jitter would count as path (sample 1: 2.1 rad against 1.15 measured so,
+    and 0.93 straight)."""
+    coarse = _spaced(q, FOLLOW_LENGTH_STEPS * step)
+    lengths = np.linalg.norm(np.diff(q[coarse], axis=0), axis=1)
+    coarse_left = np.append(np.cumsum(lengths[::-1])[::-1], 0.0)
+    after = np.minimum(np.searchsorted(coarse, np.arange(len(q))), len(coarse) - 1)
+    return np.linalg.norm(q[coarse[after]] - q, axis=1) + coarse_left[after]
+
+
 def _spaced(q: np.ndarray, spacing: float) -> np.ndarray:
-    """The rows of ``q`` at least ``spacing`` apart (max-norm) from the last kept, and the last."""
+    """The indices of the rows of ``q`` at least ``spacing`` apart (max-norm) from the last
+    kept, and the last's."""
     kept = [0]
     for i in range(1, len(q)):
         if np.abs(q[i] - q[kept[-1]]).max() >= spacing:
             kept.append(i)
     if kept[-1] != len(q) - 1:
         kept.append(len(q) - 1)
-    return q[kept]
+    return np.asarray(kept)
 
 
 def tool_positions(robot: str, q: np.ndarray) -> np.ndarray:
@@ -821,23 +827,27 @@ def _max_gap(params, row, state):
 @njit(nogil=True, cache=True)
 def _follow(params, state):
     """The follow action: ``state`` (in place) moves every joint at once, by at most one step
-    (max-norm), toward the first point of the nearest followed path (Euclidean) that lies a step
-    or more away, on the way to that path's end (pure pursuit): on a path it moves along it, off
-    one it cuts back to it. At a path's end it stays."""
+    (max-norm), along the demonstrated paths to their end. It heads for the followed point with
+    the least :data:`FOLLOW_KAPPA` x (Euclidean distance to it) + (path from it to its end): off
+    the paths it cuts to the point where joining one costs least, and within a step of that
+    point it moves on toward the first point a step ahead on its path (pure pursuit). That cost
+    falls with every move, so no sequence of follow moves returns where it was; at a path's end
+    it stays."""
     base = _TABLE + MAX_JOINTS * int(params[_COUNTS])
     joints = state.shape[0]
-    nearest, best = 0, np.inf
+    best, cheapest = 0, np.inf
     for i in range(int(params[_COUNTS + 1])):
         row = base + _POINT * i
         d = 0.0
         for j in range(joints):
             diff = params[row + j] - state[j]
             d += diff * diff
-        if d < best:
-            best, nearest = d, i
+        cost = FOLLOW_KAPPA * math.sqrt(d) + params[row + MAX_JOINTS + 1]
+        if cost < cheapest:
+            cheapest, best = cost, i
     step = params[_STEP]
-    end = int(params[base + _POINT * nearest + MAX_JOINTS])
-    target = nearest
+    end = int(params[base + _POINT * best + MAX_JOINTS])
+    target = best
     while target < end and _max_gap(params, base + _POINT * target, state) < step:
         target += 1
     row = base + _POINT * target
