@@ -356,7 +356,8 @@ class ArmReach:
         return _limits(self.robot)[1][: self.joints].copy()
 
     def to_dict(self) -> dict:
-        """JSON-ready settings (the inverse of ``ArmReach(**d)``)."""
+        """JSON-ready settings (the inverse of ``ArmReach(**d)``; ``paths`` only when there are
+        any)."""
         return {
             "joints": self.joints,
             "step_deg": self.step_deg,
@@ -366,7 +367,11 @@ class ArmReach:
             "shaping": self.shaping,
             "actions": self.actions,
             "robot": self.robot,
-            "paths": [[list(row) for row in path] for path in self.paths],
+            **(
+                {"paths": [[list(row) for row in path] for path in self.paths]}
+                if self.paths
+                else {}
+            ),
         }
 
     @classmethod

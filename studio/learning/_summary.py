@@ -70,7 +70,8 @@ def policy_summary(policy: PolicyFile | TilePolicyFile | DmpPolicyFile) -> Polic
         ``goal_deg`` (the goal of those joints in degrees: the goal bin's centre, see
         :func:`goal_degrees`, or the continuous task's goal angles), ``planning`` (the planner
         it was trained with), ``episodes`` (length of its learning curve), ``experiments`` (how
-        many the curve averages), ``created`` and ``notes``. A movement primitive's task is
+        many the curve averages), ``created`` and ``notes``. A task following demonstrations
+        (``actions="follow"``) gives their number as ``paths``. A movement primitive's task is
         ``{"kind": "dmp", "basis": ..., "robot": ...}`` and its planning ``"none"``.
     """
     task: dict[str, object]
@@ -84,6 +85,8 @@ def policy_summary(policy: PolicyFile | TilePolicyFile | DmpPolicyFile) -> Polic
             task, joints, goal = {"kind": policy.env_id or "gymnasium"}, 0, []
         else:
             task, joints = task_spec(reach, policy.coder.coding), reach.joints
+            if reach.paths:  # a listing names how many demonstrations it follows, not their points
+                task["paths"] = len(reach.paths)
             goal = [round(float(x), GOAL_DECIMALS) for x in np.degrees(reach.goal[:joints])]
         grid: dict[str, object] = {}
     else:

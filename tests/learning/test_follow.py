@@ -18,6 +18,7 @@ from studio.learning import (
     TilePolicyFile,
     load_any_policy,
     policy_likeness_card,
+    policy_summary,
     resolve_run,
     run_experiments,
 )
@@ -101,6 +102,8 @@ def test_run_experiments_gives_the_task_its_demonstrations_and_the_policy_keeps_
     save_tile_policy(saved, result)
     loaded = load_any_policy(saved)
     assert loaded.task == result.task  # the followed points come back as they were
+    assert policy_summary(loaded)["task"]["paths"] == 1  # a listing counts them
+    assert "paths" not in ArmReach(joints=3).to_dict()  # a task without any stores none
     env = gymnasium.make(ARM_REACH_ID, **result.task.to_dict())
     assert env.action_space.n == 7
 
