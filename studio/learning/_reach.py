@@ -8,7 +8,7 @@ ONE joint by ``step_deg`` (2J actions: joint 1 up, joint 1 down, joint 2 up, ...
 diagonals, 2J**2 actions), and
 ``actions="all"`` every joint -1/0/+1 at once (3**J - 1 actions); see :data:`ACTION_SETS` and
 :func:`action_directions`. ``actions="follow"`` adds to the single joints one action that moves
-every joint at once along the demonstrated paths (:attr:`ArmReach.paths`, :func:`_follow`), so a
+every joint at once along the demonstrated paths (:attr:`ArmReach.paths`, :mod:`._follow`), so a
 policy can move as its demonstrations did. A joint whose move would leave its limits stays where it is, as on
 the paper's grid (the action's other joints still move). Reaching the goal pays :data:`GOAL_REWARD` and ends the
 episode, every other step pays :data:`STEP_REWARD` (the paper's rewards), plus a potential-based
@@ -54,13 +54,38 @@ from studio.kinematics import Puma560
 
 from ._arm import GOAL_REWARD, STEP_REWARD
 from ._errors import ConfigError, LearningError
+from ._follow import checked_paths, follow, followed_points
+from ._reach_layout import (
+    _A,
+    _ALPHA,
+    _ANG_TOL,
+    _CHAIN,
+    _CHAIN_N,
+    _COUNTS,
+    _D,
+    _GOAL_P,
+    _GOAL_R,
+    _HOLD,
+    _J,
+    _LINK,
+    _LOWER,
+    _MIN_TRACE,
+    _MULTI,
+    _N_PARAMS,
+    _POINT,
+    _POS_TOL,
+    _POS_TOL2,
+    _SHAPING,
+    _STEP,
+    _TABLE,
+    _TOOL,
+    _UPPER,
+    MAX_CHAIN,
+    MAX_JOINTS,
+)
 from ._robot import PUMA560, check_robot, default_goal, task_arm
 from ._tiles import TileCoding
 
-MAX_JOINTS = 6
-"""Most joints a task learns (the first six of a seven-joint arm such as the Panda)."""
-MAX_CHAIN = 7
-"""Most joints of an arm whose forward kinematics the compiled twin computes."""
 MIN_JOINTS = 3
 """Fewest joints the continuous task offers (the paper's three)."""
 DEFAULT_JOINTS = 6
@@ -117,17 +142,6 @@ ACTION_SETS = ("single", "pairs", "all", "follow")
 joints at once (3**J - 1), or one joint or all of them along the demonstrated paths (2J + 1, see
 :attr:`ArmReach.paths`); each of the first three begins with the one before it, in the same
 order, and ``"follow"`` with the singles."""
-FOLLOW_KAPPA = 2.0
-"""How much more a radian off the demonstrated paths costs the follow action than a radian along
-them (:func:`_follow`): joining a path is worth it where the path from there is shorter than
-twice the way straight to its end. With 1 the cheapest point is always a path's end (no path is
-shorter than the straight line), and the action would head straight for the goal's joints."""
-FOLLOW_LENGTH_STEPS = 2.0
-"""A followed path's length is measured along its samples this many steps apart
-(:func:`_path_left`)."""
-FOLLOW_SPACING_STEPS = 0.25
-"""A followed path keeps a demonstration's samples this many steps apart (max-norm over the
-joints), and always its last: closer samples add search work and no shape."""
 DEFAULT_ACTIONS = "single"
 """One joint per action. ``"pairs"``, learned with the factored action value (:mod:`._factored`),
 reaches 95% greedy success in fewer real steps (81 k against 321 k at six joints) and moves joints
@@ -140,29 +154,6 @@ STORED_ACTIONS = "single"
 """What a task stored before ``actions`` existed moves: one joint per action."""
 LIMIT_SLACK_RAD = 1e-9
 """A demonstration may touch its joint limits within this rounding."""
-
-# layout of the flat float64 parameter array the compiled functions take
-_J, _STEP, _POS_TOL2, _MIN_TRACE = 0, 1, 2, 3
-_GOAL_P = 4  # 3 values
-_GOAL_R = 7  # 9 values, row-major
-_LOWER = 16  # MAX_JOINTS values
-_UPPER = 22
-_D = 28  # the Puma560's DH table, MAX_JOINTS values each
-_A = 34
-_ALPHA = 40
-_SHAPING = 46
-_POS_TOL = 47
-_ANG_TOL = 48
-_MULTI = 49  # 0: one joint per action (the fast path), else the table below
-_CHAIN_N = 50  # 0: the DH product above; else the serial chain's joints that move the tool
-_HOLD = 51  # MAX_CHAIN values: every joint's angle when not learned (the goal's)
-_CHAIN = _HOLD + MAX_CHAIN  # per joint: placement rotation (9, row-major), translation, axis
-_LINK = 15
-_TOOL = _CHAIN + _LINK * MAX_CHAIN  # jointMtool: rotation (9, row-major), translation (3)
-_COUNTS = _TOOL + 12  # the action table's rows, then the followed paths' points
-_TABLE = _COUNTS + 2  # per action, MAX_JOINTS directions -1/0/+1; then the followed points
-_N_PARAMS = _TABLE
-_POINT = MAX_JOINTS + 2  # a followed point: its joints, its path's last point, the path left (rad)
 
 
 @dataclass(frozen=True)
@@ -183,7 +174,7 @@ class ArmReach:
         robot: the robot's registry name (``studio robots`` lists them).
         paths: with ``actions="follow"``, the demonstrated joint paths (each ``(N, joints)``
             radians, ending at the goal) that the last action follows: it moves every joint at
-            once, by at most one step, along them to the goal (:func:`_follow`), so a policy
+            once, by at most one step, along them to the goal (:func:`._follow.follow`), so a policy
             can move as the demonstrations did.
             :func:`run_experiments` fills them from its demonstrations; without any the task
             is one joint per action.
@@ -265,45 +256,11 @@ class ArmReach:
                 ["goal"],
             )
         object.__setattr__(self, "goal", tuple(float(x) for x in np.clip(goal, lower, upper)))
-        object.__setattr__(self, "paths", self._checked_paths())
-
-    def _checked_paths(self) -> tuple[tuple[tuple[float, ...], ...], ...]:
-        if not self.paths:
-            return ()
-        if self.actions != "follow":
-            raise ConfigError(
-                [
-                    f'paths are given with actions={self.actions!r}; give actions="follow" to follow them, or no paths.'
-                ],
-                ["paths"],
-            )
-        checked = []
-        lower, upper = self.lower, self.upper
-        for i, path in enumerate(self.paths):
-            try:
-                q = np.asarray(path, dtype=np.float64)
-            except (TypeError, ValueError):
-                q = np.zeros((0, 0))
-            if q.ndim != 2 or q.shape[0] < 1 or q.shape[1] < self.joints:
-                raise ConfigError(
-                    [
-                        f"Path {i} has shape {q.shape}; give (N, {self.joints}) joint angles in radians."
-                    ],
-                    ["paths"],
-                )
-            if not np.all(np.isfinite(q)):
-                raise ConfigError(
-                    [f"Path {i} holds NaN or infinite angles; re-record that demonstration."],
-                    ["paths"],
-                )
-            q = np.clip(q[:, : self.joints], lower, upper)
-            checked.append(
-                tuple(
-                    tuple(float(x) for x in row)
-                    for row in q[_spaced(q, FOLLOW_SPACING_STEPS * self.step)]
-                )
-            )
-        return tuple(checked)
+        object.__setattr__(
+            self,
+            "paths",
+            checked_paths(self.paths, self.actions, self.joints, self.lower, self.upper, self.step),
+        )
 
     def with_paths(self, q_paths: Sequence[np.ndarray]) -> ArmReach:
         """This task following ``q_paths`` (joint paths, radians, ``(N, joints)`` or wider) when
@@ -313,18 +270,6 @@ class ArmReach:
         return dataclasses.replace(
             self, paths=tuple(np.asarray(q)[:, : self.joints] for q in q_paths)
         )
-
-    def _followed_points(self) -> np.ndarray:
-        """Every followed point: ``(M, joints + 2)``, its joints, the index of its path's last
-        point, and the length of the path from it to that end (rad, Euclidean)."""
-        rows = []
-        for path in self.paths:
-            q = np.asarray(path, dtype=np.float64)
-            end = len(rows) + len(q) - 1
-            rows += [
-                (*row, end, rest) for row, rest in zip(q, _path_left(q, self.step), strict=True)
-            ]
-        return np.asarray(rows, dtype=np.float64).reshape(-1, self.joints + 2)
 
     # ------------------------------------------------------------------ sizes
 
@@ -416,7 +361,7 @@ class ArmReach:
     def params(self) -> np.ndarray:
         """The flat parameter array of :func:`reach_step` and friends (read-only)."""
         table = action_directions(self.joints, self.actions)
-        points = self._followed_points()
+        points = followed_points(self.paths, self.joints, self.step)
         p = np.zeros(_N_PARAMS + MAX_JOINTS * table.shape[0] + _POINT * points.shape[0], np.float64)
         p[_MULTI] = 0.0 if table.shape[0] == self.n_actions == 2 * self.joints else 1.0
         p[_COUNTS] = table.shape[0]
@@ -554,30 +499,6 @@ def action_directions(joints: int, actions: str = DEFAULT_ACTIONS) -> np.ndarray
     if actions == "all":
         rows += [m for m in itertools.product((1, 0, -1), repeat=joints) if sum(map(abs, m)) > 2]
     return np.array(rows, dtype=np.int8).reshape(-1, joints)
-
-
-def _path_left(q: np.ndarray, step: float) -> np.ndarray:
-    """Per sample of the path ``q``, the length of the path from it to its end (rad, Euclidean),
-    measured along the samples :data:`FOLLOW_LENGTH_STEPS` steps apart: along every sample, a
-    recorded wrist's jitter would count as path (sample 1: 2.1 rad against 1.15 measured so,
-    and 0.93 straight)."""
-    coarse = _spaced(q, FOLLOW_LENGTH_STEPS * step)
-    lengths = np.linalg.norm(np.diff(q[coarse], axis=0), axis=1)
-    coarse_left = np.append(np.cumsum(lengths[::-1])[::-1], 0.0)
-    after = np.minimum(np.searchsorted(coarse, np.arange(len(q))), len(coarse) - 1)
-    return np.linalg.norm(q[coarse[after]] - q, axis=1) + coarse_left[after]
-
-
-def _spaced(q: np.ndarray, spacing: float) -> np.ndarray:
-    """The indices of the rows of ``q`` at least ``spacing`` apart (max-norm) from the last
-    kept, and the last's."""
-    kept = [0]
-    for i in range(1, len(q)):
-        if np.abs(q[i] - q[kept[-1]]).max() >= spacing:
-            kept.append(i)
-    if kept[-1] != len(q) - 1:
-        kept.append(len(q) - 1)
-    return np.asarray(kept)
 
 
 def tool_positions(robot: str, q: np.ndarray) -> np.ndarray:
@@ -745,7 +666,7 @@ def reach_step(params, state, action):
 
     Action ``2 j`` moves joint ``j`` up one step, ``2 j + 1`` down; a multi-joint task's other
     actions move the joints of their row of the action table (:func:`action_directions`), and
-    the one after the table follows the demonstrated paths (:func:`_follow`). A joint whose move
+    the one after the table follows the demonstrated paths (:func:`._follow.follow`). A joint whose move
     would leave its limits stays where it is. The reward is the paper's (+100 at
     the goal, -1 otherwise) plus ``shaping`` times the change of :func:`reach_potential`.
     """
@@ -757,7 +678,7 @@ def reach_step(params, state, action):
         if params[_LOWER + j] <= moved <= params[_UPPER + j]:
             state[j] = moved
     elif action >= params[_COUNTS]:
-        _follow(params, state)
+        follow(params, state)
     else:
         row = _TABLE + MAX_JOINTS * action
         for j in range(state.shape[0]):
@@ -818,50 +739,6 @@ def _walk(params, path, actions):
             if done:
                 return n
     return -1
-
-
-@njit(nogil=True, cache=True)
-def _max_gap(params, row, state):
-    """The largest joint distance (rad) from ``state`` to the followed point at ``row``."""
-    gap = 0.0
-    for j in range(state.shape[0]):
-        gap = max(gap, abs(params[row + j] - state[j]))
-    return gap
-
-
-@njit(nogil=True, cache=True)
-def _follow(params, state):
-    """The follow action: ``state`` (in place) moves every joint at once, by at most one step
-    (max-norm), along the demonstrated paths to their end. It heads for the followed point with
-    the least :data:`FOLLOW_KAPPA` x (Euclidean distance to it) + (path from it to its end): off
-    the paths it cuts to the point where joining one costs least, and within a step of that
-    point it moves on toward the first point a step ahead on its path (pure pursuit). That cost
-    falls with every move, so no sequence of follow moves returns where it was; at a path's end
-    it stays."""
-    base = _TABLE + MAX_JOINTS * int(params[_COUNTS])
-    joints = state.shape[0]
-    best, cheapest = 0, np.inf
-    for i in range(int(params[_COUNTS + 1])):
-        row = base + _POINT * i
-        d = 0.0
-        for j in range(joints):
-            diff = params[row + j] - state[j]
-            d += diff * diff
-        cost = FOLLOW_KAPPA * math.sqrt(d) + params[row + MAX_JOINTS + 1]
-        if cost < cheapest:
-            cheapest, best = cost, i
-    step = params[_STEP]
-    end = int(params[base + _POINT * best + MAX_JOINTS])
-    target = best
-    while target < end and _max_gap(params, base + _POINT * target, state) < step:
-        target += 1
-    row = base + _POINT * target
-    gap = _max_gap(params, row, state)
-    scale = 1.0 if gap <= step else step / gap
-    for j in range(joints):
-        moved = state[j] + scale * (params[row + j] - state[j])
-        if params[_LOWER + j] <= moved <= params[_UPPER + j]:
-            state[j] = moved
 
 
 @njit(nogil=True, cache=True)

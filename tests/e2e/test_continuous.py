@@ -197,3 +197,41 @@ def test_a_continuous_policy_is_listed_watched_uploaded_and_downloaded_in_the_po
     uploaded.wait_for(state="detached", timeout=T)
     page.fill("[data-testid='watch-seed']", "")
     assert not page.errors  # type: ignore[attr-defined]
+
+
+def test_a_run_that_follows_its_demonstration_is_asked_for_and_started_from_the_page(
+    page: Any, studio_server: Studio
+) -> None:
+    """Actions "follow the demonstrations": Start without a demonstration ticked says what is
+    missing; with one it trains, and the run keeps the choice."""
+    name = "e2e-follow"
+    page.click("[data-testid='train-defaults']")
+    page.select_option("[data-testid='train-task']", "arm-reach")
+    page.select_option("[data-testid='train-actions']", "follow")
+    page.fill("[data-testid='train-name']", name)
+    page.fill("[data-testid='train-joints']", "3")
+    page.select_option("[data-testid='train-planning']", "zero")
+    page.fill("[data-testid='train-episodes']", "20")
+    page.fill("[data-testid='train-experiments']", "1")
+    demo = page.locator("[data-testid='train-demo'][value='sample-reach-1']")
+    try:
+        page.click("[data-testid='train-start']")
+        error = page.locator("[data-testid='train-error']")
+        error.wait_for(timeout=T)
+        assert "no demonstration is picked" in error.inner_text()
+        demo.check()
+        page.click("[data-testid='train-start']")
+
+        def finished() -> dict | None:
+            runs = [r for r in studio_server.get("/api/runs") if r["name"] == name]
+            return runs[0] if runs and runs[0]["status"] in ("done", "failed", "stopped") else None
+
+        run = _wait(finished, TRAIN_TIMEOUT_S)
+        assert run and run["status"] == "done", run
+        assert run["config"]["actions"] == "follow" and run["has_policy"]
+    finally:  # leave the form as the stories expect it
+        if demo.count():
+            demo.uncheck()
+        page.select_option("[data-testid='train-task']", "arm-grid")
+        page.click("[data-testid='train-defaults']")
+    assert not page.errors  # type: ignore[attr-defined]

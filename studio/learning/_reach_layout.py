@@ -1,0 +1,33 @@
+"""The flat float64 parameter array the arm task's compiled functions take: its layout.
+
+One definition for :mod:`._reach` (the task, its dynamics and forward kinematics) and
+:mod:`._follow` (the follow action), which both read it.
+"""
+
+MAX_JOINTS = 6
+"""Most joints a task learns (the first six of a seven-joint arm such as the Panda)."""
+MAX_CHAIN = 7
+"""Most joints of an arm whose forward kinematics the compiled twin computes."""
+
+# layout of the flat float64 parameter array the compiled functions take
+_J, _STEP, _POS_TOL2, _MIN_TRACE = 0, 1, 2, 3
+_GOAL_P = 4  # 3 values
+_GOAL_R = 7  # 9 values, row-major
+_LOWER = 16  # MAX_JOINTS values
+_UPPER = 22
+_D = 28  # the Puma560's DH table, MAX_JOINTS values each
+_A = 34
+_ALPHA = 40
+_SHAPING = 46
+_POS_TOL = 47
+_ANG_TOL = 48
+_MULTI = 49  # 0: one joint per action (the fast path), else the table below
+_CHAIN_N = 50  # 0: the DH product above; else the serial chain's joints that move the tool
+_HOLD = 51  # MAX_CHAIN values: every joint's angle when not learned (the goal's)
+_CHAIN = _HOLD + MAX_CHAIN  # per joint: placement rotation (9, row-major), translation, axis
+_LINK = 15
+_TOOL = _CHAIN + _LINK * MAX_CHAIN  # jointMtool: rotation (9, row-major), translation (3)
+_COUNTS = _TOOL + 12  # the action table's rows, then the followed paths' points
+_TABLE = _COUNTS + 2  # per action, MAX_JOINTS directions -1/0/+1; then the followed points
+_N_PARAMS = _TABLE
+_POINT = MAX_JOINTS + 2  # a followed point: its joints, its path's last point, the path left (rad)
