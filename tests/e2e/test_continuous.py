@@ -29,6 +29,15 @@ def _wait(predicate: Any, timeout: float) -> Any:
     return predicate()
 
 
+def _small_run(page: Any, name: str, episodes: int) -> None:
+    """Fill the train form for a small continuous run: 3 joints, no planning, one experiment."""
+    page.fill("[data-testid='train-name']", name)
+    page.fill("[data-testid='train-joints']", "3")
+    page.select_option("[data-testid='train-planning']", "zero")
+    page.fill("[data-testid='train-episodes']", str(episodes))
+    page.fill("[data-testid='train-experiments']", "1")
+
+
 @pytest.fixture(scope="module")
 def continuous_run(page: Any, studio_server: Studio) -> dict:
     """A tiny continuous-joint run trained from the page's form; the form is left as the stories
@@ -43,11 +52,7 @@ def continuous_run(page: Any, studio_server: Studio) -> dict:
         assert float(page.input_value(f"[data-testid='train-{field}']")) == defaults[key]
     assert defaults["tiles"] is None  # the robot's own default
     assert page.input_value("[data-testid='train-tiles']") == ""
-    page.fill("[data-testid='train-name']", RUN_NAME)
-    page.fill("[data-testid='train-joints']", "3")
-    page.select_option("[data-testid='train-planning']", "zero")
-    page.fill("[data-testid='train-episodes']", "40")
-    page.fill("[data-testid='train-experiments']", "1")
+    _small_run(page, RUN_NAME, episodes=40)
     demos = page.locator("[data-testid='train-demo']")
     if demos.count():
         demos.first.check()
@@ -208,11 +213,7 @@ def test_a_run_that_follows_its_demonstration_is_asked_for_and_started_from_the_
     page.click("[data-testid='train-defaults']")
     page.select_option("[data-testid='train-task']", "arm-reach")
     page.select_option("[data-testid='train-actions']", "follow")
-    page.fill("[data-testid='train-name']", name)
-    page.fill("[data-testid='train-joints']", "3")
-    page.select_option("[data-testid='train-planning']", "zero")
-    page.fill("[data-testid='train-episodes']", "20")
-    page.fill("[data-testid='train-experiments']", "1")
+    _small_run(page, name, episodes=20)
     demo = page.locator("[data-testid='train-demo'][value='sample-reach-1']")
     try:
         page.click("[data-testid='train-start']")
