@@ -30,7 +30,12 @@ joints), and always its last: closer samples add search work and no shape."""
 
 
 def checked_paths(
-    paths: object, actions: str, joints: int, lower: np.ndarray, upper: np.ndarray, step: float
+    paths: Sequence[object] | None,
+    actions: str,
+    joints: int,
+    lower: np.ndarray,
+    upper: np.ndarray,
+    step: float,
 ) -> tuple[tuple[tuple[float, ...], ...], ...]:
     """:attr:`._reach.ArmReach.paths` as the task keeps them: each ``(N, joints)`` path clipped
     to the limits, its samples :data:`FOLLOW_SPACING_STEPS` apart.
@@ -39,7 +44,7 @@ def checked_paths(
         ConfigError: paths with another action set than ``"follow"``, a path of the wrong shape,
             or one holding NaN.
     """
-    if not paths:
+    if paths is None or len(paths) == 0:  # (an array of paths has no single truth value)
         return ()
     if actions != "follow":
         raise ConfigError(
@@ -49,7 +54,7 @@ def checked_paths(
             ["paths"],
         )
     checked = []
-    for i, path in enumerate(paths):  # type: ignore[arg-type]
+    for i, path in enumerate(paths):
         try:
             q = np.asarray(path, dtype=np.float64)
         except (TypeError, ValueError):

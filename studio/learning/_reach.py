@@ -265,7 +265,7 @@ class ArmReach:
     def with_paths(self, q_paths: Sequence[np.ndarray]) -> ArmReach:
         """This task following ``q_paths`` (joint paths, radians, ``(N, joints)`` or wider) when
         its actions are ``"follow"`` and it has none yet; else this task unchanged."""
-        if self.actions != "follow" or self.paths or not q_paths:
+        if self.actions != "follow" or self.paths or len(q_paths) == 0:
             return self
         return dataclasses.replace(
             self, paths=tuple(np.asarray(q)[:, : self.joints] for q in q_paths)

@@ -41,6 +41,7 @@ def test_the_follow_action_moves_every_joint_one_step_along_the_path_and_cuts_ba
     task, path = line_task()
     follow = task.n_actions - 1
     assert task.n_actions == 2 * task.joints + 1
+    assert len(ArmReach(joints=3, actions="follow", paths=np.stack([path, path])).paths) == 2
     direction = (path[-1] - path[0]) / np.abs(path[-1] - path[0]).max()
     q = path[0].copy()
     reach_step(task.params, q, follow)
