@@ -24,6 +24,11 @@ def test_a_follow_run_follows_its_demonstrations_and_one_without_any_is_refused(
     assert r.status_code == 201, r.text
     run = wait_run(client, r.json()["id"])
     assert run["status"] == "done" and run["config"]["actions"] == "follow"
+    listed = next(p for p in client.get("/api/policies").json() if p["name"] == run["id"])
+    assert listed["task"]["actions"] == "follow" and listed["task"]["paths"] == 1
+    watched = client.post("/api/watch", json={"run": run["id"]})
+    assert watched.status_code == 200, watched.text
+    assert watched.json()["likeness"]["name"] == "sample-reach-1"  # scored against what it follows
     r = client.post("/api/runs", json=body)
     assert r.status_code == 422
     assert "no demonstration is picked" in r.json()["detail"]
