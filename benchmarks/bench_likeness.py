@@ -44,6 +44,7 @@ import numpy as np
 import studio.learning._linear as linear
 from studio.capture import load_demonstration
 from studio.learning import (
+    ACTION_SETS,
     DMP_BASIS,
     ArmReach,
     DynaQConfig,
@@ -210,6 +211,7 @@ def main() -> None:
         "--actions",
         nargs="*",
         default=None,
+        choices=ACTION_SETS,
         help="(5) action sets (default: the default, pairs, follow)",
     )
     args = parser.parse_args()

@@ -183,8 +183,7 @@ def follow_demonstrations(
     paths yet) the joint-path demonstrations to follow (:meth:`._gym.ArmReachEnv.follow`)."""
     from ._gym import ArmReachEnv
 
-    paths = [np.asarray(d) for d in demonstrations]
-    paths = [p for p in paths if p.ndim == 2 and np.issubdtype(p.dtype, np.floating)]
+    paths = [p for p in map(np.asarray, demonstrations) if p.ndim == 2]  # as env_demonstrations
     for env in envs:
         if paths and type(env.unwrapped) is ArmReachEnv:
             env.unwrapped.follow(paths)

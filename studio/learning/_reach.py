@@ -360,10 +360,10 @@ class ArmReach:
     @cached_property
     def params(self) -> np.ndarray:
         """The flat parameter array of :func:`reach_step` and friends (read-only)."""
-        table = action_directions(self.joints, self.actions)
+        table = self.directions
         points = followed_points(self.paths, self.joints, self.step)
         p = np.zeros(_N_PARAMS + MAX_JOINTS * table.shape[0] + _POINT * points.shape[0], np.float64)
-        p[_MULTI] = 0.0 if table.shape[0] == self.n_actions == 2 * self.joints else 1.0
+        p[_MULTI] = 0.0 if self.n_actions == 2 * self.joints else 1.0  # single joints only
         p[_COUNTS] = table.shape[0]
         p[_COUNTS + 1] = points.shape[0]
         followed = _TABLE + MAX_JOINTS * table.shape[0]
