@@ -115,7 +115,7 @@ def nearest(pot, obs):
     at = 0
     for i in range(pot.points.shape[0]):
         d = 0.0
-        for j in range(obs.shape[0]):
+        for j in range(pot.points.shape[1]):  # the joints (a followed task observes more)
             d += abs(obs[j] - pot.points[i, j])
         v = pot.kappa * d * pot.inv_step + pot.togo[i]
         if v < best:

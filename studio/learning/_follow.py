@@ -3,10 +3,19 @@
 ``ArmReach(actions="follow")`` keeps its demonstrations as paths (:func:`checked_paths`), writes
 their points into the parameter array (:func:`followed_points`, layout in :mod:`._reach_layout`),
 and :func:`._reach.reach_step` moves by :func:`follow` when the follow action is taken.
+
+The follow action's worth is a function of how far following has to go, not of each joint
+alone, so a task that follows paths also observes that: its observation is the joints and then
+the follow cost (:func:`follow_cost`, between 0 and :func:`cost_bound`), tiled on its own
+(:func:`with_cost_group`). Per-joint tiles alone fit the follow action's value poorly under the
+default shaping (a step there pays anything from -31 to +29): measured, 3 demonstrations then
+lowered greedy success from random starts by 14.8 points after 1,000 episodes; with the cost
+observed they do not lower it (package README).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Sequence
 
@@ -15,6 +24,7 @@ from numba import njit
 
 from ._errors import ConfigError
 from ._reach_layout import _COUNTS, _LOWER, _POINT, _STEP, _TABLE, _UPPER, MAX_JOINTS
+from ._tiles import TileCoding
 
 FOLLOW_KAPPA = 2.0
 """How much more a radian off the demonstrated paths costs the follow action than a radian along
@@ -88,6 +98,23 @@ def followed_points(
     return np.asarray(rows, dtype=np.float64).reshape(-1, joints + 2)
 
 
+def cost_bound(lower: np.ndarray, upper: np.ndarray, points: np.ndarray) -> float:
+    """The largest :func:`follow_cost` within the joint limits ``lower``..``upper`` for the
+    followed ``points`` (:func:`followed_points`): the observation space's upper bound."""
+    longest = float(points[:, -1].max()) if len(points) else 0.0
+    return FOLLOW_KAPPA * float(np.linalg.norm(np.asarray(upper) - np.asarray(lower))) + longest
+
+
+def with_cost_group(coding: TileCoding, joints: int) -> TileCoding:
+    """``coding`` for a task that follows paths: its observation's last dimension, the follow
+    cost (index ``joints``), gets a group of its own where ``coding``'s groups leave it out (one
+    group of every dimension, the default, already holds it)."""
+    groups = coding.groups
+    if groups is None or any(joints in group for group in groups):
+        return coding
+    return dataclasses.replace(coding, groups=(*groups, (joints,)))
+
+
 def _path_left(q: np.ndarray, step: float) -> np.ndarray:
     """Per sample of the path ``q``, the length of the path from it to its end (rad, Euclidean),
     measured along the samples :data:`FOLLOW_LENGTH_STEPS` steps apart: along every sample, a
@@ -122,6 +149,25 @@ def max_gap(params, row, state):
 
 
 @njit(nogil=True, cache=True)
+def follow_cost(params, state):
+    """``(i, cost)``: the followed point ``i`` with the least :data:`FOLLOW_KAPPA` x (Euclidean
+    distance from ``state``) + (path from it to its end), and that cost (rad). The first point
+    on ties; ``(0, inf)`` without points."""
+    base = _TABLE + MAX_JOINTS * int(params[_COUNTS])
+    best, cheapest = 0, np.inf
+    for i in range(int(params[_COUNTS + 1])):
+        row = base + _POINT * i
+        d = 0.0
+        for j in range(state.shape[0]):
+            diff = params[row + j] - state[j]
+            d += diff * diff
+        cost = FOLLOW_KAPPA * math.sqrt(d) + params[row + MAX_JOINTS + 1]
+        if cost < cheapest:
+            cheapest, best = cost, i
+    return best, cheapest
+
+
+@njit(nogil=True, cache=True)
 def follow(params, state):
     """The follow action: ``state`` (in place) moves every joint at once, by at most one step
     (max-norm), along the demonstrated paths to their end. It heads for the followed point with
@@ -132,16 +178,7 @@ def follow(params, state):
     it stays."""
     base = _TABLE + MAX_JOINTS * int(params[_COUNTS])
     joints = state.shape[0]
-    best, cheapest = 0, np.inf
-    for i in range(int(params[_COUNTS + 1])):
-        row = base + _POINT * i
-        d = 0.0
-        for j in range(joints):
-            diff = params[row + j] - state[j]
-            d += diff * diff
-        cost = FOLLOW_KAPPA * math.sqrt(d) + params[row + MAX_JOINTS + 1]
-        if cost < cheapest:
-            cheapest, best = cost, i
+    best = follow_cost(params, state)[0]
     step = params[_STEP]
     end = int(params[base + _POINT * best + MAX_JOINTS])
     target = best

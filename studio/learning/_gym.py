@@ -125,7 +125,7 @@ class ArmReachEnv(gymnasium.Env):
             )
         self.task = ArmReach(**task)
         self._params = self.task.params
-        self.observation_space = spaces.Box(self.task.lower, self.task.upper, dtype=np.float64)
+        self.observation_space = spaces.Box(*self.task.observation_bounds, dtype=np.float64)
         self.action_space = spaces.Discrete(self.task.n_actions)
         self.render_mode = None
         self.q = np.ascontiguousarray(self.task.lower + self.task.upper) * 0.5
@@ -148,20 +148,22 @@ class ArmReachEnv(gymnasium.Env):
             self.q = np.ascontiguousarray(q.copy())
         else:
             self.q = np.ascontiguousarray(self.task.random_start(self.np_random))
-        return self.q.copy(), {}
+        return self.task.observe(self.q), {}
 
     def follow(self, q_paths: Sequence[np.ndarray]) -> None:
         """Follow the demonstrated joint paths ``q_paths`` when the task's actions are
         ``"follow"`` and it has none yet (:meth:`ArmReach.with_paths`): the action space gains
-        the follow action. :func:`run_experiments` calls it with its demonstrations."""
+        the follow action, and the observation the follow cost (:meth:`ArmReach.observe`).
+        :func:`run_experiments` calls it with its demonstrations."""
         self.task = self.task.with_paths(q_paths)
         self._params = self.task.params
+        self.observation_space = spaces.Box(*self.task.observation_bounds, dtype=np.float64)
         self.action_space = spaces.Discrete(self.task.n_actions)
 
     def step(self, action: int) -> tuple[NDArray[np.float64], float, bool, bool, dict[str, object]]:
         """Move the action's joints by one step each; ``terminated`` at the goal."""
         reward, terminated = reach_step(self._params, self.q, int(action))
-        return self.q.copy(), float(reward), bool(terminated), False, {}
+        return self.task.observe(self.q), float(reward), bool(terminated), False, {}
 
 
 def register() -> None:

@@ -77,6 +77,7 @@ from ._factored import (
     slot_joints,
     split_reward,
 )
+from ._follow import with_cost_group
 from ._learner import (
     GOLDEN,
     PLANNER_CODE,
@@ -387,8 +388,8 @@ def _run_compiled(task, params, agent, plays, seed, stop, steps_out, updates_out
     n_demos = plays.demo_starts.shape[0]
     dims = plays.starts.shape[1]
     state = np.empty(dims)
-    obs = np.empty(dims)
-    obs_next = np.empty(dims)
+    obs = np.empty(agent.spec.low.shape[0])  # the joints, and a followed task's cost
+    obs_next = np.empty(agent.spec.low.shape[0])
     feats = np.empty(agent.feats.shape[0], np.int64)
     rng = seed
     done = 0
@@ -405,7 +406,7 @@ def _run_compiled(task, params, agent, plays, seed, stop, steps_out, updates_out
             state[:] = plays.starts[episode]
             first = 0
             limit = plays.max_steps
-        observe(task, state, obs)
+        observe(task, params, state, obs)
         active_features(agent.spec, obs, feats)
         phi = potential(plays.potential, obs)
         steps = 0
@@ -416,7 +417,7 @@ def _run_compiled(task, params, agent, plays, seed, stop, steps_out, updates_out
             else:
                 action, rng = _act(agent, feats, plays.epsilon, rng)
             reward, terminal = task_step(task, params, state, action)
-            observe(task, state, obs_next)
+            observe(task, params, state, obs_next)
             reward, phi = shaped(plays.potential, reward, phi, obs_next)
             rng, n = _learn(
                 agent, obs, feats, action, reward, terminal, obs_next, steps > 0, n_plan, rng
@@ -440,14 +441,13 @@ def _greedy_episode(task, params, spec, w, state, max_steps, path):
     Writes each visited state into ``path`` rows (the start first) and returns the number of
     steps taken, negative (``-steps - 1``) when ``max_steps`` ran out before the goal.
     """
-    dims = state.shape[0]
     n_actions = w.shape[1]
-    obs = np.empty(dims)
+    obs = np.empty(spec.low.shape[0])
     feats = np.empty(spec.bases.size, np.int64)
     q = np.empty(n_actions)
     path[0] = state
     for steps in range(max_steps):
-        observe(task, state, obs)
+        observe(task, params, state, obs)
         active_features(spec, obs, feats)
         _q_values(w, feats, q)
         best = 0
@@ -608,13 +608,15 @@ def run_linear_experiments(
     try:
         follow_demonstrations(envs, demonstrations or [])
         task = inspect_env(envs[0], config)
+        if task.reach is not None and task.reach.paths:
+            features = with_cost_group(features, task.reach.joints)
         coder = features.bind(task.low, task.high)
         problem = weight_problem(experiments, coder, task.n_actions)
         if problem:
             raise LearningError(problem)
         dims = int(task.low.shape[0])
         demo_starts, demo_actions = env_demonstrations(demonstrations or [], task)
-        pot = demo_potential(task.reach, demo_starts, demo_actions, dims)
+        pot = demo_potential(task.reach, demo_starts, demo_actions, task.state_dims)
         factors = value_factors(task, coder, pot)
         comp = None if factors is None else factors[0]
         columns = task.n_actions if comp is None else int(comp.max()) + 1

@@ -23,6 +23,7 @@ from numba import njit
 
 from ._config import DynaQConfig
 from ._errors import LearningError
+from ._follow import follow_cost
 from ._reach import ArmReach, reach_step
 
 if TYPE_CHECKING:
@@ -75,14 +76,17 @@ def task_step(task, params, state, action):
 
 
 @njit(nogil=True, cache=True, inline="always")
-def observe(task, state, obs):
-    """The observation the learner sees: the state (Mountain Car rounds it to float32)."""
+def observe(task, params, state, obs):
+    """The observation the learner sees: the state (Mountain Car rounds it to float32); an arm
+    task that follows paths also observes the follow cost (:meth:`._reach.ArmReach.observe`)."""
     if task == TASK_MOUNTAIN_CAR:
         for d in range(state.shape[0]):
             obs[d] = np.float64(np.float32(state[d]))
     else:
         for d in range(state.shape[0]):
             obs[d] = state[d]
+        if obs.shape[0] > state.shape[0]:
+            obs[state.shape[0]] = follow_cost(params, state)[1]
 
 
 # --------------------------------------------------------------------------- set-up
@@ -100,6 +104,12 @@ class EnvTask:
     max_steps: int
     reach: ArmReach | None
     env_id: str | None
+
+    @property
+    def state_dims(self) -> int:
+        """The compiled twin's state size: the arm task's joints (its observation may add the
+        follow cost), else the observation's."""
+        return self.reach.joints if self.reach is not None else int(self.low.shape[0])
 
 
 _PASS_THROUGH_WRAPPERS = ("TimeLimit", "OrderEnforcing", "PassiveEnvChecker")
@@ -187,7 +197,8 @@ def follow_demonstrations(
     for env in envs:
         if paths and type(env.unwrapped) is ArmReachEnv:
             env.unwrapped.follow(paths)
-            env.action_space = env.unwrapped.action_space  # the wrappers read it at creation
+            env.action_space = env.unwrapped.action_space  # the wrappers read them at creation
+            env.observation_space = env.unwrapped.observation_space
 
 
 def _internal_state(env: gymnasium.Env, task: EnvTask, obs: np.ndarray) -> np.ndarray:

@@ -20,7 +20,8 @@ Format ``teach-studio-tile-policy``, version 1: a ``.policy.npz`` archive
 
 Q(s, a) is ``weights[active(s), a].sum()``, where ``active(s)`` follows the formula of
 :mod:`._tiles` from the ``features`` fields alone, so numpy reads and uses a policy without
-Teach Studio::
+Teach Studio (``s`` is the observation, :meth:`._reach.ArmReach.observe`: the joints, and the
+follow cost last for a task that follows paths)::
 
     f = np.load("reach.policy.npz")
     header = json.loads(str(f["header"]))

@@ -54,7 +54,14 @@ from studio.kinematics import Puma560
 
 from ._arm import GOAL_REWARD, STEP_REWARD
 from ._errors import ConfigError, LearningError
-from ._follow import checked_paths, follow, followed_points
+from ._follow import (
+    checked_paths,
+    cost_bound,
+    follow,
+    follow_cost,
+    followed_points,
+    with_cost_group,
+)
 from ._reach_layout import (
     _A,
     _ALPHA,
@@ -355,7 +362,27 @@ class ArmReach:
         """
         singles = tuple((j,) for j in range(self.joints))
         tiles = self.default_tiles if tiles is None else tiles
-        return TileCoding(tilings=tilings, tiles=tiles, size=size, groups=singles)
+        coding = TileCoding(tilings=tilings, tiles=tiles, size=size, groups=singles)
+        return with_cost_group(coding, self.joints) if self.paths else coding
+
+    @cached_property
+    def observation_bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """The box of :meth:`observe`: the joint limits, and with followed paths the follow
+        cost's, 0 to :func:`._follow.cost_bound`."""
+        if not self.paths:
+            return self.lower, self.upper
+        high = cost_bound(
+            self.lower, self.upper, followed_points(self.paths, self.joints, self.step)
+        )
+        return np.append(self.lower, 0.0), np.append(self.upper, high)
+
+    def observe(self, q: Sequence[float] | np.ndarray) -> np.ndarray:
+        """What a learner observes at joint angles ``q``: the joints, and with followed paths
+        then the follow cost (:func:`._follow.follow_cost`; :mod:`._follow` says why)."""
+        state = self._state(q)
+        if not self.paths:
+            return state.copy()
+        return np.append(state, follow_cost(self.params, state)[1])
 
     @cached_property
     def params(self) -> np.ndarray:

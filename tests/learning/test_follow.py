@@ -109,6 +109,51 @@ def test_run_experiments_gives_the_task_its_demonstrations_and_the_policy_keeps_
     assert env.action_space.n == 7
 
 
+def test_a_task_that_follows_paths_observes_its_follow_cost_and_tiles_it_on_its_own():
+    task, path = line_task()
+    env = gymnasium.make(ARM_REACH_ID, **task.to_dict())
+    obs, _ = env.reset(seed=1)
+    q = env.unwrapped.q
+    followed = np.asarray(task.paths[0])
+    left = np.linalg.norm(
+        followed[-1] - followed, axis=1
+    )  # a straight path: the chord is its length
+    assert obs.shape == (4,) and np.array_equal(obs[:3], q)
+    assert obs[3] == pytest.approx(
+        np.min(2.0 * np.linalg.norm(followed - q, axis=1) + left), abs=0.02
+    )
+    assert env.observation_space.contains(obs)
+    assert task.features().groups == ((0,), (1,), (2,), (3,))
+    no_paths = ArmReach(joints=3, actions="follow")
+    assert np.array_equal(no_paths.observe(q), q) and no_paths.features().groups[-1] == (2,)
+    # run_experiments tiles the cost also for a coding made before the task had paths
+    result = run_experiments(
+        lambda: gymnasium.make(ARM_REACH_ID, joints=3, goal=task.goal, actions="follow"),
+        DynaQConfig(planning="zero", max_steps_per_episode=200), 1, 3, 0, [path],
+        no_paths.features(),
+    )  # fmt: skip
+    assert result.coder.coding.groups[-1] == (3,) and result.coder.spec.low.shape == (4,)
+
+
+class PythonLoop(gymnasium.Wrapper):
+    """Any wrapper of its own makes run_experiments step the environment from Python."""
+
+
+def test_the_compiled_kernel_observes_the_follow_cost_as_the_environment_does():
+    task, _ = line_task()
+    config = DynaQConfig(planning="full", planning_steps=3, max_steps_per_episode=300)
+    runs = [
+        run_experiments(make, config, 1, 4, 2, features=task.features(), workers=1)
+        for make in (
+            lambda: gymnasium.make(ARM_REACH_ID, **task.to_dict()),
+            lambda: PythonLoop(gymnasium.make(ARM_REACH_ID, **task.to_dict())),
+        )
+    ]
+    assert runs[0].compiled and not runs[1].compiled
+    assert np.array_equal(runs[0].steps, runs[1].steps)
+    assert np.array_equal(runs[0].weights, runs[1].weights)
+
+
 def test_a_policy_taught_to_follow_its_demonstration_moves_like_it():
     """One sample demonstration, 3,000 episodes, no planning: the follow policy's rollout from
     the demonstration's start lies within 0.05 rad a sample of it; one joint per action's, a
