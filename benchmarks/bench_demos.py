@@ -1,7 +1,7 @@
 """Do joint-path demonstrations speed up the continuous arm task? Paired seeds, 95% intervals.
 
 ``python benchmarks/bench_demos.py [--pairs 6] [--episodes 1000] [--joints 6]`` measures, through
-``run_experiments`` (zero planning, the paper's alpha, gamma and epsilon, an episode cap of
+``run_experiments`` (zero planning unless ``--planning-steps``, the paper's alpha, gamma and epsilon, an episode cap of
 3,000 steps), for each pair ``k``: 3 straight joint-space demonstrations from random starts to
 the goal and 200 held-out random starts, drawn from ``default_rng([k, joints])``; the run with
 and the run without demonstrations share the seed ``k`` (the same start states, the same draws).
@@ -17,9 +17,11 @@ and the run without demonstrations share the seed ``k`` (the same start states, 
 4. Variants of the demonstrations' potential (``--variants``): its weight and kappa
    (:mod:`studio.learning._demo_shaping`), and the replay alone (weight 0, the earlier method).
 5. ``--long N``: greedy success with demonstrations under the paper's reward after N episodes.
-6. ``--actions SET``: every run with that action set (default: the task's default) and its
-   default features; with ``follow`` the demonstrations are also the paths its follow action
-   follows (without demonstrations it moves one joint per action, on the same features).
+6. ``--actions SET``: every run with that action set (default: the task's default, ``follow``)
+   and its default features; with ``follow`` the demonstrations are also the paths its follow
+   action follows (without demonstrations it moves one joint per action, on the same features).
+7. ``--planning-steps N``: every run with full planning of N steps (the studio's default is
+   100) instead of none.
 
 Each figure is the mean over pairs with a 95% t interval of the paired difference or ratio. The
 machine may be shared: the figures are counts (steps, successes), not times, so load does not
@@ -48,6 +50,7 @@ DEMOS = 3
 STARTS = 200
 FIRST_OWN = 20
 ACTIONS: dict[str, str] = {}  # the action set of every run, when --actions names one
+PLANNING: dict[str, object] = {"planning": "zero"}  # every run's planning (--planning-steps)
 SECTIONS = ("paper", "other-goal", "default", "long")
 
 
@@ -105,7 +108,7 @@ def one_run(joints, shaping, episodes, seed, demos):
     task = ArmReach(joints=joints, shaping=shaping, **ACTIONS)
     result = run_experiments(
         lambda: gymnasium.make("TeachStudio/ArmReach-v0", joints=joints, shaping=shaping, **ACTIONS),
-        DynaQConfig(planning="zero", max_steps_per_episode=CAP),
+        DynaQConfig(**PLANNING, max_steps_per_episode=CAP),
         1, episodes, seed, demos, task.features(), workers=1,
     )  # fmt: skip
     starts = np.random.default_rng([seed, joints, 7]).uniform(
@@ -180,7 +183,12 @@ def main() -> None:
         "--long", type=int, default=0, help="also greedy success with demonstrations after N"
     )
     parser.add_argument("--actions", choices=ACTION_SETS, help="every run's action set")
+    parser.add_argument(
+        "--planning-steps", type=int, default=0, help="full planning with N steps (0: none)"
+    )
     args = parser.parse_args()
+    if args.planning_steps > 0:
+        PLANNING.update(planning="full", planning_steps=args.planning_steps)
     if args.actions:
         ACTIONS["actions"] = args.actions
     j, n, pairs = args.joints, args.episodes, range(args.first, args.first + args.pairs)

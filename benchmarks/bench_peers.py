@@ -66,6 +66,7 @@ from studio.learning import (
     run_experiments,
 )
 from studio.learning._gym import ARM_REACH_ID
+from studio.learning._linear import greedy_success
 from studio.learning._reach import reach_step
 
 STARTS = 200
@@ -87,6 +88,11 @@ STUDIO: dict[str, tuple[DynaQConfig, dict | None]] = {
     "studio, 32 tilings x 8 tiles": (DynaQConfig(), WIDE_TILES),
     "studio, 32 tilings x 8 tiles, 30 planning steps": (DynaQConfig(planning_steps=30), WIDE_TILES),
 }
+STUDIO_DEMOS: dict[str, DynaQConfig] = {
+    "studio defaults, 3 demonstrations": DynaQConfig(),
+    "studio, 10 planning steps, 3 demonstrations": DynaQConfig(planning_steps=10),
+}
+"""Taught by demonstrations first (:func:`studio_demos_trace`); the peers get none."""
 
 
 @dataclass(frozen=True)
@@ -221,6 +227,51 @@ def studio_trace(
         if not same or compiled[-1] < steps[episodes - 1]:
             raise AssertionError("the compiled kernel and the Python loop learnt differently")
         trace.cpu = [cpu * trace.steps[hit] / compiled.sum()] * len(trace.steps)
+    return trace
+
+
+def studio_demos_trace(
+    joints: int, config: DynaQConfig, seed: int, budget: int, stop_at_target: bool = False
+) -> Trace:
+    """The studio's learner taught by 3 straight demonstrations from random starts
+    (``bench_demos.demonstrations`` of the seed: the same as there), its default actions
+    following them. Greedy success is judged at the end of the first episode at or past every
+    ``RHYTHM`` real steps, on a compiled run of that many episodes: a run's first E episodes
+    learn the same whatever comes after (checked at every judgement), so no Python loop is
+    needed to stop it there. The demonstrations' steps count as real steps."""
+    from bench_demos import demonstrations
+
+    task = ArmReach(joints=joints)
+    demos = demonstrations(task, seed)
+    starts = held_out_starts(joints)
+    features = task.features()
+
+    def run(episodes: int):
+        return run_experiments(
+            lambda: gymnasium.make(ARM_REACH_ID, joints=joints),
+            config, 1, episodes, seed, demos, features, workers=1,
+        )  # fmt: skip
+
+    trace, episodes, mark = Trace(), 64, RHYTHM[joints]
+    steps = run(episodes).steps[0]
+    while mark <= budget:
+        while steps.sum() < mark:
+            episodes *= 2
+            steps = run(episodes).steps[0]
+        upto = int(np.searchsorted(np.cumsum(steps), mark)) + 1
+        cpu = time.process_time()
+        result = run(upto)
+        cpu = time.process_time() - cpu
+        if not np.array_equal(result.steps[0], steps[:upto]):
+            raise AssertionError("a shorter run learnt differently from the longer one's start")
+        ok = greedy_success(result.task, result.coder, result.weights[0], starts, CAP)
+        trace.steps.append(int(steps[:upto].sum()))
+        trace.success.append(float(ok.mean()))
+        trace.cpu.append(cpu)
+        progress(f"studio with demonstrations seed {seed}", trace)
+        if stop_at_target and trace.success[-1] >= SUCCESS:
+            break
+        mark = trace.steps[-1] + RHYTHM[joints]
     return trace
 
 
@@ -440,10 +491,11 @@ def main(argv: list[str] | None = None) -> list[Row]:
         args.joints, args.seeds, args.studio_only = [3], 1, True
         args.learners = args.learners or ["studio defaults", "32 tilings"]
     peers = {} if args.studio_only else PEERS
-    studio = STUDIO
+    studio, studio_demos = STUDIO, STUDIO_DEMOS
     if args.learners is not None:
         peers = {k: v for k, v in peers.items() if any(p in k for p in args.learners)}
         studio = {k: v for k, v in studio.items() if any(p in k for p in args.learners)}
+        studio_demos = {k: v for k, v in studio_demos.items() if any(p in k for p in args.learners)}
     if peers and not have_sb3():
         print(f"Stable-Baselines3 is not installed: measuring the studio only ({INSTALL} adds it).")
         peers = {}
@@ -463,6 +515,12 @@ def main(argv: list[str] | None = None) -> list[Row]:
         for name, (config, coding) in studio.items():
             traces = [
                 studio_trace(joints, config, s, budget, coding, args.stop_at_target) for s in seeds
+            ]
+            rows.append(Row(name, traces))
+            print(rows[-1].line(), flush=True)
+        for name, config in studio_demos.items():
+            traces = [
+                studio_demos_trace(joints, config, s, budget, args.stop_at_target) for s in seeds
             ]
             rows.append(Row(name, traces))
             print(rows[-1].line(), flush=True)

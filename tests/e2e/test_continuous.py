@@ -204,22 +204,20 @@ def test_a_continuous_policy_is_listed_watched_uploaded_and_downloaded_in_the_po
     assert not page.errors  # type: ignore[attr-defined]
 
 
-def test_a_run_that_follows_its_demonstration_is_asked_for_and_started_from_the_page(
+def test_a_run_that_follows_its_demonstration_is_the_default_and_started_from_the_page(
     page: Any, studio_server: Studio
 ) -> None:
-    """Actions "follow the demonstrations": Start without a demonstration ticked says what is
-    missing; with one it trains, and the run keeps the choice."""
+    """The default actions, "one joint, or follow the demonstrations": with a demonstration
+    ticked the run trains with the follow action and keeps the choice."""
     name = "e2e-follow"
     page.click("[data-testid='train-defaults']")
     page.select_option("[data-testid='train-task']", "arm-reach")
-    page.select_option("[data-testid='train-actions']", "follow")
+    actions = page.locator("[data-testid='train-actions']")
+    assert actions.input_value() == "follow"  # the learning package's default, through /api/config
+    assert "follow the demonstrations" in actions.locator("option:checked").inner_text()
     _small_run(page, name, episodes=20)
     demo = page.locator("[data-testid='train-demo'][value='sample-reach-1']")
     try:
-        page.click("[data-testid='train-start']")
-        error = page.locator("[data-testid='train-error']")
-        error.wait_for(timeout=T)
-        assert "no demonstration is picked" in error.inner_text()
         demo.check()
         page.click("[data-testid='train-start']")
 

@@ -51,9 +51,12 @@ def test_each_action_set_has_its_size_and_begins_with_the_one_before(joints):
         assert single[2 * j, j] == 1 and single[2 * j + 1, j] == -1
 
 
-def test_the_default_moves_one_joint_per_action():
-    assert ArmReach().actions == "single" == REACH_DEFAULTS["actions"]
-    assert ArmReach(joints=6).n_actions == 12
+def test_the_default_moves_one_joint_per_action_and_follows_demonstrations_when_given():
+    assert ArmReach().actions == "follow" == REACH_DEFAULTS["actions"]
+    assert ArmReach(joints=6).n_actions == 12  # without demonstrations: one joint per action
+    goal = np.asarray(ArmReach(joints=6).goal)
+    path = np.linspace(goal - 0.3, goal, 20)
+    assert ArmReach(joints=6).with_paths([path]).n_actions == 13
 
 
 def test_a_diagonal_move_changes_two_joints_in_one_step():

@@ -182,10 +182,10 @@ def test_a_policy_taught_to_follow_its_demonstration_moves_like_it():
     assert cards["single"].dtw_rad > 0.1 and cards["single"].policy.together == 0.0
 
 
-def test_bad_paths_and_a_follow_run_without_demonstrations_are_refused_in_one_sentence():
+def test_bad_paths_are_refused_in_one_sentence_and_a_run_without_demonstrations_moves_one_joint():
     _, path = line_task()
     with pytest.raises(ConfigError, match='actions="follow"'):
-        ArmReach(joints=3, paths=(path,))
+        ArmReach(joints=3, actions="single", paths=(path,))
     with pytest.raises(ConfigError, match=r"Path 0 has shape \(4,\)"):
         ArmReach(joints=3, actions="follow", paths=((1.0, 2.0, 3.0, 4.0),))
     with pytest.raises(ConfigError, match="Path 0 holds NaN"):
@@ -202,9 +202,9 @@ def test_bad_paths_and_a_follow_run_without_demonstrations_are_refused_in_one_se
             [nan_demo],
             ArmReach(joints=3, actions="follow").features(),
         )
-    with pytest.raises(ConfigError) as err:
-        resolve_run(RunRequest(task="arm-reach", reach={"actions": "follow"}, experiments=1))
-    assert "no demonstration is picked" in err.value.by_field["actions"]
+    # the default action set: without demonstrations a run moves one joint per action
+    record = resolve_run(RunRequest(task="arm-reach", experiments=1))
+    assert record.arm_reach().actions == "follow" and record.arm_reach().n_actions == 12
 
 
 def test_following_from_anywhere_reaches_the_goal_without_going_round_in_circles():

@@ -120,17 +120,17 @@ def test_a_six_joint_run_reaches_the_goal_and_exports_a_policy_that_rolls_out(tm
         lambda: gymnasium.make(ARM_REACH_ID, joints=6), config, 1, 300, 0,
         demonstrations=demos, features=task.features(),
     )  # fmt: skip
-    assert result.compiled and result.task == task
+    assert result.compiled and result.task == task.with_paths(demos)  # it follows them
     assert (result.steps[0, :3] < 2000).all()  # the demonstrations reach the goal
     starts = np.array([d[0] for d in demos] + [task.random_start(rng) for _ in range(40)])
-    reached = greedy_success(task, result.coder, result.weights[0], starts, 2000)
+    reached = greedy_success(result.task, result.coder, result.weights[0], starts, 2000)
     assert reached.any()
     start = starts[int(np.argmax(reached))]
     policy_path = tmp_path / "reach.policy.npz"
     save_tile_policy(policy_path, result, 0)
     policy = load_any_policy(policy_path)
     assert isinstance(policy, TilePolicyFile)
-    assert np.array_equal(policy.weights, result.weights[0]) and policy.task == task
+    assert np.array_equal(policy.weights, result.weights[0]) and policy.task == result.task
     degrees = ",".join(f"{x:.9f}" for x in np.degrees(start))
     out = tmp_path / "reach.rollout.csv"
     assert main(["export", str(policy_path), f"--start-deg={degrees}", "--out", str(out)]) == 0
@@ -158,7 +158,7 @@ def test_a_continuous_run_folder_trains_saves_and_reads_back(tmp_path):
     assert np.allclose(again.record.demonstrations[0], demo)  # the joint path, not grid states
     assert np.array_equal(again.steps(), result.steps)
     policy = load_any_policy(run.policy_path)
-    assert isinstance(policy, TilePolicyFile) and policy.task == task
+    assert isinstance(policy, TilePolicyFile) and policy.task == task.with_paths([demo])
     with pytest.raises(LearningError, match="leaves joint 1's limits at sample 0"):
         RunRecord.for_arm_reach(task, task.features(), config, 2, 6, 0, [demo + 3.0])
 

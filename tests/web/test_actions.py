@@ -7,7 +7,7 @@ from tests.web.test_runs_create import PAGE_REACH
 
 
 def test_the_page_offers_the_action_set_and_a_run_keeps_it(client):
-    assert client.get("/api/config").json()["training"]["actions"] == "single"
+    assert client.get("/api/config").json()["training"]["actions"] == "follow"
     body = {**PAGE_REACH, "actions": "pairs", "episodes": 2, "experiments": 1}
     r = client.post("/api/runs", json=body)
     assert r.status_code == 201, r.text
@@ -18,7 +18,7 @@ def test_the_page_offers_the_action_set_and_a_run_keeps_it(client):
     assert r.json()["detail"].startswith("actions is 'diagonal'; give 'single', 'pairs', 'all'")
 
 
-def test_a_follow_run_follows_its_demonstrations_and_one_without_any_is_refused(client):
+def test_a_follow_run_follows_its_demonstrations_and_one_without_any_moves_one_joint(client):
     body = {**PAGE_REACH, "actions": "follow", "episodes": 3, "experiments": 1}
     r = client.post("/api/runs", json={**body, "demonstrations": ["sample-reach-1"]})
     assert r.status_code == 201, r.text
@@ -29,6 +29,8 @@ def test_a_follow_run_follows_its_demonstrations_and_one_without_any_is_refused(
     watched = client.post("/api/watch", json={"run": run["id"]})
     assert watched.status_code == 200, watched.text
     assert watched.json()["likeness"]["name"] == "sample-reach-1"  # scored against what it follows
-    r = client.post("/api/runs", json=body)
-    assert r.status_code == 422
-    assert "no demonstration is picked" in r.json()["detail"]
+    r = client.post("/api/runs", json=body)  # without any: one joint per action
+    assert r.status_code == 201, r.text
+    alone = wait_run(client, r.json()["id"])
+    listed = next(p for p in client.get("/api/policies").json() if p["name"] == alone["id"])
+    assert alone["status"] == "done" and "paths" not in listed["task"]
