@@ -27,6 +27,10 @@ The learners:
   learner steps it from Python; that loop learns exactly as the compiled kernel does (asserted
   here: the per-episode steps match), and the CPU figure is the compiled kernel's, re-run to the
   episode where 95% was reached and prorated to the step.
+- **studio taught by 3 demonstrations** (``STUDIO_DEMOS``): the same learner given
+  ``bench_demos.py``'s 3 straight demonstrations of the seed first, its default actions following
+  them, judged on compiled runs cut at each checkpoint (:func:`studio_demos_trace`); the
+  demonstrations' steps count as real steps.
 - **SB3 DQN and PPO** (``pip install -e .[peers]``), one torch thread, observations rescaled to
   [-1, 1] (the same box the studio's tile coder is given). Settings from the RL Zoo's tuned
   hyperparameters for discrete-action classic-control tasks (``rl-baselines3-zoo/hyperparams``,

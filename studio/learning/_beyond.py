@@ -133,7 +133,8 @@ def measure(
     for n in episodes:
         result = run(make, config, experiments, n, seed, demos, task.features(), workers=workers)
         success = [
-            float(greedy_success(task, result.coder, w, starts, cap).mean()) for w in result.weights
+            float(greedy_success(result.task, result.coder, w, starts, cap).mean())
+            for w in result.weights
         ]
         budgets.append(
             {

@@ -22,7 +22,7 @@ from collections.abc import Sequence
 import numpy as np
 from numba import njit
 
-from ._errors import ConfigError
+from ._errors import ConfigError, LearningError
 from ._reach_layout import _COUNTS, _LOWER, _POINT, _STEP, _TABLE, _UPPER, MAX_JOINTS
 from ._tiles import TileCoding
 
@@ -113,6 +113,20 @@ def with_cost_group(coding: TileCoding, joints: int) -> TileCoding:
     if groups is None or any(joints in group for group in groups):
         return coding
     return dataclasses.replace(coding, groups=(*groups, (joints,)))
+
+
+def check_observed(feature_dims: int, joints: int, observed: int) -> None:
+    """Refuse features of ``feature_dims`` values for a task of ``joints`` joints that observes
+    ``observed`` values (with followed paths, the follow cost after the joints). A follow policy
+    written before the cost was observed has joint features only: it rolls out as trained.
+
+    Raises:
+        LearningError: one sentence naming both counts and the fix.
+    """
+    if feature_dims not in (joints, observed):
+        raise LearningError(
+            f"The features observe {feature_dims} values but the task {observed}; roll the weights out on the task they were learned on (the run's result.task)."
+        )
 
 
 def _path_left(q: np.ndarray, step: float) -> np.ndarray:

@@ -77,7 +77,7 @@ from ._factored import (
     slot_joints,
     split_reward,
 )
-from ._follow import with_cost_group
+from ._follow import check_observed, with_cost_group
 from ._learner import (
     GOLDEN,
     PLANNER_CODE,
@@ -747,7 +747,11 @@ def greedy_rollout(
     """The greedy policy's path on the arm task from ``start``: ``(states (K + 1, joints), reached)``.
 
     Ties go to the lowest action, so a rollout is deterministic.
+
+    Raises:
+        LearningError: features of another observation than ``task``'s.
     """
+    check_observed(int(coder.spec.low.shape[0]), task.joints, len(task.observation_bounds[0]))
     state = np.array(start, dtype=np.float64)
     path = np.empty((max_steps + 1, task.joints))
     steps = _greedy_episode(
@@ -766,7 +770,12 @@ def greedy_success(
     starts: np.ndarray,
     max_steps: int,
 ) -> np.ndarray:
-    """Per start ``(N, joints)``: whether the greedy policy reaches the goal within ``max_steps``."""
+    """Per start ``(N, joints)``: whether the greedy policy reaches the goal within ``max_steps``.
+
+    Raises:
+        LearningError: features of another observation than ``task``'s.
+    """
+    check_observed(int(coder.spec.low.shape[0]), task.joints, len(task.observation_bounds[0]))
     out = np.zeros(starts.shape[0], np.bool_)
     _success_many(
         task.params, coder.spec, np.ascontiguousarray(weights, np.float64),

@@ -109,9 +109,9 @@ def test_a_continuous_run_trains_from_the_page_is_watched_and_downloaded(
     assert not page.is_visible("[data-testid='export-error']")
     policy = load_any_policy(target)
     assert isinstance(policy, TilePolicyFile) and policy.task is not None
-    # the continuous task's default action set moves one joint per action: 2J = 6
-    assert policy.task.joints == 3 and policy.task.actions == "single"
-    assert policy.weights.shape[1] == policy.task.n_actions == 6
+    # the default action set: one joint per action (2J = 6) and one along the ticked demonstration
+    assert policy.task.joints == 3 and policy.task.actions == "follow" and policy.task.paths
+    assert policy.weights.shape[1] == policy.task.n_actions == 7
     assert not page.errors  # type: ignore[attr-defined]
 
 

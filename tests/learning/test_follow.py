@@ -23,6 +23,7 @@ from studio.learning import (
     run_experiments,
 )
 from studio.learning._gym import ARM_REACH_ID
+from studio.learning._linear import greedy_success
 from studio.learning._linear_policy import save_tile_policy
 from studio.learning._reach import reach_step
 
@@ -133,6 +134,8 @@ def test_a_task_that_follows_paths_observes_its_follow_cost_and_tiles_it_on_its_
         no_paths.features(),
     )  # fmt: skip
     assert result.coder.coding.groups[-1] == (3,) and result.coder.spec.low.shape == (4,)
+    with pytest.raises(LearningError, match="observe 4 values but the task 3"):
+        greedy_success(no_paths, result.coder, result.weights[0], q[None], 10)  # not result.task
 
 
 class PythonLoop(gymnasium.Wrapper):
