@@ -606,6 +606,9 @@ def run_linear_experiments(
     seed, workers, live = check_run_arguments(config, experiments, episodes, seed, workers, live)
     envs = [make_env(env, e) for e in range(experiments)]
     try:
+        # the demonstrations as given are checked (one sentence naming the one at fault) before
+        # a task that follows them takes them as its paths
+        env_demonstrations(demonstrations or [], inspect_env(envs[0], config))
         follow_demonstrations(envs, demonstrations or [])
         task = inspect_env(envs[0], config)
         if task.reach is not None and task.reach.paths:

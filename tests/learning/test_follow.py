@@ -205,6 +205,13 @@ def test_bad_paths_are_refused_in_one_sentence_and_a_run_without_demonstrations_
             [nan_demo],
             ArmReach(joints=3, actions="follow").features(),
         )
+    with pytest.raises(
+        LearningError, match=r"Demonstration 0 has shape \(0, 3\)"
+    ):  # a zero-length cut
+        run_experiments(
+            lambda: gymnasium.make(ARM_REACH_ID, joints=3), DynaQConfig(planning="zero"), 1, 2, 0,
+            [np.zeros((0, 3))], ArmReach(joints=3).features(),
+        )  # fmt: skip
     # the default action set: without demonstrations a run moves one joint per action
     record = resolve_run(RunRequest(task="arm-reach", experiments=1))
     assert record.arm_reach().actions == "follow" and record.arm_reach().n_actions == 12
