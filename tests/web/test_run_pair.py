@@ -43,6 +43,10 @@ def test_a_continuous_twin_keeps_the_demonstrations_goal(client):
     goal = [config_of(client, run)["task"]["goal"] for run in (taught, bare)]
     np.testing.assert_allclose(goal[1], goal[0])
     assert bare["name"] != taught["name"] or not taught["name"]
+    # the default actions follow the demonstration; the twin, without any, moves one joint
+    listed = {p["name"]: p["task"] for p in client.get("/api/policies").json()}
+    assert listed[taught["id"]]["actions"] == listed[bare["id"]]["actions"] == "follow"
+    assert listed[taught["id"]]["paths"] == 1 and "paths" not in listed[bare["id"]]
 
 
 def test_a_pair_needs_a_demonstration_and_a_bad_field_queues_neither(client):
