@@ -24,7 +24,7 @@ from studio.learning import (
 )
 from studio.learning._gym import ARM_REACH_ID
 from studio.learning._linear import greedy_success
-from studio.learning._linear_policy import save_tile_policy
+from studio.learning._linear_policy import rollout_tile_policy, save_tile_policy
 from studio.learning._reach import reach_step
 
 SAMPLES = Path(__file__).resolve().parents[2] / "studio" / "samples"
@@ -136,6 +136,20 @@ def test_a_task_that_follows_paths_observes_its_follow_cost_and_tiles_it_on_its_
     assert result.coder.coding.groups[-1] == (3,) and result.coder.spec.low.shape == (4,)
     with pytest.raises(LearningError, match="observe 4 values but the task 3"):
         greedy_success(no_paths, result.coder, result.weights[0], q[None], 10)  # not result.task
+
+
+def test_a_follow_policy_from_before_the_cost_was_observed_rolls_out_on_its_joint_features(
+    tmp_path,
+):
+    """Its features tile the joints alone: the rollout observes the joints only, as in training."""
+    task, _ = line_task()
+    coder = ArmReach(joints=3).features(tilings=4, tiles=6).bind(task.lower, task.upper)
+    weights = np.zeros((coder.size, task.n_actions))
+    weights[:, task.n_actions - 1] = 1.0  # always follow
+    policy = TilePolicyFile(coder=coder, weights=weights, config=DynaQConfig(), task=task)
+    start = np.asarray(task.paths[0][0]) + 0.05
+    times, q, reached = rollout_tile_policy(policy, start, 50.0)
+    assert reached and np.allclose(q[-1, :3], task.goal[:3], atol=task.step)
 
 
 class PythonLoop(gymnasium.Wrapper):
