@@ -99,8 +99,8 @@ def followed_points(
 
 
 def cost_bound(lower: np.ndarray, upper: np.ndarray, points: np.ndarray) -> float:
-    """The largest :func:`follow_cost` within the joint limits ``lower``..``upper`` for the
-    followed ``points`` (:func:`followed_points`): the observation space's upper bound."""
+    """An upper bound on :func:`follow_cost` within the joint limits ``lower``..``upper`` for
+    the followed ``points`` (:func:`followed_points`): the observation space's."""
     longest = float(points[:, -1].max()) if len(points) else 0.0
     return FOLLOW_KAPPA * float(np.linalg.norm(np.asarray(upper) - np.asarray(lower))) + longest
 
