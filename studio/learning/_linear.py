@@ -99,8 +99,7 @@ from ._learner import (
 from ._linear_env import (
     TASK_REACH,
     env_demonstrations,
-    follow_demonstrations,
-    inspect_env,
+    followed_task,
     make_env,
     observe,
     reset_seed,
@@ -606,11 +605,7 @@ def run_linear_experiments(
     seed, workers, live = check_run_arguments(config, experiments, episodes, seed, workers, live)
     envs = [make_env(env, e) for e in range(experiments)]
     try:
-        # the demonstrations as given are checked (one sentence naming the one at fault) before
-        # a task that follows them takes them as its paths
-        env_demonstrations(demonstrations or [], inspect_env(envs[0], config))
-        follow_demonstrations(envs, demonstrations or [])
-        task = inspect_env(envs[0], config)
+        task = followed_task(envs, config, demonstrations or [])
         if task.reach is not None and task.reach.paths:
             features = with_cost_group(features, task.reach.joints)
         coder = features.bind(task.low, task.high)

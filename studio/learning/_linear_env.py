@@ -201,6 +201,19 @@ def follow_demonstrations(
             env.observation_space = env.unwrapped.observation_space
 
 
+def followed_task(
+    envs: Sequence[gymnasium.Env],
+    config: DynaQConfig,
+    demonstrations: Sequence[Sequence[int] | np.ndarray],
+) -> EnvTask:
+    """The run's task: the demonstrations as given are checked first (one sentence naming the
+    one at fault), then an arm task that follows demonstrations takes them as its paths
+    (:func:`follow_demonstrations`)."""
+    env_demonstrations(demonstrations, inspect_env(envs[0], config))
+    follow_demonstrations(envs, demonstrations)
+    return inspect_env(envs[0], config)
+
+
 def _internal_state(env: gymnasium.Env, task: EnvTask, obs: np.ndarray) -> np.ndarray:
     """The state a compiled twin steps from, right after ``env.reset``."""
     raw = env.unwrapped
