@@ -18,14 +18,14 @@ at the goal is redrawn).
 
 Why one joint per action, and beside it the follow action when there are demonstrations, is the
 default (:data:`DEFAULT_ACTIONS`; measured in ``benchmarks/bench_actions.py``,
-``benchmarks/bench_robots_learning.py`` and ``benchmarks/bench_demos.py``): with one weight column per action, each multi-joint move
-learned only from its own visits and the multi-joint sets learned far worse; the learner's
-factored action value (:mod:`._factored`) shares what each joint's part of a move learned among
-every move that has it, and with it the pairs learn in fewer real steps and move joints together,
-but their greedy success is not steady over training (:data:`DEFAULT_ACTIONS`). Every joint
--1/0/+1 at once (3**J - 1 actions, 728 for six joints) overshoots near the goal even so. There is
-no "stay" action: it never helps a reach, and with function
-approximation its estimate can stick above the moves' and freeze the arm.
+``benchmarks/bench_robots_learning.py`` and ``benchmarks/bench_demos.py``): with one weight
+column per action, each multi-joint move learned only from its own visits and the multi-joint
+sets learned far worse; the learner's factored action value (:mod:`._factored`) shares what
+each joint's part of a move learned among every move that has it, and with it the pairs learn in
+fewer real steps and move joints together, but their greedy success is not steady over training
+(:data:`DEFAULT_ACTIONS`). Every joint -1/0/+1 at once (3**J - 1 actions, 728 for six joints)
+overshoots near the goal even so. There is no "stay" action: it never helps a reach, and with
+function approximation its estimate can stick above the moves' and freeze the arm.
 
 The goal is judged where a user sees it: the robot's tool frame (the Puma560's DH frame 6) within
 ``position_tolerance`` metres and ``angle_tolerance_deg`` degrees of the goal's tool pose, by
@@ -153,17 +153,18 @@ joints at once (3**J - 1), or one joint or all of them along the demonstrated pa
 order, and ``"follow"`` with the singles."""
 DEFAULT_ACTIONS = "follow"
 """One joint per action, and with demonstrations one more that follows them (without any, the
-task is ``"single"``'s bit for bit). With 3 demonstrations (6 joints, 1,000 episodes, package
-README) it learns its first 20 own episodes in 0.036 of the real steps of a run without them
-under the paper's reward (one joint per action: 0.204) and ends at least as well; under the
-default shaping the demonstrations leave greedy success from random starts where it was (+0.8
-points; after 4,000 episodes -5.9 without planning, -0.1 with the default 100 steps), and a policy taught by one demonstration moves like it (DTW 0.028-0.047 rad a sample,
-one joint per action 0.17-0.39). ``"pairs"``, learned with the factored action value
-(:mod:`._factored`), reaches 95% greedy success in fewer real steps without demonstrations
-(81 k against 321 k at six joints), but its greedy success swings as training goes on: at six
-joints, 2 experiments, Puma560 93% / 78% / 99% / 92% after 500 / 1,000 / 2,000 / 4,000 episodes
-and UR5 70% / 81% / 63% / 42%, where one joint per action ends at 100% on the Puma560, the Panda
-and the UR5. A default that gets worse with more training is the wrong default."""
+task is ``"single"``'s bit for bit). With 3 demonstrations at six joints (package README): under
+the paper's reward its first 20 own episodes take 0.037 of the real steps without them (one
+joint per action: 0.204), 10 points ahead after 1,000 episodes, 3 behind after 4,000; under the
+default shaping greedy success from random starts stays where it was (+0.8 points; after 4,000
+episodes -5.9 without planning, -0.1 with the default 100 steps); a policy taught by one
+demonstration moves like it (DTW 0.028-0.047 rad a sample, one joint per action 0.17-0.39).
+``"pairs"``, learned with the factored action value (:mod:`._factored`), reaches 95% greedy
+success in fewer real steps without demonstrations (81 k against 321 k at six joints), but its
+greedy success swings as training goes on: at six joints, 2 experiments, Puma560 93% / 78% /
+99% / 92% after 500 / 1,000 / 2,000 / 4,000 episodes and UR5 70% / 81% / 63% / 42%, where one
+joint per action ends at 100% on the Puma560, the Panda and the UR5. A default that gets worse
+with more training is the wrong default."""
 STORED_ACTIONS = "single"
 """What a task stored before ``actions`` existed moves: one joint per action."""
 LIMIT_SLACK_RAD = 1e-9
