@@ -18,6 +18,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numba import njit
@@ -25,6 +26,10 @@ from numba import njit
 from ._errors import ConfigError, LearningError
 from ._reach_layout import _COUNTS, _LOWER, _POINT, _STEP, _TABLE, _UPPER, MAX_JOINTS
 from ._tiles import TileCoding
+
+if TYPE_CHECKING:
+    from ._reach import ArmReach
+    from ._tiles import TileCoder
 
 FOLLOW_KAPPA = 2.0
 """How much more a radian off the demonstrated paths costs the follow action than a radian along
@@ -115,17 +120,18 @@ def with_cost_group(coding: TileCoding, joints: int) -> TileCoding:
     return dataclasses.replace(coding, groups=(*groups, (joints,)))
 
 
-def check_observed(feature_dims: int, joints: int, observed: int) -> None:
-    """Refuse features of ``feature_dims`` values for a task of ``joints`` joints that observes
-    ``observed`` values (with followed paths, the follow cost after the joints). A follow policy
-    written before the cost was observed has joint features only: it rolls out as trained.
+def check_observed(task: ArmReach, coder: TileCoder) -> None:
+    """Refuse features bound to another observation than ``task``'s: its joints, and with
+    followed paths the follow cost after them. A follow policy written before the cost was
+    observed has joint features only: it rolls out as trained.
 
     Raises:
         LearningError: one sentence naming both counts and the fix.
     """
-    if feature_dims not in (joints, observed):
+    features, observed = int(coder.spec.low.shape[0]), len(task.observation_bounds[0])
+    if features not in (task.joints, observed):
         raise LearningError(
-            f"The features observe {feature_dims} values but the task {observed}; roll the weights out on the task they were learned on (the run's result.task)."
+            f"The features observe {features} values but the task {observed}; roll the weights out on the task they were learned on (the run's result.task)."
         )
 
 

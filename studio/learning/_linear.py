@@ -749,7 +749,7 @@ def greedy_rollout(
     Raises:
         LearningError: features of another observation than ``task``'s.
     """
-    check_observed(int(coder.spec.low.shape[0]), task.joints, len(task.observation_bounds[0]))
+    check_observed(task, coder)
     state = np.array(start, dtype=np.float64)
     path = np.empty((max_steps + 1, task.joints))
     steps = _greedy_episode(
@@ -773,7 +773,7 @@ def greedy_success(
     Raises:
         LearningError: features of another observation than ``task``'s.
     """
-    check_observed(int(coder.spec.low.shape[0]), task.joints, len(task.observation_bounds[0]))
+    check_observed(task, coder)
     out = np.zeros(starts.shape[0], np.bool_)
     _success_many(
         task.params, coder.spec, np.ascontiguousarray(weights, np.float64),
