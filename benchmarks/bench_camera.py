@@ -33,9 +33,9 @@ ms reads as 2.0 frames/s on either side, which hides differences of up to a fift
 4. The scene's pushes for a camera at the bare package's rate on an idle machine without a GPU
    (3.5 frames/s, lite), landmarks of a known arm motion posted straight to the studio (no
    browser, so the figure does not depend on the machine's load): how many robot poses a second
-   reach a viser client. viser's page draws each in about two frames (the studio limits its
-   frames while a slow stream drives it), in the browser's software-GL process that also runs the
-   pose model.
+   reach a viser client. Beside it, from the studio windows: the frames the page's scene drew
+   for each robot pose (the studio limits its frames while a slow stream drives it, and each is
+   drawn in the browser's software-GL process that also runs the pose model).
 
 On a 2-core machine without a GPU the model runs at a few frames a second and figures swing with
 other work on the machine: read the ratios of neighbouring windows, and rerun.
@@ -303,9 +303,6 @@ def scene_latencies(
     return out, missed
 
 
-FRAMES_PER_SLOW_PUSH = 2
-"""Frames viser's page draws for each pose of a slow stream (the update and its settling), the
-studio's frame limit (``studio/web/_scene_frames.py``) in place of viser's quarter-second burst."""
 FED_RATE_HZ = 3.5
 """The lite model's rate in a bare page on an idle 2-core machine with software WebGL."""
 
@@ -344,6 +341,13 @@ def bare_window(bare: Any, frames: int, timeout_s: float, cpu: ProcessCpu) -> Wi
         timeout_s,
         cpu,
     )
+
+
+def scene_frames_drawn(page: Any) -> int:
+    """Frames the studio page's scene iframe has drawn so far (the studio's frame pacing counts
+    them, ``studio/web/_scene_frames.py``; 0 before any pacing)."""
+    scene = page.frame(url=lambda url: url.startswith(page.get_attribute("#scene", "src")))
+    return int(scene.evaluate("() => window.__studioFramePacing?.frames ?? 0"))
 
 
 def page_frames(bare: Any, page: Any) -> dict[str, str]:
@@ -445,6 +449,7 @@ def main() -> int:
     results: dict[str, dict[str, list[Window]]] = {}
     latency: dict[str, list[float]] = {"landmarks": [], "scene": [], "answer": []}
     missed = 0
+    scene_drawn = [0, 0]  # the scene's frames drawn and its poses, over the studio windows
     idle: list[tuple[float, float]] = []  # (start, end) of the bare windows: the studio is still
     try:
         with sync_playwright() as p:
@@ -484,6 +489,7 @@ def main() -> int:
                             idle.append((t0, time.time()))
                         else:
                             page.evaluate("() => { window.__frames = []; }")
+                            drawn, poses = scene_frames_drawn(page), len(scene.arrivals)
                             http("PUT", base + "/api/source", {"kind": "camera", "side": "right"})
                             w = window(
                                 page,
@@ -495,6 +501,8 @@ def main() -> int:
                                 cpu,
                             )
                             http("PUT", base + "/api/source", IDLE_SOURCE)
+                            scene_drawn[0] += scene_frames_drawn(page) - drawn
+                            scene_drawn[1] += len(scene.arrivals) - poses
                             frames = page.evaluate("() => window.__frames")[WARMUP_FRAMES:]
                             latency["landmarks"] += [
                                 (f["tResult"] - f["body"]["t"]) * 1000 for f in frames
@@ -542,8 +550,12 @@ def main() -> int:
     )
     print(
         f"\nScene pushes for a camera at {fed[0]:.1f} frames/s (landmarks posted, no browser): "
-        f"{fed[1]:.1f} robot poses/s reach the scene; viser's page draws about "
-        f"{fed[1] * FRAMES_PER_SLOW_PUSH:.1f} frames/s for them (at most 2 a pose)"
+        f"{fed[1]:.1f} robot poses/s reach the scene"
+    )
+    frames, poses = scene_drawn
+    print(
+        f"The scene in the studio windows: {frames} frames drawn for {poses} robot poses, "
+        f"{frames / max(poses, 1):.2f} a pose"
     )
     api_ms = [v * 1000 for v in probe.latencies]
     p99 = pct(api_ms, 99)

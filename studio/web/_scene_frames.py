@@ -11,10 +11,12 @@ SwiftShader in the browser's GPU process: about 50 ms of CPU a frame for this sc
   a new pose at most once a second, and the frames after the first show the same pose again,
   in the very process where the camera's pose model runs its WebGL. So while one drives the
   scene, :class:`FramePacer` asks every browser showing the scene to start a frame at most every
-  :data:`SLOW_FRAME_GAP_MS`: the update is drawn, and one frame after it (for what viser
-  finishes after a commit, such as a texture upload), instead of a burst. Between its poses the
-  scene counts as still once nothing was sent for :data:`SLOW_STILL_AFTER_S`, so viser's
-  once-a-second frame is not drawn between them either.
+  :data:`SLOW_FRAME_GAP_MS`, and the scene counts as still once nothing was sent for
+  :data:`SLOW_STILL_AFTER_S`, before that gap is over: each pose is drawn in the one frame that
+  follows it, and neither viser's settle frames nor its once-a-second frame are drawn until the
+  next pose. One frame is enough: the page applies a message as it comes (below), and viser
+  sets a node's pose in the first of its frame hooks, so the frame after a pose draws it (tested
+  by reading what that frame drew against what the scene shows a second later).
 - **A still scene**: when nothing has been sent to the page for :data:`STILL_AFTER_S`, a page
   that has finished loading (:data:`LOADING_S`) is asked to draw at most every
   :data:`STILL_FRAME_GAP_MS`, counted from the frame it drew last. The once-a-second frame then
@@ -47,19 +49,19 @@ from collections.abc import Callable
 
 import viser
 
-SLOW_FRAME_GAP_MS = 250.0
-"""Least time between two frames of viser's page while a slow live stream drives the scene: as
-long as viser's settle window, so an update is drawn in one frame and settled in one more."""
+SLOW_FRAME_GAP_MS = 500.0
+"""Least time between two frames of viser's page while a slow live stream drives the scene: long
+enough that the scene reads as still (:data:`SLOW_STILL_AFTER_S`, and the watch's
+:data:`WATCH_EVERY_S`) before a second frame's turn comes, so a pose is drawn in one frame."""
 STILL_FRAME_GAP_MS = 4000.0
 """Least time between two frames of a page whose scene is still: viser's safety-net frame, once
 every 4 s instead of every second."""
 STILL_AFTER_S = 1.5
 """Nothing sent to the page for this long: its scene is still (viser's settle window after the
 last update, a quarter of a second, is long over)."""
-SLOW_STILL_AFTER_S = 0.3
+SLOW_STILL_AFTER_S = 0.15
 """While a slow stream drives the scene: nothing sent for this long, and its last pose is drawn
-and settled (a frame, and one more :data:`SLOW_FRAME_GAP_MS` later); the scene is still until the
-next pose."""
+(its frame comes at once); the scene is still until the next pose."""
 LOADING_S = 5.0
 """A page that connected less than this long ago is still loading the scene (meshes, shaders):
 it draws freely."""
