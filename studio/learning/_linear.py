@@ -1,7 +1,8 @@
 """Dyna-Q with linear function approximation over tile-coded features.
 
 Q(s, a) is the sum of the weights of s's active features in a's column of a ``(size, actions)``
-table (:mod:`._tiles`). A real step applies the semi-gradient Q-learning update
+table (:mod:`._tiles`; plus a column common to every action on a task that follows
+demonstrations, :mod:`._common_value`). A real step applies the semi-gradient Q-learning update
 
     w[f, a] += (alpha / active) * (r + gamma * max_b Q(s', b) - Q(s, a))   for each active f of s
 
@@ -61,6 +62,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numba import njit
 
+from ._common_value import add_common, learns_common_value, update_common, without_common
 from ._config import MAX_Q_ENTRIES, DynaQConfig
 from ._demo_shaping import demo_potential, no_potential, potential, shaped
 from ._errors import LearningError
@@ -154,6 +156,7 @@ def _q_values(w, feats, out):
         f = feats[i]
         for a in range(n_actions):
             out[a] += w[f, a]
+    add_common(w, feats, out)
 
 
 @njit(nogil=True, cache=True, inline="always")
@@ -169,8 +172,11 @@ def _values(agent, feats, out):
 def _value(agent, feats, action):
     """``Q(s, action)`` under the agent's weights."""
     value = 0.0
+    common = agent.w.shape[1] > agent.qvals.shape[0]  # (the common column, :mod:`._common_value`)
     for i in range(feats.shape[0]):
         value += agent.w[feats[i], action]
+        if common:
+            value += agent.w[feats[i], agent.qvals.shape[0]]
     return value
 
 
@@ -256,8 +262,8 @@ def _td_update(agent, obs, feats_s, action, reward, terminal, obs_next, feats_ne
         _values(agent, feats_next, q)
         target += agent.gamma * _max(q)
     delta = target - _value(agent, feats_s, action)
-    change = agent.step * delta
     w = agent.w
+    change = update_common(w, feats_s, q.shape[0], agent.step * delta)
     for i in range(feats_s.shape[0]):
         w[feats_s[i], action] += change
     return delta
@@ -618,6 +624,8 @@ def run_linear_experiments(
         factors = value_factors(task, coder, pot)
         comp = None if factors is None else factors[0]
         columns = task.n_actions if comp is None else int(comp.max()) + 1
+        common = learns_common_value(task.follows, comp is not None)
+        columns += common
         learned = np.zeros((experiments, coder.size, columns), np.float64)
         agents = [  # each learns into its row of ``learned``, which checkpoints read as it learns
             _new_agent(coder, task.n_actions, dims, config, model_capacity, learned[e], factors)
@@ -637,6 +645,7 @@ def run_linear_experiments(
 
         def so_far() -> LinearResult:
             weights = learned if comp is None else expand(learned, comp, row_joints(coder))
+            weights = without_common(weights) if common else weights
             return result_so_far(
                 LinearResult, live, cpu_seconds, weights, config, seed,
                 weights=weights, coder=coder, task=task.reach, env_id=task.env_id,

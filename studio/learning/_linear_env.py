@@ -104,6 +104,9 @@ class EnvTask:
     max_steps: int
     reach: ArmReach | None
     env_id: str | None
+    follows: bool = False
+    """The arm task, under whatever wrappers, following demonstrated paths (its learner adds a
+    value common to every action, :mod:`._common_value`)."""
 
     @property
     def state_dims(self) -> int:
@@ -183,6 +186,7 @@ def inspect_env(env: gymnasium.Env, config: DynaQConfig) -> EnvTask:
         max_steps,
         reach,
         spec_id,
+        type(raw) is ArmReachEnv and bool(raw.task.paths),
     )
 
 
