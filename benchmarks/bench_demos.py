@@ -40,6 +40,7 @@ import numpy as np
 from scipy import stats
 
 import studio.learning._linear as linear
+import studio.learning._linear_env as linear_env
 from studio.learning import ACTION_SETS, ArmReach, DynaQConfig, LearningError, run_experiments
 from studio.learning._beyond import demonstration_paths
 from studio.learning._demo_shaping import demo_potential
@@ -79,17 +80,20 @@ def potential_variant(weight: float | None, kappa: float | None):
 @contextmanager
 def demonstrations_for(goal_task: ArmReach):
     """Walk the demonstrations with ``goal_task``'s goal (the control: they end elsewhere)."""
-    original = linear.env_demonstrations
+    originals = [(module, module.env_demonstrations) for module in (linear, linear_env)]
 
     def walk(demos, task):
         pairs = [goal_task.demonstration_actions(d, i) for i, d in enumerate(demos)]
         return [p[0] for p in pairs], [p[1] for p in pairs]
 
-    linear.env_demonstrations = walk
+    # both the check of the demonstrations as given and the walk the learner replays
+    for module, _ in originals:
+        module.env_demonstrations = walk
     try:
         yield
     finally:
-        linear.env_demonstrations = original
+        for module, original in originals:
+            module.env_demonstrations = original
 
 
 _WITHOUT: dict[tuple, tuple] = {}

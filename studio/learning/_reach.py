@@ -155,10 +155,11 @@ DEFAULT_ACTIONS = "follow"
 """One joint per action, and with demonstrations one more that follows them (without any, the
 task is ``"single"``'s bit for bit). With 3 demonstrations at six joints (package README): under
 the paper's reward its first 20 own episodes take 0.037 of the real steps without them (one
-joint per action: 0.204), 10 points ahead after 1,000 episodes, 3 behind after 4,000; under the
-default shaping greedy success from random starts stays where it was (+0.8 points; after 4,000
-episodes -5.9 without planning, -0.1 with the default 100 steps); a policy taught by one
-demonstration moves like it (DTW 0.028-0.047 rad a sample, one joint per action 0.17-0.39).
+joint per action: 0.204), 9 points ahead after 1,000 episodes and 4 after 4,000 (0.991); under
+the default shaping greedy success from random starts stays where it was (+2.8 points after
+1,000 episodes, -0.1 after 4,000, no planning; the learner's common value, :mod:`._common_value`);
+a policy taught by one demonstration moves like it (DTW 0.028-0.047 rad a sample, one joint per
+action 0.17-0.39).
 ``"pairs"``, learned with the factored action value (:mod:`._factored`), reaches 95% greedy
 success in fewer real steps without demonstrations (81 k against 321 k at six joints), but its
 greedy success swings as training goes on: at six joints, 2 experiments, Puma560 93% / 78% /
