@@ -30,7 +30,8 @@ The learners:
 - **studio taught by 3 demonstrations** (``STUDIO_DEMOS``): the same learner given
   ``bench_demos.py``'s 3 straight demonstrations of the seed first, its default actions following
   them, judged on compiled runs cut at each checkpoint (:func:`studio_demos_trace`); the
-  demonstrations' steps count as real steps.
+  demonstrations' steps count as real steps. With the defaults, and with 30 or 10 planning steps
+  (with demonstrations, fewer planning steps take fewer real steps at 3 joints).
 - **SB3 DQN and PPO** (``pip install -e .[peers]``), one torch thread, observations rescaled to
   [-1, 1] (the same box the studio's tile coder is given). Settings from the RL Zoo's tuned
   hyperparameters for discrete-action classic-control tasks (``rl-baselines3-zoo/hyperparams``,
@@ -95,6 +96,7 @@ STUDIO: dict[str, tuple[DynaQConfig, dict | None]] = {
 STUDIO_DEMOS: dict[str, DynaQConfig] = {
     "studio defaults, 3 demonstrations": DynaQConfig(),
     "studio, 10 planning steps, 3 demonstrations": DynaQConfig(planning_steps=10),
+    "studio, 30 planning steps, 3 demonstrations": DynaQConfig(planning_steps=30),
 }
 """Taught by demonstrations first (:func:`studio_demos_trace`); the peers get none."""
 

@@ -84,7 +84,7 @@ def test_studio_side_runs_without_sb3(bench, monkeypatch, capsys):
     studio's learner is evaluated on the rhythm and checked against the compiled kernel."""
     monkeypatch.setitem(sys.modules, "stable_baselines3", None)  # as if not installed
     rows = bench.main(
-        ["--joints", "3", "--seeds", "1", "--budget", "3000", "--learners", "30 planning", "DQN"]
+        ["--joints", "3", "--seeds", "1", "--budget", "3000", "--learners", "8 tiles, 30", "DQN"]
     )
     out = capsys.readouterr().out
     assert 'pip install -e ".[peers]"' in out
