@@ -343,20 +343,23 @@ def bare_window(bare: Any, frames: int, timeout_s: float, cpu: ProcessCpu) -> Wi
     )
 
 
+def scene_frame(page: Any) -> Any:
+    """The studio page's scene iframe (viser's page)."""
+    return page.frame(url=lambda url: url.startswith(page.get_attribute("#scene", "src")))
+
+
 def scene_frames_drawn(page: Any) -> int:
     """Frames the studio page's scene iframe has drawn so far (the studio's frame pacing counts
     them, ``studio/web/_scene_frames.py``; 0 before any pacing)."""
-    scene = page.frame(url=lambda url: url.startswith(page.get_attribute("#scene", "src")))
-    return int(scene.evaluate("() => window.__studioFramePacing?.frames ?? 0"))
+    return int(scene_frame(page).evaluate("() => window.__studioFramePacing?.frames ?? 0"))
 
 
 def page_frames(bare: Any, page: Any) -> dict[str, str]:
     """``{DevTools frame id: role}`` of the bare page, the studio page and its scene iframe."""
-    scene = page.frame(url=lambda url: url.startswith(page.get_attribute("#scene", "src")))
     return {
         frame_id(bare.context, bare): "renderer: bare page",
         frame_id(page.context, page): "renderer: studio page",
-        frame_id(page.context, scene): "renderer: scene",
+        frame_id(page.context, scene_frame(page)): "renderer: scene",
     }
 
 
