@@ -1,7 +1,7 @@
 """A value common to every action, for the arm task that follows demonstrations.
 
-On a task that follows demonstrated paths (``ArmReach(actions="follow")`` with paths) the learner
-writes
+On a task that follows demonstrated paths (``ArmReach(actions="follow")`` with paths, under any
+Gymnasium wrappers: ``EnvTask.follows``) the learner writes
 
     Q(s, a) = C(s) + A_a(s),    C(s) = sum_f w[f, n_actions],    A_a(s) = sum_f w[f, a]
 
@@ -44,13 +44,6 @@ points, 0.5 -2.4, 0.25 0.0, 0.1 +1.2. 0.1 scores higher still (under the paper's
 from 1,000 episodes on), but each action's own column then learns at a tenth of the rate, so
 where a single joint beats the demonstrations the policy finds it that much later; 0.25 meets
 every goal with margin."""
-
-
-def learns_common_value(follows: bool, factored: bool) -> bool:
-    """Whether the learner adds a common column: on an arm task that follows paths
-    (``EnvTask.follows``, under any wrappers), learned with a column per action (the factored
-    value of :mod:`._factored` has its own sharing)."""
-    return follows and not factored
 
 
 @njit(nogil=True, cache=True, inline="always")

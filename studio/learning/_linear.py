@@ -62,7 +62,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numba import njit
 
-from ._common_value import add_common, learns_common_value, update_common, without_common
+from ._common_value import add_common, update_common, without_common
 from ._config import MAX_Q_ENTRIES, DynaQConfig
 from ._demo_shaping import demo_potential, no_potential, potential, shaped
 from ._errors import LearningError
@@ -624,7 +624,7 @@ def run_linear_experiments(
         factors = value_factors(task, coder, pot)
         comp = None if factors is None else factors[0]
         columns = task.n_actions if comp is None else int(comp.max()) + 1
-        common = learns_common_value(task.follows, comp is not None)
+        common = task.follows  # (never factored: follow is not in FACTORED_ACTION_SETS)
         columns += common
         learned = np.zeros((experiments, coder.size, columns), np.float64)
         agents = [  # each learns into its row of ``learned``, which checkpoints read as it learns

@@ -266,7 +266,7 @@ def test_the_value_common_to_every_action_is_folded_into_the_ordinary_table():
     plain = np.empty(3)
     _q_values(table, feats, plain)
     assert np.allclose(plain, q)
-    task, path = line_task()
+    task, _ = line_task()
     result = run_experiments(
         lambda: gymnasium.make(ARM_REACH_ID, **task.to_dict()),
         DynaQConfig(planning="zero", max_steps_per_episode=300),
