@@ -2,12 +2,14 @@
 
 ``likeness.json`` in the run folder, written when a run of recorded demonstrations finishes::
 
-    {"format": "teach-studio-likeness", "version": 1, "policy": "policy.policy.npz",
+    {"format": "teach-studio-likeness", "version": 2, "policy": "policy.policy.npz",
      "cards": [{"demonstration": "reach-1", "card": {...LikenessCard.to_dict()...}},
                {"demonstration": "reach-2", "error": "one sentence"}]}
 
 Each card rolls the policy out from that demonstration's own start
 (:func:`policy_likeness_card`); the page's Watch and ``studio export`` score the same way.
+Version 2: each card's ``ldlj`` is the tool path's, low-passed (``_likeness.LDLJ_CUTOFF_HZ``);
+version 1 files hold the joints' LDLJ, unfiltered, which the tape's noise dominated.
 """
 
 from __future__ import annotations
@@ -31,6 +33,8 @@ log = logging.getLogger(__name__)
 LIKENESS_FILE = "likeness.json"
 """The run folder's likeness cards."""
 LIKENESS_FORMAT = "teach-studio-likeness"
+LIKENESS_VERSION = 2
+"""2 since the card's LDLJ is the tool path's, low-passed (1: the joints', unfiltered)."""
 
 
 def likeness_cards(
@@ -59,7 +63,12 @@ def likeness_document(
             cards.append({"demonstration": motion.name, "error": card})
         else:
             cards.append({"demonstration": motion.name, "card": card.to_dict()})
-    return {"format": LIKENESS_FORMAT, "version": 1, "policy": policy_name, "cards": cards}
+    return {
+        "format": LIKENESS_FORMAT,
+        "version": LIKENESS_VERSION,
+        "policy": policy_name,
+        "cards": cards,
+    }
 
 
 def save_run_likeness(

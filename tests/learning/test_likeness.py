@@ -138,8 +138,72 @@ def test_minimum_jerk_is_smoother_than_a_staircase_between_the_same_points():
 
 def test_ldlj_does_not_depend_on_amplitude_or_duration():
     t, q = reach()
-    assert ldlj(t * 3, q * 0.1) == pytest.approx(ldlj(t, q))
+    assert ldlj(t * 3, q * 0.1, cutoff_hz=None) == pytest.approx(ldlj(t, q, cutoff_hz=None))
+    # the low-pass is in hertz, so three times slower loses a little less to it
+    assert ldlj(t * 3, q * 0.1) == pytest.approx(ldlj(t, q), rel=0.01)
     assert math.isnan(ldlj(t, np.zeros_like(q)))
+
+
+def test_the_low_pass_removes_sensor_noise_and_keeps_the_reach():
+    t, q = reach()
+    rng = np.random.default_rng(0)
+    noisy = q + rng.normal(0.0, 0.0002, q.shape)  # white, 0.01 degree a sample at 100 Hz
+    clean = ldlj(t, q)
+    assert ldlj(t, q, cutoff_hz=None) == pytest.approx(clean, abs=0.05)
+    raw = ldlj(t, noisy, cutoff_hz=None)
+    assert raw < clean - 5  # unfiltered, jerk measures the noise
+    assert clean > ldlj(t, noisy) > clean - 0.35 * (clean - raw)
+    # a cutoff at or above the rate's Nyquist frequency leaves the samples as they are
+    assert ldlj(t, noisy, cutoff_hz=50.0) == ldlj(t, noisy, cutoff_hz=None)
+    for bad in (0.0, -1.0, math.nan, "10"):
+        with pytest.raises(LearningError, match="cutoff_hz"):
+            ldlj(t, q, cutoff_hz=bad)
+
+
+@pytest.fixture(scope="module")
+def recorded_reach(tmp_path_factory):
+    """The same simulated reach recorded by a tape with and without its sensor noise:
+    ``{noise_rad: demonstration}``."""
+    from studio.capture import (
+        OperatorConfig,
+        RecordingWriter,
+        extract_demonstration,
+        goal_configuration,
+        read_recording,
+        simulate,
+    )
+    from studio.learning import ArmGrid
+
+    grid, folder, demos = ArmGrid(), tmp_path_factory.mktemp("noise"), {}
+    for noise in (0.002, 0.0):
+        operator = OperatorConfig(noise_rad=noise)
+        sim = simulate(3.5, seed=11, goal=goal_configuration(grid), operator=operator)
+        path = folder / f"reach-{noise}.tape.csv"
+        with RecordingWriter(path, config=sim.config, source="simulator") as writer:
+            writer.write_many(sim.frames)
+        rec = read_recording(path)
+        demos[noise] = extract_demonstration(rec, sim.reach_start / 110, rec.duration, grid=grid)
+    return demos
+
+
+def test_the_card_reads_a_recorded_reach_as_the_same_reach_without_the_tapes_noise(
+    recorded_reach,
+):
+    from studio.learning import puma_tool_positions
+
+    def card_ldlj(demo) -> float:
+        card = likeness_card(
+            demo.times, demo.q_robot, demo.times, demo.q_robot, puma_tool_positions
+        )
+        return card.demonstration.ldlj
+
+    noisy, clean = recorded_reach[0.002], recorded_reach[0.0]
+    np.testing.assert_array_equal(noisy.times, clean.times)
+    assert abs(card_ldlj(noisy) - card_ldlj(clean)) < 0.2 * abs(card_ldlj(clean))
+    # the joint-space form the card used before read the noise: 40-60% off
+    joints = (ldlj(d.times, d.q_robot, cutoff_hz=None) for d in (noisy, clean))
+    raw_noisy, raw_clean = joints
+    assert abs(raw_noisy - raw_clean) > 0.3 * abs(raw_clean)
 
 
 def test_joint_shares_and_moving_together():
@@ -161,8 +225,8 @@ def test_the_card_holds_the_policy_and_the_demonstration_side_by_side():
     ts, qs = staircase()
     card = likeness_card(ts, qs, t, q, fake_tool)
     assert isinstance(card, LikenessCard)
-    assert card.demonstration.ldlj == pytest.approx(ldlj(t, q))
-    assert card.policy.ldlj == pytest.approx(ldlj(ts, qs))
+    assert card.demonstration.ldlj == pytest.approx(ldlj(t, fake_tool(q)))
+    assert card.policy.ldlj == pytest.approx(ldlj(ts, fake_tool(qs)))
     assert card.dtw_rad == pytest.approx(dtw_distance(qs, q))
     assert card.frechet_m == pytest.approx(frechet_distance(qs, q))
     assert card.policy.duration_s == pytest.approx(2.0)
