@@ -8,7 +8,7 @@ each ``studio/samples/sample-reach-*.demo.json``:
    same samples: straight-line joint interpolation over the same duration, and a minimum-jerk
    straight line. Figures: joint-space DTW per sample on the demonstration's learned joints (its
    grid's 3; goal <= 0.02 rad) and on all six, and the tool path's discrete Fréchet distance.
-   The wrist joints of the samples carry sample-to-sample jitter of up to 0.3 rad (fit noise near
+   The wrist joints of the samples carry sample-to-sample jitter of up to 0.07 rad (fit noise near
    the wrist singularity); the "jitter floor" column is the six-joint DTW of a 9-sample moving
    average of the demonstration itself, which no smooth motion can beat.
 2. The likeness card of the DMP policy (``dmp_likeness_card``: 50 Hz, from the demonstration's
