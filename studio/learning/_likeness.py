@@ -53,7 +53,7 @@ lies well below it. Chosen by measurement on the card's tool path, over 20 simul
 recorded with and without the tape's sensor noise (the same motion, its physiological tremor
 kept): with this cutoff the noise moved the LDLJ by a median 11% (at most 15%); unfiltered by 28%
 on the tool path and by 52% on the six joints (the wrist joints carry the fit's noise near the
-Puma560's wrist singularity); at 3-6 Hz by up to 22-32% (reaching's own content is cut), at 15 Hz
+Puma560's wrist singularity); at 3-6 Hz by up to 22-33% (reaching's own content is cut), at 15 Hz
 by 13%. ``python benchmarks/bench_likeness.py --noise`` measures it."""
 
 ToolPositions = Callable[[np.ndarray], np.ndarray]
