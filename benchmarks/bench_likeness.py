@@ -34,7 +34,7 @@ each ``studio/samples/sample-reach-*.demo.json``:
    motion, its tremor kept), cut into demonstrations; per way of measuring LDLJ (the card's: the
    tool path low-passed at ``LDLJ_CUTOFF_HZ``; the baseline: the six joints unfiltered, the card's
    form before), the median and largest change the noise makes, and the ratio of the medians.
-   Other cutoffs and the first three joints are printed beside them.
+   Other cutoffs and the first three joints are printed beside them, and the card's SPARC.
 
 LDLJ everywhere here is the card's (``ldlj`` of the tool path, low-passed at ``LDLJ_CUTOFF_HZ``).
 """
@@ -79,6 +79,7 @@ from studio.learning import (
     roll_out_primitive,
     rollout_dmp_policy,
     run_experiments,
+    sparc,
 )
 from studio.learning._likeness import LDLJ_CUTOFF_HZ
 from studio.learning._linear import greedy_success
@@ -210,7 +211,8 @@ def learned(path: Path, actions: str | None, episodes: int) -> tuple[int, int]:
         print(
             f"  {path.name} {label:<16} seed {seed}: DTW {card.dtw_rad:.3f} rad/sample, "
             f"LDLJ {card.policy.ldlj:.2f} (demonstration {card.demonstration.ldlj:.2f}, "
-            f"{100 * share:.0f}% off), together {100 * card.policy.together:.0f}% "
+            f"{100 * share:.0f}% off), SPARC {card.policy.sparc:.2f} ({card.demonstration.sparc:.2f}), "
+            f"together {100 * card.policy.together:.0f}% "
             f"(demonstration {100 * card.demonstration.together:.0f}%), duration "
             f"{card.policy.duration_s:.1f} s ({card.demonstration.duration_s:.1f} s), greedy "
             f"success {success.mean():.2f}, CPU {result.cpu_seconds[0]:.1f} s: "
@@ -268,6 +270,17 @@ def noise() -> None:
             print(
                 f"  {label:<11}{name:<18}{100 * medians[label, cutoff]:>6.1f}%{100 * max(change):>7.1f}%{mark}"
             )
+    change = [
+        abs(
+            sparc(n.times, puma_tool_positions(n.q_robot))
+            / sparc(c.times, puma_tool_positions(c.q_robot))
+            - 1
+        )
+        for n, c in pairs
+    ]
+    print(
+        f"  SPARC of the tool path (the card's other row) {100 * np.median(change):>6.1f}%{100 * max(change):>7.1f}%"
+    )
     ours, before = medians["tool path", LDLJ_CUTOFF_HZ], medians["six joints", None]
     print(
         f"the card's median change {100 * ours:.1f}% against {100 * before:.1f}% before: ratio {before / ours:.1f}x"

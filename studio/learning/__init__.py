@@ -58,6 +58,7 @@ from ._likeness import frechet_distance as frechet_distance
 from ._likeness import ldlj as ldlj
 from ._likeness import likeness_card as likeness_card
 from ._likeness import puma_tool_positions as puma_tool_positions
+from ._likeness import sparc as sparc
 from ._linear import greedy_rollout as greedy_rollout
 from ._linear_policy import DEFAULT_MAX_STEPS as TILE_ROLLOUT_MAX_STEPS  # noqa: F401 (re-export)
 from ._linear_policy import DEFAULT_SECONDS_PER_STEP as TILE_ROLLOUT_SECONDS_PER_STEP  # noqa: F401

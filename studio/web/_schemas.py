@@ -620,6 +620,7 @@ class MotionFiguresPublic(BaseModel):
     """One motion's own figures (``studio.learning.MotionFigures``; null where undefined)."""
 
     ldlj: float | None
+    sparc: float | None
     joint_shares: list[float | None]
     together: float | None
     duration_s: float | None

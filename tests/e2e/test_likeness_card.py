@@ -35,12 +35,13 @@ def test_watching_a_policy_shows_its_likeness_card_with_both_columns(
     card.locator("[data-testid='likeness-row']").first.wait_for(timeout=T)
     assert DEMO in card.inner_text()
     rows = card.locator("[data-testid='likeness-row']")
-    assert rows.count() == 7
+    assert rows.count() == 8
     for i in range(rows.count()):  # every figure has the policy's value and the demonstration's
         assert rows.nth(i).locator("[data-testid='likeness-policy']").inner_text().strip()
         assert rows.nth(i).locator("[data-testid='likeness-demo']").inner_text().strip()
-    smooth = rows.filter(has_text="LDLJ")
-    assert smooth.locator("[data-testid='likeness-demo']").inner_text() != "–"
+    for measure in ("LDLJ", "SPARC"):
+        smooth = rows.filter(has_text=measure)
+        assert smooth.locator("[data-testid='likeness-demo']").inner_text() != "–"
     shot(page, "likeness-01-card", "sec-watch")
     assert not page.errors  # type: ignore[attr-defined]
 

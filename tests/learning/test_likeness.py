@@ -18,6 +18,7 @@ from studio.learning import (
     frechet_distance,
     ldlj,
     likeness_card,
+    sparc,
 )
 from studio.learning._likeness import joint_shares, js_divergence, moving_together
 
@@ -303,3 +304,28 @@ def test_every_policy_kind_gets_a_card_from_the_demonstrations_start(tmp_path):
     assert policy_likeness_card(tile, demo.times, demo.q_robot).dtw_rad > 0.1
     with pytest.raises(LearningError, match=r"\(N, 6\)"):
         policy_likeness_card(dmp, demo.times, demo.q_robot[:, :3])
+
+
+def test_sparc_tells_a_bell_shaped_speed_from_a_constant_pace():
+    t, q = reach()
+    bell = sparc(t, q)
+    assert bell == pytest.approx(-1.40, abs=0.05)  # a minimum-jerk reach
+    line = START + np.linspace(0.0, 1.0, len(t))[:, None] * (END - START)
+    assert sparc(t, line) < bell - 0.5  # the same path at a constant pace, started abruptly
+    ts, qs = staircase()
+    assert sparc(ts, qs) < sparc(t, line)
+    assert sparc(t * 3, q * 0.1) == pytest.approx(bell, abs=0.02)  # nor amplitude, nor duration
+    assert math.isnan(sparc(t, np.zeros_like(q)))
+
+
+def test_the_cards_sparc_barely_moves_with_the_tapes_noise(recorded_reach):
+    from studio.learning import puma_tool_positions
+
+    noisy, clean = recorded_reach[0.002], recorded_reach[0.0]
+    values = [
+        likeness_card(
+            d.times, d.q_robot, d.times, d.q_robot, puma_tool_positions
+        ).demonstration.sparc
+        for d in (noisy, clean)
+    ]
+    assert values[0] == pytest.approx(values[1], rel=0.05)

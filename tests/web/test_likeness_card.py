@@ -7,7 +7,15 @@ import json
 from tests.web.conftest import TINY_RUN, wait_run
 from tests.web.test_policies import policy_bytes, upload
 
-FIGURES = {"ldlj", "joint_shares", "together", "duration_s", "joint_travel_rad", "tool_path_m"}
+FIGURES = {
+    "ldlj",
+    "sparc",
+    "joint_shares",
+    "together",
+    "duration_s",
+    "joint_travel_rad",
+    "tool_path_m",
+}
 
 
 def both_columns(card: dict) -> None:

@@ -122,6 +122,7 @@ function renderLikeness(card, note) {
     ["DTW, joints (rad/sample)", fmt(card.dtw_rad, 4), `0 (travel ${fmt(d.joint_travel_rad, 2)} rad)`, "mean joint distance along the best time alignment"],
     ["Fréchet, tool (m)", fmt(card.frechet_m, 4), `0 (path ${fmt(d.tool_path_m, 3)} m)`, "shortest leash joining the two tool paths"],
     ["smoothness LDLJ", fmt(p.ldlj, 2), fmt(d.ldlj, 2), "log dimensionless jerk of the tool's path, low-passed first: higher is smoother"],
+    ["smoothness SPARC", fmt(p.sparc, 2), fmt(d.sparc, 2), "spectral arc length of the tool's speed: nearer 0 is smoother; a constant pace with abrupt starts scores low"],
     ["joint shares (%)", shares(p), shares(d), "each joint's share of the total joint travel"],
     ["  JS divergence (bits)", fmt(card.shares_js, 3), "0", "0 = the same spread over the joints, 1 = disjoint"],
     ["joints together (%)", pct(p.together), pct(d.together), "share of the moving time with two or more joints moving"],
