@@ -202,8 +202,7 @@ def test_the_card_reads_a_recorded_reach_as_the_same_reach_without_the_tapes_noi
     np.testing.assert_array_equal(noisy.times, clean.times)
     assert abs(card_ldlj(noisy) - card_ldlj(clean)) < 0.2 * abs(card_ldlj(clean))
     # the joint-space form the card used before read the noise: 40-60% off
-    joints = (ldlj(d.times, d.q_robot, cutoff_hz=None) for d in (noisy, clean))
-    raw_noisy, raw_clean = joints
+    raw_noisy, raw_clean = (ldlj(d.times, d.q_robot, cutoff_hz=None) for d in (noisy, clean))
     assert abs(raw_noisy - raw_clean) > 0.3 * abs(raw_clean)
 
 
@@ -228,6 +227,8 @@ def test_the_card_holds_the_policy_and_the_demonstration_side_by_side():
     assert isinstance(card, LikenessCard)
     assert card.demonstration.ldlj == pytest.approx(ldlj(t, fake_tool(q)))
     assert card.policy.ldlj == pytest.approx(ldlj(ts, fake_tool(qs)))
+    assert card.policy.sparc == pytest.approx(sparc(ts, fake_tool(qs)))
+    assert card.demonstration.sparc > card.policy.sparc  # a reach against a staircase
     assert card.dtw_rad == pytest.approx(dtw_distance(qs, q))
     assert card.frechet_m == pytest.approx(frechet_distance(qs, q))
     assert card.policy.duration_s == pytest.approx(2.0)
