@@ -257,11 +257,12 @@ def noise() -> None:
     )
     medians = {}
     for label, space in spaces.items():
+        paths = [[(d.times, space(d.q_robot)) for d in pair] for pair in pairs]
         for cutoff in NOISE_CUTOFFS:
             change = []
-            for noisy, clean in pairs:
-                a = ldlj(noisy.times, space(noisy.q_robot), cutoff_hz=cutoff)
-                b = ldlj(clean.times, space(clean.q_robot), cutoff_hz=cutoff)
+            for (t_noisy, noisy), (t_clean, clean) in paths:
+                a = ldlj(t_noisy, noisy, cutoff_hz=cutoff)
+                b = ldlj(t_clean, clean, cutoff_hz=cutoff)
                 change.append(abs(a - b) / abs(b))
             medians[label, cutoff] = float(np.median(change))
             name = "unfiltered" if cutoff is None else f"low-pass {cutoff:g} Hz"
@@ -270,14 +271,8 @@ def noise() -> None:
             print(
                 f"  {label:<11}{name:<18}{100 * medians[label, cutoff]:>6.1f}%{100 * max(change):>7.1f}%{mark}"
             )
-    change = [
-        abs(
-            sparc(n.times, puma_tool_positions(n.q_robot))
-            / sparc(c.times, puma_tool_positions(c.q_robot))
-            - 1
-        )
-        for n, c in pairs
-    ]
+    tools = [[(d.times, puma_tool_positions(d.q_robot)) for d in pair] for pair in pairs]
+    change = [abs(sparc(*noisy) / sparc(*clean) - 1) for noisy, clean in tools]
     print(
         f"  SPARC of the tool path (the card's other row) {100 * np.median(change):>6.1f}%{100 * max(change):>7.1f}%"
     )

@@ -170,11 +170,28 @@ def _times(times: np.ndarray, n: int) -> np.ndarray:
     return t
 
 
+def _samples(times: np.ndarray, path: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """A smoothness measure's input: the checked times and the path as an ``(N, D)`` array."""
+    x = np.asarray(path, dtype=np.float64)
+    x = x[:, None] if x.ndim == 1 else x
+    return _times(times, x.shape[0]), x
+
+
+def _still(x: np.ndarray) -> bool:
+    """Fewer than 4 samples, or no motion: no smoothness to measure (NaN)."""
+    return x.shape[0] < 4 or not np.any(np.diff(x, axis=0))
+
+
+def _mean_rate(t: np.ndarray) -> float:
+    """Samples per second over ``t``."""
+    return (t.shape[0] - 1) / (t[-1] - t[0])
+
+
 def low_pass(times: np.ndarray, x: np.ndarray, cutoff_hz: float) -> np.ndarray:
     """``x`` ``(N, D)`` through a zero-lag Butterworth (2nd order, forward and back) at
     ``cutoff_hz``, at the samples' mean rate; unchanged when that rate's Nyquist frequency is not
     above the cutoff (nothing to remove)."""
-    rate = (x.shape[0] - 1) / (times[-1] - times[0])
+    rate = _mean_rate(times)
     if cutoff_hz >= rate / 2:
         return x
     sos = butter(2, cutoff_hz, fs=rate, output="sos")
@@ -201,14 +218,12 @@ def ldlj(times: np.ndarray, q: np.ndarray, cutoff_hz: float | None = LDLJ_CUTOFF
     Raises:
         LearningError: bad times, or a cutoff that is not a positive number.
     """
-    q = np.asarray(q, dtype=np.float64)
-    q = q[:, None] if q.ndim == 1 else q
-    t = _times(times, q.shape[0])
+    t, q = _samples(times, q)
     if cutoff_hz is not None and (
         not isinstance(cutoff_hz, int | float) or not math.isfinite(cutoff_hz) or cutoff_hz <= 0
     ):
         raise LearningError(f"cutoff_hz is {cutoff_hz!r}; give a positive frequency or None.")
-    if q.shape[0] < 4 or not np.any(np.diff(q, axis=0)):
+    if _still(q):
         return math.nan
     if cutoff_hz is not None:
         q = low_pass(t, q, float(cutoff_hz))
@@ -242,18 +257,15 @@ def sparc(
         The SPARC (higher, nearer 0, is smoother; a minimum-jerk reach scores about -1.4),
         NaN for a path that does not move or has fewer than 4 samples.
     """
-    x = np.asarray(path, dtype=np.float64)
-    x = x[:, None] if x.ndim == 1 else x
-    t = _times(times, x.shape[0])
-    if x.shape[0] < 4 or not np.any(np.diff(x, axis=0)):
+    t, x = _samples(times, path)
+    if _still(x):
         return math.nan
     speed = np.linalg.norm(np.gradient(x, t, axis=0), axis=1)
-    rate = (x.shape[0] - 1) / (t[-1] - t[0])
     size = 2 ** (math.ceil(math.log2(x.shape[0])) + 4)
     magnitude = np.abs(np.fft.rfft(speed, size))
     if magnitude.max() <= 0.0:
         return math.nan
-    frequency = np.fft.rfftfreq(size, 1.0 / rate)
+    frequency = np.fft.rfftfreq(size, 1.0 / _mean_rate(t))
     keep = frequency <= cutoff_hz
     frequency, magnitude = frequency[keep], magnitude[keep] / magnitude.max()
     above = np.nonzero(magnitude >= threshold)[0]

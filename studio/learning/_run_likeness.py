@@ -8,8 +8,9 @@
 
 Each card rolls the policy out from that demonstration's own start
 (:func:`policy_likeness_card`); the page's Watch and ``studio export`` score the same way.
-Version 2: each card's ``ldlj`` is the tool path's, low-passed (``_likeness.LDLJ_CUTOFF_HZ``);
-version 1 files hold the joints' LDLJ, unfiltered, which the tape's noise dominated.
+Version 2: each card's ``ldlj`` is the tool path's, low-passed (``_likeness.LDLJ_CUTOFF_HZ``),
+and beside it is the tool's ``sparc``; version 1 files hold the joints' LDLJ, unfiltered, which
+the tape's noise dominated, and no SPARC.
 """
 
 from __future__ import annotations
