@@ -68,6 +68,7 @@ from studio.learning import (
     ArmReach,
     DynaQConfig,
     TilePolicyFile,
+    demonstrated_pace,
     dmp_likeness_card,
     dtw_distance,
     fit_dmp_policy,
@@ -201,7 +202,11 @@ def learned(path: Path, actions: str | None, episodes: int) -> tuple[int, int]:
             make, config, 1, episodes, seed, [demo.q_robot], task.features(), workers=1
         )
         policy = TilePolicyFile(  # result.task: with the demonstration when it follows it
-            coder=result.coder, weights=result.weights[0], config=config, task=result.task
+            coder=result.coder,
+            weights=result.weights[0],
+            config=config,
+            task=result.task,
+            seconds_per_step=demonstrated_pace(result.task, [(demo.times, demo.q_robot)]),
         )
         success = greedy_success(result.task, result.coder, result.weights[0], starts, CAP)
         card = policy_likeness_card(policy, demo.times, demo.q_robot)

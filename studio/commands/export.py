@@ -113,7 +113,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--seconds-per-step",
         type=float,
         default=None,
-        help=f"seconds per step of a policy (default: {ROLLOUT_SECONDS_PER_STEP:g} per grid step, {TILE_ROLLOUT_SECONDS_PER_STEP:g} per joint step of a tile-coded policy; with --format, default: timed within the robot's limits)",
+        help=f"seconds per step of a policy (default: {ROLLOUT_SECONDS_PER_STEP:g} per grid step, a tile-coded policy's own pace (the demonstrations' it was taught from, else {TILE_ROLLOUT_SECONDS_PER_STEP:g} a step); with --format, default: timed within the robot's limits)",
     )
     parser.add_argument(
         "--max-steps",
@@ -166,9 +166,7 @@ def _rollout_tile(
         start,
         rate_hz=args.rate,
         max_steps=TILE_ROLLOUT_MAX_STEPS if args.max_steps is None else args.max_steps,
-        seconds_per_step=TILE_ROLLOUT_SECONDS_PER_STEP
-        if seconds_per_step is None
-        else seconds_per_step,
+        seconds_per_step=seconds_per_step,  # None: the policy's own pace
     )
     return (
         times,

@@ -63,6 +63,7 @@ from ._linear import greedy_rollout as greedy_rollout
 from ._linear_policy import DEFAULT_MAX_STEPS as TILE_ROLLOUT_MAX_STEPS  # noqa: F401 (re-export)
 from ._linear_policy import DEFAULT_SECONDS_PER_STEP as TILE_ROLLOUT_SECONDS_PER_STEP  # noqa: F401
 from ._linear_policy import TilePolicyFile as TilePolicyFile
+from ._linear_policy import demonstrated_pace as demonstrated_pace
 from ._linear_policy import load_any_policy as load_any_policy
 from ._linear_policy import rollout_tile_policy as rollout_tile_policy
 from ._live_curve import LiveCurve as LiveCurve

@@ -14,7 +14,8 @@ Format ``teach-studio-tile-policy``, version 1: a ``.policy.npz`` archive
        "features": {"low": [...], "high": [...], "groups": [[0], [1], ...], "size": 1584,
                     "hashed": false, "n_active": 48},             (as bound to the observations)
        "n_actions": 12, "config": {... DynaQConfig fields ...},
-       "curve": {"mean_steps": [...], "experiments": 2}, "created": "...", "notes": ""}
+       "curve": {"mean_steps": [...], "experiments": 2}, "created": "...", "notes": "",
+       "seconds_per_step": 0.104}                    (optional: 0.04 when absent)
 
 - ``weights``: float64 ``(features.size, n_actions)``.
 
@@ -34,6 +35,8 @@ member's size checked by its header before it is decompressed).
 from __future__ import annotations
 
 import json
+import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
 from pathlib import Path
@@ -63,7 +66,8 @@ from ._tiles import TileCoder, TileCoding
 FORMAT_NAME = "teach-studio-tile-policy"
 FORMAT_VERSION = 1
 DEFAULT_SECONDS_PER_STEP = 0.04
-"""Time the arm takes for one joint step of a tile-coded rollout (2 degrees in 0.04 s: 50 deg/s)."""
+"""Time the arm takes for one step of a tile-coded rollout (2 degrees in 0.04 s: 50 deg/s) when
+the policy was not taught from timed demonstrations (:func:`demonstrated_pace`)."""
 DEFAULT_MAX_STEPS = 5_000
 """Default cap on greedy steps of a tile-coded rollout."""
 
@@ -82,6 +86,9 @@ class TilePolicyFile:
         experiments: how many experiments the curve averages.
         created: ISO 8601 time of writing.
         notes: free text.
+        seconds_per_step: the time one step of its rollouts takes (s): the pace of the
+            demonstrations it was taught from (:func:`demonstrated_pace`), else
+            :data:`DEFAULT_SECONDS_PER_STEP`.
     """
 
     coder: TileCoder
@@ -93,6 +100,10 @@ class TilePolicyFile:
     experiments: int = 1
     created: str = ""
     notes: str = ""
+    seconds_per_step: float = DEFAULT_SECONDS_PER_STEP
+
+    def __post_init__(self) -> None:
+        _check_pace(self.seconds_per_step, LearningError)
 
     @property
     def n_actions(self) -> int:
@@ -127,6 +138,7 @@ class TilePolicyFile:
             "curve": curve_header(self.mean_steps, self.experiments),
             "created": self.created,
             "notes": self.notes,
+            "seconds_per_step": self.seconds_per_step,
         }
 
     def q_values(self, obs: np.ndarray) -> np.ndarray:
@@ -141,6 +153,7 @@ def save_tile_policy(
     *,
     notes: str = "",
     compress: bool = True,
+    seconds_per_step: float = DEFAULT_SECONDS_PER_STEP,
 ) -> TilePolicyFile:
     """Write one experiment's weights of a linear run as a policy file (format above).
 
@@ -149,6 +162,8 @@ def save_tile_policy(
         result: what :func:`run_experiments` returned for a Gymnasium environment.
         experiment: which experiment's weights (default: ``result.best_experiment()``).
         notes: free text kept in the header.
+        seconds_per_step: its rollouts' pace (:func:`demonstrated_pace` of the demonstrations
+            it was taught from, when their times are known).
         compress: deflate the members (a training checkpoint does not: a large table is written
             in a fraction of the time, and the file reads the same).
     """
@@ -174,6 +189,7 @@ def save_tile_policy(
         experiments=int(result.steps.shape[0]),
         created=datetime.now(UTC).isoformat(timespec="seconds"),
         notes=notes,
+        seconds_per_step=seconds_per_step,
     )
     with Path(path).open("wb") as stream:
         (np.savez_compressed if compress else np.savez)(
@@ -197,6 +213,8 @@ def load_tile_policy(path: str | Path) -> TilePolicyFile:
     with BoundedNpz(path, name, MAX_NPZ_BYTES) as archive:
         header = _read_header(archive, name)
         coder, config, task, n_actions = _check_header(name, header)
+        pace = header.get("seconds_per_step", DEFAULT_SECONDS_PER_STEP)
+        _check_pace(pace, PolicyFileError, f"{name}'s seconds_per_step")
         weights = archive.read("weights", (coder.size, n_actions), "f").astype(np.float64)
     if not np.all(np.isfinite(weights)):
         raise PolicyFileError(f"{name} holds invalid weights; export the policy again.")
@@ -216,7 +234,51 @@ def load_tile_policy(path: str | Path) -> TilePolicyFile:
         experiments=experiments,
         created=str(header.get("created", "")),
         notes=str(header.get("notes", "")),
+        seconds_per_step=float(pace),
     )
+
+
+def _check_pace(value: object, error: type[Exception], label: str = "seconds_per_step") -> None:
+    """Refuse a pace that is not a positive number of seconds (with ``error``)."""
+    if (
+        not isinstance(value, int | float)
+        or isinstance(value, bool)
+        or not math.isfinite(value)
+        or value <= 0
+    ):
+        raise error(f"{label} is {value!r}; give a positive number of seconds.")
+
+
+def demonstrated_pace(task: ArmReach, motions: Sequence[tuple[np.ndarray, np.ndarray]]) -> float:
+    """The time one step of ``task`` takes at the pace of the demonstrations ``motions``.
+
+    The paper's robot learns the demonstration's execution time as well as its path. Each
+    demonstration, walked in ``task`` from its first sample (:meth:`ArmReach.demonstration_actions`:
+    the follow action along it, or the single steps that trace it), takes some number of steps;
+    the pace is the demonstrations' total duration over their total steps, so a rollout along a
+    demonstration's route takes as long as the person did. Demonstrations that start at the goal
+    (no step) are left out; with none left, :data:`DEFAULT_SECONDS_PER_STEP`.
+
+    Args:
+        task: the task the policy learns (with its followed paths, if any).
+        motions: each demonstration's sample times ``(N,)`` (s) and joints ``(N, >= joints)``.
+
+    Raises:
+        LearningError: a demonstration the task cannot walk (as
+            :meth:`ArmReach.demonstration_actions` says), or times that do not increase.
+    """
+    seconds = steps = 0.0
+    for index, (times, q) in enumerate(motions):
+        t = np.asarray(times, dtype=np.float64).reshape(-1)
+        if t.shape[0] < 2 or not np.all(np.isfinite(t)) or np.any(np.diff(t) <= 0):
+            raise LearningError(
+                f"Demonstration {index}'s times do not increase; cut it again from its recording."
+            )
+        _, actions = task.demonstration_actions(q, index)
+        if actions.size:
+            seconds += float(t[-1] - t[0])
+            steps += actions.size
+    return seconds / steps if steps else DEFAULT_SECONDS_PER_STEP
 
 
 def _read_header(archive: BoundedNpz, name: str) -> object:
@@ -305,11 +367,11 @@ def rollout_tile_policy(
     rate_hz: float,
     max_steps: int = DEFAULT_MAX_STEPS,
     *,
-    seconds_per_step: float = DEFAULT_SECONDS_PER_STEP,
+    seconds_per_step: float | None = None,
 ) -> tuple[np.ndarray, np.ndarray, bool]:
     """The greedy policy from ``start_q`` as a joint trajectory of its robot.
 
-    Each action moves one joint by one step at constant speed over ``seconds_per_step``; the
+    Each action moves its joints by one step at constant speed over ``seconds_per_step``; the
     trajectory is sampled at ``rate_hz`` (joints beyond the task's held at the goal's values).
 
     Args:
@@ -317,7 +379,8 @@ def rollout_tile_policy(
         start_q: the learned joints' start angles, radians ``(joints,)``.
         rate_hz: control rate of the samples.
         max_steps: cap on greedy steps.
-        seconds_per_step: duration of one step.
+        seconds_per_step: duration of one step (default: the policy's own pace,
+            :attr:`TilePolicyFile.seconds_per_step`).
 
     Returns:
         ``(times (N,), q (N, nq), reached)``: every joint of the robot (six for the Puma560).
@@ -330,6 +393,8 @@ def rollout_tile_policy(
         raise LearningError(
             f"This policy was trained on {policy.env_id or 'another environment'}, not the arm; only arm policies roll out to joint trajectories."
         )
+    if seconds_per_step is None:
+        seconds_per_step = policy.seconds_per_step
     for label, value in (("rate_hz", rate_hz), ("seconds_per_step", seconds_per_step)):
         if not isinstance(value, int | float) or not np.isfinite(value) or value <= 0:
             raise LearningError(f"{label} is {value!r}; give a positive number.")

@@ -527,10 +527,14 @@ class RunFolder:
         tmp = self.path / f".{POLICY_FILE}.{secrets.token_hex(4)}.tmp.npz"
         notes = f"run {self.id}: experiment {best} of {self.record.experiments}, seed {self.record.seed}, {len(self.record.demonstrations)} demonstrations"
         if self.record.kind == TASK_ARM_REACH:
-            from ._linear_policy import save_tile_policy
+            from ._linear_policy import demonstrated_pace, save_tile_policy
 
+            motions = [(m.times, m.q_robot) for m in self.record.demonstration_motions]
+            pace = demonstrated_pace(result.task, motions)  # type: ignore[union-attr]
             try:
-                save_tile_policy(tmp, result, best, notes=notes, compress=compress)  # type: ignore[arg-type]
+                save_tile_policy(  # type: ignore[arg-type]
+                    tmp, result, best, notes=notes, compress=compress, seconds_per_step=pace
+                )
                 os.replace(tmp, self.policy_path)
             except OSError as err:
                 with contextlib.suppress(OSError):

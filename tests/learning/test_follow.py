@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import gymnasium
@@ -9,11 +10,14 @@ import numpy as np
 import pytest
 
 from studio.capture import load_demonstration
+from studio.cli import main
 from studio.learning import (
+    TILE_ROLLOUT_SECONDS_PER_STEP,
     ArmReach,
     ConfigError,
     DynaQConfig,
     LearningError,
+    PolicyFileError,
     RunRequest,
     TilePolicyFile,
     load_any_policy,
@@ -26,7 +30,12 @@ from studio.learning._beyond import demonstration_paths
 from studio.learning._common_value import without_common
 from studio.learning._gym import ARM_REACH_ID
 from studio.learning._linear import _q_values, greedy_success
-from studio.learning._linear_policy import rollout_tile_policy, save_tile_policy
+from studio.learning._linear_policy import (
+    demonstrated_pace,
+    load_tile_policy,
+    rollout_tile_policy,
+    save_tile_policy,
+)
 from studio.learning._reach import reach_step
 
 SAMPLES = Path(__file__).resolve().parents[2] / "studio" / "samples"
@@ -293,3 +302,103 @@ def test_demonstrations_cost_no_greedy_success_after_long_training_without_plann
         w = result.weights[0]
         success.append(greedy_success(result.task, result.coder, w, starts, 3000).mean())
     assert success[0] >= success[1] - 0.02, success
+
+
+def test_a_policy_taught_from_a_demonstration_moves_at_its_pace(tmp_path):
+    """The run's policy keeps the demonstration's pace: its duration over the steps the task
+    takes along it, so a rollout along its route takes as long as the person did."""
+    demo = load_demonstration(SAMPLES / "sample-reach-1.demo.json")
+    out = tmp_path / "run"
+    args = ["train", "--task", "arm-reach", "--demos", "sample-reach-1", "--planning", "zero"]
+    args += ["--episodes", "2", "--experiments", "1", "--out", str(out), "--no-progress"]
+    assert main(args) == 0
+    policy = load_tile_policy(out / "policy.policy.npz")
+    _, actions = policy.task.demonstration_actions(demo.q_robot)
+    duration = demo.times[-1] - demo.times[0]
+    assert policy.seconds_per_step == pytest.approx(duration / len(actions))
+    assert policy.seconds_per_step > 2 * TILE_ROLLOUT_SECONDS_PER_STEP  # 24 steps in 2.5 s
+    # every rollout takes the policy's pace unless told otherwise
+    start = demo.q_robot[0]
+    own = rollout_tile_policy(policy, start, 50.0, 200)
+    told = rollout_tile_policy(policy, start, 50.0, 200, seconds_per_step=policy.seconds_per_step)
+    np.testing.assert_array_equal(own[0], told[0])
+    quick = rollout_tile_policy(policy, start, 50.0, 200, seconds_per_step=0.04)
+    assert own[0][-1] == pytest.approx(quick[0][-1] * policy.seconds_per_step / 0.04)
+    # two demonstrations: their total time over their total steps; one at the goal adds nothing
+    twice = [(demo.times, demo.q_robot), (demo.times * 3, demo.q_robot)]
+    assert demonstrated_pace(policy.task, twice) == pytest.approx(2 * policy.seconds_per_step)
+    still = np.repeat(demo.q_robot[-1:], 5, axis=0)
+    assert (
+        demonstrated_pace(policy.task, [(demo.times[:5], still)]) == TILE_ROLLOUT_SECONDS_PER_STEP
+    )
+    with pytest.raises(LearningError, match="times do not increase"):
+        demonstrated_pace(policy.task, [(demo.times[::-1], demo.q_robot)])
+
+
+def test_a_policy_file_without_a_pace_has_the_default_and_a_bad_pace_is_refused(tmp_path):
+    task, path = line_task()
+    result = run_experiments(
+        lambda: gymnasium.make(ARM_REACH_ID, joints=3, goal=task.goal, actions="follow"),
+        DynaQConfig(planning="zero", max_steps_per_episode=500),
+        1,
+        5,
+        0,
+        [path],
+        task.features(),
+    )
+    saved = tmp_path / "follow.policy.npz"
+    assert save_tile_policy(saved, result, seconds_per_step=0.25).seconds_per_step == 0.25
+    assert load_tile_policy(saved).seconds_per_step == 0.25
+    with np.load(saved) as archive:
+        header, weights = json.loads(str(archive["header"])), archive["weights"]
+    for pace, expected in ((None, TILE_ROLLOUT_SECONDS_PER_STEP), (0.0, None), ("fast", None)):
+        if pace is None:
+            header.pop("seconds_per_step")  # a file written before policies kept a pace
+        else:
+            header["seconds_per_step"] = pace
+        np.savez(saved, header=np.array(json.dumps(header)), weights=weights)
+        if expected is not None:
+            assert load_tile_policy(saved).seconds_per_step == expected
+            continue
+        with pytest.raises(PolicyFileError) as err:
+            load_tile_policy(saved)
+        assert "seconds_per_step" in str(err.value) and "positive number" in str(err.value)
+    with pytest.raises(LearningError, match="positive number"):
+        TilePolicyFile(result.coder, result.weights[0], result.config, seconds_per_step=-1.0)
+
+
+def test_at_the_demonstrations_pace_the_follow_policy_is_as_smooth_as_the_person():
+    """Sample 1, 3,000 episodes, no planning: rolled out at the demonstration's pace the policy
+    takes the person's time and its LDLJ is within 20% of the person's; at the fixed 0.04 s a
+    step it took 1.0 s and read 24% smoother."""
+    demo = load_demonstration(SAMPLES / "sample-reach-1.demo.json")
+    goal = tuple(demo.q_robot[-1])
+    config = DynaQConfig(planning="zero", max_steps_per_episode=3000)
+    result = run_experiments(
+        lambda: gymnasium.make(ARM_REACH_ID, goal=goal),
+        config,
+        1,
+        3000,
+        0,
+        [demo.q_robot],
+        ArmReach(goal=goal).features(),
+        workers=1,
+    )
+    cards = {}
+    for pace in (TILE_ROLLOUT_SECONDS_PER_STEP, None):
+        policy = TilePolicyFile(
+            coder=result.coder,
+            weights=result.weights[0],
+            config=config,
+            task=result.task,
+            seconds_per_step=pace or demonstrated_pace(result.task, [(demo.times, demo.q_robot)]),
+        )
+        cards[pace] = policy_likeness_card(policy, demo.times, demo.q_robot)
+
+    def off(card) -> float:
+        return abs(card.policy.ldlj / card.demonstration.ldlj - 1.0)
+
+    paced, quick = cards[None], cards[TILE_ROLLOUT_SECONDS_PER_STEP]
+    assert paced.dtw_rad <= 0.05 and off(paced) <= 0.2
+    assert paced.policy.duration_s == pytest.approx(paced.demonstration.duration_s, abs=0.05)
+    assert off(quick) > 0.2 and quick.policy.duration_s < 0.5 * quick.demonstration.duration_s
