@@ -520,6 +520,18 @@ class RunFolder:
             self._owner.release()
             self._owner = None
 
+    def _pace(self, result: ExperimentResult) -> float:
+        """The policy's pace: its recorded demonstrations' (:func:`demonstrated_pace`), else the
+        default; a demonstration the task cannot time costs the pace, never the policy."""
+        from ._linear_policy import DEFAULT_SECONDS_PER_STEP, demonstrated_pace
+
+        motions = [(m.times, m.q_robot) for m in self.record.demonstration_motions]
+        try:
+            return demonstrated_pace(result.task, motions)  # type: ignore[union-attr]
+        except LearningError as err:
+            log.warning("run %s: its policy keeps the default pace: %s", self.id, err)
+            return DEFAULT_SECONDS_PER_STEP
+
     def save_policy(self, result: ExperimentResult, compress: bool = True) -> None:
         """Write the best experiment's Q table (or tile-coded weights) as the run's policy
         (``compress`` false for a checkpoint: far quicker to write, read the same)."""
@@ -527,10 +539,9 @@ class RunFolder:
         tmp = self.path / f".{POLICY_FILE}.{secrets.token_hex(4)}.tmp.npz"
         notes = f"run {self.id}: experiment {best} of {self.record.experiments}, seed {self.record.seed}, {len(self.record.demonstrations)} demonstrations"
         if self.record.kind == TASK_ARM_REACH:
-            from ._linear_policy import demonstrated_pace, save_tile_policy
+            from ._linear_policy import save_tile_policy
 
-            motions = [(m.times, m.q_robot) for m in self.record.demonstration_motions]
-            pace = demonstrated_pace(result.task, motions)  # type: ignore[union-attr]
+            pace = self._pace(result)
             try:
                 save_tile_policy(  # type: ignore[arg-type]
                     tmp, result, best, notes=notes, compress=compress, seconds_per_step=pace

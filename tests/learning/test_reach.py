@@ -14,7 +14,9 @@ from hypothesis import strategies as st
 from studio.cli import main
 from studio.kinematics import Puma560
 from studio.learning import (
+    TILE_ROLLOUT_SECONDS_PER_STEP,
     ArmReach,
+    DemonstrationMotion,
     DynaQConfig,
     LearningError,
     LiveProgress,
@@ -161,6 +163,16 @@ def test_a_continuous_run_folder_trains_saves_and_reads_back(tmp_path):
     assert isinstance(policy, TilePolicyFile) and policy.task == task.with_paths([demo])
     with pytest.raises(LearningError, match="leaves joint 1's limits at sample 0"):
         RunRecord.for_arm_reach(task, task.features(), config, 2, 6, 0, [demo + 3.0])
+    # no recorded motion: the default pace; one the task cannot walk costs the pace, not the run
+    assert policy.seconds_per_step == TILE_ROLLOUT_SECONDS_PER_STEP
+    astray = DemonstrationMotion("astray", np.linspace(0.0, 1.0, 10), demo[:10].copy())
+    record = RunRecord.for_arm_reach(
+        task, task.features(), config, 1, 2, 0, [demo], demonstration_motions=[astray]
+    )
+    run = RunFolder.create(tmp_path, record, name="astray")
+    run.train(workers=1)
+    assert run.status == "done"
+    assert load_any_policy(run.policy_path).seconds_per_step == TILE_ROLLOUT_SECONDS_PER_STEP
 
 
 def test_beyond_the_paper_measures_memory_and_success(tmp_path):
