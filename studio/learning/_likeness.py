@@ -308,23 +308,44 @@ def js_divergence(p: np.ndarray, q: np.ndarray) -> float:
     return max(0.0, 0.5 * kl(p) + 0.5 * kl(q))
 
 
+def _moving(times: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+    """Per interval between samples: its length (s) and how many joints move in it (faster
+    than :data:`MOVING_SPEED_FRACTION` of the path's fastest joint speed); None for a path of
+    fewer than 2 samples or one that does not move."""
+    q = np.asarray(q, dtype=np.float64)
+    t = _times(times, q.shape[0])
+    if q.shape[0] < 2:
+        return None
+    dt = np.diff(t)
+    speed = np.abs(np.diff(q, axis=0)) / dt[:, None]
+    peak = speed.max()
+    if peak <= 0:
+        return None
+    return dt, (speed > MOVING_SPEED_FRACTION * peak).sum(axis=1)
+
+
 def moving_together(times: np.ndarray, q: np.ndarray) -> float:
     """Share of the moving time in which two or more joints move (see the module docstring).
 
     NaN for a path that does not move.
     """
-    q = np.asarray(q, dtype=np.float64)
-    t = _times(times, q.shape[0])
-    if q.shape[0] < 2:
+    moving = _moving(times, q)
+    if moving is None:
         return math.nan
-    dt = np.diff(t)
-    speed = np.abs(np.diff(q, axis=0)) / dt[:, None]
-    peak = speed.max()
-    if peak <= 0:
-        return math.nan
-    moving = (speed > MOVING_SPEED_FRACTION * peak).sum(axis=1)
-    moving_time = dt[moving >= 1].sum()
-    return float(dt[moving >= 2].sum() / moving_time)
+    dt, count = moving
+    return float(dt[count >= 2].sum() / dt[count >= 1].sum())
+
+
+def moving_span(times: np.ndarray, q: np.ndarray) -> float:
+    """Seconds from the first interval in which a joint moves (as :func:`moving_together`
+    counts it) to the end of the last: the motion without the stillness a cut holds before and
+    after it. 0 for a path that does not move."""
+    moving = _moving(times, q)
+    if moving is None:
+        return 0.0
+    dt, count = moving
+    inside = np.flatnonzero(count >= 1)
+    return float(dt[inside[0] : inside[-1] + 1].sum())
 
 
 @dataclass(frozen=True)

@@ -47,6 +47,7 @@ from ._config import DynaQConfig
 from ._dmp_policy import FORMAT_NAME as DMP_FORMAT_NAME
 from ._dmp_policy import DmpPolicyFile, load_dmp_policy
 from ._errors import LearningError, PolicyFileError
+from ._likeness import moving_span
 from ._linear import LinearResult, greedy_rollout
 from ._policy import (
     FORMAT_NAME as TABULAR_FORMAT_NAME,
@@ -255,9 +256,11 @@ def demonstrated_pace(task: ArmReach, motions: Sequence[tuple[np.ndarray, np.nda
     The paper's robot learns the demonstration's execution time as well as its path. Each
     demonstration, walked in ``task`` from its first sample (:meth:`ArmReach.demonstration_actions`:
     the follow action along it, or the single steps that trace it), takes some number of steps;
-    the pace is the demonstrations' total duration over their total steps, so a rollout along a
-    demonstration's route takes as long as the person did. Demonstrations that start at the goal
-    (no step) are left out; with none left, :data:`DEFAULT_SECONDS_PER_STEP`.
+    the pace is the demonstrations' total moving time over their total steps, so a rollout along
+    a demonstration's route takes as long as the person moved. The moving time is the task's
+    joints' :func:`._likeness.moving_span`: a cut that holds still before or after the motion
+    does not slow the robot. Demonstrations that do not move or start at the goal (no step) are
+    left out; with none left, :data:`DEFAULT_SECONDS_PER_STEP`.
 
     Args:
         task: the task the policy learns (with its followed paths, if any).
@@ -275,8 +278,9 @@ def demonstrated_pace(task: ArmReach, motions: Sequence[tuple[np.ndarray, np.nda
                 f"Demonstration {index}'s times do not increase; cut it again from its recording."
             )
         _, actions = task.demonstration_actions(q, index)
-        if actions.size:
-            seconds += float(t[-1] - t[0])
+        moving = moving_span(t, np.asarray(q, dtype=np.float64)[:, : task.joints])
+        if actions.size and moving > 0:
+            seconds += moving
             steps += actions.size
     return seconds / steps if steps else DEFAULT_SECONDS_PER_STEP
 

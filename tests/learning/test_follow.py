@@ -305,8 +305,9 @@ def test_demonstrations_cost_no_greedy_success_after_long_training_without_plann
 
 
 def test_a_policy_taught_from_a_demonstration_moves_at_its_pace(tmp_path):
-    """The run's policy keeps the demonstration's pace: its duration over the steps the task
-    takes along it, so a rollout along its route takes as long as the person did."""
+    """The run's policy keeps the demonstration's pace: its moving time (sample 1 moves from
+    its first sample to its last) over the steps the task takes along it, so a rollout along its
+    route takes as long as the person moved."""
     demo = load_demonstration(SAMPLES / "sample-reach-1.demo.json")
     out = tmp_path / "run"
     args = ["train", "--task", "arm-reach", "--demos", "sample-reach-1", "--planning", "zero"]
@@ -324,6 +325,13 @@ def test_a_policy_taught_from_a_demonstration_moves_at_its_pace(tmp_path):
     np.testing.assert_array_equal(own[0], told[0])
     quick = rollout_tile_policy(policy, start, 50.0, 200, seconds_per_step=0.04)
     assert own[0][-1] == pytest.approx(quick[0][-1] * policy.seconds_per_step / 0.04)
+    # a cut that holds still for a second before and after the motion: the same pace
+    hold = np.arange(1, 111) / 110.0
+    padded_t = np.r_[demo.times[0] - hold[::-1], demo.times, demo.times[-1] + hold]
+    padded_q = np.r_[[demo.q_robot[0]] * 110, demo.q_robot, [demo.q_robot[-1]] * 110]
+    assert demonstrated_pace(policy.task, [(padded_t, padded_q)]) == pytest.approx(
+        policy.seconds_per_step
+    )
     # two demonstrations: their total time over their total steps; one at the goal adds nothing
     twice = [(demo.times, demo.q_robot), (demo.times * 3, demo.q_robot)]
     assert demonstrated_pace(policy.task, twice) == pytest.approx(2 * policy.seconds_per_step)

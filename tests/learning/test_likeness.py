@@ -20,7 +20,12 @@ from studio.learning import (
     likeness_card,
     sparc,
 )
-from studio.learning._likeness import joint_shares, js_divergence, moving_together
+from studio.learning._likeness import (
+    joint_shares,
+    js_divergence,
+    moving_span,
+    moving_together,
+)
 
 
 def min_jerk(u: np.ndarray) -> np.ndarray:
@@ -213,6 +218,14 @@ def test_joint_shares_and_moving_together():
     assert moving_together(t, q) > 0.9
     ts, qs = staircase()
     assert moving_together(ts, qs) < 0.1  # one joint at a time
+    # the moving span leaves out the stillness a cut holds before and after the motion
+    rate = 1.0 / (t[1] - t[0])
+    held = np.arange(1, 51) / rate
+    padded_t = np.r_[t[0] - held[::-1], t, t[-1] + held]
+    padded_q = np.r_[[q[0]] * 50, q, [q[-1]] * 50]
+    assert moving_span(padded_t, padded_q) <= t[-1] - t[0] + 1e-9
+    assert moving_span(padded_t, padded_q) >= 0.8 * (t[-1] - t[0])  # the bell's slow ends
+    assert moving_span(t, np.repeat(q[:1], len(t), axis=0)) == 0.0
 
 
 def fake_tool(q: np.ndarray) -> np.ndarray:

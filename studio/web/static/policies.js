@@ -126,7 +126,7 @@ function renderLikeness(card, note) {
     ["joint shares (%)", shares(p), shares(d), "each joint's share of the total joint travel"],
     ["  JS divergence (bits)", fmt(card.shares_js, 3), "0", "0 = the same spread over the joints, 1 = disjoint"],
     ["joints together (%)", pct(p.together), pct(d.together), "share of the moving time with two or more joints moving"],
-    ["duration (s)", fmt(p.duration_s, 2), fmt(d.duration_s, 2), "a continuous policy taught from recorded demonstrations moves at their pace: their duration over the steps the task takes along them"],
+    ["duration (s)", fmt(p.duration_s, 2), fmt(d.duration_s, 2), "a continuous policy taught from recorded demonstrations moves at their pace: their moving time (stillness before and after left out) over the steps the task takes along them"],
   ];
   box.replaceChildren(
     el("div", { class: "muted small", text: `Likeness to ${card.name}, rolled out from its start` }),
