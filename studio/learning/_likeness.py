@@ -42,6 +42,7 @@ from scipy.signal import butter, sosfiltfilt
 
 from studio.kinematics import Puma560
 
+from .._numbers import is_number
 from ._errors import LearningError
 from ._reach import tool_positions
 from ._robot import PUMA560
@@ -219,9 +220,7 @@ def ldlj(times: np.ndarray, q: np.ndarray, cutoff_hz: float | None = LDLJ_CUTOFF
         LearningError: bad times, or a cutoff that is not a positive number.
     """
     t, q = _samples(times, q)
-    if cutoff_hz is not None and (
-        not isinstance(cutoff_hz, int | float) or not math.isfinite(cutoff_hz) or cutoff_hz <= 0
-    ):
+    if cutoff_hz is not None and (not is_number(cutoff_hz) or cutoff_hz <= 0):
         raise LearningError(f"cutoff_hz is {cutoff_hz!r}; give a positive frequency or None.")
     if _still(q):
         return math.nan

@@ -35,7 +35,6 @@ member's size checked by its header before it is decompressed).
 from __future__ import annotations
 
 import json
-import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
@@ -43,6 +42,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._numbers import is_number
 from ._config import DynaQConfig
 from ._dmp_policy import FORMAT_NAME as DMP_FORMAT_NAME
 from ._dmp_policy import DmpPolicyFile, load_dmp_policy
@@ -241,12 +241,7 @@ def load_tile_policy(path: str | Path) -> TilePolicyFile:
 
 def _check_pace(value: object, error: type[Exception], label: str = "seconds_per_step") -> None:
     """Refuse a pace that is not a positive number of seconds (with ``error``)."""
-    if (
-        not isinstance(value, int | float)
-        or isinstance(value, bool)
-        or not math.isfinite(value)
-        or value <= 0
-    ):
+    if not is_number(value) or value <= 0:
         raise error(f"{label} is {value!r}; give a positive number of seconds.")
 
 
