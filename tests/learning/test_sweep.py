@@ -605,10 +605,14 @@ def test_a_sweep_on_a_two_node_cluster_uses_both_nodes(tmp_path: Path) -> None:
         )
         status = [ray_cli, "status", f"--address={address}"]
         wait_for(lambda: _run_quiet(status, env).count(" node_") >= 2, "two nodes")
+        # Tune re-uses a worker whose trial ended for the next trial waiting, also one waiting
+        # for the other node's worker to start. Trials of 0.02-0.3 s (40 episodes) could all run
+        # in the first worker up before the other started (CI saw it once); trials of about
+        # 2.5 s each give the second worker 5 s or more.
         spec = write_spec(
             tmp_path / "two.toml",
-            'task = "arm-grid"\nseeds = [0, 1, 2, 3]\nexperiments = 2\nepisodes = 40\n'
-            '[fixed]\nplanning_steps = 100\n[space]\nplanning = ["full"]\n',
+            'task = "arm-grid"\nseeds = [0, 1, 2, 3]\nexperiments = 4\nepisodes = 4000\n'
+            '[fixed]\nplanning_steps = 1000\n[space]\nplanning = ["full"]\n',
         )  # fmt: skip
         data = tmp_path / "data"
         proc = subprocess.run(
