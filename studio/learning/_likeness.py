@@ -255,7 +255,17 @@ def sparc(
     Returns:
         The SPARC (higher, nearer 0, is smoother; a minimum-jerk reach scores about -1.4),
         NaN for a path that does not move or has fewer than 4 samples.
+
+    Raises:
+        LearningError: bad times, a cutoff that is not a positive frequency, or a threshold
+            outside (0, 1).
     """
+    if not is_number(cutoff_hz) or cutoff_hz <= 0:
+        raise LearningError(f"cutoff_hz is {cutoff_hz!r}; give a positive frequency.")
+    if not is_number(threshold) or not 0 < threshold < 1:
+        raise LearningError(
+            f"threshold is {threshold!r}; give a share of the largest magnitude, between 0 and 1."
+        )
     t, x = _samples(times, path)
     if _still(x):
         return math.nan

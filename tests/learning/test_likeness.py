@@ -330,6 +330,12 @@ def test_sparc_tells_a_bell_shaped_speed_from_a_constant_pace():
     assert sparc(ts, qs) < sparc(t, line)
     assert sparc(t * 3, q * 0.1) == pytest.approx(bell, abs=0.02)  # nor amplitude, nor duration
     assert math.isnan(sparc(t, np.zeros_like(q)))
+    for cutoff in (0.0, -1.0, math.nan, "10"):
+        with pytest.raises(LearningError, match="cutoff_hz"):
+            sparc(t, q, cutoff_hz=cutoff)
+    for threshold in (0.0, 1.0, math.inf):
+        with pytest.raises(LearningError, match="threshold"):
+            sparc(t, q, threshold=threshold)
 
 
 def test_the_cards_sparc_barely_moves_with_the_tapes_noise(recorded_reach):
