@@ -34,6 +34,10 @@ reach of the wrist, the position alone is solved. While the arm moves, no joint 
 :meth:`RetargetConfig.within_reach`) is looked for first, and only when there is none does the
 IK look on other branches, whose answer is then walked to over several frames.
 
+On a robot standing on a table the target is kept above the table, out of the column around
+the first axis that an arm with a sideways shoulder offset cannot enter (``RobotSpec.hollow``,
+the UR arms') and within the arm's reach, each softly (:class:`RetargetConfig`).
+
 The hand's target is placed in the robot's base frame turned by ``RobotArm.base_rotation``,
 so an arm whose URDF faces elsewhere than +x (the SO-100's faces -y) faces the operator, as the
 scene draws it. Any robot of :func:`load_robot` (a :class:`RobotArm`) is driven in cartesian mode, the only one
@@ -100,6 +104,10 @@ class RetargetConfig:
             the scaled hand's sphere beyond the arm's reach; a target further than
             ``reach_fraction`` of the reach from the robot's shoulder is drawn back inside that
             sphere, smoothly over this width (m), and left exactly where it is nearer.
+        hollow_softness: a target nearer the first joint's axis than the robot's
+            :attr:`RobotSpec.hollow` plus this width (m) is moved out, smoothly, to beyond the
+            hollow (the UR's: where the raised arm cannot go), and left exactly where it is
+            further.
         max_joint_step: largest change of any joint of the robot from one frame to the next
             (rad): a target that moves the IK's answer further (a wrist flip, a jump back into
             reach, the Puma560's shoulder passing near its first axis) is followed over several
@@ -147,6 +155,7 @@ class RetargetConfig:
     floor_height: float = 0.05
     floor_softness: float = 0.05
     reach_softness: float = 0.1
+    hollow_softness: float = 0.1
     max_joint_step: float = math.radians(4.5)
     input_jump: float = 0.15
     clearance: float = 0.005
@@ -165,6 +174,7 @@ class RetargetConfig:
         positive_number(self.floor_height, "RetargetConfig.floor_height")
         positive_number(self.floor_softness, "RetargetConfig.floor_softness")
         positive_number(self.reach_softness, "RetargetConfig.reach_softness")
+        positive_number(self.hollow_softness, "RetargetConfig.hollow_softness")
         positive_number(self.max_joint_step, "RetargetConfig.max_joint_step")
         positive_number(self.input_jump, "RetargetConfig.input_jump")
         positive_number(self.clearance, "RetargetConfig.clearance")
@@ -207,12 +217,60 @@ def _unbent(r: float, ceiling: float, width: float) -> float:
     return r if r <= knee else knee + width * math.atanh(min((r - knee) / width, 1.0 - 1e-12))
 
 
+def out_of_hollow(
+    across: np.ndarray, hollow: float, width: float, forward: np.ndarray
+) -> np.ndarray:
+    """A target's level offset from a robot's first axis (m, (2,)) moved out of its hollow.
+
+    An offset nearer the axis than ``hollow + width`` is moved to the radius
+    ``-_soft_ceiling(-r, -hollow, width)`` (beyond ``hollow``, smoothly: a further one stays
+    exactly where it is), along ``across + (hollow + width / 2) * forward``, not straight out
+    from the axis. Straight out, the direction of a hand held just above or below the shoulder
+    turns with every millimetre of its noise, and the robot's base would turn with it. Any
+    continuous way out of a disc tears somewhere (the disc's edge cannot shrink onto a point
+    around the hollow); this one tears at a single point behind the axis (``forward`` the way
+    the arm faces, towards the operator), where a hand rarely stays.
+    """
+    radius = float(np.linalg.norm(across))
+    kept = -_soft_ceiling(-radius, -hollow, width)
+    if kept <= radius:
+        return across
+    way = across + (hollow + width / 2) * forward
+    norm = float(np.linalg.norm(way))
+    way = forward if norm == 0.0 else way / norm
+    along = float(across @ way)
+    return across + (math.sqrt(along * along + kept * kept - radius * radius) - along) * way
+
+
+def into_hollow(moved: np.ndarray, hollow: float, width: float, forward: np.ndarray) -> np.ndarray:
+    """An offset that :func:`out_of_hollow` moves to ``moved``, found by fixed-point steps (one
+    within 0.1 mm, or the nearest found; ``moved`` itself from beyond the hollow's edge)."""
+    if float(np.linalg.norm(moved)) >= hollow + width:
+        return moved
+    best, miss = moved, math.inf
+    guess = moved.copy()
+    for _ in range(50):
+        error = out_of_hollow(guess, hollow, width, forward) - moved
+        size = float(np.linalg.norm(error))
+        if size < miss:
+            best, miss = guess.copy(), size
+        if size < 1e-4:
+            break
+        guess = guess - error
+    return best
+
+
 PINNED = 0.01
 """A joint within this share of its range from a limit counts as pinned there."""
 
 
 RESTART_SEED = 0
 """Seed of the fixed IK starts (:attr:`RetargetConfig.restart_starts` and ``near_starts``)."""
+
+
+def _forward(robot: RobotArm) -> np.ndarray:
+    """The level direction ``robot`` faces (towards the operator) in its URDF's base frame."""
+    return robot.base_rotation.T[:2, 0].copy()
 
 
 def _turned_near(robot: RobotArm, q: np.ndarray, reference: np.ndarray) -> np.ndarray:
@@ -274,7 +332,11 @@ class Retargeter:
         self._draws: dict[str, np.ndarray] = {}
         self.pulled_in = 0.0
         """How far (m) the last cartesian-mode hand target was drawn back into the robot's reach
-        (0 while the scaled hand lies within it; see ``RetargetConfig.reach_softness``)."""
+        (0 while the scaled hand lies within it; see ``RetargetConfig.reach_softness`` and
+        ``hollow_softness``)."""
+        self.pushed_out = 0.0
+        """The part of ``pulled_in`` (m) that moved the target out of the column around the
+        robot's first axis where it cannot reach (:attr:`RobotSpec.hollow`)."""
         self.held = False
         """Whether the last cartesian-mode frame held the previous pose, because the new one
         would have brought the robot's links into contact."""
@@ -380,13 +442,14 @@ class Retargeter:
         Returns:
             ``oMdes``: the mirrored (if set), scaled hand-centre pose placed at the Puma's
             shoulder, with the tool's approach axis along the fingers. For a robot on a table
-            the target is then kept above the table and within the arm's reach, both softly
-            (see :class:`RetargetConfig`).
+            the target is then kept above the table, out of the arm's hollow (if it has one)
+            and within its reach, all softly (see :class:`RetargetConfig`).
         """
         return self._target(q_human)[0]
 
-    def _target(self, q_human: object) -> tuple[np.ndarray, float]:
-        """The hand target and how far it was drawn back into reach (m)."""
+    def _target(self, q_human: object) -> tuple[np.ndarray, float, float]:
+        """The hand target, how far it was drawn back into reach (m), and how much of that
+        moved it out of the robot's hollow (m)."""
         pose = self.arm.forward(q_human).hand
         p, R = self._mirrored(pose[:3, 3]), pose[:3, :3]
         if self._mirror:
@@ -400,18 +463,26 @@ class Retargeter:
         oMdes[:3, :3] = R
         oMdes[:3, 3] = self._shoulder() + self._scale() * p
         if not isinstance(robot, RobotArm):
-            return oMdes, 0.0
+            return oMdes, 0.0, 0.0
         oMdes[2, 3] = _soft_floor(float(oMdes[2, 3]), config.floor_height, config.floor_softness)
+        pushed = 0.0
+        if robot.spec.hollow > 0.0:  # out of the column around the first axis, level
+            across = oMdes[:2, 3] - robot.shoulder[:2]
+            moved = out_of_hollow(
+                across, robot.spec.hollow * robot.reach, config.hollow_softness, _forward(robot)
+            )
+            oMdes[:2, 3] = robot.shoulder[:2] + moved
+            pushed = float(np.linalg.norm(moved - across))
         # Between two points above the table, so the drawn-back target stays above it too.
         offset = oMdes[:3, 3] - robot.shoulder
         distance = float(np.linalg.norm(offset))
         kept = _soft_ceiling(distance, config.reach_fraction * robot.reach, config.reach_softness)
         if kept < distance:
             oMdes[:3, 3] = robot.shoulder + offset * (kept / distance)
-        return oMdes, distance - kept
+        return oMdes, pushed + distance - kept, pushed
 
     def _cartesian(self, q_human: np.ndarray) -> np.ndarray:
-        oMdes, self.pulled_in = self._target(q_human)
+        oMdes, self.pulled_in, self.pushed_out = self._target(q_human)
         robot = self.robot
         if isinstance(robot, RobotArm):
             found: IKResult | RobotIK = self._solve_arm(robot, oMdes, q_human)
@@ -598,7 +669,7 @@ class Retargeter:
 
         Joint mode (the Puma560): :meth:`human_from_robot`, exact. Cartesian mode: the hand pose
         whose target (:meth:`hand_target`) is the robot's tool pose at ``q_robot``, undoing the
-        soft limits of the reach and the table, the placement, the scale, the base's turn and
+        soft limits of the reach, the hollow and the table, the placement, the scale, the base's turn and
         the mirror, then
         the arm that holds the hand there (:func:`fit_hand_pose`, within the arm's limits; where
         the arm cannot, the closest it can). The simulator uses it to reach a goal of any robot.
@@ -628,6 +699,11 @@ class Retargeter:
             t = robot.shoulder + offset * (
                 _unbent(distance, ceiling, config.reach_softness) / distance
             )
+        if robot.spec.hollow > 0.0:
+            hollow = robot.spec.hollow * robot.reach
+            across = t[:2] - robot.shoulder[:2]
+            found = into_hollow(across, hollow, config.hollow_softness, _forward(robot))
+            t[:2] = robot.shoulder[:2] + found
         t[2] = _unfloored(float(t[2]), config.floor_height, config.floor_softness)
         p = turn @ (t - self._shoulder()) / self._scale()
         if self._mirror:  # both mirrors are their own inverses

@@ -64,6 +64,10 @@ class RobotSpec:
         facing: the direction the arm faces in its URDF's base frame, as an angle about z from
             +x (rad): the studio turns its targets and its drawing by it, so that every arm
             faces the operator (the SO-100's URDF faces -y).
+        hollow: the radius, as a share of :attr:`RobotArm.reach`, of the column around the
+            first joint's axis that the tool cannot enter with the arm raised (an arm whose
+            shoulder is offset sideways, the UR's): the retargeting keeps hand targets out of
+            it smoothly (:attr:`RetargetConfig.hollow_softness`); 0 for none.
     """
 
     name: str
@@ -78,11 +82,19 @@ class RobotSpec:
     ready: tuple[float, ...] = field(default=())
     approach: str = "z"
     facing: float = 0.0
+    hollow: float = 0.0
 
 
 UR_READY_DEG = (0.0, -90.0, 90.0, -90.0, -90.0, 0.0)
 """The UR arms' ready pose: upper arm up, forearm level and forward, tool pointing down. Their
 ``home`` (every joint 0) is the arm stretched out level, at the edge of the workspace."""
+
+UR_HOLLOW = 0.2
+"""The UR arms' :attr:`RobotSpec.hollow`. Their wrist is offset sideways from the first axis
+(0.11, 0.11 and 0.16 m on the UR3, UR5 and UR10), so with the arm raised the tool cannot come
+nearer the axis than about that: a hand held straight above or below the operator's shoulder,
+mapped there, was out of every pose's reach (10-19% of the frames of ``test_reach``'s motions
+with a minute of simulator). Kept 0.2 of the reach out, such a frame is reached."""
 
 TOOL_AXES = {
     "z": np.eye(3),
@@ -114,6 +126,7 @@ ROBOT_SPECS: dict[str, RobotSpec] = {
             "tool0",
             6,
             ready=UR_READY_DEG,
+            hollow=UR_HOLLOW,
         ),
         RobotSpec(
             "ur5",
@@ -123,6 +136,7 @@ ROBOT_SPECS: dict[str, RobotSpec] = {
             "tool0",
             6,
             ready=UR_READY_DEG,
+            hollow=UR_HOLLOW,
         ),
         RobotSpec(
             "ur10",
@@ -132,6 +146,7 @@ ROBOT_SPECS: dict[str, RobotSpec] = {
             "tool0",
             6,
             ready=UR_READY_DEG,
+            hollow=UR_HOLLOW,
         ),
         RobotSpec(
             "so100",

@@ -583,6 +583,12 @@ def robot_note(arm: RobotArm, retargeter: Retargeter) -> str | None:
             f"The hand is out of the {title}'s reach: its tool stops {error * 100.0:.0f} cm "
             "short, as near as it gets; bring the hand closer to the shoulder."
         )
+    if retargeter.pushed_out > retargeter.config.reach_tolerance:
+        return (
+            f"The hand is straight above or below the shoulder, where the {title} cannot "
+            f"reach: its target is kept {retargeter.pushed_out * 100.0:.0f} cm out from the "
+            "robot's first axis; move the hand forward to follow it exactly."
+        )
     if retargeter.pulled_in > retargeter.config.reach_tolerance:
         return (
             f"The hand is beyond the {title}'s reach: its target is drawn "
