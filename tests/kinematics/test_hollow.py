@@ -15,7 +15,6 @@ from hypothesis import strategies as st
 
 from studio.kinematics import HumanArm, Retargeter, load_robot, reachable, tool_reaches
 from studio.kinematics._retarget import into_hollow, out_of_hollow
-from studio.kinematics._robots import RobotArm
 from studio.web._pipeline import robot_note
 
 HOLLOW, WIDTH = 0.19, 0.1
@@ -64,13 +63,8 @@ def test_a_ur5_reaches_a_hand_hanging_below_the_shoulder_and_the_page_says_it_mo
     note = robot_note(ur5, retargeter)
     assert note is not None and "straight above or below the shoulder" in note, note
     # without the hollow the target lies where no pose of the UR5 reaches
-    plain = RobotArm(
-        dataclasses.replace(ur5.spec, hollow=0.0),
-        ur5.model,
-        ur5.visual_model,
-        ur5.collision_model,
-        ur5.urdf_text,
-    )
+    plain = ur5.scratch_copy()
+    plain.spec = dataclasses.replace(ur5.spec, hollow=0.0)
     unmoved = Retargeter(robot=plain).hand_target(hanging)
     assert np.hypot(*unmoved[:2, 3]) < 0.05
     assert not reachable(plain, unmoved)
