@@ -586,17 +586,26 @@ def fit_reading(
 ) -> PoseFit:
     """The arm fitted to one frame's directions, unobservable joints held at ``q_hold``."""
     observable = observable_joints(reading, cfg)
-    best: tuple[float, bool, float, np.ndarray, np.ndarray] | None = None
+    candidates = []
     for overhead in (False, True):
         q = _closed_form(reading, arm, data, q_hold, overhead)
         fitted = _fitted_points(arm, data, q, reading)
         gap = reading.points[1:] - fitted[1:]
         if reading.hand is None:
             gap = gap[:2]
-        residual = math.sqrt(float(np.mean(np.sum(gap * gap, axis=1))))
+        natural = not overhead and abs(q[1]) <= cfg.overhead_abduction
+        candidates.append((q, fitted, gap, natural))
+    # Humeral rotation read off a nearly straight elbow is noise that one branch may clamp where
+    # the other does not: a hanging arm's few millimetres at the wrist must not turn the
+    # shoulder half round, so while the first branch is the natural one they are judged by the
+    # elbow alone.
+    elbow_only = not observable[HUMERAL_ROTATION] and candidates[0][3]
+    best: tuple[float, bool, float, np.ndarray, np.ndarray] | None = None
+    for q, fitted, gap, natural in candidates:
+        judged = gap[:1] if elbow_only else gap
+        residual = math.sqrt(float(np.mean(np.sum(judged * judged, axis=1))))
         # Meet the landmarks first (to a tenth of a millimetre), then the first branch away from
         # the gimbal lock, then stay near the reference.
-        natural = not overhead and abs(q[1]) <= cfg.overhead_abduction
         key = (round(residual, 4), not natural, float(np.linalg.norm(q - q_hold)))
         if best is None or key < best[:3]:
             best = (*key, q, fitted)

@@ -273,3 +273,17 @@ def test_bad_side_and_image_arguments_raise_one_sentence() -> None:
         fit_pose_landmarks(world, np.zeros((33, 5)), "left", image_size=(640, 480))
     with pytest.raises(KinematicsError, match="one pixel"):
         fit_pose_landmarks(world, np.full((33, 2), 0.5), "left", image_size=(640, 480))
+
+
+def test_a_hanging_arm_read_with_noise_stays_on_the_shoulders_first_branch() -> None:
+    # Humeral rotation read off a straight elbow is noise; where it fell beyond its limit on
+    # the first branch, 3 mm at the wrist turned flexion and abduction to about 180 degrees.
+    arm = HumanArm("right")
+    world, _ = landmarks_from_arm(np.zeros(7), arm)
+    for dz in (-0.003, 0.003):
+        for dx in (-0.003, 0.0, 0.003):
+            moved = world.copy()
+            moved[[14, 16], 2] += dz
+            moved[[14, 16], 0] += dx
+            q = fit_pose_landmarks(moved, side="right").q_human
+            assert np.degrees(np.abs(q[:2])).max() < 2.0, np.degrees(q[:4])
