@@ -47,7 +47,7 @@ from studio.kinematics import ArmTracker, Puma560, TrackerConfig, robot_spec
 from studio.learning import ArmGrid, LearningError, motion_problem
 
 from ._errors import DemonstrationError
-from ._fitters import fitter_for
+from ._fitters import fit_frames, fitter_for
 from ._observation_format import kind_of_name
 from ._observation_recording import ObservationRecording, read_any_recording
 from ._recording_edit import DEMO_SUFFIX, atomic_write_text
@@ -484,11 +484,10 @@ def _track_segment(
             residual[i] = tracked.residual if np.isfinite(tracked.residual) else np.inf
         return q_robot, residual
     observations = [rec.frame_at(i) for i in range(*rows.indices(len(rec)))]
-    fitter = fitter_for(observations[0], side=rec.side, mode=mode) if observations else None
-    for i, observation in enumerate(observations):
-        assert fitter is not None
-        fitted = fitter.fit(observation)
-        q_robot[i], residual[i] = fitted.q_robot, fitted.residual
+    if observations:
+        fitter = fitter_for(observations[0], side=rec.side, mode=mode)
+        for i, fitted in enumerate(fit_frames(fitter, observations)):
+            q_robot[i], residual[i] = fitted.q_robot, fitted.residual
     return q_robot, residual
 
 

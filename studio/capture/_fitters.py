@@ -2,19 +2,22 @@
 
 Every teacher ends in the same ``q_human``; every robot starts from it. The live pipeline and
 demonstration extraction both fit through :func:`fitter_for`, so the pose the page shows live is
-the pose a demonstration cut from the same observations records:
+the pose a demonstration cut from the same observations records (but for camera landmarks, below):
 
 - tape frames: the kinematics package's :class:`~studio.kinematics.ArmTracker` (reconstruct, fit
   the arm to the tape, retarget);
 - pose landmarks: :class:`~studio.kinematics.PoseStreamFitter` (Kalman filtered, joints the
-  camera cannot see held smoothly), then a :class:`~studio.kinematics.Retargeter`;
+  camera cannot see held smoothly), then a :class:`~studio.kinematics.Retargeter`; frames of a
+  recording are smoothed with the future as well (:func:`fit_frames`), so a demonstration cut
+  from a camera recording follows the person more closely than the live scene could;
 - hand poses: :func:`~studio.kinematics.fit_hand_pose` (damped least squares on the arm within
   its limits, seeded with the previous solution), then the same retargeting.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
 from typing import Protocol, runtime_checkable
 
 import numpy as np
@@ -27,6 +30,7 @@ from studio.kinematics import (
     Retargeter,
     TapeConfig,
     TrackerConfig,
+    smooth_landmarks,
 )
 
 from ._frames import TapeFrame
@@ -224,6 +228,61 @@ class LandmarkFitter(_Retargeted):
         self.stream = PoseStreamFitter(side=self.side)
 
     def fit(self, observation: Observation) -> Fitted:
+        return self._fit(observation, smoothed=False)
+
+    def fit_recorded(self, observations: Sequence[Observation]) -> list[Fitted]:
+        """A recording's frames, fitted in order, each run of frames that show the arm
+        smoothed with the past and the future first (:func:`~studio.kinematics.smooth_landmarks`).
+
+        A run ends where the person or the arm leaves the picture, or at a gap longer than
+        ``StreamConfig.max_gap_s``; a frame outside every run is fitted as live.
+        """
+        frames = [observation for observation in observations]
+        smoothed = [False] * len(frames)
+        for run in self._runs(frames):
+            first = frames[run[0]]
+            assert isinstance(first, LandmarkFrame)
+            runs = [frames[i] for i in run]
+            times = np.array([f.t for f in runs])
+            world = np.array([f.world for f in runs])
+            image = np.array([f.image for f in runs]) if first.image is not None else None
+            size = np.array([(f.width, f.height) for f in runs], dtype=float)
+            try:
+                world, image = smooth_landmarks(times, world, image, size, self.stream.config)
+            except KinematicsError:  # left as recorded, fitted as live
+                continue
+            for k, i in enumerate(run):
+                frame = frames[i]
+                assert isinstance(frame, LandmarkFrame)
+                frames[i] = replace(
+                    frame, world=world[k], image=None if image is None else image[k]
+                )
+                smoothed[i] = True
+        return [self._fit(f, smoothed=s) for f, s in zip(frames, smoothed, strict=True)]
+
+    def _runs(self, frames: list[Observation]) -> list[list[int]]:
+        """Index runs of two or more frames that show the arm, one picture size, no long gap."""
+        runs: list[list[int]] = []
+        last: LandmarkFrame | None = None
+        for i, frame in enumerate(frames):
+            assert isinstance(frame, LandmarkFrame)
+            if frame.world is None or arm_out_of_view(frame, self.side):
+                last = None
+                continue
+            joins = (
+                last is not None
+                and 0.0 < frame.t - last.t <= self.stream.config.max_gap_s
+                and (frame.image is None) == (last.image is None)
+                and (frame.width, frame.height) == (last.width, last.height)
+            )
+            if joins:
+                runs[-1].append(i)
+            else:
+                runs.append([i])
+            last = frame
+        return [run for run in runs if len(run) > 1]
+
+    def _fit(self, observation: Observation, smoothed: bool) -> Fitted:
         assert isinstance(observation, LandmarkFrame)
         frame = observation
         hidden = np.zeros(HUMAN_JOINTS, dtype=bool)
@@ -238,6 +297,7 @@ class LandmarkFitter(_Retargeted):
                 frame.world,
                 image_landmarks=frame.image,
                 image_size=(frame.width, frame.height),
+                smoothed=smoothed,
             )
         except KinematicsError as err:  # the arm not seen, or landmarks the fit refuses
             why = warning or str(err)
@@ -282,6 +342,19 @@ class HandFitter(_Retargeted):
         return self._fitted(
             hand.q_human, hand.position_error_m, bool(hand.reached), warning=warning
         )
+
+
+def fit_frames(fitter: ObservationFitter, observations: Sequence[Observation]) -> list[Fitted]:
+    """A recording's observations fitted in order by ``fitter``.
+
+    Landmark frames are smoothed with the future first (:meth:`LandmarkFitter.fit_recorded`):
+    a recording has every frame at hand, where a live camera has only the past, so what is cut,
+    played back or exported from it follows the person more closely than the live scene did.
+    Tape frames and hand poses are fitted one by one, as live.
+    """
+    if isinstance(fitter, LandmarkFitter):
+        return fitter.fit_recorded(observations)
+    return [fitter.fit(observation) for observation in observations]
 
 
 def fitter_for(

@@ -2,8 +2,9 @@
 and what the recording itself holds (its :class:`Signal` groups).
 
 Every kind of recording (tape, pose landmarks, hand poses) goes through its own fitter
-(:func:`~studio.capture.fitter_for`), the very fitting the live pipeline and demonstration
-extraction use, so the timeline shows the joints a demonstration cut from it would hold. Beside
+(:func:`~studio.capture.fitter_for`, :func:`~studio.capture._fitters.fit_frames`: camera landmarks
+smoothed with the future, as demonstration extraction does), so the timeline shows the joints a
+demonstration cut from it would hold. Beside
 them come the observations as recorded: a tape's bend and twist per region, a camera's visibility
 of the arm's landmarks, a hand guide's hand position.
 """
@@ -15,7 +16,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ._fitters import ARM_LANDMARKS, fitter_for
+from ._fitters import ARM_LANDMARKS, fit_frames, fitter_for
 from ._observation_recording import ObservationRecording, read_any_recording
 from ._recording_reader import Recording
 
@@ -101,8 +102,9 @@ def human_angles(
     recording: Recording | ObservationRecording, rows: slice | np.ndarray
 ) -> np.ndarray:
     """The human arm's angles ``(N, 7)`` at ``rows`` of a recording (a slice, or row indices in
-    order), each frame fitted by the recording's own fitter seeded by the frame before: the arm a
-    live session would have shown, ready to be retargeted onto any robot.
+    order), each frame fitted by the recording's own fitter seeded by the frame before
+    (:func:`~studio.capture._fitters.fit_frames`: camera landmarks smoothed with the future too), ready to
+    be retargeted onto any robot.
     """
     indices = range(*rows.indices(len(recording))) if isinstance(rows, slice) else rows
     if not len(indices):
@@ -112,7 +114,8 @@ def human_angles(
         fitter = fitter_for(first, tape=recording.config)
     else:
         fitter = fitter_for(first, side=recording.side)
-    return np.array([fitter.fit(recording.frame_at(int(i))).q_human for i in indices])
+    frames = [recording.frame_at(int(i)) for i in indices]
+    return np.array([fitted.q_human for fitted in fit_frames(fitter, frames)])
 
 
 def recording_series(
@@ -153,8 +156,8 @@ def recording_series(
         tape = rec.config if isinstance(rec, Recording) else None
         side = rec.side if isinstance(rec, ObservationRecording) else None
         fitter = fitter_for(first, tape=tape, side=side, mode=mode)
-        for i, row in enumerate(rows):
-            fitted = fitter.fit(first if i == 0 else rec.frame_at(int(row)))
+        frames = [first, *(rec.frame_at(int(row)) for row in rows[1:])]
+        for i, fitted in enumerate(fit_frames(fitter, frames)):
             q_human[i], q_robot[i], residual[i] = fitted.q_human, fitted.q_robot, fitted.residual
     origin = float(rec.t[0]) if len(rec) else 0.0
     return RecordingSeries(

@@ -19,6 +19,7 @@ from ._pose import PoseFit as PoseFit
 from ._pose import fit_pose_landmarks as fit_pose_landmarks
 from ._pose_stream import PoseStreamFitter as PoseStreamFitter
 from ._pose_stream import StreamConfig as StreamConfig
+from ._pose_stream import smooth_landmarks as smooth_landmarks
 from ._puma import IKConfig as IKConfig
 from ._puma import Puma560 as Puma560
 from ._reach import reachable as reachable

@@ -1,4 +1,4 @@
-"""Landmark filters: the One Euro filter, and a constant-velocity Kalman filter.
+"""Landmark filters: the One Euro filter, and a constant-velocity Kalman filter and smoother.
 
 The One Euro filter: low jitter when still, low lag when moving.
 
@@ -181,20 +181,107 @@ class ConstantVelocityFilter:
                 f"ConstantVelocityFilter got time {float(t)!r} s after {self._t!r} s; give "
                 "increasing times."
             )
-        q = self.acceleration**2
-        p00, p01, p11 = self._p
-        x = self._x + dt * self._v
-        p00 = p00 + dt * (2.0 * p01 + dt * p11) + q * dt**3 / 3.0
-        p01 = p01 + dt * p11 + q * dt**2 / 2.0
-        p11 = p11 + q * dt
-        s = p00 + r
-        k0, k1 = p00 / s, p01 / s
-        innovation = z - x
-        self._x = x + k0 * innovation
-        self._v = self._v + k1 * innovation
-        self._p = [(1.0 - k0) * p00, (1.0 - k0) * p01, p11 - k1 * p01]
+        x, v, cov = _predict(self._x, self._v, self._p, dt, self.acceleration**2)
+        self._x, self._v, self._p = _update(x, v, cov, z, r)
         self._t = float(t)
         return self._x.copy()
+
+
+def _predict(
+    x: np.ndarray, v: np.ndarray, cov: list[np.ndarray], dt: float, q: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, list[np.ndarray]]:
+    """The constant-velocity model ``dt`` later: position, velocity and covariance
+    ``[p00, p01, p11]``, the velocity driven by white acceleration of spectral density ``q``."""
+    p00, p01, p11 = cov
+    return (
+        x + dt * v,
+        v,
+        [
+            p00 + dt * (2.0 * p01 + dt * p11) + q * dt**3 / 3.0,
+            p01 + dt * p11 + q * dt**2 / 2.0,
+            p11 + q * dt,
+        ],
+    )
+
+
+def _update(
+    x: np.ndarray, v: np.ndarray, cov: list[np.ndarray], z: np.ndarray, r: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, list[np.ndarray]]:
+    """The prediction corrected by the position ``z`` measured with variance ``r``."""
+    p00, p01, p11 = cov
+    s = p00 + r
+    k0, k1 = p00 / s, p01 / s
+    innovation = z - x
+    return (
+        x + k0 * innovation,
+        v + k1 * innovation,
+        [(1.0 - k0) * p00, (1.0 - k0) * p01, p11 - k1 * p01],
+    )
+
+
+def smooth_constant_velocity(
+    times: object, samples: object, noise: float | np.ndarray, acceleration: float | np.ndarray
+) -> np.ndarray:
+    """The samples smoothed with the past and the future: :class:`ConstantVelocityFilter`'s
+    model run forward, then back (Rauch, Tung and Striebel, AIAA J. 1965).
+
+    Each sample's estimate uses the whole sequence, so unlike the filter it has no lag at all:
+    for a recording, where every frame is at hand, not for a live source.
+
+    Args:
+        times: increasing times (s), shape (N,).
+        samples: the values, shape (N, ...), each element filtered on its own.
+        noise, acceleration: as :class:`ConstantVelocityFilter` takes them.
+
+    Returns:
+        The smoothed positions, shape (N, ...).
+
+    Raises:
+        KinematicsError: times that do not increase, or shapes that do not fit.
+    """
+    t = real_array(times, "The smoothed times", "pass seconds")
+    z = real_array(samples, "The smoothed samples", "pass numbers")
+    if t.ndim != 1 or len(z) != len(t):
+        raise KinematicsError(
+            f"smooth_constant_velocity got {t.shape} times for samples of shape {z.shape}; "
+            "give one time per sample."
+        )
+    if len(t) > 1 and not np.all(np.diff(t) > 0.0):
+        raise KinematicsError("smooth_constant_velocity got times that do not increase.")
+    filt = ConstantVelocityFilter(noise, acceleration)
+    if not len(t):
+        return z.copy()
+    try:
+        r = np.broadcast_to(filt.noise**2, z.shape[1:])
+        q = np.broadcast_to(filt.acceleration**2, z.shape[1:])
+    except ValueError:
+        raise KinematicsError(
+            f"smooth_constant_velocity's noise {filt.noise.shape} and acceleration "
+            f"{filt.acceleration.shape} do not fit samples of shape {z.shape[1:]}."
+        ) from None
+    x, v = z[0].copy(), np.zeros_like(z[0])
+    cov = [r.copy(), np.zeros_like(z[0]), 1e6 * np.ones_like(z[0])]
+    filtered, predicted = [(x, v, cov)], [(x, v, cov)]
+    for k in range(1, len(t)):
+        ahead = _predict(x, v, cov, float(t[k] - t[k - 1]), q)
+        predicted.append(ahead)
+        x, v, cov = _update(*ahead, z[k], r)
+        filtered.append((x, v, cov))
+    out = np.empty_like(z)
+    xs, vs = x, v
+    out[-1] = xs
+    for k in range(len(t) - 2, -1, -1):
+        dt = float(t[k + 1] - t[k])
+        (xf, vf, (f00, f01, f11)), (xp, vp, (p00, p01, p11)) = filtered[k], predicted[k + 1]
+        # gain A = P_f F^T P_p^-1, element by element (2 x 2 each)
+        m00, m01, m10, m11 = f00 + dt * f01, f01, f01 + dt * f11, f11
+        det = p00 * p11 - p01 * p01
+        i00, i01, i11 = p11 / det, -p01 / det, p00 / det
+        dx, dv = xs - xp, vs - vp
+        xs = xf + (m00 * i00 + m01 * i01) * dx + (m00 * i01 + m01 * i11) * dv
+        vs = vf + (m10 * i00 + m11 * i01) * dx + (m10 * i01 + m11 * i11) * dv
+        out[k] = xs
+    return out
 
 
 JITTER_RAD = math.radians(0.5)
