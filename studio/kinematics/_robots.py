@@ -93,8 +93,8 @@ UR_HOLLOW = 0.2
 """The UR arms' :attr:`RobotSpec.hollow`. Their wrist is offset sideways from the first axis
 (0.11, 0.11 and 0.16 m on the UR3, UR5 and UR10), so with the arm raised the tool cannot come
 nearer the axis than about that: a hand held straight above or below the operator's shoulder,
-mapped there, was out of every pose's reach (10-19% of the frames of ``test_reach``'s motions
-with a minute of simulator). Kept 0.2 of the reach out, such a frame is reached. Between 0.15
+mapped there, was out of every pose's reach (85-211 of the 566 frames ``test_reach`` judges).
+Kept 0.2 of the reach out, such a frame is reached. Between 0.15
 and 0.25 the frames reached change by a few points either way, differently on each motion."""
 
 TOOL_AXES = {
