@@ -348,8 +348,9 @@ def fit_frames(fitter: ObservationFitter, observations: Sequence[Observation]) -
     """A recording's observations fitted in order by ``fitter``.
 
     Landmark frames are smoothed with the future first (:meth:`LandmarkFitter.fit_recorded`):
-    a recording has every frame at hand, where a live camera has only the past, so what is cut,
-    played back or exported from it follows the person more closely than the live scene did.
+    a recording has every frame at hand, where a live camera has only the past, so what is cut
+    or exported from it, and its timeline, follow the person more closely than the live scene
+    did (played back as a source, it runs through the live fit again).
     Tape frames and hand poses are fitted one by one, as live.
     """
     if isinstance(fitter, LandmarkFitter):
