@@ -237,16 +237,16 @@ class LandmarkFitter(_Retargeted):
         A run ends where the person or the arm leaves the picture, or at a gap longer than
         ``StreamConfig.max_gap_s``; a frame outside every run is fitted as live.
         """
-        frames = [observation for observation in observations]
+        frames = list(observations)
         smoothed = [False] * len(frames)
         for run in self._runs(frames):
-            first = frames[run[0]]
+            in_run = [frames[i] for i in run]
+            first = in_run[0]
             assert isinstance(first, LandmarkFrame)
-            runs = [frames[i] for i in run]
-            times = np.array([f.t for f in runs])
-            world = np.array([f.world for f in runs])
-            image = np.array([f.image for f in runs]) if first.image is not None else None
-            size = np.array([(f.width, f.height) for f in runs], dtype=float)
+            times = np.array([f.t for f in in_run])
+            world = np.array([f.world for f in in_run])
+            image = np.array([f.image for f in in_run]) if first.image is not None else None
+            size = np.array([(f.width, f.height) for f in in_run], dtype=float)
             try:
                 world, image = smooth_landmarks(times, world, image, size, self.stream.config)
             except KinematicsError:  # left as recorded, fitted as live
