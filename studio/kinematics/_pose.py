@@ -94,6 +94,11 @@ LIMBS = (("shoulder", "elbow"), ("elbow", "wrist"))
 HUMERAL_ROTATION, FOREARM_ROTATION = 2, 4
 """Indices of ``shoulder_Y`` and ``elbow_Y`` in ``q_human``."""
 
+BRANCH_NOISE = 0.01
+"""While the wrist lies this near the upper arm's line (m), the arm reads straight and the
+shoulder's second branch is taken for meeting the wrist better only when it does by more than
+this: a few millimetres there is noise."""
+
 _SEEN = 1e-6  # sine below which a rotation about a limb is not seen at all (held)
 
 
@@ -577,6 +582,11 @@ def observable_joints(reading: _Reading, cfg: PoseConfig) -> np.ndarray:
     return np.array([True, True, flexion >= cfg.bent_elbow, True, palm, hand, hand])
 
 
+def _rms(gap: np.ndarray) -> float:
+    """The RMS length (m) of the rows of ``gap``."""
+    return math.sqrt(float(np.mean(np.sum(gap * gap, axis=1))))
+
+
 def fit_reading(
     reading: _Reading,
     arm: HumanArm,
@@ -595,15 +605,18 @@ def fit_reading(
             gap = gap[:2]
         natural = not overhead and abs(q[1]) <= cfg.overhead_abduction
         candidates.append((q, fitted, gap, natural))
-    # Humeral rotation read off a nearly straight elbow is noise that one branch may clamp where
-    # the other does not: a hanging arm's few millimetres at the wrist must not turn the
-    # shoulder half round, so while the first branch is the natural one they are judged by the
-    # elbow alone.
-    elbow_only = not observable[HUMERAL_ROTATION] and candidates[0][3]
+    # Humeral rotation read off a straight elbow is noise that one branch may clamp where the
+    # other does not: a hanging arm's few millimetres at the wrist must not turn the shoulder
+    # half round. So while the wrist lies within BRANCH_NOISE of the upper arm's line, the first
+    # branch is the natural one and misses the wrist by no more than that beyond the second,
+    # they are judged by the elbow alone.
+    first, second = (_rms(c[2]) for c in candidates)
+    forearm = float(np.linalg.norm(reading.points[2] - reading.points[1]))
+    off_line = forearm * math.sqrt(max(0.0, 1.0 - float(reading.upper @ reading.fore) ** 2))
+    elbow_only = off_line <= BRANCH_NOISE and candidates[0][3] and first - second <= BRANCH_NOISE
     best: tuple[float, bool, float, np.ndarray, np.ndarray] | None = None
     for q, fitted, gap, natural in candidates:
-        judged = gap[:1] if elbow_only else gap
-        residual = math.sqrt(float(np.mean(np.sum(judged * judged, axis=1))))
+        residual = _rms(gap[:1] if elbow_only else gap)
         # Meet the landmarks first (to a tenth of a millimetre), then the first branch away from
         # the gimbal lock, then stay near the reference.
         key = (round(residual, 4), not natural, float(np.linalg.norm(q - q_hold)))
@@ -614,7 +627,7 @@ def fit_reading(
     gap = reading.points[1:] - fitted[1:]
     if reading.hand is None:
         gap = gap[:2]
-    residual = math.sqrt(float(np.mean(np.sum(gap * gap, axis=1))))
+    residual = _rms(gap)
     return PoseFit(
         q_human=q,
         observable=observable,

@@ -287,3 +287,15 @@ def test_a_hanging_arm_read_with_noise_stays_on_the_shoulders_first_branch() -> 
             moved[[14, 16], 0] += dx
             q = fit_pose_landmarks(moved, side="right").q_human
             assert np.degrees(np.abs(q[:2])).max() < 2.0, np.degrees(q[:4])
+
+
+def test_a_slightly_bent_arm_raised_overhead_round_trips_on_the_shoulders_second_branch() -> None:
+    # Elbow bent 19 deg, the arm abducted 156 deg: the first branch cannot take its humeral
+    # rotation and misses the wrist by centimetres; judged by the elbow alone (as a hanging arm's
+    # noise is), it was taken anyway and the forearm came out 8 deg off.
+    arm = HumanArm("right", **PERSON)
+    q = np.radians([134.3, 155.8, 64.2, 18.9, 33.8, 50.4, -10.4])
+    world, _ = landmarks_from_arm(q, arm, BodyShape(yaw=0.514))
+    fit = fit_pose_landmarks(world, side="right")
+    _, e_upper, e_fore = errors(arm, q, fit.q_human)
+    assert e_upper < 1e-3 and e_fore < 1e-3
