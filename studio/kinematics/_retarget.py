@@ -522,7 +522,8 @@ class Retargeter:
         from the last pose, the pose or else the position."""
         if self._q_prev is not None and self._smooth(q_human):
             chain_arm = load_robot("puma560", geometry=False)  # the same DH model, compiled
-            near = self._within_a_step(chain_arm, oMdes, {"iterations": self.config.ik_iterations})
+            settings = {"iterations": self.config.ik_iterations}
+            near = self._within_a_step(chain_arm, self._q_prev, oMdes, settings)
             if near is not None:
                 return near
         found = puma.inverse(oMdes, q0=self._q_prev)
@@ -547,16 +548,10 @@ class Retargeter:
         over as many frames as it needs.
         """
         config = self.config
-        elbow = self.elbow_target(q_human) if robot.nq > 6 else None
         start = robot.home if self._q_prev is None else self._q_prev
-        settings = {
-            "elbow": elbow,
-            "iterations": config.ik_iterations,
-            "elbow_iterations": 1,
-            "damping": self._damping(robot, start),
-        }
+        settings = self._settings(robot, start, q_human)
         if self._q_prev is not None:
-            near = self._within_a_step(robot, oMdes, settings)
+            near = self._within_a_step(robot, self._q_prev, oMdes, settings)
             if near is not None:
                 return near
         found = robot.inverse(oMdes, q0=start, **settings)
@@ -578,6 +573,35 @@ class Retargeter:
                 found = position
         return found
 
+    def pose_near(self, q: np.ndarray, q_human: np.ndarray) -> np.ndarray | None:
+        """A pose of the robot (a :class:`RobotArm`) within one frame's joint motion of ``q``
+        that reaches the target of ``q_human``, clear of self-collision; or None. The step the
+        live retargeting looks for first, taken from any pose (the path planner's)."""
+        robot = self.robot
+        assert isinstance(robot, RobotArm)
+        oMdes = self.hand_target(q_human)
+        found = self._within_a_step(robot, q, oMdes, self._settings(robot, q, q_human))
+        if found is None or self._clearance(robot).collisions(found.q):
+            return None
+        return found.q
+
+    def poses_reaching(self, q_human: np.ndarray, apart: float) -> list[np.ndarray]:
+        """Poses of the robot (a :class:`RobotArm`) that reach the target of ``q_human``, clear
+        of self-collision, found by the IK from home and the fixed restart poses; no two closer
+        than ``apart`` (rad, any joint)."""
+        robot = self.robot
+        assert isinstance(robot, RobotArm)
+        oMdes, found = self.hand_target(q_human), []
+        for seed in (robot.home, *self._starts(robot)):
+            settings = self._settings(robot, seed, q_human)
+            settings["iterations"] = self.config.restart_iterations
+            answer = robot.inverse(oMdes, q0=seed, **settings)
+            if not self._reached(answer) or self._clearance(robot).collisions(answer.q):
+                continue
+            if all(np.abs(answer.q - other).max() >= apart for other in found):
+                found.append(answer.q)
+        return found
+
     def _damping(self, robot: RobotArm, q: np.ndarray) -> float:
         """The IK's damping for a frame that starts at ``q`` (see
         :attr:`RetargetConfig.singular_margin`)."""
@@ -594,11 +618,20 @@ class Retargeter:
     def _reached(self, found: RobotIK) -> bool:
         return self.config.within_reach(found.position_error, found.rotation_error)
 
-    def _within_a_step(self, arm: RobotArm, oMdes: np.ndarray, settings: dict) -> RobotIK | None:
-        """A pose within one frame's joint motion of the last that reaches ``oMdes``, searched
-        from the last pose and from ``config.near_starts`` fixed points around it; or None."""
-        q_prev = self._q_prev
-        assert q_prev is not None
+    def _settings(self, robot: RobotArm, start: np.ndarray, q_human: np.ndarray) -> dict:
+        """The IK's settings for a frame of ``q_human`` that starts at ``start``."""
+        return {
+            "elbow": self.elbow_target(q_human) if robot.nq > 6 else None,
+            "iterations": self.config.ik_iterations,
+            "elbow_iterations": 1,
+            "damping": self._damping(robot, start),
+        }
+
+    def _within_a_step(
+        self, arm: RobotArm, q_prev: np.ndarray, oMdes: np.ndarray, settings: dict
+    ) -> RobotIK | None:
+        """A pose within one frame's joint motion of ``q_prev`` that reaches ``oMdes``, searched
+        from ``q_prev`` and from ``config.near_starts`` fixed points around it; or None."""
         step = self.config.max_joint_step
         lower, upper = q_prev - step, q_prev + step
         offsets = self._fixed_draws("near", -np.ones(arm.nq), np.ones(arm.nq))
@@ -713,62 +746,3 @@ class Retargeter:
         oMhand[:3, 3] = self._mirrored(p)
         q = fit_hand_pose(oMhand, self.arm.side, q_seed).q_human
         return np.minimum(np.maximum(q, self.arm.lower), self.arm.upper)
-
-
-@dataclass(frozen=True)
-class RetargetedPath:
-    """A human-arm path retargeted onto one robot, frame by frame (:func:`retarget_path`).
-
-    Attributes:
-        q: the robot's joints, one row per frame (rad, ``(N, nq)``).
-        position_error: how far the tool stays from the hand's target per frame (m; 0 in joint
-            mode, which has no target).
-        out_of_reach: the frames whose target is out of reach (``RetargetConfig.reach_tolerance``).
-        pulled_in: per frame, how far the hand's target was drawn back into the robot's reach
-            (m; the hand went beyond it, and the robot followed the drawn-back target; 0 in
-            joint mode).
-    """
-
-    q: np.ndarray
-    position_error: np.ndarray
-    out_of_reach: np.ndarray
-    pulled_in: np.ndarray
-
-
-def retarget_path(
-    robot: RobotArm, q_human: np.ndarray, config: RetargetConfig | None = None
-) -> RetargetedPath:
-    """Retarget a human-arm path ``(N, 7)`` onto ``robot``, frame after frame, as live.
-
-    The Puma560 in joint mode (the paper's), any other arm in cartesian mode; the first frame is
-    settled first (the IK starts cold there, so it gets ``config.settle_tries`` passes). The
-    frames are taken in order, each warm-started from the one before, so the path is the one a
-    live session would have shown. Safe beside a live session of the same robot: it computes on
-    scratch data of its own (:meth:`RobotArm.scratch_copy`).
-
-    Raises:
-        KinematicsError: angles of the wrong shape or not finite.
-    """
-    config = config or RetargetConfig()
-    q_h = np.asarray(q_human, dtype=float).reshape(-1, 7)
-    puma = robot.name == "puma560"
-    if puma:
-        retargeter = Retargeter(config=config)
-    else:
-        retargeter = Retargeter(robot=robot.scratch_copy(), config=config)
-    q = np.empty((len(q_h), robot.nq))
-    error = np.zeros(len(q_h))
-    out = np.zeros(len(q_h), dtype=bool)
-    pulled = np.zeros(len(q_h))
-    for _ in range(config.settle_tries if len(q_h) else 0):
-        retargeter.robot_from_human(q_h[0])
-        if not isinstance(retargeter.last_ik, RobotIK) or retargeter.last_ik.success:
-            break
-    for i, q_frame in enumerate(q_h):
-        q[i] = retargeter.robot_from_human(q_frame)
-        pulled[i] = retargeter.pulled_in
-        ik = retargeter.last_ik
-        if isinstance(ik, RobotIK):
-            error[i] = ik.position_error
-            out[i] = not ik.success and ik.position_error > config.reach_tolerance
-    return RetargetedPath(q, error, out, pulled)

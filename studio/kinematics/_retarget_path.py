@@ -1,0 +1,325 @@
+"""A recorded human-arm motion retargeted onto a robot, its IK branches planned with the whole
+motion known.
+
+Live, the retargeting knows only the past. It keeps to the IK branch it is on while a pose within
+one frame's joint motion (``RetargetConfig.max_joint_step``) reaches the hand's target; when
+none does, it walks at that step to the nearest pose of another branch, and misses the target
+while it walks. A recording is known whole, so :func:`retarget_path` plans the branches:
+
+1. The live pass, frame after frame: the path a session would have shown. Where it reaches every
+   frame, that is the path.
+2. *Tracks*: runs of frames along which a pose that reaches the target is followed within the
+   step cap (:meth:`Retargeter.pose_near`). The live pass's reached runs are tracks, each also
+   followed back before its first frame. More start from the poses the IK finds
+   (:meth:`Retargeter.poses_reaching`) on the first frame and at the start, middle and end of
+   each run of frames the live pass missed, each followed both ways for as long as it reaches
+   and does not join a track already found.
+3. The route through the tracks that misses the fewest frames, by dynamic programming over the
+   frames. Staying on a track costs nothing. Leaving track k at frame a for track j at frame b
+   costs the b - a - 1 frames between, walked in a straight line in joint space, and is allowed
+   when no joint has further to go than b - a steps. A walk that would bring the robot's links
+   closer than ``RetargetConfig.clearance`` is struck out and the route found again.
+
+The live pass is one of the routes, and the plan is kept only where it reaches at least as many
+frames, so a planned path never reaches fewer. Every joint stays within its limits (the tracks'
+poses do, and a straight walk between two of them does) and moves at most ``max_joint_step`` a
+frame.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ._reach import tool_reaches
+from ._retarget import RetargetConfig, Retargeter
+from ._robots import RobotArm, RobotIK
+
+APART = 0.2
+"""Poses the IK finds on one frame count as different branches when a joint differs by more
+than this (rad)."""
+
+JOINED = 0.05
+"""A track being followed stops where it comes this near a track already found (rad, every
+joint): it has joined that branch."""
+
+DEPART_EVERY = 2
+"""The route may leave a track at every this many frames, and at its last frame."""
+
+WALK_BAN = 10
+"""A walk that brings links into contact is struck out from the departures this many frames
+either side of it too (their walks pass the same poses)."""
+
+WALK_RETRIES = 8
+"""Routes found again after a walk was struck out for a collision, before the live pass is
+kept."""
+
+
+@dataclass(frozen=True)
+class RetargetedPath:
+    """A human-arm path retargeted onto one robot, frame by frame (:func:`retarget_path`).
+
+    Attributes:
+        q: the robot's joints, one row per frame (rad, ``(N, nq)``).
+        position_error: how far the tool stays from the hand's target per frame (m; 0 in joint
+            mode, which has no target).
+        out_of_reach: the frames whose target is out of reach (``RetargetConfig.reach_tolerance``):
+            the IK found no pose that reaches it.
+        pulled_in: per frame, how far the hand's target was drawn back into the robot's reach
+            (m; the hand went beyond it, and the robot followed the drawn-back target; 0 in
+            joint mode).
+    """
+
+    q: np.ndarray
+    position_error: np.ndarray
+    out_of_reach: np.ndarray
+    pulled_in: np.ndarray
+
+
+@dataclass
+class _Track:
+    """Poses that reach the target on frames ``start`` .. ``start + len(q) - 1``."""
+
+    start: int
+    q: np.ndarray
+
+    @property
+    def end(self) -> int:
+        return self.start + len(self.q) - 1
+
+
+def retarget_path(
+    robot: RobotArm,
+    q_human: np.ndarray,
+    config: RetargetConfig | None = None,
+    *,
+    as_live: bool = False,
+) -> RetargetedPath:
+    """Retarget a human-arm path ``(N, 7)`` onto ``robot``, its IK branches planned.
+
+    The Puma560 in joint mode (the paper's, which has no branches to plan), any other arm in
+    cartesian mode, planned as the module docstring says. The first frame is settled first (the
+    IK starts cold there, so it gets ``config.settle_tries`` passes). Safe beside a live session
+    of the same robot: it computes on scratch data of its own (:meth:`RobotArm.scratch_copy`).
+
+    Args:
+        robot: the robot, from :func:`load_robot`.
+        q_human: the human arm's angles, one row per frame (rad).
+        config: the retargeting's settings.
+        as_live: the path a live session would have shown (frame after frame, each
+            warm-started from the one before), without the plan.
+
+    Raises:
+        KinematicsError: angles of the wrong shape or not finite.
+    """
+    config = config or RetargetConfig()
+    q_h = np.asarray(q_human, dtype=float).reshape(-1, 7)
+    if robot.name == "puma560":
+        retargeter = Retargeter(config=config)
+    else:
+        retargeter = Retargeter(robot=robot.scratch_copy(), config=config)
+    live, reached = _live(retargeter, q_h, config)
+    arm = retargeter.robot
+    if as_live or not isinstance(arm, RobotArm) or reached.all():
+        return live
+    planned = _plan(retargeter, q_h, live.q, reached, config)
+    targets = [retargeter.hand_target(q) for q in q_h]
+    now = np.array(
+        [tool_reaches(arm, *pair, config) for pair in zip(planned, targets, strict=True)]
+    )
+    if now.sum() < reached.sum():
+        return live
+    error = [
+        np.linalg.norm(arm.forward(q)[:3, 3] - t[:3, 3])
+        for q, t in zip(planned, targets, strict=True)
+    ]
+    return RetargetedPath(planned, np.array(error), live.out_of_reach & ~now, live.pulled_in)
+
+
+def _live(
+    retargeter: Retargeter, q_h: np.ndarray, config: RetargetConfig
+) -> tuple[RetargetedPath, np.ndarray]:
+    """The path a live session would have shown, frame after frame, and which of its frames
+    reach their target."""
+    robot = retargeter.robot
+    q = np.empty((len(q_h), robot.nq))
+    error = np.zeros(len(q_h))
+    out = np.zeros(len(q_h), dtype=bool)
+    reached = np.ones(len(q_h), dtype=bool)
+    pulled = np.zeros(len(q_h))
+    for _ in range(config.settle_tries if len(q_h) else 0):
+        retargeter.robot_from_human(q_h[0])
+        if not isinstance(retargeter.last_ik, RobotIK) or retargeter.last_ik.success:
+            break
+    for i, q_frame in enumerate(q_h):
+        q[i] = retargeter.robot_from_human(q_frame)
+        pulled[i] = retargeter.pulled_in
+        ik = retargeter.last_ik
+        if isinstance(ik, RobotIK):
+            error[i] = ik.position_error
+            out[i] = not ik.success and ik.position_error > config.reach_tolerance
+            reached[i] = tool_reaches(robot, q[i], retargeter.hand_target(q_frame), config)
+    return RetargetedPath(q, error, out, pulled), reached
+
+
+def _runs(flags: np.ndarray) -> list[tuple[int, int]]:
+    """The runs of True in ``flags``, as (first, last) frames."""
+    edges = np.flatnonzero(np.diff(np.r_[0, flags.astype(int), 0]))
+    return [(int(a), int(b) - 1) for a, b in zip(edges[::2], edges[1::2], strict=True)]
+
+
+def _plan(
+    retargeter: Retargeter,
+    q_h: np.ndarray,
+    live: np.ndarray,
+    reached: np.ndarray,
+    config: RetargetConfig,
+) -> np.ndarray:
+    """The planned path's joints (see the module docstring), or ``live``'s."""
+    tracks: list[_Track] = []
+    for first, last in _runs(reached):
+        before = _follow(retargeter, q_h, first, live[first], -1, tracks)
+        poses = np.vstack([*before[::-1], live[first : last + 1]])
+        tracks.append(_Track(first - len(before), poses))
+    seeds = {0}
+    for first, last in _runs(~reached):
+        seeds |= {first, (first + last) // 2, last}
+    for t in sorted(seeds):
+        for q in retargeter.poses_reaching(q_h[t], APART):
+            if _joined(tracks, t, q):
+                continue
+            before = _follow(retargeter, q_h, t, q, -1, tracks)
+            after = _follow(retargeter, q_h, t, q, 1, tracks)
+            tracks.append(_Track(t - len(before), np.vstack([*before[::-1], q, *after])))
+    arm = retargeter.robot
+    assert isinstance(arm, RobotArm)
+    if not tracks:  # no pose found reaches any frame
+        return live
+    banned: set[tuple[int, int, int]] = set()
+    for _ in range(WALK_RETRIES):
+        route = _route(tracks, len(q_h), config.max_joint_step, banned)
+        path, clash = _walked(tracks, route, len(q_h), arm, config.clearance)
+        if clash is None:
+            return path
+        k, t, j = clash  # its neighbours would mostly touch too
+        banned |= {(k, t + dt, j) for dt in range(-WALK_BAN, WALK_BAN + 1)}
+    return live
+
+
+def _joined(tracks: list[_Track], t: int, q: np.ndarray) -> bool:
+    """Whether ``q`` on frame ``t`` lies on a track already found."""
+    return any(
+        track.start <= t <= track.end and np.abs(track.q[t - track.start] - q).max() < JOINED
+        for track in tracks
+    )
+
+
+def _follow(
+    retargeter: Retargeter,
+    q_h: np.ndarray,
+    t: int,
+    q: np.ndarray,
+    direction: int,
+    tracks: list[_Track],
+) -> list[np.ndarray]:
+    """The poses that follow ``q`` (on frame ``t``) frame by frame in ``direction`` while one
+    within a step reaches the target, until it joins a track of ``tracks``."""
+    out = []
+    t += direction
+    while 0 <= t < len(q_h):
+        found = retargeter.pose_near(q, q_h[t])
+        if found is None:
+            break
+        q = found
+        out.append(q)
+        if _joined(tracks, t, q):
+            break
+        t += direction
+    return out
+
+
+def _route(
+    tracks: list[_Track], frames: int, step: float, banned: set[tuple[int, int, int]]
+) -> list[tuple[int, int, int]]:
+    """The route that misses the fewest frames: (track, first frame, last frame) per leg."""
+    count, nq = len(tracks), tracks[0].q.shape[1]
+    every = np.vstack([track.q for track in tracks])
+    # no walk between two tracks' poses is longer than this
+    window = math.ceil(float((every.max(axis=0) - every.min(axis=0)).max()) / step) + 1
+    poses = np.full((count, frames + window + 1, nq), np.nan)
+    for k, track in enumerate(tracks):
+        poses[k, track.start : track.end + 1] = track.q
+    best = np.full((count, frames), np.inf)
+    came = np.full((count, frames, 2), -1)
+    for k, track in enumerate(tracks):
+        best[k, track.start] = track.start  # the frames before are held, missed
+    steps = np.arange(1, window + 1)
+    starts = np.array([track.start for track in tracks])
+    ends = np.array([track.end for track in tracks])
+    for t in range(frames):
+        near = np.flatnonzero((starts <= t + window) & (ends > t))  # tracks a walk could reach
+        for k in np.flatnonzero(np.isfinite(best[:, t])):
+            end = tracks[k].end
+            if t < end and best[k, t] < best[k, t + 1]:
+                best[k, t + 1], came[k, t + 1] = best[k, t], (k, t)
+            if t % DEPART_EVERY and t != end:
+                continue
+            with np.errstate(invalid="ignore"):
+                ahead = poses[near, t + 1 : t + 1 + window]
+                ok = np.ceil(np.abs(ahead - poses[k, t]).max(axis=2) / step - 1e-9) <= steps
+            ok[near == k] = False
+            for row in np.flatnonzero(ok.any(axis=1)):
+                j = int(near[row])
+                b = t + 1 + int(ok[row].argmax())
+                cost = best[k, t] + b - t - 1
+                if b < frames and (k, t, j) not in banned and cost < best[j, b]:
+                    best[j, b], came[j, b] = cost, (k, t)
+            if t == end:  # beyond the window any walk has time enough: on at their first frame
+                for j in np.flatnonzero(starts > t + window):
+                    cost = best[k, t] + starts[j] - t - 1
+                    if (k, t, j) not in banned and cost < best[j, starts[j]]:
+                        best[j, starts[j]], came[j, starts[j]] = cost, (k, t)
+    ends = [best[k, track.end] + frames - 1 - track.end for k, track in enumerate(tracks)]
+    k = int(np.argmin(ends))
+    t = tracks[k].end
+    legs = [[k, t, t]]
+    while True:
+        pk, pt = came[k, t]
+        if pk < 0:
+            legs[-1][1] = t
+            break
+        if pk != k:
+            legs[-1][1] = t
+            legs.append([int(pk), int(pt), int(pt)])
+        k, t = int(pk), int(pt)
+    return [(k, a, b) for k, a, b in reversed(legs)]
+
+
+def _walked(
+    tracks: list[_Track],
+    route: list[tuple[int, int, int]],
+    frames: int,
+    arm: RobotArm,
+    clearance: float,
+) -> tuple[np.ndarray, tuple[int, int, int] | None]:
+    """The joints along ``route``: its legs, the straight walks between them and the first and
+    last poses held before and after; and the first walk that brings links into contact (as the
+    route's (track, frame, next track)), or None."""
+    nq = tracks[0].q.shape[1]
+    path = np.empty((frames, nq))
+    k0, a0, _ = route[0]
+    path[:a0] = tracks[k0].q[a0 - tracks[k0].start]
+    for (k, a, b), nxt in zip(route, [*route[1:], None], strict=True):
+        path[a : b + 1] = tracks[k].q[a - tracks[k].start : b - tracks[k].start + 1]
+        if nxt is None:
+            path[b + 1 :] = path[b]
+            break
+        j, c, _ = nxt
+        start, goal = path[b], tracks[j].q[c - tracks[j].start]
+        for i in range(b + 1, c):
+            path[i] = start + (goal - start) * (i - b) / (c - b)
+            if arm.self_collisions(path[i], clearance):
+                return path, (k, b, j)
+    return path, None
