@@ -573,13 +573,16 @@ class Retargeter:
                 found = position
         return found
 
-    def pose_near(self, q: np.ndarray, q_human: np.ndarray) -> np.ndarray | None:
+    def pose_near(
+        self, q: np.ndarray, q_human: np.ndarray, oMdes: np.ndarray | None = None
+    ) -> np.ndarray | None:
         """A pose of the robot (a :class:`RobotArm`) within one frame's joint motion of ``q``
-        that reaches the target of ``q_human``, clear of self-collision; or None. The step the
-        live retargeting looks for first, taken from any pose (the path planner's)."""
+        that reaches the target of ``q_human`` (``oMdes``, if already known), clear of
+        self-collision; or None. The step the live retargeting looks for first, taken from any
+        pose (the path planner's)."""
         robot = self.robot
         assert isinstance(robot, RobotArm)
-        oMdes = self.hand_target(q_human)
+        oMdes = self.hand_target(q_human) if oMdes is None else oMdes
         found = self._within_a_step(robot, q, oMdes, self._settings(robot, q, q_human))
         if found is None or self._clearance(robot).collisions(found.q):
             return None

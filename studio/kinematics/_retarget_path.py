@@ -48,6 +48,10 @@ joint): it has joined that branch."""
 DEPART_EVERY = 2
 """The route may leave a track at every this many frames, and at its last frame."""
 
+MID_WALK = 40
+"""Frames of the longest walk looked at from a track before its last frame (180 degrees at the
+4.5 degree step); from its last frame, walks of any length are."""
+
 WALK_BAN = 10
 """A walk that brings links into contact is struck out from the departures this many frames
 either side of it too (their walks pass the same poses)."""
@@ -124,8 +128,8 @@ def retarget_path(
     arm = retargeter.robot
     if as_live or not isinstance(arm, RobotArm) or reached.all():
         return live
-    planned = _plan(retargeter, q_h, live.q, reached, config)
     targets = [retargeter.hand_target(q) for q in q_h]
+    planned = _plan(retargeter, q_h, targets, live.q, reached, config)
     now = np.array(
         [tool_reaches(arm, *pair, config) for pair in zip(planned, targets, strict=True)]
     )
@@ -173,26 +177,28 @@ def _runs(flags: np.ndarray) -> list[tuple[int, int]]:
 def _plan(
     retargeter: Retargeter,
     q_h: np.ndarray,
+    targets: list[np.ndarray],
     live: np.ndarray,
     reached: np.ndarray,
     config: RetargetConfig,
 ) -> np.ndarray:
-    """The planned path's joints (see the module docstring), or ``live``'s."""
-    tracks: list[_Track] = []
+    """The planned path's joints (see the module docstring), or ``live``'s. ``targets``: the
+    hand's target on each frame."""
+    found = _Found(len(q_h))
     for first, last in _runs(reached):
-        before = _follow(retargeter, q_h, first, live[first], -1, tracks)
-        poses = np.vstack([*before[::-1], live[first : last + 1]])
-        tracks.append(_Track(first - len(before), poses))
+        before = _follow(retargeter, q_h, first, live[first], -1, found, targets)
+        found.add(_Track(first - len(before), np.vstack([*before[::-1], live[first : last + 1]])))
     seeds = {0}
     for first, last in _runs(~reached):
         seeds |= {first, (first + last) // 2, last}
     for t in sorted(seeds):
         for q in retargeter.poses_reaching(q_h[t], APART):
-            if _joined(tracks, t, q):
+            if found.joined(t, q):
                 continue
-            before = _follow(retargeter, q_h, t, q, -1, tracks)
-            after = _follow(retargeter, q_h, t, q, 1, tracks)
-            tracks.append(_Track(t - len(before), np.vstack([*before[::-1], q, *after])))
+            before = _follow(retargeter, q_h, t, q, -1, found, targets)
+            after = _follow(retargeter, q_h, t, q, 1, found, targets)
+            found.add(_Track(t - len(before), np.vstack([*before[::-1], q, *after])))
+    tracks = found.tracks
     arm = retargeter.robot
     assert isinstance(arm, RobotArm)
     if not tracks:  # no pose found reaches any frame
@@ -208,12 +214,22 @@ def _plan(
     return live
 
 
-def _joined(tracks: list[_Track], t: int, q: np.ndarray) -> bool:
-    """Whether ``q`` on frame ``t`` lies on a track already found."""
-    return any(
-        track.start <= t <= track.end and np.abs(track.q[t - track.start] - q).max() < JOINED
-        for track in tracks
-    )
+class _Found:
+    """The tracks found so far, and the poses they hold on each frame."""
+
+    def __init__(self, frames: int) -> None:
+        self.tracks: list[_Track] = []
+        self._on: list[list[np.ndarray]] = [[] for _ in range(frames)]
+
+    def add(self, track: _Track) -> None:
+        self.tracks.append(track)
+        for i, q in enumerate(track.q):
+            self._on[track.start + i].append(q)
+
+    def joined(self, t: int, q: np.ndarray) -> bool:
+        """Whether ``q`` on frame ``t`` lies on a track already found."""
+        on = self._on[t]
+        return bool(on) and float(np.abs(np.asarray(on) - q).max(axis=1).min()) < JOINED
 
 
 def _follow(
@@ -222,19 +238,21 @@ def _follow(
     t: int,
     q: np.ndarray,
     direction: int,
-    tracks: list[_Track],
+    found: _Found,
+    targets: list[np.ndarray],
 ) -> list[np.ndarray]:
     """The poses that follow ``q`` (on frame ``t``) frame by frame in ``direction`` while one
-    within a step reaches the target, until it joins a track of ``tracks``."""
+    within a step reaches the target (``targets``, per frame), until it joins a track already
+    ``found``."""
     out = []
     t += direction
     while 0 <= t < len(q_h):
-        found = retargeter.pose_near(q, q_h[t])
-        if found is None:
+        near = retargeter.pose_near(q, q_h[t], targets[t])
+        if near is None:
             break
-        q = found
+        q = near
         out.append(q)
-        if _joined(tracks, t, q):
+        if found.joined(t, q):
             break
         t += direction
     return out
@@ -248,6 +266,7 @@ def _route(
     every = np.vstack([track.q for track in tracks])
     # no walk between two tracks' poses is longer than this
     window = math.ceil(float((every.max(axis=0) - every.min(axis=0)).max()) / step) + 1
+    mid = min(window, MID_WALK)
     poses = np.full((count, frames + window + 1, nq), np.nan)
     for k, track in enumerate(tracks):
         poses[k, track.start : track.end + 1] = track.q
@@ -259,16 +278,18 @@ def _route(
     starts = np.array([track.start for track in tracks])
     ends = np.array([track.end for track in tracks])
     for t in range(frames):
-        near = np.flatnonzero((starts <= t + window) & (ends > t))  # tracks a walk could reach
+        alive = ends > t
         for k in np.flatnonzero(np.isfinite(best[:, t])):
             end = tracks[k].end
             if t < end and best[k, t] < best[k, t + 1]:
                 best[k, t + 1], came[k, t + 1] = best[k, t], (k, t)
             if t % DEPART_EVERY and t != end:
                 continue
+            walk = window if t == end else mid  # the longest walk looked at from here
+            near = np.flatnonzero(alive & (starts <= t + walk))  # tracks a walk could reach
             with np.errstate(invalid="ignore"):
-                ahead = poses[near, t + 1 : t + 1 + window]
-                ok = np.ceil(np.abs(ahead - poses[k, t]).max(axis=2) / step - 1e-9) <= steps
+                ahead = poses[near, t + 1 : t + 1 + walk]
+                ok = np.ceil(np.abs(ahead - poses[k, t]).max(axis=2) / step - 1e-9) <= steps[:walk]
             ok[near == k] = False
             for row in np.flatnonzero(ok.any(axis=1)):
                 j = int(near[row])
