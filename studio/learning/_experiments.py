@@ -23,7 +23,7 @@ if TYPE_CHECKING:
 
 
 def run_experiments(
-    mdp: TabularMDP | str | Callable[[], gymnasium.Env],
+    env: TabularMDP | str | Callable[[], gymnasium.Env],
     config: DynaQConfig,
     experiments: int,
     episodes: int,
@@ -41,7 +41,7 @@ def run_experiments(
     pool of ``workers`` threads; the compiled kernels release the GIL.
 
     Args:
-        mdp: the task: a :class:`TabularMDP` (tabular Dyna-Q), or a Gymnasium environment (a
+        env: the task: a :class:`TabularMDP` (tabular Dyna-Q), or a Gymnasium environment (a
             registered id or a zero-argument callable returning one, Box observations, Discrete
             actions) learnt by linear Dyna-Q over ``features``.
         config: learning settings.
@@ -62,15 +62,15 @@ def run_experiments(
     Raises:
         LearningError: for a bad argument, a bad demonstration or a run over the limits.
     """
-    if isinstance(mdp, TabularMDP):
+    if isinstance(env, TabularMDP):
         return run_tabular_experiments(
-            mdp, config, experiments, episodes, seed, demonstrations, workers=workers, live=live
+            env, config, experiments, episodes, seed, demonstrations, workers=workers, live=live
         )
-    if isinstance(mdp, str) or callable(mdp):
+    if isinstance(env, str) or callable(env):
         return run_linear_experiments(
-            mdp, config, experiments, episodes, seed, demonstrations, features,
+            env, config, experiments, episodes, seed, demonstrations, features,
             workers=workers, live=live,
         )  # fmt: skip
     raise LearningError(
-        f"mdp is a {type(mdp).__name__}; give a TabularMDP (for example ArmGrid().mdp()), a Gymnasium environment id or a zero-argument callable returning an environment."
+        f"env is a {type(env).__name__}; give a TabularMDP (for example ArmGrid().mdp()), a Gymnasium environment id or a zero-argument callable returning an environment."
     )

@@ -138,6 +138,11 @@ def test_seeded_runs_repeat_bit_for_bit_and_seeds_differ():
     assert np.array_equal(a.weights, b.weights) and np.array_equal(a.steps, b.steps)
     assert not np.array_equal(a.weights, c.weights)
     assert a.cpu_seconds.shape == (2,) and a.steps.shape == (2, 3)
+    # the keywords the public API names: env, config, experiments, episodes, seed, features
+    d = run_experiments(
+        env=mountain_car, config=config, experiments=2, episodes=3, seed=11, features=TileCoding()
+    )
+    assert np.array_equal(a.weights, d.weights)
 
 
 def test_mountain_car_learns_like_sutton_and_barto():
