@@ -545,26 +545,34 @@ class Retargeter:
         pinned joints moved home, from home and from ``config.restart_starts`` fixed poses; of
         the answers that reach the target, the one nearest the last pose is taken (a joint with
         a turn to spare counted the short way round), and the step cap walks the robot there
-        over as many frames as it needs.
+        over as many frames as it needs. A pose that would bring the robot's links into contact
+        does not count as reaching: another branch's is looked for, and only where none is clear
+        does the robot hold its last pose. While the robot walks, the restarts also start from
+        the pose it walks to, so that pose is followed rather than found afresh on whichever
+        branch is nearest each frame (which turned joints back and forth).
         """
         config = self.config
         start = robot.home if self._q_prev is None else self._q_prev
         settings = self._settings(robot, start, q_human)
+        touches = self._clearance(robot).collisions
         if self._q_prev is not None:
             near = self._within_a_step(robot, self._q_prev, oMdes, settings)
-            if near is not None:
+            if near is not None and not touches(near.q):
                 return near
         found = robot.inverse(oMdes, q0=start, **settings)
         settings["iterations"] = config.restart_iterations
         if not self._reached(found):  # the pose may have moved further than a few iterations go
             found = robot.inverse(oMdes, q0=found.q, **settings)
-        if not self._reached(found):
+        if not self._reached(found) or touches(found.q):
             nearest = math.inf
-            for seed in (_unpinned(robot, found.q), robot.home, *self._starts(robot)):
+            seeds = [_unpinned(robot, found.q), robot.home, *self._starts(robot)]
+            if isinstance(self.last_ik, RobotIK):  # the pose walked to, followed
+                seeds.insert(0, self.last_ik.q)
+            for seed in seeds:
                 other = robot.inverse(oMdes, q0=seed, **settings)
                 q = _turned_near(robot, other.q, start)
                 distance = float(np.abs(q - start).max())
-                if self._reached(other) and distance < nearest:
+                if self._reached(other) and distance < nearest and not touches(q):
                     found, nearest = replace(other, q=q), distance
             settings["iterations"] = config.ik_iterations
         if not self._reached(found) and robot.spec.orientation:
