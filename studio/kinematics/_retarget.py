@@ -547,9 +547,9 @@ class Retargeter:
         a turn to spare counted the short way round), and the step cap walks the robot there
         over as many frames as it needs. A pose that would bring the robot's links into contact
         does not count as reaching: another branch's is looked for, and only where none is clear
-        does the robot hold its last pose. While the robot walks, the restarts also start from
-        the pose it walks to, so that pose is followed rather than found afresh on whichever
-        branch is nearest each frame (which turned joints back and forth).
+        does the robot hold its last pose. There the restarts also start from the pose the
+        robot walks to, so that pose is followed rather than found afresh on whichever branch is
+        nearest each frame (which turned joints back and forth).
         """
         config = self.config
         start = robot.home if self._q_prev is None else self._q_prev
@@ -566,7 +566,7 @@ class Retargeter:
         if not self._reached(found) or touches(found.q):
             nearest = math.inf
             seeds = [_unpinned(robot, found.q), robot.home, *self._starts(robot)]
-            if isinstance(self.last_ik, RobotIK):  # the pose walked to, followed
+            if isinstance(self.last_ik, RobotIK) and touches(found.q):  # the pose walked to
                 seeds.insert(0, self.last_ik.q)
             for seed in seeds:
                 other = robot.inverse(oMdes, q0=seed, **settings)
