@@ -14,6 +14,7 @@ Puma560's).
 from __future__ import annotations
 
 import functools
+import math
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Literal
@@ -136,20 +137,34 @@ def retarget(
     robot: RobotArm, times: np.ndarray, q_human: np.ndarray, config: RetargetConfig | None = None
 ) -> tuple[np.ndarray, list[Finding], tuple[str, ...]]:
     """The robot's joints (N, nq) for human-arm angles (N, 7)
-    (:func:`studio.kinematics.retarget_path`), the first frame out of reach as a finding, and a
-    note when the hand went beyond the robot's reach (its target drawn back into it, as the page
-    says live): the motion is the robot's own and safe, but it is not the hand's there."""
+    (:func:`studio.kinematics.retarget_path`), the first frame out of reach as a finding, and
+    notes where the motion is the robot's own and safe but not the hand's: where the hand went
+    beyond the robot's reach (its target drawn back into it, as the page says live), and where
+    its tool is off the hand's target though within reach (turning from one IK branch to
+    another, or at the end of its wrist's turn)."""
+    config = config or RetargetConfig()
     path = retarget_path(robot, q_human, config)
-    tolerance = (config or RetargetConfig()).reach_tolerance
+    tolerance = config.reach_tolerance
     beyond = np.flatnonzero(path.pulled_in > tolerance)
     notes: tuple[str, ...] = ()
     if len(beyond):
         i = int(beyond[0])
-        notes = (
+        notes += (
             f"the hand went beyond the {robot.spec.title}'s reach in {len(beyond)} of "
             f"{len(times)} frames (first at frame {i}, t = {times[i]:.3f} s; at most "
             f"{path.pulled_in.max() * 100:.1f} cm): there the robot follows the hand's target "
             "drawn back into its reach",
+        )
+    walked = np.flatnonzero(~path.reached & ~path.out_of_reach)
+    if len(walked):
+        i = int(walked[0])
+        notes += (
+            f"the {robot.spec.title}'s tool is more than {tolerance * 100:.0f} cm or "
+            f"{math.degrees(config.reach_angle):.0f} deg off the hand's target in {len(walked)} "
+            f"of {len(times)} frames (first at frame {i}, t = {times[i]:.3f} s): there it turns "
+            "from one of its IK branches to another (an elbow or wrist turned over, no joint "
+            f"faster than {math.degrees(config.max_joint_step):.1f} deg a frame), or cannot "
+            "turn its tool as far as the hand turned",
         )
     findings: list[Finding] = []
     for i in np.flatnonzero(path.out_of_reach)[:1]:

@@ -74,12 +74,16 @@ class RetargetedPath:
         pulled_in: per frame, how far the hand's target was drawn back into the robot's reach
             (m; the hand went beyond it, and the robot followed the drawn-back target; 0 in
             joint mode).
+        reached: per frame, whether the tool is on the hand's target
+            (:func:`tool_reaches`; True in joint mode, which has no target). A frame neither
+            reached nor out of reach is one the robot walks from one IK branch to another.
     """
 
     q: np.ndarray
     position_error: np.ndarray
     out_of_reach: np.ndarray
     pulled_in: np.ndarray
+    reached: np.ndarray
 
 
 @dataclass
@@ -139,7 +143,7 @@ def retarget_path(
         np.linalg.norm(arm.forward(q)[:3, 3] - t[:3, 3])
         for q, t in zip(planned, targets, strict=True)
     ]
-    return RetargetedPath(planned, np.array(error), live.out_of_reach & ~now, live.pulled_in)
+    return RetargetedPath(planned, np.array(error), live.out_of_reach & ~now, live.pulled_in, now)
 
 
 def _live(
@@ -165,7 +169,7 @@ def _live(
             error[i] = ik.position_error
             out[i] = not ik.success and ik.position_error > config.reach_tolerance
             reached[i] = tool_reaches(robot, q[i], retargeter.hand_target(q_frame), config)
-    return RetargetedPath(q, error, out, pulled), reached
+    return RetargetedPath(q, error, out, pulled, reached), reached
 
 
 def _runs(flags: np.ndarray) -> list[tuple[int, int]]:

@@ -318,7 +318,8 @@ class TimelinePublic(BaseModel):
     robot_notes: list[str] = Field(
         default_factory=list,
         description="what retargeting onto it met, one sentence each: the first frame out of "
-        "its reach, and the frames where the hand went beyond its reach",
+        "its reach, the frames where the hand went beyond its reach, and the frames where its "
+        "tool is off the hand's target though within reach",
     )
     residual_mm: list[float] = Field(description="how far the fitted arm misses, mm")
     signals: list[TimelineSignal] = Field(
