@@ -145,27 +145,31 @@ def retarget(
     config = config or RetargetConfig()
     path = retarget_path(robot, q_human, config)
     tolerance = config.reach_tolerance
-    beyond = np.flatnonzero(path.pulled_in > tolerance)
+    title = robot.spec.title
+    cases = (
+        (
+            path.pulled_in > tolerance,
+            f"the hand went beyond the {title}'s reach",
+            f"at most {path.pulled_in.max() * 100:.1f} cm",
+            "there the robot follows the hand's target drawn back into its reach",
+        ),
+        (
+            ~path.reached & ~path.out_of_reach,
+            f"the {title}'s tool is more than {tolerance * 100:.0f} cm or "
+            f"{math.degrees(config.reach_angle):.0f} deg off the hand's target",
+            None,
+            "there it turns from one of its IK branches to another (an elbow or wrist turned "
+            f"over, no joint faster than {math.degrees(config.max_joint_step):.1f} deg a "
+            "frame), or cannot turn its tool as far as the hand turned",
+        ),
+    )
     notes: tuple[str, ...] = ()
-    if len(beyond):
-        i = int(beyond[0])
-        notes += (
-            f"the hand went beyond the {robot.spec.title}'s reach in {len(beyond)} of "
-            f"{len(times)} frames (first at frame {i}, t = {times[i]:.3f} s; at most "
-            f"{path.pulled_in.max() * 100:.1f} cm): there the robot follows the hand's target "
-            "drawn back into its reach",
-        )
-    walked = np.flatnonzero(~path.reached & ~path.out_of_reach)
-    if len(walked):
-        i = int(walked[0])
-        notes += (
-            f"the {robot.spec.title}'s tool is more than {tolerance * 100:.0f} cm or "
-            f"{math.degrees(config.reach_angle):.0f} deg off the hand's target in {len(walked)} "
-            f"of {len(times)} frames (first at frame {i}, t = {times[i]:.3f} s): there it turns "
-            "from one of its IK branches to another (an elbow or wrist turned over, no joint "
-            f"faster than {math.degrees(config.max_joint_step):.1f} deg a frame), or cannot "
-            "turn its tool as far as the hand turned",
-        )
+    for flags, what, extent, why in cases:
+        frames = np.flatnonzero(flags)
+        if len(frames):
+            i = int(frames[0])
+            first = f"first at frame {i}, t = {times[i]:.3f} s" + (f"; {extent}" if extent else "")
+            notes += (f"{what} in {len(frames)} of {len(times)} frames ({first}): {why}",)
     findings: list[Finding] = []
     for i in np.flatnonzero(path.out_of_reach)[:1]:
         findings.append(
