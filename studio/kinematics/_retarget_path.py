@@ -48,6 +48,11 @@ joint): it has joined that branch."""
 DEPART_EVERY = 2
 """The route may leave a track at every this many frames, and at its last frame."""
 
+CHUNK = 2200
+"""Frames routed at a time (20 s at 110 Hz): the route search holds every track's poses over
+the frames it routes, so a long recording is routed a chunk at a time, each chunk from the last
+one's final pose."""
+
 MID_WALK = 40
 """Frames of the longest walk looked at from a track before its last frame (180 degrees at the
 4.5 degree step); from its last frame, walks of any length are."""
@@ -202,20 +207,46 @@ def _plan(
             before = _follow(retargeter, q_h, t, q, -1, found, targets)
             after = _follow(retargeter, q_h, t, q, 1, found, targets)
             found.add(_Track(t - len(before), np.vstack([*before[::-1], q, *after])))
-    tracks = found.tracks
     arm = retargeter.robot
     assert isinstance(arm, RobotArm)
-    if not tracks:  # no pose found reaches any frame
+    if not found.tracks:  # no pose found reaches any frame
         return live
+    # Routed a chunk at a time (the search holds every track's poses over its frames), each
+    # chunk from the last one's final pose.
+    path = np.empty_like(live)
+    for c0 in range(0, len(q_h), CHUNK):
+        c1 = min(c0 + CHUNK, len(q_h))
+        lo = max(c0 - 1, 0)
+        tracks = [_Track(0, path[lo : lo + 1])] if c0 else []
+        for track in found.tracks:
+            first, last = max(track.start, lo), min(track.end, c1 - 1)
+            if first <= last:
+                q = track.q[first - track.start : last - track.start + 1]
+                tracks.append(_Track(first - lo, q))
+        piece = _chunk_path(tracks, c1 - lo, arm, config, anchored=c0 > 0)
+        if piece is None:
+            return live
+        path[lo:c1] = piece
+    return path
+
+
+def _chunk_path(
+    tracks: list[_Track], frames: int, arm: RobotArm, config: RetargetConfig, anchored: bool
+) -> np.ndarray | None:
+    """The joints of the route through ``tracks`` over ``frames`` frames whose walks keep the
+    links clear (None if none is found in ``WALK_RETRIES`` tries); ``anchored``: it starts on
+    the first track, at frame 0."""
+    if not tracks:
+        return None
     banned: set[tuple[int, int, int]] = set()
     for _ in range(WALK_RETRIES):
-        route = _route(tracks, len(q_h), config.max_joint_step, banned)
-        path, clash = _walked(tracks, route, len(q_h), arm, config.clearance)
+        route = _route(tracks, frames, config.max_joint_step, banned, anchored)
+        path, clash = _walked(tracks, route, frames, arm, config.clearance)
         if clash is None:
             return path
         k, t, j = clash  # its neighbours would mostly touch too
         banned |= {(k, t + dt, j) for dt in range(-WALK_BAN, WALK_BAN + 1)}
-    return live
+    return None
 
 
 class _Found:
@@ -263,9 +294,14 @@ def _follow(
 
 
 def _route(
-    tracks: list[_Track], frames: int, step: float, banned: set[tuple[int, int, int]]
+    tracks: list[_Track],
+    frames: int,
+    step: float,
+    banned: set[tuple[int, int, int]],
+    anchored: bool = False,
 ) -> list[tuple[int, int, int]]:
-    """The route that misses the fewest frames: (track, first frame, last frame) per leg."""
+    """The route that misses the fewest frames: (track, first frame, last frame) per leg. It
+    starts on any track (the frames before it held), or, ``anchored``, on the first."""
     count, nq = len(tracks), tracks[0].q.shape[1]
     every = np.vstack([track.q for track in tracks])
     # no walk between two tracks' poses is longer than this
@@ -276,7 +312,7 @@ def _route(
         poses[k, track.start : track.end + 1] = track.q
     best = np.full((count, frames), np.inf)
     came = np.full((count, frames, 2), -1)
-    for k, track in enumerate(tracks):
+    for k, track in enumerate(tracks[:1] if anchored else tracks):
         best[k, track.start] = track.start  # the frames before are held, missed
     steps = np.arange(1, window + 1)
     starts = np.array([track.start for track in tracks])

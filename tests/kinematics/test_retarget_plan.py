@@ -55,6 +55,15 @@ def test_the_route_crosses_a_stretch_no_track_reaches_however_long():
     assert [leg[0] for leg in route] == [0, 1] and _missed(route, 121) == 90
 
 
+def test_an_anchored_route_starts_where_the_last_chunk_ended():
+    # track 0 is the last chunk's final pose (frame 0 only); track 1 holds 1.0 throughout.
+    # Free, the route starts on track 1; anchored, it walks there from track 0 (10 steps).
+    tracks = [_track(0, [0.0]), _track(0, [1.0] * 50)]
+    assert _route(tracks, 50, STEP, set())[0][0] == 1
+    route = _route(tracks, 50, STEP, set(), anchored=True)
+    assert route[0] == (0, 0, 0) and route[1][0] == 1 and _missed(route, 50) == 9
+
+
 def test_a_walk_struck_out_is_not_taken_again():
     first = _track(0, [0.0] * 30)
     second = _track(10, [0.3] * 40)
@@ -150,3 +159,18 @@ def test_a_path_the_live_pass_reaches_whole_is_the_live_path():
     np.testing.assert_array_equal(
         retarget_path(ur5, q_human).q, retarget_path(ur5, q_human, as_live=True).q
     )
+
+
+def test_a_long_recording_is_routed_a_chunk_at_a_time_without_a_seam(monkeypatch):
+    # Chunks of 100 frames instead of 2,200: each starts from the last one's final pose, so the
+    # step cap holds across the seams, and the route still reaches far more than live.
+    import studio.kinematics._retarget_path as planner
+
+    monkeypatch.setattr(planner, "CHUNK", 100)
+    arm, config = load_robot("ur3"), RetargetConfig()
+    q_human = _sample(3)
+    planned = retarget_path(arm, q_human)
+    assert np.abs(np.diff(planned.q, axis=0)).max() <= config.max_joint_step + 1e-9
+    assert np.all((planned.q >= arm.lower) & (planned.q <= arm.upper))
+    live = retarget_path(arm, q_human, as_live=True)
+    assert planned.reached.mean() >= 0.95 > live.reached.mean()
