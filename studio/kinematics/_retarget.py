@@ -407,20 +407,26 @@ class Retargeter:
         """Where the operator's shoulder is placed in the robot's base frame.
 
         The Puma560's shoulder; for a robot on a table, its shoulder raised to at least half its
-        reach above the table, so the operator's hand at shoulder height (a reach forward) lands
+        reach (:meth:`_reach`) above the table, so the operator's hand at shoulder height (a reach forward) lands
         mid-workspace and a lowered hand near the table, not under it.
         """
         robot = self.robot
         if isinstance(robot, Puma560):
             return np.array([0.0, 0.0, robot.dh[0].d])
         lifted = robot.shoulder.copy()
-        lifted[2] = max(lifted[2], 0.5 * robot.reach)
+        lifted[2] = max(lifted[2], 0.5 * self._reach())
         return lifted
+
+    def _reach(self) -> float:
+        """How far the robot's tool reaches (m), as the retargeting maps the operator's reach
+        onto it (:attr:`RobotSpec.usable_reach`), before ``config.reach_fraction``."""
+        robot = self.robot
+        return robot.reach * (robot.spec.usable_reach if isinstance(robot, RobotArm) else 1.0)
 
     def _scale(self) -> float:
         arm = self.arm
         human_reach = arm.upper_arm_length + arm.forearm_length + arm.hand_length
-        return self.config.reach_fraction * self.robot.reach / human_reach
+        return self.config.reach_fraction * self._reach() / human_reach
 
     def _mirrored(self, p: np.ndarray) -> np.ndarray:
         return SAGITTAL_MIRROR @ p if self._mirror else p
@@ -476,7 +482,7 @@ class Retargeter:
         # Between two points above the table, so the drawn-back target stays above it too.
         offset = oMdes[:3, 3] - robot.shoulder
         distance = float(np.linalg.norm(offset))
-        kept = _soft_ceiling(distance, config.reach_fraction * robot.reach, config.reach_softness)
+        kept = _soft_ceiling(distance, config.reach_fraction * self._reach(), config.reach_softness)
         if kept < distance:
             oMdes[:3, 3] = robot.shoulder + offset * (kept / distance)
         return oMdes, pushed + distance - kept, pushed
@@ -739,7 +745,7 @@ class Retargeter:
         offset = t - robot.shoulder
         distance = float(np.linalg.norm(offset))
         if distance > 0.0:
-            ceiling = config.reach_fraction * robot.reach
+            ceiling = config.reach_fraction * self._reach()
             t = robot.shoulder + offset * (
                 _unbent(distance, ceiling, config.reach_softness) / distance
             )

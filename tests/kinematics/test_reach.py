@@ -40,18 +40,19 @@ SHARE_EVERY = 4
 REACHED_SHARE = 0.75
 """Of the frames some pose reaches, at least this share is reached: the rest are frames walked
 from one IK branch to another at the step cap. Missed, as this test prints them (``-s``): 13% on
-the Z1 and the Puma560 in cartesian mode, 10% on the UR5 and UR10 (a target drawn back to the
-reach shell, tracked with the elbow straight, is then reached only with the shoulder flipped),
-6-7% on the SO arms, 5.5% on the UR3 (13% while it held its pose where the nearest would touch
-itself, rather than take another branch), 4% on the Panda (joints 1, 5 and 7 at their +-166 deg limits end
+the Z1 and the Puma560 in cartesian mode, 6-7% on the SO arms, 5.5% on the UR3 (13% while it
+held its pose where the nearest would touch itself, rather than take another branch), 1% on the
+UR5 and none on the UR10 (10% while the hand mapped onto 0.95 of their sampled reach, where a
+target drawn back to the reach shell was tracked with the elbow straight and then reached only
+with the shoulder flipped: ``RobotSpec.usable_reach``), 4% on the Panda (joints 1, 5 and 7 at their +-166 deg limits end
 branches mid-motion), 2% on the Kinova, 0.2% on the xArm7. Since the UR arms keep targets out
 of their hollow (``RobotSpec.hollow``), none of their frames is out of every pose's reach
 (85-211 of the 566 judged were)."""
 PLANNED_SHARE = 0.9
 """Of the same frames, at least this share is reached on the path planned with the whole motion
 known (:func:`retarget_path`, as a recording is exported or played back on the robot). As this
-test prints them: 94% on the Z1, 96% on the UR5, UR10, SO-100 and SO-101, 98-99% on the UR3 and the
-Panda, 99.5% on the Kinova, 100% on the xArm7."""
+test prints them: 94% on the Z1, 96% on the SO-100 and SO-101, 98-99% on the UR3 and the Panda,
+99.5% on the Kinova, 100% on the UR5, UR10 and xArm7."""
 MISSED_WITHIN_A_STEP = 0.005
 """At most this share of frames is missed although a pose within one step reaches it: a few
 frames a branch change starts, where the retargeting's search around the last pose (5 starts,
