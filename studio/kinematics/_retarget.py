@@ -569,10 +569,11 @@ class Retargeter:
         settings["iterations"] = config.restart_iterations
         if not self._reached(found):  # the pose may have moved further than a few iterations go
             found = robot.inverse(oMdes, q0=found.q, **settings)
-        if not self._reached(found) or touches(found.q):
+        touching = bool(touches(found.q))
+        if not self._reached(found) or touching:
             nearest = math.inf
             seeds = [_unpinned(robot, found.q), robot.home, *self._starts(robot)]
-            if isinstance(self.last_ik, RobotIK) and touches(found.q):  # the pose walked to
+            if isinstance(self.last_ik, RobotIK) and touching:  # the pose walked to
                 seeds.insert(0, self.last_ik.q)
             for seed in seeds:
                 other = robot.inverse(oMdes, q0=seed, **settings)

@@ -33,7 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._reach import tool_reaches
+from ._reach import reach_errors, tool_reaches
 from ._retarget import RetargetConfig, Retargeter
 from ._robots import RobotArm, RobotIK
 
@@ -129,33 +129,33 @@ def retarget_path(
     """
     config = config or RetargetConfig()
     q_h = np.asarray(q_human, dtype=float).reshape(-1, 7)
-    if robot.name == "puma560":
-        retargeter = Retargeter(config=config)
+    if robot.name == "puma560":  # joint mode: no target
+        retargeter, targets = Retargeter(config=config), None
     else:
         retargeter = Retargeter(robot=robot.scratch_copy(), config=config)
-    live, reached = _live(retargeter, q_h, config)
+        targets = [retargeter.hand_target(q) for q in q_h]
+    live = _live(retargeter, q_h, config, targets)
     arm = retargeter.robot
-    if as_live or not isinstance(arm, RobotArm) or reached.all():
+    if as_live or targets is None or live.reached.all():
         return live
-    targets = [retargeter.hand_target(q) for q in q_h]
-    planned = _plan(retargeter, q_h, targets, live.q, reached, config)
-    now = np.array(
-        [tool_reaches(arm, *pair, config) for pair in zip(planned, targets, strict=True)]
-    )
-    if now.sum() < reached.sum():
+    assert isinstance(arm, RobotArm)
+    planned = _plan(retargeter, q_h, targets, live.q, live.reached, config)
+    errors = [reach_errors(arm, q, t) for q, t in zip(planned, targets, strict=True)]
+    now = np.array([config.within_reach(*e) for e in errors], dtype=bool)
+    if now.sum() < live.reached.sum():
         return live
-    error = [
-        np.linalg.norm(arm.forward(q)[:3, 3] - t[:3, 3])
-        for q, t in zip(planned, targets, strict=True)
-    ]
-    return RetargetedPath(planned, np.array(error), live.out_of_reach & ~now, live.pulled_in, now)
+    error = np.array([e[0] for e in errors])
+    return RetargetedPath(planned, error, live.out_of_reach & ~now, live.pulled_in, now)
 
 
 def _live(
-    retargeter: Retargeter, q_h: np.ndarray, config: RetargetConfig
-) -> tuple[RetargetedPath, np.ndarray]:
-    """The path a live session would have shown, frame after frame, and which of its frames
-    reach their target."""
+    retargeter: Retargeter,
+    q_h: np.ndarray,
+    config: RetargetConfig,
+    targets: list[np.ndarray] | None,
+) -> RetargetedPath:
+    """The path a live session would have shown, frame after frame; ``targets``: the hand's
+    target per frame (None in joint mode, whose frames all count as reached)."""
     robot = retargeter.robot
     q = np.empty((len(q_h), robot.nq))
     error = np.zeros(len(q_h))
@@ -170,11 +170,11 @@ def _live(
         q[i] = retargeter.robot_from_human(q_frame)
         pulled[i] = retargeter.pulled_in
         ik = retargeter.last_ik
-        if isinstance(ik, RobotIK):
+        if isinstance(ik, RobotIK) and targets is not None:
             error[i] = ik.position_error
             out[i] = not ik.success and ik.position_error > config.reach_tolerance
-            reached[i] = tool_reaches(robot, q[i], retargeter.hand_target(q_frame), config)
-    return RetargetedPath(q, error, out, pulled, reached), reached
+            reached[i] = tool_reaches(robot, q[i], targets[i], config)
+    return RetargetedPath(q, error, out, pulled, reached)
 
 
 def _runs(flags: np.ndarray) -> list[tuple[int, int]]:
@@ -342,8 +342,8 @@ def _route(
                     cost = best[k, t] + starts[j] - t - 1
                     if (k, t, j) not in banned and cost < best[j, starts[j]]:
                         best[j, starts[j]], came[j, starts[j]] = cost, (k, t)
-    ends = [best[k, track.end] + frames - 1 - track.end for k, track in enumerate(tracks)]
-    k = int(np.argmin(ends))
+    missed = [best[k, track.end] + frames - 1 - track.end for k, track in enumerate(tracks)]
+    k = int(np.argmin(missed))
     t = tracks[k].end
     legs = [[k, t, t]]
     while True:
