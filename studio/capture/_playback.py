@@ -82,8 +82,7 @@ class PlaybackSource(ThreadedSource[TapeFrame | LandmarkFrame | HandPose]):
     @property
     def side(self) -> str:
         """The teaching arm (a pose or hand recording's; the tape's for a tape)."""
-        rec = self.recording
-        return rec.side if isinstance(rec, ObservationRecording) else rec.config.side
+        return self.recording.side
 
     @property
     def observation_kind(self) -> str:

@@ -145,6 +145,11 @@ class Recording(RecordingTimeline):
 
         return tape_config_from_dict(self.meta.get("tape"))
 
+    @property
+    def side(self) -> str:
+        """The teaching arm: the one the tape is strapped to."""
+        return self.config.side
+
     def frames(self) -> list[TapeFrame]:
         """The frames as :class:`TapeFrame` objects."""
         return [self.frame_at(i) for i in range(len(self))]

@@ -86,6 +86,7 @@ class RecordingSeries:
         frames: the recording's frame index of each sample ``(N,)`` (how many frames lie
             between two samples: a robot path retargeted from ``q_human`` moves that many
             frames' worth between them).
+        side: the teaching arm, whose convention ``q_human`` is in.
     """
 
     times: np.ndarray
@@ -96,6 +97,7 @@ class RecordingSeries:
     kind: str
     signals: tuple[Signal, ...] = ()
     frames: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    side: str = "right"
 
 
 def human_angles(
@@ -154,8 +156,7 @@ def recording_series(
     if len(rows):
         first = rec.frame_at(int(rows[0]))
         tape = rec.config if isinstance(rec, Recording) else None
-        side = rec.side if isinstance(rec, ObservationRecording) else None
-        fitter = fitter_for(first, tape=tape, side=side, mode=mode)
+        fitter = fitter_for(first, tape=tape, side=rec.side, mode=mode)
         frames = [first, *(rec.frame_at(int(row)) for row in rows[1:])]
         for i, fitted in enumerate(fit_frames(fitter, frames)):
             q_human[i], q_robot[i], residual[i] = fitted.q_human, fitted.q_robot, fitted.residual
@@ -169,4 +170,5 @@ def recording_series(
         kind=rec.kind_name,
         signals=recording_signals(rec, rows),
         frames=rows,
+        side=rec.side,
     )

@@ -134,16 +134,20 @@ def find_source(given: str | Path, data_dir: str | Path = ".") -> Path:
 
 
 def retarget(
-    robot: RobotArm, times: np.ndarray, q_human: np.ndarray, config: RetargetConfig | None = None
+    robot: RobotArm,
+    times: np.ndarray,
+    q_human: np.ndarray,
+    side: str,
+    config: RetargetConfig | None = None,
 ) -> tuple[np.ndarray, list[Finding], tuple[str, ...]]:
-    """The robot's joints (N, nq) for human-arm angles (N, 7)
+    """The robot's joints (N, nq) for the ``side`` arm's angles (N, 7)
     (:func:`studio.kinematics.retarget_path`), the first frame out of reach as a finding, and
     notes where the motion is the robot's own and safe but not the hand's: where the hand went
     beyond the robot's reach (its target drawn back into it, as the page says live), and where
     its tool is off the hand's target though within reach (turning from one IK branch to
     another, or at the end of its wrist's turn)."""
     config = config or RetargetConfig()
-    path = retarget_path(robot, q_human, config)
+    path = retarget_path(robot, q_human, config, side=side)
     tolerance = config.reach_tolerance
     title = robot.spec.title
     cases = (
@@ -219,7 +223,7 @@ def recording_motion(
     stride = 1 if most_frames is None else max(1, -(-(stop - start) // max(int(most_frames), 2)))
     rows = slice(start, stop, stride)
     times = np.asarray(rec.t[rows] - rec.t[start], dtype=float)
-    q, findings, notes = retarget(robot, times, human_angles(rec, rows), _strided(stride))
+    q, findings, notes = retarget(robot, times, human_angles(rec, rows), rec.side, _strided(stride))
     rate = _capture_rate(rec, times) / stride
     return Motion("recording", path.name, robot, times, q, True, rate, tuple(findings), notes)
 
@@ -252,7 +256,7 @@ def series_motion(series: RecordingSeries, robot_name: str, name: str = "") -> M
         return Motion("recording", name, robot, times, q, True, rate)
     gaps = np.diff(np.asarray(series.frames))
     stride = int(gaps.max()) if len(gaps) else 1
-    q, findings, notes = retarget(robot, times, series.q_human, _strided(stride))
+    q, findings, notes = retarget(robot, times, series.q_human, series.side, _strided(stride))
     return Motion("recording", name, robot, times, q, True, rate, tuple(findings), notes)
 
 
@@ -274,7 +278,7 @@ def demonstration_motion(path: Path, robot_name: str, rate_hz: float) -> Motion:
     rec = read_any_recording(recording)
     rows = rec.segment(demo.t0, demo.t1)
     times = np.asarray(rec.t[rows] - rec.t[rows][0], dtype=float)
-    q, findings, notes = retarget(robot, times, human_angles(rec, rows))
+    q, findings, notes = retarget(robot, times, human_angles(rec, rows), rec.side)
     return Motion(
         "demonstration", path.name, robot, times, q, False, rate_hz, tuple(findings), notes
     )

@@ -33,6 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ._human import HumanArm
 from ._reach import reach_errors, tool_reaches
 from ._retarget import RetargetConfig, Retargeter
 from ._robots import RobotArm, RobotIK
@@ -108,6 +109,7 @@ def retarget_path(
     q_human: np.ndarray,
     config: RetargetConfig | None = None,
     *,
+    side: str = "right",
     as_live: bool = False,
 ) -> RetargetedPath:
     """Retarget a human-arm path ``(N, 7)`` onto ``robot``, its IK branches planned.
@@ -121,18 +123,23 @@ def retarget_path(
         robot: the robot, from :func:`load_robot`.
         q_human: the human arm's angles, one row per frame (rad).
         config: the retargeting's settings.
+        side: the operator's arm the angles are of (``HumanArm``'s convention for that side),
+            as the recording says: a left arm's angles read as a right arm's would mirror the
+            robot's motion.
         as_live: the path a live session would have shown (frame after frame, each
             warm-started from the one before), without the plan.
 
     Raises:
-        KinematicsError: angles of the wrong shape or not finite.
+        KinematicsError: angles of the wrong shape or not finite, or a side other than
+            ``"right"`` or ``"left"``.
     """
     config = config or RetargetConfig()
     q_h = np.asarray(q_human, dtype=float).reshape(-1, 7)
+    human = HumanArm(side=side)
     if robot.name == "puma560":  # joint mode: no target
-        retargeter, targets = Retargeter(config=config), None
+        retargeter, targets = Retargeter(arm=human, config=config), None
     else:
-        retargeter = Retargeter(robot=robot.scratch_copy(), config=config)
+        retargeter = Retargeter(robot=robot.scratch_copy(), arm=human, config=config)
         targets = [retargeter.hand_target(q) for q in q_h]
     live = _live(retargeter, q_h, config, targets)
     arm = retargeter.robot

@@ -14,10 +14,10 @@ from studio.kinematics import HumanArm, TapeConfig, tape_from_arm
 RATE_HZ = 110.0
 
 
-def write_arm_recording(path: Path, q_human: np.ndarray) -> Path:
-    """A tape recording at 110 Hz of the right arm moving through ``q_human`` (N, 7)."""
-    config = TapeConfig()
-    bend, twist = tape_from_arm(HumanArm(), q_human, config)
+def write_arm_recording(path: Path, q_human: np.ndarray, side: str = "right") -> Path:
+    """A tape recording at 110 Hz of the ``side`` arm moving through ``q_human`` (N, 7)."""
+    config = TapeConfig(side=side)
+    bend, twist = tape_from_arm(HumanArm(side=side), q_human, config)
     with RecordingWriter(path, config=config, source="simulator") as writer:
         writer.write_many(
             [TapeFrame(i / RATE_HZ, i, bend[i], twist[i]) for i in range(len(q_human))]
