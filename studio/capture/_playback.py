@@ -3,11 +3,14 @@
 from __future__ import annotations
 
 import dataclasses
+import math
 import os
 import queue
 import threading
 import time
 from typing import TYPE_CHECKING
+
+import numpy as np
 
 from ._errors import CaptureError
 from ._frames import TapeFrame
@@ -21,6 +24,8 @@ if TYPE_CHECKING:
 
 MAX_SLEEP_SECONDS = 0.05
 """Longest single sleep, so pause/seek/stop take effect quickly."""
+ROW_TIME_TOLERANCE_S = 1e-6
+"""A played frame's time names a recording row within this (s; a loop adds whole passes)."""
 PUT_RETRY_SECONDS = 0.1
 """A file is not a live device: when the consumer lags, playback waits (never drops)."""
 
@@ -73,6 +78,7 @@ class PlaybackSource(ThreadedSource[TapeFrame | LandmarkFrame | HandPose]):
         self._resume = threading.Event()
         self._resume.set()
         self._control = threading.Lock()
+        self._rising: bool | None = None  # whether the recording's times rise (row_at)
 
     @property
     def config(self) -> TapeConfig | None:
@@ -111,6 +117,25 @@ class PlaybackSource(ThreadedSource[TapeFrame | LandmarkFrame | HandPose]):
     def paused(self) -> bool:
         """Whether playback is paused."""
         return not self._resume.is_set()
+
+    def row_at(self, t: float) -> int | None:
+        """The recording's row (0-based) that a frame this source played was read from, by the
+        frame's time ``t``: a loop's later passes are shifted by whole passes. None when no row
+        has that time (or the recording's times do not rise, so a time names no single row)."""
+        rec = self.recording
+        if self._rising is None:
+            self._rising = bool(np.all(np.diff(rec.t) > 0))
+        if not self._rising:
+            return None
+        start = float(rec.t[0])
+        offset = float(t) - start
+        lap = rec.duration + (1.0 / rec.rate_hz if rec.rate_hz > 0 else 0.0)
+        if self.loop and lap > 0 and offset > rec.duration + ROW_TIME_TOLERANCE_S:
+            offset -= lap * math.floor((offset + ROW_TIME_TOLERANCE_S) / lap)
+        row = int(rec.t.searchsorted(start + offset - ROW_TIME_TOLERANCE_S))
+        if row < len(rec) and abs(float(rec.t[row]) - start - offset) <= ROW_TIME_TOLERANCE_S:
+            return row
+        return None
 
     def pause(self) -> None:
         """Hold playback at the current frame."""

@@ -31,7 +31,13 @@ from studio.capture import (
     load_demonstration,
     read_any_recording,
 )
-from studio.kinematics import RetargetConfig, RobotArm, load_robot, retarget_path
+from studio.kinematics import (
+    RetargetConfig,
+    RetargetedPath,
+    RobotArm,
+    load_robot,
+    retarget_path,
+)
 from studio.learning import POLICY_SUFFIX, DemonstrationPath, LearningError
 from studio.learning import check_policy_robot as check_policy_robot_named
 from studio.samples import SAMPLES_DIR
@@ -67,6 +73,9 @@ class Motion:
         findings: problems met while retargeting (targets out of reach).
         notes: what the retargeting did that is no problem but the file should say (the hand
             went beyond the robot's reach and its target was drawn back into it).
+        path: the retargeting's account of each sample (whether the tool reached the hand's
+            target, how far it was drawn back; :class:`studio.kinematics.RetargetedPath`), for a
+            motion retargeted from a human arm; None for a stored or rolled-out joint path.
     """
 
     kind: SourceKind
@@ -78,6 +87,7 @@ class Motion:
     rate_hz: float
     findings: tuple[Finding, ...] = field(default=())
     notes: tuple[str, ...] = field(default=())
+    path: RetargetedPath | None = None
 
 
 def source_kind(path: Path) -> SourceKind:
@@ -139,8 +149,8 @@ def retarget(
     q_human: np.ndarray,
     side: str,
     config: RetargetConfig | None = None,
-) -> tuple[np.ndarray, list[Finding], tuple[str, ...]]:
-    """The robot's joints (N, nq) for the ``side`` arm's angles (N, 7)
+) -> tuple[RetargetedPath, list[Finding], tuple[str, ...]]:
+    """The robot's path for the ``side`` arm's angles (N, 7)
     (:func:`studio.kinematics.retarget_path`), the first frame out of reach as a finding, and
     notes where the motion is the robot's own and safe but not the hand's: where the hand went
     beyond the robot's reach (its target drawn back into it, as the page says live), and where
@@ -187,7 +197,7 @@ def retarget(
                 f"(tolerance {tolerance * 100:.0f} cm)",
             )
         )
-    return path.q, findings, notes
+    return path, findings, notes
 
 
 def _capture_rate(rec: Recording | ObservationRecording, times: np.ndarray) -> float:
@@ -223,9 +233,13 @@ def recording_motion(
     stride = 1 if most_frames is None else max(1, -(-(stop - start) // max(int(most_frames), 2)))
     rows = slice(start, stop, stride)
     times = np.asarray(rec.t[rows] - rec.t[start], dtype=float)
-    q, findings, notes = retarget(robot, times, human_angles(rec, rows), rec.side, _strided(stride))
+    found, findings, notes = retarget(
+        robot, times, human_angles(rec, rows), rec.side, _strided(stride)
+    )
     rate = _capture_rate(rec, times) / stride
-    return Motion("recording", path.name, robot, times, q, True, rate, tuple(findings), notes)
+    return Motion(
+        "recording", path.name, robot, times, found.q, True, rate, tuple(findings), notes, found
+    )
 
 
 def _strided(stride: int) -> RetargetConfig | None:
@@ -256,8 +270,10 @@ def series_motion(series: RecordingSeries, robot_name: str, name: str = "") -> M
         return Motion("recording", name, robot, times, q, True, rate)
     gaps = np.diff(np.asarray(series.frames))
     stride = int(gaps.max()) if len(gaps) else 1
-    q, findings, notes = retarget(robot, times, series.q_human, series.side, _strided(stride))
-    return Motion("recording", name, robot, times, q, True, rate, tuple(findings), notes)
+    found, findings, notes = retarget(robot, times, series.q_human, series.side, _strided(stride))
+    return Motion(
+        "recording", name, robot, times, found.q, True, rate, tuple(findings), notes, found
+    )
 
 
 def demonstration_motion(path: Path, robot_name: str, rate_hz: float) -> Motion:
@@ -278,9 +294,18 @@ def demonstration_motion(path: Path, robot_name: str, rate_hz: float) -> Motion:
     rec = read_any_recording(recording)
     rows = rec.segment(demo.t0, demo.t1)
     times = np.asarray(rec.t[rows] - rec.t[rows][0], dtype=float)
-    q, findings, notes = retarget(robot, times, human_angles(rec, rows), rec.side)
+    found, findings, notes = retarget(robot, times, human_angles(rec, rows), rec.side)
     return Motion(
-        "demonstration", path.name, robot, times, q, False, rate_hz, tuple(findings), notes
+        "demonstration",
+        path.name,
+        robot,
+        times,
+        found.q,
+        False,
+        rate_hz,
+        tuple(findings),
+        notes,
+        found,
     )
 
 

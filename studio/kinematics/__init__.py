@@ -26,6 +26,7 @@ from ._reach import reachable as reachable
 from ._reach import tool_reaches as tool_reaches
 from ._retarget import RetargetConfig as RetargetConfig
 from ._retarget import Retargeter as Retargeter
+from ._retarget_path import RetargetedPath as RetargetedPath
 from ._retarget_path import retarget_path as retarget_path
 from ._robot_load import isolate_robot_loading as isolate_robot_loading
 from ._robot_load import load_robot as load_robot

@@ -36,9 +36,10 @@ from studio.capture import (
     ObservationFitter,
     fitter_for,
 )
-from studio.kinematics import HumanArm, Retargeter, RobotArm, TapeConfig
+from studio.kinematics import HumanArm, RetargetedPath, Retargeter, RobotArm, TapeConfig
 
 from ._errors import ConflictError, storage_sentence
+from ._planned_playback import PlannedPlayback
 from ._protocols import CaptureWriter, LivePose, LiveScene
 
 log = logging.getLogger(__name__)
@@ -77,6 +78,7 @@ class Pipeline:
         self._fitter: ObservationFitter | None = None  # the live chain for the source's kind
         self._arm: RobotArm | None = None  # the robot taught, when not the Puma560
         self._arm_retargeter: Retargeter | None = None  # the fitted arm onto it (cartesian)
+        self._planned = PlannedPlayback()  # a recording played: its path planned over all of it
         self._robot_note: str | None = None  # why it does not follow the hand now
         self._q_human: np.ndarray | None = None
         self._q_robot = np.zeros(ROBOT_JOINTS)
@@ -136,6 +138,7 @@ class Pipeline:
             self._start_error = None
             self._fitter = None
             self._arm_retargeter = None
+            self._planned.forget()
             self._robot_note = None
             self._observable = None
             self._kin_error = None
@@ -224,6 +227,7 @@ class Pipeline:
         with self._fit_lock, self._lock:
             self._arm = arm
             self._arm_retargeter = None
+            self._planned.forget()
             self._robot_note = None
             self._q_robot = np.zeros(ROBOT_JOINTS) if arm is None else np.array(arm.home)
 
@@ -236,6 +240,11 @@ class Pipeline:
         robot = None if arm is None else arm.scratch_copy()
         retargeter = Retargeter(robot=robot, arm=HumanArm(side=self.side()), mirror=mirror)
         return retargeter.human_reaching(q_robot)
+
+    def plan_note(self) -> str | None:
+        """One sentence on the robot's path over the recording played as the source (being
+        planned, followed, or why it could not be planned); None for any other source."""
+        return self._planned.note()
 
     @property
     def robot_name(self) -> str:
@@ -508,7 +517,7 @@ class Pipeline:
                 fitter = self._live_fitter(observations[0])
                 fitted = None
                 for observation in observations:
-                    fitted = self._onto_arm(fitter.fit(observation))
+                    fitted = self._onto_arm(fitter.fit(observation), float(observation.t))
                     with self._lock:
                         self._q_human = fitted.q_human
                         self._q_robot = fitted.q_robot
@@ -531,8 +540,11 @@ class Pipeline:
                 self._kin_error = message
         return None
 
-    def _onto_arm(self, fitted: Fitted) -> Fitted:
-        """``fitted`` with its robot pose for the robot taught (unchanged for the Puma560)."""
+    def _onto_arm(self, fitted: Fitted, t: float) -> Fitted:
+        """``fitted`` (the frame at time ``t``) with its robot pose for the robot taught
+        (unchanged for the Puma560): retargeted live, or from a recording played as the source,
+        its path planned over the whole recording once that is ready
+        (:class:`~studio.web._planned_playback.PlannedPlayback`)."""
         arm = self._arm
         if arm is None:
             return fitted
@@ -541,8 +553,14 @@ class Pipeline:
             human = HumanArm(side=self.side())
             retargeter = Retargeter(robot=arm, arm=human, mirror=self._mirror)
             self._arm_retargeter = retargeter
-        q_robot = retargeter.robot_from_human(fitted.q_human)
-        self._robot_note = robot_note(arm, retargeter)
+        q_robot = retargeter.robot_from_human(fitted.q_human)  # kept warm while on the plan
+        note = robot_note(arm, retargeter)
+        step = retargeter.config.max_joint_step
+        planned = self._planned.pose(self._source, arm, self._mirror, t, q_robot, step)
+        if planned is not None:
+            plan, row = planned
+            q_robot, note = plan.q[row].copy(), planned_note(arm, retargeter, plan, row)
+        self._robot_note = note
         return dataclasses.replace(fitted, q_robot=q_robot)
 
     def observe(self, observation: Observation) -> Fitted | None:
@@ -579,10 +597,39 @@ def robot_note(arm: RobotArm, retargeter: Retargeter) -> str | None:
     found = retargeter.last_ik
     error = getattr(found, "position_error", 0.0)
     if found is not None and not found.success and error > retargeter.config.reach_tolerance:
+        return _out_of_reach(title, error)
+    return _target_note(arm, retargeter)
+
+
+def planned_note(
+    arm: RobotArm, retargeter: Retargeter, plan: RetargetedPath, row: int
+) -> str | None:
+    """:func:`robot_note` for a frame of a recording's planned path (``plan`` at ``row``): out
+    of reach, turning between IK branches, or the hand's target moved (``retargeter`` has just
+    worked out the same frame's target)."""
+    title = arm.spec.title
+    if plan.out_of_reach[row]:
+        return _out_of_reach(title, float(plan.position_error[row]))
+    if not plan.reached[row]:
         return (
-            f"The hand is out of the {title}'s reach: its tool stops {error * 100.0:.0f} cm "
-            "short, as near as it gets; bring the hand closer to the shoulder."
+            f"The {title} turns from one of its IK branches to another here, its tool off the "
+            "hand's target: planned over the whole recording, it turns where it misses the "
+            "fewest frames."
         )
+    return _target_note(arm, retargeter)
+
+
+def _out_of_reach(title: str, error: float) -> str:
+    return (
+        f"The hand is out of the {title}'s reach: its tool stops {error * 100.0:.0f} cm "
+        "short, as near as it gets; bring the hand closer to the shoulder."
+    )
+
+
+def _target_note(arm: RobotArm, retargeter: Retargeter) -> str | None:
+    """Why the hand's target is not where the hand is: kept out of the robot's hollow, or drawn
+    back into its reach; None when it is."""
+    title = arm.spec.title
     if retargeter.pushed_out > retargeter.config.reach_tolerance:
         return (
             f"The hand is straight above or below the shoulder, where the {title} cannot "

@@ -127,12 +127,13 @@ class SourcePublic(BaseModel):
     robot_notes: list[str] = Field(
         default_factory=list,
         description="one sentence each: meshes loading, a motion being retargeted onto the "
-        "robot, or what cannot be shown on it and why",
+        "robot, what cannot be shown on it and why, or a recording played as the source: its "
+        "path over the whole recording being planned or followed",
     )
     robot_warning: str | None = Field(
         None,
-        description="why the robot does not follow the hand now (out of its reach, or held "
-        "clear of a self-collision), else null",
+        description="why the robot does not follow the hand now (out of its reach, held "
+        "clear of a self-collision, or turning between IK branches), else null",
     )
 
 

@@ -343,6 +343,10 @@ class Studio:
         """``SourcePublic``: the pipeline status plus the playback state."""
         status = self.pipeline.status()
         status.update(self.robot_state())
+        plan = self.pipeline.plan_note()
+        notes = status["robot_notes"]
+        if plan and isinstance(notes, list):
+            status["robot_notes"] = [*notes, plan]
         status["playback"] = None
         source = self.pipeline.source
         if self.pipeline.kind == "recording" and isinstance(source, PlaybackSource):

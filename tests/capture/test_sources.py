@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import socket
 import threading
 import time
@@ -85,6 +86,17 @@ def test_playback_seek_pause_and_loop(tmp_path, frames):
     wrap = len(frames) - first
     assert got[wrap].frame == len(frames) and np.array_equal(got[wrap].bend, frames[0].bend)
     assert all(b.t > a.t for a, b in zip(got, got[1:], strict=False))
+
+    # every frame played names the row it was read from, through the loop's later passes
+    rows = [source.row_at(f.t) for f in got]
+    assert rows == [(first + k) % len(frames) for k in range(len(got))]
+    assert source.row_at(rec.t[0] + 0.5 / 110) is None  # between two frames: no row
+
+
+def test_row_at_is_none_where_the_recordings_times_do_not_rise(tmp_path, frames):
+    backwards = [*frames[:5], dataclasses.replace(frames[5], t=frames[2].t), *frames[6:10]]
+    source = PlaybackSource(_recording(tmp_path, backwards), speed=None)
+    assert source.row_at(frames[7].t) is None
 
 
 def test_playback_real_time_is_paced_not_dumped(tmp_path, frames):

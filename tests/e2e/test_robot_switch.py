@@ -1,7 +1,8 @@
 """In a real browser: the user picks the Panda, the page says its meshes are loading, the scene
 draws it from its own meshes and the simulated operator drives it; a demonstration plays on the
 Panda and exports checked for it, while its recording is refused by the safety checks, then
-written with the findings in it; the Puma560 comes back and a recording exports for it."""
+written with the findings in it; that recording, played as the source, moves the Panda along the
+path planned over all of it; the Puma560 comes back and a recording exports for it."""
 
 from __future__ import annotations
 
@@ -139,6 +140,20 @@ def test_the_user_teaches_the_panda_plays_and_exports_a_demonstration_then_back(
     name, text = _download_anyway(page, "recording", DEMO, "csv")
     assert name == f"{DEMO}.panda.csv"
     assert "NOT checked" in text and "acceleration" in text
+
+    # the recording played as the source: the Panda follows the path planned over all of it,
+    # the path the export wrote, and the page says so
+    page.select_option("[data-testid='source-kind']", "recording")
+    page.select_option("[data-testid='source-recording']", DEMO)
+    page.click("[data-testid='source-apply']")
+    planned = "Franka Emika Panda follows the path planned over the whole recording"
+    assert wait_for(lambda: planned in page.inner_text("#robot-notes"), timeout=DRAW_TIMEOUT_S), (
+        page.inner_text("#robot-notes"),
+        studio_server.log_tail(),
+    )
+    q = _q_robot(studio_server)
+    assert np.all(q >= panda.lower - 1e-9) and np.all(q <= panda.upper + 1e-9)
+    shot(page, "robot-panda-recording-planned", "sec-source")
 
     select.select_option("puma560")
     assert wait_for(

@@ -1,0 +1,173 @@
+"""A recording played as the source moves the robot taught along the path planned over the whole
+recording (the path ``studio export`` writes), once that is planned, and never jumps onto it."""
+
+from __future__ import annotations
+
+import subprocess
+import threading
+import time
+
+import numpy as np
+import pytest
+
+from studio.capture import PlaybackSource, human_angles, read_any_recording
+from studio.export import recording_motion
+from studio.kinematics import RetargetConfig, load_robot, retarget_path
+from studio.samples import SAMPLES_DIR
+from studio.web import _planned_playback
+from studio.web._pipeline import Pipeline
+from tests.export.conftest import smooth_arm, write_arm_recording
+
+SAMPLE = SAMPLES_DIR / "sample-reach-2.tape.csv"
+STEP = RetargetConfig().max_joint_step
+WAIT_S = 60.0
+
+
+@pytest.fixture(scope="module")
+def ur3():
+    return load_robot("ur3")
+
+
+@pytest.fixture
+def playing(ur3):
+    """A pipeline teaching the UR3, with sample 2 as its source (frames handed in by the test)."""
+    pipeline = Pipeline()
+    pipeline.set_robot(ur3)
+    pipeline.set_source(PlaybackSource(SAMPLE, speed=None), "recording", "sample-reach-2")
+    yield pipeline, read_any_recording(SAMPLE)
+    pipeline.close()
+
+
+def wait_for(pipeline: Pipeline, words: str) -> str:
+    deadline = time.monotonic() + WAIT_S
+    while words not in (pipeline.plan_note() or ""):
+        assert time.monotonic() < deadline, pipeline.plan_note()
+        time.sleep(0.02)
+    return pipeline.plan_note() or ""
+
+
+def play(pipeline: Pipeline, recording, rows) -> tuple[np.ndarray, list[str | None]]:
+    """The robot's pose and note after each row is fitted, in order."""
+    q, notes = [], []
+    for row in rows:
+        q.append(pipeline.observe(recording.frame_at(row)).q_robot)
+        notes.append(pipeline.status()["robot_warning"])
+    return np.array(q), notes
+
+
+def test_played_from_its_start_the_robot_follows_the_planned_path(playing, ur3):
+    pipeline, recording = playing
+    pipeline.observe(recording.frame_at(0))  # the first frame asks for the plan
+    assert "Planning the Universal Robots UR3's path" in pipeline.plan_note()
+    wait_for(pipeline, "is planned")
+    q, notes = play(pipeline, recording, range(len(recording)))
+    exported = recording_motion(SAMPLE, "ur3")
+    np.testing.assert_array_equal(q, exported.q)  # from the first frame: the arm jumped there
+    assert "follows the path planned over the whole recording" in pipeline.plan_note()
+    assert exported.path is not None
+    # more frames on the hand's target than the live retargeting gives the same recording
+    q_human = human_angles(recording, slice(0, len(recording)))
+    live = retarget_path(ur3, q_human, side=recording.side, as_live=True)
+    assert exported.path.reached.sum() > live.reached.sum()
+    # where the plan turns between IK branches, the page says so, frame by frame
+    turning = ~exported.path.reached & ~exported.path.out_of_reach
+    assert turning.any()
+    said = np.array(["turns from one of its IK branches" in (n or "") for n in notes])
+    np.testing.assert_array_equal(said, turning)
+
+
+@pytest.mark.parametrize("sample", ["sample-reach-3", "sample-reach-2"])
+def test_the_robot_moves_onto_the_plan_where_it_meets_it_or_at_the_loop_never_jumping(
+    ur3, monkeypatch, sample
+):
+    path = SAMPLES_DIR / f"{sample}.tape.csv"
+    recording = read_any_recording(path)
+    pipeline = Pipeline()
+    pipeline.set_robot(ur3)
+    pipeline.set_source(PlaybackSource(path, speed=None, loop=True), "recording", sample)
+    release = threading.Event()
+    plan = _planned_playback.plan_recording
+
+    def slow(path, robot, abandoned):
+        release.wait(WAIT_S)
+        return plan(path, robot, abandoned)
+
+    monkeypatch.setattr(_planned_playback, "plan_recording", slow)
+    try:
+        q_live, _ = play(pipeline, recording, range(40))  # played live while it plans
+        assert "Planning" in pipeline.plan_note()
+        release.set()
+        wait_for(pipeline, "is planned")
+        q_rest, _ = play(pipeline, recording, range(40, len(recording)))
+        q_again, _ = play(pipeline, recording, range(len(recording)))  # the loop's next pass
+    finally:
+        pipeline.close()
+    q = np.vstack([q_live, q_rest])
+    assert np.abs(np.diff(q, axis=0)).max() <= STEP + 1e-9  # it never jumped onto the plan
+    planned = recording_motion(path, "ur3").q
+    on_plan = np.flatnonzero(np.all(q == planned, axis=1))
+    if sample == "sample-reach-3":  # the live pose meets the plan's mid-way: it joins there
+        assert len(on_plan) and on_plan[0] > 40
+        assert np.array_equal(q[on_plan[0] :], planned[on_plan[0] :])  # and stays on it
+    else:  # they never meet in the first pass: it joins at the loop, where the arm jumps too
+        assert not len(on_plan)
+    np.testing.assert_array_equal(q_again, planned)
+
+
+def test_a_seek_back_or_a_loop_moves_the_robot_onto_the_plan_with_the_arm(playing):
+    pipeline, recording = playing
+    pipeline.observe(recording.frame_at(200))
+    wait_for(pipeline, "is planned")
+    q, _ = play(pipeline, recording, [201, 202, 10, 11])  # a seek back to row 10
+    planned = recording_motion(SAMPLE, "ur3").q
+    np.testing.assert_array_equal(q[2:], planned[10:12])
+
+
+def test_unmirrored_the_robot_follows_the_hand_live(playing, ur3):
+    pipeline, recording = playing
+    pipeline.set_retarget("cartesian", False)
+    q, _ = play(pipeline, recording, range(60))
+    assert pipeline.plan_note() is None
+    # the path a live session shows, unmirrored (the plan is made for the mirrored robot)
+    assert not np.array_equal(q, recording_motion(SAMPLE, "ur3").q[:60])
+
+
+def test_a_recording_that_cannot_be_planned_plays_live_and_says_why(ur3, tmp_path):
+    path = write_arm_recording(tmp_path / "one.tape.csv", smooth_arm(1))
+    pipeline = Pipeline()
+    pipeline.set_robot(ur3)
+    pipeline.set_source(PlaybackSource(path, speed=None), "recording", "one")
+    try:
+        fitted = pipeline.observe(read_any_recording(path).frame_at(0))
+        note = wait_for(pipeline, "could not be planned")
+        assert note.startswith("The robot follows the hand as it would live: ")
+        assert "one.tape.csv holds 1 frame there" in note  # the export's own sentence
+        assert np.isfinite(fitted.q_robot).all() and pipeline.status()["error"] is None
+    finally:
+        pipeline.close()
+
+
+def test_a_plan_no_longer_wanted_stops_its_process(monkeypatch):
+    children = []
+    popen = subprocess.Popen
+
+    def spy(*args, **kwargs):
+        children.append(popen(*args, **kwargs))
+        return children[-1]
+
+    monkeypatch.setattr(subprocess, "Popen", spy)
+    assert _planned_playback.plan_recording(SAMPLE, "ur3", lambda: True) is None
+    assert len(children) == 1 and children[0].returncode is not None  # killed, and reaped
+
+
+def test_switching_the_source_or_the_robot_forgets_the_plan(playing):
+    pipeline, recording = playing
+    pipeline.observe(recording.frame_at(0))
+    wait_for(pipeline, "is planned")
+    pipeline.set_robot(load_robot("puma560"))
+    assert pipeline.plan_note() is None
+    pipeline.set_robot(load_robot("ur3"))
+    pipeline.observe(recording.frame_at(0))
+    assert "follows the path planned" in pipeline.plan_note()  # kept: not planned again
+    pipeline.set_source(None, None)
+    assert pipeline.plan_note() is None
