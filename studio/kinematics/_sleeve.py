@@ -59,13 +59,17 @@ def tape_on_sleeve(
     axis = np.asarray(axis, dtype=float)
     out = np.array(tape, dtype=float)
     for _ in range(rounds):  # all points at once: this runs for every live pose shown
-        for a, b, lift in zip(axis[:-1], axis[1:], lift_m, strict=True):
+        for k, (a, b, lift) in enumerate(zip(axis[:-1], axis[1:], lift_m, strict=True)):
             ab = b - a
-            t = np.clip((out - a) @ ab / (ab @ ab), 0.0, 1.0)
+            along = (out - a) @ ab / (ab @ ab)
+            t = np.clip(along, 0.0, 1.0)
             c = a + t[:, None] * ab
             away = out - c
             d = np.linalg.norm(away, axis=1)
-            inside = d < lift
+            # Past the elbow, a point is the other segment's: pushed out of this one's end, a
+            # point on the axis would go along it, then across the other, twice as far.
+            beyond_elbow = (along > 1.0) if k == 0 else (along < 0.0)
+            inside = (d < lift) & ~beyond_elbow
             if not inside.any():
                 continue
             on_axis = inside & (d <= 1e-9)

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from studio.kinematics import (
@@ -41,6 +41,7 @@ def body() -> HumanBody:
         max_size=20,
     )
 )
+@example([(0.0, 0.0, 0.0), (0.3125, 0.0, 0.0)])  # on the axis just past the elbow
 def test_no_point_stays_inside_the_sleeve_and_none_moves_beyond_it(points):
     tape = np.array(points)
     out = tape_on_sleeve(tape, AXIS)
