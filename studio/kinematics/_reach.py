@@ -10,13 +10,17 @@ benchmarks:
 - :func:`reachable`: some pose of the arm reaches the target: within its joint limits, its links
   at least ``RetargetConfig.clearance`` apart, and, given ``near``, no joint further than
   ``RetargetConfig.max_joint_step`` from ``near`` (the target can be reached in the one frame the
-  step cap allows from there). It is a search: the IK, run to convergence from ``near`` (or
+  step cap allows from there), or given ``within_steps_of``, within the joint motion so many
+  frames allow of each of those poses (the target can be reached on the way from one to the
+  other). It is a search: the IK, run to convergence from ``near`` (or
   home) and from :data:`REACHABLE_STARTS` (:data:`NEAR_STARTS` given ``near``) starts drawn at
   random (seeded) within those bounds;
   "not reachable" means none of those starts found a pose.
 """
 
 from __future__ import annotations
+
+from collections.abc import Iterable, Sequence
 
 import numpy as np
 
@@ -59,6 +63,8 @@ def reachable(
     oMdes: np.ndarray,
     config: RetargetConfig | None = None,
     near: np.ndarray | None = None,
+    *,
+    within_steps_of: Sequence[tuple[np.ndarray, int]] = (),
 ) -> bool:
     """Whether some pose of ``arm`` reaches ``oMdes`` (see the module docstring).
 
@@ -67,23 +73,53 @@ def reachable(
         oMdes: the tool's target (4x4, the arm's base frame).
         config: the tolerances, the clearance and the step cap.
         near: a pose: only poses within one frame's joint motion of it count.
+        within_steps_of: ``(pose, frames)`` pairs: only poses within ``frames`` frames' joint
+            motion of every such pose count (a target reachable on the way from one pose to
+            another, ``frames`` after the first and before the second).
     """
     config = config or RetargetConfig()
-    lower, upper = arm.lower, arm.upper
-    if near is not None:
-        lower = np.maximum(lower, near - config.max_joint_step)
-        upper = np.minimum(upper, near + config.max_joint_step)
+    bounds = [*within_steps_of, *([] if near is None else [(near, 1)])]
+    lower, upper = steps_box(arm, config, bounds)
+    if np.any(lower > upper):
+        return False
     rng = np.random.default_rng(0)
     first = arm.home if near is None else near
     starts = REACHABLE_STARTS if near is None else NEAR_STARTS
-    for start in (first, *rng.uniform(lower, upper, (starts, arm.nq))):
+    found = pose_within(
+        arm, oMdes, config, (lower, upper), (first, *rng.uniform(lower, upper, (starts, arm.nq)))
+    )
+    return found is not None
+
+
+def steps_box(
+    arm: RobotArm, config: RetargetConfig, poses: Sequence[tuple[np.ndarray, int]]
+) -> tuple[np.ndarray, np.ndarray]:
+    """The joint box ``(lower, upper)`` within the limits and within ``frames`` frames' joint
+    motion (``config.max_joint_step`` each) of every ``(pose, frames)``; empty (some lower above
+    its upper) where they do not meet."""
+    lower, upper = arm.lower, arm.upper
+    for pose, frames in poses:
+        reach = config.max_joint_step * frames
+        lower, upper = np.maximum(lower, pose - reach), np.minimum(upper, pose + reach)
+    return lower, upper
+
+
+def pose_within(
+    arm: RobotArm,
+    oMdes: np.ndarray,
+    config: RetargetConfig,
+    box: tuple[np.ndarray, np.ndarray],
+    starts: Iterable[np.ndarray],
+    iterations: int = REACHABLE_ITERATIONS,
+) -> np.ndarray | None:
+    """The first pose within ``box`` (``(lower, upper)``) that the IK finds from one of
+    ``starts`` (each clipped into it) and that reaches ``oMdes`` clear of self-collision; None
+    if none does."""
+    lower, upper = box
+    for start in starts:
         q = arm.inverse(
-            oMdes,
-            np.clip(start, lower, upper),
-            iterations=REACHABLE_ITERATIONS,
-            lower=lower,
-            upper=upper,
+            oMdes, np.clip(start, lower, upper), iterations=iterations, lower=lower, upper=upper
         ).q
         if tool_reaches(arm, q, oMdes, config) and not arm.self_collisions(q, config.clearance):
-            return True
-    return False
+            return q
+    return None

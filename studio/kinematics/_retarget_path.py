@@ -20,8 +20,12 @@ while it walks. A recording is known whole, so :func:`retarget_path` plans the b
    when no joint has further to go than b - a steps. A walk that would bring the robot's links
    closer than ``RetargetConfig.clearance`` is struck out and the route found again.
 
+4. Through the frames the route still misses: between the reached frames either side of each
+   run, the walk goes through poses that reach some of its frames, found frame by frame within
+   the step cap of the last pose kept and of the reached frame after (``_through_misses``).
+
 The live pass is one of the routes, and the plan is kept only where it reaches at least as many
-frames, so a planned path never reaches fewer. Every joint stays within its limits (the tracks'
+frames, so a planned path never reaches fewer; step 4 only adds frames reached. Every joint stays within its limits (the tracks'
 poses do, and a straight walk between two of them does) and moves at most ``max_joint_step`` a
 frame.
 """
@@ -34,7 +38,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ._human import HumanArm
-from ._reach import reach_errors, tool_reaches
+from ._reach import pose_within, reach_errors, steps_box, tool_reaches
 from ._retarget import RetargetConfig, Retargeter
 from ._robots import RobotArm, RobotIK
 
@@ -65,6 +69,10 @@ either side of it too (their walks pass the same poses)."""
 WALK_RETRIES = 8
 """Routes found again after a walk was struck out for a collision, before the live pass is
 kept."""
+
+THROUGH_STARTS = 16
+"""Random starts, within the step cap of the poses either side, of the search for a pose that
+reaches a frame the route walks through (besides the last pose kept)."""
 
 
 @dataclass(frozen=True)
@@ -147,12 +155,73 @@ def retarget_path(
         return live
     assert isinstance(arm, RobotArm)
     planned = _plan(retargeter, q_h, targets, live.q, live.reached, config)
+    reached = _reaching(arm, planned, targets, config)
+    if reached.sum() < live.reached.sum():  # never fewer frames than live
+        planned, reached = live.q, live.reached
+    planned = _through_misses(arm, planned, reached, targets, config)
     errors = [reach_errors(arm, q, t) for q, t in zip(planned, targets, strict=True)]
     now = np.array([config.within_reach(*e) for e in errors], dtype=bool)
-    if now.sum() < live.reached.sum():
-        return live
     error = np.array([e[0] for e in errors])
     return RetargetedPath(planned, error, live.out_of_reach & ~now, live.pulled_in, now)
+
+
+def _reaching(
+    arm: RobotArm, q: np.ndarray, targets: list[np.ndarray], config: RetargetConfig
+) -> np.ndarray:
+    """Per frame, whether the tool at ``q`` is on its target."""
+    return np.array([tool_reaches(arm, *pair, config) for pair in zip(q, targets, strict=True)])
+
+
+def _through_misses(
+    arm: RobotArm,
+    path: np.ndarray,
+    reached: np.ndarray,
+    targets: list[np.ndarray],
+    config: RetargetConfig,
+) -> np.ndarray:
+    """``path`` with each run of frames it misses walked through poses that reach some of them.
+
+    Between the reached frames either side of a run (or the run's open end), the walk is
+    straight in joint space. Frame by frame along the run, a pose is searched that reaches the
+    frame's target within the step cap of the last pose kept (the reached frame before, or the
+    last such pose) and of the reached frame after; each one found is kept, and the walk goes
+    straight from one to the next. A rebuilt walk that would bring links into contact is left
+    as it was. So no frame reached before is missed after, and no joint moves further than the
+    step cap a frame.
+    """
+    path = path.copy()
+    n = len(path)
+    rng = np.random.default_rng(0)
+    for first, last in _runs(~reached):
+        end = (last + 1, path[last + 1]) if last + 1 < n else None
+        kept = [(first - 1, path[first - 1])] if first > 0 else []
+        for i in range(first, last + 1):
+            ends = [*kept[-1:], *([] if end is None else [end])]
+            lower, upper = steps_box(arm, config, [(q, abs(frame - i)) for frame, q in ends])
+            if np.any(lower > upper):
+                continue
+            starts = [q for _, q in kept[-1:]]
+            starts += list(rng.uniform(lower, upper, (THROUGH_STARTS, arm.nq)))
+            found = pose_within(
+                arm, targets[i], config, (lower, upper), starts, config.restart_iterations
+            )
+            if found is not None:
+                kept.append((i, found))
+        if not any(i >= first for i, _ in kept):
+            continue
+        walk = _straight([*kept, *([] if end is None else [end])], first, last)
+        if not any(arm.self_collisions(q, config.clearance) for q in walk):
+            path[first : last + 1] = walk
+    return path
+
+
+def _straight(poses: list[tuple[int, np.ndarray]], first: int, last: int) -> np.ndarray:
+    """Frames ``first`` .. ``last`` walked straight in joint space from one of ``poses``
+    (``(frame, q)`` in order of frame) to the next; held before the first and after the last."""
+    frames = np.arange(first, last + 1)
+    at = np.array([i for i, _ in poses], dtype=float)
+    q = np.array([q for _, q in poses])
+    return np.column_stack([np.interp(frames, at, q[:, j]) for j in range(q.shape[1])])
 
 
 def _live(
