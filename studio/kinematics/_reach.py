@@ -20,7 +20,7 @@ benchmarks:
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 
 import numpy as np
 
@@ -111,15 +111,18 @@ def pose_within(
     box: tuple[np.ndarray, np.ndarray],
     starts: Iterable[np.ndarray],
     iterations: int = REACHABLE_ITERATIONS,
+    accept: Callable[[np.ndarray], bool] | None = None,
 ) -> np.ndarray | None:
     """The first pose within ``box`` (``(lower, upper)``) that the IK finds from one of
-    ``starts`` (each clipped into it) and that reaches ``oMdes`` clear of self-collision; None
-    if none does."""
+    ``starts`` (each clipped into it), that reaches ``oMdes`` clear of self-collision and that
+    ``accept`` (if given) takes; None if none does."""
     lower, upper = box
     for start in starts:
         q = arm.inverse(
             oMdes, np.clip(start, lower, upper), iterations=iterations, lower=lower, upper=upper
         ).q
-        if tool_reaches(arm, q, oMdes, config) and not arm.self_collisions(q, config.clearance):
+        if not tool_reaches(arm, q, oMdes, config) or arm.self_collisions(q, config.clearance):
+            continue
+        if accept is None or accept(q):
             return q
     return None

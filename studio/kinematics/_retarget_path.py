@@ -184,35 +184,49 @@ def _through_misses(
     Between the reached frames either side of a run (or the run's open end), the walk is
     straight in joint space. Frame by frame along the run, a pose is searched that reaches the
     frame's target within the step cap of the last pose kept (the reached frame before, or the
-    last such pose) and of the reached frame after; each one found is kept, and the walk goes
-    straight from one to the next. A rebuilt walk that would bring links into contact is left
-    as it was. So no frame reached before is missed after, and no joint moves further than the
-    step cap a frame.
+    last such pose) and of the reached frame after, and whose straight walks from the one and
+    on to the other keep the links clear; each one found is kept, and the walk goes straight
+    from one to the next. So no frame reached before is missed after, no joint moves further
+    than the step cap a frame, and the walk touches nothing.
     """
     path = path.copy()
     n = len(path)
     rng = np.random.default_rng(0)
     for first, last in _runs(~reached):
-        end = (last + 1, path[last + 1]) if last + 1 < n else None
+        end = [(last + 1, path[last + 1])] if last + 1 < n else []
         kept = [(first - 1, path[first - 1])] if first > 0 else []
         for i in range(first, last + 1):
-            ends = [*kept[-1:], *([] if end is None else [end])]
+            ends = [*kept[-1:], *end]
             lower, upper = steps_box(arm, config, [(q, abs(frame - i)) for frame, q in ends])
             if np.any(lower > upper):
                 continue
             starts = [q for _, q in kept[-1:]]
             starts += list(rng.uniform(lower, upper, (THROUGH_STARTS, arm.nq)))
+            before = kept[-1:]
             found = pose_within(
-                arm, targets[i], config, (lower, upper), starts, config.restart_iterations
+                arm,
+                targets[i],
+                config,
+                (lower, upper),
+                starts,
+                config.restart_iterations,
+                accept=lambda q, i=i, before=before, end=end: _clear_walk(
+                    arm, [*before, (i, q), *end], config
+                ),
             )
             if found is not None:
                 kept.append((i, found))
-        if not any(i >= first for i, _ in kept):
-            continue
-        walk = _straight([*kept, *([] if end is None else [end])], first, last)
-        if not any(arm.self_collisions(q, config.clearance) for q in walk):
-            path[first : last + 1] = walk
+        if any(i >= first for i, _ in kept):
+            path[first : last + 1] = _straight([*kept, *end], first, last)
     return path
+
+
+def _clear_walk(arm: RobotArm, poses: list[tuple[int, np.ndarray]], config: RetargetConfig) -> bool:
+    """Whether the straight walks between ``poses`` (``(frame, q)``, in order) keep the links
+    clear on every frame between them."""
+    first, last = poses[0][0], poses[-1][0]
+    walk = _straight(poses, first, last)
+    return not any(arm.self_collisions(q, config.clearance) for q in walk[1:-1])
 
 
 def _straight(poses: list[tuple[int, np.ndarray]], first: int, last: int) -> np.ndarray:
