@@ -23,8 +23,9 @@ step cap walks the robot there over several frames), targets reachable within on
 of where the robot stood (the retargeting should never miss these), and self-collisions among
 those frames.
 Then the same motion as a recording: ``retarget_path`` plans which IK branch to take where, with
-the whole motion known; its share reached and reachable-but-missed against the live pass's, and
-the seconds it takes against the live pass's.
+the whole motion known; its share reached and reachable-but-missed against the live pass's, how
+many of its misses a pose reaches on the way between the path's reached frames either side at
+the step cap (the plan should leave none), and the seconds it takes against the live pass's.
 
     python benchmarks/bench_retarget.py [--seconds 20] [--robots panda ur5 ...]
 """
@@ -211,16 +212,28 @@ def planned(
     reached = np.array([tool_reaches(arm, p, t) for p, t in zip(q, targets, strict=True)])
     sample = range(1, len(motion), 11)
     missed = [i for i in sample if not reached[i] and reachable(arm, targets[i])]
+    on_the_way = [
+        i for i in missed if reachable(arm, targets[i], within_steps_of=_ends(q, reached, i))
+    ]
     step = float(np.degrees(np.abs(np.diff(q, axis=0))).max())
     hits = sum(bool(arm.self_collisions(q[i])) for i in sample)
     print(
         f"{'':8s} as a recording, branches planned: reached {reached.mean():.0%} (live "
         f"{live_reached.mean():.0%}) | reachable but missed {len(missed) / len(sample):.1%} "
-        f"(live {live_missed / len(sample):.1%}) | largest step {step:.1f} deg | "
+        f"(live {live_missed / len(sample):.1%}; of the planned, {len(on_the_way)} reachable "
+        f"on the way between their reached neighbours) | largest step {step:.1f} deg | "
         f"self-collision {hits}/{len(sample)} | {seconds:.1f} s for the motion "
         f"(live {live_s:.1f} s, {seconds / live_s:.1f}x)",
         flush=True,
     )
+
+
+def _ends(q: np.ndarray, reached: np.ndarray, i: int) -> list[tuple[np.ndarray, int]]:
+    """The path's nearest reached frames before and after frame ``i``, as ``(pose, frames
+    away)``: a pose reaching frame ``i`` within the step cap of both could be walked through."""
+    before = np.flatnonzero(reached[:i])[-1:]
+    after = i + 1 + np.flatnonzero(reached[i + 1 :])[:1]
+    return [(q[a], i - a) for a in before] + [(q[b], b - i) for b in after]
 
 
 def main() -> None:
