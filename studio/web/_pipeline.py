@@ -113,6 +113,7 @@ class Pipeline:
         if self._thread is not None:
             self._thread.join(timeout=5.0)
             self._thread = None
+        self._planned.close()  # no planning child outlives the studio
         with self._lock:
             if self._writer is not None:
                 self._close_writer()

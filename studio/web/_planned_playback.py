@@ -38,6 +38,8 @@ CACHED_PLANS = 4
 """Plans kept (switching back to a robot already planned for follows its plan at once)."""
 POLL_S = 0.1
 """How often the planning is checked on (whether it is still wanted, and its child alive)."""
+CLOSE_TIMEOUT_S = 5.0
+"""How long closing waits for the planning under way to stop."""
 LIVE_INSTEAD = "The robot follows the hand as it would live"
 """How a sentence on a plan that could not be made begins."""
 
@@ -126,6 +128,15 @@ class PlannedPlayback:
             f"The {title}'s path over the whole recording is planned; it moves onto it where "
             "the two meet, or where playback starts over."
         )
+
+    def close(self, timeout: float = CLOSE_TIMEOUT_S) -> None:
+        """Stop following and stop the planning under way (its child process is killed), waiting
+        up to ``timeout`` s for that."""
+        self.forget()
+        with self._lock:
+            worker = self._worker
+        if worker is not None:
+            worker.join(timeout)
 
     def forget(self) -> None:
         """Stop following (the source or the robot changed); plans made are kept."""

@@ -171,3 +171,25 @@ def test_switching_the_source_or_the_robot_forgets_the_plan(playing):
     assert "follows the path planned" in pipeline.plan_note()  # kept: not planned again
     pipeline.set_source(None, None)
     assert pipeline.plan_note() is None
+
+
+def test_closing_the_studio_stops_the_planning_under_way(ur3, monkeypatch):
+    children = []
+    popen = subprocess.Popen
+
+    def spy(*args, **kwargs):
+        children.append(popen(*args, **kwargs))
+        return children[-1]
+
+    monkeypatch.setattr(subprocess, "Popen", spy)
+    pipeline = Pipeline()
+    pipeline.set_robot(ur3)
+    pipeline.set_source(PlaybackSource(SAMPLE, speed=None), "recording", "sample-reach-2")
+    pipeline.observe(read_any_recording(SAMPLE).frame_at(0))
+    deadline = time.monotonic() + WAIT_S
+    while not children:  # the worker has started the child
+        assert time.monotonic() < deadline
+        time.sleep(0.01)
+    pipeline.close()
+    assert children[0].returncode is not None  # killed and reaped, not left running
+    assert children[0].returncode != 0  # stopped before it had planned
