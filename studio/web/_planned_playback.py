@@ -7,11 +7,12 @@ branches) follows the path ``studio export`` writes for it (:func:`studio.export
 planned by :func:`studio.kinematics.retarget_path`).
 
 Planning takes a fraction of the recording's length, in a child process (:mod:`._plan_child`)
-watched by one worker thread (the latest request wins; a plan no longer wanted is stopped). The live retargeting drives the robot meanwhile. The robot moves onto the plan where that
-makes no jump the live path would not make: at a frame where the plan's pose lies within the
-joint motion the frames since the last one allow of the pose shown, or where the operator's arm
-jumps too (the first frame played, a seek back, a loop). Once on it, it stays on it until the
-source, the robot or the mirroring changes.
+watched by one worker thread (the latest request wins; a plan no longer wanted is stopped, and
+so is one under way when the studio closes). The live retargeting drives the robot meanwhile.
+The robot moves onto the plan where that makes no jump the live path would not make: at a frame
+where the plan's pose lies within the joint motion the frames since the last one allow of the
+pose shown, or where the operator's arm jumps too (the first frame played, a seek back, a loop).
+Once on it, it stays on it until the source, the robot or the mirroring changes.
 """
 
 from __future__ import annotations
