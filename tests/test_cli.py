@@ -1,5 +1,7 @@
 from __future__ import annotations
 
+import sys
+
 import pytest
 
 from studio.cli import build_parser, main
@@ -79,3 +81,19 @@ def test_a_usage_error_is_one_line_pointing_to_help(argv, says, capsys) -> None:
     assert err.count("\n") == 1 and err.startswith(says), err
     verb = "studio" if argv[0] == "no-such-verb" else f"studio {argv[0]}"
     assert err.rstrip().endswith(f"see {verb} --help."), err
+
+
+def test_a_terminal_is_told_a_recording_is_being_retargeted_a_script_is_not(
+    tmp_path, capsys, monkeypatch
+):
+    argv = ["export", "sample-reach-1.tape.csv", "--robot", "ur5", "--format", "csv"]
+    out = ["--out", str(tmp_path / "a.csv"), "--unchecked"]
+    assert main([*argv, *out]) == 0
+    assert "Retargeting" not in capsys.readouterr().err  # not a terminal: nothing said
+    monkeypatch.setattr(sys.stderr, "isatty", lambda: True)
+    assert main([*argv, *out]) == 0
+    said = capsys.readouterr().err
+    assert said.startswith(
+        "Retargeting sample-reach-1.tape.csv onto the Universal Robots UR5, its IK branches "
+        "planned over the whole motion"
+    )

@@ -31,7 +31,7 @@ from studio.export import (
     recording_motion,
     source_kind,
 )
-from studio.kinematics import robot_names
+from studio.kinematics import DEFAULT_ROBOT, robot_names, robot_spec
 from studio.learning import (
     POLICY_SUFFIX,
     ROLLOUT_MAX_STEPS,
@@ -278,6 +278,8 @@ def _print_likeness(
 def _motion(args: argparse.Namespace, source: Path, robot: str) -> tuple[Motion, str]:
     """The source's motion on ``robot``, and a phrase saying what it is."""
     kind = source_kind(source)
+    if kind in ("recording", "demonstration"):
+        _say_retargeting(source, robot)
     if kind == "recording":
         return recording_motion(source, robot), "recording"
     if kind == "demonstration":
@@ -287,6 +289,22 @@ def _motion(args: argparse.Namespace, source: Path, robot: str) -> tuple[Motion,
     times, q, summary = _rollout(args, policy, args.seconds_per_step)
     timed = args.seconds_per_step is not None
     return Motion("policy", source.name, arm, times, q, timed, args.rate), summary
+
+
+def _say_retargeting(source: Path, robot: str) -> None:
+    """Tell a person at a terminal that a human-arm motion is being retargeted onto ``robot``:
+    with its IK branches planned, that takes seconds a minute of recording, and a long one
+    would otherwise look stuck. Said only to a terminal, so a script's stderr still holds
+    nothing but the one sentence of a refusal. The Puma560 (the default robot) maps joint to
+    joint, at once."""
+    if robot == DEFAULT_ROBOT or not sys.stderr.isatty() or robot not in robot_names():
+        return
+    print(
+        f"Retargeting {source.name} onto the {robot_spec(robot).title}, its IK branches planned "
+        "over the whole motion (seconds a minute of recording)...",
+        file=sys.stderr,
+        flush=True,
+    )
 
 
 def run(args: argparse.Namespace) -> int:
