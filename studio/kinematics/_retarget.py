@@ -420,8 +420,8 @@ class Retargeter:
         """Where the operator's shoulder is placed in the robot's base frame.
 
         The Puma560's shoulder; for a robot on a table, its shoulder raised to at least half its
-        reach (:meth:`_reach`) above the table, so the operator's hand at shoulder height (a reach forward) lands
-        mid-workspace and a lowered hand near the table, not under it.
+        reach (:meth:`_reach`) above the table, so the operator's hand at shoulder height (a
+        reach forward) lands mid-workspace and a lowered hand near the table, not under it.
         """
         robot = self.robot
         if isinstance(robot, Puma560):
@@ -564,8 +564,8 @@ class Retargeter:
         pinned joints moved home, from home and from ``config.restart_starts`` fixed poses; of
         the answers that reach the target, the one nearest the last pose is taken (a joint with
         a turn to spare counted the short way round, one cramped at a limit counted further:
-        ``config.limit_room``), and the step cap walks the robot there
-        over as many frames as it needs. A pose that would bring the robot's links into contact
+        ``config.limit_room``), and the step cap walks the robot there over as many frames as
+        it needs. A pose that would bring the robot's links into contact
         does not count as reaching: another branch's is looked for, and only where none is clear
         does the robot hold its last pose. There the restarts also start from the pose the
         robot walks to, so that pose is followed rather than found afresh on whichever branch is

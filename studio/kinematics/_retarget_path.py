@@ -19,15 +19,14 @@ while it walks. A recording is known whole, so :func:`retarget_path` plans the b
    costs the b - a - 1 frames between, walked in a straight line in joint space, and is allowed
    when no joint has further to go than b - a steps. A walk that would bring the robot's links
    closer than ``RetargetConfig.clearance`` is struck out and the route found again.
-
 4. Through the frames the route still misses: between the reached frames either side of each
    run, the walk goes through poses that reach some of its frames, found frame by frame within
    the step cap of the last pose kept and of the reached frame after (``_through_misses``).
 
 The live pass is one of the routes, and the plan is kept only where it reaches at least as many
-frames, so a planned path never reaches fewer; step 4 only adds frames reached. Every joint stays within its limits (the tracks'
-poses do, and a straight walk between two of them does) and moves at most ``max_joint_step`` a
-frame.
+frames, so a planned path never reaches fewer; step 4 only adds frames reached. Every joint stays
+within its limits (the tracks' poses do, and a straight walk between two of them does) and moves
+at most ``max_joint_step`` a frame.
 """
 
 from __future__ import annotations
@@ -196,13 +195,13 @@ def _through_misses(
         end = [(last + 1, path[last + 1])] if last + 1 < n else []
         kept = [(first - 1, path[first - 1])] if first > 0 else []
         for i in range(first, last + 1):
-            ends = [*kept[-1:], *end]
-            lower, upper = steps_box(arm, config, [(q, abs(frame - i)) for frame, q in ends])
+            before = kept[-1:]
+            ends = [(q, abs(frame - i)) for frame, q in [*before, *end]]
+            lower, upper = steps_box(arm, config, ends)
             if np.any(lower > upper):
                 continue
-            starts = [q for _, q in kept[-1:]]
+            starts = [q for _, q in before]
             starts += list(rng.uniform(lower, upper, (THROUGH_STARTS, arm.nq)))
-            before = kept[-1:]
             found = pose_within(
                 arm,
                 targets[i],

@@ -91,10 +91,9 @@ class PlannedPlayback:
                 if key not in self._plans:
                     self._wanted = key
                     self._start_worker()
-        with self._lock:
-            plan = self._plans.get(key)
         row = source.row_at(t)
         with self._lock:
+            plan = self._plans.get(key)
             last, self._last = self._last, None if row is None else (row, q_live)
             if not isinstance(plan, RetargetedPath) or row is None or row >= len(plan.q):
                 self._following = False

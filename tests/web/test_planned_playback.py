@@ -38,6 +38,20 @@ def playing(ur3):
     pipeline.close()
 
 
+@pytest.fixture
+def children(monkeypatch) -> list[subprocess.Popen]:
+    """Every child process started, as started (the planning's)."""
+    started: list[subprocess.Popen] = []
+    popen = subprocess.Popen
+
+    def spy(*args, **kwargs):
+        started.append(popen(*args, **kwargs))
+        return started[-1]
+
+    monkeypatch.setattr(subprocess, "Popen", spy)
+    return started
+
+
 def wait_for(pipeline: Pipeline, words: str) -> str:
     deadline = time.monotonic() + WAIT_S
     while words not in (pipeline.plan_note() or ""):
@@ -147,15 +161,7 @@ def test_a_recording_that_cannot_be_planned_plays_live_and_says_why(ur3, tmp_pat
         pipeline.close()
 
 
-def test_a_plan_no_longer_wanted_stops_its_process(monkeypatch):
-    children = []
-    popen = subprocess.Popen
-
-    def spy(*args, **kwargs):
-        children.append(popen(*args, **kwargs))
-        return children[-1]
-
-    monkeypatch.setattr(subprocess, "Popen", spy)
+def test_a_plan_no_longer_wanted_stops_its_process(children):
     assert _planned_playback.plan_recording(SAMPLE, "ur3", lambda: True) is None
     assert len(children) == 1 and children[0].returncode is not None  # killed, and reaped
 
@@ -173,15 +179,7 @@ def test_switching_the_source_or_the_robot_forgets_the_plan(playing):
     assert pipeline.plan_note() is None
 
 
-def test_closing_the_studio_stops_the_planning_under_way(ur3, monkeypatch):
-    children = []
-    popen = subprocess.Popen
-
-    def spy(*args, **kwargs):
-        children.append(popen(*args, **kwargs))
-        return children[-1]
-
-    monkeypatch.setattr(subprocess, "Popen", spy)
+def test_closing_the_studio_stops_the_planning_under_way(ur3, children):
     pipeline = Pipeline()
     pipeline.set_robot(ur3)
     pipeline.set_source(PlaybackSource(SAMPLE, speed=None), "recording", "sample-reach-2")
