@@ -71,8 +71,9 @@ class PlannedPlayback:
         step: float,
     ) -> tuple[RetargetedPath, int] | None:
         """The plan and its row for the frame at time ``t``, when the robot follows the plan
-        there; else None (not a recording, not mirrored, still planning, or the live pose
-        ``q_live`` not yet within ``step`` of the plan's)."""
+        there; else None (not a recording, not mirrored, still planning, or the plan's pose not
+        yet within ``step`` a frame of the pose last shown). ``q_live`` is this frame's live
+        pose, the one shown when the plan's is not."""
         recording = getattr(getattr(source, "recording", None), "path", None)
         if not isinstance(source, PlaybackSource) or not mirror or recording is None:
             self.forget()
@@ -98,7 +99,7 @@ class PlannedPlayback:
             if not isinstance(plan, RetargetedPath) or row is None or row >= len(plan.q):
                 self._following = False
                 return None
-            if not self._following and not _may_join(plan.q[row], row, q_live, last, step):
+            if not self._following and not _may_join(plan.q[row], row, last, step):
                 return None
             self._following = True
             self._last = (row, plan.q[row])
@@ -215,16 +216,14 @@ def plan_recording(
 def _may_join(
     q_plan: np.ndarray,
     row: int,
-    q_live: np.ndarray,
     last: tuple[int, np.ndarray] | None,
     step: float,
 ) -> bool:
     """Whether the robot may move onto the plan at ``row`` without a jump the live path would not
-    make: the live pose meets the plan's there, the arm itself jumped (nothing fitted before,
-    or a seek back or a loop), or the plan's pose is within the frames' joint motion since the
-    last frame fitted (some are skipped when the fit falls behind, or a seek forward)."""
-    if np.abs(q_plan - q_live).max() <= step + 1e-9:
-        return True
+    make: the arm itself jumped (nothing fitted before, or a seek back or a loop), or the plan's
+    pose is within the frames' joint motion since the pose last shown (one step a frame; some
+    frames are skipped when the fit falls behind, or on a seek forward). Measured from the live
+    pose of this frame instead, a join could step twice as far."""
     if last is None or row <= last[0]:
         return True
     return bool(np.abs(q_plan - last[1]).max() <= step * (row - last[0]) + 1e-9)
