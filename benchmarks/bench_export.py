@@ -6,7 +6,8 @@ edition (no intermediate waypoints), so following a path means stopping at each 
 each shipped demonstration, on the Puma560 with the same thinned waypoints and the same limits
 (0.8 of the robot's), this prints the trajectory's duration and the time to compute it with
 both, measured interleaved in the same run, and their ratios; then the safety checks' cost per
-sample for a robot with collision geometry (the Panda) and without (the Puma560).
+sample for a robot with collision geometry (the Panda) and without (the Puma560); then a
+recording's export with its fitted arm smoothed with the future, against the live filter.
 
 Run: ``python benchmarks/bench_export.py`` (about a minute; ``pip install ruckig`` for the
 baseline). Wall times on a shared machine are noisy; the durations are not.
@@ -79,6 +80,45 @@ def main() -> None:
         check_trajectory(robot, t, path)
         per = (time.process_time() - t0) / 500
         print(f"safety checks, {name}: {per * 1e3:.3f} ms of CPU per sample")
+    recorded_noise()
+
+
+def recorded_noise() -> None:
+    """A recording exported onto a robot: its fitted arm smoothed with the future
+    (``smooth_recorded_arm``, what ``fit_frames`` does) against the live filter (the baseline),
+    on simulated takes whose true arm is known. Printed per take and robot: the timed
+    trajectory's duration as a share of the true arm's path's, the joints' turns back, and the
+    shoulder and elbow's mean error (deg)."""
+    import tempfile
+    from pathlib import Path
+
+    from studio.capture import RecordingWriter, human_angles, read_any_recording, simulate
+    from studio.kinematics import ArmTracker, retarget_path
+    from studio.kinematics._filter import turn_backs
+
+    print("\na recording's export, smoothed with the future (ours) against the live filter (base):")
+    print(f"{'take':<8}{'robot':<8}{'duration / true':>18}{'turns back':>14}"
+          f"{'sh+el err deg':>16}{'ratio':>7}")  # fmt: skip
+    folder = Path(tempfile.mkdtemp())
+    for seed in (1, 3, 7):
+        sim = simulate(10.0, seed=seed)
+        path = folder / f"take-{seed}.tape.csv"
+        with RecordingWriter(path, config=sim.config, source="simulator") as writer:
+            writer.write_many(sim.frames)
+        ours = human_angles(read_any_recording(path), slice(None))
+        tracker = ArmTracker(sim.config)
+        base = [tracker.track(f.bend, f.twist, f.t).q_human for f in sim.frames]
+        for name in ("panda", "ur5", "kinova"):
+            robot = load_robot(name)
+            true_s = time_path(robot, retarget_path(robot, sim.q_human).q, RATE_HZ)[0][-1]
+            row = []
+            for q_human in (ours, np.array(base)):
+                q = retarget_path(robot, q_human).q
+                error = np.degrees(np.abs(q_human - sim.q_human)[:, [0, 1, 3]]).mean()
+                row.append((time_path(robot, q, RATE_HZ)[0][-1] / true_s, turn_backs(q), error))
+            (d, n, e), (bd, bn, be) = row
+            print(f"{seed:<8}{name:<8}{d:>8.2f} / {bd:<8.2f}{n:>6} / {bn:<6}"
+                  f"{e:>7.2f} / {be:<7.2f}{bd / d:>6.2f}x")  # fmt: skip
 
 
 if __name__ == "__main__":

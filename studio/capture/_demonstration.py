@@ -43,11 +43,11 @@ from typing import TypedDict, TypeVar, cast
 import numpy as np
 
 from studio import StudioError, read_json
-from studio.kinematics import ArmTracker, Puma560, TrackerConfig, robot_spec
+from studio.kinematics import ArmTracker, Puma560, robot_spec
 from studio.learning import ArmGrid, LearningError, motion_problem
 
 from ._errors import DemonstrationError
-from ._fitters import fit_frames, fitter_for
+from ._fitters import TapeFitter, fit_frames, fitter_for
 from ._observation_format import kind_of_name
 from ._observation_recording import ObservationRecording, read_any_recording
 from ._recording_edit import DEMO_SUFFIX, atomic_write_text
@@ -461,33 +461,28 @@ def _check_joint_range(q_robot: np.ndarray, times: np.ndarray) -> None:
 def _track_segment(
     rec: Recording | ObservationRecording, rows: slice, mode: str, tracker: ArmTracker | None
 ) -> tuple[np.ndarray, np.ndarray]:
-    """The Puma560 path ``(N, 6)`` and fit residuals ``(N,)`` of a recording's rows."""
-    n = len(range(*rows.indices(len(rec))))
-    q_robot = np.empty((n, 6))
-    residual = np.empty(n)
-    if isinstance(rec, Recording):
-        if tracker is None:
-            tracker = ArmTracker(TrackerConfig(tape=rec.config, mode=mode))
-        elif tracker.tape != rec.config:
+    """The Puma560 path ``(N, 6)`` and fit residuals ``(N,)`` of a recording's rows, fitted as
+    a recording's frames are (:func:`fit_frames`: smoothed with the past and the future)."""
+    observations = [rec.frame_at(i) for i in range(*rows.indices(len(rec)))]
+    q_robot = np.empty((len(observations), 6))
+    residual = np.empty(len(observations))
+    if not observations:
+        return q_robot, residual
+    fitter = fitter_for(observations[0], tape=getattr(rec, "config", None), side=rec.side)
+    if isinstance(fitter, TapeFitter) and tracker is not None:
+        if tracker.tape != fitter.tracker.tape:
             raise DemonstrationError(
                 f"the tracker follows another tape than {rec.path.name}'s; pass a tracker built for the recording's tape config, or none.",
                 "bad_fit",
             )
         tracker.reset()
-        tracker.mode = mode
-        bend, twist, t = rec.bend[rows], rec.twist[rows], rec.t[rows]
-        for i in range(n):
-            tracked = tracker.track(bend[i], twist[i], t[i])
-            q_robot[i] = tracked.q_robot
-            # the residual (tape against the fitted arm) is the fit's quality; ``success`` also
-            # asks for millimetre landmark agreement, which sensor noise alone can exceed
-            residual[i] = tracked.residual if np.isfinite(tracked.residual) else np.inf
-        return q_robot, residual
-    observations = [rec.frame_at(i) for i in range(*rows.indices(len(rec)))]
-    if observations:
-        fitter = fitter_for(observations[0], side=rec.side, mode=mode)
-        for i, fitted in enumerate(fit_frames(fitter, observations)):
-            q_robot[i], residual[i] = fitted.q_robot, fitted.residual
+        fitter.tracker = tracker
+    fitter.mode = mode
+    for i, fitted in enumerate(fit_frames(fitter, observations)):
+        q_robot[i] = fitted.q_robot
+        # the residual (tape against the fitted arm) is the fit's quality; ``success`` also
+        # asks for millimetre landmark agreement, which sensor noise alone can exceed
+        residual[i] = fitted.residual if np.isfinite(fitted.residual) else np.inf
     return q_robot, residual
 
 

@@ -1,15 +1,16 @@
 """One fitter per observation kind, into the 7-joint human arm, then the one retargeting.
 
 Every teacher ends in the same ``q_human``; every robot starts from it. The live pipeline and
-demonstration extraction both fit through :func:`fitter_for`, so the pose the page shows live is
-the pose a demonstration cut from the same observations records (but for camera landmarks, below):
+demonstration extraction both fit through :func:`fitter_for`; a recording's frames, all at hand,
+are smoothed with the future as well (:func:`fit_frames`), so a demonstration cut from a
+recording, its export and its timeline follow the person more closely than the live scene could:
 
 - tape frames: the kinematics package's :class:`~studio.kinematics.ArmTracker` (reconstruct, fit
-  the arm to the tape, retarget);
+  the arm to the tape, retarget); a recording's fitted arm smoothed with the future
+  (:meth:`TapeFitter.fit_recorded`);
 - pose landmarks: :class:`~studio.kinematics.PoseStreamFitter` (Kalman filtered, joints the
-  camera cannot see held smoothly), then a :class:`~studio.kinematics.Retargeter`; frames of a
-  recording are smoothed with the future as well (:func:`fit_frames`), so a demonstration cut
-  from a camera recording follows the person more closely than the live scene could;
+  camera cannot see held smoothly), then a :class:`~studio.kinematics.Retargeter`; a
+  recording's landmarks smoothed with the future (:meth:`LandmarkFitter.fit_recorded`);
 - hand poses: :func:`~studio.kinematics.fit_hand_pose` (damped least squares on the arm within
   its limits, seeded with the previous solution), then the same retargeting.
 """
@@ -31,6 +32,7 @@ from studio.kinematics import (
     TapeConfig,
     TrackerConfig,
     smooth_landmarks,
+    smooth_recorded_arm,
 )
 
 from ._frames import TapeFrame
@@ -160,6 +162,33 @@ class TapeFitter:
             tape_points=tracked.tape_points,
             warning=self.watch.update(float(observation.t), float(tracked.residual)),
         )
+
+    def fit_recorded(self, observations: Sequence[Observation]) -> list[Fitted]:
+        """A recording's tape frames, each fitted on its own in order, the fitted arm then
+        smoothed with the past and the future (:func:`~studio.kinematics.smooth_recorded_arm`)
+        in place of the live filter, and retargeted."""
+        frames = list(observations)
+        tracked = []
+        for frame in frames:
+            assert isinstance(frame, TapeFrame)
+            tracked.append(self.tracker.track(frame.bend, frame.twist))  # no time: its own fit
+        if not frames:
+            return []
+        times = [frame.t for frame in frames]
+        q_human = smooth_recorded_arm(times, [x.q_human for x in tracked], self.tracker.config)
+        retargeter = self.tracker.retargeter
+        retargeter.reset()
+        return [
+            Fitted(
+                q,
+                np.asarray(retargeter.robot_from_human(q), dtype=np.float64),
+                float(x.residual),
+                bool(x.success),
+                tape_points=x.tape_points,
+                warning=self.watch.update(float(t), float(x.residual)),
+            )
+            for q, x, t in zip(q_human, tracked, times, strict=True)
+        ]
 
     def reset(self) -> None:
         self.tracker.reset()
@@ -347,13 +376,14 @@ class HandFitter(_Retargeted):
 def fit_frames(fitter: ObservationFitter, observations: Sequence[Observation]) -> list[Fitted]:
     """A recording's observations fitted in order by ``fitter``.
 
-    Landmark frames are smoothed with the future first (:meth:`LandmarkFitter.fit_recorded`):
-    a recording has every frame at hand, where a live camera has only the past, so what is cut
+    A recording has every frame at hand, where a live source has only the past, so what is cut
     or exported from it, and its timeline, follow the person more closely than the live scene
-    did (played back as a source, it runs through the live fit again).
-    Tape frames and hand poses are fitted one by one, as live.
+    did (played back as a source, it runs through the live fit again): landmark frames are
+    smoothed with the future before the fit (:meth:`LandmarkFitter.fit_recorded`), and a tape's
+    fitted arm after it (:meth:`TapeFitter.fit_recorded`). Hand poses, which carry no sensor
+    noise, are fitted one by one, as live.
     """
-    if isinstance(fitter, LandmarkFitter):
+    if isinstance(fitter, LandmarkFitter | TapeFitter):
         return fitter.fit_recorded(observations)
     return [fitter.fit(observation) for observation in observations]
 

@@ -284,6 +284,22 @@ def smooth_constant_velocity(
     return out
 
 
+def white_noise(samples: object) -> np.ndarray:
+    """The standard deviation of white measurement noise on ``samples`` ``(N, ...)`` taken at a
+    steady rate, element by element, estimated from their second differences.
+
+    White noise of deviation s gives second differences of deviation s * sqrt(6); a smooth
+    motion sampled fast gives second differences near zero. The median absolute deviation
+    (times 1.4826, the normal's) keeps a few jumps from counting. Fewer than 3 samples: zeros.
+    """
+    z = real_array(samples, "The samples", "pass numbers")
+    if len(z) < 3:
+        return np.zeros(z.shape[1:])
+    d2 = np.diff(z, 2, axis=0)
+    spread = np.median(np.abs(d2 - np.median(d2, axis=0)), axis=0)
+    return 1.4826 * spread / math.sqrt(6.0)
+
+
 JITTER_RAD = math.radians(0.5)
 """A joint step this large, followed by one as large the other way, is a turn back
 (:func:`turn_backs`): jitter rather than motion."""

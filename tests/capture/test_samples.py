@@ -67,6 +67,6 @@ def test_human_angles_are_the_frames_fitted_in_order_as_the_timeline_fits_them()
     every = human_angles(rec, slice(None))
     assert every.shape == (len(rec), 7) and np.all(np.isfinite(every))
     assert np.allclose(every, recording_series(rec, points=len(rec)).q_human)
-    rows = rec.segment(1.0, 2.0)
-    assert np.allclose(human_angles(rec, rows)[0], human_angles(rec, np.array([rows.start]))[0])
+    rows = rec.segment(1.0, 2.0)  # a segment's rows, as a slice or as indices
+    assert np.allclose(human_angles(rec, rows), human_angles(rec, np.arange(rows.start, rows.stop)))
     assert human_angles(rec, slice(0, 0)).shape == (0, 7)

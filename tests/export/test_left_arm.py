@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from studio.capture import read_any_recording, recording_series
-from studio.export import recording_motion, series_motion
+from studio.export import Motion, recording_motion, series_motion
 from studio.kinematics import RobotArm, load_robot
 
 from .conftest import write_arm_recording
@@ -46,12 +46,20 @@ def tool_paths(robot: RobotArm, paths: dict[str, np.ndarray]) -> dict[str, np.nd
     }
 
 
-def assert_mirrored(robot: RobotArm, tools: dict[str, np.ndarray]) -> None:
+def assert_mirrored(robot: RobotArm, motions: dict[str, Motion]) -> None:
     """The left arm's tool path is the right arm's mirrored across the robot's sagittal plane
-    (the same angles on the left arm are the right arm's motion mirrored across the body)."""
+    (the same angles on the left arm are the right arm's motion mirrored across the body),
+    wherever both tools reach the hand's target: where neither pose reaches, each is the
+    nearest its own IK search found, and the searches' fixed restarts are not mirrored."""
+    tools = tool_paths(robot, {side: motion.q for side, motion in motions.items()})
+    both = np.ones(len(tools["left"]), dtype=bool)
+    for motion in motions.values():
+        assert motion.path is not None
+        both &= motion.path.reached
+    assert both.mean() >= 0.5, f"only {both.sum()} of {len(both)} frames reached on both sides"
     facing = robot.base_rotation
     flip = facing.T @ np.diag([1.0, -1.0, 1.0]) @ facing
-    np.testing.assert_allclose(tools["left"], tools["right"] @ flip.T, atol=0.02)
+    np.testing.assert_allclose(tools["left"][both], tools["right"][both] @ flip.T, atol=0.02)
     assert np.abs(tools["left"] - tools["right"]).max() > 0.1  # the motion is not symmetric
 
 
@@ -71,8 +79,8 @@ def test_a_left_arm_recording_moves_another_robot_as_the_mirror_image_of_a_right
     recordings,
 ):
     ur5 = load_robot("ur5")
-    paths = {side: recording_motion(path, "ur5").q for side, path in recordings.items()}
-    assert_mirrored(ur5, tool_paths(ur5, paths))
+    motions = {side: recording_motion(path, "ur5") for side, path in recordings.items()}
+    assert_mirrored(ur5, motions)
 
 
 def test_a_left_arm_recordings_timeline_on_a_robot_is_the_mirror_image_of_a_right_arms(
@@ -81,5 +89,4 @@ def test_a_left_arm_recordings_timeline_on_a_robot_is_the_mirror_image_of_a_righ
     panda = load_robot("panda")
     series = {side: recording_series(path, points=40) for side, path in recordings.items()}
     assert series["left"].side == "left" and series["right"].side == "right"
-    paths = {side: series_motion(s, "panda").q for side, s in series.items()}
-    assert_mirrored(panda, tool_paths(panda, paths))
+    assert_mirrored(panda, {side: series_motion(s, "panda") for side, s in series.items()})

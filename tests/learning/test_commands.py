@@ -164,7 +164,7 @@ SAMPLE_DEMO = (
         ('"t":[1.0,', '"t":[NaN,', "holds NaN or infinite samples (sample 1 of"),
         ('"goal":[5,6,2],"grid_path"', '"goal":[Infinity,6,2],"grid_path"', "goal is missing"),
         ('"grid_path":[898,', '"grid_path":[1e999,', "grid_path is missing or is not"),
-        ('"reached_at":2.27', '"reached_at":1e999,"x":2.27', "reached_at holds NaN or infinite"),
+        ('"reached_at":2.24', '"reached_at":1e999,"x":2.24', "reached_at holds NaN or infinite"),
         ('"segment":[1.0,', '"segment":[-Infinity,', "segment holds NaN or infinite values"),
     ],
 )

@@ -74,7 +74,7 @@ def test_a_cut_demonstration_replays_the_same_path_in_the_page_and_the_cli(
     page = _page_paths(client, tmp_path / "runs", ["reach"])
     cli = _cli_paths(recordings / "reach.demo.json", tmp_path / "cli-run")
     assert page == cli == [detail["grid_path"]]
-    assert listed["steps"] == len(page[0]) - 1 == 8
+    assert listed["steps"] == len(page[0]) - 1 == 9
     path = page[0]
     grid = ArmGrid()
     assert path[-1] == grid.goal_state and len(set(path)) == len(path)  # no flicker
@@ -121,7 +121,7 @@ def test_the_shipped_sample_replays_its_listed_steps(client, tmp_path, capsys):
     page = _page_paths(client, tmp_path / "runs", ["sample-reach-2"])
     cli = _cli_paths(recordings / "sample-reach-2.demo.json", tmp_path / "cli-run")
     assert page == cli
-    assert len(page[0]) - 1 == listed["steps"] == 8  # the page replayed 20 before
+    assert len(page[0]) - 1 == listed["steps"] == 9  # the page replayed 20 before
 
 
 def test_the_cli_replays_the_trajectory_not_a_stored_grid_path(client, tmp_path, capsys):

@@ -163,7 +163,7 @@ def test_a_recording_failing_the_checks_is_refused_in_one_sentence_unless_unchec
     refused = client.get(url, params={"format": "csv"})
     assert refused.status_code == 422
     detail = refused.json()["detail"]
-    assert isinstance(detail, str) and detail.startswith("Refused") and "joint1" in detail
+    assert isinstance(detail, str) and detail.startswith("Refused") and " joint joint" in detail
     written = client.get(url, params={"format": "csv", "unchecked": "true"})
     assert written.status_code == 200 and "NOT checked" in written.text
     missing = client.get("/api/robot/export/recording/nope", params={"format": "csv"})
