@@ -1,11 +1,12 @@
 """``studio export``: a policy, a demonstration or a recording as a robot's joint trajectory.
 
 ``studio export SOURCE --robot NAME --format csv|mcap|lerobot --out PATH`` times the motion
-(TOPP-RA, within the robot's limits), checks it (positions, velocities, accelerations,
-self-collision) and writes it; the :mod:`studio.export` package does all three. ``SOURCE`` is a
-path, or a name in the data folder or among the shipped samples (``sample-reach-1``).
+(TOPP-RA, within the robot's limits; a recording keeps its capture times unless ``--retime``),
+checks it (positions, velocities, accelerations, self-collision) and writes it; the
+:mod:`studio.export` package does all three. ``SOURCE`` is a path, or a name in the data folder
+or among the shipped samples (``sample-reach-1``).
 
-``studio export POLICY`` alone (no ``--format``, ``--robot`` nor ``--unchecked``) writes the
+``studio export POLICY`` alone (no ``--format``, ``--robot``, ``--unchecked`` nor ``--retime``) writes the
 policy's greedy rollout at its own pace as before: ``time,q1..q6`` CSV, not checked.
 """
 
@@ -22,6 +23,7 @@ from studio.export import (
     FORMAT_SUFFIXES,
     FORMATS,
     LIMIT_FRACTION,
+    ExportError,
     Motion,
     check_policy_robot,
     demonstration_motion,
@@ -81,6 +83,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="write even when the safety checks find problems, stating them in the file",
     )
     parser.add_argument(
+        "--retime",
+        action="store_true",
+        help="time a recording's path within the robot's limits (TOPP-RA) at --rate, as a "
+        "demonstration is, instead of keeping its capture times: a recording to send to a robot",
+    )
+    parser.add_argument(
         "--limit-fraction",
         type=float,
         default=LIMIT_FRACTION,
@@ -107,7 +115,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--rate",
         type=float,
         default=ROLLOUT_RATE_HZ,
-        help=f"control rate in Hz of a policy or demonstration (default: {ROLLOUT_RATE_HZ:g}); a recording keeps its capture rate",
+        help=f"control rate in Hz of a policy, a demonstration or a recording with --retime (default: {ROLLOUT_RATE_HZ:g}); a recording otherwise keeps its capture rate",
     )
     parser.add_argument(
         "--seconds-per-step",
@@ -281,7 +289,8 @@ def _motion(args: argparse.Namespace, source: Path, robot: str) -> tuple[Motion,
     if kind in ("recording", "demonstration"):
         _say_retargeting(source, robot)
     if kind == "recording":
-        return recording_motion(source, robot), "recording"
+        motion = recording_motion(source, robot)
+        return (motion.retimed(args.rate) if args.retime else motion), "recording"
     if kind == "demonstration":
         return demonstration_motion(source, robot, args.rate), "demonstration"
     policy = load_any_policy(source)
@@ -308,7 +317,12 @@ def _say_retargeting(source: Path, robot: str) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    legacy = args.format is None and args.robot is None and not args.unchecked
+    if args.retime and args.seconds_per_step is not None:
+        raise ExportError(
+            "--retime times the path within the robot's limits and --seconds-per-step sets a "
+            "fixed pace; give one of them (a policy's rollout with --format is timed by default)."
+        )
+    legacy = args.format is None and args.robot is None and not (args.unchecked or args.retime)
     if legacy and str(args.policy).endswith(".npz"):
         return _run_legacy(args, load_any_policy(args.policy))
     source = find_source(args.policy, args.data_dir)

@@ -98,7 +98,12 @@ def export_motion(
         timed_by = "toppra"
     findings = check_trajectory(robot, times, q, extra=list(motion.findings))
     if not unchecked:
-        refuse(findings, f"{motion.kind} {motion.name}", robot)
+        refuse(
+            findings,
+            f"{motion.kind} {motion.name}",
+            robot,
+            own_times=timed_by == "source" and motion.kind == "recording",
+        )
     notes = _notes(motion, findings, checked=not unchecked)
     names = robot.joint_names
     if fmt == "csv":
@@ -113,7 +118,9 @@ def export_motion(
             "findings": "\n".join(f.sentence for f in findings),
             "notes": "\n".join(motion.notes),
         }
-        write_mcap(out, names, times, q, states=motion.kind == "recording", metadata=metadata)
+        # a recording at its capture times is what the arm did: joint states; timed, a trajectory
+        states = motion.kind == "recording" and timed_by == "source"
+        write_mcap(out, names, times, q, states=states, metadata=metadata)
     else:
         fps = int(round(motion.rate_hz))
         extra = {

@@ -169,15 +169,25 @@ def check_trajectory(
     return sorted(findings, key=lambda f: (f.sample, f.what))
 
 
-def refuse(findings: list[Finding], source: str, robot: RobotArm) -> None:
-    """Raise a :class:`SafetyError` naming the first finding, or return when there is none."""
+RETIME_HINT = "pass --retime to time its path within the limits (TOPP-RA)"
+"""What a refusal of a motion kept at its own times (a recording's capture times) suggests."""
+
+
+def refuse(findings: list[Finding], source: str, robot: RobotArm, *, own_times: bool) -> None:
+    """Raise a :class:`SafetyError` naming the first finding, or return when there is none.
+
+    Args:
+        own_times: the samples are at the source's own times (a recording's capture times),
+            not timed within the limits: the sentence then suggests timing it
+            (:data:`RETIME_HINT`).
+    """
     if not findings:
         return
     more = len(findings) - 1
     rest = f" (and {more} more finding{'s' if more > 1 else ''})" if more else ""
+    fix = RETIME_HINT if own_times else "export a slower or other motion or for another robot"
     raise SafetyError(
-        f"Refused: {source} for the {robot.spec.title}: {findings[0].sentence}{rest}; export a "
-        "slower or other motion (a demonstration is timed within the limits) or for another "
-        "robot, or pass --unchecked to write it anyway with the findings stated in the file.",
+        f"Refused: {source} for the {robot.spec.title}: {findings[0].sentence}{rest}; {fix}, "
+        "or pass --unchecked to write it anyway with the findings stated in the file.",
         [f.sentence for f in findings],
     )

@@ -89,6 +89,13 @@ class Motion:
     notes: tuple[str, ...] = field(default=())
     path: RetargetedPath | None = None
 
+    def retimed(self, rate_hz: float) -> Motion:
+        """This motion as a path that :func:`time_path` times within the robot's limits and
+        samples at ``rate_hz``, rather than at its own times: a recording to send to a robot
+        (at its capture times it starts mid-motion, and an arm moves faster than most robots
+        may). Its retargeting findings and notes still name the source's frames."""
+        return replace(self, timed=False, rate_hz=rate_hz)
+
 
 def source_kind(path: Path) -> SourceKind:
     """What the file at ``path`` is, by its name's ending."""

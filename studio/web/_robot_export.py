@@ -36,11 +36,12 @@ MEDIA_TYPES = {
 
 
 def export_for_robot(
-    path: Path, robot: str, fmt: ExportFormat, unchecked: bool = False
+    path: Path, robot: str, fmt: ExportFormat, unchecked: bool = False, retime: bool = False
 ) -> tuple[Path, str, Path]:
     """Export a recording or demonstration ``path`` for ``robot`` as ``fmt`` into a fresh
     temporary folder (``unchecked``: written despite failed checks, the findings stated in it;
-    a demonstration at the rollout rate, a recording at its capture rate).
+    a demonstration timed within the limits at the rollout rate, a recording at its capture
+    times, or timed as a demonstration is with ``retime``).
 
     Returns:
         ``(file, download name, folder)``: the file to send and the folder to remove after.
@@ -56,6 +57,8 @@ def export_for_robot(
         motion = demonstration_motion(path, robot, ROLLOUT_RATE_HZ)
     else:
         motion = recording_motion(path, robot)
+        if retime:
+            motion = motion.retimed(ROLLOUT_RATE_HZ)
     folder = Path(tempfile.mkdtemp(prefix="studio-export-"))
     try:
         out = folder / f"{stem}.{robot}{FORMAT_SUFFIXES[fmt]}"

@@ -1,7 +1,7 @@
 """In a real browser: the user picks the Panda, the page says its meshes are loading, the scene
 draws it from its own meshes and the simulated operator drives it; a demonstration plays on the
 Panda and exports checked for it, while its recording is refused by the safety checks, then
-written with the findings in it; that recording, played as the source, moves the Panda along the
+written with the findings in it, or timed within the Panda's limits and checked; that recording, played as the source, moves the Panda along the
 path planned over all of it; the Puma560 comes back and a recording exports for it."""
 
 from __future__ import annotations
@@ -21,6 +21,7 @@ DRAW_TIMEOUT_S = 120.0
 """Reading a robot's meshes takes seconds alone, far longer on a machine shared by many."""
 DEMO = "sample-reach-1"
 ANYWAY = "Export anyway, findings written in the file"
+RETIME = "Time it within the robot's limits"
 SIZES = ((1280, 720), (1920, 1080))
 """The screens the page is looked at on: a laptop's and a desktop monitor's."""
 
@@ -33,9 +34,12 @@ def _q_robot(studio_server: Studio) -> np.ndarray:
     return np.array(studio_server.get("/api/source")["q_robot"])
 
 
-def _download_anyway(page: Any, kind: str, name: str, fmt: str) -> tuple[str, str]:
+def _download_anyway(
+    page: Any, kind: str, name: str, fmt: str, fix: str = ANYWAY
+) -> tuple[str, str]:
     """Export ``name`` from the ``kind`` list as ``fmt``: refused by the checks (the sentence
-    shown), then written anyway. Returns the file's name and text."""
+    shown), then written anyway, or as the button ``fix`` offers. Returns the file's name and
+    text."""
     noun = kind.capitalize()
     page.get_by_role("combobox", name=f"{noun} to export").select_option(name)
     page.get_by_role("combobox", name=f"{noun} export format").select_option(fmt)
@@ -44,7 +48,7 @@ def _download_anyway(page: Any, kind: str, name: str, fmt: str) -> tuple[str, st
     error.wait_for(state="visible", timeout=DRAW_TIMEOUT_S * 1000)
     assert error.inner_text().startswith("Refused"), error.inner_text()
     with page.expect_download(timeout=DRAW_TIMEOUT_S * 1000) as download:
-        page.get_by_role("button", name=ANYWAY, exact=True).click()
+        page.get_by_role("button", name=fix, exact=True).click()
     text = open(download.value.path()).read()  # noqa: PTH123, SIM115
     return download.value.suggested_filename, text
 
@@ -140,6 +144,11 @@ def test_the_user_teaches_the_panda_plays_and_exports_a_demonstration_then_back(
     name, text = _download_anyway(page, "recording", DEMO, "csv")
     assert name == f"{DEMO}.panda.csv"
     assert "NOT checked" in text and "acceleration" in text
+    # or timed within the Panda's limits, it passes the checks: a recording to send to the arm
+    name, text = _download_anyway(page, "recording", DEMO, "csv", RETIME)
+    assert name == f"{DEMO}.panda.csv"
+    assert "NOT checked" not in text and text.startswith("time," + ",".join(panda.joint_names))
+    assert not page.get_by_test_id("recording-export-error").is_visible()
 
     # the recording played as the source: the Panda follows the path planned over all of it,
     # the path the export wrote, and the page says so

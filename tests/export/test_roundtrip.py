@@ -15,6 +15,7 @@ from studio.cli import main
 from studio.export import (
     JOINT_STATE,
     JOINT_TRAJECTORY,
+    check_trajectory,
     demonstration_motion,
     export_motion,
     recording_motion,
@@ -128,3 +129,44 @@ def test_an_unchecked_export_states_its_findings_in_the_file(fmt, tmp_path, caps
         info = json.loads((out / "meta/info.json").read_text())
         assert info["teach_studio"]["checked"] is False
         assert any(first in finding for finding in info["teach_studio"]["findings"])
+
+
+@pytest.mark.parametrize("fmt", ["csv", "mcap", "lerobot"])
+def test_a_refused_recording_exports_timed_within_the_limits_with_retime(fmt, tmp_path, capsys):
+    """At its capture times a recording breaks the robot's limits, and the refusal says how to
+    send it to a robot: --retime times its path within them (TOPP-RA), and it passes."""
+    out = tmp_path / f"rec.{fmt}"
+    sample = str(SAMPLES_DIR / "sample-reach-1.tape.csv")
+    argv = ["export", sample, "--robot", "ur5", "--format", fmt, "--out", str(out)]
+    assert main(argv) == 2
+    assert "pass --retime to time its path within the limits" in capsys.readouterr().err
+    assert main([*argv, "--retime", "--rate", "100"]) == 0, capsys.readouterr().err
+    said = capsys.readouterr().out
+    assert "timed within the limits (TOPP-RA), passed the safety checks" in said
+    ur5 = load_robot("ur5")
+    if fmt == "csv":
+        header, rows = read_csv(out)
+        times, q = rows[:, 0], rows[:, 1:]
+    elif fmt == "mcap":
+        schema, names, times, q = read_mcap(out)
+        # timed, a recording is a trajectory to send, no longer the arm's joint states
+        assert schema == JOINT_TRAJECTORY and names == list(ur5.joint_names)
+    else:
+        info = json.loads((out / "meta/info.json").read_text())
+        assert info["fps"] == 100 and info["teach_studio"]["timed_by"] == "toppra"
+        table = pq.read_table(out / "data/chunk-000/file-000.parquet")
+        times = np.array(table.column("timestamp").to_pylist())
+        q = np.array(table.column("observation.state").to_pylist())
+    assert np.allclose(np.diff(times), 0.01, atol=1e-6)  # --rate
+    assert check_trajectory(ur5, times, q) == []
+    # the retargeted path, start to end: the hand's first and last poses
+    path = recording_motion(SAMPLES_DIR / "sample-reach-1.tape.csv", "ur5").q
+    assert np.allclose(q[0], path[0], atol=1e-6) and np.allclose(q[-1], path[-1], atol=1e-6)
+
+
+def test_retime_and_a_fixed_pace_for_a_policy_is_one_sentence(tmp_path, capsys):
+    policy = str(tmp_path / "p.policy.npz")
+    argv = ["export", policy, "--format", "csv", "--retime", "--seconds-per-step", "0.5"]
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert "--retime" in err and "--seconds-per-step" in err and "\n" not in err

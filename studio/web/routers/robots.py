@@ -46,18 +46,21 @@ def export_for_the_robot(
     format: ExportFormat = "csv",
     unchecked: bool = False,
     robot: str | None = None,
+    retime: bool = False,
 ) -> FileResponse:
     """A recording or demonstration as the chosen robot's joint trajectory, retargeted, timed
     and checked for safety as ``studio export SOURCE --robot NAME --format FORMAT`` does: CSV,
     MCAP (ROS 2 messages) or a zipped LeRobotDataset v3.0. Failed checks answer 422 with one
     sentence naming the sample, joint and margin; ``unchecked`` writes the file anyway with the
-    findings stated in it (``reason`` "safety" in the 422 says the checks refused it). For the
-    robot taught unless ``robot`` names another (an unknown name: 422 with the list). 404 for no
-    such recording or demonstration."""
+    findings stated in it (``reason`` "safety" in the 422 says the checks refused it). A
+    recording keeps its capture times unless ``retime`` times its path within the robot's
+    limits, as a demonstration's is (``studio export --retime``). For the robot taught unless
+    ``robot`` names another (an unknown name: 422 with the list). 404 for no such recording or
+    demonstration."""
     store = studio.recordings if kind == "recording" else studio.demonstrations
     path = store.path(name)
     target = robot_spec(robot).name if robot is not None else studio.pipeline.robot_name
-    out, filename, folder = export_for_robot(path, target, format, unchecked)
+    out, filename, folder = export_for_robot(path, target, format, unchecked, retime)
     return FileResponse(
         out,
         media_type=MEDIA_TYPES[format],

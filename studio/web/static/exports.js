@@ -1,7 +1,8 @@
 /* Teach Studio page: exporting a recording, a demonstration or a policy's rollout as a robot's
  * trajectory. One control for the three lists: what to export, a format, an Export button; a
  * refusal by the safety checks is shown in one sentence with "Export anyway, findings written in
- * the file" (the page's `studio export --unchecked`).
+ * the file" (the page's `studio export --unchecked`) and, for a recording kept at its capture
+ * times, "Time it within the robot's limits" (`studio export --retime`).
  *
  * Recordings and demonstrations export for the robot chosen above (GET
  * /api/robot/export/{recording|demonstration}/{name}: retargeted, timed and checked as `studio
@@ -18,11 +19,13 @@ import { S } from "./state.js";
 const ALL_FORMATS = [["csv", "CSV"], ["mcap", "MCAP (ROS 2)"], ["lerobot", "LeRobot dataset (zip)"]];
 const ENDINGS = { csv: "csv", mcap: "mcap", lerobot: "lerobot.zip" };
 const ANYWAY = "Export anyway, findings written in the file";
+const RETIME = "Time it within the robot's limits";
 const HOW = "retargeted onto the robot chosen under Source, timed within its limits and checked for safety, as `studio export --robot` writes it";
 
 const KINDS = {
   recording: {
-    noun: "recording", formats: ALL_FORMATS, title: `the recording as the robot's joint trajectory, ${HOW}`,
+    noun: "recording", formats: ALL_FORMATS, retimes: true,
+    title: "the recording as the robot's joint trajectory at its capture times, retargeted onto the robot chosen under Source and checked for safety, as `studio export --robot` writes it",
     items: () => S.recordings.filter((r) => !r.error && !r.capturing).map((r) => [r.name, r.name]),
   },
   demonstration: {
@@ -45,12 +48,16 @@ export function buildExportControl(kind) {
   }
   parts.push(el("select", { id: `${kind}-export-format`, testid: `${kind}-export-format`, class: "export-format", "aria-label": `${noun} export format` },
     ...k.formats.map(([value, label]) => el("option", { value, text: label }))));
-  parts.push(el("button", { id: `${kind}-export-go`, testid: k.testid || `${kind}-export-go`, title: k.title, onclick: () => exportNow(kind, false) }, `Export ${k.noun}`));
-  const anyway = el("button", { id: `${kind}-export-anyway`, testid: `${kind}-export-anyway`, hidden: true, title: "write the file even though the safety checks refuse it; every finding is stated in it", onclick: () => exportNow(kind, true) }, ANYWAY);
+  parts.push(el("button", { id: `${kind}-export-go`, testid: k.testid || `${kind}-export-go`, title: k.title, onclick: () => exportNow(kind, { unchecked: false, retime: false }) }, `Export ${k.noun}`));
+  const anyway = el("button", { id: `${kind}-export-anyway`, testid: `${kind}-export-anyway`, hidden: true, title: "write the file even though the safety checks refuse it; every finding is stated in it", onclick: () => exportNow(kind, { unchecked: true, retime: retimed[kind] }) }, ANYWAY);
+  const fixes = [anyway];
+  if (k.retimes) {
+    fixes.unshift(el("button", { id: `${kind}-export-retime`, testid: `${kind}-export-retime`, hidden: true, title: "time the recording's path within the robot's velocity and acceleration limits (TOPP-RA), as a demonstration's is, then check it: a recording to send to a robot", onclick: () => exportNow(kind, { unchecked: false, retime: true }) }, RETIME));
+  }
   $(`${kind}-export`).replaceChildren(
     el("div", { class: "row" }, ...parts),
     el("div", { class: "err", id: `${kind}-export-error`, testid: `${kind}-export-error`, role: "alert", hidden: true }),
-    anyway,
+    el("div", { class: "row" }, ...fixes),
   );
   fillExportItems(kind);
 }
@@ -64,7 +71,10 @@ export function fillExportItems(kind) {
   fillSelect(select, items.length ? items : [["", `(no ${k.noun} yet)`]]);
 }
 
-function target(kind, unchecked) {
+/** Whether each kind's last export asked for its path timed within the limits. */
+const retimed = {};
+
+function target(kind, { unchecked, retime }) {
   const k = KINDS[kind];
   const format = $(`${kind}-export-format`).value;
   const query = new URLSearchParams();
@@ -80,22 +90,30 @@ function target(kind, unchecked) {
   if (!name) return { error: `Choose a ${k.noun} to export first.` };
   query.set("format", format);
   if (unchecked) query.set("unchecked", "true");
+  if (retime) query.set("retime", "true");
   const robot = (S.source && S.source.robot) || "robot";
   return { url: `/api/robot/export/${kind}/${enc(name)}?${query}`, name: `${name}.${robot}.${ENDINGS[format]}` };
 }
 
-async function exportNow(kind, unchecked) {
+async function exportNow(kind, how) {
   const errId = `${kind}-export-error`;
   const anyway = $(`${kind}-export-anyway`);
+  const retime = $(`${kind}-export-retime`);
   setProp(anyway, "hidden", true);
-  const t = target(kind, unchecked);
+  if (retime) setProp(retime, "hidden", true);
+  retimed[kind] = how.retime;
+  const t = target(kind, how);
   if (t.error) { showError(errId, t.error); return; }
   const button = $(`${kind}-export-go`);
   button.disabled = true;
   try {
     const answer = await download(t.url, t.name, errId);
-    // refused by the safety checks: say why, and offer to write it with the findings in it
-    if (answer && answer.reason === "safety") setProp(anyway, "hidden", false);
+    // refused by the safety checks: say why, and offer to time it within the limits (a
+    // recording kept at its capture times) or to write it with the findings in it
+    if (answer && answer.reason === "safety") {
+      setProp(anyway, "hidden", false);
+      if (retime && !how.retime) setProp(retime, "hidden", false);
+    }
   } finally {
     button.disabled = false;
   }
