@@ -31,7 +31,7 @@ from pathlib import Path
 from types import ModuleType
 from typing import Protocol
 
-from studio import is_loopback
+from studio import StudioError, is_loopback
 
 from .._files import now_iso
 from .._numbers import is_int
@@ -46,6 +46,7 @@ from ._sweep_folder import (
     prepare_folder,
     record_trial_end,
     set_status,
+    trial_records,
     trial_run_path,
 )
 from ._sweep_spec import SweepError, SweepSpec, Trial, trial_record
@@ -60,6 +61,9 @@ STOP_WAIT_SECONDS = 300
 """How long a worker whose trial the scheduler stopped waits for the trial to save its run (the
 learners end at their next episode boundary) before Tune gives up re-using the worker for the next
 trial, which would then fail. Tune's own default, 2 s, is shorter than one episode of a big trial."""
+STOP_POLL_SECONDS = 0.1
+"""How often the driver looks whether a stopped trial has saved its run (:data:`STOP_WAIT_SECONDS`
+at most)."""
 TUNE_SNAPSHOT_SECONDS = 600
 """At most how often Tune snapshots its experiment state while a sweep runs (its default is every
 10 s, longer for big sweeps). A sweep resumes from its own records (:func:`finished_trials`), not
@@ -358,6 +362,7 @@ def run_sweep(
     try:
         callback = _progress_callback(folder, spec, progress, notify, ran, failed)
         _fit(spec, data_dir, folder, todo, callback)
+        _await_stopped_saves(data_dir, spec, folder, ran)
     finally:
         if started:
             ray.shutdown()
@@ -366,6 +371,38 @@ def run_sweep(
     rows = write_summary(data_dir, spec)
     set_status(folder, "done" if len(done) == len(trials) else "interrupted")
     return SweepResult(folder, spec, rows, ran=ran, interrupted=interrupted, failed=failed)
+
+
+def _await_stopped_saves(
+    data_dir: Path,
+    spec: SweepSpec,
+    folder: Path,
+    ran: list[str],
+    timeout: float = STOP_WAIT_SECONDS,
+) -> None:
+    """Wait (up to ``timeout`` s) until every trial of ``ran`` that the scheduler stopped has
+    saved its run. Tune counts a trial ended as soon as it stops it, while the trial's worker
+    still runs to the next episode boundary to save what it learnt; the sweep's last such trial
+    has no next trial waiting on its worker, and shutting Ray down then killed it unsaved (on a
+    busy machine): its run held no episode, so the sweep read as interrupted and lost its row."""
+    records = trial_records(folder)
+    pending = [key for key in ran if records.get(key, {}).get("status") == "early-stopped"]
+    deadline = time.monotonic() + timeout
+    while pending and time.monotonic() < deadline:
+        pending = [key for key in pending if _unsaved(data_dir, spec, key)]
+        if pending:
+            time.sleep(STOP_POLL_SECONDS)
+
+
+def _unsaved(data_dir: Path, spec: SweepSpec, key: str) -> bool:
+    """Whether trial ``key``'s run folder still says it is running (or cannot be read yet)."""
+    path = trial_run_path(data_dir, spec.name, key)
+    if not path.exists():
+        return False  # never started: nothing to wait for
+    try:
+        return RunFolder.load(path).status == "running"
+    except StudioError:
+        return True
 
 
 def _fit(

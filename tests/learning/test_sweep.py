@@ -24,12 +24,13 @@ from studio.learning import ArmGrid, DynaQConfig, generate_demonstrations, run_e
 from studio.learning._runs import RunFolder
 from studio.learning._sweep_folder import (
     SUMMARY_FILE,
+    record_trial_end,
     sweep_folder,
     trial_records,
     trial_run_path,
 )
-from studio.learning._sweep_ray import run_sweep
-from studio.learning._sweep_spec import SweepError, load_sweep_spec, parse_sweep_spec
+from studio.learning._sweep_ray import _await_stopped_saves, run_sweep
+from studio.learning._sweep_spec import SweepError, load_sweep_spec, parse_sweep_spec, trial_record
 from tests.conftest import free_port as _free_port
 from tests.conftest import require
 
@@ -640,3 +641,32 @@ def _run_quiet(cmd: list[str], env: dict) -> str:
         return subprocess.run(cmd, capture_output=True, text=True, timeout=30, env=env).stdout
     except subprocess.TimeoutExpired:
         return ""
+
+
+def test_the_driver_waits_for_a_stopped_trial_to_save_its_run(tmp_path: Path) -> None:
+    """Tune calls a trial ended as soon as its scheduler stops it; the trial's worker still runs
+    to its next episode boundary to save. The sweep's last stopped trial has no next trial
+    waiting on that worker, so the driver waits for the save before shutting Ray down (on a
+    busy machine it was killed unsaved, and the sweep read as interrupted)."""
+    spec = parse_sweep_spec(spec_dict(name="w", seeds=[0], space={"planning": ["zero"]}))
+    (trial,) = spec.trials()
+    folder = sweep_folder(tmp_path, "w")
+    (folder / "trials").mkdir(parents=True)
+    path = trial_run_path(tmp_path, "w", trial.key)
+    run = RunFolder.create(path.parent, trial_record(spec, trial), name=path.name, status="running")
+    record_trial_end(folder, {"key": trial.key, "status": "early-stopped"})  # type: ignore[typeddict-item]
+
+    def save() -> None:
+        time.sleep(0.3)  # the worker reaching its episode boundary
+        run.status = "stopped"
+        run.save_status()
+
+    saver = threading.Thread(target=save)
+    saver.start()
+    _await_stopped_saves(tmp_path, spec, folder, [trial.key], timeout=60.0)
+    assert RunFolder.load(path).status == "stopped"  # returned once saved, not before
+    saver.join()
+    # a trial that never saves does not hold the sweep past the timeout
+    run.status = "running"
+    run.save_status()
+    _await_stopped_saves(tmp_path, spec, folder, [trial.key], timeout=0.2)
