@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from studio.kinematics import RobotArm
+from studio.kinematics import TABLE, RobotArm
 
 from ._errors import SafetyError
 
@@ -122,27 +122,40 @@ def limit_findings(robot: RobotArm, times: np.ndarray, q: np.ndarray) -> list[Fi
 def collision_findings(
     robot: RobotArm, times: np.ndarray, q: np.ndarray, margin: float = COLLISION_MARGIN_M
 ) -> list[Finding]:
-    """The first sample at which each link pair comes closer than ``margin`` (m)."""
+    """The first sample at which each link pair comes closer than ``margin`` (m), and at which
+    each link comes nearer than that to the table the robot stands on (the plane of its base:
+    :meth:`~studio.kinematics.RobotArm.table_contacts`)."""
     found: dict[tuple[str, str], Finding] = {}
     if not robot.checks_collisions:
         return []
     for i in range(len(times)):
-        for hit in robot.self_collisions(q[i], margin):
+        for hit in robot.contacts(q[i], margin):
             pair = (hit.link_a, hit.link_b)
             if pair in found:
                 continue
-            gap = (
-                f"overlap by {-hit.distance * 100:.2f} cm"
-                if hit.distance < 0
-                else f"are {hit.distance * 100:.2f} cm apart"
-            )
+            at = f"sample {i} (t = {times[i]:.3f} s)"
+            if hit.link_b == TABLE:
+                where = (
+                    f"reaches {-hit.distance * 100:.2f} cm below"
+                    if hit.distance < 0
+                    else f"comes within {hit.distance * 100:.2f} cm of"
+                )
+                sentence = (
+                    f"{at}: link {hit.link_a} {where} the table top the robot stands on (its "
+                    f"base's plane), inside the {margin * 100:.1f} cm margin"
+                )
+            else:
+                gap = (
+                    f"overlap by {-hit.distance * 100:.2f} cm"
+                    if hit.distance < 0
+                    else f"are {hit.distance * 100:.2f} cm apart"
+                )
+                sentence = (
+                    f"{at}: links {hit.link_a} and {hit.link_b} {gap}, inside the "
+                    f"{margin * 100:.1f} cm self-collision margin"
+                )
             found[pair] = Finding(
-                i,
-                float(times[i]),
-                "collision",
-                f"{hit.link_a}/{hit.link_b}",
-                f"sample {i} (t = {times[i]:.3f} s): links {hit.link_a} and {hit.link_b} {gap}, "
-                f"inside the {margin * 100:.1f} cm self-collision margin",
+                i, float(times[i]), "collision", f"{hit.link_a}/{hit.link_b}", sentence
             )
     return list(found.values())
 

@@ -32,6 +32,7 @@ from ._robot_load import isolate_robot_loading as isolate_robot_loading
 from ._robot_load import load_robot as load_robot
 from ._robot_load import prepare_arm_ik_in_background as prepare_arm_ik_in_background
 from ._robots import DEFAULT_ROBOT as DEFAULT_ROBOT
+from ._robots import TABLE as TABLE
 from ._robots import RobotArm as RobotArm
 from ._robots import robot_names as robot_names
 from ._robots import robot_spec as robot_spec

@@ -114,14 +114,15 @@ def pose_within(
     accept: Callable[[np.ndarray], bool] | None = None,
 ) -> np.ndarray | None:
     """The first pose within ``box`` (``(lower, upper)``) that the IK finds from one of
-    ``starts`` (each clipped into it), that reaches ``oMdes`` clear of self-collision and that
+    ``starts`` (each clipped into it), that reaches ``oMdes`` clear of contact (its own links
+    and the table: :meth:`RobotArm.contacts`) and that
     ``accept`` (if given) takes; None if none does."""
     lower, upper = box
     for start in starts:
         q = arm.inverse(
             oMdes, np.clip(start, lower, upper), iterations=iterations, lower=lower, upper=upper
         ).q
-        if not tool_reaches(arm, q, oMdes, config) or arm.self_collisions(q, config.clearance):
+        if not tool_reaches(arm, q, oMdes, config) or arm.contacts(q, config.clearance):
             continue
         if accept is None or accept(q):
             return q

@@ -117,8 +117,9 @@ class RetargetConfig:
             turns at most about 10 rad/s, 0.09 rad a frame at 110 Hz), the new arm is a new pose
             rather than a motion, and the Puma560 goes straight to its answer. Every other
             robot always keeps to ``max_joint_step``.
-        clearance: such a robot's links keep at least this distance from each other (m); a
-            pose closer than that is not taken (the last one is held). Convex-hull distances
+        clearance: such a robot's links keep at least this distance from each other and from
+            the table it stands on (m, :meth:`RobotArm.contacts`); a pose closer than that is
+            not taken (the last one is held). Convex-hull distances
             near contact vary by about a millimetre between evaluations, so the margin keeps
             every pose taken clear of contact for any later check.
         reach_tolerance: a tool further than this from the hand's target is out of reach (m):
@@ -516,7 +517,7 @@ class Retargeter:
         if isinstance(robot, RobotArm):
             self.held = bool(self._clearance(robot).collisions(q))
             if self.held:
-                # hold the last pose free of self-collision (the robot's home before the first)
+                # hold the last pose clear of contact (the robot's home before the first)
                 q = robot.home if self._q_prev is None else self._q_prev
         self._q_prev = q.copy()
         return q.copy()
@@ -528,7 +529,8 @@ class Retargeter:
         return last is not None and float(np.abs(q_human - last).max()) <= self.config.input_jump
 
     def _clearance(self, robot: RobotArm) -> ClearanceGuard:
-        """The self-collision guard for the configured clearance (made again if it changed)."""
+        """The contact guard (links and table) for the configured clearance (made again if it
+        changed)."""
         if self._guard is None or self._guard.margin != self.config.clearance:
             self._guard = ClearanceGuard(robot, self.config.clearance)
         return self._guard
@@ -565,8 +567,8 @@ class Retargeter:
         the answers that reach the target, the one nearest the last pose is taken (a joint with
         a turn to spare counted the short way round, one cramped at a limit counted further:
         ``config.limit_room``), and the step cap walks the robot there over as many frames as
-        it needs. A pose that would bring the robot's links into contact
-        does not count as reaching: another branch's is looked for, and only where none is clear
+        it needs. A pose that would bring the robot's links into contact, with each other or
+        with the table it stands on, does not count as reaching: another branch's is looked for, and only where none is clear
         does the robot hold its last pose. There the restarts also start from the pose the
         robot walks to, so that pose is followed rather than found afresh on whichever branch is
         nearest each frame (which turned joints back and forth).
@@ -607,7 +609,7 @@ class Retargeter:
     ) -> np.ndarray | None:
         """A pose of the robot (a :class:`RobotArm`) within one frame's joint motion of ``q``
         that reaches the target of ``q_human`` (``oMdes``, if already known), clear of
-        self-collision; or None. The step the live retargeting looks for first, taken from any
+        contact (:meth:`RobotArm.contacts`); or None. The step the live retargeting looks for first, taken from any
         pose (the path planner's)."""
         robot = self.robot
         assert isinstance(robot, RobotArm)
@@ -619,7 +621,7 @@ class Retargeter:
 
     def poses_reaching(self, q_human: np.ndarray, apart: float) -> list[np.ndarray]:
         """Poses of the robot (a :class:`RobotArm`) that reach the target of ``q_human``, clear
-        of self-collision, found by the IK from home and the fixed restart poses; no two closer
+        of contact (its own links and the table), found by the IK from home and the fixed restart poses; no two closer
         than ``apart`` (rad, any joint)."""
         robot = self.robot
         assert isinstance(robot, RobotArm)

@@ -225,7 +225,7 @@ def _clear_walk(arm: RobotArm, poses: list[tuple[int, np.ndarray]], config: Reta
     clear on every frame between them."""
     first, last = poses[0][0], poses[-1][0]
     walk = _straight(poses, first, last)
-    return not any(arm.self_collisions(q, config.clearance) for q in walk[1:-1])
+    return not any(arm.contacts(q, config.clearance) for q in walk[1:-1])
 
 
 def _straight(poses: list[tuple[int, np.ndarray]], first: int, last: int) -> np.ndarray:
@@ -470,6 +470,6 @@ def _walked(
         start, goal = path[b], tracks[j].q[c - tracks[j].start]
         for i in range(b + 1, c):
             path[i] = start + (goal - start) * (i - b) / (c - b)
-            if arm.self_collisions(path[i], clearance):
+            if arm.contacts(path[i], clearance):
                 return path, (k, b, j)
     return path, None

@@ -407,6 +407,8 @@ class RobotArm:
         self.base_rotation.setflags(write=False)
         self.reach = self._sampled_reach()
         self._collision_data: pin.GeometryData | None = None
+        self._table_points = _table_points(collision_model)
+        self._table_data: pin.GeometryData | None = None  # made at first use
         if len(collision_model.geometryObjects):
             self._set_collision_pairs(srdf)
 
@@ -415,6 +417,7 @@ class RobotArm:
         geometry are shared (never written), the data each computation writes is not."""
         other = copy.copy(self)
         other.data = self.model.createData()
+        other._table_data = None
         if self._collision_data is not None:
             other._collision_data = pin.GeometryData(self.collision_model)
         return other
@@ -599,6 +602,42 @@ class RobotArm:
                 found.append(Collision(_link_of(a), _link_of(b), distance))
         return sorted(found, key=lambda c: c.distance)
 
+    def table_contacts(self, q: object, margin: float = 0.0) -> list[Collision]:
+        """The links lower than ``margin`` above the table the robot stands on, at ``q``:
+        ``Collision(link, TABLE, height)`` with the height (m) of the link's lowest point above
+        the plane of the robot's base (negative below it), lowest first.
+
+        A robot of :func:`load_robot` is mounted on a table whose top is that plane; the links
+        the first joint turns about the vertical (and the base) stay where they stand, the
+        others (an elbow, a wrist, the hand) can be driven into it. An arm without collision
+        geometry (the Puma560's DH model) reports none.
+        """
+        arr = self.check_q(q)
+        if not self._table_points:
+            return []
+        geom = self.collision_model
+        if self._table_data is None:
+            self._table_data = pin.GeometryData(geom)
+        gdata = self._table_data
+        pin.updateGeometryPlacements(self.model, self.data, geom, gdata, arr)
+        lowest: dict[str, float] = {}
+        for k, points, centre, radius in self._table_points:
+            placement = gdata.oMg[k]
+            up, height = placement.rotation[2], placement.translation[2]
+            if up @ centre + height - radius >= margin:  # its bounding sphere clears the table
+                continue
+            z = float((points @ up).min() + height)
+            link = _link_of(geom.geometryObjects[k].name)
+            lowest[link] = min(lowest.get(link, math.inf), z)
+        found = [Collision(link, TABLE, z) for link, z in lowest.items() if z < margin]
+        return sorted(found, key=lambda c: c.distance)
+
+    def contacts(self, q: object, margin: float = 0.0) -> list[Collision]:
+        """:meth:`self_collisions` and :meth:`table_contacts` at ``q``: every contact within
+        ``margin`` a pose must not make, closest first."""
+        found = self.self_collisions(q, margin) + self.table_contacts(q, margin)
+        return sorted(found, key=lambda c: c.distance)
+
     @property
     def checks_collisions(self) -> bool:
         """Whether :meth:`self_collisions` has geometry to check."""
@@ -642,6 +681,42 @@ def _frame_id(model: pin.Model, spec: RobotSpec) -> int:
         )
     bodies = [i for i in matches if model.frames[i].type == pin.FrameType.BODY]
     return (bodies or matches)[0]
+
+
+TABLE = "table"
+"""The name :meth:`RobotArm.table_contacts` gives the table the robot stands on."""
+
+
+def _table_points(
+    geom: pin.GeometryModel,
+) -> list[tuple[int, np.ndarray, np.ndarray, float]]:
+    """For each collision geometry a joint after the first moves: its index, the points (in its
+    own frame) its lowest point is among (a convex hull's vertices, a box's corners), and the
+    centre and radius of a sphere around them (a quick test that it clears the table)."""
+    found = []
+    for k, obj in enumerate(geom.geometryObjects):
+        if obj.parentJoint < 2:  # the base, or a link turned about the vertical first axis
+            continue
+        shape = obj.geometry
+        if hasattr(shape, "points") and callable(shape.points):
+            points = np.array([np.array(p, dtype=float) for p in shape.points()])
+        else:
+            shape.computeLocalAABB()
+            box = shape.aabb_local
+            low, high = np.array(box.min_), np.array(box.max_)
+            points = np.array(
+                [
+                    [x, y, z]
+                    for x in (low[0], high[0])
+                    for y in (low[1], high[1])
+                    for z in (low[2], high[2])
+                ]
+            )
+        if len(points):
+            centre = 0.5 * (points.min(axis=0) + points.max(axis=0))
+            radius = float(np.linalg.norm(points - centre, axis=1).max())
+            found.append((k, points, centre, radius))
+    return found
 
 
 def _link_of(geometry_name: str) -> str:

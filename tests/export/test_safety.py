@@ -18,7 +18,7 @@ from studio.export import (
     time_path,
 )
 from studio.export._timing import STILL_RAD
-from studio.kinematics import HumanArm, load_robot, robot_names
+from studio.kinematics import TABLE, HumanArm, load_robot, robot_names
 
 from .conftest import write_arm_recording
 from .test_roundtrip import read_csv
@@ -189,7 +189,7 @@ def test_a_colliding_pose_is_refused_naming_the_link_pair_and_the_margin(tmp_pat
     while True:
         pose = rng.uniform(panda.lower, panda.upper)
         hits = panda.self_collisions(pose, 0.0)
-        if hits:
+        if hits and not panda.table_contacts(pose, 0.005):  # the table is the next test's
             break
     q = np.repeat(pose[None], 11, axis=0)
     motion = Motion("recording", "still", panda, np.arange(11) / 10.0, q, True, 10.0)
@@ -203,6 +203,31 @@ def test_a_colliding_pose_is_refused_naming_the_link_pair_and_the_margin(tmp_pat
     assert tuple(named.split(" and ")) in pairs
     assert not (tmp_path / "c.mcap").exists()
     assert check_trajectory(panda, motion.times, q)  # and the checks say the same
+
+
+@pytest.mark.parametrize("name", ["panda", "ur5"])
+def test_a_pose_into_the_table_is_refused_naming_the_link_and_how_deep(name, tmp_path):
+    """The robot stands on a table, the plane of its base: a hand or an elbow driven below it
+    is refused as a collision is, though no two links touch."""
+    arm = load_robot(name)
+    rng = np.random.default_rng(3)
+    while True:
+        pose = rng.uniform(arm.lower, arm.upper)
+        under = arm.table_contacts(pose, 0.0)
+        if under and under[0].distance < -0.05 and not arm.self_collisions(pose, 0.005):
+            break
+    assert all(c.link_b == TABLE for c in under)
+    q = np.repeat(pose[None], 11, axis=0)
+    motion = Motion("recording", "low", arm, np.arange(11) / 10.0, q, True, 10.0)
+    with pytest.raises(SafetyError) as err:
+        export_motion(motion, "csv", tmp_path / "low.csv")
+    message = str(err.value)
+    deepest = under[0]
+    assert (
+        f"sample 0 (t = 0.000 s): link {deepest.link_a} reaches {-deepest.distance * 100:.2f} "
+        "cm below the table top the robot stands on" in message
+    )
+    assert not (tmp_path / "low.csv").exists()
 
 
 def test_a_target_out_of_reach_is_refused_naming_the_sample(tmp_path):

@@ -84,9 +84,9 @@ def test_the_walk_between_two_legs_is_straight_and_within_the_step():
 
 
 class _NeverTouching:
-    """A stand-in arm for one-joint paths: its links never touch."""
+    """A stand-in arm for one-joint paths: its links never touch, nor the table."""
 
-    def self_collisions(self, q, margin):
+    def contacts(self, q, margin):
         return []
 
 

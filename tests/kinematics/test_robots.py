@@ -9,7 +9,7 @@ import math
 import numpy as np
 import pytest
 
-from studio.kinematics import KinematicsError, load_robot, robot_names
+from studio.kinematics import TABLE, KinematicsError, load_robot, robot_names
 from studio.kinematics._robots import robot_spec
 
 OFFERED = ("puma560", "panda", "ur3", "ur5", "ur10", "so100", "so101", "xarm7", "z1", "kinova")
@@ -192,3 +192,21 @@ def test_a_pose_near_contact_reads_the_same_every_time_it_is_checked():
         ]
         assert again == first
     assert any(first)  # some of these poses do collide: the check is not vacuous
+
+
+def test_the_links_a_joint_can_drive_into_the_table_are_found_and_the_base_is_not():
+    panda = load_robot("panda")
+    assert panda.table_contacts(panda.home, 0.005) == []  # standing up, well clear
+    # the shoulder folded forward and down: the hand and the wrist go below the base's plane
+    q = np.array(panda.home, dtype=float)
+    q[1], q[3] = 1.7, -1.0
+    under = panda.table_contacts(q)
+    links = {c.link_a for c in under}
+    assert {"panda_hand", "panda_link7"} <= links
+    assert "panda_link0" not in links and "panda_link1" not in links  # they stand on it
+    assert all(c.link_b == TABLE and c.distance < 0 for c in under)
+    assert [c.distance for c in under] == sorted(c.distance for c in under)
+    # the margin widens what counts; contacts() holds them with the self-collisions
+    assert len(panda.table_contacts(q, 0.3)) >= len(under)
+    assert set(panda.contacts(q)) == set(panda.self_collisions(q)) | set(under)
+    assert load_robot("puma560").table_contacts(np.zeros(6)) == []  # no collision geometry
