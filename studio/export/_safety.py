@@ -191,14 +191,20 @@ def refuse(findings: list[Finding], source: str, robot: RobotArm, *, own_times: 
 
     Args:
         own_times: the samples are at the source's own times (a recording's capture times),
-            not timed within the limits: the sentence then suggests timing it
-            (:data:`RETIME_HINT`).
+            not timed within the limits: where a velocity or acceleration is over its limit,
+            the sentence then suggests timing it (:data:`RETIME_HINT`); timing cannot mend a
+            pose.
     """
     if not findings:
         return
     more = len(findings) - 1
     rest = f" (and {more} more finding{'s' if more > 1 else ''})" if more else ""
-    fix = RETIME_HINT if own_times else "export a slower or other motion or for another robot"
+    too_fast = any(f.what in ("velocity", "acceleration") for f in findings)
+    fix = (
+        RETIME_HINT
+        if own_times and too_fast
+        else "export a slower or other motion or for another robot"
+    )
     raise SafetyError(
         f"Refused: {source} for the {robot.spec.title}: {findings[0].sentence}{rest}; {fix}, "
         "or pass --unchecked to write it anyway with the findings stated in the file.",
