@@ -6,8 +6,8 @@ checks it (positions, velocities, accelerations, self-collision) and writes it; 
 :mod:`studio.export` package does all three. ``SOURCE`` is a path, or a name in the data folder
 or among the shipped samples (``sample-reach-1``).
 
-``studio export POLICY`` alone (no ``--format``, ``--robot``, ``--unchecked`` nor ``--retime``) writes the
-policy's greedy rollout at its own pace as before: ``time,q1..q6`` CSV, not checked.
+``studio export POLICY`` alone (no ``--format``, ``--robot``, ``--unchecked`` nor ``--retime``)
+writes the policy's greedy rollout at its own pace as before: ``time,q1..q6`` CSV, not checked.
 """
 
 from __future__ import annotations

@@ -96,14 +96,11 @@ def export_motion(
     else:
         times, q = time_path(robot, motion.q, motion.rate_hz, fraction=fraction)
         timed_by = "toppra"
+    # a recording at its capture times is what the arm did (joint states); timed, a trajectory
+    as_captured = motion.kind == "recording" and timed_by == "source"
     findings = check_trajectory(robot, times, q, extra=list(motion.findings))
     if not unchecked:
-        refuse(
-            findings,
-            f"{motion.kind} {motion.name}",
-            robot,
-            own_times=timed_by == "source" and motion.kind == "recording",
-        )
+        refuse(findings, f"{motion.kind} {motion.name}", robot, own_times=as_captured)
     notes = _notes(motion, findings, checked=not unchecked)
     names = robot.joint_names
     if fmt == "csv":
@@ -118,9 +115,7 @@ def export_motion(
             "findings": "\n".join(f.sentence for f in findings),
             "notes": "\n".join(motion.notes),
         }
-        # a recording at its capture times is what the arm did: joint states; timed, a trajectory
-        states = motion.kind == "recording" and timed_by == "source"
-        write_mcap(out, names, times, q, states=states, metadata=metadata)
+        write_mcap(out, names, times, q, states=as_captured, metadata=metadata)
     else:
         fps = int(round(motion.rate_hz))
         extra = {

@@ -115,8 +115,8 @@ def pose_within(
 ) -> np.ndarray | None:
     """The first pose within ``box`` (``(lower, upper)``) that the IK finds from one of
     ``starts`` (each clipped into it), that reaches ``oMdes`` clear of contact (its own links
-    and the table: :meth:`RobotArm.contacts`) and that
-    ``accept`` (if given) takes; None if none does."""
+    and the table: :meth:`RobotArm.contacts`) and that ``accept`` (if given) takes; None if
+    none does."""
     lower, upper = box
     for start in starts:
         q = arm.inverse(

@@ -568,10 +568,10 @@ class Retargeter:
         a turn to spare counted the short way round, one cramped at a limit counted further:
         ``config.limit_room``), and the step cap walks the robot there over as many frames as
         it needs. A pose that would bring the robot's links into contact, with each other or
-        with the table it stands on, does not count as reaching: another branch's is looked for, and only where none is clear
-        does the robot hold its last pose. There the restarts also start from the pose the
-        robot walks to, so that pose is followed rather than found afresh on whichever branch is
-        nearest each frame (which turned joints back and forth).
+        with the table it stands on, does not count as reaching: another branch's is looked
+        for, and only where none is clear does the robot hold its last pose. There the restarts
+        also start from the pose the robot walks to, so that pose is followed rather than found
+        afresh on whichever branch is nearest each frame (which turned joints back and forth).
         """
         config = self.config
         start = robot.home if self._q_prev is None else self._q_prev
@@ -609,8 +609,8 @@ class Retargeter:
     ) -> np.ndarray | None:
         """A pose of the robot (a :class:`RobotArm`) within one frame's joint motion of ``q``
         that reaches the target of ``q_human`` (``oMdes``, if already known), clear of
-        contact (:meth:`RobotArm.contacts`); or None. The step the live retargeting looks for first, taken from any
-        pose (the path planner's)."""
+        contact (:meth:`RobotArm.contacts`); or None. The step the live retargeting looks for
+        first, taken from any pose (the path planner's)."""
         robot = self.robot
         assert isinstance(robot, RobotArm)
         oMdes = self.hand_target(q_human) if oMdes is None else oMdes
@@ -621,8 +621,8 @@ class Retargeter:
 
     def poses_reaching(self, q_human: np.ndarray, apart: float) -> list[np.ndarray]:
         """Poses of the robot (a :class:`RobotArm`) that reach the target of ``q_human``, clear
-        of contact (its own links and the table), found by the IK from home and the fixed restart poses; no two closer
-        than ``apart`` (rad, any joint)."""
+        of contact (its own links and the table), found by the IK from home and the fixed
+        restart poses; no two closer than ``apart`` (rad, any joint)."""
         robot = self.robot
         assert isinstance(robot, RobotArm)
         oMdes, found = self.hand_target(q_human), []
