@@ -643,11 +643,13 @@ def _run_quiet(cmd: list[str], env: dict) -> str:
         return ""
 
 
-def test_the_driver_waits_for_a_stopped_trial_to_save_its_run(tmp_path: Path) -> None:
+def test_the_driver_waits_for_a_stopped_trial_to_save_its_run(tmp_path: Path, monkeypatch) -> None:
     """Tune calls a trial ended as soon as its scheduler stops it; the trial's worker still runs
     to its next episode boundary to save. The sweep's last stopped trial has no next trial
     waiting on that worker, so the driver waits for the save before shutting Ray down (on a
     busy machine it was killed unsaved, and the sweep read as interrupted)."""
+    from studio.learning import _sweep_ray
+
     spec = parse_sweep_spec(spec_dict(name="w", seeds=[0], space={"planning": ["zero"]}))
     (trial,) = spec.trials()
     folder = sweep_folder(tmp_path, "w")
@@ -655,18 +657,20 @@ def test_the_driver_waits_for_a_stopped_trial_to_save_its_run(tmp_path: Path) ->
     path = trial_run_path(tmp_path, "w", trial.key)
     run = RunFolder.create(path.parent, trial_record(spec, trial), name=path.name, status="running")
     record_trial_end(folder, {"key": trial.key, "status": "early-stopped"})  # type: ignore[typeddict-item]
+    looks = []
+    unsaved = _sweep_ray._unsaved
 
-    def save() -> None:
-        time.sleep(0.3)  # the worker reaching its episode boundary
-        run.status = "stopped"
-        run.save_status()
+    def look(data_dir, sweep, key):  # the worker reaches its episode boundary at the 3rd look
+        looks.append(key)
+        if len(looks) == 3:
+            run.status = "stopped"
+            run.save_status()
+        return unsaved(data_dir, sweep, key)
 
-    saver = threading.Thread(target=save)
-    saver.start()
-    _await_stopped_saves(tmp_path, spec, folder, [trial.key], timeout=60.0)
-    assert RunFolder.load(path).status == "stopped"  # returned once saved, not before
-    saver.join()
+    monkeypatch.setattr(_sweep_ray, "_unsaved", look)
+    _await_stopped_saves(tmp_path, spec, folder, [trial.key], timeout=600.0)
+    assert looks == [trial.key] * 3  # it looked until the run was saved, and then no more
     # a trial that never saves does not hold the sweep past the timeout
-    run.status = "running"
-    run.save_status()
-    _await_stopped_saves(tmp_path, spec, folder, [trial.key], timeout=0.2)
+    monkeypatch.setattr(_sweep_ray, "_unsaved", lambda *_: looks.append("never") or True)
+    _await_stopped_saves(tmp_path, spec, folder, [trial.key], timeout=0.3)
+    assert "never" in looks  # it looked, and gave up
