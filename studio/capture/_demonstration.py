@@ -48,10 +48,9 @@ from studio.learning import ArmGrid, LearningError, motion_problem
 
 from ._errors import DemonstrationError
 from ._fitters import TapeFitter, fit_frames, fitter_for
-from ._observation_format import kind_of_name
 from ._observation_recording import ObservationRecording, read_any_recording
 from ._recording_edit import DEMO_SUFFIX, atomic_write_text
-from ._recording_format import RECORDING_SUFFIX
+from ._recording_format import RECORDING_SUFFIX, kind_of_name
 from ._recording_reader import Recording
 
 DEMO_FORMAT = "teach-studio-demonstration"

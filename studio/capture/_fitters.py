@@ -35,8 +35,7 @@ from studio.kinematics import (
     smooth_recorded_arm,
 )
 
-from ._frames import TapeFrame
-from ._observations import HUMAN_JOINTS, HandPose, LandmarkFrame, Observation
+from ._observations import HUMAN_JOINTS, HandPose, LandmarkFrame, Observation, TapeFrame
 
 ARM_LANDMARKS = {"right": (12, 14, 16), "left": (11, 13, 15)}
 """MediaPipe Pose's shoulder, elbow and wrist landmarks of the person's right and left arm."""

@@ -1,4 +1,4 @@
-"""Write and read pose-landmark and hand-pose recordings (formats: :mod:`._observation_format`).
+"""Write and read pose-landmark and hand-pose recordings (formats: :mod:`._recording_format`).
 
 The writer is the tape recorder's crash-safe appender (:class:`~._recording_writer.AppendWriter`):
 rows are flushed and fsynced at least every 0.5 s, a full disk stops it with the rows on disk
@@ -21,11 +21,18 @@ import numpy as np
 from studio import JSONFileError, loads_json
 
 from ._errors import RecordingError
-from ._observation_format import (
+from ._observations import HandPose, LandmarkFrame, Observation
+from ._recording_format import (
+    END_PREFIX,
+    MAX_HEADER_BYTES,
+    MAX_RATE_HZ,
     OBSERVATION_VERSION,
     POSE_KIND,
     RECORDING_KINDS,
+    RecordingEnd,
+    RecordingHeader,
     RecordingKind,
+    RecordingSummary,
     check_hand_rows,
     check_pose_rows,
     hand_at,
@@ -33,15 +40,6 @@ from ._observation_format import (
     observation_meta,
     pose_at,
     pose_row,
-)
-from ._observations import HandPose, LandmarkFrame, Observation
-from ._recording_format import (
-    END_PREFIX,
-    MAX_HEADER_BYTES,
-    MAX_RATE_HZ,
-    RecordingEnd,
-    RecordingHeader,
-    RecordingSummary,
 )
 from ._recording_reader import (
     FIX_HINT,

@@ -13,9 +13,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ._errors import CaptureError
-from ._frames import TapeFrame
 from ._observation_recording import ObservationRecording, read_any_recording
-from ._observations import HandPose, LandmarkFrame
+from ._observations import HandPose, LandmarkFrame, TapeFrame
 from ._recording_reader import Recording
 from ._source import DEFAULT_QUEUE_FRAMES, ThreadedSource
 

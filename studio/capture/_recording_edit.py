@@ -30,6 +30,7 @@ from ._recording_format import (
     end_line,
     format_row,
     header_line,
+    kind_of_name,
 )
 from ._recording_reader import READ_BLOCK_BYTES, Recording, _first_line, _open
 from ._recording_writer import make_folder_of
@@ -151,8 +152,6 @@ def rename_recording(path: str | os.PathLike[str], new_name: str) -> Path:
     Raises:
         RecordingError: a name with a path separator, an existing target, or a capture in progress.
     """
-    from ._observation_format import kind_of_name
-
     path = Path(path)
     kind = kind_of_name(path.name)
     suffix = kind.suffix if kind is not None else RECORDING_SUFFIX

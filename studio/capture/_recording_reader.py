@@ -21,7 +21,7 @@ import numpy as np
 from studio import FileLimitError, JSONFileError, loads_json, open_regular
 
 from ._errors import RecordingError
-from ._frames import TapeFrame
+from ._observations import TapeFrame
 from ._recording_format import (
     END_PREFIX,
     FIXED_COLUMNS,

@@ -24,8 +24,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Self, cast
 
 from ._errors import RecordingError
-from ._frames import TapeFrame
-from ._observations import Observation
+from ._observations import Observation, TapeFrame
 from ._recording_format import (
     DEFAULT_RATE_HZ,
     DEFAULT_REGIONS,

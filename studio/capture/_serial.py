@@ -1,32 +1,146 @@
-"""A real ShapeTape on a serial port (pyserial, the optional ``serial`` extra).
+"""A ShapeTape on a serial port: its protocol, the source that reads it (pyserial, the optional
+``serial`` extra) and an emulated tape on a pseudo-terminal (for tests and demos).
 
-The source polls the tape at ``rate_hz`` with absolute deadlines (so the rate never drifts),
-decodes each reply (:mod:`._shapetape_protocol`) and calibrates it into a :class:`TapeFrame`
-(numbered by the tape's own frame counter when it sends one, serial numbers above 4096). A
-bad checksum or a missing reply loses that frame (counted as dropped) and the stream continues; an
-unplugged device ends the source with a clear ``status().error``.
+The ShapeTape serial protocol (Measurand tapeAPI, 2000). The host sends ``0x20``; the tape
+answers with one frame::
+
+    status      1 byte   bits 0-2: number of 8-channel groups G; bit 4 switch0, 5 trigger, 6 switch1
+    serial      2 bytes  big-endian serial number
+    [if serial > 4096:  counter 2 bytes BE, timer 3 bytes BE, filler 8 bytes]
+    data        16 * G   8 x uint16 big-endian per group
+    checksum    1 byte   sum of the data bytes, modulo 256
+
+:class:`SerialSource` polls the tape at ``rate_hz`` with absolute deadlines (so the rate never
+drifts), decodes each reply and calibrates it into a :class:`TapeFrame` (numbered by the tape's
+own frame counter when it sends one, serial numbers above 4096). A bad checksum or a missing
+reply loses that frame (counted as dropped) and the stream continues; an unplugged device ends
+the source with a clear ``status().error``.
+
+:class:`ShapeTapeEmulator` answers every ``0x20`` with a frame built from a frame generator, can
+corrupt chosen replies' checksums, and can be "unplugged" (its pty closed) mid-stream.
 """
 
 from __future__ import annotations
 
 import contextlib
 import os
+import select
+import threading
 import time
+import tty
+from collections.abc import Callable
+from dataclasses import dataclass
 from types import ModuleType
 from typing import Protocol
 
+import numpy as np
+
 from ._calibration import Calibration, load_calibration
 from ._errors import CaptureError
-from ._frames import STATUS_BITS_MASK, TapeFrame
-from ._shapetape_protocol import (
-    BAUD_RATE,
-    REQUEST,
-    ProtocolError,
-    RawFrame,
-    decode_reply,
-    reply_length,
-)
+from ._observations import STATUS_BITS_MASK, TapeFrame
 from ._source import DEFAULT_QUEUE_FRAMES, ThreadedSource
+
+REQUEST = b"\x20"
+"""The byte that asks the tape for one frame."""
+BAUD_RATE = 115200
+"""The tape's serial speed."""
+GROUP_MASK = 0x07
+"""Status bits holding the group count."""
+CHANNELS_PER_GROUP = 8
+"""uint16 channels per group."""
+GROUP_BYTES = 2 * CHANNELS_PER_GROUP
+"""Bytes per group."""
+EXTENDED_SERIAL = 4096
+"""Tapes with a larger serial number send a counter, a timer and filler."""
+EXTENDED_BYTES = 2 + 3 + 8
+"""Counter, timer and filler bytes of extended frames."""
+
+
+class ProtocolError(ValueError):
+    """A frame that does not decode (bad checksum, wrong length)."""
+
+
+@dataclass(frozen=True, eq=False)
+class RawFrame:
+    """One decoded reply: status byte, serial, optional counter/timer, raw channel counts."""
+
+    status: int
+    serial: int
+    counter: int | None
+    timer: int | None
+    raw: np.ndarray
+
+    @property
+    def groups(self) -> int:
+        """8-channel groups in the frame."""
+        return self.status & GROUP_MASK
+
+
+def groups_for(channels: int) -> int:
+    """Groups needed to carry ``channels`` channels."""
+    return -(-channels // CHANNELS_PER_GROUP)
+
+
+def encode_reply(
+    raw: np.ndarray,
+    serial: int,
+    switches: int = 0,
+    counter: int = 0,
+    timer: int = 0,
+    corrupt: bool = False,
+) -> bytes:
+    """The bytes a tape sends for these raw counts (padded with zeros to whole groups).
+
+    Args:
+        raw: uint16 channel counts.
+        serial: the tape's serial number (extended layout when above 4096).
+        switches: status bits 4-6.
+        counter: frame counter (extended layout).
+        timer: timer ticks (extended layout).
+        corrupt: send a wrong checksum (for testing receivers).
+    """
+    groups = groups_for(len(raw))
+    padded = np.zeros(groups * CHANNELS_PER_GROUP, dtype=">u2")
+    padded[: len(raw)] = raw
+    data = padded.tobytes()
+    head = bytes([(switches & 0x70) | groups]) + int(serial).to_bytes(2, "big")
+    if serial > EXTENDED_SERIAL:
+        head += (
+            (counter & 0xFFFF).to_bytes(2, "big") + (timer & 0xFFFFFF).to_bytes(3, "big") + bytes(8)
+        )
+    checksum = (sum(data) + (1 if corrupt else 0)) & 0xFF
+    return head + data + bytes([checksum])
+
+
+def reply_length(status: int, serial: int) -> int:
+    """Bytes still to read after the 3-byte status+serial prefix."""
+    extra = EXTENDED_BYTES if serial > EXTENDED_SERIAL else 0
+    return extra + GROUP_BYTES * (status & GROUP_MASK) + 1
+
+
+def decode_reply(prefix: bytes, rest: bytes) -> RawFrame:
+    """Decode a reply from its 3-byte prefix and the remaining bytes.
+
+    Raises:
+        ProtocolError: wrong length or checksum.
+    """
+    status, serial = prefix[0], int.from_bytes(prefix[1:3], "big")
+    if len(rest) != reply_length(status, serial):
+        raise ProtocolError(
+            f"{len(rest)} bytes after the header, expected {reply_length(status, serial)}"
+        )
+    counter = timer = None
+    offset = 0
+    if serial > EXTENDED_SERIAL:
+        counter = int.from_bytes(rest[0:2], "big")
+        timer = int.from_bytes(rest[2:5], "big")
+        offset = EXTENDED_BYTES
+    data = rest[offset:-1]
+    if (sum(data) & 0xFF) != rest[-1]:
+        raise ProtocolError(f"checksum {rest[-1]} does not match the data ({sum(data) & 0xFF})")
+    raw = np.frombuffer(data, dtype=">u2").astype(np.int64)
+    return RawFrame(status, serial, counter, timer, raw)
+
 
 DEFAULT_RATE_HZ = 110.0
 """Polling rate (the paper's 110 Hz)."""
@@ -203,3 +317,83 @@ class SerialSource(ThreadedSource[TapeFrame]):
                 f"the tape on {self.port} sends {frame.raw.shape[0]} channels but the calibration has {self.calibration.channels}; use this tape's calibration."
             )
         return frame
+
+
+POLL_SECONDS = 0.05
+"""How often the emulator checks for a stop request."""
+DEFAULT_SERIAL = 5001
+"""Above 4096, so replies use the extended layout (counter, timer, filler)."""
+
+
+class ShapeTapeEmulator:
+    """A fake tape behind a pty; open :attr:`port` with :class:`SerialSource`.
+
+    Args:
+        angles: ``f(k) -> (bend, twist, switches)`` for the k-th reply.
+        calibration: how angles become raw counts (default identity for 16 regions).
+        serial: the serial number it reports.
+        counter_start: its 16-bit frame counter's first value (start near 65535 to test the wrap).
+    """
+
+    def __init__(
+        self,
+        angles: Callable[[int], tuple[np.ndarray, np.ndarray, int]],
+        calibration: Calibration | None = None,
+        serial: int = DEFAULT_SERIAL,
+        counter_start: int = 0,
+    ) -> None:
+        self.angles = angles
+        self.calibration = calibration or Calibration.identity()
+        self.serial = serial
+        self.counter_start = counter_start
+        self.master, self._slave = os.openpty()
+        tty.setraw(self._slave)
+        self.port = os.ttyname(self._slave)
+        self.replies = 0
+        self.corrupt: set[int] = set()
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._run, name="shapetape-emulator", daemon=True)
+
+    def start(self) -> ShapeTapeEmulator:
+        """Start answering requests."""
+        self._thread.start()
+        return self
+
+    def unplug(self) -> None:
+        """Close the device side, as if the cable were pulled."""
+        self._stop.set()
+        if self._thread.ident is not None:  # started
+            self._thread.join(1.0)
+        for fd in (self.master, self._slave):
+            with contextlib.suppress(OSError):
+                os.close(fd)
+
+    stop = unplug
+
+    def _run(self) -> None:
+        while not self._stop.is_set():
+            try:
+                ready, _, _ = select.select([self.master], [], [], POLL_SECONDS)
+                if not ready:
+                    continue
+                requests = os.read(self.master, 1024)
+            except OSError:
+                return
+            for byte in requests:
+                if byte != REQUEST[0]:
+                    continue
+                k = self.replies
+                bend, twist, switches = self.angles(k)
+                reply = encode_reply(
+                    self.calibration.raw(bend, twist),
+                    self.serial,
+                    switches,
+                    counter=self.counter_start + k,
+                    timer=k,
+                    corrupt=k in self.corrupt,
+                )
+                try:
+                    os.write(self.master, reply)
+                except OSError:
+                    return
+                self.replies += 1

@@ -24,7 +24,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ._errors import CaptureError
-from ._frames import TRIGGER_BIT, TapeFrame
+from ._observations import TRIGGER_BIT, TapeFrame
 from ._recording_format import DEFAULT_RATE_HZ
 from ._source import DEFAULT_QUEUE_FRAMES, ThreadedSource
 

@@ -133,7 +133,7 @@ def test_too_short_segment(reach):
 
 
 def test_trigger_marks_the_reach_as_a_segment(reach):
-    from studio.capture._segments import trigger_segments
+    from studio.capture._review import trigger_segments
 
     rec, sim, grid = reach
     [(t0, t1)] = trigger_segments(rec)

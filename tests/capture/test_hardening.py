@@ -33,9 +33,8 @@ from studio.capture import (
     recording_bytes,
     update_recording_meta,
 )
-from studio.capture._calibration import load_calibration
+from studio.capture._calibration import load_calibration, read_raw_text
 from studio.capture._network import FrameSender
-from studio.capture._raw_import import read_raw_text
 from studio.capture._recording_format import MAX_HEADER_BYTES, MAX_REGIONS
 from studio.capture._recording_reader import read_header, summarize_recording
 from studio.cli import main

@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from studio.capture import read_any_recording, recording_series
-from studio.capture._series import recording_signals
+from studio.capture._review import recording_signals
 from studio.samples import SAMPLES_DIR
 from tests.capture.test_observations import hand_recording, pose_frames, write
 

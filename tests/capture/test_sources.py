@@ -24,9 +24,8 @@ from studio.capture import (
     read_recording,
     stream_source,
 )
-from studio.capture._network import FrameSender
-from studio.capture._shapetape_protocol import ProtocolError, decode_reply, encode_reply
-from studio.capture._wire import WireError, bridge_key, decode_frame
+from studio.capture._network import FrameSender, WireError, bridge_key, decode_frame
+from studio.capture._serial import ProtocolError, decode_reply, encode_reply
 
 from .conftest import synthetic_frames
 
