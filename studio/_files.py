@@ -104,6 +104,33 @@ def _too_large(what: str, size: int, limit: int) -> str:
     )
 
 
+def _read_umask() -> int:
+    """This process's umask (read once, at import, before any thread could race the read)."""
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+_UMASK = _read_umask()
+
+
+def default_mode(directory: bool = False) -> int:
+    """The permission bits a plain ``open()`` (or ``mkdir()``) gives under the process's umask.
+
+    ``tempfile.mkstemp`` and ``mkdtemp`` create private (0600 / 0700) entries; what the studio
+    moves into place from them gets this mode, so an export reads like a recording or a run.
+    """
+    return (0o777 if directory else 0o666) & ~_UMASK
+
+
+def make_temp_dir(prefix: str, parent: Path) -> Path:
+    """A new empty folder in ``parent`` to fill and then rename into place, with the mode of a
+    folder made by ``mkdir`` (not ``mkdtemp``'s 0700)."""
+    folder = Path(tempfile.mkdtemp(prefix=prefix, dir=parent))
+    folder.chmod(default_mode(directory=True))
+    return folder
+
+
 def atomic_write(path: str | os.PathLike[str], write: Callable[[BinaryIO], None]) -> Path:
     """Let ``write`` fill a temporary file next to ``path``, fsync it, and ``os.replace`` it in.
 
@@ -113,6 +140,7 @@ def atomic_write(path: str | os.PathLike[str], write: Callable[[BinaryIO], None]
     path = Path(path)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     try:
+        os.fchmod(fd, default_mode())
         with os.fdopen(fd, "wb") as f:
             write(f)
             f.flush()

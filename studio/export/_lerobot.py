@@ -19,11 +19,12 @@ from __future__ import annotations
 
 import json
 import shutil
-import tempfile
 from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
+
+from studio._files import make_temp_dir
 
 from ._errors import ExportError
 
@@ -206,7 +207,7 @@ def write_lerobot(
         )
     try:
         out.parent.mkdir(parents=True, exist_ok=True)
-        tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=out.parent))
+        tmp = make_temp_dir(f".{out.name}.", out.parent)
     except OSError as err:
         raise ExportError(
             f"Cannot write the LeRobot dataset {out} ({err.strerror or err}); choose a writable "

@@ -15,12 +15,12 @@ from __future__ import annotations
 
 import re
 import shutil
-import tempfile
 from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
 
+from studio._files import make_temp_dir
 from studio.kinematics import (
     KinematicsError,
     MeshConfig,
@@ -168,7 +168,7 @@ def export_urdf(robot: RobotArm | str, out: Path) -> Path:
         )
     try:
         out.parent.mkdir(parents=True, exist_ok=True)
-        tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=out.parent))
+        tmp = make_temp_dir(f".{out.name}.", out.parent)
     except OSError as err:
         raise ExportError(
             f"Cannot write the folder {out} ({err.strerror or err}); choose a writable --out."
