@@ -12,6 +12,7 @@ import argparse
 import importlib
 import os
 import pkgutil
+import re
 import sys
 from collections.abc import Sequence
 from types import ModuleType
@@ -33,9 +34,21 @@ def _verb_modules() -> dict[str, ModuleType]:
     return modules
 
 
+NUMBERS = re.compile(r"^-\.?\d[\d.,eE+\- ]*$")
+"""A value that starts with a minus and holds only numbers: ``-30,45,-90``, ``-0.5``, ``-1e-3``."""
+
+
 class _Parser(argparse.ArgumentParser):
     """An argument parser whose usage errors are one line: the problem and where help is (not
-    argparse's usage block, which buries the one line that matters)."""
+    argparse's usage block, which buries the one line that matters).
+
+    A value such as ``--goal-deg -30,45,-90`` is taken as the option's value, not as an unknown
+    option: argparse itself only knows a lone negative number (``-30``) as a value.
+    """
+
+    def __init__(self, *args, **kwargs) -> None:
+        super().__init__(*args, **kwargs)
+        self._negative_number_matcher = NUMBERS
 
     def error(self, message: str) -> NoReturn:
         self.exit(2, f"{self.prog}: {message}; see {self.prog} --help.\n")

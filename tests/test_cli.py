@@ -97,3 +97,53 @@ def test_a_terminal_is_told_a_recording_is_being_retargeted_a_script_is_not(
         "Retargeting sample-reach-1.tape.csv onto the Universal Robots UR5, its IK branches "
         "planned over the whole motion"
     )
+
+
+@pytest.mark.parametrize(
+    ("argv", "option", "value"),
+    [
+        (["train", "--goal-deg", "-30,45,-90"], "goal_deg", "-30,45,-90"),
+        (["export", "x", "--start-deg", "-90,0,0"], "start_deg", "-90,0,0"),
+        (["export", "x", "--start-deg", "-0.5,1e-3,-2"], "start_deg", "-0.5,1e-3,-2"),
+    ],
+)
+def test_a_list_of_numbers_that_starts_negative_is_the_options_value(argv, option, value):
+    """``--goal-deg -30,45,-90`` is the goal, as ``--goal-deg=-30,45,-90`` is (argparse alone
+    takes it for an unknown option and says 'expected one argument')."""
+    parser, _ = build_parser()
+    assert getattr(parser.parse_args(argv), option) == value
+
+
+def test_an_unknown_option_still_is_one(capsys):
+    with pytest.raises(SystemExit):
+        main(["train", "--goal-deg", "-x"])
+    assert "expected one argument" in capsys.readouterr().err
+
+
+def test_a_recording_gets_a_name_the_other_verbs_take(tmp_path, monkeypatch, capsys):
+    """``studio record --out x.csv`` writes ``x.tape.csv``, which ``studio info`` then reads."""
+    monkeypatch.chdir(tmp_path)
+    assert main(["record", "--seconds", "0.2", "--out", "x.csv"]) == 0
+    assert [p.name for p in tmp_path.iterdir()] == ["x.tape.csv"]
+    capsys.readouterr()
+    assert main(["info", "x.tape.csv", "--json"]) == 0
+    assert '"frames": ' in capsys.readouterr().out
+
+
+def test_a_recording_named_as_another_kind_is_refused(tmp_path, capsys):
+    assert main(["record", "--seconds", "0.2", "--out", str(tmp_path / "x.pose.csv")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "give a name ending in .tape.csv" in err
+    assert not list(tmp_path.iterdir())
+
+
+@pytest.mark.parametrize(
+    ("name", "says"),
+    [("sample-reach-1", '"grid_path"'), ("sample-reach-1.tape.csv", '"regions": 16')],
+)
+def test_info_takes_a_samples_name_as_train_and_export_do(
+    name, says, tmp_path, monkeypatch, capsys
+):
+    monkeypatch.chdir(tmp_path)
+    assert main(["info", name, "--json"]) == 0
+    assert says in capsys.readouterr().out

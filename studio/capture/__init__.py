@@ -57,6 +57,7 @@ from ._recording_edit import write_recording as write_recording
 from ._recording_format import DEFAULT_RATE_HZ as DEFAULT_RATE_HZ
 from ._recording_format import RECORDING_SUFFIX as RECORDING_SUFFIX
 from ._recording_format import RECORDING_SUFFIXES as RECORDING_SUFFIXES
+from ._recording_format import recording_path as recording_path
 from ._recording_format import recording_suffix as recording_suffix
 from ._recording_reader import Recording as Recording
 from ._recording_reader import read_recording as read_recording

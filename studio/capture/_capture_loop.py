@@ -19,7 +19,12 @@ from studio import StudioError
 from ._errors import CaptureError
 from ._network import DEFAULT_PORT
 from ._observation_recording import ObservationWriter
-from ._recording_format import DEFAULT_RATE_HZ, DEFAULT_REGIONS, RecordingSummary
+from ._recording_format import (
+    DEFAULT_RATE_HZ,
+    DEFAULT_REGIONS,
+    RecordingSummary,
+    recording_path,
+)
 from ._recording_writer import AppendWriter, RecordingWriter
 from ._source import SourceStatus, ThreadedSource, check_seconds
 
@@ -249,6 +254,7 @@ def _writer_for(
     """A new recording of ``source``'s observation kind at ``out``: a tape's with its config and
     regions, or a pose or hand recording (played back, or any fed source) of the same kind."""
     kind = getattr(source, "observation_kind", "tape")
+    out = recording_path(out, kind)
     if kind == "tape":
         config = getattr(source, "config", None)
         regions = int(getattr(config, "regions", DEFAULT_REGIONS) or DEFAULT_REGIONS)

@@ -40,13 +40,15 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import os
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
+from pathlib import Path
 from typing import TYPE_CHECKING, NotRequired, TypedDict, cast
 
 import numpy as np
 
-from ._errors import RecordingError
+from ._errors import CaptureError, RecordingError
 from ._observations import (
     HUMAN_JOINTS,
     IMAGE_FIELDS,
@@ -289,6 +291,26 @@ RECORDING_SUFFIXES = tuple(kind.suffix for kind in RECORDING_KINDS.values())
 def recording_suffix(kind: str) -> str:
     """The file name ending of recordings of ``kind`` (``"tape"``, ``"pose"`` or ``"hand"``)."""
     return RECORDING_KINDS[kind].suffix
+
+
+def recording_path(out: str | os.PathLike[str], kind: str) -> Path:
+    """``out`` named as a recording of ``kind`` that every verb takes (``studio info``,
+    ``export``, the page's lists go by the ending): ``x`` and ``x.csv`` become ``x.tape.csv``.
+
+    Raises:
+        CaptureError: ``out`` ends as a recording of another kind.
+    """
+    out = Path(out)
+    suffix = recording_suffix(kind)
+    if out.name.endswith(suffix):
+        return out
+    other = kind_of_name(out.name)
+    if other is not None:
+        raise CaptureError(
+            f"{out} is named as a {other.name} recording, but this source records a {kind}; "
+            f"give a name ending in {suffix}."
+        )
+    return out.with_name(out.name.removesuffix(".csv") + suffix)
 
 
 def kind_of_name(filename: str) -> RecordingKind | None:

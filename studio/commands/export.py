@@ -109,7 +109,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     start.add_argument("--start-state", type=int, help="grid state number to start from")
     start.add_argument(
         "--start-deg",
-        help="start joint angles in degrees, comma-separated; write --start-deg=-90,0,0 when the first is negative (default: all 0)",
+        help="start joint angles in degrees, comma-separated, e.g. -90,0,0 (default: all 0)",
     )
     parser.add_argument(
         "--rate",

@@ -7,7 +7,8 @@ import argparse
 import json
 from pathlib import Path
 
-from studio.capture import being_recorded, describe, summarize_any_recording
+from studio.capture import RECORDING_SUFFIXES, being_recorded, describe, summarize_any_recording
+from studio.export import ExportError, find_source
 
 NAME = "info"
 HELP = "Show a recording's or demonstration's metadata, length and any problems."
@@ -19,7 +20,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         type=Path,
         nargs="+",
         metavar="FILE",
-        help="*.tape.csv, *.pose.csv, *.hand.csv or *.demo.json files",
+        help="*.tape.csv, *.pose.csv, *.hand.csv or *.demo.json files, or their names in the "
+        "data folder's recordings/ or among the samples (sample-reach-1, "
+        "sample-reach-1.tape.csv)",
     )
     parser.add_argument("--json", action="store_true", help="print JSON instead of text")
     parser.add_argument(
@@ -30,7 +33,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    for path in args.files:
+    for given in args.files:
+        path = _file(given)
         if path.name.endswith(".demo.json"):
             from studio.capture import load_demonstration
 
@@ -47,6 +51,20 @@ def run(args: argparse.Namespace) -> int:
                 summary["recovered"] = False
             print(json.dumps(summary) if args.json else describe(summary))
     return 0
+
+
+def _file(given: Path) -> Path:
+    """The recording or demonstration ``given`` names: a path, or a name as ``studio export`` and
+    ``studio train --demos`` take it (the data folder's, then the samples')."""
+    if given.exists():
+        return given
+    path = find_source(given)
+    if not path.name.endswith((".demo.json", *RECORDING_SUFFIXES)):
+        raise ExportError(
+            f"{given} names {path}, which is not a recording or a demonstration; studio info "
+            "shows those (give a *.tape.csv, *.pose.csv, *.hand.csv or *.demo.json)."
+        )
+    return path
 
 
 def _shown(key: str, value: object) -> object:

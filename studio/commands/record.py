@@ -20,6 +20,7 @@ from studio.capture import (
     check_seconds,
     cli_speed,
     describe,
+    recording_path,
     source_from_spec,
     summarize_any_recording,
 )
@@ -79,6 +80,9 @@ def run(args: argparse.Namespace) -> int:
         calibration=args.calibration,
         **({"token": token} if args.source.startswith("udp") else {}),
     )
+    out = recording_path(args.out, getattr(source, "observation_kind", "tape"))
+    if out != args.out:
+        print(f"recording into {out}: a name every other verb takes", file=sys.stderr)
     total = f"/{args.seconds:g} s" if args.seconds else ""
     nominal = float(getattr(source, "rate_hz", 0.0) or DEFAULT_RATE_HZ)
 
@@ -101,7 +105,7 @@ def run(args: argparse.Namespace) -> int:
     try:
         path = capture(
             source,
-            args.out,
+            out,
             args.seconds,
             operator=args.operator,
             notes=args.notes,
@@ -110,8 +114,8 @@ def run(args: argparse.Namespace) -> int:
             give_up_seconds=args.wait,
         )
     except KeyboardInterrupt:
-        print(f"\nstopped: every captured frame is kept in {args.out}.", file=sys.stderr)
-        path = args.out
+        print(f"\nstopped: every captured frame is kept in {out}.", file=sys.stderr)
+        path = out
     except StudioError:
         if last[0]:  # end the progress line, so the error starts a line of its own
             print(file=sys.stderr)

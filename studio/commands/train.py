@@ -144,8 +144,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     goal.add_argument(
         "--goal-deg",
         help="goal as joint 1-3 angles in degrees, comma-separated, checked against the robot's "
-        "limits as the page does; write --goal-deg=-30,45,-90 when the first is negative "
-        "(default: the robot's default goal)",
+        "limits as the page does, e.g. -30,45,-90 (default: the robot's default goal)",
     )
     parser.add_argument(
         "--demos",
