@@ -18,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
+from studio._layout import robot_cache_dir
 from studio.capture import DEMO_SUFFIX, RECORDING_SUFFIXES
 from studio.export import (
     FORMAT_SUFFIXES,
@@ -33,7 +34,13 @@ from studio.export import (
     recording_motion,
     source_kind,
 )
-from studio.kinematics import DEFAULT_ROBOT, robot_names, robot_spec
+from studio.kinematics import (
+    DEFAULT_ROBOT,
+    isolate_robot_loading,
+    robot_is_kept,
+    robot_names,
+    robot_spec,
+)
 from studio.learning import (
     POLICY_SUFFIX,
     ROLLOUT_MAX_STEPS,
@@ -300,6 +307,21 @@ def _motion(args: argparse.Namespace, source: Path, robot: str) -> tuple[Motion,
     return Motion("policy", source.name, arm, times, q, timed, args.rate), summary
 
 
+def _say_loading(robot: str, cache: Path) -> None:
+    """Keep ``robot``'s built geometry in the data folder's cache, as ``studio serve`` does, and
+    tell a person at a terminal when its first load will build it (a minute or more), so the
+    export does not look stuck. Said only to a terminal, as :func:`_say_retargeting` is."""
+    isolate_robot_loading(cache)
+    if robot not in robot_names() or robot_is_kept(robot) or not sys.stderr.isatty():
+        return
+    print(
+        f"Loading the {robot_spec(robot).title}: the first time, its collision geometry is built "
+        f"(a minute or more), then kept in {cache} for the next export...",
+        file=sys.stderr,
+        flush=True,
+    )
+
+
 def _say_retargeting(source: Path, robot: str) -> None:
     """Tell a person at a terminal that a human-arm motion is being retargeted onto ``robot``:
     with its IK branches planned, that takes seconds a minute of recording, and a long one
@@ -327,7 +349,9 @@ def run(args: argparse.Namespace) -> int:
         return _run_legacy(args, load_any_policy(args.policy))
     source = find_source(args.policy, args.data_dir)
     fmt = args.format or "csv"
-    motion, summary = _motion(args, source, args.robot or robot_names()[0])
+    robot = args.robot or robot_names()[0]
+    _say_loading(robot, robot_cache_dir(args.data_dir))
+    motion, summary = _motion(args, source, robot)
     stem = source.name
     for ending in (POLICY_SUFFIX, DEMO_SUFFIX, *RECORDING_SUFFIXES):
         stem = stem.removesuffix(ending)

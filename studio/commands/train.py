@@ -32,6 +32,7 @@ from pathlib import Path
 from typing import cast
 
 from studio import StudioError, read_json
+from studio._layout import RECORDINGS_DIR
 from studio.capture import DEMO_FORMAT, DEMO_SUFFIX
 from studio.export import ExportError, training_demonstration
 from studio.kinematics import DEFAULT_ROBOT, robot_names, robot_spec
@@ -58,8 +59,6 @@ from studio.samples import SAMPLES_DIR
 
 NAME = "train"
 HELP = "Train Dyna-Q on the arm grid or the arm's continuous joints: a run folder with curves and a policy out."
-RECORDINGS_DIR = "recordings"
-"""Where a data folder keeps its recordings and the demonstrations cut from them."""
 _DYNAQ = DynaQConfig()
 _GRID = ArmGrid()
 

@@ -21,6 +21,7 @@ from typing import Literal
 
 import numpy as np
 
+from studio._layout import POLICIES_DIR, RECORDINGS_DIR, RUNS_DIR
 from studio.capture import (
     DEMO_SUFFIX,
     RECORDING_SUFFIXES,
@@ -46,12 +47,6 @@ from ._errors import ExportError
 from ._safety import Finding
 
 SourceKind = Literal["policy", "demonstration", "recording"]
-RECORDINGS_DIR = "recordings"
-"""Where a data folder keeps its recordings and the demonstrations cut from them."""
-POLICIES_DIR = "policies"
-"""Where a data folder keeps uploaded policy files."""
-RUNS_DIR = "runs"
-"""Where a data folder keeps training runs (each with ``policy.policy.npz``)."""
 PUMA560 = "puma560"
 """The paper's robot: a demonstration keeps its stored trajectory for it, and joint mode maps the
 human arm onto it."""

@@ -31,6 +31,7 @@ from ._retarget_path import retarget_path as retarget_path
 from ._robot_load import isolate_robot_loading as isolate_robot_loading
 from ._robot_load import load_robot as load_robot
 from ._robot_load import prepare_arm_ik_in_background as prepare_arm_ik_in_background
+from ._robot_load import robot_is_kept as robot_is_kept
 from ._robots import DEFAULT_ROBOT as DEFAULT_ROBOT
 from ._robots import TABLE as TABLE
 from ._robots import RobotArm as RobotArm

@@ -29,6 +29,7 @@ from typing import NotRequired, TypedDict, cast
 from studio import StudioError, read_json
 
 from .._files import atomic_write_text, now_iso
+from .._layout import RUNS_DIR
 from ._errors import LearningError
 from ._owner import pid_alive, this_host
 from ._runs import RunFolder
@@ -39,8 +40,6 @@ SWEEP_FORMAT = "teach-studio-sweep"
 SWEEP_VERSION = 1
 SWEEPS_DIR = "sweeps"
 """Sweep folders live in ``<data>/sweeps/<id>/``."""
-RUNS_DIR = "runs"
-"""Trial runs live in ``<data>/runs/<id>/<id>-<trial>/``."""
 SWEEP_FILE = "sweep.json"
 TRIALS_DIR = "trials"
 SUMMARY_FILE = "sweep.csv"

@@ -12,6 +12,13 @@ from pathlib import Path
 from pydantic import BaseModel, ConfigDict, Field
 
 from studio import is_loopback
+from studio._layout import (
+    POLICIES_DIR,
+    RECORDINGS_DIR,
+    RUNS_DIR,
+    mesh_cache_dir,
+    robot_cache_dir,
+)
 
 DEFAULT_UPLOAD_LIMIT_BYTES = 50_000_000
 """Largest accepted upload (recordings, policies): 50 MB, about 40 minutes of 110 Hz tape frames."""
@@ -64,27 +71,27 @@ class Settings(BaseModel):
     @property
     def recordings_dir(self) -> Path:
         """Recordings (``*.tape.csv``) and demonstrations (``*.demo.json``)."""
-        return self.data_dir / "recordings"
+        return self.data_dir / RECORDINGS_DIR
 
     @property
     def runs_dir(self) -> Path:
         """One folder per training run."""
-        return self.data_dir / "runs"
+        return self.data_dir / RUNS_DIR
 
     @property
     def policies_dir(self) -> Path:
         """Uploaded policy files."""
-        return self.data_dir / "policies"
+        return self.data_dir / POLICIES_DIR
 
     @property
     def mesh_cache_dir(self) -> Path:
         """Where the drawn robots' simplified meshes are kept (a cache: safe to delete)."""
-        return self.data_dir / "cache" / "meshes"
+        return mesh_cache_dir(self.data_dir)
 
     @property
     def robot_cache_dir(self) -> Path:
         """Where the robots' built models and collision hulls are kept (a cache: safe to delete)."""
-        return self.data_dir / "cache" / "robots"
+        return robot_cache_dir(self.data_dir)
 
     @property
     def is_loopback(self) -> bool:
