@@ -19,6 +19,7 @@ PACKAGES = (
     "studio.web",
     "studio.samples",
     "studio.export",
+    "studio.physics",
 )
 OWNER = re.compile(r"`(studio\.[a-z]+)(?:\.([\w.]+))?`(?: \(([^)|]*)\))?")
 

@@ -19,9 +19,13 @@ from ._lerobot import CODEBASE_VERSION as CODEBASE_VERSION
 from ._lerobot import write_lerobot as write_lerobot
 from ._likeness import demonstration_of as demonstration_of
 from ._likeness import likeness_motions as likeness_motions
+from ._read import Trajectory as Trajectory
+from ._read import read_trajectory as read_trajectory
 from ._safety import COLLISION_MARGIN_M as COLLISION_MARGIN_M
 from ._safety import Finding as Finding
 from ._safety import check_trajectory as check_trajectory
+from ._simulate import physics_model as physics_model
+from ._simulate import simulate_trajectory as simulate_trajectory
 from ._sources import Motion as Motion
 from ._sources import check_policy_robot as check_policy_robot
 from ._sources import demonstration_motion as demonstration_motion

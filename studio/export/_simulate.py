@@ -1,0 +1,94 @@
+"""A robot's trajectory checked in physics: :func:`simulate_trajectory` replays it in MuJoCo.
+
+The robot's MuJoCo model is built from the URDF folder ``studio export-urdf --robot NAME``
+writes (:func:`~._urdf.export_urdf`: the studio's own URDF, meshes beside it), kept in the cache
+folder under a name that changes with the URDF, so it is written and converted once per machine;
+the compiled model is kept per robot for the process. :mod:`studio.physics` does the rest.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import shutil
+import tempfile
+import threading
+from pathlib import Path
+
+import numpy as np
+
+from studio.kinematics import RobotArm, load_robot
+from studio.physics import PhysicsModel, SimulationReport, build_model, mujoco_urdf, simulate
+
+from ._errors import ExportError
+from ._urdf import export_urdf
+
+_models: dict[str, PhysicsModel] = {}
+_lock = threading.Lock()
+_scratch: list[Path] = []
+
+
+def _folder(arm: RobotArm, cache: Path | None) -> Path:
+    """The robot's URDF folder in ``cache`` (a process-wide temporary folder when None)."""
+    if cache is None:
+        if not _scratch:
+            _scratch.append(Path(tempfile.mkdtemp(prefix="studio-physics-")))
+        cache = _scratch[0]
+    digest = hashlib.sha256(arm.urdf_text.encode("utf-8")).hexdigest()[:12]
+    folder = cache / f"{arm.name}-{digest}"
+    urdf = folder / f"{arm.name}.urdf"
+    if not urdf.is_file():
+        if folder.exists():
+            shutil.rmtree(folder, ignore_errors=True)  # not ours: export_urdf renames whole
+        try:
+            export_urdf(arm, folder)
+        except ExportError:
+            if not urdf.is_file():  # another process wrote the same folder meanwhile: fine
+                raise
+    return folder
+
+
+def physics_model(robot: RobotArm | str, cache: Path | None = None) -> PhysicsModel:
+    """The robot's MuJoCo model (built once per process; its files kept in ``cache``).
+
+    Raises:
+        ExportError: the URDF folder cannot be written.
+        PhysicsError: MuJoCo cannot compile it.
+    """
+    arm = load_robot(robot) if isinstance(robot, str) else robot
+    with _lock:
+        model = _models.get(arm.name)
+        if model is None:
+            folder = _folder(arm, cache)
+            model = build_model(arm, mujoco_urdf(folder / f"{arm.name}.urdf", folder / "converted"))
+            _models[arm.name] = model
+    return model
+
+
+def simulate_trajectory(
+    robot: RobotArm | str,
+    times: np.ndarray,
+    q: np.ndarray,
+    *,
+    names: tuple[str, ...] | None = None,
+    cache: Path | None = None,
+) -> SimulationReport:
+    """Replay ``q`` at ``times`` in MuJoCo on ``robot`` (:func:`studio.physics.simulate`).
+
+    Args:
+        robot: the robot or its name.
+        times: seconds, one per sample.
+        q: radians, one row per sample.
+        names: the joint names the trajectory gives, checked against the robot's.
+        cache: the folder the robot's MuJoCo files are kept in (None: a temporary one).
+
+    Raises:
+        ExportError: ``names`` are not the robot's joints.
+        PhysicsError: a malformed trajectory, or a model MuJoCo cannot compile.
+    """
+    arm = load_robot(robot) if isinstance(robot, str) else robot
+    if names is not None and tuple(names) != arm.joint_names:
+        raise ExportError(
+            f"The trajectory's joints ({', '.join(names)}) are not the {arm.spec.title}'s "
+            f"({', '.join(arm.joint_names)}); give the --robot it was exported for."
+        )
+    return simulate(physics_model(arm, cache), times, q)

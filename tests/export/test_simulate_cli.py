@@ -1,0 +1,86 @@
+"""``studio simulate FILE --robot NAME [--json]``: an exported file replayed in physics, and
+bad inputs refused in one sentence with exit status 2."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from studio.cli import main
+from studio.export import read_trajectory, write_csv, write_mcap
+from studio.kinematics import load_robot
+from studio.physics import JSON_KEYS
+from tests.physics.motions import smooth_move
+
+
+@pytest.fixture(scope="module")
+def physics_cache(tmp_path_factory):
+    return tmp_path_factory.mktemp("physics-cache")
+
+
+@pytest.fixture(scope="module")
+def gentle(tmp_path_factory):
+    """A gentle Panda move written as CSV and as MCAP (as `studio export` writes them)."""
+    arm = load_robot("panda")
+    times, q = smooth_move(arm.home, arm.home + 0.2, 1.5)
+    folder = tmp_path_factory.mktemp("simulate")
+    write_csv(folder / "gentle.csv", arm.joint_names, times, q, ["a note"])
+    write_mcap(folder / "gentle.mcap", arm.joint_names, times, q, states=False, metadata={})
+    write_mcap(folder / "states.mcap", arm.joint_names, times, q, states=True, metadata={})
+    return folder, times, q
+
+
+@pytest.mark.parametrize("name", ["gentle.csv", "gentle.mcap", "states.mcap"])
+def test_the_export_formats_read_back_whole(gentle, name):
+    folder, times, q = gentle
+    trajectory = read_trajectory(folder / name)
+    assert trajectory.names == load_robot("panda").joint_names
+    np.testing.assert_allclose(trajectory.times, times, atol=1e-9)
+    np.testing.assert_allclose(trajectory.q, q, rtol=1e-8)
+
+
+def test_json_is_one_object_with_exactly_the_keys(gentle, capsys, physics_cache):
+    folder, _, _ = gentle
+    code = main(
+        ["simulate", str(folder / "gentle.mcap"), "--robot", "panda", "--json",
+         "--data-dir", str(physics_cache)]
+    )  # fmt: skip
+    assert code == 0
+    report = json.loads(capsys.readouterr().out)
+    assert list(report) == list(JSON_KEYS)
+    assert report["completed"] is True and report["contacts"] == []
+    assert report["saturated_samples"] == 0
+    assert 0 <= report["max_tool_error_m"] < 0.002
+
+
+def test_the_human_report_says_the_verdict(gentle, capsys, physics_cache):
+    folder, _, _ = gentle
+    args = ["simulate", str(folder / "gentle.csv"), "--robot", "panda"]
+    assert main([*args, "--data-dir", str(physics_cache)]) == 0
+    out = capsys.readouterr().out
+    assert "completed" in out and "saturation: none" in out and "contacts: none" in out
+
+
+@pytest.mark.parametrize(
+    ("name", "content", "robot", "problem"),
+    [
+        ("missing.csv", None, "panda", "cannot open"),
+        ("gentle.csv", "", "ur5", "are not the Universal Robots UR5's"),
+        ("gentle.csv", "", "nosuchrobot", "Unknown robot"),
+        ("bad.csv", "time,a\n1,x\n", "panda", "not numbers"),
+        ("noheader.csv", "1,2,3\n", "panda", "header"),
+        ("bad.mcap", "not an mcap", "panda", "cannot be read as MCAP"),
+        ("traj.txt", "x", "panda", "neither a .csv nor a .mcap"),
+    ],
+)
+def test_a_bad_input_is_one_sentence_and_exit_2(gentle, capsys, name, content, robot, problem):
+    folder, _, _ = gentle
+    path = folder / name
+    if content:
+        path.write_text(content)
+    assert main(["simulate", str(path), "--robot", robot, "--json"]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == ""
+    assert problem in captured.err and captured.err.count("\n") == 1, captured.err
