@@ -27,3 +27,9 @@ def mesh_cache_dir(data_dir: str | os.PathLike[str]) -> Path:
 def robot_cache_dir(data_dir: str | os.PathLike[str]) -> Path:
     """Where the robots' built models and collision hulls are kept (a cache: safe to delete)."""
     return Path(data_dir) / CACHE_DIR / "robots"
+
+
+def physics_cache_dir(data_dir: str | os.PathLike[str]) -> Path:
+    """Where the robots' MuJoCo files (their URDF folders, converted meshes) are kept (a cache:
+    safe to delete)."""
+    return Path(data_dir) / CACHE_DIR / "physics"

@@ -34,23 +34,25 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--data-dir",
         type=Path,
         default=Path("."),
-        help="data folder whose cache/physics keeps each robot's MuJoCo files (default: .)",
+        help="data folder whose cache keeps each robot's built model and MuJoCo files (default: .)",
     )
 
 
 def run(args: argparse.Namespace) -> int:
     # imported here so that `studio --help` stays fast (MuJoCo, Pinocchio)
+    from studio._layout import physics_cache_dir, robot_cache_dir
     from studio.export import read_trajectory, simulate_trajectory
-    from studio.kinematics import load_robot, robot_spec
+    from studio.kinematics import isolate_robot_loading, robot_spec
 
     robot_spec(args.robot)  # an unknown name: one sentence before the file is read
     trajectory = read_trajectory(args.file)
+    isolate_robot_loading(robot_cache_dir(args.data_dir))  # built once per machine, as export's
     report = simulate_trajectory(
-        load_robot(args.robot),
+        args.robot,
         trajectory.times,
         trajectory.q,
         names=trajectory.names,
-        cache=args.data_dir / "cache" / "physics",
+        cache=physics_cache_dir(args.data_dir),
     )
     if args.json:
         print(json.dumps(report.as_json()))

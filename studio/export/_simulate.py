@@ -85,10 +85,11 @@ def simulate_trajectory(
         ExportError: ``names`` are not the robot's joints.
         PhysicsError: a malformed trajectory, or a model MuJoCo cannot compile.
     """
-    arm = load_robot(robot) if isinstance(robot, str) else robot
-    if names is not None and tuple(names) != arm.joint_names:
+    # the joints are checked on the model without geometry: a wrong robot is refused at once
+    light = load_robot(robot, geometry=False) if isinstance(robot, str) else robot
+    if names is not None and tuple(names) != light.joint_names:
         raise ExportError(
-            f"The trajectory's joints ({', '.join(names)}) are not the {arm.spec.title}'s "
-            f"({', '.join(arm.joint_names)}); give the --robot it was exported for."
+            f"The trajectory's joints ({', '.join(names)}) are not the {light.spec.title}'s "
+            f"({', '.join(light.joint_names)}); give the --robot it was exported for."
         )
-    return simulate(physics_model(arm, cache), times, q)
+    return simulate(physics_model(robot, cache), times, q)

@@ -80,7 +80,8 @@ def test_a_bad_input_is_one_sentence_and_exit_2(gentle, capsys, name, content, r
     path = folder / name
     if content:
         path.write_text(content)
-    assert main(["simulate", str(path), "--robot", robot, "--json"]) == 2
+    args = ["simulate", str(path), "--robot", robot, "--json", "--data-dir", str(folder)]
+    assert main(args) == 2
     captured = capsys.readouterr()
     assert captured.out == ""
     assert problem in captured.err and captured.err.count("\n") == 1, captured.err
