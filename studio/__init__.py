@@ -22,6 +22,7 @@ from ._json import TOMLFileError as TOMLFileError
 from ._json import loads_json as loads_json
 from ._json import read_json as read_json
 from ._json import read_toml as read_toml
+from ._json import unpaired_surrogate as unpaired_surrogate
 from ._net import is_loopback as is_loopback
 
 __version__ = "0.1.0"

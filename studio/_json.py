@@ -36,6 +36,10 @@ _STRING = re.compile(rb'"[^"\\]*(?:\\.[^"\\]*)*"', re.DOTALL)
 _BRACKET_STEP = np.zeros(256, dtype=np.int8)
 _BRACKET_STEP[[ord("["), ord("{")]] = 1
 _BRACKET_STEP[[ord("]"), ord("}")]] = -1
+_SURROGATE_ESCAPE = re.compile(rb"\\u[dD][89a-fA-F]")
+"""A JSON escape of a UTF-16 surrogate: the only way a JSON text can hold an unpaired one."""
+_SURROGATE = re.compile("[\ud800-\udfff]")
+"""An unpaired surrogate in a Python string (a shell's non-UTF-8 byte, or a lone JSON escape)."""
 
 
 class JSONFileError(StudioError, ValueError):
@@ -93,7 +97,7 @@ def loads_json(
             "damaged or not a Teach Studio file."
         )
     try:
-        return json.loads(text)
+        value = json.loads(text)
     except UnicodeDecodeError:
         raise JSONFileError(f"{what} is not UTF-8 text; it is damaged or not JSON.") from None
     except json.JSONDecodeError as err:
@@ -103,6 +107,46 @@ def loads_json(
         ) from None
     except (ValueError, RecursionError) as err:  # e.g. an integer of more than 4300 digits
         raise JSONFileError(f"{what} is not usable JSON ({err}); fix or re-export it.") from None
+    raw = text.encode("utf-8", errors="surrogatepass") if isinstance(text, str) else bytes(text)
+    if _SURROGATE_ESCAPE.search(raw):  # a text stored before such names were refused
+        value = _replace_surrogates(value)
+    return value
+
+
+def unpaired_surrogate(value: object, where: str = "") -> tuple[str, str] | None:
+    """Where a parsed value holds a string that is not text: ``(path, string)`` or None.
+
+    An unpaired UTF-16 surrogate (a byte a non-UTF-8 shell passed, or a lone ``\\udce9`` escape in
+    JSON) cannot be written as UTF-8, so a name holding one would break every answer that lists it.
+
+    Args:
+        value: a string, or parsed JSON (lists and dicts, keys included).
+        where: the path of ``value`` (``"name"``, ``"tags.2"``), for the caller's sentence.
+    """
+    stack = [(value, where)]
+    while stack:
+        item, path = stack.pop()
+        if isinstance(item, str):
+            if _SURROGATE.search(item):
+                return path, item
+        elif isinstance(item, dict):
+            for key, child in item.items():
+                inner = f"{path}.{key}" if path else str(key)
+                stack.extend([(child, inner), (key, inner)])
+        elif isinstance(item, list | tuple):
+            stack.extend((child, f"{path}.{i}" if path else str(i)) for i, child in enumerate(item))
+    return None
+
+
+def _replace_surrogates(value: object) -> object:
+    """``value`` with each unpaired surrogate replaced by U+FFFD, so it can be shown and saved."""
+    if isinstance(value, str):
+        return _SURROGATE.sub("\ufffd", value)
+    if isinstance(value, dict):
+        return {_replace_surrogates(k): _replace_surrogates(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [_replace_surrogates(item) for item in value]
+    return value
 
 
 def read_json(

@@ -20,6 +20,7 @@ from typing import NoReturn
 
 from . import __version__, commands
 from ._errors import StudioError
+from ._json import unpaired_surrogate
 
 DEFAULT_VERB = "serve"
 
@@ -82,6 +83,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         parser.exit(
             2, f"{where}: unrecognized arguments: {' '.join(unknown)}; see {where} --help.\n"
         )
+    broken = _broken_text(args)
+    if broken is not None:
+        parser.exit(2, f"studio {args.verb}: {broken}\n")
     try:
         return int(modules[args.verb].run(args) or 0)
     except StudioError as err:
@@ -95,6 +99,29 @@ def main(argv: Sequence[str] | None = None) -> int:
         # Point stdout at /dev/null so the interpreter's final flush cannot fail again.
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
+
+
+def _broken_text(args: argparse.Namespace) -> str | None:
+    """The sentence refusing an argument that is not text (a shell's non-UTF-8 byte), or None.
+
+    Such a name, stored in a run's or a recording's file, could never be shown as UTF-8. A path
+    to an existing file is left alone: the operating system names it by those same bytes.
+    """
+    for dest, value in vars(args).items():
+        found = unpaired_surrogate(value, "--" + dest.replace("_", "-"))
+        if found is None or os.path.lexists(found[1]):
+            continue
+        option, text = found
+        try:
+            raw = text.encode("utf-8", errors="surrogateescape")
+        except UnicodeEncodeError:  # a surrogate no shell byte stands for
+            raw = text.encode("utf-8", errors="backslashreplace")
+        given = raw.decode("ascii", "backslashreplace")
+        return (
+            f"{option.split('.')[0]} '{given}' is not UTF-8 text; type it again in a terminal set "
+            "to UTF-8 (or with plain ASCII letters)."
+        )
+    return None
 
 
 if __name__ == "__main__":

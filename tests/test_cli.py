@@ -147,3 +147,24 @@ def test_info_takes_a_samples_name_as_train_and_export_do(
     monkeypatch.chdir(tmp_path)
     assert main(["info", name, "--json"]) == 0
     assert says in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(
+    ("argv", "option"),
+    [
+        (["train", "--name", "caf\udce9", "--episodes", "2"], "--name 'caf\\xe9'"),
+        (["record", "--operator", "Jos\udce9", "--out", "x.tape.csv"], "--operator 'Jos\\xe9'"),
+    ],
+)
+def test_a_name_a_latin1_shell_sent_is_refused_in_one_sentence(
+    argv, option, tmp_path, capsys, monkeypatch
+):
+    """A shell's non-UTF-8 byte reaches Python as a lone surrogate; stored, it once broke the
+    page's whole run or recording list. Refused before anything is made."""
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(SystemExit) as exc:
+        main(argv)
+    assert exc.value.code == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith(f"studio {argv[0]}: {option} is not UTF-8")
+    assert not list(tmp_path.iterdir())

@@ -13,7 +13,7 @@ from collections.abc import AsyncIterator, Mapping, Sequence
 from contextlib import asynccontextmanager
 from pathlib import Path
 
-from fastapi import FastAPI, Request
+from fastapi import Depends, FastAPI, Request
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import FileResponse, JSONResponse
 from fastapi.staticfiles import StaticFiles
@@ -24,6 +24,7 @@ from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from studio import StudioError, __version__, human_size
 
+from ._deps import refuse_broken_text
 from ._errors import (
     NotFoundError,
     StorageError,
@@ -88,6 +89,7 @@ def create_app(settings: Settings | None = None, scene: Scene | None = None) -> 
         description="Teach a robot arm by showing it a motion: capture, demonstrations, "
         "Dyna-Q training with live curves, policies. The contract is docs/api.md.",
         lifespan=lifespan,
+        dependencies=[Depends(refuse_broken_text)],
     )
     app.dependency_overrides[get_settings] = lambda: settings
     app.add_middleware(UploadLimitMiddleware, limit=settings.upload_limit_bytes)
