@@ -1,6 +1,6 @@
 """Which action set of the continuous arm task learns and looks better: one joint per action,
 also two joints together (the diagonals), or any joints at once; and for the multi-joint sets,
-one weight column per action against the factored action value (``studio.learning._factored``:
+one weight column per action against the factored action value (``studio.learning.linear._factored``:
 a per-joint term for each joint's part of the move, each learning from its joint's share of the
 reward).
 
@@ -37,7 +37,7 @@ from contextlib import contextmanager
 import gymnasium
 import numpy as np
 
-import studio.learning._linear as linear
+import studio.learning.linear._linear as linear
 from studio.learning import (
     ACTION_SETS,
     ArmReach,
@@ -46,9 +46,9 @@ from studio.learning import (
     policy_likeness_card,
     run_experiments,
 )
-from studio.learning._gym import ARM_REACH_ID
-from studio.learning._linear import greedy_success
-from studio.learning._linear_policy import DEFAULT_SECONDS_PER_STEP
+from studio.learning.linear._linear import greedy_success
+from studio.learning.linear._policy import DEFAULT_SECONDS_PER_STEP
+from studio.learning.tasks._gym import ARM_REACH_ID
 
 SEED = 0
 STARTS = 200

@@ -15,7 +15,7 @@ and the run without demonstrations share the seed ``k`` (the same start states, 
 3. Control: the default shaping, with against without demonstrations (goal: never more than 2
    points lower).
 4. Variants of the demonstrations' potential (``--variants``): its weight and kappa
-   (:mod:`studio.learning._demo_shaping`), and the replay alone (weight 0, the earlier method).
+   (:mod:`studio.learning.tasks._demo_shaping`), and the replay alone (weight 0, the earlier method).
 5. ``--long N``: greedy success with demonstrations under the paper's reward after N episodes.
 6. ``--actions SET``: every run with that action set (default: the task's default, ``follow``)
    and its default features; with ``follow`` the demonstrations are also the paths its follow
@@ -39,12 +39,12 @@ import gymnasium
 import numpy as np
 from scipy import stats
 
-import studio.learning._linear as linear
-import studio.learning._linear_env as linear_env
+import studio.learning.linear._env as linear_env
+import studio.learning.linear._linear as linear
 from studio.learning import ACTION_SETS, ArmReach, DynaQConfig, LearningError, run_experiments
-from studio.learning._beyond import demonstration_paths
-from studio.learning._demo_shaping import demo_potential
-from studio.learning._linear import greedy_success
+from studio.learning.linear._linear import greedy_success
+from studio.learning.paper._beyond import demonstration_paths
+from studio.learning.tasks._demo_shaping import demo_potential
 
 CAP = 3_000
 DEMOS = 3

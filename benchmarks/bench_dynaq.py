@@ -36,7 +36,7 @@ sys.path.insert(0, str(Path(__file__).parent))
 from dynaq_reference import run_experiment as reference_experiment  # noqa: E402
 
 from studio.learning import ArmGrid, DynaQConfig, generate_demonstrations, run_experiments, warm_up  # noqa: E402
-from studio.learning._reproduce import CONFIGURATIONS, DEMONSTRATIONS  # noqa: E402
+from studio.learning.paper._reproduce import CONFIGURATIONS, DEMONSTRATIONS  # noqa: E402
 
 EXPERIMENTS = 20
 EPISODES = 100

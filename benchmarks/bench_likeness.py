@@ -27,7 +27,7 @@ each ``studio/samples/sample-reach-*.demo.json``:
    other action sets (the pairs, and ``follow``: one joint, or all of them along the
    demonstration), and (``--path-potential``) with the
    demonstrations' potential over the whole demonstrated path (kappa 2, weight 5 on top of the
-   task's shaping; :mod:`studio.learning._demo_shaping`), which pulls the greedy path along the
+   task's shaping; :mod:`studio.learning.tasks._demo_shaping`), which pulls the greedy path along the
    demonstration rather than only to its end.
 6. The card's smoothness against the tape's noise (``--noise``, about a minute): NOISE_REACHES
    simulated reaches, each recorded twice, with the tape's sensor noise and without it (the same
@@ -50,7 +50,7 @@ from pathlib import Path
 import gymnasium
 import numpy as np
 
-import studio.learning._linear as linear
+import studio.learning.linear._linear as linear
 from studio.capture import (
     Demonstration,
     OperatorConfig,
@@ -82,8 +82,8 @@ from studio.learning import (
     run_experiments,
     sparc,
 )
-from studio.learning._likeness import LDLJ_CUTOFF_HZ
-from studio.learning._linear import greedy_success
+from studio.learning.likeness._likeness import LDLJ_CUTOFF_HZ
+from studio.learning.linear._linear import greedy_success
 
 SAMPLES = sorted((Path(__file__).resolve().parents[1] / "studio" / "samples").glob("*.demo.json"))
 GOAL_DTW_RAD = 0.02
@@ -179,7 +179,7 @@ def timing(path: Path) -> None:
 def path_potential() -> None:
     """Every later run: the demonstrations' potential along their whole path (kappa 2), weight 5
     beyond the task's own shaping."""
-    from studio.learning._demo_shaping import demo_potential
+    from studio.learning.tasks._demo_shaping import demo_potential
 
     shaping = ArmReach().shaping
     linear.demo_potential = functools.partial(demo_potential, weight=5.0 + shaping, kappa=2.0)

@@ -70,9 +70,9 @@ from studio.learning import (
     greedy_rollout,
     run_experiments,
 )
-from studio.learning._gym import ARM_REACH_ID
-from studio.learning._linear import greedy_success
-from studio.learning._reach import reach_step
+from studio.learning.linear._linear import greedy_success
+from studio.learning.tasks._gym import ARM_REACH_ID
+from studio.learning.tasks._reach import reach_step
 
 STARTS = 200
 CAP = 3_000

@@ -22,8 +22,8 @@ import gymnasium
 import numpy as np
 
 from studio.learning import ArmReach, DynaQConfig, run_experiments
-from studio.learning._gym import ARM_REACH_ID
-from studio.learning._linear import greedy_success
+from studio.learning.linear._linear import greedy_success
+from studio.learning.tasks._gym import ARM_REACH_ID
 
 SEED = 0
 STARTS = 200

@@ -52,9 +52,9 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from studio.learning import warm_up
-from studio.learning._runs import RunFolder
-from studio.learning._sweep_ray import _connect, _import_ray, run_sweep
-from studio.learning._sweep_spec import parse_sweep_spec, trial_record
+from studio.learning.runs._folder import RunFolder
+from studio.learning.sweeps._ray import _connect, _import_ray, run_sweep
+from studio.learning.sweeps._spec import parse_sweep_spec, trial_record
 
 SIZES = (4, 16)
 REPEATS = 2

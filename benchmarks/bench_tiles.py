@@ -29,7 +29,7 @@ from tiles_reference import run_experiment as reference_experiment  # noqa: E402
 
 from studio.learning import ArmReach, DynaQConfig, TileCoding, run_experiments  # noqa: E402
 from studio.learning._learner import experiment_seed  # noqa: E402
-from studio.learning._linear_env import reset_seed  # noqa: E402
+from studio.learning.linear._env import reset_seed  # noqa: E402
 
 EPISODES = 500
 SEED = 0

@@ -2,7 +2,7 @@
 
 A line-by-line transcription of semi-gradient Q-learning with tile-coded features (Sutton & Barto,
 section 10.1, with Q-learning's max target) and Dyna planning from a sample model of the visited
-transitions, as :mod:`studio.learning._linear` describes it: lists and floats only, the
+transitions, as :mod:`studio.learning.linear._linear` describes it: lists and floats only, the
 environment's own ``step``, and the same splitmix64 draws, so on the same seed it must give the
 same weights bit for bit (``tests/learning/test_linear.py``), and ``bench_tiles.py`` compares
 speed on equal work. Planners: zero, full and soft (prioritized sweeping is not transcribed).

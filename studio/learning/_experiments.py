@@ -11,12 +11,12 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ._config import DynaQConfig
-from ._dynaq import run_tabular_experiments
 from ._errors import LearningError
 from ._learner import ExperimentResult, LiveProgress
-from ._linear import run_linear_experiments
-from ._mdp import TabularMDP
 from ._tiles import TileCoding
+from .linear._linear import run_linear_experiments
+from .tabular._dynaq import run_tabular_experiments
+from .tasks._mdp import TabularMDP
 
 if TYPE_CHECKING:
     import gymnasium

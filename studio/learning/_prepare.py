@@ -27,11 +27,11 @@ import time
 import numpy as np
 
 from ._config import DynaQConfig
-from ._dynaq import _run_experiment
 from ._experiments import run_experiments
 from ._learner import LiveProgress
-from ._mdp import TabularMDP
-from ._run_record import TASK_ARM_GRID, TASK_ARM_REACH, TASK_KINDS
+from .runs._record import TASK_ARM_GRID, TASK_ARM_REACH, TASK_KINDS
+from .tabular._dynaq import _run_experiment
+from .tasks._mdp import TabularMDP
 
 log = logging.getLogger(__name__)
 
@@ -55,7 +55,7 @@ _background: tuple[subprocess.Popen | None, str | None] = (None, None)  # child,
 def _kernels(kind: str) -> list:
     """The task's compiled entry points (their callees are compiled into them)."""
     if kind == TASK_ARM_REACH:
-        from ._linear import _greedy_episode, _run_compiled
+        from .linear._linear import _greedy_episode, _run_compiled
 
         return [_run_compiled, _greedy_episode]
     return [_run_experiment]
@@ -89,9 +89,9 @@ def _warm(kind: str) -> None:
     if kind == TASK_ARM_REACH:
         import gymnasium
 
-        from ._gym import ARM_REACH_ID
-        from ._linear import greedy_rollout
-        from ._reach import ArmReach
+        from .linear._linear import greedy_rollout
+        from .tasks._gym import ARM_REACH_ID
+        from .tasks._reach import ArmReach
 
         task = ArmReach(joints=3)
         coding = task.features()

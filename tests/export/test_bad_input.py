@@ -11,7 +11,7 @@ from studio.cli import main
 from studio.export import ExportError, export_urdf, find_source, portable_urdf
 from studio.kinematics import robot_spec
 from studio.learning import ArmGrid, DynaQConfig
-from studio.learning._policy import save_policy
+from studio.learning.tabular._policy import save_policy
 from studio.samples import SAMPLES_DIR
 
 

@@ -26,7 +26,7 @@ from studio.learning import (
     rollout_dmp_policy,
     save_dmp_policy,
 )
-from studio.learning._likeness import robot_tool_positions
+from studio.learning.likeness._likeness import robot_tool_positions
 from studio.samples import SAMPLES_DIR
 from tests.export.test_roundtrip import read_csv
 

@@ -22,9 +22,9 @@ from studio.learning import (
     resolve_run,
     run_experiments,
 )
-from studio.learning._gym import ARM_REACH_ID
-from studio.learning._linear_policy import save_tile_policy
-from studio.learning._reach import action_directions, reach_step
+from studio.learning.linear._policy import save_tile_policy
+from studio.learning.tasks._gym import ARM_REACH_ID
+from studio.learning.tasks._reach import action_directions, reach_step
 from studio.web._schemas import ReachRunCreate
 
 
@@ -146,7 +146,7 @@ def test_a_bad_action_set_is_refused_in_one_sentence(capsys):
 
 
 def test_a_sweep_trial_takes_the_action_set():
-    from studio.learning._sweep_spec import resolve_trial
+    from studio.learning.sweeps._spec import resolve_trial
 
     record = resolve_trial("arm-reach", {"joints": 3, "actions": "all"}, 1, 2, 0)
     assert record.arm_reach().n_actions == 26

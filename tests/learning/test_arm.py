@@ -6,7 +6,7 @@ from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 from studio.learning import MAX_TABLE_ENTRIES, ArmGrid, DynaQConfig, LearningError, run_experiments
-from studio.learning._arm import erase_loops
+from studio.learning.tasks._arm import erase_loops
 
 grids = st.builds(
     ArmGrid,

@@ -24,9 +24,9 @@ from studio.learning import (
     load_any_policy,
     load_policy,
 )
-from studio.learning._curves import CURVE_COLUMNS, TIME_COLUMNS
-from studio.learning._goal import goal_problems
-from studio.learning._reproduce import CONFIGURATIONS, EXTENSIONS, PAPER_MATLAB_SECONDS
+from studio.learning.paper._reproduce import CONFIGURATIONS, EXTENSIONS, PAPER_MATLAB_SECONDS
+from studio.learning.runs._curves import CURVE_COLUMNS, TIME_COLUMNS
+from studio.learning.tasks._goal import goal_problems
 from studio.web import create_app
 from studio.web._schemas import ReachRunCreate
 from tests.web.conftest import TINY_RUN, make_settings, wait_run

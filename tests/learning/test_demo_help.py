@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from studio.learning import ArmReach, DynaQConfig, run_experiments
-from studio.learning._beyond import demonstration_paths
-from studio.learning._demo_shaping import DEMO_SHAPING, demo_potential, potential
+from studio.learning.paper._beyond import demonstration_paths
+from studio.learning.tasks._demo_shaping import DEMO_SHAPING, demo_potential, potential
 
 ARM = "TeachStudio/ArmReach-v0"
 

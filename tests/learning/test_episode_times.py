@@ -18,18 +18,18 @@ from studio.learning import (
     LiveProgress,
     RunFolder,
     RunRecord,
-    _run_train,
     curve_statistics,
     curves_csv,
 )
-from studio.learning._curves import (
+from studio.learning.runs import _train as _run_train
+from studio.learning.runs._curves import (
     CURVE_COLUMNS,
     TIME_COLUMNS,
     downsample_curve,
     episode_seconds,
     read_curve_times,
 )
-from studio.learning._run_train import EpisodeClock
+from studio.learning.runs._train import EpisodeClock
 from tests.learning.test_runs import tiny_record
 
 

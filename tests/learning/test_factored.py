@@ -6,10 +6,9 @@ import gymnasium
 import numpy as np
 import pytest
 
-import studio.learning._linear as linear
+import studio.learning.linear._linear as linear
 from studio.learning import ArmReach, DynaQConfig, TileCoding, run_experiments
-from studio.learning._demo_shaping import demo_potential, no_potential, potential
-from studio.learning._factored import (
+from studio.learning.linear._factored import (
     action_components,
     expand,
     factored_values,
@@ -18,9 +17,10 @@ from studio.learning._factored import (
     slot_joints,
     split_reward,
 )
-from studio.learning._gym import ARM_REACH_ID
-from studio.learning._linear import greedy_success
-from studio.learning._reach import reach_potential, reach_step
+from studio.learning.linear._linear import greedy_success
+from studio.learning.tasks._demo_shaping import demo_potential, no_potential, potential
+from studio.learning.tasks._gym import ARM_REACH_ID
+from studio.learning.tasks._reach import reach_potential, reach_step
 
 
 def brute_force(task, coder, w, obs):

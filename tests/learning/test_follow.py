@@ -26,17 +26,17 @@ from studio.learning import (
     resolve_run,
     run_experiments,
 )
-from studio.learning._beyond import demonstration_paths
-from studio.learning._common_value import without_common
-from studio.learning._gym import ARM_REACH_ID
-from studio.learning._linear import _q_values, greedy_success
-from studio.learning._linear_policy import (
+from studio.learning.linear._common_value import without_common
+from studio.learning.linear._linear import _q_values, greedy_success
+from studio.learning.linear._policy import (
     demonstrated_pace,
     load_tile_policy,
     rollout_tile_policy,
     save_tile_policy,
 )
-from studio.learning._reach import reach_step
+from studio.learning.paper._beyond import demonstration_paths
+from studio.learning.tasks._gym import ARM_REACH_ID
+from studio.learning.tasks._reach import reach_step
 
 SAMPLES = Path(__file__).resolve().parents[2] / "studio" / "samples"
 
@@ -246,7 +246,7 @@ def test_following_from_anywhere_reaches_the_goal_without_going_round_in_circles
     """Three straight demonstrations from random starts: the follow action alone brings every
     random start to the goal. (Heading for the nearest point instead, a start between two paths
     went to and fro between them for ever: 25% of these starts.)"""
-    from studio.learning._beyond import demonstration_paths
+    from studio.learning.paper._beyond import demonstration_paths
 
     task = ArmReach(joints=6)
     paths = demonstration_paths(task, 3, np.random.default_rng([1, 6]))

@@ -9,8 +9,8 @@ from gymnasium.utils.env_checker import check_env
 
 import studio.learning  # noqa: F401  (registers the environments)
 from studio.learning import ArmGrid, ArmReach, LearningError
-from studio.learning._gym import ARM_GRID_ID, ARM_REACH_ID
-from studio.learning._reach import reach_step
+from studio.learning.tasks._gym import ARM_GRID_ID, ARM_REACH_ID
+from studio.learning.tasks._reach import reach_step
 
 
 @pytest.mark.filterwarnings("ignore:.*render_mode")

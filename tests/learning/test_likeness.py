@@ -20,7 +20,7 @@ from studio.learning import (
     likeness_card,
     sparc,
 )
-from studio.learning._likeness import (
+from studio.learning.likeness._likeness import (
     joint_shares,
     js_divergence,
     moving_span,
@@ -301,7 +301,7 @@ def test_every_policy_kind_gets_a_card_from_the_demonstrations_start(tmp_path):
         load_policy,
         policy_likeness_card,
     )
-    from studio.learning._policy import save_policy
+    from studio.learning.tabular._policy import save_policy
     from studio.samples import __file__ as samples
 
     demo = load_demonstration(Path(samples).parent / "sample-reach-2.demo.json")

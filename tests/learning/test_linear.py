@@ -13,8 +13,8 @@ import pytest
 
 from studio.learning import ArmReach, DynaQConfig, LearningError, TileCoding, run_experiments
 from studio.learning._learner import experiment_seed
-from studio.learning._linear import LinearResult
-from studio.learning._linear_env import _MOUNTAIN_CAR_PARAMS, mountain_car_step, reset_seed
+from studio.learning.linear._env import _MOUNTAIN_CAR_PARAMS, mountain_car_step, reset_seed
+from studio.learning.linear._linear import LinearResult
 
 REFERENCE = Path(__file__).resolve().parents[2] / "benchmarks" / "tiles_reference.py"
 MOUNTAIN_CAR = dict(alpha=0.5, gamma=1.0, epsilon=0.0)  # Sutton & Barto, section 10.1
@@ -189,7 +189,7 @@ def test_bad_input_one_sentence_each():
 
 def test_rollout_sample_times_end_once_at_the_duration():
     # 188 steps of 0.04 s end 1e-15 s past the 376th tick at 50 Hz: one sample there, not two
-    from studio.learning._linear_policy import sample_times
+    from studio.learning.linear._policy import sample_times
 
     for steps, per_step, rate in (
         (188, 0.04, 50.0),

@@ -16,7 +16,7 @@ from studio.learning import (
     run_experiments,
     save_trajectory_csv,
 )
-from studio.learning._policy import save_policy
+from studio.learning.tabular._policy import save_policy
 
 
 @pytest.fixture(scope="module")

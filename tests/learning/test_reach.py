@@ -26,10 +26,10 @@ from studio.learning import (
     load_any_policy,
     run_experiments,
 )
-from studio.learning._gym import ARM_REACH_ID
-from studio.learning._linear import greedy_success
-from studio.learning._linear_policy import save_tile_policy
-from studio.learning._reach import reach_step
+from studio.learning.linear._linear import greedy_success
+from studio.learning.linear._policy import save_tile_policy
+from studio.learning.tasks._gym import ARM_REACH_ID
+from studio.learning.tasks._reach import reach_step
 
 ROBOT = Puma560()
 
@@ -176,7 +176,7 @@ def test_a_continuous_run_folder_trains_saves_and_reads_back(tmp_path):
 
 
 def test_beyond_the_paper_measures_memory_and_success(tmp_path):
-    from studio.learning._beyond import beyond_the_paper, memory_row
+    from studio.learning.paper._beyond import beyond_the_paper, memory_row
 
     row = memory_row(ArmReach(joints=6))
     assert row["paper_entries"] == 11**6 * 3**6  # the paper's grid at six joints
@@ -203,7 +203,7 @@ def test_six_joint_greedy_policy_reaches_the_goal_from_random_starts_without_osc
 
 
 def test_first_own_success_counts_episodes_after_the_demonstrations():
-    from studio.learning._beyond import _first_own_success
+    from studio.learning.paper._beyond import _first_own_success
 
     steps = np.array([[40, 50, 3000, 700, 9], [40, 50, 3000, 3000, 3000]])
     assert _first_own_success(steps, 2, 3000) == [[2, 700], None]

@@ -25,10 +25,10 @@ from studio.learning import (
     load_any_policy,
     run_experiments,
 )
-from studio.learning._linear import greedy_rollout, greedy_success
-from studio.learning._linear_policy import save_tile_policy
-from studio.learning._policy import save_policy
-from studio.learning._reach import reach_step
+from studio.learning.linear._linear import greedy_rollout, greedy_success
+from studio.learning.linear._policy import save_tile_policy
+from studio.learning.tabular._policy import save_policy
+from studio.learning.tasks._reach import reach_step
 
 
 @pytest.mark.parametrize("robot", robot_names())
@@ -315,7 +315,7 @@ def test_a_run_on_the_panda_replays_demonstrations_retargeted_to_the_panda(tmp_p
 
 
 def test_a_sweep_trial_names_its_robot():
-    from studio.learning._sweep_spec import parse_sweep_spec, resolve_trial, trial_record
+    from studio.learning.sweeps._spec import parse_sweep_spec, resolve_trial, trial_record
 
     assert resolve_trial("arm-reach", {"robot": "panda", "joints": 3}, 1, 2, 0).robot == "panda"
     assert resolve_trial("arm-grid", {"robot": "ur5"}, 1, 2, 0).arm_grid().robot == "ur5"
@@ -337,7 +337,7 @@ def test_a_sweep_trial_names_its_robot():
 
 
 def test_the_grid_environment_takes_a_robot():
-    from studio.learning._summary import has_default_goal
+    from studio.learning.runs._summary import has_default_goal
 
     env = gymnasium.make("TeachStudio/ArmGrid-v0", robot="panda")
     assert env.unwrapped.grid == ArmGrid(robot="panda")

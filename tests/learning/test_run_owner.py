@@ -20,7 +20,7 @@ from pathlib import Path
 import pytest
 
 from studio.learning import ArmGrid, DynaQConfig, LearningError, RunFolder, RunRecord
-from studio.learning._owner import owner_alive, process_started
+from studio.learning.runs._owner import owner_alive, process_started
 
 OTHER_HOST = {"hostname": f"not-{socket.gethostname()}", "node": None}
 

@@ -18,7 +18,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-import studio.learning._run_record as runs_module
+import studio.learning.runs._record as runs_module
 from studio.learning import (
     ArmGrid,
     ConfigError,
@@ -33,7 +33,7 @@ from studio.learning import (
     find_runs,
     load_policy,
 )
-from studio.learning._curves import CURVE_COLUMNS, curve_plot
+from studio.learning.runs._curves import CURVE_COLUMNS, curve_plot
 
 REPO = Path(__file__).resolve().parents[2]
 

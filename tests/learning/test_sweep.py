@@ -21,16 +21,16 @@ import numpy as np
 import pytest
 
 from studio.learning import ArmGrid, DynaQConfig, generate_demonstrations, run_experiments
-from studio.learning._runs import RunFolder
-from studio.learning._sweep_folder import (
+from studio.learning.runs._folder import RunFolder
+from studio.learning.sweeps._folder import (
     SUMMARY_FILE,
     record_trial_end,
     sweep_folder,
     trial_records,
     trial_run_path,
 )
-from studio.learning._sweep_ray import _await_stopped_saves, run_sweep
-from studio.learning._sweep_spec import SweepError, load_sweep_spec, parse_sweep_spec, trial_record
+from studio.learning.sweeps._ray import _await_stopped_saves, run_sweep
+from studio.learning.sweeps._spec import SweepError, load_sweep_spec, parse_sweep_spec, trial_record
 from tests.conftest import free_port as _free_port
 from tests.conftest import require
 
@@ -176,7 +176,7 @@ def test_a_huge_seed_count_is_refused_before_any_seed_is_listed() -> None:
     is capped at 256 MB above what it holds, so building the list of seeds would fail."""
     script = (
         "import resource\n"
-        "from studio.learning._sweep_spec import SweepError, parse_sweep_spec\n"
+        "from studio.learning.sweeps._spec import SweepError, parse_sweep_spec\n"
         "from tests.learning.test_sweep import spec_dict\n"
         "size = next(int(line.split()[1]) * 1024 for line in open('/proc/self/status')\n"
         "            if line.startswith('VmSize:'))\n"
@@ -205,7 +205,7 @@ def test_a_spec_file_that_is_not_toml_is_refused(tmp_path: Path) -> None:
 
 
 def test_without_ray_the_error_says_how_to_install_it(monkeypatch, tmp_path: Path) -> None:
-    from studio.learning import _sweep_ray as _sweep
+    from studio.learning.sweeps import _ray as _sweep
 
     monkeypatch.setitem(sys.modules, "ray", None)
     with pytest.raises(SweepError, match=r"pip install -e '\.\[cluster\]'"):
@@ -291,7 +291,7 @@ def test_continuous_joint_trials_equal_serial_runs(local_ray, tmp_path: Path) ->
     import gymnasium
 
     from studio.learning import ArmReach
-    from studio.learning._gym import ARM_REACH_ID
+    from studio.learning.tasks._gym import ARM_REACH_ID
 
     spec = parse_sweep_spec(
         spec_dict(
@@ -648,7 +648,7 @@ def test_the_driver_waits_for_a_stopped_trial_to_save_its_run(tmp_path: Path, mo
     to its next episode boundary to save. The sweep's last stopped trial has no next trial
     waiting on that worker, so the driver waits for the save before shutting Ray down (on a
     busy machine it was killed unsaved, and the sweep read as interrupted)."""
-    from studio.learning import _sweep_ray
+    from studio.learning.sweeps import _ray as _sweep_ray
 
     spec = parse_sweep_spec(spec_dict(name="w", seeds=[0], space={"planning": ["zero"]}))
     (trial,) = spec.trials()

@@ -20,11 +20,11 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from studio.learning import ArmGrid, DynaQConfig
-from studio.learning._owner import on_this_host, pid_alive, this_host
-from studio.learning._runs import RunFolder, RunRecord
-from studio.learning._sweep_folder import prepare_folder as _prepare
-from studio.learning._sweep_list import load_sweep
-from studio.learning._sweep_spec import parse_sweep_spec
+from studio.learning.runs._folder import RunFolder, RunRecord
+from studio.learning.runs._owner import on_this_host, pid_alive, this_host
+from studio.learning.sweeps._folder import prepare_folder as _prepare
+from studio.learning.sweeps._list import load_sweep
+from studio.learning.sweeps._spec import parse_sweep_spec
 
 OTHER_HOST = {"hostname": f"not-{socket.gethostname()}", "node": "a0b1c2"}
 

@@ -95,7 +95,7 @@ def test_training_runs_below_the_studios_priority(
     a heavy run takes only the CPU the API, the pipeline and the scene leave."""
     import os
 
-    import studio.learning._dynaq as dynaq
+    import studio.learning.tabular._dynaq as dynaq
     from studio.learning import ArmGrid, DynaQConfig, run_experiments
     from studio.web._runs import TRAINING_NICENESS
 

@@ -22,7 +22,7 @@ from numpy.lib import format as npy_format
 from studio.capture import RecordingWriter, read_recording
 from studio.capture._network import FrameSender
 from studio.learning import ArmGrid, DynaQConfig
-from studio.learning._policy import save_policy
+from studio.learning.tabular._policy import save_policy
 from tests.capture.conftest import synthetic_frames
 from tests.web.conftest import wait_for
 

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from studio.learning import ArmGrid, DynaQConfig, load_policy
-from studio.learning._policy import save_policy
+from studio.learning.tabular._policy import save_policy
 from tests.web.conftest import TINY_RUN, wait_run
 
 

@@ -10,8 +10,8 @@ import os
 import pytest
 
 from studio.learning import curves_csv
-from studio.learning._curves import CURVE_COLUMNS, TIME_COLUMNS
-from studio.learning._run_notes import MAX_NOTES_CHARS, MAX_TAG_CHARS, MAX_TAGS, NOTES_FILE
+from studio.learning.runs._curves import CURVE_COLUMNS, TIME_COLUMNS
+from studio.learning.runs._notes import MAX_NOTES_CHARS, MAX_TAG_CHARS, MAX_TAGS, NOTES_FILE
 from tests.web.conftest import TINY_RUN, wait_run
 
 EVIL = "http://evil.example"

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from studio.learning import load_policy
-from studio.learning._curves import CURVE_COLUMNS, TIME_COLUMNS
+from studio.learning.runs._curves import CURVE_COLUMNS, TIME_COLUMNS
 from tests.conftest import hold_preparation
 from tests.web.conftest import TINY_RUN, wait_for, wait_run
 
@@ -363,10 +363,10 @@ def test_csv_of_curve_is_parseable(client):
 
 
 def test_a_failing_run_shows_why_and_the_queue_goes_on(client, monkeypatch):
-    import studio.learning._run_train
+    import studio.learning.runs._train
     from studio.learning import LearningError
 
-    real = studio.learning._run_train.run_experiments
+    real = studio.learning.runs._train.run_experiments
     calls = []
 
     def flaky(*args, **kwargs):
@@ -377,7 +377,7 @@ def test_a_failing_run_shows_why_and_the_queue_goes_on(client, monkeypatch):
             raise RuntimeError("boom")
         return real(*args, **kwargs)
 
-    monkeypatch.setattr(studio.learning._run_train, "run_experiments", flaky)
+    monkeypatch.setattr(studio.learning.runs._train, "run_experiments", flaky)
     first = client.post("/api/runs", json=TINY_RUN).json()
     second = client.post("/api/runs", json=TINY_RUN).json()
     third = client.post("/api/runs", json=TINY_RUN).json()
@@ -554,7 +554,7 @@ def test_the_page_marks_where_a_run_averages_fewer_experiments(page_server, brow
 )
 def test_the_simulators_reach_and_a_run_check_a_goal_with_one_function(client, goal):
     from studio.learning import ConfigError, goal_pose
-    from studio.learning._goal import goal_problems
+    from studio.learning.tasks._goal import goal_problems
 
     with pytest.raises(ConfigError) as err:
         goal_pose(goal)

@@ -13,12 +13,12 @@ from pathlib import Path
 
 import pytest
 
-from studio.learning._runs import RunFolder
-from studio.learning._sweep_folder import prepare_folder as _prepare
-from studio.learning._sweep_folder import set_status as _set_status
-from studio.learning._sweep_folder import trial_run_path
-from studio.learning._sweep_spec import parse_sweep_spec, trial_record
-from studio.learning._sweep_summary import write_summary
+from studio.learning.runs._folder import RunFolder
+from studio.learning.sweeps._folder import prepare_folder as _prepare
+from studio.learning.sweeps._folder import set_status as _set_status
+from studio.learning.sweeps._folder import trial_run_path
+from studio.learning.sweeps._spec import parse_sweep_spec, trial_record
+from studio.learning.sweeps._summary import write_summary
 
 SPEC = {
     "name": "tiny",

@@ -1,0 +1,1 @@
+"""The paper's experiments (``studio reproduce``) and the measurements beyond it."""

@@ -1,0 +1,1 @@
+"""Dynamic movement primitives: fitting one to a demonstration, rolling it out, its policy files."""

@@ -1,0 +1,2 @@
+"""Run folders: a run's request and record, training it in a thread, its curves, notes, owner and
+policy summary."""

@@ -1,0 +1,402 @@
+"""From what a person asks for to a checked run record: the one resolver of a run request.
+
+The page's run form, ``studio train``'s flags and a sweep trial's settings all describe a run in
+the same terms: a task kind, Dyna-Q settings, the task's settings (the grid's bins or the
+continuous task's joints, step, tilings and tiles), a goal, a budget, a seed and demonstrations.
+Each fills in a :class:`RunRequest`; :func:`resolve_run` turns it into a :class:`RunRecord`,
+with the learning package's defaults for whatever was left out, and reports every bad setting at
+once in one :class:`ConfigError` whose ``by_field`` keys each sentence by the field the person
+set (``planning``, ``bins``, ``goal_deg``, ``joints``, ``tiles``, ``demonstrations``, ...).
+
+Use::
+
+    record = resolve_run(RunRequest(config={"planning": "zero"}, goal_deg=(0, 45, -90)))
+    record = resolve_run(RunRequest(task="arm-reach", reach={"joints": 4}, experiments=5))
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field, replace
+from typing import Final, cast
+
+import numpy as np
+
+from ..._numbers import is_int
+from .._config import DEFAULT_EPISODES, DEFAULT_EXPERIMENTS, DEFAULT_SEED, DynaQConfig
+from .._errors import ConfigError, LearningError
+from .._tiles import TileCoding
+from ..paper._reproduce import generate_demonstrations
+from ..tasks._arm import ArmGrid
+from ..tasks._demo_motion import DemonstrationMotion, demonstration_grid_path
+from ..tasks._goal import goal_pose, goal_problems, grid_for_goal
+from ..tasks._reach import ArmReach
+from ..tasks._robot import PUMA560, check_robot, robot_title, task_arm
+from ._record import (
+    CONFIG_FORM_FIELDS,
+    TASK_ARM_GRID,
+    TASK_ARM_REACH,
+    TASK_KINDS,
+    RunRecord,
+    raise_problems,
+    run_problems,
+)
+
+_FEATURES = ArmReach().features()
+REACH_DEFAULTS: Final = {
+    "joints": ArmReach.joints,
+    "step_deg": ArmReach.step_deg,
+    "actions": ArmReach.actions,
+    "tilings": _FEATURES.tilings,
+    "tiles": None,
+}
+"""The continuous task's settings a person sets, and their defaults (:class:`ArmReach` and its
+default :meth:`ArmReach.features`; ``tiles`` None: the robot's :attr:`ArmReach.default_tiles`,
+32 for the Puma560)."""
+CODING_SETTINGS = ("tilings", "tiles", "size")
+"""The continuous task's tile-coding settings (:meth:`ArmReach.features`); its other settings
+are :class:`ArmReach` fields."""
+GENERATED_DEMO_STREAM = 1
+"""Generated demonstrations draw from ``default_rng([seed, 1])`` (``studio train``, sweeps)."""
+
+
+@dataclass(frozen=True)
+class DemonstrationPath:
+    """A recorded demonstration a run replays: its joint path and how a message names it.
+
+    Attributes:
+        label: how a message names it (``Demonstration 'reach-1'``, ``The demonstration
+            recordings/reach-1.demo.json``).
+        q_robot: the robot's joint path ``(N, nq)``, radians (a demonstration file stores the
+            Puma560's; for another robot, its recording's segment retargeted:
+            ``studio.export.demonstration_motion``).
+        name: the name the page lists it by (kept in the run record), or "".
+        times: its sample times ``(N,)`` (s), when known: the run keeps its motion for the
+            likeness card (``likeness.json``).
+        robot: the robot whose joints ``q_robot`` holds.
+    """
+
+    label: str
+    q_robot: np.ndarray
+    name: str = ""
+    times: np.ndarray | None = None
+    robot: str = PUMA560
+
+
+@dataclass(frozen=True, kw_only=True)
+class RunRequest:
+    """A run as a person asks for it; every setting left out takes the learning package's default.
+
+    Attributes:
+        task: ``"arm-grid"`` (the paper's grid, tabular) or ``"arm-reach"`` (continuous joints,
+            tile coding).
+        robot: the robot learnt on (a registry name, ``studio robots``; the Puma560 by default):
+            the grid's first three joints or the continuous task's first ``joints``.
+        config: :class:`DynaQConfig` fields set (the others take its defaults).
+        grid: :class:`ArmGrid` fields set (``joints``, ``bins``, ``low_deg``, ``high_deg``,
+            ``goal`` as bins), for the arm grid.
+        reach: the continuous task's settings: :data:`REACH_DEFAULTS`' keys, any other
+            :class:`ArmReach` field and ``size`` of the tile coding.
+        goal_deg: the goal as joint 1-3 angles in degrees (instead of ``grid``'s ``goal`` bins;
+            the continuous task's goal when it replays no demonstration).
+        experiments: independent experiments averaged.
+        episodes: episodes per experiment.
+        seed: the run's seed.
+        demonstrations: recorded demonstrations replayed first (their joint paths).
+        grid_paths: arm grid state paths replayed first, given as such.
+        generated: how many generated demonstrations the arm grid replays (after the others).
+        name: a label for the run.
+        origin: what makes the run (``"page"``, ``"cli"``, ``"sweep"``, ``"reproduce"``).
+        group: runs made together share it.
+        problems: ``(field, sentence)`` the caller found already (a flag that does not apply),
+            reported with the others.
+    """
+
+    task: str = TASK_ARM_GRID
+    robot: str = PUMA560
+    config: Mapping[str, object] = field(default_factory=dict)
+    grid: Mapping[str, object] = field(default_factory=dict)
+    reach: Mapping[str, object] = field(default_factory=dict)
+    goal_deg: Sequence[float] | None = None
+    experiments: object = DEFAULT_EXPERIMENTS
+    episodes: object = DEFAULT_EPISODES
+    seed: object = DEFAULT_SEED
+    demonstrations: Sequence[DemonstrationPath] = ()
+    grid_paths: Sequence[Sequence[int]] = ()
+    generated: int = 0
+    name: str = ""
+    origin: str = "cli"
+    group: str | None = None
+    problems: Sequence[tuple[str, str]] = ()
+
+    @classmethod
+    def from_form(
+        cls,
+        form: Mapping[str, object],
+        *,
+        demonstrations: Sequence[DemonstrationPath] = (),
+        origin: str = "page",
+    ) -> RunRequest:
+        """The request of a run form's values, in the layout of :meth:`RunRecord.form` (the
+        page's ``RunCreate``): its ``task``, Dyna-Q settings, budget, seed, name, goal in degrees
+        and the task's settings; the demonstrations named in it are given as their paths."""
+        task = form.get("task") or TASK_ARM_GRID
+        reach = task == TASK_ARM_REACH
+        given = {key: form[key] for key in ("experiments", "episodes", "seed") if key in form}
+        goal = form.get("goal_deg")
+        return cls(
+            task=str(task),
+            robot=str(form.get("robot") or PUMA560),
+            config={k: form[k] for k in CONFIG_FORM_FIELDS if k in form},
+            grid={"bins": form["bins"]} if not reach and "bins" in form else {},
+            reach={k: form[k] for k in REACH_DEFAULTS if k in form} if reach else {},
+            goal_deg=None if goal is None else cast(Sequence[float], goal),
+            demonstrations=demonstrations,
+            name=str(form.get("name") or ""),
+            origin=origin,
+            **given,  # type: ignore[arg-type]
+        )
+
+
+def resolve_run(request: RunRequest) -> RunRecord:
+    """The checked record of the run ``request`` asks for.
+
+    Raises:
+        ConfigError: every bad setting at once, each keyed by the field the person set.
+    """
+    problems = list(request.problems)
+    if request.task not in TASK_KINDS:
+        problems.append(("task", f"task is {request.task!r}; give one of {', '.join(TASK_KINDS)}."))
+        raise_problems(problems)
+    try:
+        check_robot(request.robot)
+    except ConfigError as err:
+        raise_problems(problems + list(err.by_field.items()))
+    for demo in request.demonstrations:
+        if demo.robot != request.robot:  # its joints mean nothing on this robot: say only that
+            raise_problems(
+                problems
+                + [
+                    (
+                        "demonstrations",
+                        f"{demo.label} holds joints of the {robot_title(demo.robot)}, not of the {robot_title(request.robot)}; retarget it to the {request.robot} from its recording, or train on the {demo.robot}.",
+                    )
+                ]
+            )
+    config = _dynaq_config(request.config, problems)
+    if request.task == TASK_ARM_REACH:
+        return _reach_record(request, config, problems)
+    return _grid_record(request, config, problems)
+
+
+BASELINE_SUFFIX = " · no demos"
+"""Added to the name of a run's twin without demonstrations (:func:`without_demonstrations`)."""
+
+
+def without_demonstrations(request: RunRequest, record: RunRecord) -> RunRequest:
+    """The same run without its demonstrations, to compare with: the same settings, budget, seed
+    and goal (a continuous run's goal is its first demonstration's final pose, kept as such).
+
+    Args:
+        request: the run as asked for, with demonstrations.
+        record: ``resolve_run(request)``.
+
+    Returns:
+        The request of its twin, named ``<name> · no demos`` when the run is named.
+    """
+    name = request.name[: 100 - len(BASELINE_SUFFIX)] + BASELINE_SUFFIX if request.name else ""
+    if record.kind == TASK_ARM_REACH:
+        goal = record.arm_reach().goal
+        reach = {**request.reach, "goal": goal}
+        return replace(
+            request, demonstrations=(), generated=0, goal_deg=None, reach=reach, name=name
+        )
+    return replace(request, demonstrations=(), grid_paths=(), generated=0, name=name)
+
+
+def _dynaq_config(
+    settings: Mapping[str, object], problems: list[tuple[str, str]]
+) -> DynaQConfig | None:
+    """The Dyna-Q settings, or None with their problems added to ``problems``."""
+    try:
+        return DynaQConfig.from_dict(dict(settings))
+    except ConfigError as err:
+        problems += list(err.by_field.items())
+        return None
+
+
+def _grid(request: RunRequest, problems: list[tuple[str, str]]) -> ArmGrid | None:
+    """The arm grid the request sets (a goal in degrees put on its bins), or None with its
+    problems added to ``problems``."""
+    spec = {**request.grid, "robot": request.robot}
+    if spec.get("goal") is not None:
+        spec["goal"] = tuple(cast(Sequence[int], spec["goal"]))
+    try:
+        if request.goal_deg is None:
+            return ArmGrid(**spec)  # type: ignore[arg-type]
+        wrong = goal_problems(request.goal_deg, request.robot)
+        if wrong:
+            problems += [("goal_deg", text) for text in wrong]
+            return None
+        if set(spec) - {"bins", "joints", "robot"} or spec.get("joints", 3) != 3:
+            problems.append(
+                (
+                    "goal_deg",
+                    "A goal in degrees sets the goal on the paper's 3-joint grid; give goal bins for another grid.",
+                )
+            )
+            return None
+        return grid_for_goal(
+            request.goal_deg, cast(int, spec.get("bins", ArmGrid.bins)), request.robot
+        )
+    except ConfigError as err:
+        problems += list(err.by_field.items())
+    except TypeError as err:
+        problems.append(
+            (
+                "grid",
+                f"The grid settings are wrong ({err}); use joints, bins, low_deg, high_deg and goal.",
+            )
+        )
+    except LearningError as err:
+        problems.append(("bins", str(err)))
+    return None
+
+
+def _grid_paths(
+    request: RunRequest, grid: ArmGrid, problems: list[tuple[str, str]]
+) -> list[list[int]]:
+    """The grid state paths the run replays: the given ones, then the recorded demonstrations'
+    (each must end in the goal bin), then the generated ones."""
+    paths = [[int(s) for s in path] for path in request.grid_paths]
+    for demo in request.demonstrations:
+        try:
+            paths.append(demonstration_grid_path(demo.label, demo.q_robot, grid))
+        except LearningError as err:
+            problems.append(("demonstrations", str(err)))
+    count = request.generated
+    if not is_int(count) or count < 0:
+        problems.append(
+            (
+                "demonstrations",
+                f"demonstrations is {count!r}; give how many generated demonstrations to replay (0 or more).",
+            )
+        )
+    elif count and not problems:  # (a refused request: nothing to generate them for)
+        rng = np.random.default_rng([cast(int, request.seed), GENERATED_DEMO_STREAM])
+        paths += generate_demonstrations(grid, count, rng)
+    return paths
+
+
+def _motions(request: RunRequest, problems: list[tuple[str, str]]) -> list[DemonstrationMotion]:
+    """The motions of the demonstrations whose times are known (for the likeness card)."""
+    motions = []
+    for demo in request.demonstrations:
+        if demo.times is None:
+            continue
+        try:
+            name = demo.name or demo.label
+            motions.append(DemonstrationMotion.checked(name, demo.times, demo.q_robot, demo.label))
+        except LearningError as err:
+            problems.append(("demonstrations", str(err)))
+    return motions
+
+
+def _budget(request: RunRequest) -> tuple[int, int, int]:
+    """The request's experiments, episodes and seed, once :func:`run_problems` found them whole
+    numbers (the record checks them again)."""
+    return cast(tuple[int, int, int], (request.experiments, request.episodes, request.seed))
+
+
+def _grid_record(
+    request: RunRequest, config: DynaQConfig | None, problems: list[tuple[str, str]]
+) -> RunRecord:
+    """:func:`resolve_run` for the arm grid."""
+    grid = _grid(request, problems)
+    problems += run_problems(
+        request.experiments, request.episodes, request.seed, request.name, grid
+    )
+    paths = _grid_paths(request, grid, problems) if grid is not None else []
+    motions = _motions(request, problems)
+    raise_problems(problems)
+    assert grid is not None and config is not None
+    return RunRecord.for_arm_grid(
+        grid,
+        config,
+        *_budget(request),
+        paths,
+        name=request.name,
+        origin=request.origin,
+        group=request.group,
+        goal_deg=request.goal_deg,
+        demonstration_names=[d.name for d in request.demonstrations if d.name],
+        demonstration_motions=motions,
+    )
+
+
+def _reach_task(
+    request: RunRequest, goal: tuple[float, ...] | None, problems: list[tuple[str, str]]
+) -> tuple[ArmReach, TileCoding] | None:
+    """The continuous task and its tile coding, or None with their problems added."""
+    most = min(cast(int, REACH_DEFAULTS["joints"]), task_arm(request.robot).nq)
+    settings = {**REACH_DEFAULTS, "joints": most, **request.reach, "robot": request.robot}
+    coding_settings = {k: settings.pop(k) for k in CODING_SETTINGS if k in settings}
+    if goal is not None:
+        settings["goal"] = goal
+    try:
+        task = ArmReach.from_dict(settings)
+    except ConfigError as err:  # a bad goal is the goal the person typed
+        problems += [(k if k != "goal" else "goal_deg", v) for k, v in err.by_field.items()]
+        return None
+    except TypeError as err:
+        problems.append(("task", f"The continuous task's settings are wrong ({err})."))
+        return None
+    try:
+        return task, task.features(**coding_settings)  # type: ignore[arg-type]
+    except ConfigError as err:
+        problems += list(err.by_field.items())
+        return None
+
+
+def _reach_record(
+    request: RunRequest, config: DynaQConfig | None, problems: list[tuple[str, str]]
+) -> RunRecord:
+    """:func:`resolve_run` for the continuous task. Its goal is the first demonstration's final
+    pose, else ``goal_deg`` for joints 1-3 (:func:`goal_pose`), else the task's default."""
+    paths = [np.asarray(d.q_robot, dtype=np.float64) for d in request.demonstrations]
+    goal: tuple[float, ...] | None = None
+    robot = request.robot
+    if paths:
+        goal = tuple(paths[0][-1])
+    elif request.goal_deg is not None:
+        wrong = goal_problems(request.goal_deg, robot)
+        problems += [("goal_deg", text) for text in wrong]
+        if not wrong:
+            goal = tuple(goal_pose(request.goal_deg, robot))
+    built = _reach_task(request, goal, problems)
+    if built is None or config is None:
+        raise_problems(
+            problems
+            + run_problems(request.experiments, request.episodes, request.seed, request.name)
+        )
+    assert built is not None and config is not None
+    task, coding = built  # "follow" without demonstrations is one joint per action
+    try:
+        record = RunRecord.for_arm_reach(
+            task,
+            coding,
+            config,
+            *_budget(request),
+            [p[:, : task.joints] for p in paths],
+            name=request.name,
+            origin=request.origin,
+            group=request.group,
+            goal_deg=request.goal_deg,
+            demonstration_names=[d.name for d in request.demonstrations if d.name],
+            demonstration_motions=_motions(request, problems),
+        )
+    except ConfigError as err:
+        raise_problems(problems + list(err.by_field.items()))
+        raise
+    raise_problems(problems)
+    return record

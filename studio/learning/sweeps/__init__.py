@@ -1,0 +1,1 @@
+"""Sweeps: specs, running their trials on Ray Tune, the sweep folder, its summary and listing."""
