@@ -8,7 +8,10 @@ One rule for both servers. The API (:class:`GuardMiddleware`) and the scene serv
 - requests whose ``Origin`` is absent (command-line clients, scripts) or one of the studio's own
   pages. For the API that is Jupyter Server's rule: a state-changing request (POST, PUT, PATCH,
   DELETE) is refused when its ``Origin``, or failing that its ``Referer``, is another site; a
-  websocket is refused from another site whatever its method;
+  websocket is refused from another site whatever its method; a read of the API (``GET
+  /api/...``: an export, a figure, a rollout can cost minutes of CPU) is refused when its
+  ``Origin`` is another site or the browser marks it ``Sec-Fetch-Site: cross-site`` (an
+  ``<img>`` or a link another site's page loads sends no ``Origin``);
 - when a token is set (required beyond loopback), only requests carrying it: ``?token=`` once
   (the link printed at start; the answer sets a cookie the page's later requests carry), the
   cookie, or an ``Authorization: token <token>`` (or ``Bearer``) header for scripts.
@@ -29,6 +32,10 @@ log = logging.getLogger(__name__)
 
 STATE_CHANGING_METHODS = frozenset({"POST", "PUT", "PATCH", "DELETE"})
 """Methods that change something: refused from another site's page."""
+READ_METHODS = frozenset({"GET", "HEAD"})
+"""Methods that only read: refused from another site's page under :data:`WORK_PREFIX`."""
+WORK_PREFIX = "/api/"
+"""Paths whose reads do work (exports, figures, rollouts): the page itself and its files are not."""
 API_TOKEN_COOKIE = "teach-studio-{port}"
 """Cookie that carries the token to the API after the page was opened with ``?token=``."""
 DEFAULT_PORTS = {"http": 80, "https": 443}
@@ -182,7 +189,18 @@ class GuardMiddleware:
             )
             return
         method = scope.get("method", "GET").upper()
-        if scope["type"] == "websocket" or method in STATE_CHANGING_METHODS:
+        if scope["type"] == "http" and method in READ_METHODS:
+            if scope["path"].startswith(WORK_PREFIX) and self._cross_site_read(headers):
+                self.refused += 1
+                log.warning("Refused %s %s from another site.", method, scope["path"])
+                await self._refuse(
+                    scope,
+                    receive,
+                    send,
+                    "This request comes from another site's page; only the studio's own page may ask the studio for work, so open it in the studio's page or from a client that sends no Origin.",
+                )
+                return
+        elif scope["type"] == "websocket" or method in STATE_CHANGING_METHODS:
             source = headers.get("origin")
             if source is None:
                 source = headers.get("referer")
@@ -200,6 +218,13 @@ class GuardMiddleware:
             await self.app(scope, receive, self._with_cookie(send))
         else:
             await self.app(scope, receive, send)
+
+    def _cross_site_read(self, headers: dict[str, str]) -> bool:
+        """Whether a read comes from another site's page: a foreign ``Origin`` (a script's
+        ``fetch``), or the browser's own ``Sec-Fetch-Site: cross-site`` (an image, a link)."""
+        if headers.get("sec-fetch-site", "").strip().lower() == "cross-site":
+            return True
+        return not self.rule.origin_ok(headers.get("origin"), headers.get("host"))
 
     def _with_cookie(self, send: Send) -> Send:
         async def send_with_cookie(message: Message) -> None:

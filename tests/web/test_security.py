@@ -57,11 +57,30 @@ def test_a_cross_site_upload_stores_nothing(client: TestClient, tmp_path: Path) 
     assert [p.name for p in (tmp_path / "recordings").iterdir()] == ["mine.tape.csv"]
 
 
-def test_reading_from_another_site_is_not_a_change(client: TestClient) -> None:
-    # no CORS header is sent, so the other site's script cannot read the answer anyway
-    r = client.get("/api/capture", headers={"Origin": EVIL})
-    assert r.status_code == 200
-    assert "access-control-allow-origin" not in r.headers
+@pytest.mark.parametrize(
+    "headers",
+    [{"Origin": EVIL}, {"Sec-Fetch-Site": "cross-site"}, {"Origin": "http://127.0.0.1:1"}],
+)
+def test_a_read_from_another_site_does_no_work(
+    client: TestClient, headers: dict[str, str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """An export is minutes of CPU: any page could once start one with an ``<img>`` or a
+    ``fetch`` (the sample names are always there to aim at). No CORS header is ever sent, so no
+    other site's page could read an answer anyway: refusing it loses nothing."""
+    from studio.web.routers import robots
+
+    started: list[str] = []
+    monkeypatch.setattr(robots, "export_for_robot", lambda *a, **k: started.append("export"))
+    path = "/api/robot/export/recording/sample-reach-1?format=csv"
+    refused = client.get(path, headers=headers)
+    assert refused.status_code == 403 and "another site" in refused.json()["detail"]
+    assert "access-control-allow-origin" not in refused.headers
+    assert client.get("/api/capture", headers=headers).status_code == 403
+    assert started == []
+    # the studio's own page, a link typed into the address bar, a command-line client
+    for own in ({"Origin": "http://testserver"}, {"Sec-Fetch-Site": "same-origin"}, {}):
+        assert client.get("/api/capture", headers=own).status_code == 200
+    assert client.get("/", headers={"Sec-Fetch-Site": "cross-site"}).status_code == 200
 
 
 @pytest.mark.parametrize(
