@@ -519,8 +519,13 @@ class Studio:
         Raises:
             InvalidError: the segment is refused (the capture package's reason) or the name is bad.
         """
-        from studio.capture import extract_demonstration
+        from studio.capture import extract_demonstration, load_demonstration
 
+        if not (np.isfinite(t0) and np.isfinite(t1)):
+            raise InvalidError(
+                f"The segment [{t0:g}, {t1:g}] s is not two finite times; give t0 and t1 in "
+                "seconds within the recording."
+            )
         if t1 <= t0:
             raise InvalidError(
                 f"The segment ends at {t1:g} s, not after its start at {t0:g} s; give t1 > t0."
@@ -538,7 +543,17 @@ class Studio:
             name=final,
         )
         tmp = self.settings.recordings_dir / f".cut-{uuid.uuid4().hex}.tmp"
-        demo.save(tmp)  # then named without replacing a file that took the name meanwhile
+        try:
+            demo.save(tmp)
+            load_demonstration(tmp)  # what the list would refuse is never stored
+        except StudioError as err:
+            tmp.unlink(missing_ok=True)
+            said = str(err).replace(str(tmp), f"{recording} [{t0:.2f}, {t1:.2f}] s")
+            raise InvalidError(said) from None
+        except BaseException:
+            tmp.unlink(missing_ok=True)
+            raise
+        # named without replacing a file that took the name meanwhile
         final = self.demonstrations.claim(tmp, final, exact=name is not None)
         self.show_demonstration(final, play=False)
         return final

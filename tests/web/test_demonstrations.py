@@ -163,3 +163,37 @@ def test_damaged_demonstrations_are_listed_with_the_reason_and_hide_nothing(clie
     r = client.post("/api/runs", json={**TINY_RUN, "demonstrations": ["badjson"]})
     assert r.status_code == 422
     assert client.delete("/api/demonstrations/deep").status_code == 204  # damaged files can go
+
+
+def _recording_going_back(seconds: float) -> bytes:
+    """The sample reach with frame 250's time set ``seconds`` back."""
+    from studio.samples import SAMPLES_DIR
+
+    lines = (SAMPLES_DIR / "sample-reach-1.tape.csv").read_text().split("\n")
+    row = next(i for i, line in enumerate(lines) if line.startswith("0.0,0,"))
+    cells = lines[row + 250].split(",")
+    cells[0] = repr(float(cells[0]) - seconds)
+    lines[row + 250] = ",".join(cells)
+    return "\n".join(lines).encode()
+
+
+@pytest.mark.parametrize(
+    ("body", "words"),
+    [
+        ('{"recording": "sample-reach-1", "t0": 0, "t1": 1e999}', "not two finite times"),
+        ('{"recording": "odd", "t0": 1.0, "t1": 3.4}', "times that do not increase"),
+    ],
+)
+def test_a_refused_cut_writes_no_file(client, tmp_path, body, words):
+    """Such a cut once answered 422 but left ``….0.00-inf.demo.json`` behind, listed as damaged
+    from then on."""
+    files = {"file": ("odd.tape.csv", _recording_going_back(0.5), "text/csv")}
+    assert client.post("/api/recordings", files=files).status_code == 201
+    before = sorted(p.name for p in (tmp_path / "recordings").iterdir())
+    r = client.post(
+        "/api/demonstrations", content=body, headers={"content-type": "application/json"}
+    )
+    assert r.status_code == 422 and words in r.json()["detail"], r.text
+    assert ".tmp" not in r.json()["detail"]
+    assert sorted(p.name for p in (tmp_path / "recordings").iterdir()) == before
+    assert all(not d["error"] for d in client.get("/api/demonstrations").json())
