@@ -55,7 +55,6 @@ from studio.capture import (
     Demonstration,
     OperatorConfig,
     RecordingWriter,
-    extract_demonstration,
     goal_configuration,
     load_demonstration,
     read_recording,
@@ -84,6 +83,7 @@ from studio.learning import (
 )
 from studio.learning.likeness._likeness import LDLJ_CUTOFF_HZ
 from studio.learning.linear._linear import greedy_success
+from studio.motion import extract_demonstration
 
 SAMPLES = sorted((Path(__file__).resolve().parents[1] / "studio" / "samples").glob("*.demo.json"))
 GOAL_DTW_RAD = 0.02

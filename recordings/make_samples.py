@@ -22,7 +22,6 @@ from pathlib import Path
 import numpy as np
 
 from studio.capture import (
-    extract_demonstration,
     frames_to_arrays,
     goal_configuration,
     recording_meta,
@@ -30,6 +29,7 @@ from studio.capture import (
     write_recording,
 )
 from studio.learning import ArmGrid
+from studio.motion import extract_demonstration
 from studio.samples import SAMPLES_DIR
 
 SEEDS = (1, 2, 3)

@@ -16,6 +16,7 @@ PACKAGES = (
     "studio.kinematics",
     "studio.capture",
     "studio.learning",
+    "studio.motion",
     "studio.web",
     "studio.samples",
     "studio.export",
@@ -88,7 +89,7 @@ STUDIO = Path(__file__).resolve().parents[1] / "studio"
 
 
 ROOT = Path(__file__).resolve().parents[1]
-NARROW = ("studio.kinematics", "studio.capture", "studio.learning")
+NARROW = ("studio.kinematics", "studio.capture", "studio.learning", "studio.motion")
 """Packages that export only what is used outside them: by the other packages, the commands,
 the web layer, the benchmarks, ``recordings/make_samples.py``, or users' scripts as the READMEs
 and ``docs/`` show them."""
@@ -296,6 +297,87 @@ def test_no_import_cycle_through_late_imports():
     assert _cycles(graph) == []
 
 
+LAYERS = {
+    "studio.kinematics": set(),
+    "studio.capture": {"studio.kinematics"},
+    "studio.learning": {"studio.kinematics"},
+    "studio.physics": {"studio.kinematics"},
+    "studio.samples": set(),
+    "studio.motion": {"studio.kinematics", "studio.capture", "studio.learning"},
+    "studio.export": {
+        "studio.kinematics",
+        "studio.capture",
+        "studio.learning",
+        "studio.physics",
+        "studio.samples",
+        "studio.motion",
+    },
+}
+"""The packages of ``studio`` each package may import. Data flows from capture to learning
+through ``studio.motion``: capture stores observations and joints and knows no learning task,
+learning knows no recording, and neither knows the motion package that joins them. The web
+layer and the commands sit on top."""
+
+
+def _every_import(body: list[ast.stmt]) -> Iterator[ast.Import | ast.ImportFrom | str]:
+    """Every import in a module, type-only ones and late ones included."""
+    for node in ast.walk(ast.Module(body=body, type_ignores=[])):
+        if isinstance(node, ast.Import | ast.ImportFrom):
+            yield node
+
+
+def _package_imports() -> dict[str, set[str]]:
+    """For each package of ``LAYERS``, the other packages of ``studio`` its modules import (any
+    import: at import time, late, or under ``TYPE_CHECKING``)."""
+    found: dict[str, set[str]] = {package: set() for package in LAYERS}
+    tops = {f"studio.{p.name}" for p in STUDIO.iterdir() if (p / "__init__.py").is_file()}
+    for path in STUDIO.rglob("*.py"):
+        name = _module_name(path)
+        own = next((p for p in LAYERS if name == p or name.startswith(f"{p}.")), None)
+        if own is None:
+            continue
+        package = name if path.name == "__init__.py" else name.rpartition(".")[0]
+        for node in _every_import(ast.parse(path.read_text(), str(path)).body):
+            if isinstance(node, ast.Import):
+                targets = [alias.name for alias in node.names]
+            else:
+                targets = [node.module or ""]
+                if node.level:
+                    parts = package.split(".")
+                    anchor = ".".join(parts[: len(parts) - node.level + 1])
+                    targets = [f"{anchor}.{node.module}" if node.module else anchor]
+                    targets += [f"{targets[0]}.{alias.name}" for alias in node.names]
+            for target in targets:
+                top = ".".join(target.split(".")[:2])
+                if top in tops and top != own:
+                    found[own].add(top)
+    return found
+
+
+def test_each_package_imports_only_the_layers_below_it():
+    """Capture imports nothing from learning (nor learning from capture, nor either from the
+    motion package above them), not even for a type annotation."""
+    found = _package_imports()
+    assert found["studio.motion"] >= {"studio.capture", "studio.learning"}
+    assert {"studio.kinematics"} <= found["studio.capture"]
+    wrong = {p: sorted(found[p] - allowed) for p, allowed in LAYERS.items() if found[p] - allowed}
+    assert wrong == {}, "a package imports one above it or beside it: move the code up a layer"
+
+
+def test_the_layer_scan_counts_type_only_and_late_imports():
+    source = """
+from typing import TYPE_CHECKING
+if TYPE_CHECKING:
+    from studio.learning import ArmGrid
+def f():
+    import studio.web
+"""
+    names = set()
+    for node in _every_import(ast.parse(source).body):
+        names |= {a.name for a in node.names} if isinstance(node, ast.Import) else {node.module}
+    assert {"studio.learning", "studio.web"} <= names
+
+
 LATE_AND_EARLY = """
 from typing import TYPE_CHECKING
 import studio.a
@@ -424,6 +506,7 @@ def test_the_narrow_packages_export_only_what_is_used_outside_them():
     assert {"ArmGrid", "RunFolder", "resolve_run"} <= uses["studio.learning"]
     assert {"source_from_spec", "load_demonstration"} <= uses["studio.capture"]
     assert {"TapeConfig", "load_robot"} <= uses["studio.kinematics"]
+    assert {"training_demonstration", "checked_demonstration"} <= uses["studio.motion"]
     unused = []
     for package in NARROW:
         module = importlib.import_module(package)

@@ -1,5 +1,6 @@
 """Capture: observations of the arm (tape frames, pose landmarks, hand poses), sources (simulator,
-playback, network, serial, camera, hand guide), recordings, demonstrations.
+playback, network, serial, camera, hand guide), recordings, and the demonstrations cut from them
+(stored here, cut by :func:`studio.motion.extract_demonstration`).
 
 See ``docs/architecture.md`` for the public names and :mod:`._recording_format` for the file format::
 
@@ -23,8 +24,8 @@ from ._capture_loop import parse_host_port as parse_host_port
 from ._capture_loop import source_from_spec as source_from_spec
 from ._demonstration import DEMO_FORMAT as DEMO_FORMAT
 from ._demonstration import Demonstration as Demonstration
-from ._demonstration import extract_demonstration as extract_demonstration
 from ._demonstration import load_demonstration as load_demonstration
+from ._demonstration import track_segment as track_segment
 from ._errors import CaptureError as CaptureError
 from ._errors import DemonstrationError as DemonstrationError
 from ._errors import RecordingError as RecordingError

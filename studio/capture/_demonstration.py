@@ -1,17 +1,16 @@
-"""Demonstrations: a recording segment turned into a Puma560 trajectory and a grid path to the goal.
+"""Demonstrations as capture stores them: a recording segment's Puma560 trajectory and the grid
+path the cutter gave, in a ``*.demo.json`` file next to its recording.
 
 A segment ``[t0, t1]`` of a recording runs through the kinematics (reconstruct + fit the human
-arm, retarget onto the Puma560), then onto the learning task's :class:`ArmGrid` with
-:meth:`ArmGrid.path_from_joints` (the one demonstration-to-grid-path function, which the page's
-run queue and ``studio train`` replay too): valid consecutive actions, cut at the first visit to
-the goal (a reach-and-return motion keeps its reach), pauses and loops (bin-boundary flicker)
-removed. A segment that never reaches the goal, drives the robot into a joint limit, or fits the
-arm badly is refused with the reason; with ``goal_from_end=True`` the goal becomes wherever the
-segment ends, and a ``grid`` with another goal cuts at that goal.
+arm, retarget onto the Puma560) in :func:`track_segment`: a segment that is too short, drives the
+robot into a joint limit, or fits the arm badly is refused with the reason. What a learning task
+makes of the trajectory (the grid path to the goal, cut at its first visit) is computed by
+:func:`studio.motion.extract_demonstration`, the cutter, through :mod:`studio.learning`; this
+module stores it and reads it back.
 
 File (``*.demo.json``, next to its recording), version 2: the trajectory and its own goal;
 ``grid_path`` is what learning's one path function gave when it was cut (for readers outside the
-studio), checked on load and traced again from the trajectory::
+studio)::
 
     {"format": "teach-studio-demonstration", "version": 2, "robot": "puma560",
      "recording": "reach.tape.csv", "segment": [t0, t1], "mode": "joint",
@@ -20,18 +19,16 @@ studio), checked on load and traced again from the trajectory::
      "fit": {"residual_max": m, "residual_mean": m},
      "trajectory": {"t": [...], "q_robot": [[6 angles], ...]}, "name": "...", "created": "..."}
 
-What a task makes of the trajectory is :mod:`studio.learning`'s alone: the grid path
-(``ArmGrid.path_from_joints``, traced again on load and by every run), a continuous run's joint
-path and the likeness card's motion. Version 1 files also stored ``mirror`` and
-``fit.max_allowed``, which nothing read; they load as before. A
-file is refused with one sentence when its joints are for another robot or another number of
-joints, it holds NaN samples or it is a cut of zero length; a run refuses one whose trajectory
-never reaches the run's goal.
+:func:`load_demonstration` reads the file as it is: a file is refused with one sentence when it is
+not a demonstration, a field is missing or of the wrong kind, or its joints are for another robot
+or another number of joints. Whether its trajectory is usable by a task (NaN samples, a cut of
+zero length) and the grid path a task replays (traced again from the trajectory) are learning's
+to say: :func:`studio.motion.checked_demonstration` reads a file so, for every task. Version 1
+files also stored ``mirror`` and ``fit.max_allowed``, which nothing read; they load as before.
 """
 
 from __future__ import annotations
 
-import dataclasses
 import json
 import os
 from collections.abc import Callable
@@ -44,7 +41,6 @@ import numpy as np
 
 from studio import StudioError, read_json
 from studio.kinematics import ArmTracker, Puma560, robot_spec
-from studio.learning import ArmGrid, LearningError, motion_problem
 
 from ._errors import DemonstrationError
 from ._fitters import TapeFitter, fit_frames, fitter_for
@@ -136,11 +132,6 @@ class Demonstration:
     name: str = ""
     created: str = field(default_factory=lambda: datetime.now(UTC).isoformat(timespec="seconds"))
 
-    def arm_grid(self) -> ArmGrid:
-        """The :class:`studio.learning.ArmGrid` this demonstration's path lives on."""
-        make: Callable[..., ArmGrid] = ArmGrid  # it checks each setting read from the file
-        return make(**{**self.grid, "goal": tuple(self.goal)})
-
     def default_path(self) -> Path:
         """Where :meth:`save` writes by default: ``<recording stem>.<t0>-<t1>.demo.json``."""
         kind = kind_of_name(self.recording.name)
@@ -229,7 +220,8 @@ def load_demonstration(path: str | os.PathLike[str]) -> Demonstration:
 
     def read(key: str, what: str, convert: Callable[[object], T], value: object = None) -> T:
         """``convert`` of field ``key`` (or of ``value``, a part of it); numbers must be finite
-        (the trajectory's samples are judged by learning's :func:`motion_problem`)."""
+        (the trajectory's samples are judged by learning, through
+        :func:`studio.motion.checked_demonstration`)."""
         try:
             out = convert(data[key] if value is None else value)
             numeric = convert not in (_table, _text, _joint_rows) and key != "trajectory"
@@ -250,15 +242,13 @@ def load_demonstration(path: str | os.PathLike[str]) -> Demonstration:
     q_robot = read(
         "trajectory", "rows of robot joint angles (q_robot)", _joint_rows, trajectory.get("q_robot")
     )
-    problem = motion_problem(f"The demonstration {path}", times, q_robot)
     width = robot_spec(DEMO_ROBOT).arm_joints
-    if problem is None and q_robot.shape[1] != width:
-        problem = (
+    if len(q_robot) and q_robot.shape[1] != width:
+        raise DemonstrationError(
             f"The demonstration {path} holds {q_robot.shape[1]} joint angles per sample, not the "
-            f"{DEMO_ROBOT}'s {width}: it is for another robot; cut it again from its recording."
+            f"{DEMO_ROBOT}'s {width}: it is for another robot; cut it again from its recording.",
+            "bad_file",
         )
-    if problem is not None:
-        raise DemonstrationError(problem, "bad_file")
     reached_at = data.get("reached_at")
     try:
         demo = Demonstration(
@@ -267,10 +257,10 @@ def load_demonstration(path: str | os.PathLike[str]) -> Demonstration:
             t1=float(read("segment", "two times in seconds", _floats)[1]),
             times=times,
             q_robot=q_robot,
-            # checked, then traced again from the trajectory below: a path stored by older
-            # code, or edited by hand, never replays
+            # as stored: a task traces it again from the trajectory (a path stored by older
+            # code, or edited by hand, never replays)
             grid_path=read("grid_path", "a list of whole grid states", _whole_numbers),
-            # the grid's values are checked by ArmGrid when the path is traced below
+            # the grid's values are checked by learning's grid when a task reads it
             grid=cast(GridSpec, read("grid", "a table of grid settings", _table)),
             goal=tuple(read("goal", "whole grid bins, one per joint", _whole_numbers)),
             mode=str(data.get("mode", "joint")),
@@ -285,23 +275,7 @@ def load_demonstration(path: str | os.PathLike[str]) -> Demonstration:
             f"{path}: segment is missing or is not two times in seconds; re-extract the demonstration.",
             "bad_file",
         ) from None
-    demo.grid_path = _own_grid_path(path, demo)
     return demo
-
-
-def _own_grid_path(path: Path, demo: Demonstration) -> list[int]:
-    """The grid path of a loaded demonstration toward its own goal, by learning's one path
-    function: a file written by older code (which erased loops before cutting at the goal) gets
-    today's path, so the listing, the page and the CLI replay the same steps. A trajectory that
-    never reaches the goal keeps the path to where it ends, and a run refuses it with its
-    sentence (the page as the demonstration is picked)."""
-    try:
-        return demo.arm_grid().trace_joints(demo.q_robot, stop_at_goal=True).states
-    except (LearningError, TypeError) as err:
-        raise DemonstrationError(
-            f"{path} has a bad grid or trajectory ({err}); re-extract the demonstration.",
-            "bad_file",
-        ) from None
 
 
 def _table(value: object) -> dict[str, object]:
@@ -323,7 +297,7 @@ def _floats(value: object) -> np.ndarray:
 
 
 def _joint_rows(value: object) -> np.ndarray:
-    """Rows of joint angles, all of one width (which learning's ``motion_problem`` judges)."""
+    """Rows of joint angles, all of one width (learning judges the samples)."""
     if not isinstance(value, list) or any(not isinstance(row, list) for row in value):
         raise TypeError("not a list of rows")
     rows = [_floats(row) for row in value]
@@ -346,19 +320,61 @@ def _text(value: object) -> str:
     return value
 
 
-def extract_demonstration(
+@dataclass(frozen=True, eq=False)
+class TrackedSegment:
+    """A recording segment's Puma560 path: what :func:`track_segment` gives the cutter.
+
+    Attributes:
+        recording: the recording it was cut from.
+        t0: segment start (s after the recording's first frame).
+        t1: segment end (s after the first frame).
+        times: the recording's times of the samples ``(N,)``.
+        q_robot: the Puma560 joint path ``(N, 6)`` (rad), to the micro-unit a file stores.
+        residual: each frame's fit residual ``(N,)`` (m).
+        mode: retargeting mode (``"joint"`` or ``"cartesian"``).
+    """
+
+    recording: Recording | ObservationRecording
+    t0: float
+    t1: float
+    times: np.ndarray
+    q_robot: np.ndarray
+    residual: np.ndarray
+    mode: str
+
+    def demonstration(
+        self, grid_path: list[int], grid: dict[str, object], reached_at: float, name: str = ""
+    ) -> Demonstration:
+        """The demonstration of this segment, with the grid path the cutter traced on ``grid``
+        (``ArmGrid.to_dict()``, its goal included) and when the path first reached the goal."""
+        rec = self.recording
+        return Demonstration(
+            recording=rec.path,
+            t0=float(self.t0),
+            t1=float(self.t1),
+            times=self.times.copy(),
+            q_robot=self.q_robot,
+            grid_path=list(grid_path),
+            grid=cast(GridSpec, grid),
+            goal=tuple(int(b) for b in cast(GridSpec, grid)["goal"]),
+            mode=self.mode,
+            reached_at=reached_at,
+            residual_max=float(self.residual.max()),
+            residual_mean=float(self.residual.mean()),
+            name=name or f"{rec.name} {self.t0:.2f}-{self.t1:.2f} s",
+        )
+
+
+def track_segment(
     recording: Recording | ObservationRecording | str | os.PathLike[str],
     t0: float,
     t1: float,
-    grid: ArmGrid | None = None,
     mode: str = "joint",
-    goal_from_end: bool = False,
     *,
     max_residual: float = MAX_FIT_RESIDUAL_M,
     tracker: ArmTracker | None = None,
-    name: str = "",
-) -> Demonstration:
-    """Turn the segment ``[t0, t1]`` of a recording into a demonstration.
+) -> TrackedSegment:
+    """The Puma560 path of the segment ``[t0, t1]`` of a recording, checked for a demonstration.
 
     Args:
         recording: a recording of any kind (tape, pose landmarks, hand poses) or its path; each
@@ -366,31 +382,23 @@ def extract_demonstration(
             arm, then the one retargeting.
         t0: segment start (s after the recording's first frame, as playback's ``seek``).
         t1: segment end (s after the first frame).
-        grid: the :class:`studio.learning.ArmGrid` (default ``ArmGrid()``, the paper's task);
-            its goal is where the path is cut (the first visit).
         mode: retargeting mode, ``"joint"`` or ``"cartesian"``.
-        goal_from_end: instead of refusing a segment that misses the goal, make its end the goal.
         max_residual: worst allowed fit residual (m) of a tape recording (a camera's fit holds
             what it cannot see and a hand guide's arm stops at its nearest pose, so those are
             judged by where the robot goes).
         tracker: the :class:`studio.kinematics.ArmTracker` to track the frames with, for this
             recording's tape (default: a mirroring one for the recording's tape); it is reset
             and set to ``mode`` first.
-        name: display name.
-
-    Returns:
-        The demonstration (call :meth:`Demonstration.save` to write it).
 
     Raises:
-        DemonstrationError: with ``reason`` ``too_short``, ``bad_fit``, ``leaves_joint_range`` or
-            ``never_reaches_goal``, and one sentence saying what to change.
+        DemonstrationError: with ``reason`` ``too_short``, ``bad_fit`` or
+            ``leaves_joint_range``, and one sentence saying what to change.
     """
     rec = (
         recording
         if isinstance(recording, Recording | ObservationRecording)
         else read_any_recording(recording)
     )
-    grid = grid if grid is not None else ArmGrid()
     rows = rec.segment(t0, t1)
     times = rec.t[rows]
     if times.shape[0] < MIN_SEGMENT_FRAMES:
@@ -407,40 +415,9 @@ def extract_demonstration(
         )
     _check_joint_range(q_robot, times)
     # the demonstration holds what its file holds, so a path traced again from the saved
-    # trajectory (the page's run queue does) is this very path
+    # trajectory (the page's run queue does) is the cutter's very path
     q_robot = np.round(q_robot, TRAJECTORY_DECIMALS)
-    trace = grid.trace_joints(q_robot, stop_at_goal=True)
-    if not trace.reaches_goal:
-        if not goal_from_end:
-            end = tuple(int(b) for b in grid.bins_of_angles(q_robot[-1, : grid.joints]))
-            raise DemonstrationError(
-                f"the segment ends in grid bins {end} and never reaches the goal {tuple(grid.goal)}; extend the segment, or set the goal from where it ends.",
-                "never_reaches_goal",
-            )
-        end = grid.bins_of_angles(q_robot[-1, : grid.joints])
-        grid = dataclasses.replace(grid, goal=tuple(int(b) for b in end))
-        trace = grid.trace_joints(q_robot, stop_at_goal=True)
-    if trace.steps < 1:
-        raise DemonstrationError(
-            f"the segment [{t0:.2f}, {t1:.2f}] s already starts at the goal; start the segment before the reach.",
-            "too_short",
-        )
-    reached_at = float(times[trace.samples[-1]])
-    return Demonstration(
-        recording=rec.path,
-        t0=float(t0),
-        t1=float(t1),
-        times=times.copy(),
-        q_robot=q_robot,
-        grid_path=trace.states,
-        grid=cast(GridSpec, grid.to_dict()),
-        goal=tuple(grid.goal),
-        mode=mode,
-        reached_at=reached_at,
-        residual_max=float(residual.max()),
-        residual_mean=float(residual.mean()),
-        name=name or f"{rec.name} {t0:.2f}-{t1:.2f} s",
-    )
+    return TrackedSegment(rec, float(t0), float(t1), times, q_robot, residual, mode)
 
 
 def _check_joint_range(q_robot: np.ndarray, times: np.ndarray) -> None:

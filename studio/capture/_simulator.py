@@ -19,7 +19,7 @@ from __future__ import annotations
 import threading
 import time
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
 
@@ -30,7 +30,6 @@ from ._source import DEFAULT_QUEUE_FRAMES, ThreadedSource
 
 if TYPE_CHECKING:
     from studio.kinematics import HumanArm, Retargeter, TapeConfig
-    from studio.learning import ArmGrid
 
 CHUNK_SECONDS = 0.1
 """The live source computes frames this far ahead in one vectorised batch."""
@@ -396,7 +395,26 @@ GOAL_MARGIN_RAD = np.radians(4.0)
 joint at its limit is a singular pose for the fit (a straight elbow hides the arm's plane)."""
 
 
-def goal_configuration(grid: ArmGrid, retargeter: Retargeter | None = None) -> np.ndarray:
+class GoalGrid(Protocol):
+    """What :func:`goal_configuration` asks of a task's grid (:class:`studio.learning.ArmGrid`
+    has it): capture knows no learning task, only a grid of joint bins with a goal."""
+
+    @property
+    def joints(self) -> int:
+        """How many joints, from joint 1, the grid covers."""
+
+    @property
+    def goal_state(self) -> int:
+        """The goal's state."""
+
+    def angles_of(self, state: int) -> np.ndarray:
+        """The centre of a state's bins (rad), one angle per covered joint."""
+
+    def state_of_angles(self, q_rad: np.ndarray) -> int:
+        """The state whose bins hold these angles (rad)."""
+
+
+def goal_configuration(grid: GoalGrid, retargeter: Retargeter | None = None) -> np.ndarray:
     """A Puma560 configuration in the grid's goal bin that the operator can mirror comfortably.
 
     The goal bins' centres, with joints beyond ``grid.joints`` at zero, moved (within the bin) so

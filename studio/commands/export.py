@@ -25,13 +25,10 @@ from studio.export import (
     FORMATS,
     LIMIT_FRACTION,
     ExportError,
-    Motion,
     check_policy_robot,
-    demonstration_motion,
     export_motion,
     find_source,
     likeness_motions,
-    recording_motion,
     source_kind,
 )
 from studio.kinematics import (
@@ -60,6 +57,7 @@ from studio.learning import (
     rollout_tile_policy,
     save_trajectory_csv,
 )
+from studio.motion import Motion, demonstration_motion, recording_motion
 
 NAME = "export"
 HELP = "Export a policy, demonstration or recording as a robot trajectory checked for safety (CSV, MCAP, LeRobot)."

@@ -36,9 +36,9 @@ def run(args: argparse.Namespace) -> int:
     for given in args.files:
         path = _file(given)
         if path.name.endswith(".demo.json"):
-            from studio.capture import load_demonstration
+            from studio.motion import checked_demonstration
 
-            demo = load_demonstration(path).summary()
+            demo = checked_demonstration(path).summary()
             shown = {k: _shown(k, v) for k, v in demo.items()}
             text = "\n".join([str(path), *(f"  {k:<13} {v}" for k, v in shown.items())])
             print(json.dumps(demo) if args.json else text)

@@ -34,7 +34,6 @@ from typing import cast
 from studio import StudioError, read_json
 from studio._layout import RECORDINGS_DIR
 from studio.capture import DEMO_FORMAT, DEMO_SUFFIX
-from studio.export import ExportError, training_demonstration
 from studio.kinematics import DEFAULT_ROBOT, robot_names, robot_spec
 from studio.learning import (
     ACTION_SETS,
@@ -55,6 +54,7 @@ from studio.learning import (
     RunRequest,
     resolve_run,
 )
+from studio.motion import MotionError, training_demonstration
 from studio.samples import SAMPLES_DIR
 
 NAME = "train"
@@ -207,7 +207,7 @@ def _recorded(source: Path, robot: str) -> DemonstrationPath:
     older code, or edited by hand); its times too, for the run's likeness card."""
     try:
         return training_demonstration(source, robot, f"The demonstration {source}")
-    except ExportError as err:
+    except MotionError as err:
         raise LearningError(str(err)) from None
 
 

@@ -5,6 +5,14 @@ a robot's URDF with its meshes.
 The public names are listed in ``docs/architecture.md``; the formats in ``studio/export/README.md``.
 """
 
+# a recorded motion on a robot has its home in studio.motion; the names stay here for scripts
+from studio.motion import Finding as Finding
+from studio.motion import Motion as Motion
+from studio.motion import demonstration_motion as demonstration_motion
+from studio.motion import recording_motion as recording_motion
+from studio.motion import series_motion as series_motion
+from studio.motion import training_demonstration as training_demonstration
+
 from ._errors import ExportError as ExportError
 from ._errors import SafetyError as SafetyError
 from ._export import FORMAT_SUFFIXES as FORMAT_SUFFIXES
@@ -22,18 +30,12 @@ from ._likeness import likeness_motions as likeness_motions
 from ._read import Trajectory as Trajectory
 from ._read import read_trajectory as read_trajectory
 from ._safety import COLLISION_MARGIN_M as COLLISION_MARGIN_M
-from ._safety import Finding as Finding
 from ._safety import check_trajectory as check_trajectory
 from ._simulate import physics_model as physics_model
 from ._simulate import simulate_trajectory as simulate_trajectory
-from ._sources import Motion as Motion
 from ._sources import check_policy_robot as check_policy_robot
-from ._sources import demonstration_motion as demonstration_motion
 from ._sources import find_source as find_source
-from ._sources import recording_motion as recording_motion
-from ._sources import series_motion as series_motion
 from ._sources import source_kind as source_kind
-from ._sources import training_demonstration as training_demonstration
 from ._timing import LIMIT_FRACTION as LIMIT_FRACTION
 from ._timing import time_path as time_path
 from ._urdf import export_urdf as export_urdf

@@ -17,11 +17,11 @@ from typing import Literal
 import numpy as np
 
 from studio._files import now_iso
+from studio.motion import Finding, Motion
 
 from ._formats import write_csv, write_mcap
 from ._lerobot import write_lerobot
-from ._safety import COLLISION_MARGIN_M, Finding, check_trajectory, refuse
-from ._sources import Motion
+from ._safety import COLLISION_MARGIN_M, check_trajectory, refuse
 from ._timing import LIMIT_FRACTION, time_path
 
 Format = Literal["csv", "mcap", "lerobot"]

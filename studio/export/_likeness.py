@@ -15,6 +15,7 @@ import numpy as np
 
 from studio import StudioError, read_json
 from studio.capture import DEMO_SUFFIX
+from studio.kinematics import DEFAULT_ROBOT
 from studio.learning import (
     DemonstrationMotion,
     DmpPolicyFile,
@@ -23,20 +24,21 @@ from studio.learning import (
     RunRecord,
     TilePolicyFile,
 )
+from studio.motion import MotionError, training_demonstration
 
 from ._errors import ExportError
-from ._sources import PUMA560, find_source, source_kind, training_demonstration
+from ._sources import find_source, source_kind
 
 RUN_CONFIG = "config.json"
 """A run folder's record, beside its policy."""
 
 
 def demonstration_of(
-    given: str | Path, data_dir: str | Path = ".", robot: str = PUMA560
+    given: str | Path, data_dir: str | Path = ".", robot: str = DEFAULT_ROBOT
 ) -> DemonstrationMotion:
     """The motion on ``robot`` of the demonstration ``given`` names (a path, or a name as
     :func:`find_source` looks it up): its stored Puma560 path, or for another robot its
-    recording's segment retargeted onto it (:func:`training_demonstration`).
+    recording's segment retargeted onto it (:func:`studio.motion.training_demonstration`).
 
     Raises:
         ExportError: nothing of that name, not a demonstration, its recording missing for
@@ -47,11 +49,11 @@ def demonstration_of(
         raise ExportError(f"--demo names {path.name}, which is not a demonstration (*.demo.json).")
     name = path.name.removesuffix(DEMO_SUFFIX)
     label = f"The demonstration {path}"
-    demo = training_demonstration(path, robot, label, name)
-    times = demo.times if demo.times is not None else np.zeros(0)
     try:
+        demo = training_demonstration(path, robot, label, name)
+        times = demo.times if demo.times is not None else np.zeros(0)
         return DemonstrationMotion.checked(name, times, demo.q_robot, label)
-    except LearningError as err:
+    except (MotionError, LearningError) as err:
         raise ExportError(str(err)) from None
 
 
@@ -62,7 +64,7 @@ def likeness_motions(
     data_dir: str | Path = ".",
 ) -> list[DemonstrationMotion]:
     """The demonstrations to score ``policy`` (read from ``policy_path``) against (module doc)."""
-    robot = policy.robot or PUMA560
+    robot = policy.robot or DEFAULT_ROBOT
     if demo is not None:
         return [demonstration_of(demo, data_dir, robot)]
     config = Path(policy_path).parent / RUN_CONFIG

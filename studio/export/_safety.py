@@ -10,17 +10,16 @@ Every sample is checked against the robot's URDF limits (:class:`studio.kinemati
   :data:`COLLISION_MARGIN_M`.
 
 The differences are taken on exactly the samples that go into the file, so what is checked is
-what a controller would be sent. Each problem is one :class:`Finding`; a refusal names the first
+what a controller would be sent. Each problem is one :class:`studio.motion.Finding`; a refusal names the first
 (by time) and counts the rest.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
 from studio.kinematics import TABLE, RobotArm
+from studio.motion import Finding
 
 from ._errors import SafetyError
 
@@ -30,25 +29,6 @@ collision meshes' own error need room. The meshes are convex hulls, which alread
 LIMIT_TOLERANCE = 1e-6
 """Relative slack on the velocity and acceleration limits (floating-point noise of the
 differences), and absolute slack (rad) on the position limits."""
-
-
-@dataclass(frozen=True)
-class Finding:
-    """One safety problem of a trajectory.
-
-    Attributes:
-        sample: the sample's index (0-based row of the file).
-        time: its time (s).
-        what: ``"position"``, ``"velocity"``, ``"acceleration"``, ``"collision"`` or ``"reach"``.
-        where: the joint's name, or the link pair ``"a/b"``.
-        sentence: the problem in words, with the margin.
-    """
-
-    sample: int
-    time: float
-    what: str
-    where: str
-    sentence: str
 
 
 def _first_over(values: np.ndarray, limit: np.ndarray) -> tuple[int, int] | None:

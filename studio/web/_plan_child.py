@@ -17,8 +17,8 @@ from pathlib import Path
 import numpy as np
 
 from studio import StudioError
-from studio.export import recording_motion
 from studio.kinematics import RetargetedPath
+from studio.motion import recording_motion
 
 CANNOT = 2
 """The exit code of a recording or robot that cannot be planned (the sentence on stdout)."""

@@ -19,8 +19,8 @@ import numpy as np
 from fastapi import Depends, Request
 
 from studio.capture import RecordingSeries, recording_series
-from studio.export import Motion, recording_motion, series_motion
 from studio.kinematics import load_robot
+from studio.motion import Motion, recording_motion, series_motion
 
 from ._robot_playback import PREVIEW_FRAMES
 from ._state import Studio

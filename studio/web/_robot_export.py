@@ -15,13 +15,11 @@ from studio.capture import DEMO_SUFFIX, RECORDING_SUFFIXES
 from studio.export import (
     FORMAT_SUFFIXES,
     FORMATS,
-    Motion,
     check_policy_robot,
-    demonstration_motion,
     export_motion,
-    recording_motion,
 )
 from studio.learning import ROLLOUT_RATE_HZ
+from studio.motion import Motion, demonstration_motion, recording_motion
 
 ExportFormat = Literal["csv", "mcap", "lerobot"]
 """The formats of :data:`studio.export.FORMATS`, as the API's query parameter."""

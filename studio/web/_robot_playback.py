@@ -18,7 +18,7 @@ from collections.abc import Callable, Hashable
 import numpy as np
 
 from studio import StudioError
-from studio.export import Motion
+from studio.motion import Motion
 
 from ._protocols import Scene
 from ._robot_view import RobotViews

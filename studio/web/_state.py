@@ -31,7 +31,6 @@ from studio.capture import (
     SimulatorSource,
     source_from_spec,
 )
-from studio.export import ExportError, training_demonstration
 from studio.kinematics import (
     DEFAULT_ROBOT,
     KinematicsError,
@@ -46,6 +45,7 @@ from studio.learning import (
     default_goal_deg,
     goal_pose,
 )
+from studio.motion import MotionError, training_demonstration
 
 from ._errors import ConflictError, InvalidError, NotFoundError, TooManyRequestsError
 from ._pipeline import Pipeline
@@ -503,7 +503,7 @@ class Studio:
             raise InvalidError(
                 f"demonstrations names {name!r}, which does not exist; pick demonstrations from the list."
             ) from None
-        except (ExportError, KinematicsError) as err:
+        except (MotionError, KinematicsError) as err:
             raise InvalidError(str(err)) from None
 
     def cut_demonstration(
@@ -519,7 +519,7 @@ class Studio:
         Raises:
             InvalidError: the segment is refused (the capture package's reason) or the name is bad.
         """
-        from studio.capture import extract_demonstration, load_demonstration
+        from studio.motion import checked_demonstration, extract_demonstration
 
         if not (np.isfinite(t0) and np.isfinite(t1)):
             raise InvalidError(
@@ -545,7 +545,7 @@ class Studio:
         tmp = self.settings.recordings_dir / f".cut-{uuid.uuid4().hex}.tmp"
         try:
             demo.save(tmp)
-            load_demonstration(tmp)  # what the list would refuse is never stored
+            checked_demonstration(tmp)  # what the list would refuse is never stored
         except StudioError as err:
             tmp.unlink(missing_ok=True)
             said = str(err).replace(str(tmp), f"{recording} [{t0:.2f}, {t1:.2f}] s")
@@ -596,8 +596,8 @@ class Studio:
         Raises:
             NotFoundError: no such demonstration (or a damaged one: the reader's sentence).
         """
-        from studio.export import demonstration_motion
         from studio.learning import ROLLOUT_RATE_HZ
+        from studio.motion import demonstration_motion
 
         demo = self.demonstrations.load(name)
         scene, player = self.scene, self.player

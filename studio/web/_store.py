@@ -49,12 +49,12 @@ from studio.capture import (
     Demonstration,
     being_recorded,
     delete_recording,
-    load_demonstration,
     rename_recording,
     summarize_any_recording,
     update_recording_meta,
 )
 from studio.learning import POLICY_SUFFIX, PolicyFile, TilePolicyFile, load_any_policy
+from studio.motion import checked_demonstration
 from studio.samples import SAMPLES_DIR
 
 from ._errors import ConflictError, InvalidError, NotFoundError, TooLargeError
@@ -721,7 +721,7 @@ def demonstration_store(
         suffix=DEMONSTRATION_SUFFIX,
         what="demonstration",
         plural="demonstrations",
-        load=load_demonstration,
+        load=checked_demonstration,
         samples=SAMPLES_DIR,
         sample_fix="cut your own from its recording instead",
         on_change=on_change,

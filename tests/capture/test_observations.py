@@ -22,7 +22,6 @@ from studio.capture import (
     RecordingError,
     RecordingWriter,
     describe,
-    extract_demonstration,
     read_any_recording,
     read_recording,
     summarize_any_recording,
@@ -30,6 +29,7 @@ from studio.capture import (
 from studio.capture._observation_recording import ObservationWriter, recording_kind
 from studio.capture._observations import hand_pose, landmark_frame
 from studio.kinematics import HumanArm
+from studio.motion import extract_demonstration
 
 
 def some_landmarks(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:

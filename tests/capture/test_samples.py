@@ -17,6 +17,7 @@ from studio.capture import (
     recording_series,
 )
 from studio.learning import ArmGrid
+from studio.motion import demonstration_grid
 from studio.samples import SAMPLES_DIR
 
 RECORDINGS = Path(__file__).resolve().parents[2] / "recordings"
@@ -34,7 +35,7 @@ def test_every_sample_demo_reaches_the_default_goal_of_arm_grid():
         rec = read_recording(demo.recording)
         total += path.stat().st_size + demo.recording.stat().st_size
         assert not rec.recovered and rec.problems == []
-        assert demo.arm_grid() == grid and demo.grid_path[-1] == grid.goal_state
+        assert demonstration_grid(demo) == grid and demo.grid_path[-1] == grid.goal_state
         bins = np.array([grid.bins_of(s) for s in demo.grid_path])
         assert np.all(np.abs(np.diff(bins, axis=0)) <= 1)
         assert 0 <= demo.t0 < demo.t1 <= rec.duration + 1e-9

@@ -173,12 +173,12 @@ def recorded_reach(tmp_path_factory):
     from studio.capture import (
         OperatorConfig,
         RecordingWriter,
-        extract_demonstration,
         goal_configuration,
         read_recording,
         simulate,
     )
     from studio.learning import ArmGrid
+    from studio.motion import extract_demonstration
 
     grid, folder, demos = ArmGrid(), tmp_path_factory.mktemp("noise"), {}
     for noise in (0.002, 0.0):
@@ -302,10 +302,11 @@ def test_every_policy_kind_gets_a_card_from_the_demonstrations_start(tmp_path):
         policy_likeness_card,
     )
     from studio.learning.tabular._policy import save_policy
+    from studio.motion import demonstration_grid
     from studio.samples import __file__ as samples
 
     demo = load_demonstration(Path(samples).parent / "sample-reach-2.demo.json")
-    grid = demo.arm_grid()
+    grid = demonstration_grid(demo)
     q_table = np.zeros((grid.n_states, grid.n_actions))
     save_policy(tmp_path / "grid.policy.npz", grid, q_table, DynaQConfig())
     task = ArmReach(joints=3)

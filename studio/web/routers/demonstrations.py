@@ -22,6 +22,7 @@ from studio.learning import (
     has_default_goal,
     save_dmp_policy,
 )
+from studio.motion import demonstration_grid
 
 from .._deps import StudioDep
 from .._errors import InvalidError
@@ -62,7 +63,7 @@ def demonstration_public(entry: StoredFile[Demonstration]) -> DemonstrationPubli
             sample=entry.sample,
             error=entry.error,
         )
-    grid = demo.arm_grid()
+    grid = demonstration_grid(demo)
     return DemonstrationPublic(
         name=entry.name,
         recording=demo.recording.name.removesuffix(

@@ -1,5 +1,5 @@
 """One demonstration contract: a file holds its trajectory and its own goal, every stored field is
-read, and bad input is one sentence."""
+read (as every task reads it: ``checked_demonstration``), and bad input is one sentence."""
 
 from __future__ import annotations
 
@@ -8,7 +8,8 @@ import math
 
 import pytest
 
-from studio.capture import DemonstrationError, load_demonstration
+from studio.capture import DemonstrationError
+from studio.motion import checked_demonstration as load_demonstration
 from studio.samples import SAMPLES_DIR
 
 

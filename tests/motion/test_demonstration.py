@@ -1,4 +1,5 @@
-"""Demonstrations: a simulated reach becomes a grid path to the goal; bad segments are refused."""
+"""Demonstrations cut by studio.motion: a simulated reach becomes a grid path to the goal; bad
+segments are refused; a file is read back as every task reads it."""
 
 from __future__ import annotations
 
@@ -15,12 +16,12 @@ from studio.capture import (
     DemonstrationError,
     RecordingWriter,
     TapeFrame,
-    extract_demonstration,
     load_demonstration,
     read_recording,
     simulate,
 )
 from studio.learning import ArmGrid
+from studio.motion import checked_demonstration, demonstration_grid, extract_demonstration
 from studio.samples import SAMPLES_DIR
 
 SECONDS = 5.0
@@ -77,7 +78,7 @@ def test_saved_demonstration_round_trips(reach, tmp_path):
         back.grid_path == demo.grid_path and back.goal == demo.goal and back.recording == rec.path
     )
     assert np.allclose(back.q_robot, demo.q_robot, atol=1e-6)
-    assert back.arm_grid() == grid
+    assert demonstration_grid(back) == grid
     assert path.stat().st_size < 100_000
 
 
@@ -88,7 +89,7 @@ def test_a_segment_that_misses_the_goal_is_refused_or_sets_the_goal(reach):
         extract_demonstration(rec, 0.0, t1, grid=grid)
     assert err.value.reason == "never_reaches_goal"
     demo = extract_demonstration(rec, 0.0, t1, grid=grid, goal_from_end=True)
-    assert demo.grid_path[-1] == demo.arm_grid().goal_state != grid.goal_state
+    assert demo.grid_path[-1] == demonstration_grid(demo).goal_state != grid.goal_state
     assert _one_action_apart(grid, demo.grid_path)
 
 
@@ -237,7 +238,7 @@ def test_a_file_written_by_older_code_still_loads(tmp_path):
     }
     path = tmp_path / "old.demo.json"
     path.write_text(json.dumps(old))
-    demo = load_demonstration(path)
+    demo = checked_demonstration(path)
     assert demo.grid_path == [grid.state_of(b) for b in [(5, 5, 5), (6, 5, 5), (7, 5, 5)]]
     assert demo.grid_path == grid.path_from_joints(demo.q_robot)
     assert (demo.name, demo.reached_at, demo.goal, demo.t0) == ("old", 3.0, (7, 5, 5), 1.0)
@@ -245,7 +246,7 @@ def test_a_file_written_by_older_code_still_loads(tmp_path):
     # a file whose grid is garbled is refused with one sentence, not a traceback
     path.write_text(json.dumps({**old, "grid": {**old["grid"], "bins": -1}}))
     with pytest.raises(DemonstrationError, match="re-extract") as err:
-        load_demonstration(path)
+        checked_demonstration(path)
     assert err.value.reason == "bad_file"
 
 
@@ -253,5 +254,5 @@ def test_the_shipped_samples_replay_what_their_files_say():
     """The sample demonstrations' stored paths are what the one path function gives."""
     for demo_path in sorted(SAMPLES_DIR.glob("sample-reach-*.demo.json")):
         stored = json.loads(demo_path.read_text())["grid_path"]
-        demo = load_demonstration(demo_path)
-        assert demo.grid_path == stored == demo.arm_grid().path_from_joints(demo.q_robot)
+        demo = checked_demonstration(demo_path)
+        assert demo.grid_path == stored == demonstration_grid(demo).path_from_joints(demo.q_robot)
