@@ -20,7 +20,7 @@ tabular and tile-coded formats, holding
 
 ``joints`` is the robot's joint count (``nq``: six for the Puma560, seven for the Panda): a
 primitive is fitted in its robot's joint space, to a demonstration retargeted onto that robot
-(``studio.export.training_demonstration``, the path a training run replays).
+(``studio.motion.training_demonstration``, the path a training run replays).
 """
 
 from __future__ import annotations
@@ -118,7 +118,7 @@ def fit_dmp_policy(
         times: the demonstration's sample times ``(N,)`` (s).
         q_robot: its joints on the robot ``(N, nq)`` (rad): a demonstration's ``q_robot`` for
             the Puma560; for another robot, the demonstration retargeted onto it
-            (``studio.export.training_demonstration(path, robot, label).q_robot``).
+            (``studio.motion.training_demonstration(path, robot, label).q_robot``).
         goal: where rollouts go (default: where the demonstration ends).
         learned_joints: the joints its likeness card compares (a demonstration's grid joints;
             default: all the robot's).

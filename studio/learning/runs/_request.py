@@ -69,7 +69,7 @@ class DemonstrationPath:
             recordings/reach-1.demo.json``).
         q_robot: the robot's joint path ``(N, nq)``, radians (a demonstration file stores the
             Puma560's; for another robot, its recording's segment retargeted:
-            ``studio.export.demonstration_motion``).
+            ``studio.motion.demonstration_motion``).
         name: the name the page lists it by (kept in the run record), or "".
         times: its sample times ``(N,)`` (s), when known: the run keeps its motion for the
             likeness card (``likeness.json``).
