@@ -66,6 +66,7 @@ REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
 from tests.e2e.camera_clips import COLLECT_FRAMES_JS, READ_STAMP_JS, figure_clip  # noqa: E402
+from tests.page_hooks import hook  # noqa: E402
 
 BARE_PATH = "/bench-bare-blazepose"
 """Where the browser is handed the bare page, on the studio's own origin (so the vendored files
@@ -518,7 +519,7 @@ def main() -> int:
                             to_scene, lost = scene_latencies(frames, origin_s, scene)
                             latency["scene"] += to_scene
                             missed += lost
-                            page.wait_for_function("() => !window.studio.camera.running")
+                            page.wait_for_function("p => !p.S.camera.running", arg=hook(page))
                         results[model][side].append(w)
                         print(
                             f"{model:4s} {side:6s} {w.fps:5.2f} frames/s, "

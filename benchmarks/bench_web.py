@@ -406,13 +406,13 @@ def measure_with_page(
         page.wait_for_selector("body[data-ready='1']", timeout=30_000)
         wait_until_browser_settles()
         wait_until_scene_still(page)
-        before = page.evaluate("() => window.studio.curveRenders || 0")
+        before = page.evaluate(CURVE_RENDERS)
         cpu = chromium_cpu_seconds()
         cpu0 = process_cpu_seconds(studio_pid)
         run = train(base, f"{tag}-page-{i}")
         studio_cores = (process_cpu_seconds(studio_pid) - cpu0) / wall(run)
         cores.append((chromium_cpu_seconds() - cpu) / wall(run))
-        renders = page.evaluate("() => window.studio.curveRenders || 0") - before
+        renders = page.evaluate(CURVE_RENDERS) - before
         walls.append(wall(run))
         rates.append(renders / wall(run))
         ctx.close()
@@ -429,6 +429,8 @@ def measure_with_page(
     return without, walls, rates, cores, shares
 
 
+CURVE_RENDERS = "async () => (await import('/static/state.js')).S.curveRenders"
+"""The chart's redraws with new data so far (state.js)."""
 SOFTWARE_DPR_QUERY = "fixedDpr=0.5"
 """How the page loads the scene in a browser without a GPU (scene.js, SOFTWARE_SCENE_DPR)."""
 IDLE_SLOWDOWN_GOAL = 1.10

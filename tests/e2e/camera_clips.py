@@ -40,10 +40,11 @@ READ_STAMP_JS = f"""(frame) => {{
 }}"""
 """A page-side function(canvas) -> the stamped frame index, or null (camera.js's ``probe``)."""
 
-COLLECT_FRAMES_JS = f"""() => {{
+COLLECT_FRAMES_JS = f"""async () => {{
     window.__frames = [];
-    window.studio.camera.probe = {READ_STAMP_JS};
-    document.addEventListener("studio:landmarks", (e) => window.__frames.push(e.detail));
+    const {{ S, listen }} = await import("/static/state.js");
+    S.camera.probe = {READ_STAMP_JS};
+    listen("landmarks", (frame) => window.__frames.push(frame));
 }}"""
 """Run in the studio page: every answered frame, with the stamp of its picture, in ``__frames``."""
 

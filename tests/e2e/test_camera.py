@@ -34,6 +34,7 @@ from tests.e2e.camera_clips import (
     mannequin_q,
 )
 from tests.e2e.conftest import CHROMIUM, CHROMIUM_FLAGS, Studio, shot
+from tests.page_hooks import hook
 
 READY_TIMEOUT_MS = 60_000
 ESTIMATE_TIMEOUT_MS = 420_000
@@ -306,7 +307,7 @@ def test_a_busy_camera_says_so(open_camera: Callable[..., CameraPage]) -> None:
         timeout=STATUS_TIMEOUT_MS,
     )
     assert one_sentence(cam.status())
-    assert cam.page.evaluate("() => window.studio.camera.running") is False
+    assert cam.page.evaluate("p => p.S.camera.running", hook(cam.page)) is False
 
 
 def test_hand_guide_countdown_and_named_controls(
@@ -320,7 +321,7 @@ def test_hand_guide_countdown_and_named_controls(
         assert page.get_by_label(name, exact=True).count() == 1, name
     page.select_option("[data-testid='source-kind']", "hand")
     page.click("[data-testid='source-apply']")
-    page.wait_for_function("() => window.studio.source && window.studio.source.kind === 'hand'")
+    page.wait_for_function("p => p.S.source && p.S.source.kind === 'hand'", arg=hook(page))
     note = page.locator("[data-testid='hand-guide-note']")
     assert note.is_visible() and "Drag the handle" in note.inner_text()
     assert not page.locator("[data-testid='camera-panel']").is_visible()

@@ -14,6 +14,7 @@ import pytest
 from studio.kinematics import load_robot
 from studio.learning import check_goal_deg, default_goal
 from tests.e2e.conftest import Studio, pose_by_hand, shot
+from tests.page_hooks import hook
 from tests.web.conftest import wait_for
 
 pytestmark = pytest.mark.e2e
@@ -26,7 +27,8 @@ RECORDING = "sample-reach-1"
 
 def _timeline_robot(page: Any, name: str) -> None:
     page.wait_for_function(
-        f"() => ((window.studio.timeline || {{}}).data || {{}}).robot_name === '{name}'",
+        f"p => ((p.S.timeline || {{}}).data || {{}}).robot_name === '{name}'",
+        arg=hook(page),
         timeout=LOAD_MS,
     )
 
@@ -58,21 +60,21 @@ def test_the_timeline_goal_and_jog_sliders_follow_the_robot_chosen(
     page.get_by_role("button", name=f"Timeline of {RECORDING}").click()
     _timeline_robot(page, "puma560")
     puma = load_robot("puma560", geometry=False)
-    assert page.evaluate("window.studio.timelineShown")[:6] == list(puma.joint_names)
+    assert page.evaluate("p => p.S.timelineShown", hook(page))[:6] == list(puma.joint_names)
     try:
         robot.select_option("panda")
         panda = load_robot("panda", geometry=False)
 
         # the timeline: the Panda's seven joints by their own names, and it says whose they are
         _timeline_robot(page, "panda")
-        shown = page.evaluate("window.studio.timelineShown")
+        shown = page.evaluate("p => p.S.timelineShown", hook(page))
         assert shown[:7] == list(panda.joint_names) and len(shown) == 7 + 7
         # built once per machine: kept in the data folder's cache for the next studio
         assert list((studio_server.data_dir / "cache" / "robots").glob("panda-*/sha256.json"))
         legend = page.get_by_test_id("timeline-robot")
         assert "Franka Emika Panda" in legend.inner_text()
         assert "panda_joint7" in legend.inner_text()
-        drawn = np.array(page.evaluate("window.studio.timeline.chart.data.slice(1, 8)"))
+        drawn = np.array(page.evaluate("p => p.S.timeline.chart.data.slice(1, 8)", hook(page)))
         assert np.all(np.radians(drawn.T) >= panda.lower - 1e-3)
         assert np.all(np.radians(drawn.T) <= panda.upper + 1e-3)
 
@@ -147,7 +149,7 @@ def test_the_timeline_goal_and_jog_sliders_follow_the_robot_chosen(
 
     # back on the Puma560: its joints, its goal, its six sliders
     _timeline_robot(page, "puma560")
-    assert page.evaluate("window.studio.timelineShown")[:6] == list(puma.joint_names)
+    assert page.evaluate("p => p.S.timelineShown", hook(page))[:6] == list(puma.joint_names)
     page.wait_for_function(
         "() => document.querySelector(\"[data-testid='train-goal-2']\").value === '-90'",
         timeout=LOAD_MS,

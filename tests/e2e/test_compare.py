@@ -22,6 +22,7 @@ import pytest
 
 from studio.learning import curve_statistics, curves_csv
 from tests.e2e.conftest import ARTIFACTS, Studio, own_page
+from tests.page_hooks import hook
 from tests.web.conftest import wait_for
 
 T = 20.0  # s: the longest one step of the page may take (the machine may be busy)
@@ -65,8 +66,8 @@ def small_page(browser: Any, studio_server: Studio, two_runs: list[dict]) -> Ite
             if box.count() and box.is_checked() != (row.get_attribute("data-id") in ids):
                 box.click()
         page.wait_for_function(
-            "ids => JSON.stringify([...window.studio.plottedRuns()].sort()) === JSON.stringify(ids)",
-            arg=sorted(ids),
+            "([p, ids]) => JSON.stringify([...p.chart.drawnRuns()].sort()) === JSON.stringify(ids)",
+            arg=[hook(page), sorted(ids)],
             timeout=T * 1000,
         )
         yield page
@@ -170,7 +171,7 @@ def test_smoothing_other_x_axes_the_legend_and_one_csv_of_the_plotted_runs(
     for _ in range(60):  # 0.60, TensorBoard's usual setting, as a keyboard user reaches it
         page.keyboard.press("ArrowRight")
     assert slider.input_value() == "0.6"
-    line = "id => window.studio.chartLine(id)"
+    line = "async (id) => (await import('/static/chart.js')).drawnLine(id)"
     want = pytest.approx(ema(curve["mean"], 0.6))
     # the chart redraws at its frame rate: wait for the frame after the last key press
     assert wait_for(lambda: page.evaluate(line, zero["id"])["smooth"] == want, T)
@@ -238,12 +239,12 @@ def test_a_run_saved_without_times_per_episode_keeps_the_estimated_time_axes(
     assert wait_for(lambda: row.count() == 1, T)
     row.get_by_test_id("run-show").check()
     page.wait_for_function(
-        "() => window.studio.plottedRuns().includes('cmp-older')", timeout=T * 1000
+        "p => p.chart.drawnRuns().includes('cmp-older')", arg=hook(page), timeout=T * 1000
     )
     page.get_by_test_id("curve-x").select_option("cpu")
     plot = page.locator("#curve-plot")
     assert wait_for(lambda: "CPU time ≈ per experiment" in plot.inner_text(), T)
-    line = "id => window.studio.chartLine(id)"
+    line = "async (id) => (await import('/static/chart.js')).drawnLine(id)"
     drawn = page.evaluate(line, "cmp-older")
     xs = [x for x, m in zip(drawn["x"], drawn["mean"], strict=True) if m is not None]
     # the estimate ends at the run's CPU time over its experiments

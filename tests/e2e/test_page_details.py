@@ -188,8 +188,10 @@ def test_the_scene_and_the_chart_explain_their_marks(
     assert wait_for(lambda: "min–max" in key.inner_text())
     # the dashed marker's key shows exactly when the chart draws a marker
     drawn = page.evaluate(
-        """() => { const runs = plottedRuns(); const d = chartData(runs, "minmax", true);
-                   return runs.some((r, i) => fewerFrom(d, i) !== null); }"""
+        """async () => {
+            const { plottedRuns, chartData, fewerFrom } = await import("/static/chart.js");
+            const runs = plottedRuns(); const d = chartData(runs, "minmax", true);
+            return runs.some((r, i) => fewerFrom(d, i) !== null); }"""
     )
     assert page.get_by_test_id("curve-key-fewer").is_visible() == drawn
     shot(page, "13-legends")

@@ -14,6 +14,7 @@ from typing import Any
 import pytest
 
 from tests.e2e.conftest import Studio
+from tests.page_hooks import hook
 
 SOURCE_EVENTS = 8
 """Source events to wait for while watching the DOM (the stream sends about four a second)."""
@@ -47,14 +48,16 @@ def test_a_still_source_writes_nothing_to_the_page(quiet_page: Any) -> None:
     # Let the status settle after the pause (the frame rate falls to 0 over its window), then
     # watch every change to the parts of the page the status is drawn into.
     page.wait_for_function(
-        "() => { const s = window.studio.source; return s && !s.playback.playing && !s.rate_hz; }",
+        "p => { const s = p.S.source; return s && !s.playback.playing && !s.rate_hz; }",
+        arg=hook(page),
         timeout=EVENTS_TIMEOUT_MS,
     )
     assert page.locator(SOURCE_ROOTS).count() == 4
     page.evaluate(
-        """(SOURCE_ROOTS) => {
+        """async (SOURCE_ROOTS) => {
             window.__mutations = [];
             window.__sourceEvents = 0;
+            const { events } = await import("/static/events.js");
             events.addEventListener("source", () => { window.__sourceEvents++; });
             const observer = new MutationObserver((records) => {
                 for (const m of records) {
@@ -86,12 +89,14 @@ def test_redrawing_the_run_list_keeps_unchanged_rows(
     row = f"tr[data-id='{run['id']}']"
     page.wait_for_selector(f"{row}[data-status='done']", timeout=EVENTS_TIMEOUT_MS)
     same, updated = page.evaluate(
-        """(id) => {
+        """async (id) => {
+            const { renderRuns } = await import("/static/runs.js");
+            const { S } = await import("/static/state.js");
             const find = () => document.querySelector(`tr[data-id='${id}']`);
             const before = find();
             renderRuns();
             const same = find() === before;
-            const r = window.studio.runs.find((x) => x.id === id);
+            const r = S.runs.find((x) => x.id === id);
             r.status = "stopped"; // a change the row shows: it must be redrawn
             renderRuns();
             const updated = find() !== before && find().dataset.status === "stopped";
@@ -113,9 +118,9 @@ def test_a_training_run_redraws_its_row_less_often_than_the_chart(
     the page's own work while a run trained."""
     page = quiet_page
     page.evaluate(
-        """() => {
+        """async () => {
             window.__rowRedraws = {};
-            window.__chartFrames0 = window.studio.curveRenders || 0;
+            window.__chartFrames0 = (await import("/static/state.js")).S.curveRenders;
             new MutationObserver((records) => {
                 for (const m of records) {
                     for (const n of m.addedNodes) {
@@ -135,13 +140,15 @@ def test_a_training_run_redraws_its_row_less_often_than_the_chart(
     try:
         # while it trains: wait for the chart to have drawn enough frames to tell the rates apart
         page.wait_for_selector(f"{row}[data-status='running']", timeout=EVENTS_TIMEOUT_MS * 6)
+        p = hook(page)
         page.wait_for_function(
-            f"() => (window.studio.curveRenders || 0) - window.__chartFrames0 >= {ROW_RATE_FRAMES}",
+            f"p => p.S.curveRenders - window.__chartFrames0 >= {ROW_RATE_FRAMES}",
+            arg=p,
             timeout=EVENTS_TIMEOUT_MS * 6,
         )
         redraws, frames = page.evaluate(
-            "(id) => [window.__rowRedraws[id] || 0, (window.studio.curveRenders || 0) - window.__chartFrames0]",
-            run["id"],
+            "([p, id]) => [window.__rowRedraws[id] || 0, p.S.curveRenders - window.__chartFrames0]",
+            [p, run["id"]],
         )
     finally:
         studio_server.send("POST", f"/api/runs/{run['id']}/stop")

@@ -11,6 +11,7 @@ from typing import Any
 import pytest
 
 from tests.e2e.conftest import ARTIFACTS, Studio, own_page
+from tests.page_hooks import hook
 from tests.web.conftest import wait_for
 
 T = 20.0  # s: the longest one step of the page may take (the machine may be busy)
@@ -52,8 +53,8 @@ def test_one_click_trains_with_and_without_demonstrations_and_compares_them(
             lambda r=r: studio_server.get(f"/api/runs/{r['id']}")["status"] == "done", 180
         )
     page.wait_for_function(
-        "ids => JSON.stringify([...window.studio.plottedRuns()].sort()) === JSON.stringify(ids)",
-        arg=ids,
+        "([p, ids]) => JSON.stringify([...p.chart.drawnRuns()].sort()) === JSON.stringify(ids)",
+        arg=[hook(page), ids],
         timeout=T * 1000 * 3,
     )
     # on disk: the same settings and seed, demonstrations in one only
@@ -96,7 +97,9 @@ def test_a_run_that_finished_unseen_is_plotted_when_the_runs_list_reloads(
         page.wait_for_selector("body[data-ready='1']", timeout=60_000)
         plotted = page.evaluate(
             """async (id) => {
-                const S = window.studio;
+                const { S } = await import("/static/state.js");
+                const { loadRuns } = await import("/static/runs.js");
+                const { plottedRuns } = await import("/static/chart.js");
                 const empty = Object.fromEntries(Object.keys(S.curves.values().next().value || { episodes: 0 }).map((k) => [k, []]));
                 S.shownTouched = true;
                 S.shown = new Set([id]);

@@ -11,6 +11,8 @@ from urllib.parse import parse_qs, urlsplit
 
 from tests.e2e.conftest import Studio
 
+SCENE = "(await import('/static/scene.js'))"
+"""The page's scene module (scene.js), as the page runs it."""
 GPU_RENDERERS = (
     "ANGLE (NVIDIA, NVIDIA GeForce RTX 3080 (0x00002206) Direct3D11 vs_5_0 ps_5_0, D3D11)",
     "ANGLE (Intel, Mesa Intel(R) UHD Graphics 620 (KBL GT2), OpenGL 4.6)",
@@ -26,9 +28,11 @@ def test_the_scene_is_drawn_at_half_resolution_without_a_gpu(
     page: Any, studio_server: Studio
 ) -> None:
     page.wait_for_function("() => document.querySelector('#scene').src !== ''")
-    assert page.evaluate("() => softwareWebGL()") is True  # SwiftShader, as launched here
+    assert (
+        page.evaluate(f"async () => {SCENE}.softwareWebGL()") is True
+    )  # SwiftShader, as launched here
     query = parse_qs(urlsplit(page.locator("#scene").get_attribute("src")).query)
-    assert query.get("fixedDpr") == [str(page.evaluate("() => SOFTWARE_SCENE_DPR"))]
+    assert query.get("fixedDpr") == [str(page.evaluate(f"async () => {SCENE}.SOFTWARE_SCENE_DPR"))]
     assert float(query["fixedDpr"][0]) < 1
     assert page.get_by_test_id("scene-note").is_visible()
     # the scene still loads and draws at that ratio
@@ -38,6 +42,6 @@ def test_the_scene_is_drawn_at_half_resolution_without_a_gpu(
 
 def test_only_software_renderers_are_taken_for_software(page: Any) -> None:
     for name in SOFTWARE_RENDERERS:
-        assert page.evaluate("(n) => SOFTWARE_RENDERERS.test(n)", name), name
+        assert page.evaluate(f"async (n) => {SCENE}.SOFTWARE_RENDERERS.test(n)", name), name
     for name in GPU_RENDERERS:
-        assert not page.evaluate("(n) => SOFTWARE_RENDERERS.test(n)", name), name
+        assert not page.evaluate(f"async (n) => {SCENE}.SOFTWARE_RENDERERS.test(n)", name), name

@@ -21,6 +21,8 @@ from .conftest import ARTIFACTS, Studio, shot
 pytestmark = pytest.mark.e2e
 
 T = 20_000  # ms: the longest a single UI step may take
+POINTS = "async (id) => (await import('/static/chart.js')).drawnPoints(id)"
+"""A run's plotted mean-curve points, as the chart draws them."""
 
 
 def _pixels(png: bytes) -> np.ndarray:
@@ -338,13 +340,13 @@ def test_story5_training_curve_updates_live(page: Any, studio_server: Studio) ->
     status = ""
     end = time.monotonic() + 150
     while time.monotonic() < end:
-        counts.append(page.evaluate("id => window.studio.curvePoints(id)", run_id))
+        counts.append(page.evaluate(POINTS, run_id))
         status = page.get_attribute(f"[data-testid='run-row'][data-id='{run_id}']", "data-status")
         if status in ("done", "stopped", "failed"):
             break
         time.sleep(0.1)
     time.sleep(0.5)
-    counts.append(page.evaluate("id => window.studio.curvePoints(id)", run_id))
+    counts.append(page.evaluate(POINTS, run_id))
     shot(page, "05-trained", "sec-train")
     assert status == "done", studio_server.get(f"/api/runs/{run_id}")
     # Live: the curve grew in several steps while the run was running, not at once at the end.
@@ -360,13 +362,13 @@ def test_story5_training_curve_updates_live(page: Any, studio_server: Studio) ->
     second = page.locator("[data-testid='run-row']", has_text="e2e-zero").first
     assert _wait(lambda: second.get_attribute("data-id") != run_id, 10)
     second_id = second.get_attribute("data-id")
-    assert _wait(lambda: page.evaluate("id => window.studio.curvePoints(id)", second_id) > 0, 30)
+    assert _wait(lambda: page.evaluate(POINTS, second_id) > 0, 30)
     second.locator("[data-testid='run-stop']").click()
     assert _wait(lambda: second.get_attribute("data-status") == "stopped", 30)
     page.click("[data-testid='curve-log']")
     time.sleep(0.3)
     shot(page, "05-two-runs", "sec-train")
-    shown = page.evaluate("() => window.studio.plottedRuns()")
+    shown = page.evaluate("async () => (await import('/static/chart.js')).drawnRuns()")
     assert {run_id, second_id} <= set(shown)
     # The chart draws both: its canvas is not blank, and it has a legend row per run.
     legend = page.locator("#curve-plot .u-legend .u-series:visible")

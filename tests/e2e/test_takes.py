@@ -9,6 +9,8 @@ from typing import Any
 
 import numpy as np
 
+from tests.page_hooks import hook
+
 from .conftest import Studio, shot
 
 T = 20_000  # ms: the longest a single UI step may take
@@ -21,13 +23,14 @@ def _phase(page: Any, phase: str) -> None:
     try:
         page.wait_for_selector(f"[data-testid='take-start'][data-phase='{phase}']", timeout=T)
     except Exception:
-        state = page.evaluate("() => [window.studio.takesPhase(), window.studio.takes]")
+        state = page.evaluate("p => [p.S.takePhase, p.S.takes]", hook(page))
         raise AssertionError(f"{state}: {page.inner_text('[data-testid=takes-error]')}") from None
 
 
 def _recorded_for(page: Any, seconds: float) -> None:
     page.wait_for_function(
-        f"() => window.studio.capture && window.studio.capture.active && window.studio.capture.seconds > {seconds}",
+        f"p => p.S.capture && p.S.capture.active && p.S.capture.seconds > {seconds}",
+        arg=hook(page),
         timeout=T,
     )
 
@@ -68,9 +71,7 @@ def test_record_in_takes(page: Any, studio_server: Studio) -> None:
     if studio_server.get("/api/source")["kind"] != "simulator":
         page.select_option("[data-testid='source-kind']", "simulator")
         page.click("[data-testid='source-apply']")
-        page.wait_for_function(
-            "() => window.studio.source && window.studio.source.kind === 'simulator'"
-        )
+        page.wait_for_function("p => p.S.source && p.S.source.kind === 'simulator'", arg=hook(page))
     for name in ("Countdown", "Timeline"):
         assert page.get_by_label(name, exact=True).count() == 1, name
     page.get_by_label("Countdown", exact=True).fill("1")

@@ -5,6 +5,8 @@ from __future__ import annotations
 import json
 from typing import Any
 
+from tests.page_hooks import hook
+
 from .conftest import Studio, shot
 
 T = 20_000  # ms: the longest a single UI step may take
@@ -35,7 +37,8 @@ def test_cut_on_the_timeline(page: Any, studio_server: Studio) -> None:
     page.wait_for_selector("[data-testid='timeline-plot'] canvas", timeout=60_000)
     # the answer to this click drawn (an earlier story's plot of the same recording may be up)
     page.wait_for_function(
-        "() => { const t = window.studio.timeline; return t.data && t.drawn === t.asked; }",
+        "p => { const t = p.S.timeline; return t.data && t.drawn === t.asked; }",
+        arg=hook(page),
         timeout=60_000,
     )
     duration = float(timeline.get_attribute("aria-valuemax"))
@@ -53,8 +56,8 @@ def test_cut_on_the_timeline(page: Any, studio_server: Studio) -> None:
     # as a person's drag spans frames: the plot has the pointer where it is before the release
     # (on a busy machine the plot takes the moves a frame late, and a release before ends short)
     page.wait_for_function(
-        "x => Math.abs(window.studio.timeline.chart.cursor.left - x) < 2",
-        arg=over["width"] * 0.6,
+        "([p, x]) => Math.abs(p.S.timeline.chart.cursor.left - x) < 2",
+        arg=[hook(page), over["width"] * 0.6],
         timeout=T,
     )
     page.mouse.up()
@@ -76,7 +79,7 @@ def test_cut_on_the_timeline(page: Any, studio_server: Studio) -> None:
     # Space plays from the segment's start and pauses.
     timeline.press("Home")
     timeline.press(" ")
-    page.wait_for_function("() => window.studio.timeline.playhead > 0.3", timeout=T)
+    page.wait_for_function("p => p.S.timeline.playhead > 0.3", arg=hook(page), timeout=T)
     timeline.press(" ")
     assert timeline.get_attribute("data-playing") == "0"
     shot(page, "timeline-ends", "sec-demos")
@@ -102,7 +105,8 @@ def test_a_tape_timeline_plots_its_bend_and_twist_per_region(
 ) -> None:
     page.get_by_role("button", name="Timeline of sample-reach-2").click()
     page.wait_for_function(
-        "() => (window.studio.timeline.data || {}).name === 'sample-reach-2'",
+        "p => (p.S.timeline.data || {}).name === 'sample-reach-2'",
+        arg=hook(page),
         timeout=60_000,
     )
     served = studio_server.get("/api/recordings/sample-reach-2/timeline?points=50")
@@ -110,22 +114,23 @@ def test_a_tape_timeline_plots_its_bend_and_twist_per_region(
     show = page.get_by_role("combobox", name="Timeline shows")
     options = show.locator("option").all_inner_texts()
     assert options == ["joints (robot and human arm)", "tape bend", "tape twist"]
-    assert len(page.evaluate("window.studio.timelineShown")) == 13  # 6 robot, 7 human joints
+    assert len(page.evaluate("p => p.S.timelineShown", hook(page))) == 13  # 6 robot, 7 human joints
     show.select_option("tape bend")
-    shown = page.evaluate("window.studio.timelineShown")
+    shown = page.evaluate("p => p.S.timelineShown", hook(page))
     assert shown == [f"tape bend region {i + 1}" for i in range(regions)]
     # the plotted values are the recording's own, in degrees, as the server serves them
     drawn, own = page.evaluate(
-        "() => { const d = window.studio.timeline; "
-        "return [d.chart.data[1], d.data.signals[0].values.map((v) => v[0])]; }"
+        "p => { const d = p.S.timeline; "
+        "return [d.chart.data[1], d.data.signals[0].values.map((v) => v[0])]; }",
+        hook(page),
     )
     assert drawn == own and len(set(own)) > 1  # region 1's bend, as it varies over the reach
     assert own[0] == served["signals"][0]["values"][0][0]  # the first frame's, as served
     page.locator("#timeline").scroll_into_view_if_needed()
     shot(page, "timeline-tape-bend", "timeline")
     show.select_option("tape twist")
-    assert page.evaluate("window.studio.timelineShown")[0] == "tape twist region 1"
+    assert page.evaluate("p => p.S.timelineShown", hook(page))[0] == "tape twist region 1"
     _shoot_small_and_large(page, "timeline-tape-twist")
     show.select_option("joints")
-    assert len(page.evaluate("window.studio.timelineShown")) == 13
+    assert len(page.evaluate("p => p.S.timelineShown", hook(page))) == 13
     assert not page.errors  # type: ignore[attr-defined]

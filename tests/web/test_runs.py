@@ -14,6 +14,7 @@ import pytest
 from studio.learning import load_policy
 from studio.learning.runs._curves import CURVE_COLUMNS, TIME_COLUMNS
 from tests.conftest import hold_preparation
+from tests.page_hooks import hook
 from tests.web.conftest import TINY_RUN, wait_for, wait_run
 
 BAD_RUNS = [
@@ -515,15 +516,19 @@ def test_the_page_form_reports_every_bad_field_and_plots_short_beside_long_runs(
 
     # a 100-episode run beside a 30,000-episode one: a log or fraction axis keeps its shape
     assert runs.wait_idle(300)
-    page.evaluate("() => loadRuns()")
-    points = "id => window.studio.curvePoints(id)"
-    assert wait_for(lambda: page.evaluate(points, long["id"]) > 0, 60)
-    linear = page.evaluate(points, short["id"])
+    p = hook(page)
+    page.evaluate("p => p.runs.loadRuns()", p)
+
+    def points(run_id: str) -> int:
+        return page.evaluate("([p, id]) => p.chart.drawnPoints(id)", [p, run_id])
+
+    assert wait_for(lambda: points(long["id"]) > 0, 60)
+    linear = points(short["id"])
     page.select_option("[data-testid='curve-x']", "log")
-    assert wait_for(lambda: page.evaluate(points, short["id"]) > 2 * linear, 60)
+    assert wait_for(lambda: points(short["id"]) > 2 * linear, 60)
     page.select_option("[data-testid='curve-x']", "fraction")
-    assert wait_for(lambda: page.evaluate(points, short["id"]) == 100, 60)
-    assert page.evaluate(points, long["id"]) <= 600
+    assert wait_for(lambda: points(short["id"]) == 100, 60)
+    assert points(long["id"]) <= 600
     assert not page.errors
 
 
@@ -543,9 +548,10 @@ def test_the_page_marks_where_a_run_averages_fewer_experiments(page_server, brow
     folder.save_status()
     page.goto(base + "/")
     page.wait_for_selector("body[data-ready='1']", timeout=60_000)
-    fewer = "id => window.studio.chartFewerFrom(id)"
-    assert wait_for(lambda: page.evaluate(fewer, "uneven") is not None, 60)
-    assert 201 <= page.evaluate(fewer, "uneven") <= 202  # the bucket holding episode 201
+    p = hook(page)
+    fewer = "([p, id]) => p.chart.drawnFewerFrom(id)"
+    assert wait_for(lambda: page.evaluate(fewer, [p, "uneven"]) is not None, 60)
+    assert 201 <= page.evaluate(fewer, [p, "uneven"]) <= 202  # the bucket holding episode 201
     assert not page.errors
 
 

@@ -19,6 +19,7 @@ from studio.learning.sweeps._folder import set_status as _set_status
 from studio.learning.sweeps._folder import trial_run_path
 from studio.learning.sweeps._spec import parse_sweep_spec, trial_record
 from studio.learning.sweeps._summary import write_summary
+from tests.page_hooks import hook
 
 SPEC = {
     "name": "tiny",
@@ -153,12 +154,14 @@ def test_the_page_groups_a_sweep_and_ticking_it_plots_every_trial(tmp_path: Path
                 assert page.locator('[data-testid="run-row"]').count() == 0  # folded
                 run_ids = {f"tiny~tiny-{key}" for key in keys}
                 row.locator('[data-testid="sweep-show"]').uncheck()  # the newest runs are shown
-                page.wait_for_function("() => window.studio.plottedRuns().length === 0")
-                page.evaluate("window.studio.curves.clear()")
+                p = hook(page)
+                page.wait_for_function("p => p.chart.drawnRuns().length === 0", arg=p)
+                page.evaluate("p => p.S.curves.clear()", p)
                 row.locator('[data-testid="sweep-show"]').check()
                 page.wait_for_function(  # the chart overlays exactly the sweep's runs
-                    "ids => JSON.stringify([...window.studio.plottedRuns()].sort()) === JSON.stringify(ids)",
-                    arg=sorted(run_ids),
+                    "([p, ids]) => JSON.stringify([...p.chart.drawnRuns()].sort())"
+                    " === JSON.stringify(ids)",
+                    arg=[p, sorted(run_ids)],
                 )
                 row.locator('[data-testid="sweep-open"]').click()
                 table = page.locator('[data-testid="sweep-table"] tbody tr')

@@ -1,8 +1,8 @@
-/* Teach Studio page: the camera teacher and the hand guide (docs/api.md, "Teachers without hardware").
+/* Teach Studio page: the camera teacher (docs/api.md, "Teachers without hardware").
  *
- * An ES module loaded after app.js, no build step. It uses app.js's helpers (`api`, `showError`,
- * `setText`, `setProp`, `$`) and its state `window.studio`, and hears the live source through the
- * `studio:source` event app.js fires on every status.
+ * An ES module that index.html loads after main.js. It follows the live source (`listen("source")`
+ * in state.js, on every status), keeps its loop in `S.camera`, and announces each frame it sent
+ * and the studio's answer as `S.landmarks` (the browser tests collect them).
  *
  * When the live source is `camera`, the page asks for the camera, runs BlazePose (the vendored
  * `@mediapipe/pose`, loaded only then) on each new video frame, draws the picture small with the
@@ -11,6 +11,10 @@
  * yield to the page between them: `pose.send()` called back to back blocks the page. A person the
  * model takes for one seen from behind has their left and right put back (see facesAway).
  */
+
+import { api } from "./api.js";
+import { $, setProp, setText } from "./dom.js";
+import { S, listen, set } from "./state.js";
 
 const VENDOR = "/static/vendor/mediapipe-pose";
 const MODELS = { lite: 0, full: 1 }; // BlazePose modelComplexity
@@ -35,7 +39,6 @@ const CAPTURE_AGE_MS = 5000; // a frame's captureTime older than this is taken a
 const FRAME_WAIT_MS = 100; // wait at most this long for the next video frame (hidden tabs, old browsers)
 const PREFS_KEY = "studio.camera";
 
-const S = window.studio;
 const C = {
   running: false, // the camera loop is on
   starting: null, // the promise of a start under way
@@ -55,6 +58,7 @@ const C = {
   probe: null, // tests and benchmarks: a function(canvas) of the frame; its value travels with it
   swapped: 0, // results whose left and right labels the page swapped back (see facesAway)
   grabbed: null, // the canvas each frame is copied into
+  current: null, // the frame the model works on: {t, tag, width, height}
 };
 S.camera = C;
 
@@ -321,9 +325,7 @@ async function post(body, info) {
   }
   renderStatus();
   renderObservable(answer ? answer.observable : null);
-  document.dispatchEvent(new CustomEvent("studio:landmarks", {
-    detail: { body, answer, tag: info.tag, swapped: info.swapped, tResult: info.tResult, tAnswered: performance.now() / 1000 },
-  }));
+  set("landmarks", { body, answer, tag: info.tag, swapped: info.swapped, tResult: info.tResult, tAnswered: performance.now() / 1000 });
 }
 
 /* ------------------------------------------------------------------ drawing */
@@ -383,42 +385,6 @@ function renderObservable(observable) {
   setProp(box.dataset, "observable", observable ? observable.map((o) => (o ? "1" : "0")).join("") : "");
 }
 
-/* ------------------------------------------------------------------ countdown before recording */
-let countdownRun = null; // {cancel()} while a countdown runs
-
-/**
- * Count down before a recording of the camera or the hand guide starts (before a take, whatever
- * the source: ``always``), so the user can get into place. Resolves true to start, false when
- * cancelled (the same button pressed again, or Escape during a take's countdown).
- */
-function recordCountdown(always = false, cancelHint = "press Record again to cancel") {
-  if (countdownRun) { countdownRun.cancel(); return Promise.resolve(false); }
-  const kind = S.source && S.source.kind;
-  const seconds = Math.max(0, Math.min(10, Math.round(Number($("capture-countdown").value) || 0)));
-  if ((!always && !["camera", "hand"].includes(kind)) || !seconds) return Promise.resolve(true);
-  const left = $("capture-countdown-left");
-  return new Promise((resolve) => {
-    let n = seconds;
-    const finish = (go) => {
-      clearInterval(timer);
-      countdownRun = null;
-      setProp(left, "hidden", true);
-      setText(left, "");
-      resolve(go);
-    };
-    const show = () => setText(left, `Recording in ${n} s (${cancelHint})`);
-    const timer = setInterval(() => {
-      n -= 1;
-      if (n <= 0) finish(true);
-      else show();
-    }, 1000);
-    countdownRun = { cancel: () => finish(false) };
-    show();
-    setProp(left, "hidden", false);
-  });
-}
-window.recordCountdown = recordCountdown;
-
 /* ------------------------------------------------------------------ following the source */
 function onSource(s) {
   if (!s) return;
@@ -435,7 +401,7 @@ function wire() {
   if (typeof prefs.mirror === "boolean") $("camera-mirror").checked = prefs.mirror;
   if (prefs.countdown !== undefined && prefs.countdown !== "") $("capture-countdown").value = prefs.countdown;
   for (const id of ["camera-model", "camera-mirror", "capture-countdown"]) $(id).addEventListener("change", savePrefs);
-  document.addEventListener("studio:source", (e) => onSource(e.detail));
+  listen("source", onSource);
   renderObservable(null);
   renderFps();
   onSource(S.source);

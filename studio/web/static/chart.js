@@ -200,9 +200,9 @@ function chartOptions(runs, band, log, width, height, xMode = "episode", smoothi
     hooks: {
       init: [(u) => {
         // Drag to zoom into episodes (the zoom then survives live updates); double-click resets.
-        u.over.addEventListener("dblclick", () => { S.chartZoomed = false; });
+        u.over.addEventListener("dblclick", () => { zoomed = false; });
       }],
-      setSelect: [(u) => { if (u.select.width > 0) S.chartZoomed = true; }],
+      setSelect: [(u) => { if (u.select.width > 0) zoomed = true; }],
       draw: [(u) => {
         // Mark where each run's band stops averaging all of its experiments (runs of different
         // lengths, or a stopped run): the band goes on, over fewer experiments, as the legend says.
@@ -240,6 +240,7 @@ let chartKey = "";
 let chartRuns = []; // run ids of the chart's mean columns, in order
 let chartSmooth = false; // each run has a smoothed mean column, its last
 let chartStride = 1; // columns per run: mean, or mean, low and high; then the smoothed mean
+let zoomed = false; // the user dragged to zoom: live updates keep the x range
 
 /** Size the chart to its pane, leaving room for the legend under it. */
 export function fitChart() {
@@ -268,7 +269,7 @@ export function renderCurves() {
   const data = chartData(runs, band, log, xMode, smoothing);
   renderCurveKey(runs, data, band);
   if (chart && key === chartKey) {
-    chart.setData(data, !S.chartZoomed);
+    chart.setData(data, !zoomed);
   } else {
     if (chart) chart.destroy();
     const box = $("curve-plot");
@@ -277,20 +278,20 @@ export function renderCurves() {
     chartRuns = runs.map((r) => r.id);
     chartSmooth = smoothing > 0;
     chartStride = (band === "none" ? 1 : 3) + (chartSmooth ? 1 : 0);
-    S.chartZoomed = false;
+    zoomed = false;
     fitChart();
   }
-  S.curveRenders = (S.curveRenders || 0) + 1; // chart redraws with new data (benchmarks read it)
+  S.curveRenders += 1;
 }
 
 /** Ids of the runs in the chart, in legend order (used by the browser tests). */
-S.plottedRuns = () => (chart ? [...chartRuns] : []);
+export const drawnRuns = () => (chart ? [...chartRuns] : []);
 
 /** The x where a plotted run starts averaging fewer experiments than it has, or null (tests). */
-S.chartFewerFrom = (id) => (chart && chartRuns.includes(id) ? fewerFrom(chart.data, chartRuns.indexOf(id)) : null);
+export const drawnFewerFrom = (id) => (chart && chartRuns.includes(id) ? fewerFrom(chart.data, chartRuns.indexOf(id)) : null);
 
 /** Number of plotted mean-curve points of a run, or of all runs (used by the browser tests). */
-S.curvePoints = (id) => {
+export const drawnPoints = (id) => {
   if (!chart) return 0;
   let n = 0;
   chartRuns.forEach((run, i) => {
@@ -300,7 +301,7 @@ S.curvePoints = (id) => {
 };
 
 /** A plotted run's columns as drawn: x, its mean and its smoothed mean (null without smoothing). */
-S.chartLine = (id) => {
+export const drawnLine = (id) => {
   const i = chart ? chartRuns.indexOf(id) : -1;
   if (i < 0) return null;
   const base = 1 + i * chartStride;

@@ -12,7 +12,7 @@ import { runColor, runLabel, runTask } from "./chart.js";
 import { $, el, enc, fmtCpu, setProp, setText, showError } from "./dom.js";
 import { reconcileRows, renderRuns, toggleShown } from "./runs.js";
 import { runMatches } from "./runfilter.js";
-import { S, markCurvesDirty } from "./state.js";
+import { S, listen, markCurvesDirty } from "./state.js";
 
 /** Settings that say nothing about how a run learns (shown elsewhere, or its name). */
 const NOT_SETTINGS = new Set(["name"]);
@@ -115,7 +115,7 @@ export function openCompare() {
 }
 
 export function wireCompare() {
-  S.afterRunsRender = renderCompare;
+  listen("drawnRuns", renderCompare);
   $("curve-smooth").addEventListener("input", () => {
     setText("curve-smooth-value", Number($("curve-smooth").value).toFixed(2));
     markCurvesDirty();

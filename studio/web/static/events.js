@@ -6,8 +6,7 @@ import { $, setProp, setText } from "./dom.js";
 import { loadPolicies, renderWatchChoices } from "./policies.js";
 import { loadRecordings, renderCaptureButton } from "./recordings.js";
 import { loadCurve, loadRuns, mergeCurve, renderRuns, upsertRun } from "./runs.js";
-import { renderSource } from "./sources.js";
-import { S } from "./state.js";
+import { S, set } from "./state.js";
 
 // Live updates (the chart and the run list's progress) are drawn together, at most this often:
 // without a GPU every repaint of the page is composited by the CPU that trains, so two timers
@@ -23,7 +22,7 @@ export function connectEvents() {
   events.onerror = () => {
     conn.textContent = "reconnecting…"; conn.className = "chip bad";
   };
-  events.addEventListener("source", (e) => { S.source = JSON.parse(e.data); renderSource(); });
+  events.addEventListener("source", (e) => set("source", JSON.parse(e.data)));
   events.addEventListener("capture", (e) => { S.capture = JSON.parse(e.data); renderCaptureButton(); updateMarkButton(); });
   events.addEventListener("run", (e) => {
     const d = JSON.parse(e.data);

@@ -3,29 +3,29 @@
  * ES modules, no build step: this one wires the page and starts it. Read the others by what they
  * show: sources, recordings (and capture), demos, training (the form), runs, chart (curves.js holds
  * the averaging rule the server shares), policies, scene; events is the live stream that feeds
- * them; api and dom are the helpers; state the one state, `window.studio`. Live data arrives over
+ * them; api and dom are the helpers; state the one state and its announcements. Live data arrives over
  * one EventSource('/api/events'); the curve chart (uPlot) gets new data at most CURVE_FPS times a
  * second, whatever the event rate.
  */
 
 import { api, guarded } from "./api.js";
-import { chartData, fewerFrom, fitChart, plottedRuns } from "./chart.js";
+import { fitChart } from "./chart.js";
 import { cutDemo, loadDemos, setDemoRange, syncDemoRange, toggleMark, updateMarkButton } from "./demos.js";
-import { $, setProp, setText, showError } from "./dom.js";
-import { CURVE_FPS, connectEvents, events, renderLive } from "./events.js";
+import { $, showError } from "./dom.js";
+import { CURVE_FPS, connectEvents, renderLive } from "./events.js";
 import { exportFile, loadPolicies, uploadPolicy, watch } from "./policies.js";
 import { dismissCaptureFailure, loadRecordings, renderCaptureButton, saveRecordingEdit, toggleCapture, uploadRecording } from "./recordings.js";
-import { loadRuns, renderRuns } from "./runs.js";
+import { loadRuns } from "./runs.js";
 import { wireCompare } from "./compare.js";
-import { SOFTWARE_RENDERERS, SOFTWARE_SCENE_DPR, loadConfig, softwareWebGL } from "./scene.js";
+import { loadConfig, softwareWebGL } from "./scene.js";
 import { buildExportControl } from "./exports.js";
-import { applySource, loadRobots, playback, renderSource, setRetarget, setRobot, simulatorReach, syncKindOptions } from "./sources.js";
-import { S, markCurvesDirty } from "./state.js";
+import { applySource, loadRobots, playback, setRetarget, setRobot, simulatorReach, syncKindOptions } from "./sources.js";
+import { S, listen, markCurvesDirty, set } from "./state.js";
 import { checkTrainForm, resetTrainForm, startRun, syncTaskFields } from "./training.js";
 
 function wire() {
-  // The buttons that follow the live source; camera.js listens after them.
-  document.addEventListener("studio:source", () => { renderCaptureButton(); updateMarkButton(); });
+  // The buttons that follow the live source, after its status line; camera.js listens after them.
+  listen("source", () => { renderCaptureButton(); updateMarkButton(); });
   $("source-kind").addEventListener("change", syncKindOptions);
   $("source-apply").addEventListener("click", applySource);
   $("playback-toggle").addEventListener("click", () => playback($("playback-toggle").dataset.playing === "1" ? "pause" : "play"));
@@ -97,10 +97,9 @@ async function main() {
   S.softwareScene = softwareWebGL();
   await loadConfig();
   const initial = api("GET", "/api/source").then((s) => {
-    S.source = s;
     if (s.kind) $("source-kind").value = s.kind;
     syncKindOptions();
-    renderSource();
+    set("source", s);
   }).catch((e) => showError("source-error", e));
   const cap = api("GET", "/api/capture").then((c) => { S.capture = c; renderCaptureButton(); updateMarkButton(); }).catch(() => {});
   const mark = api("GET", "/api/demonstrations/mark").then((m) => {
@@ -112,12 +111,5 @@ async function main() {
   if (S.source && S.source.recording) $("source-recording").value = S.source.recording;
   document.body.dataset.ready = "1";
 }
-
-// camera.js (a module loaded after this one) and the browser tests reach these by name, as they
-// did when the page was one classic script.
-Object.assign(window, { $, api, showError, setText, setProp });
-Object.assign(window, { plottedRuns, chartData, fewerFrom, loadRuns, renderRuns });
-Object.assign(window, { softwareWebGL, SOFTWARE_SCENE_DPR, SOFTWARE_RENDERERS });
-Object.defineProperty(window, "events", { get: () => events }); // the live EventSource
 
 main();

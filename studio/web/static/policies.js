@@ -3,7 +3,7 @@
 import { api, download, guarded, uploadChosen } from "./api.js";
 import { runLabel } from "./chart.js";
 import { $, confirmDialog, el, emptyRow, enc, fillSelect, flashRow, fmt, setText, showError } from "./dom.js";
-import { S } from "./state.js";
+import { S, set } from "./state.js";
 
 export async function loadPolicies() {
   await guarded("policies-error", async () => {
@@ -96,8 +96,7 @@ export async function watch() {
     const from = w.seed != null ? `from a random start (seed ${w.seed})` : body.start === "current" ? "from the current pose" : "from its demonstration's start";
     setText("watch-result", `${w.steps} steps, ${secs.toFixed(1)} s ${from} — ${w.reached_goal ? "reaches the goal" : "does not reach the goal"}`);
     renderLikeness(w.likeness, w.likeness_note);
-    S.watchedRun = t;
-    document.dispatchEvent(new CustomEvent("studio:watch", { detail: w })); // watch.js: the scrubber
+    set("watchedRun", t); // watch.js: the scrubber
   }, $("watch-go"));
 }
 

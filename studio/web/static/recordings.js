@@ -6,6 +6,7 @@ import { fillExportItems } from "./exports.js";
 import { $, confirmDialog, el, emptyRow, enc, fillSelect, flashRow, fmt, fmtDuration, groupRow, setProp, setText, showError } from "./dom.js";
 import { applySource, syncKindOptions } from "./sources.js";
 import { S } from "./state.js";
+import { recordCountdown } from "./countdown.js";
 
 export function renderCaptureButton() {
   const active = !!(S.capture && S.capture.active) || !!(S.source && S.source.recording_active);
@@ -41,7 +42,7 @@ export async function toggleCapture() {
       flashRow("recordings-body", rec && rec.name);
     }, b);
   } else {
-    if (window.recordCountdown && !(await window.recordCountdown())) return; // camera.js: cancelled
+    if (!(await recordCountdown())) return; // cancelled
     const body = {};
     if ($("capture-name").value.trim()) body.name = $("capture-name").value.trim();
     if ($("capture-operator").value.trim()) body.operator = $("capture-operator").value.trim();

@@ -8,7 +8,7 @@ const TIME_KEY_SET = new Set(Object.values(TIME_KEYS));
 import { $, confirmDialog, el, emptyRow, enc, fmtCpu, showError } from "./dom.js";
 import { renderPolicies, renderWatchChoices } from "./policies.js";
 import { runMatches, tagChips } from "./runfilter.js";
-import { S, markCurvesDirty } from "./state.js";
+import { S, markCurvesDirty, set } from "./state.js";
 
 export function upsertRun(run) {
   const i = S.runs.findIndex((r) => r.id === run.id);
@@ -69,7 +69,7 @@ export function renderRuns() {
     else if (!grouped.has(sweep)) { grouped.add(sweep); rows.push(...sweepRows(sweep)); }
   }
   reconcileRows(body, rows);
-  if (S.afterRunsRender) S.afterRunsRender(); // the run table, when it is open
+  set("drawnRuns", S.drawnRuns + 1); // the run table follows, when it is open
   const failed = S.runs.find((r) => r.status === "failed" && r.error && !r._errorShown);
   if (failed) { failed._errorShown = true; showError("runs-error", `${failed.name || failed.id}: ${failed.error}`); }
 }

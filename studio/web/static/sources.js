@@ -2,7 +2,7 @@
 
 import { api, guarded, inTurn } from "./api.js";
 import { $, fmt, setProp, setText, showError } from "./dom.js";
-import { S } from "./state.js";
+import { S, listen, set } from "./state.js";
 
 export function renderSource() {
   const s = S.source;
@@ -40,9 +40,9 @@ export function renderSource() {
     }
     if (!$("playback-loop").dataset.pending) setProp("playback-loop", "checked", !!pb.loop);
   }
-  // The capture button and the mark button follow it (wired in main.js), then camera.js.
-  document.dispatchEvent(new CustomEvent("studio:source", { detail: s }));
 }
+// The status line follows every status; the capture and mark buttons (main.js) and camera.js after it.
+listen("source", renderSource);
 
 export function syncKindOptions() {
   const kind = $("source-kind").value;
@@ -68,8 +68,7 @@ export async function applySource() {
     body.seed = Number($("source-seed").value);
   }
   const switched = await guarded("source-error", async () => {
-    S.source = await api("PUT", "/api/source", body);
-    renderSource();
+    set("source", await api("PUT", "/api/source", body));
     return true;
   }, $("source-apply"));
   // A refused switch changed nothing on the server: the selector goes back to the source that
@@ -87,8 +86,7 @@ export async function simulatorReach(action) {
     body.goal_deg = [Number(f.goal0.value), Number(f.goal1.value), Number(f.goal2.value)];
   }
   await guarded("source-error", async () => {
-    S.source = await api("POST", "/api/source/reach", body);
-    renderSource();
+    set("source", await api("POST", "/api/source/reach", body));
   }, $(action === "reach" ? "source-reach" : "source-wander"));
 }
 
@@ -96,18 +94,16 @@ const playbackInTurn = inTurn(); // a seek, then play: in that order
 
 export function playback(action, extra = {}) {
   return playbackInTurn(() => guarded("source-error", async () => {
-    S.source = await api("POST", "/api/source/playback", { action, ...extra });
-    renderSource();
+    set("source", await api("POST", "/api/source/playback", { action, ...extra }));
   }));
 }
 
 export async function setRetarget() {
   await guarded("source-error", async () => {
-    S.source = await api("PUT", "/api/source/retarget", {
+    set("source", await api("PUT", "/api/source/retarget", {
       mode: $("retarget-mode").value,
       mirror: $("retarget-mirror").checked,
-    });
-    renderSource();
+    }));
   });
 }
 
@@ -167,11 +163,10 @@ export async function loadRobots() {
 }
 
 /** Tell the page's other parts (the train form's goal, the timeline, the jog sliders) that the
- * robot taught is now ``name``: the `studio:robot` event, once per change. */
+ * robot taught is now ``name``: `set("robot")`, once per change. */
 function announceRobot(name) {
   if (!S.robots || S.robot === name) return;
-  S.robot = name;
-  document.dispatchEvent(new CustomEvent("studio:robot", { detail: name }));
+  set("robot", name);
 }
 
 /** The train form says which robot a run trains: the one chosen here. */

@@ -1,6 +1,6 @@
 /* Teach Studio page: recording in takes, as LeRobot's recording loop.
  *
- * Start take counts down (the Countdown control, camera.js's countdown), then records; Stop take
+ * Start take counts down (the Countdown control, countdown.js), then records; Stop take
  * (Escape) plays the take on the robot with its tool path drawn, for review. Then Keep take, Keep
  * and next (→) or Redo take (←, the take's recording is deleted). Make demonstrations cuts every
  * kept take, whole, into a demonstration in one go. The session lives in the data folder
@@ -11,9 +11,9 @@ import { api, guarded } from "./api.js";
 import { loadDemos } from "./demos.js";
 import { $, el, setProp, setText } from "./dom.js";
 import { loadRecordings, renderCaptureButton } from "./recordings.js";
+import { recordCountdown } from "./countdown.js";
 import { S } from "./state.js";
 
-S.takes = { started: null, finished: null, takes: [] };
 let counting = false;
 
 function lastTake() {
@@ -38,6 +38,7 @@ const STATE_TEXT = {
 
 export function renderTakes() {
   const p = phase();
+  S.takePhase = p;
   const start = $("take-start");
   setText(start, p === "recording" ? "■ Stop take" : p === "countdown" ? "Cancel" : "● Start take");
   start.classList.toggle("active", p === "recording");
@@ -69,12 +70,12 @@ async function refreshCapture() {
 export async function startTake() {
   const p = phase();
   if (p === "recording") return stopTake();
-  if (p === "countdown") { await window.recordCountdown(); return; } // cancels it
+  if (p === "countdown") { await recordCountdown(); return; } // cancels it
   if (p === "review") { showTakesError("Keep or redo the take under review first."); return; }
   counting = true;
   setProp("takes-made", "hidden", true);
   renderTakes();
-  const go = await window.recordCountdown(true, "Esc cancels");
+  const go = await recordCountdown(true, "Esc cancels");
   counting = false;
   if (!go) { renderTakes(); return; }
   const operator = $("capture-operator").value.trim();
@@ -143,7 +144,7 @@ function onKey(ev) {
   if (ev.key === "Escape" && (p === "recording" || p === "countdown")) {
     ev.preventDefault();
     if (p === "recording") stopTake();
-    else window.recordCountdown();
+    else recordCountdown();
   } else if (ev.key === "ArrowRight" && p === "review") {
     ev.preventDefault();
     keepTake(true);
@@ -168,5 +169,4 @@ async function wire() {
   });
 }
 
-S.takesPhase = phase; // for the browser tests
 wire();

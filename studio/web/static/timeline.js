@@ -15,7 +15,7 @@
 import { api, guarded } from "./api.js";
 import { setDemoRange } from "./demos.js";
 import { $, el, enc, fmt, setProp, setText } from "./dom.js";
-import { S } from "./state.js";
+import { S, listen } from "./state.js";
 
 const ROBOT = ["#1f4e9c", "#2a7bd8", "#0f8b8d", "#23874b", "#6b4fbb", "#b83280", "#5c6b7a"];
 const HUMAN = ["#d9822b", "#b8661f", "#a0522d", "#c9a227", "#e05a47", "#8c6d46", "#7a7a7a"];
@@ -24,7 +24,7 @@ const STEP_S = 0.1;
 const UNITS = { deg: (x) => `${x}°`, cm: (x) => `${x} cm` };
 
 const T = { asked: 0, drawn: 0, name: null, show: "joints", data: null, chart: null, playhead: 0, playing: false, last: 0, want: null, sending: false };
-S.timeline = T; // for the browser tests and the console
+S.timeline = T;
 
 function duration() { return T.data ? T.data.duration : 0; }
 function clamp(t) { return Math.max(0, Math.min(duration(), t)); }
@@ -106,7 +106,7 @@ function draw() {
   if (typeof uPlot === "undefined" || !T.data) return;
   const d = T.data;
   const { cols, series, unit } = plotted(d);
-  S.timelineShown = series.slice(1).map((s) => s.label); // for the browser tests
+  S.timelineShown = series.slice(1).map((s) => s.label);
   showLegend();
   const box = $("timeline-plot");
   T.chart = new uPlot({
@@ -244,7 +244,7 @@ function onKey(ev) {
 
 function wire() {
   // another robot chosen under Source: plot its joints (the server retargets the recording onto it)
-  document.addEventListener("studio:robot", () => { if (T.name) showTimeline(T.name); });
+  listen("robot", () => { if (T.name) showTimeline(T.name); });
   $("timeline").addEventListener("keydown", onKey);
   $("timeline-show").addEventListener("change", (e) => { T.show = e.target.value; draw(); });
   $("demo-recording").addEventListener("change", () => showTimeline($("demo-recording").value));

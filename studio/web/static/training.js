@@ -5,7 +5,7 @@ import { emptyCurve } from "./curves.js";
 import { $, el, showError } from "./dom.js";
 import { openCompare } from "./compare.js";
 import { renderRuns, upsertRun } from "./runs.js";
-import { S, markCurvesDirty } from "./state.js";
+import { S, listen, markCurvesDirty } from "./state.js";
 
 /** Form inputs of a field the API names (the goal is three inputs). */
 const TRAIN_INPUTS = { goal_deg: ["goal0", "goal1", "goal2"] };
@@ -40,9 +40,7 @@ function fillGoal(goal) {
 // another arm's pose, often beyond its limits), and the picked demonstrations are checked again.
 // A goal taken from a pose by hand (watch.js) is checked at once, as Start would check it: a
 // joint within the robot's limits may still fall in a grid bin whose centre lies beyond them.
-document.addEventListener("studio:goal", () => checkTrainForm(true));
-
-document.addEventListener("studio:robot", () => {
+listen("robot", () => {
   const goal = robotGoal();
   if (!goal) return;
   fillGoal(goal);

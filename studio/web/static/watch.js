@@ -3,8 +3,8 @@
  * The scene keeps the scrub position, the speed and the pause (POST /api/scene/playback); this
  * module only shows them and sends the user's changes. Between answers the time shown runs on the
  * page's own clock at the playback's speed, and only while the rollout plays: a paused or finished
- * rollout writes nothing to the page. It hears a new watch through the `studio:watch` event that
- * policies.js fires.
+ * rollout writes nothing to the page. It follows the policy watched (`watchedRun`, set by
+ * policies.js).
  *
  * Posing by hand: a slider per robot joint between its limits (shown at both ends), which moves the
  * robot in the scene (POST /api/scene/jog, latest wins), and "use this pose as the goal", which
@@ -13,7 +13,8 @@
 
 import { api, guarded, inTurn } from "./api.js";
 import { $, el, fmt, setProp, setText, showError } from "./dom.js";
-import { S } from "./state.js";
+import { S, listen } from "./state.js";
+import { checkTrainForm } from "./training.js";
 
 const TICK_MS = 100; // the time shown moves this often while a rollout plays
 const VIEWS = [["front", "Front view", "Front"], ["top", "Top view", "Top"], ["side", "Side view", "Side"]];
@@ -157,7 +158,7 @@ function keyTakenElsewhere(ev) {
   if (target.isContentEditable || ["INPUT", "TEXTAREA", "SELECT"].includes(target.tagName)) return true;
   if ((ev.key === " " || ev.key === "Enter") && target.closest("button, summary, a, [role='button']")) return true;
   if (target.closest("[data-keys='own'], dialog[open]")) return true;
-  const take = S.takesPhase ? S.takesPhase() : "idle";
+  const take = S.takePhase;
   return take !== "idle" && take !== "kept";
 }
 
@@ -256,12 +257,12 @@ function useAsGoal() {
     input.dispatchEvent(new Event("change", { bubbles: true }));
   }
   showError("rollout-error", null);
-  document.dispatchEvent(new CustomEvent("studio:goal")); // the train form checks it now
+  checkTrainForm(true); // at once, as Start would check it
 }
 
 build();
-document.addEventListener("studio:watch", loadRollout);
+listen("watchedRun", loadRollout);
 // Another robot chosen under Source: the sliders become its joints, between its limits.
-document.addEventListener("studio:robot", () => { if ($("jog").open) loadJog(); else $("jog-joints").replaceChildren(); });
+listen("robot", () => { if ($("jog").open) loadJog(); else $("jog-joints").replaceChildren(); });
 $("watch-stop").addEventListener("click", () => showRollout(null)); // the robot goes back to live
 loadRollout();
