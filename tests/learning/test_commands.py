@@ -185,6 +185,29 @@ def test_train_on_a_damaged_demonstration_is_one_sentence(
 
 
 @pytest.mark.parametrize(
+    ("text", "says"),
+    [
+        ('[["a", "b"]]', "Demonstration 0 holds 'a', not a grid state"),
+        ("[[0, 1], [NaN, 1]]", "Demonstration 1 holds nan, not a grid state"),
+        ("[[Infinity]]", "Demonstration 0 holds inf, not a grid state"),
+        ('{"demonstrations": [[1e999, 2]]}', "Demonstration 0 holds inf, not a grid state"),
+        ("[[1.5, 2]]", "Demonstration 0 holds 1.5, not a grid state"),
+        ("[[true, 2]]", "Demonstration 0 holds True, not a grid state"),
+    ],
+)
+def test_train_on_a_file_of_bad_grid_paths_is_one_sentence(text: str, says: str, tmp_path, capsys):
+    """Grid paths holding strings, NaN, Infinity or 1e999 once gave ``ValueError: invalid
+    literal for int()`` (or an ``OverflowError``) from the run request."""
+    bad = tmp_path / "paths.json"
+    bad.write_text(text)
+    argv = ["train", "--demos", str(bad), "--episodes", "2", "--experiments", "1", "--no-progress"]
+    assert main([*argv, "--out", str(tmp_path / "run")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and err.startswith("studio train: ") and says in err, err
+    assert "from 0 to 1330" in err and not (tmp_path / "run").exists()
+
+
+@pytest.mark.parametrize(
     ("old", "new", "says"),
     [
         ('"experiments": 1', '"experiments": Infinity', "experiments is inf"),

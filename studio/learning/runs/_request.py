@@ -268,7 +268,19 @@ def _grid_paths(
 ) -> list[list[int]]:
     """The grid state paths the run replays: the given ones, then the recorded demonstrations'
     (each must end in the goal bin), then the generated ones."""
-    paths = [[int(s) for s in path] for path in request.grid_paths]
+    paths = []
+    for i, path in enumerate(request.grid_paths):
+        bad = next((s for s in path if not is_int(s)), None)
+        if bad is not None:
+            problems.append(
+                (
+                    "demonstrations",
+                    f"Demonstration {i} holds {bad!r}, not a grid state; give whole state "
+                    f"numbers from 0 to {grid.n_states - 1}.",
+                )
+            )
+            continue
+        paths.append([int(s) for s in path])
     for demo in request.demonstrations:
         try:
             paths.append(demonstration_grid_path(demo.label, demo.q_robot, grid))
