@@ -19,8 +19,12 @@ from ._export import FORMAT_SUFFIXES as FORMAT_SUFFIXES
 from ._export import FORMATS as FORMATS
 from ._export import Exported as Exported
 from ._export import export_motion as export_motion
+from ._formats import DESCRIPTION_TOPIC as DESCRIPTION_TOPIC
 from ._formats import JOINT_STATE as JOINT_STATE
 from ._formats import JOINT_TRAJECTORY as JOINT_TRAJECTORY
+from ._formats import STATE_TOPIC as STATE_TOPIC
+from ._formats import TF_TOPIC as TF_TOPIC
+from ._formats import TRAJECTORY_TOPIC as TRAJECTORY_TOPIC
 from ._formats import write_csv as write_csv
 from ._formats import write_mcap as write_mcap
 from ._lerobot import CODEBASE_VERSION as CODEBASE_VERSION
@@ -36,6 +40,8 @@ from ._simulate import simulate_trajectory as simulate_trajectory
 from ._sources import check_policy_robot as check_policy_robot
 from ._sources import find_source as find_source
 from ._sources import source_kind as source_kind
+from ._tf import LinkTransforms as LinkTransforms
+from ._tf import link_transforms as link_transforms
 from ._timing import LIMIT_FRACTION as LIMIT_FRACTION
 from ._timing import time_path as time_path
 from ._urdf import export_urdf as export_urdf

@@ -4,12 +4,13 @@ The checks run on the very samples that are written and before a byte is written
 a :class:`SafetyError` and leaves any earlier file at ``out`` untouched. ``unchecked=True`` writes
 anyway, with every finding stated in the file (CSV comment lines, the MCAP ``teach_studio``
 metadata, ``info.json``'s ``teach_studio`` key). A motion's notes (the hand went beyond the
-robot's reach while retargeting) are stated in the MCAP and LeRobot files whether checked or not,
-and in an unchecked CSV's comment lines (a checked CSV has none, as its readers expect).
+robot's reach while retargeting) are stated in every file, checked or not, and a CSV's comment
+lines always name the robot, the joint order, the units and the source.
 """
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Literal
@@ -22,6 +23,7 @@ from studio.motion import Finding, Motion
 from ._formats import write_csv, write_mcap
 from ._lerobot import write_lerobot
 from ._safety import COLLISION_MARGIN_M, check_trajectory, refuse
+from ._tf import link_transforms
 from ._timing import LIMIT_FRACTION, time_path
 
 Format = Literal["csv", "mcap", "lerobot"]
@@ -56,7 +58,12 @@ def _notes(motion: Motion, findings: list[Finding], checked: bool) -> list[str]:
         f"Teach Studio export of {motion.kind} {motion.name} for the {robot.spec.title} "
         f"({robot.name}), {now_iso()}"
     )
-    notes = [f"note: {note}" for note in motion.notes]
+    notes = [
+        f"robot: {robot.name}; joints in order: {', '.join(robot.joint_names)}",
+        "units: time in seconds from the first sample, joint angles in radians",
+        f"source: the {motion.kind} {motion.name}",
+        *(f"note: {note}" for note in motion.notes),
+    ]
     if not findings:
         return [head, *notes, "safety checks: passed (joint positions, velocities, "
                 f"accelerations, self-collision margin {COLLISION_MARGIN_M * 100:.1f} cm)"]  # fmt: skip
@@ -104,7 +111,7 @@ def export_motion(
     notes = _notes(motion, findings, checked=not unchecked)
     names = robot.joint_names
     if fmt == "csv":
-        write_csv(out, names, times, q, notes if findings else ())  # a checked file: no # lines
+        write_csv(out, names, times, q, notes)
     elif fmt == "mcap":
         metadata = {
             "source": motion.name,
@@ -115,7 +122,19 @@ def export_motion(
             "findings": "\n".join(f.sentence for f in findings),
             "notes": "\n".join(motion.notes),
         }
-        write_mcap(out, names, times, q, states=as_captured, metadata=metadata)
+        start_ns = int(round((motion.started or time.time()) * 1e9))
+        links = link_transforms(robot.model, q)
+        write_mcap(
+            out,
+            names,
+            times,
+            q,
+            states=as_captured,
+            metadata=metadata,
+            start_ns=start_ns,
+            urdf=robot.urdf_text,
+            links=links,
+        )
     else:
         fps = int(round(motion.rate_hz))
         extra = {

@@ -1,14 +1,23 @@
 """The trajectory file formats: CSV with the URDF's joint names, and MCAP with ROS 2 messages.
 
-CSV: ``time,<joint names>``, one row per sample, seconds (to the nanosecond) and radians. Findings of an unchecked
-export come first as ``#`` comment lines (``numpy.loadtxt`` and pandas' ``comment="#"`` skip them).
+CSV: ``#`` comment lines first, on every export (the robot, the joint order, the units, the
+source, the checks and any finding; ``numpy.loadtxt`` and pandas' ``comment="#"`` skip them),
+then ``time,<joint names>`` and one row per sample, seconds (to the nanosecond) and radians.
 
-MCAP (``mcap`` + ``mcap-ros2-support``, no ROS installation needed; opens in Foxglove and
-Lichtblick): a policy or a demonstration is one ``trajectory_msgs/msg/JointTrajectory`` on
-``/joint_trajectory`` whose points carry positions, velocities and ``time_from_start``; a
-recording is one ``sensor_msgs/msg/JointState`` per captured frame on ``/joint_states``, stamped
-at its capture time. The file's metadata record ``teach_studio`` states the source, the robot and
-whether the checks passed, with the findings of an unchecked export.
+MCAP (``mcap`` + ``mcap-ros2-support``, no ROS installation needed; Foxglove and Lichtblick draw
+the robot moving from it alone):
+
+- ``/robot_description``: the URDF as ``std_msgs/msg/String``, latched, at the start;
+- ``/joint_trajectory``: a policy's or a demonstration's one ``trajectory_msgs/msg/JointTrajectory``
+  whose points carry positions, velocities and ``time_from_start`` (a recording at its capture
+  times has none: it is what the arm did, not a trajectory to follow);
+- ``/joint_states``: one ``sensor_msgs/msg/JointState`` per sample;
+- ``/tf``: one ``tf2_msgs/msg/TFMessage`` per sample, every link's transform from its parent.
+
+Log times and stamps are real times, nanoseconds since the Unix epoch: a recording's own, or the
+export's. Frame ids are the URDF's link names. The file's metadata record ``teach_studio``
+states the source, the robot and whether the checks passed, with the findings of an unchecked
+export.
 """
 
 from __future__ import annotations
@@ -23,11 +32,16 @@ import numpy as np
 from studio._files import atomic_write
 
 from ._errors import ExportError
+from ._tf import LinkTransforms
 
 JOINT_TRAJECTORY = "trajectory_msgs/msg/JointTrajectory"
 JOINT_STATE = "sensor_msgs/msg/JointState"
+STRING = "std_msgs/msg/String"
+TF_MESSAGE = "tf2_msgs/msg/TFMessage"
 TRAJECTORY_TOPIC = "/joint_trajectory"
 STATE_TOPIC = "/joint_states"
+DESCRIPTION_TOPIC = "/robot_description"
+TF_TOPIC = "/tf"
 METADATA_NAME = "teach_studio"
 """The MCAP metadata record that describes the export."""
 
@@ -35,6 +49,21 @@ _SEPARATOR = "=" * 80
 _TIME = "int32 sec\nuint32 nanosec\n"
 _HEADER = "builtin_interfaces/Time stamp\nstring frame_id\n"
 _MSGDEFS = {
+    STRING: ("string data\n", []),
+    TF_MESSAGE: (
+        "geometry_msgs/TransformStamped[] transforms\n",
+        [
+            (
+                "geometry_msgs/TransformStamped",
+                "std_msgs/Header header\nstring child_frame_id\nTransform transform\n",
+            ),
+            ("std_msgs/Header", _HEADER),
+            ("builtin_interfaces/Time", _TIME),
+            ("geometry_msgs/Transform", "Vector3 translation\nQuaternion rotation\n"),
+            ("geometry_msgs/Vector3", "float64 x\nfloat64 y\nfloat64 z\n"),
+            ("geometry_msgs/Quaternion", "float64 x\nfloat64 y\nfloat64 z\nfloat64 w\n"),
+        ],
+    ),
     JOINT_STATE: (
         "std_msgs/Header header\nstring[] name\nfloat64[] position\nfloat64[] velocity\n"
         "float64[] effort\n",
@@ -86,7 +115,8 @@ def write_csv(
         names: the joint names (the URDF's).
         times: seconds from the start.
         q: radians, one row per sample.
-        notes: lines written first as ``# `` comments (an unchecked export's findings).
+        notes: lines written first as ``# `` comments (what the file is, its checks and
+            findings).
     """
     buffer = io.StringIO()
     for note in notes:
@@ -104,8 +134,21 @@ def write_csv(
 
 
 def _stamp(t: float) -> dict[str, int]:
-    ns = int(round(t * 1e9))
+    return _stamp_ns(int(round(t * 1e9)))
+
+
+def _stamp_ns(ns: int) -> dict[str, int]:
     return {"sec": ns // 1_000_000_000, "nanosec": ns % 1_000_000_000}
+
+
+LATCHED = (
+    "- history: keep_last\n  depth: 1\n  reliability: reliable\n  durability: transient_local\n"
+    "  deadline:\n    sec: 2147483647\n    nsec: 4294967295\n  lifespan:\n    sec: 2147483647\n"
+    "    nsec: 4294967295\n  liveliness: automatic\n  liveliness_lease_duration:\n"
+    "    sec: 2147483647\n    nsec: 4294967295\n  avoid_ros_namespace_conventions: false\n"
+)
+"""The QoS a ROS 2 bag records for a latched topic (``offered_qos_profiles``): a subscriber that
+joins late (``robot_state_publisher``, Foxglove) still gets ``/robot_description``."""
 
 
 def write_mcap(
@@ -116,37 +159,39 @@ def write_mcap(
     *,
     states: bool,
     metadata: dict[str, str],
+    start_ns: int,
+    urdf: str = "",
+    links: LinkTransforms | None = None,
 ) -> None:
-    """Write an MCAP file of ROS 2 messages (atomically).
+    """Write an MCAP file of ROS 2 messages (atomically) that robot tools read whole.
 
     Args:
         path: the ``.mcap`` file.
         names: the joint names.
         times: seconds from the start.
         q: radians, one row per sample.
-        states: one ``JointState`` per sample (a recording) instead of one ``JointTrajectory``.
+        states: a recording at its capture times: joint states only, no trajectory to follow.
         metadata: the ``teach_studio`` metadata record's key-value pairs.
+        start_ns: the first sample's time, nanoseconds since the Unix epoch (the recording's own
+            time, or the export's): every log time and stamp counts from it.
+        urdf: the robot's URDF, latched on ``/robot_description`` at the start.
+        links: every link's transform per sample (:func:`link_transforms`), on ``/tf``; its
+            root link is the frame id of the joint messages.
     """
     from mcap_ros2.writer import Writer
 
     names = list(names)
     velocity = np.gradient(q, times, axis=0) if len(times) > 1 else np.zeros_like(q)
+    at = [start_ns + int(round(float(t) * 1e9)) for t in times]
+    frame_id = links.root if links is not None else ""
 
     def write(stream: BinaryIO) -> None:
         writer = Writer(stream)
-        if states:
-            schema = writer.register_msgdef(JOINT_STATE, msgdef(JOINT_STATE))
-            for i, t in enumerate(times):
-                ns = int(round(float(t) * 1e9))
-                message = {
-                    "header": {"stamp": _stamp(float(t)), "frame_id": ""},
-                    "name": names,
-                    "position": q[i].tolist(),
-                    "velocity": velocity[i].tolist(),
-                    "effort": [],
-                }
-                writer.write_message(STATE_TOPIC, schema, message, log_time=ns, publish_time=ns)
-        else:
+        if urdf:
+            schema = writer.register_msgdef(STRING, msgdef(STRING))
+            _latch(writer, DESCRIPTION_TOPIC, schema)
+            writer.write_message(DESCRIPTION_TOPIC, schema, {"data": urdf}, log_time=at[0])
+        if not states:
             schema = writer.register_msgdef(JOINT_TRAJECTORY, msgdef(JOINT_TRAJECTORY))
             points = [
                 {
@@ -159,12 +204,56 @@ def write_mcap(
                 for i, t in enumerate(times)
             ]
             message = {
-                "header": {"stamp": _stamp(0.0), "frame_id": ""},
+                "header": {"stamp": _stamp_ns(at[0]), "frame_id": frame_id},
                 "joint_names": names,
                 "points": points,
             }
-            writer.write_message(TRAJECTORY_TOPIC, schema, message, log_time=0, publish_time=0)
+            writer.write_message(TRAJECTORY_TOPIC, schema, message, log_time=at[0])
+        state = writer.register_msgdef(JOINT_STATE, msgdef(JOINT_STATE))
+        tf = writer.register_msgdef(TF_MESSAGE, msgdef(TF_MESSAGE)) if links else None
+        for i, ns in enumerate(at):
+            message = {
+                "header": {"stamp": _stamp_ns(ns), "frame_id": frame_id},
+                "name": names,
+                "position": q[i].tolist(),
+                "velocity": velocity[i].tolist(),
+                "effort": [],
+            }
+            writer.write_message(STATE_TOPIC, state, message, log_time=ns, publish_time=ns)
+            if tf is not None and links is not None:
+                writer.write_message(TF_TOPIC, tf, _tf_message(links, i, ns), log_time=ns)
         writer.add_metadata(METADATA_NAME, metadata)
         writer.finish()
 
     _write_or_refuse(path, write, "MCAP file")
+
+
+def _latch(writer: object, topic: str, schema: object) -> None:
+    """Register ``topic`` with the latched QoS a ROS 2 bag gives it (mcap_ros2's writer
+    registers its channels with no metadata, so the channel is registered here first)."""
+    channel = writer._writer.register_channel(  # type: ignore[attr-defined]
+        topic=topic,
+        message_encoding="cdr",
+        schema_id=schema.id,  # type: ignore[attr-defined]
+        metadata={"offered_qos_profiles": LATCHED},
+    )
+    writer._channel_ids[topic] = channel  # type: ignore[attr-defined]
+
+
+def _tf_message(links: LinkTransforms, i: int, ns: int) -> dict[str, object]:
+    stamp = _stamp_ns(ns)
+    transforms = []
+    for e, (parent, child) in enumerate(links.edges):
+        x, y, z = links.translation[i, e].tolist()
+        qx, qy, qz, qw = links.rotation[i, e].tolist()
+        transforms.append(
+            {
+                "header": {"stamp": stamp, "frame_id": parent},
+                "child_frame_id": child,
+                "transform": {
+                    "translation": {"x": x, "y": y, "z": z},
+                    "rotation": {"x": qx, "y": qy, "z": qz, "w": qw},
+                },
+            }
+        )
+    return {"transforms": transforms}

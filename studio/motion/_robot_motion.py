@@ -15,6 +15,7 @@ from __future__ import annotations
 import functools
 import math
 from dataclasses import dataclass, field, replace
+from datetime import datetime
 from pathlib import Path
 from typing import Literal
 
@@ -84,6 +85,8 @@ class Motion:
         path: the retargeting's account of each sample (whether the tool reached the hand's
             target, how far it was drawn back; :class:`studio.kinematics.RetargetedPath`), for a
             motion retargeted from a human arm; None for a stored or rolled-out joint path.
+        started: when the first sample happened, seconds since the Unix epoch (a recording's
+            capture); None: the export's own time stamps the file.
     """
 
     kind: SourceKind
@@ -96,6 +99,7 @@ class Motion:
     findings: tuple[Finding, ...] = field(default=())
     notes: tuple[str, ...] = field(default=())
     path: RetargetedPath | None = None
+    started: float | None = None
 
     def retimed(self, rate_hz: float) -> Motion:
         """This motion as a path that :func:`time_path` times within the robot's limits and
@@ -199,9 +203,29 @@ def recording_motion(
         robot, times, human_angles(rec, rows), rec.side, _strided(stride)
     )
     rate = _capture_rate(rec, times) / stride
+    started = _captured_at(rec.meta.get("created", ""), float(rec.t[start] - rec.t[0]))
     return Motion(
-        "recording", path.name, robot, times, found.q, True, rate, tuple(findings), notes, found
+        "recording",
+        path.name,
+        robot,
+        times,
+        found.q,
+        True,
+        rate,
+        tuple(findings),
+        notes,
+        found,
+        started,
     )
+
+
+def _captured_at(created: str, offset: float) -> float | None:
+    """The Unix time of a recording's frame ``offset`` seconds after its first, from the header's
+    ISO 8601 ``created`` stamp (None: no readable stamp)."""
+    try:
+        return datetime.fromisoformat(created).timestamp() + offset
+    except (TypeError, ValueError):
+        return None
 
 
 def _strided(stride: int) -> RetargetConfig | None:

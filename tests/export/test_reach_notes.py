@@ -47,7 +47,10 @@ def test_a_checked_export_states_the_hand_beyond_reach(fmt, tmp_path, capsys):
     assert "passed the safety checks" in printed
     assert f"note: {BEYOND}" in printed
     if fmt == "csv":
-        assert out.read_text().startswith("time,"), "a checked CSV has no comment lines"
+        # issue 39: every CSV's comment lines say what it is, the notes among them
+        comments = [line for line in out.read_text().splitlines() if line.startswith("# ")]
+        assert f"# note: {BEYOND}" in "\n".join(comments)
+        assert "# safety checks: passed" in "\n".join(comments)
     elif fmt == "mcap":
         with out.open("rb") as f:
             meta = {m.name: m.metadata for m in make_reader(f).iter_metadata()}

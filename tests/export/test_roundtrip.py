@@ -15,6 +15,8 @@ from studio.cli import main
 from studio.export import (
     JOINT_STATE,
     JOINT_TRAJECTORY,
+    STATE_TOPIC,
+    TRAJECTORY_TOPIC,
     check_trajectory,
     demonstration_motion,
     export_motion,
@@ -30,23 +32,26 @@ def read_csv(path: Path) -> tuple[list[str], np.ndarray]:
 
 
 def read_mcap(path: Path) -> tuple[str, list[str], np.ndarray, np.ndarray]:
-    """The schema name, joint names, times and positions an MCAP file holds."""
-    schemas, names, times, rows = set(), [], [], []
-    for message in read_ros2_messages(str(path)):
-        schemas.add(message.schema.name)
-        msg = message.ros_msg
+    """The schema name, joint names, times (from the first sample) and positions an MCAP file
+    holds: its trajectory where it has one, else its joint states."""
+    trajectory, states = None, []
+    for message in read_ros2_messages(str(path), topics=[TRAJECTORY_TOPIC, STATE_TOPIC]):
         if message.schema.name == JOINT_TRAJECTORY:
-            names = list(msg.joint_names)
-            for point in msg.points:
-                times.append(point.time_from_start.sec + point.time_from_start.nanosec * 1e-9)
-                rows.append(list(point.positions))
+            trajectory = message.ros_msg
         else:
-            names = list(msg.name)
-            times.append(msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9)
-            rows.append(list(msg.position))
-            assert message.log_time_ns == round(times[-1] * 1e9)
-    assert len(schemas) == 1
-    return schemas.pop(), names, np.array(times), np.array(rows)
+            msg = message.ros_msg
+            stamp = msg.header.stamp.sec * 1_000_000_000 + msg.header.stamp.nanosec
+            assert message.log_time_ns == stamp
+            states.append((stamp, list(msg.name), list(msg.position)))
+    if trajectory is not None:
+        times = [
+            p.time_from_start.sec + p.time_from_start.nanosec * 1e-9 for p in trajectory.points
+        ]
+        rows = [list(p.positions) for p in trajectory.points]
+        return JOINT_TRAJECTORY, list(trajectory.joint_names), np.array(times), np.array(rows)
+    stamps = np.array([s[0] for s in states], dtype=np.int64)
+    times = (stamps - stamps[0]) * 1e-9
+    return JOINT_STATE, states[0][1], times, np.array([s[2] for s in states])
 
 
 def test_a_demonstrations_mcap_is_its_csv_as_a_ros2_joint_trajectory(tmp_path):
@@ -170,3 +175,91 @@ def test_retime_and_a_fixed_pace_for_a_policy_is_one_sentence(tmp_path, capsys):
     assert main(argv) == 2
     err = capsys.readouterr().err.strip()
     assert "--retime" in err and "--seconds-per-step" in err and "\n" not in err
+
+
+def _topics(path: Path) -> dict[str, list]:
+    found: dict[str, list] = {}
+    for message in read_ros2_messages(str(path)):
+        found.setdefault(message.channel.topic, []).append(message)
+    return found
+
+
+def test_an_mcap_carries_what_foxglove_needs_to_draw_the_robot_moving(tmp_path):
+    """``/robot_description`` (the URDF, latched, first), ``/tf`` (every link from its parent,
+    per sample, matching Pinocchio's forward kinematics), joint states with frame ids, and real
+    log times."""
+    import time
+
+    from studio.export import DESCRIPTION_TOPIC, TF_TOPIC
+
+    robot = load_robot("panda")
+    motion = demonstration_motion(SAMPLES_DIR / "sample-reach-1.demo.json", "panda", 30.0)
+    before = time.time_ns()
+    export_motion(motion, "mcap", tmp_path / "demo.mcap", unchecked=True)
+    topics = _topics(tmp_path / "demo.mcap")
+    assert set(topics) == {DESCRIPTION_TOPIC, TRAJECTORY_TOPIC, STATE_TOPIC, TF_TOPIC}
+    (description,) = topics[DESCRIPTION_TOPIC]
+    assert description.ros_msg.data == robot.urdf_text
+    assert "transient_local" in description.channel.metadata["offered_qos_profiles"]
+    first = min(m.log_time_ns for ms in topics.values() for m in ms)
+    assert description.log_time_ns == first >= before  # a real time, not 1970
+    states, tfs = topics[STATE_TOPIC], topics[TF_TOPIC]
+    assert len(states) == len(tfs) > 10
+    assert {m.ros_msg.header.frame_id for m in states} == {"panda_link0"}
+    # chain the transforms from the root to the hand: Pinocchio's tool pose at that sample
+    _, _, times, q = read_mcap(tmp_path / "demo.mcap")
+    i = len(tfs) // 2
+    edges = {t.child_frame_id: t for t in tfs[i].ros_msg.transforms}
+    assert tfs[i].log_time_ns == first + round(times[i] * 1e9)
+
+    def pose(link: str) -> np.ndarray:
+        if link not in edges:
+            return np.eye(4)
+        t = edges[link]
+        r, p = t.transform.rotation, t.transform.translation
+        x, y, z, w = r.x, r.y, r.z, r.w
+        m = np.eye(4)
+        m[:3, :3] = [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+        ]
+        m[:3, 3] = [p.x, p.y, p.z]
+        return pose(t.header.frame_id) @ m
+
+    import pinocchio as pin
+
+    data = robot.model.createData()
+    pin.framesForwardKinematics(robot.model, data, q[i])
+    hand = robot.model.getFrameId("panda_hand")
+    np.testing.assert_allclose(pose("panda_hand"), data.oMf[hand].homogeneous, atol=1e-9)
+
+
+def test_a_recordings_mcap_is_stamped_at_its_own_capture_time(slow_recording, tmp_path):
+    from datetime import datetime
+
+    from studio.capture import read_any_recording
+
+    created = read_any_recording(slow_recording).meta["created"]
+    export_motion(recording_motion(slow_recording, "puma560"), "mcap", tmp_path / "rec.mcap")
+    topics = _topics(tmp_path / "rec.mcap")
+    assert TRAJECTORY_TOPIC not in topics  # what the arm did, not a trajectory to follow
+    first = topics[STATE_TOPIC][0].log_time_ns
+    assert first == round(datetime.fromisoformat(created).timestamp() * 1e9)
+
+
+def test_every_csv_names_its_robot_joint_order_units_and_source(tmp_path):
+    motion = demonstration_motion(SAMPLES_DIR / "sample-reach-2.demo.json", "puma560", 50.0)
+    done = export_motion(motion, "csv", tmp_path / "demo.csv")
+    assert not done.findings  # a checked file has them too
+    comments = [line for line in (tmp_path / "demo.csv").read_text().splitlines() if line[0] == "#"]
+    text = "\n".join(comments)
+    robot = load_robot("puma560")
+    assert f"robot: puma560; joints in order: {', '.join(robot.joint_names)}" in text
+    assert "seconds" in text and "radians" in text
+    assert "source: the demonstration sample-reach-2.demo.json" in text
+    assert "safety checks: passed" in text
+    rows = np.loadtxt(
+        tmp_path / "demo.csv", delimiter=",", comments="#", skiprows=len(comments) + 1
+    )
+    assert rows.shape[1] == 1 + robot.nq

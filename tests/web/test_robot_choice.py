@@ -168,8 +168,9 @@ def test_a_recording_failing_the_checks_is_refused_in_one_sentence_unless_unchec
     assert written.status_code == 200 and "NOT checked" in written.text
     assert "--retime" in detail  # the page offers it as "Time it within the robot's limits"
     timed = client.get(url, params={"format": "csv", "retime": "true"})
-    assert timed.status_code == 200 and not timed.text.startswith("#")  # checked, passed
-    rows = np.loadtxt(timed.text.splitlines()[1:], delimiter=",", ndmin=2)
+    assert timed.status_code == 200 and "# safety checks: passed" in timed.text
+    data = [line for line in timed.text.splitlines() if not line.startswith(("#", "time"))]
+    rows = np.loadtxt(data, delimiter=",", ndmin=2)
     assert np.allclose(np.diff(rows[:, 0]), 1 / 50)  # at the rollout rate, as a demonstration
     missing = client.get("/api/robot/export/recording/nope", params={"format": "csv"})
     assert missing.status_code == 404 and isinstance(missing.json()["detail"], str)

@@ -225,7 +225,7 @@ def test_a_watched_rollout_exports_as_mcap_checked_or_refused_with_the_reason(
     assert f'filename="{name}.rollout.mcap"' in answer.headers["content-disposition"]
     path = tmp_path / "rollout.mcap"
     path.write_bytes(answer.content)
-    messages = list(read_ros2_messages(str(path)))
+    messages = list(read_ros2_messages(str(path), topics=["/joint_trajectory"]))
     assert messages and messages[0].schema.name == "trajectory_msgs/msg/JointTrajectory"
     csv = client.get("/api/watch/trajectory.csv", params={"policy": name})
     rows = [line for line in csv.text.splitlines()[1:] if line]
