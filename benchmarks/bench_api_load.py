@@ -34,7 +34,7 @@ from pathlib import Path
 
 import numpy as np
 
-from studio.web._runs import TRAINING_NICENESS
+from studio.web.services._runs import TRAINING_NICENESS
 
 CLIENTS = 20
 PATHS = (
@@ -66,7 +66,7 @@ GOAL_P99_MS = 250.0
 SERVER = """
 import json, sys
 from pathlib import Path
-import studio.web._runs as runs
+import studio.web.services._runs as runs
 from studio.web import Settings, serve
 import studio.web._serve as served
 a = json.loads(sys.argv[1])

@@ -351,7 +351,7 @@ def scene_frame(page: Any) -> Any:
 
 def scene_frames_drawn(page: Any) -> int:
     """Frames the studio page's scene iframe has drawn so far (the studio's frame pacing counts
-    them, ``studio/web/_scene_frames.py``; 0 before any pacing)."""
+    them, ``studio/web/scene/_frames.py``; 0 before any pacing)."""
     return int(scene_frame(page).evaluate("() => window.__studioFramePacing?.frames ?? 0"))
 
 

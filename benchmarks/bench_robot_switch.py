@@ -4,7 +4,7 @@
    load its model with collision and visual geometry (``load_robot``, once per process, here in
    this process), then to build the drawn view from its URDF meshes (read with trimesh and
    simplified: the baseline), and from the mesh cache the studio keeps under its data folder
-   (``studio/web/_mesh_cache.py``), with the ratio. The longest the process's other threads were
+   (``studio/web/scene/_mesh_cache.py``), with the ratio. The longest the process's other threads were
    held up meanwhile is printed too: Pinocchio keeps Python's lock while it loads.
 2. The visual geometry alone, built with Coal's default mesh loader (the baseline) and with the
    one ``load_robot`` uses (axis-aligned boxes: the visual meshes are never queried).
@@ -43,7 +43,7 @@ from studio.kinematics import MeshConfig, load_robot, robot_names  # noqa: E402
 from studio.kinematics._robot_load import _visual_mesh_loader  # noqa: E402
 from studio.kinematics._robots import robot_spec, robots_folder  # noqa: E402
 from studio.web import Settings  # noqa: E402
-from studio.web._robot_view import arm_view  # noqa: E402
+from studio.web.scene._robot_view import arm_view  # noqa: E402
 
 SWITCH_SERVER = """
 import json, sys

@@ -196,7 +196,7 @@ def wait_until_browser_settles() -> None:
 
 
 def wait_until_scene_still(page: Any) -> None:
-    """Wait until the scene's page has been told its scene is still (``_scene_frames.py``): a page
+    """Wait until the scene's page has been told its scene is still (``studio/web/scene/_frames.py``): a page
     left open, as a user's is while training runs, draws its still scene rarely; one opened a
     second ago is still loading it and draws freely."""
     still = "() => !!window.__studioFramePacing && window.__studioFramePacing.still === true"

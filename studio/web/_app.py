@@ -33,7 +33,6 @@ from ._errors import (
     os_error_answer,
 )
 from ._guard import GuardMiddleware, SiteRule
-from ._protocols import Scene
 from ._schemas import RUN_TASK_TAGS
 from ._settings import Settings, get_settings
 from ._state import Studio
@@ -53,6 +52,7 @@ from .routers import (
     takes,
     watch,
 )
+from .scene import Scene
 
 log = logging.getLogger(__name__)
 
@@ -67,7 +67,7 @@ def create_app(settings: Settings | None = None, scene: Scene | None = None) -> 
 
     Args:
         settings: data directory, ports, limits (default: ``Settings()``).
-        scene: the :class:`~studio.web._scene.StudioScene` the studio drives, or None.
+        scene: the :class:`~studio.web.scene._scene.StudioScene` the studio drives, or None.
     """
     settings = settings if settings is not None else get_settings()
 

@@ -22,8 +22,8 @@ from studio.capture import RecordingSeries, recording_series
 from studio.kinematics import load_robot
 from studio.motion import Motion, recording_motion, series_motion
 
-from ._robot_playback import PREVIEW_FRAMES
 from ._state import Studio
+from .scene import PREVIEW_FRAMES
 
 REVIEW_PATH = "review"
 """The scene path that shows the segment under review (one at a time, replaced by the next)."""

@@ -37,7 +37,7 @@ if TYPE_CHECKING:
     from websockets.asyncio.server import Server, ServerConnection
     from websockets.http11 import Request, Response
 
-    from ._scene import StudioScene
+    from .scene import StudioScene
 
     ProcessRequest = Callable[[ServerConnection, Request], Response | None]
     """websockets' hook that may answer a handshake request itself."""
@@ -210,7 +210,7 @@ def start_scene(
     """
     import viser
 
-    from ._scene import StudioScene
+    from .scene import StudioScene
 
     server = viser.ViserServer(host=settings.host, port=settings.viser_port, verbose=False)
     try:

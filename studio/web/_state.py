@@ -48,14 +48,12 @@ from studio.learning import (
 from studio.motion import MotionError, training_demonstration
 
 from ._errors import ConflictError, InvalidError, NotFoundError, TooManyRequestsError
-from ._pipeline import Pipeline
-from ._protocols import Scene
-from ._robot_playback import RobotPlayer
-from ._robot_view import RobotViews
-from ._runs import RunQueue
 from ._schemas import RunCreate
 from ._settings import Settings
-from ._store import (
+from .live import Pipeline
+from .scene import RobotPlayer, RobotViews, Scene
+from .services import (
+    RunQueue,
     demonstration_store,
     policy_store,
     recording_store,

@@ -1,7 +1,7 @@
 """viser's page draws fewer frames while a slow live stream drives the scene, or while the scene
 is still, and still shows every change.
 
-``studio/web/_scene_frames.py`` wraps the page's ``requestAnimationFrame`` so that frames start
+``studio/web/scene/_frames.py`` wraps the page's ``requestAnimationFrame`` so that frames start
 at least ``SLOW_FRAME_GAP_MS`` apart while a slow stream (pose estimation without a GPU) drives
 the scene. These tests run the wrapper in Chromium: alone (it delays frames and never drops one,
 and a cancelled request never runs), and in viser's own page beside a real scene (each pose is
@@ -22,9 +22,9 @@ import viser
 from playwright.sync_api import TimeoutError as PlaywrightTimeout
 
 from studio.kinematics import HumanBody
-from studio.web import _scene_frames
-from studio.web._scene import SceneLayout, StudioScene
-from studio.web._scene_frames import SLOW_FRAME_GAP_MS, pacing_js
+from studio.web.scene import _frames as _scene_frames
+from studio.web.scene._frames import SLOW_FRAME_GAP_MS, pacing_js
+from studio.web.scene._scene import SceneLayout, StudioScene
 from tests.conftest import free_port
 from tests.web.conftest import wait_for
 

@@ -15,7 +15,7 @@ from hypothesis import strategies as st
 
 from studio.kinematics import HumanArm, Retargeter, load_robot, reachable, tool_reaches
 from studio.kinematics._retarget import into_hollow, out_of_hollow
-from studio.web._pipeline import robot_note
+from studio.web.live._pipeline import robot_note
 
 HOLLOW, WIDTH = 0.19, 0.1
 FORWARD = np.array([1.0, 0.0])

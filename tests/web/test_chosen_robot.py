@@ -14,8 +14,8 @@ from studio.capture import recording_series
 from studio.kinematics import load_robot, robot_names
 from studio.learning import ArmGrid, RunRequest, check_goal_deg, default_goal, resolve_run
 from studio.samples import SAMPLES_DIR
-from studio.web._scene import StudioScene
-from studio.web._scene_model import Mode
+from studio.web.scene._model import Mode
+from studio.web.scene._scene import StudioScene
 from tests.web.conftest import wait_for, wait_run
 from tests.web.test_robot_playback import studio  # noqa: F401  (a studio with a scene)
 

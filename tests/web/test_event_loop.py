@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 from fastapi.testclient import TestClient
 
-import studio.web._store as store_module
+import studio.web.services._store as store_module
 from tests.web.conftest import TINY_RUN, wait_for
 
 SAMPLES = Path(__file__).resolve().parents[2] / "studio" / "samples"
@@ -97,7 +97,7 @@ def test_training_runs_below_the_studios_priority(
 
     import studio.learning.tabular._dynaq as dynaq
     from studio.learning import ArmGrid, DynaQConfig, run_experiments
-    from studio.web._runs import TRAINING_NICENESS
+    from studio.web.services._runs import TRAINING_NICENESS
 
     seen: list[int] = []
     real = dynaq._run_experiment

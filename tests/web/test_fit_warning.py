@@ -7,7 +7,7 @@ import numpy as np
 from studio.capture import simulate
 from studio.capture._fitters import FIT_WARNING_AFTER_S, FIT_WARNING_CLEAR_FRACTION, FitWatch
 from studio.kinematics import FitConfig
-from studio.web._pipeline import Pipeline
+from studio.web.live._pipeline import Pipeline
 
 RATE_HZ = 110.0
 SIMULATED_S = 49.0

@@ -11,7 +11,7 @@ from fastapi.testclient import TestClient
 
 from studio.kinematics import HumanArm, HumanBody
 from studio.web import create_app
-from studio.web._scene import SceneLayout, StudioScene
+from studio.web.scene._scene import SceneLayout, StudioScene
 from tests.conftest import free_port
 from tests.web.conftest import make_settings
 

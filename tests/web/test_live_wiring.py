@@ -11,12 +11,12 @@ import viser
 
 from studio.capture import RecordingError, RecordingWriter, read_recording
 from studio.kinematics import HumanArm, HumanBody, TapeConfig, reconstruct, tape_from_arm
-from studio.web import _scene
 from studio.web._errors import ConflictError
-from studio.web._pipeline import Pipeline
-from studio.web._protocols import LivePose
-from studio.web._scene import SceneLayout, StudioScene
-from studio.web._store import demonstration_store, recording_store
+from studio.web.live._pipeline import Pipeline
+from studio.web.scene import _scene
+from studio.web.scene._protocols import LivePose
+from studio.web.scene._scene import SceneLayout, StudioScene
+from studio.web.services._store import demonstration_store, recording_store
 from tests.capture.conftest import synthetic_frames
 from tests.conftest import free_port
 from tests.web.conftest import wait_for

@@ -8,8 +8,8 @@ the recording, counts them, and keeps capturing.
 from __future__ import annotations
 
 from studio.capture import RecordingWriter, read_recording
-from studio.web._pipeline import Pipeline
 from studio.web._schemas import CapturePublic
+from studio.web.live._pipeline import Pipeline
 from tests.capture.conftest import synthetic_frames
 
 

@@ -14,8 +14,8 @@ from studio.capture import PlaybackSource, human_angles, read_any_recording
 from studio.export import recording_motion
 from studio.kinematics import RetargetConfig, load_robot, retarget_path
 from studio.samples import SAMPLES_DIR
-from studio.web import _planned_playback
-from studio.web._pipeline import Pipeline
+from studio.web.live import _planned_playback
+from studio.web.live._pipeline import Pipeline
 from tests.export.conftest import smooth_arm, write_arm_recording
 
 SAMPLE = SAMPLES_DIR / "sample-reach-2.tape.csv"

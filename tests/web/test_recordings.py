@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 
 from studio.capture import RecordingWriter, TapeFrame, read_recording
 from studio.samples import SAMPLES_DIR
-from studio.web._store import NAME_PATTERN, SAMPLE_PREFIX, check_name, clean_upload_name
+from studio.web.services._store import NAME_PATTERN, SAMPLE_PREFIX, check_name, clean_upload_name
 
 REGIONS = 16
 RATE_HZ = 110.0

@@ -11,10 +11,10 @@ import viser
 from fastapi.testclient import TestClient
 
 from studio.kinematics import RetargetConfig, Retargeter, load_robot, robot_names
-from studio.web._pipeline import robot_note
-from studio.web._protocols import LivePose
-from studio.web._scene import StudioScene
-from studio.web._scene_model import SceneLayout
+from studio.web.live._pipeline import robot_note
+from studio.web.scene._model import SceneLayout
+from studio.web.scene._protocols import LivePose
+from studio.web.scene._scene import StudioScene
 
 from .conftest import wait_for
 

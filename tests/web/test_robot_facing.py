@@ -9,7 +9,7 @@ import numpy as np
 import pinocchio as pin
 
 from studio.kinematics import MeshConfig, Retargeter, load_robot
-from studio.web._robot_view import arm_framing, arm_tool, arm_view
+from studio.web.scene._robot_view import arm_framing, arm_tool, arm_view
 
 
 def test_the_so100_reaching_ahead_is_drawn_reaching_towards_the_operator():

@@ -20,9 +20,9 @@ from studio.kinematics import MeshConfig, load_robot
 from studio.learning import ROLLOUT_RATE_HZ
 from studio.samples import SAMPLES_DIR
 from studio.web import create_app
-from studio.web._mesh_cache import cached_parts, mesh_key
-from studio.web._scene import StudioScene
-from studio.web._scene_model import Mode, SceneLayout
+from studio.web.scene._mesh_cache import cached_parts, mesh_key
+from studio.web.scene._model import Mode, SceneLayout
+from studio.web.scene._scene import StudioScene
 from tests.web.conftest import make_settings, wait_for
 from tests.web.test_policies import policy_bytes, upload
 

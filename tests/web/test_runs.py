@@ -633,7 +633,7 @@ def test_the_run_list_says_a_first_run_prepares_the_learner(page_server, browser
 
 
 def test_a_curve_encoded_in_slices_is_the_same_json():
-    from studio.web._runs import JSON_SLICE, _json_in_slices
+    from studio.web.services._runs import JSON_SLICE, _json_in_slices
 
     rng = np.random.default_rng(0)
     n = 2 * JSON_SLICE + 7

@@ -25,7 +25,7 @@ from studio.kinematics import (
     tape_from_arm,
 )
 from studio.kinematics._meshes import simplify
-from studio.web._scene import (
+from studio.web.scene._scene import (
     Mode,
     Playback,
     SceneLayout,
@@ -507,7 +507,7 @@ def test_an_error_in_the_loop_is_logged_and_the_scene_goes_on(scene, monkeypatch
         push(handles, q)
 
     monkeypatch.setattr(scene, "_push_robot", flaky)
-    with caplog.at_level(logging.ERROR, logger="studio.web._scene"):
+    with caplog.at_level(logging.ERROR, logger="studio.web.scene._scene"):
         scene.update_live(np.zeros(7), np.full(6, 0.11), None)
         assert _wait_until(lambda: scene.errors >= 1)
         scene.update_live(np.zeros(7), np.full(6, 0.22), None)

@@ -6,7 +6,7 @@ at a few frames a second in software WebGL would make the page redraw most of th
 browser process that also runs the model. So a slow stream's poses are pushed at most
 ``slow_live_rate_hz`` times a second (latest wins), while a fast one (the tape, a camera with a
 GPU, a dragged hand) is pushed as it comes, and while a slow stream drives the scene viser's
-page is asked to draw fewer frames (``studio/web/_scene_frames.py``).
+page is asked to draw fewer frames (``studio/web/scene/_frames.py``).
 """
 
 from __future__ import annotations
@@ -24,9 +24,9 @@ import websockets
 import zstandard
 
 from studio.kinematics import HumanBody
-from studio.web import _scene_frames
-from studio.web._scene import STREAM_STOPPED_S, SceneLayout, StudioScene
-from studio.web._scene_frames import SLOW_FRAME_GAP_MS, STILL_FRAME_GAP_MS
+from studio.web.scene import _frames as _scene_frames
+from studio.web.scene._frames import SLOW_FRAME_GAP_MS, STILL_FRAME_GAP_MS
+from studio.web.scene._scene import STREAM_STOPPED_S, SceneLayout, StudioScene
 from tests.conftest import free_port
 from tests.web.conftest import wait_for
 

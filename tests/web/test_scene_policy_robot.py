@@ -8,7 +8,7 @@ import pytest
 import viser
 
 from studio.kinematics import HumanBody, load_robot
-from studio.web._scene import SceneLayout, StudioScene
+from studio.web.scene._scene import SceneLayout, StudioScene
 from tests.conftest import free_port
 from tests.web.conftest import wait_for
 

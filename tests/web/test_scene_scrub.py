@@ -12,9 +12,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from studio.web import create_app
-from studio.web._scene import SceneLayout, StudioScene
-from studio.web._scene_model import Mode, playback_time, pose_at, rescheduled
-from studio.web._scene_views import VIEW_NAMES, camera_view, following
+from studio.web.scene._model import Mode, playback_time, pose_at, rescheduled
+from studio.web.scene._scene import SceneLayout, StudioScene
+from studio.web.scene._views import VIEW_NAMES, camera_view, following
 from tests.conftest import free_port
 from tests.web.conftest import make_settings, wait_for
 from tests.web.test_policies import policy_bytes, upload

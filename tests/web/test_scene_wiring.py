@@ -147,7 +147,7 @@ def test_a_recording_taped_on_the_left_arm_is_drawn_on_the_left_arm(tmp_path):
     (the left arm follows the fit, the right rests), and back to the right for a right-arm one."""
     import viser
 
-    from studio.web._scene import SceneLayout, StudioScene
+    from studio.web.scene._scene import SceneLayout, StudioScene
     from tests.conftest import free_port
     from tests.web.conftest import wait_for
 

@@ -32,7 +32,7 @@ from hypothesis import HealthCheck, settings
 from schemathesis import checks
 from schemathesis.python import asgi
 
-import studio.web._store as recordings_router
+import studio.web.services._store as recordings_router
 from studio.web import create_app
 from tests.web.conftest import make_settings
 

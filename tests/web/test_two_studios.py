@@ -12,7 +12,7 @@ import pytest
 
 from studio.capture import RecordingError, RecordingWriter, TapeFrame
 from studio.samples import SAMPLES_DIR
-from studio.web._store import recording_store
+from studio.web.services._store import recording_store
 from tests.web.conftest import TINY_RUN, wait_for, wait_run
 
 

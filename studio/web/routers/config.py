@@ -9,8 +9,8 @@ from studio.learning import PLANNERS
 
 from ... import __version__
 from .._deps import SettingsDep
-from .._scene import SceneLayout
 from .._schemas import ConfigPublic, RunDefaults
+from ..scene import SceneLayout
 
 router = APIRouter(prefix="/api/config", tags=["config"])
 

@@ -26,7 +26,6 @@ from studio.motion import demonstration_grid
 
 from .._deps import StudioDep
 from .._errors import InvalidError
-from .._runs import prepare_run
 from .._schemas import (
     DemonstrationCreate,
     DemonstrationDetail,
@@ -37,7 +36,7 @@ from .._schemas import (
     RunCreate,
 )
 from .._state import Studio
-from .._store import StoredFile
+from ..services import StoredFile, prepare_run
 from .policies import policy_public
 
 router = APIRouter(prefix="/api/demonstrations", tags=["demonstrations"])

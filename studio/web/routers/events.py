@@ -17,8 +17,8 @@ from fastapi import APIRouter, Request
 from fastapi.responses import StreamingResponse
 
 from .._deps import StudioDep
-from .._runs import Run
 from .._state import Studio
+from ..services import Run
 
 router = APIRouter(prefix="/api/events", tags=["events"])
 

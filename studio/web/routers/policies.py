@@ -12,7 +12,7 @@ from studio.learning import POLICY_SUFFIX, PolicyFile, TilePolicyFile, policy_su
 
 from .._deps import SettingsDep, StudioDep
 from .._schemas import PolicyPublic
-from .._store import StoredFile, receive_upload
+from ..services import StoredFile, receive_upload
 from . import file_responses
 
 router = APIRouter(prefix="/api/policies", tags=["policies"])

@@ -27,7 +27,7 @@ from .._schemas import (
     TimelineSignal,
 )
 from .._state import Studio
-from .._store import RecordingSummary, StoredFile, receive_upload
+from ..services import RecordingSummary, StoredFile, receive_upload
 from . import file_responses
 
 router = APIRouter(prefix="/api/recordings", tags=["recordings"])

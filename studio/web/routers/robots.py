@@ -13,8 +13,8 @@ from studio.kinematics import DEFAULT_ROBOT, robot_spec
 
 from .._deps import StudioDep
 from .._errors import ConflictError
-from .._robot_export import MEDIA_TYPES, ExportFormat, export_for_robot, export_rollout
 from .._schemas import RobotChoice, RobotsPublic
+from ..services import MEDIA_TYPES, ExportFormat, export_for_robot, export_rollout
 from . import file_responses
 
 router = APIRouter(tags=["robots"])

@@ -1,7 +1,7 @@
 """``/api/scene``: scrub the rollout being watched, point the cameras, pose the robot by hand.
 
 The scene keeps the scrub position, speed and pause as part of its playback
-(:func:`studio.web._scene_model.rescheduled`); this router only checks the values and passes them
+(:func:`studio.web.scene._model.rescheduled`); this router only checks the values and passes them
 on. Angles are in degrees here, at the user's edge, and radians inside.
 """
 
@@ -17,10 +17,8 @@ from studio.kinematics import RobotArm, load_robot
 
 from .._deps import StudioDep
 from .._errors import ConflictError, InvalidError
-from .._protocols import Scene
-from .._scene_model import PLAYBACK_SPEEDS, Playback
-from .._scene_views import VIEW_NAMES
 from .._schemas import _Body
+from ..scene import PLAYBACK_SPEEDS, VIEW_NAMES, Playback, Scene
 
 router = APIRouter(prefix="/api/scene", tags=["scene"])
 

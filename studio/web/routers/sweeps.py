@@ -16,8 +16,8 @@ from studio.learning import SweepError, SweepInfo, list_sweeps, load_sweep
 
 from .._deps import SettingsDep
 from .._errors import NotFoundError
-from .._runs import GROUP_SEPARATOR
 from .._schemas import SweepPublic
+from ..services import GROUP_SEPARATOR
 
 router = APIRouter(prefix="/api/sweeps", tags=["sweeps"])
 

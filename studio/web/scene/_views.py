@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 import viser
 
-from ._scene_model import SceneLayout
+from ._model import SceneLayout
 
 VIEW_NAMES = ("front", "top", "side")
 """The camera presets, in the order the page offers them."""

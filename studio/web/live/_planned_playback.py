@@ -176,12 +176,12 @@ def plan_recording(
     path: Path, robot: str, abandoned: Callable[[], bool]
 ) -> RetargetedPath | str | None:
     """The path of the recording at ``path`` on ``robot`` over all of it, planned in a child
-    process (:mod:`studio.web._plan_child`, which says why it runs apart). Returns the path, or
+    process (:mod:`studio.web.live._plan_child`, which says why it runs apart). Returns the path, or
     one sentence on why there is none, or None once ``abandoned()`` (polled) says it is not
     wanted any more (the child is stopped)."""
     with tempfile.TemporaryDirectory(prefix="studio-plan-") as folder:
         out = Path(folder) / "path.npz"
-        command = [sys.executable, "-m", "studio.web._plan_child", str(path), robot, str(out)]
+        command = [sys.executable, "-m", "studio.web.live._plan_child", str(path), robot, str(out)]
         try:
             child = subprocess.Popen(
                 command,

@@ -5,7 +5,7 @@ Everything a user makes lives in plain files so it survives a restart and can be
 studio: ``recordings/*.tape.csv``, ``recordings/*.demo.json``, ``policies/*.policy.npz``. Each
 kind is a :class:`FolderStore`: a folder, a file suffix and the owning package's reader
 (:mod:`studio.capture` for recordings and demonstrations, :mod:`studio.learning` for policies).
-Training runs have their own store in :mod:`studio.web._runs`.
+Training runs have their own store in :mod:`studio.web.services._runs`.
 
 Names are plain file stems (letters, digits, ``-``, ``_``, ``.``; no separators, no ``..``), so a
 name from a request can never point outside its folder. New files never replace old ones: an
@@ -57,7 +57,7 @@ from studio.learning import POLICY_SUFFIX, PolicyFile, TilePolicyFile, load_any_
 from studio.motion import checked_demonstration
 from studio.samples import SAMPLES_DIR
 
-from ._errors import ConflictError, InvalidError, NotFoundError, TooLargeError
+from .._errors import ConflictError, InvalidError, NotFoundError, TooLargeError
 
 log = logging.getLogger(__name__)
 

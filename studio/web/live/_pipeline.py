@@ -25,6 +25,7 @@ import threading
 import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
+from typing import Protocol
 
 import numpy as np
 
@@ -38,9 +39,9 @@ from studio.capture import (
 )
 from studio.kinematics import HumanArm, RetargetedPath, Retargeter, RobotArm, TapeConfig
 
-from ._errors import ConflictError, storage_sentence
+from .._errors import ConflictError, storage_sentence
+from ..scene import LivePose, LiveScene
 from ._planned_playback import PlannedPlayback
-from ._protocols import CaptureWriter, LivePose, LiveScene
 
 log = logging.getLogger(__name__)
 
@@ -53,11 +54,26 @@ IDLE_SLEEP_S = 0.05
 ROBOT_JOINTS = 6
 
 
+class CaptureWriter(Protocol):
+    """What the pipeline asks of a recording's writer (:class:`studio.capture.AppendWriter`)."""
+
+    path: Path
+
+    def write_many(self, frames: Sequence[Observation]) -> None:
+        """Append observations."""
+
+    def flush(self) -> None:
+        """Make the written observations durable now."""
+
+    def close(self) -> None:
+        """Finish the file cleanly."""
+
+
 class Pipeline:
     """The live source, its kinematics, the capture writer, and live demonstration marking.
 
     Args:
-        scene: the :class:`studio.web._scene.StudioScene` to feed, or None (headless, tests).
+        scene: the :class:`studio.web.scene._scene.StudioScene` to feed, or None (headless, tests).
         on_change: called with ``"recordings"`` whenever a capture adds or finishes a recording
             (the studio's list versions, as the stores and the run queue announce theirs).
     """
@@ -545,7 +561,7 @@ class Pipeline:
         """``fitted`` (the frame at time ``t``) with its robot pose for the robot taught
         (unchanged for the Puma560): retargeted live, or from a recording played as the source,
         its path planned over the whole recording once that is ready
-        (:class:`~studio.web._planned_playback.PlannedPlayback`)."""
+        (:class:`~studio.web.live._planned_playback.PlannedPlayback`)."""
         arm = self._arm
         if arm is None:
             return fitted

@@ -9,7 +9,7 @@ from collections.abc import Callable
 import numpy as np
 import viser
 
-from ._scene_model import SceneLayout
+from ._model import SceneLayout
 
 
 class ScenePaths:

@@ -16,8 +16,8 @@ import viser
 
 from studio.kinematics import Puma560, RobotArm, load_robot
 
+from ._model import Playback, SceneLayout
 from ._robot_view import RobotView, RobotViews, add_robot, arm_tool, wxyz_of
-from ._scene_model import Playback, SceneLayout
 
 PUMA = "puma560"
 """The robot a joint path belongs to when it names none (policies, the grid's goals)."""

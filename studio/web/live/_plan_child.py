@@ -1,7 +1,7 @@
 """The child process that plans a recording's path on a robot for the studio
-(:func:`studio.web._planned_playback.plan_recording`).
+(:func:`studio.web.live._planned_playback.plan_recording`).
 
-``python -m studio.web._plan_child RECORDING ROBOT OUT.npz`` writes the recording's
+``python -m studio.web.live._plan_child RECORDING ROBOT OUT.npz`` writes the recording's
 :class:`~studio.kinematics.RetargetedPath` (:func:`studio.export.recording_motion`) to
 ``OUT.npz`` and exits 0; a recording or robot it cannot plan prints the one sentence saying why
 and exits 2. It runs apart from the studio because the planning holds the interpreter for up to

@@ -42,15 +42,15 @@ from studio.kinematics import (
     pose_body,
 )
 
+from ._frames import FramePacer
 from ._hand_handle import HandHandle
+from ._model import Mode, Playback, SceneLayout, playback_time, pose_at, rescheduled
+from ._model import camera_projection as camera_projection
+from ._paths import ScenePaths
 from ._protocols import HandMoved, LivePose
+from ._robot import PUMA, SceneRobot
 from ._robot_view import RobotViews, rgb255, wxyz_of
-from ._scene_frames import FramePacer
-from ._scene_model import Mode, Playback, SceneLayout, playback_time, pose_at, rescheduled
-from ._scene_model import camera_projection as camera_projection
-from ._scene_paths import ScenePaths
-from ._scene_robot import PUMA, SceneRobot
-from ._scene_views import SceneCamera
+from ._views import SceneCamera
 
 log = logging.getLogger(__name__)
 

@@ -1,24 +1,22 @@
-"""What the web layer's parts ask of each other: the live pose, the scene, the capture writer.
+"""What the web layer's parts ask of the scene: the live pose it shows, and the scene itself.
 
-The live pipeline, the studio's state and the routers hold the scene and the capture writer by
-these protocols, so a test can hand in a recording fake and the studio runs headless with none.
-Sources are held by :class:`studio.capture.FrameSource`; a kind's own calls (playback, the
-simulator's reach, a fed source's ``submit``) are made after an ``isinstance`` check.
+The live pipeline, the services and the routers hold the scene by these protocols, so a test can
+hand in a recording fake and the studio runs headless with none. Sources are held by
+:class:`studio.capture.FrameSource`; a kind's own calls (playback, the simulator's reach, a fed
+source's ``submit``) are made after an ``isinstance`` check.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
-from pathlib import Path
 from typing import NamedTuple, Protocol
 
 import numpy as np
 
-from studio.capture import Observation
 from studio.kinematics import RobotArm
 
-from ._scene_model import Playback
-from ._scene_views import SceneCamera
+from ._model import Playback
+from ._views import SceneCamera
 
 
 class LivePose(NamedTuple):
@@ -127,18 +125,3 @@ class Scene(LiveScene, Protocol):
 
     def show_hand_handle(self, side: str | None, on_move: HandMoved | None) -> None:
         """Show the hand guide's handle on ``side``'s hand (None hides it)."""
-
-
-class CaptureWriter(Protocol):
-    """What the pipeline asks of a recording's writer (:class:`studio.capture.AppendWriter`)."""
-
-    path: Path
-
-    def write_many(self, frames: Sequence[Observation]) -> None:
-        """Append observations."""
-
-    def flush(self) -> None:
-        """Make the written observations durable now."""
-
-    def close(self) -> None:
-        """Finish the file cleanly."""

@@ -26,6 +26,7 @@ from pathlib import Path
 
 from pydantic import TypeAdapter
 
+from studio._files import now_iso
 from studio.kinematics import DEFAULT_ROBOT
 from studio.learning import (
     DEFAULT_GOAL_JOINTS_DEG,
@@ -44,9 +45,8 @@ from studio.learning import (
     without_demonstrations,
 )
 
-from .._files import now_iso
-from ._errors import ConflictError, InvalidError, NotFoundError
-from ._schemas import GridRunCreate, RunCreate, RunPublic
+from .._errors import ConflictError, InvalidError, NotFoundError
+from .._schemas import GridRunCreate, RunCreate, RunPublic
 
 __all__ = ["Run", "RunQueue", "prepare_run"]
 
