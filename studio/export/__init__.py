@@ -28,6 +28,8 @@ from ._formats import TRAJECTORY_TOPIC as TRAJECTORY_TOPIC
 from ._formats import write_csv as write_csv
 from ._formats import write_mcap as write_mcap
 from ._lerobot import CODEBASE_VERSION as CODEBASE_VERSION
+from ._lerobot import LeRobotConventions as LeRobotConventions
+from ._lerobot import lerobot_conventions as lerobot_conventions
 from ._lerobot import write_lerobot as write_lerobot
 from ._likeness import demonstration_of as demonstration_of
 from ._likeness import likeness_motions as likeness_motions

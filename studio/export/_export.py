@@ -21,7 +21,7 @@ from studio._files import now_iso
 from studio.motion import Finding, Motion
 
 from ._formats import write_csv, write_mcap
-from ._lerobot import write_lerobot
+from ._lerobot import lerobot_conventions, write_lerobot
 from ._safety import COLLISION_MARGIN_M, check_trajectory, refuse
 from ._tf import link_transforms
 from ._timing import LIMIT_FRACTION, time_path
@@ -29,6 +29,12 @@ from ._timing import LIMIT_FRACTION, time_path
 Format = Literal["csv", "mcap", "lerobot"]
 FORMATS: tuple[Format, ...] = ("csv", "mcap", "lerobot")
 """The trajectory formats ``studio export --format`` writes."""
+TASKS = {
+    "demonstration": "Reach the goal the way the person showed it.",
+    "recording": "Move the arm the way the person moved theirs.",
+    "policy": "Reach the goal.",
+}
+"""A LeRobot episode's task text by what the motion came from, as a person would write it."""
 FORMAT_SUFFIXES: dict[Format, str] = {"csv": ".csv", "mcap": ".mcap", "lerobot": ".lerobot"}
 """Each format's default ending after the source's name (a LeRobot dataset is a folder)."""
 
@@ -91,7 +97,7 @@ def export_motion(
         out: the file (a folder for ``lerobot``).
         unchecked: write even when the checks find problems, stating them in the file.
         fraction: the share of the limits the timing may use.
-        task: the LeRobot task text (default: the source's name).
+        task: the LeRobot task text (default: a sentence for the source's kind, :data:`TASKS`).
 
     Raises:
         SafetyError: the checks found problems (nothing written).
@@ -137,16 +143,28 @@ def export_motion(
         )
     else:
         fps = int(round(motion.rate_hz))
+        layout = lerobot_conventions(robot.name, names, robot.lower, robot.upper)
         extra = {
             "teach_studio": {
                 "source": motion.name,
                 "kind": motion.kind,
+                "robot": robot.name,
+                "units": dict(zip(layout.names, layout.units, strict=True)),
                 "timed_by": timed_by,
                 "checked": not findings,
                 "findings": [f.sentence for f in findings],
                 "notes": list(motion.notes),
             }
         }
-        task = task or f"Move as in {motion.name}"
-        write_lerobot(out, names, times, q, fps=fps, robot_type=robot.name, task=task, extra=extra)
+        task = task or TASKS[motion.kind]
+        write_lerobot(
+            out,
+            layout.names,
+            times,
+            layout.values(q),
+            fps=fps,
+            robot_type=layout.robot_type,
+            task=task,
+            extra=extra,
+        )
     return Exported(out, times, q, tuple(findings), timed_by)

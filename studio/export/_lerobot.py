@@ -9,8 +9,11 @@ The layout and fields follow lerobot's ``datasets/utils.py`` (``CODEBASE_VERSION
     data/chunk-000/file-000.parquet                  one row per frame
 
 A frame holds ``timestamp`` (s from the episode's start), ``frame_index``, ``episode_index``,
-``index`` (across the dataset), ``task_index``, ``observation.state`` (the robot's joints, rad)
-and ``action`` (the next frame's joints; the last frame holds its own). One export is one
+``index`` (across the dataset), ``task_index``, ``observation.state`` (the robot's joints) and
+``action`` (the next frame's joints; the last frame holds its own). The joints are named and
+scaled as the robot's own LeRobot driver does (:func:`lerobot_conventions`): the SO-100 and
+SO-101 as ``so100_follower`` / ``so101_follower`` record them, every other arm by its URDF joint
+names in radians, with the units stated in ``info.json``. One export is one
 episode of one task. The folder is built next to ``out`` and renamed into place, so a failed
 export leaves nothing half-written, and an existing non-empty folder is never replaced.
 """
@@ -20,6 +23,7 @@ from __future__ import annotations
 import json
 import shutil
 from collections.abc import Sequence
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -41,6 +45,66 @@ INFO_PATH = "meta/info.json"
 STATS_PATH = "meta/stats.json"
 QUANTILES = (0.01, 0.10, 0.50, 0.90, 0.99)
 """The quantiles lerobot's stats carry (``q01`` ... ``q99``)."""
+
+
+SO_FOLLOWERS = {"so100": "so100_follower", "so101": "so101_follower"}
+"""The robots LeRobot drives itself, by the ``robot_type`` its driver registers."""
+GRIPPER_OPEN = 100.0
+"""The SO followers' ``gripper.pos`` while the studio teaches no gripper: open. LeRobot's
+calibration maps the gripper's range onto 0 (closed) .. 100 (open) (``MotorNormMode.RANGE_0_100``)."""
+
+
+@dataclass(frozen=True)
+class LeRobotConventions:
+    """How one robot's joints are written in a LeRobot dataset.
+
+    Attributes:
+        robot_type: ``info.json``'s ``robot_type`` (the LeRobot driver's name, or the studio's).
+        names: the ``observation.state`` and ``action`` names.
+        units: each name's unit, in the same order.
+        offset, scale: a value is ``(q - offset) * scale`` per joint.
+        extra: constant columns after the joints (the SO followers' open gripper).
+    """
+
+    robot_type: str
+    names: tuple[str, ...]
+    units: tuple[str, ...]
+    offset: np.ndarray
+    scale: float
+    extra: tuple[float, ...] = ()
+
+    def values(self, q: np.ndarray) -> np.ndarray:
+        """The dataset's columns for joint angles ``q`` (N, joints), radians."""
+        joints = (np.asarray(q, dtype=float) - self.offset) * self.scale
+        constant = np.broadcast_to(
+            np.array(self.extra, dtype=float), (len(joints), len(self.extra))
+        )
+        return np.hstack([joints, constant])
+
+
+def lerobot_conventions(
+    robot: str, joint_names: Sequence[str], lower: np.ndarray, upper: np.ndarray
+) -> LeRobotConventions:
+    """How ``robot``'s joints are written so that LeRobot's own driver can replay them.
+
+    The SO-100 and SO-101 follow LeRobot's ``so100_follower`` / ``so101_follower``: motors
+    ``<joint>.pos`` in degrees (its ``use_degrees``, on by default), which its calibration counts
+    from the middle of each joint's range (``(position - mid) * 360 / 4095``), so the middle of the
+    URDF's limits is 0 degrees; then ``gripper.pos`` held open. Any other arm: the URDF's joint
+    names in radians.
+    """
+    names = tuple(joint_names)
+    if robot in SO_FOLLOWERS:
+        middle = (np.asarray(lower, dtype=float) + np.asarray(upper, dtype=float)) / 2.0
+        return LeRobotConventions(
+            SO_FOLLOWERS[robot],
+            (*(f"{name}.pos" for name in names), "gripper.pos"),
+            (*("deg" for _ in names), "percent open"),
+            middle,
+            180.0 / np.pi,
+            (GRIPPER_OPEN,),
+        )
+    return LeRobotConventions(robot, names, tuple("rad" for _ in names), np.zeros(len(names)), 1.0)
 
 
 def features(names: Sequence[str]) -> dict[str, dict[str, object]]:
@@ -191,7 +255,8 @@ def write_lerobot(
         out: the dataset folder (must not exist, or be empty).
         names: the joint names (``observation.state`` and ``action`` names).
         times: seconds from the start, one per frame.
-        q: radians, one row per frame.
+        q: the joints' values, one row per frame, in the units :func:`lerobot_conventions`
+            gives the robot.
         fps: the frame rate ``info.json`` states.
         robot_type: ``info.json``'s ``robot_type``.
         task: the episode's task text.

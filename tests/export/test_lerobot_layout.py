@@ -128,3 +128,53 @@ def test_stats_describe_the_data(dataset):
     np.testing.assert_allclose(stats["observation.state"]["min"], state.min(axis=0), rtol=1e-6)
     np.testing.assert_allclose(stats["observation.state"]["mean"], state.mean(axis=0), rtol=1e-5)
     assert stats["observation.state"]["count"] == [len(state)]
+
+
+@pytest.mark.parametrize("robot", ["so100", "so101"])
+def test_an_so_arm_is_written_as_lerobots_own_follower_records_it(robot, tmp_path):
+    """``robot_type`` ``so10x_follower``, ``<motor>.pos`` in degrees from the middle of each
+    joint's range (LeRobot's ``use_degrees``), and ``gripper.pos`` held open, so that LeRobot's
+    own driver can replay the dataset on the arm."""
+    from studio.kinematics import load_robot
+
+    motion = demonstration_motion(SAMPLES_DIR / "sample-reach-1.demo.json", robot, 30.0)
+    out = tmp_path / "reach"
+    done = export_motion(motion, "lerobot", out, unchecked=True)
+    info = json.loads((out / "meta/info.json").read_text())
+    assert info["robot_type"] == f"{robot}_follower"
+    motors = ["shoulder_pan", "shoulder_lift", "elbow_flex", "wrist_flex", "wrist_roll"]
+    names = [f"{m}.pos" for m in motors] + ["gripper.pos"]
+    assert info["features"]["observation.state"]["names"] == names
+    assert info["features"]["action"]["names"] == names
+    assert info["teach_studio"]["units"]["shoulder_pan.pos"] == "deg"
+    data = pq.read_table(out / "data/chunk-000/file-000.parquet").to_pydict()
+    state = np.array(data["observation.state"], dtype=float)
+    arm = load_robot(robot)
+    middle = (arm.lower + arm.upper) / 2
+    np.testing.assert_allclose(state[:, :5], np.degrees(done.q - middle), atol=1e-3)
+    assert np.all(state[:, 5] == 100.0)  # the gripper, open
+    assert info["teach_studio"]["units"]["gripper.pos"] == "percent open"
+
+
+def test_another_arm_keeps_its_urdf_names_in_radians_and_says_so(tmp_path):
+    motion = demonstration_motion(SAMPLES_DIR / "sample-reach-1.demo.json", "panda", 30.0)
+    out = tmp_path / "reach"
+    done = export_motion(motion, "lerobot", out, unchecked=True)
+    info = json.loads((out / "meta/info.json").read_text())
+    assert info["robot_type"] == "panda"
+    assert info["features"]["observation.state"]["names"] == list(motion.robot.joint_names)
+    assert set(info["teach_studio"]["units"].values()) == {"rad"}
+    data = pq.read_table(out / "data/chunk-000/file-000.parquet").to_pydict()
+    np.testing.assert_allclose(np.array(data["observation.state"]), done.q, atol=1e-5)
+
+
+def test_the_task_is_a_sentence_a_person_would_write(dataset):
+    out, _ = dataset
+    tasks = pq.read_table(out / "meta/tasks.parquet").to_pydict()["task"]
+    assert tasks == ["Reach the goal"]  # given
+    motion = demonstration_motion(SAMPLES_DIR / "sample-reach-3.demo.json", "puma560", 30.0)
+    other = out.parent / "default-task"
+    export_motion(motion, "lerobot", other)
+    (task,) = pq.read_table(other / "meta/tasks.parquet").to_pydict()["task"]
+    assert task == "Reach the goal the way the person showed it."
+    assert ".json" not in task
