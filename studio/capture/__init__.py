@@ -49,6 +49,7 @@ from ._playback import PlaybackSource as PlaybackSource
 from ._push_sources import CameraSource as CameraSource
 from ._push_sources import FloodError as FloodError
 from ._push_sources import HandSource as HandSource
+from ._push_sources import SecondSenderError as SecondSenderError
 from ._recording_edit import DEMO_SUFFIX as DEMO_SUFFIX
 from ._recording_edit import being_recorded as being_recorded
 from ._recording_edit import delete_recording as delete_recording

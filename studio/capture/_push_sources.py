@@ -7,6 +7,12 @@ sizes), counted towards ``frames`` and ``rate_hz`` like a device's frames, and r
 caller to fit and record at once, so the answer can say what the fit made of it. A flood (more
 than :data:`MAX_OBSERVATIONS_PER_SECOND` in one second) is refused with :class:`FloodError` and
 counted as dropped: the studio, and a recording in progress, carry on.
+
+Each page stamps its frames by its own clock. One page at a time sends: a frame whose clock does
+not run with the live page's is another page's (a second tab with the camera), refused with
+:class:`SecondSenderError` while the live one sends; once that one has been quiet for
+:data:`SENDER_QUIET_S` (closed, reloaded), the next page takes over, its times continuing by the
+studio's own clock across the gap. So a recording's time is never a difference of two clocks.
 """
 
 from __future__ import annotations
@@ -37,12 +43,22 @@ MAX_OBSERVATIONS_PER_SECOND = 120
 handle updates); more are refused as a flood."""
 RESTART_STEP_S = 1.0 / 30.0
 """When a page's clock goes back (a reload), its times continue this long after the last one."""
+SENDER_QUIET_S = 1.0
+"""A page that sent no frame for this long is gone (closed, reloaded): another may take over."""
+CLOCK_TOLERANCE_S = 1.0
+"""How far a frame's time may stray from the live page's clock (as the studio's clock measures
+the time between their arrivals) and still be that page's: a page's own delays are far shorter,
+while two pages' clocks differ by the time between their openings."""
 MODELS = ("lite", "full", "heavy")
 """BlazePose models the page may report."""
 
 
 class FloodError(CaptureError):
     """More observations in one second than a fed source takes (the API answers 429)."""
+
+
+class SecondSenderError(CaptureError):
+    """A frame from a second page while another one sends (the API answers 409)."""
 
 
 class PushSource(ThreadedSource[FedT]):
@@ -67,6 +83,7 @@ class PushSource(ThreadedSource[FedT]):
         self._counter = 0
         self._last_t: float | None = None
         self._offset = 0.0
+        self._sender: tuple[float, float] | None = None  # live page: (its last time, arrival)
         self._admitted: collections.deque[float] = collections.deque(
             maxlen=MAX_OBSERVATIONS_PER_SECOND
         )
@@ -113,12 +130,37 @@ class PushSource(ThreadedSource[FedT]):
         self._record_arrival()
         return counter, now
 
-    def _stream_time(self, t: float) -> float:
-        """``t`` on a clock that always moves forward (a reloaded page restarts its own; a
-        repeated time stamp moves on too, as the landmark filter needs)."""
+    def _check_sender(self, t: float, now: float) -> None:
+        """Refuse a frame whose clock is not the live page's (see the module docstring).
+
+        Raises:
+            SecondSenderError: another page sent within the last :data:`SENDER_QUIET_S`.
+        """
         with self._admit_lock:
+            if self._sender is None or now - self._sender[1] > SENDER_QUIET_S:
+                return
+            last_t, arrived = self._sender
+            if abs(t - (last_t + now - arrived)) > CLOCK_TOLERANCE_S:
+                raise SecondSenderError(
+                    f"Another page is sending {self.observation_kind} frames to this studio "
+                    "already; close the other tab (or stop its camera), then start the camera "
+                    "here again."
+                )
+
+    def _stream_time(self, t: float, now: float | None = None) -> float:
+        """``t`` on a clock that always moves forward: a page that takes over from another
+        (a reload) continues after the last time by the studio's own clock; a repeated time
+        stamp moves on too, as the landmark filter needs."""
+        now = time.monotonic() if now is None else now
+        with self._admit_lock:
+            sender = self._sender
+            if self._last_t is not None and sender is not None:
+                same_clock = abs(t - (sender[0] + now - sender[1])) <= CLOCK_TOLERANCE_S
+                if not same_clock:  # a new page: continue by the studio's clock
+                    self._offset = self._last_t + max(now - sender[1], RESTART_STEP_S) - t
             if self._last_t is not None and t + self._offset <= self._last_t:
                 self._offset = self._last_t + RESTART_STEP_S - t
+            self._sender = (t, now)
             self._last_t = t + self._offset
             return self._last_t
 
@@ -164,12 +206,18 @@ class CameraSource(PushSource[LandmarkFrame]):
             raise CaptureError(f"fps is {fps!r}; send the page's frame rate (0 to 1000) or null.")
         if model is not None and model not in MODELS:
             raise CaptureError(f"model is {model!r}; send one of {', '.join(MODELS)} or null.")
-        counter, _ = self._admit()
+        self._check_sender(frame.t, time.monotonic())
+        counter, now = self._admit()
         self.person_detected = frame.person
         self.camera_fps = None if fps is None else float(fps)
         self.model = model
         return LandmarkFrame(
-            self._stream_time(frame.t), counter, frame.world, frame.image, frame.width, frame.height
+            self._stream_time(frame.t, now),
+            counter,
+            frame.world,
+            frame.image,
+            frame.width,
+            frame.height,
         )
 
 

@@ -28,6 +28,7 @@ from studio.capture import (
     HandSource,
     LandmarkFrame,
     PlaybackSource,
+    SecondSenderError,
     SimulatorSource,
     source_from_spec,
 )
@@ -115,6 +116,8 @@ class Studio:
         self.rollouts: dict[str, tuple[np.ndarray, np.ndarray]] = {}
         self.mark_t0: float | None = None  # live demonstration start, recording time (s)
         self._robot_lock = threading.Lock()  # one robot switch at a time
+        # one fed update at a time, numbered, timed, fitted and written in the order it came
+        self._fed_lock = threading.Lock()
         self._robot_switching: str | None = None  # the robot whose model loads (set_robot)
 
     def start(self) -> None:
@@ -286,12 +289,16 @@ class Studio:
 
         Raises:
             TooManyRequestsError: a flood (the update is dropped).
+            ConflictError: another page sends frames already (the update is dropped).
         """
-        try:
-            observation = submit()
-        except FloodError as err:
-            raise TooManyRequestsError(str(err)) from None
-        return observation, self.pipeline.observe(observation)
+        with self._fed_lock:
+            try:
+                observation = submit()
+            except FloodError as err:
+                raise TooManyRequestsError(str(err)) from None
+            except SecondSenderError as err:
+                raise ConflictError(str(err)) from None
+            return observation, self.pipeline.observe(observation)
 
     def post_landmarks(self, frame: dict[str, object]) -> dict[str, object]:
         """Fit and record one frame of landmarks from the page (``LandmarksFrame``).

@@ -9,6 +9,7 @@ import time
 
 import numpy as np
 import pandas as pd
+import pytest
 from fastapi.testclient import TestClient
 
 from studio.capture import read_any_recording
@@ -144,15 +145,58 @@ def test_a_flood_is_refused_and_the_recording_keeps_every_frame(client: TestClie
     assert listed["cam"]["frames"] == 5
 
 
-def test_a_page_reload_keeps_time_moving_forward(client: TestClient) -> None:
+class FakeClock:
+    """The studio's monotonic clock for fed sources, moved by the test."""
+
+    def __init__(self, monkeypatch: pytest.MonkeyPatch) -> None:
+        self.now = 1000.0
+        monkeypatch.setattr("studio.capture._push_sources.time.monotonic", lambda: self.now)
+
+
+def test_a_page_reload_keeps_time_moving_forward(client: TestClient, monkeypatch) -> None:
+    clock = FakeClock(monkeypatch)
     camera(client)
     no_one = {**landmarks(), "world": None, "image": None}
     assert client.post("/api/capture/start", json={"name": "reload"}).status_code in (200, 201)
     for t in (10.0, 10.1, 0.0, 0.1):  # the page reloaded between the second and third
+        if t == 0.0:
+            clock.now += 3.0  # a reload: the page and its pose model load again
         assert client.post("/api/source/landmarks", json={**no_one, "t": t}).status_code == 200
+        clock.now += 0.1
     client.post("/api/capture/stop")
     t = read_any_recording(client.app.state.studio.recordings.path("reload")).t
     assert (np.diff(t) > 0).all()
+    assert np.allclose(np.diff(t), [0.1, 3.1, 0.1])  # the gap as the studio's clock saw it
+
+
+def test_a_second_page_sending_frames_is_refused_and_time_stays_true(
+    client: TestClient, monkeypatch
+) -> None:
+    """Two tabs with the camera source, each with its own clock: 120 frames over 4.8 s were once
+    recorded as 23,504 s (every step back taken as a reload). The second page is refused while
+    the first sends; once the first is gone, the second takes over."""
+    clock = FakeClock(monkeypatch)
+    camera(client)
+    no_one = {**landmarks(), "world": None, "image": None}
+    assert client.post("/api/capture/start", json={"name": "two"}).status_code in (200, 201)
+    refused = []
+    for k in range(60):
+        for page_clock in (8000.0, 3.0):  # pages opened about two hours apart
+            r = client.post("/api/source/landmarks", json={**no_one, "t": page_clock + k / 25})
+            if r.status_code != 200:
+                refused.append(r)
+        clock.now += 1 / 25
+    assert len(refused) == 60 and {r.status_code for r in refused} == {409}
+    assert refused[0].json()["detail"].startswith("Another page is sending pose frames")
+    clock.now += 2.0  # the first page is closed; the second takes over
+    for k in range(10):
+        r = client.post("/api/source/landmarks", json={**no_one, "t": 5.0 + k / 25})
+        assert r.status_code == 200, r.text
+        clock.now += 1 / 25
+    client.post("/api/capture/stop")
+    t = read_any_recording(client.app.state.studio.recordings.path("two")).t
+    assert len(t) == 70 and (np.diff(t) > 0).all()
+    assert t[-1] - t[0] == pytest.approx(59 / 25 + 2.0 + 1 / 25 + 9 / 25, abs=1e-6)
 
 
 def test_hand_guide_moves_the_arm_and_the_robot(client: TestClient) -> None:
@@ -275,3 +319,71 @@ def test_with_a_token_landmarks_and_hand_poses_need_it(open_client) -> None:
     assert client.put("/api/source", json={"kind": "hand"}, headers=auth).status_code == 200
     assert client.post("/api/source/hand", json=REACH).status_code == 403
     assert client.post("/api/source/hand", json=REACH, headers=auth).status_code == 200
+
+
+def test_a_frame_posted_meanwhile_is_written_after_the_one_being_fitted(
+    client: TestClient, monkeypatch
+) -> None:
+    """A frame was numbered and timed under one lock and written under another: with several
+    senders, a later frame could be written first (time and counter going back in the file, the
+    take impossible to cut). Here a second post arrives while the first is being fitted."""
+    import threading
+
+    camera(client)
+    no_one = {**landmarks(), "world": None, "image": None}
+    assert client.post("/api/capture/start", json={"name": "order"}).status_code in (200, 201)
+    studio = client.app.state.studio
+    pipeline, source = studio.pipeline, studio.pipeline.source
+    second_arrived, entered = threading.Event(), []
+    real_fit, real_submit = pipeline._fit, source.submit
+
+    class Announcing:
+        """The studio's lock, saying when the second post waits for it."""
+
+        def __init__(self, lock) -> None:
+            self.lock = lock
+
+        def __enter__(self):
+            entered.append(1)
+            if len(entered) == 2:  # the second post
+                second_arrived.set()
+            return self.lock.__enter__()
+
+        def __exit__(self, *exc):
+            return self.lock.__exit__(*exc)
+
+    def submit(t, *args, **kwargs):
+        if t == 1.04:
+            second_arrived.set()  # (were it not waiting, it would be numbered now)
+        return real_submit(t, *args, **kwargs)
+
+    def slow_fit(src, observations):
+        if observations[0].frame == 0:
+            assert second_arrived.wait(30)
+        return real_fit(src, observations)
+
+    lock = getattr(studio, "_fed_lock", threading.Lock())
+    monkeypatch.setattr(studio, "_fed_lock", Announcing(lock), raising=False)
+    monkeypatch.setattr(source, "submit", submit)
+    monkeypatch.setattr(pipeline, "_fit", slow_fit)
+    first = threading.Thread(
+        target=client.post, args=("/api/source/landmarks",), kwargs={"json": {**no_one, "t": 1.0}}
+    )
+    first.start()
+    assert wait_for_fit_of_frame_0(source)
+    second = threading.Thread(
+        target=client.post, args=("/api/source/landmarks",), kwargs={"json": {**no_one, "t": 1.04}}
+    )
+    second.start()
+    first.join(30)
+    second.join(30)
+    client.post("/api/capture/stop")
+    recording = read_any_recording(studio.recordings.path("order"))
+    assert len(recording) == 2 and (np.diff(recording.t) > 0).all()
+
+
+def wait_for_fit_of_frame_0(source) -> bool:
+    """Whether the first frame was counted in (its fit then waits for the second post)."""
+    from tests.web.conftest import wait_for
+
+    return wait_for(lambda: source.status().frames >= 1)
