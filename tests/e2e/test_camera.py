@@ -310,6 +310,36 @@ def test_a_busy_camera_says_so(open_camera: Callable[..., CameraPage]) -> None:
     assert cam.page.evaluate("p => p.S.camera.running", hook(cam.page)) is False
 
 
+NO_CAMERA = """
+navigator.mediaDevices.getUserMedia = () =>
+    Promise.reject(new DOMException("Requested device not found", "NotFoundError"));
+"""
+"""What Chromium answers on a machine with no camera."""
+
+
+def test_a_camera_error_goes_with_the_camera(open_camera: Callable[..., CameraPage]) -> None:
+    """The red "No camera was found" stays while the camera is the source, and goes when the
+    user switches to the hand guide or the simulator (it stayed until a reload)."""
+    cam = open_camera(None, init_script=NO_CAMERA)
+    page = cam.page
+    status = page.get_by_test_id("camera-status")
+    for other in ("hand", "simulator"):
+        cam.use_camera()
+        page.wait_for_function(
+            "() => /No camera was found/.test("
+            "document.querySelector(\"[data-testid='camera-status']\").textContent)",
+            timeout=STATUS_TIMEOUT_MS,
+        )
+        assert status.is_visible()
+        page.select_option("[data-testid='source-kind']", other)
+        page.click("[data-testid='source-apply']")
+        page.wait_for_function(
+            "([p, kind]) => p.S.source && p.S.source.kind === kind", arg=[hook(page), other]
+        )
+        status.wait_for(state="hidden", timeout=STATUS_TIMEOUT_MS)
+        assert status.inner_text() == ""
+
+
 def test_hand_guide_countdown_and_named_controls(
     open_camera: Callable[..., CameraPage], studio_server: Studio
 ) -> None:

@@ -35,6 +35,22 @@ def test_a_grid_run_and_its_twin_without_demonstrations(client):
     assert len(a.record.demonstrations) == 1 and len(b.record.demonstrations) == 0
 
 
+def test_an_unnamed_runs_twin_is_named_no_demos(client):
+    """Unnamed, a run is listed after its settings ("full x20"); its twin without
+    demonstrations was listed the same, and the two could not be told apart."""
+    body = {**TINY_RUN, "demonstrations": ["sample-reach-1"]}
+    r = client.post("/api/runs/pair", json=body)
+    assert r.status_code == 201, r.text
+    taught, bare = r.json()
+    assert bare["name"].endswith(" · no demos")
+    assert (
+        bare["name"] == f"{TINY_RUN.get('planning', 'full')} x{TINY_RUN['experiments']} · no demos"
+    )
+    assert taught["name"] != bare["name"]
+    for run in (taught, bare):
+        assert wait_run(client, run["id"])["status"] == "done"
+
+
 def test_a_continuous_twin_keeps_the_demonstrations_goal(client):
     body = {**PAGE_REACH, "episodes": 2, "demonstrations": ["sample-reach-1"]}
     taught, bare = client.post("/api/runs/pair", json=body).json()

@@ -202,9 +202,11 @@ def without_demonstrations(request: RunRequest, record: RunRecord) -> RunRequest
         record: ``resolve_run(request)``.
 
     Returns:
-        The request of its twin, named ``<name> · no demos`` when the run is named.
+        The request of its twin, named ``<name> · no demos``; an unnamed run's twin is named
+        after its settings, as runs without a name are listed (``full x20 · no demos``).
     """
-    name = request.name[: 100 - len(BASELINE_SUFFIX)] + BASELINE_SUFFIX if request.name else ""
+    base = request.name or replace(record, demonstrations=[]).label()
+    name = base[: 100 - len(BASELINE_SUFFIX)] + BASELINE_SUFFIX
     if record.kind == TASK_ARM_REACH:
         goal = record.arm_reach().goal
         reach = {**request.reach, "goal": goal}

@@ -391,7 +391,8 @@ function onSource(s) {
   // Follow the studio's side when it changes there, not on every status: a choice not yet applied stays.
   if (s.side && s.side !== C.studioSide) { C.studioSide = s.side; setProp("source-side", "value", s.side); }
   if (s.kind === "camera" && !C.running && !C.starting) start();
-  else if (s.kind !== "camera" && (C.running || C.starting || C.stream)) stop();
+  // Another source: the camera stops, and what it said (a failed start too) goes with it.
+  else if (s.kind !== "camera" && (C.running || C.starting || C.stream || C.status)) stop();
 }
 
 function wire() {

@@ -22,12 +22,49 @@ export function runTask(r) {
   return c.task === "arm-reach" ? `continuous, ${c.joints} joints` : "grid";
 }
 
-export function runLabel(r) {
+function nameAndTask(r) {
   const c = r.config || {};
   const name = r.name || r.id;
   const demos = (c.demonstrations || []).length;
   const planning = c.planning && !name.includes(c.planning) ? ` · ${c.planning}` : "";
   return `${name} · ${runTask(r)}${planning}${demos && !/demo/.test(name) ? ` +${demos} demo` : ""}`;
+}
+
+function madeAt(r) {
+  const made = new Date(r.created);
+  return Number.isNaN(made.getTime()) ? r.id : made.toLocaleTimeString([], { hour12: false });
+}
+
+// Run id -> its label, for the runs whose names alone read the same; rebuilt when the list changes.
+let twins = { runs: null, length: -1, labels: new Map() };
+
+function twinLabels() {
+  if (twins.runs === S.runs && twins.length === S.runs.length) return twins.labels;
+  const groups = new Map();
+  for (const r of S.runs) {
+    const label = nameAndTask(r);
+    if (!groups.has(label)) groups.set(label, []);
+    groups.get(label).push(r);
+  }
+  const labels = new Map();
+  for (const [label, runs] of groups) {
+    if (runs.length < 2) continue;
+    const oldestFirst = [...runs].reverse();
+    const times = oldestFirst.map(madeAt);
+    oldestFirst.forEach((r, i) => {
+      const clash = times.filter((t) => t === times[i]).length > 1; // made in the same second
+      labels.set(r.id, `${label} · ${times[i]}${clash ? ` #${i + 1}` : ""}`);
+    });
+  }
+  twins = { runs: S.runs, length: S.runs.length, labels };
+  return labels;
+}
+
+/** A run's name as the legend, the run list and the Compare table show it: its name (its
+ * settings when unnamed) and task; runs that would read the same (the same settings run twice,
+ * unnamed) each add the time they were made, and their order when made in the same second. */
+export function runLabel(r) {
+  return twinLabels().get(r.id) || nameAndTask(r);
 }
 
 /** The runs to plot, oldest first (so colours and legend order stay put as runs are added). */

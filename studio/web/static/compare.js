@@ -15,7 +15,7 @@ import { runMatches } from "./runfilter.js";
 import { S, listen, markCurvesDirty } from "./state.js";
 
 /** Settings that say nothing about how a run learns (shown elsewhere, or its name). */
-const NOT_SETTINGS = new Set(["name"]);
+const NOT_SETTINGS = new Set(["name", "task"]); // the task has its own column (runTask)
 
 /** A setting's value as the table shows it (lists joined, nothing as a dash). */
 function shown(v) {
@@ -23,6 +23,11 @@ function shown(v) {
   if (Array.isArray(v)) return v.join(", ");
   if (typeof v === "object") return JSON.stringify(v);
   return String(v);
+}
+
+/** A setting's name with a line-break opportunity after each underscore (planning_steps). */
+function wrapAtUnderscores(key) {
+  return key.split("_").flatMap((part, i, all) => (i < all.length - 1 ? [`${part}_`, el("wbr")] : [part]));
 }
 
 /** The settings columns: every config field any listed run has, with whether the plotted runs
@@ -90,7 +95,7 @@ export function renderCompare() {
   let columns = settingColumns(runs);
   if ($("compare-differing").checked) columns = columns.filter((c) => c.differs);
   const head = el("tr", {}, el("th", {}), el("th", { text: "run" }), el("th", { text: "status" }), el("th", { text: "task" }),
-    ...columns.map((c) => el("th", { class: c.differs ? "differs" : null, text: c.key, title: c.differs ? "the plotted runs differ here" : "" })),
+    ...columns.map((c) => el("th", { class: c.differs ? "differs" : null, "data-key": c.key, title: c.differs ? "the plotted runs differ here" : "" }, ...wrapAtUnderscores(c.key))),
     el("th", { class: "num", text: "CPU" }), el("th", { text: "tags" }), el("th", { text: "notes" }));
   reconcileRows($("compare-head"), [head]);
   reconcileRows($("compare-body"), runs.map((r) => compareRow(r, columns)));

@@ -122,6 +122,26 @@ function renderRobot(s) {
   setProp("robot-warning", "hidden", !s.robot_warning);
   setText("robot-warning", s.robot_warning || "");
   renderRobotNotes(s.robot_notes || []);
+  steadyNotices(s);
+}
+
+// The notices under the source come and go with the frames (a hand that moves between two
+// warnings changes them every second): the room they took stays theirs while the same source
+// feeds the same robot, so the sections below never jump. Another source or robot starts afresh.
+let notices = { key: null, height: 0 };
+
+function steadyNotices(s) {
+  const box = $("source-notices");
+  const key = `${s.kind} ${s.recording || ""} ${s.robot || ""}`;
+  if (key !== notices.key) {
+    notices = { key, height: 0 };
+    setProp(box.style, "minHeight", "");
+  }
+  const height = box.offsetHeight; // never below the room already kept
+  if (height > notices.height) {
+    notices.height = height;
+    setProp(box.style, "minHeight", `${height}px`);
+  }
 }
 
 /** One line per sentence the studio gives about the robot drawn (its meshes loading, a motion
