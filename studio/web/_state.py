@@ -49,7 +49,7 @@ from studio.learning import (
 from studio.motion import MotionError, training_demonstration
 
 from ._errors import ConflictError, InvalidError, NotFoundError, TooManyRequestsError
-from ._schemas import RunCreate
+from ._schemas import LandmarksFrame, LandmarksPublic, RunCreate
 from ._settings import Settings
 from .live import Pipeline
 from .scene import RobotPlayer, RobotViews, Scene
@@ -300,8 +300,10 @@ class Studio:
                 raise ConflictError(str(err)) from None
             return observation, self.pipeline.observe(observation)
 
-    def post_landmarks(self, frame: dict[str, object]) -> dict[str, object]:
-        """Fit and record one frame of landmarks from the page (``LandmarksFrame``).
+    def post_landmarks(self, frame: LandmarksFrame) -> LandmarksPublic:
+        """Fit and record one frame of landmarks from the page, as the API parsed it; the camera
+        source checks its values (the one check: NaN, sizes, time) and the answer is built
+        typed, not read back from a dict.
 
         Raises:
             ConflictError: the live source is not the camera.
@@ -309,16 +311,19 @@ class Studio:
             CaptureError: NaN or wrong sizes (422).
         """
         camera = self._fed_source("camera")
-        observation, fitted = self._observe_fed(lambda: camera.submit(**frame))
+        observation, fitted = self._observe_fed(
+            lambda: camera.submit(
+                frame.t, frame.world, frame.image, frame.width, frame.height, frame.fps, frame.model
+            )
+        )
         observable = None if fitted is None else fitted.observable
-        warning = fitted.warning if fitted is not None else self.pipeline.status()["error"]
-        return {
-            "person_detected": observation.person,
-            "observable": None if observable is None else [bool(b) for b in observable],
-            "warning": warning,
-            "q_human": None if fitted is None else [float(x) for x in fitted.q_human],
-            "q_robot": None if fitted is None else [float(x) for x in fitted.q_robot],
-        }
+        return LandmarksPublic(
+            person_detected=observation.person,
+            observable=None if observable is None else [bool(b) for b in observable],
+            warning=fitted.warning if fitted is not None else self.pipeline.status()["error"],
+            q_human=None if fitted is None else [float(x) for x in fitted.q_human],
+            q_robot=None if fitted is None else [float(x) for x in fitted.q_robot],
+        )
 
     def hand_moved(self, position: object, wxyz: object = None) -> dict[str, object]:
         """Move the operator's hand to a pose (``HandTarget``): what dragging the scene's handle

@@ -68,7 +68,7 @@ def post_landmarks(body: LandmarksFrame, studio: StudioDep) -> LandmarksPublic:
     """One frame of pose landmarks from the page's camera: fitted, shown, and recorded while a
     capture runs (409 unless the source is the camera; 422 for NaN or wrong sizes; 429 for a
     flood, the frame dropped and the studio running on)."""
-    return LandmarksPublic.model_validate(studio.post_landmarks(body.model_dump()))
+    return studio.post_landmarks(body)
 
 
 @router.post("/hand")
