@@ -192,12 +192,15 @@ def _module_name(path: Path) -> str:
     return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
 
 
-def _imports(body: list[ast.stmt], late: bool) -> Iterator[ast.Import | ast.ImportFrom | str]:
+def _imports(
+    body: list[ast.stmt], late: bool, typing: bool = False
+) -> Iterator[ast.Import | ast.ImportFrom | str]:
     """The imports that run when a module is imported (anywhere in its body and in its class
     bodies, which run then too, inside any ``if``/``try``/``with``/loop/``match``) and, if
-    ``late``, also those in its functions, methods and lambdas, which run when called. Never those
-    under ``if TYPE_CHECKING:``, which never run. ``importlib.import_module("studio....")`` with a
-    literal name counts as an import of that module (yielded as its name)."""
+    ``late``, also those in its functions, methods and lambdas, which run when called. Those
+    under ``if TYPE_CHECKING:``, which never run, only if ``typing``: the module still depends
+    on what they name. ``importlib.import_module("studio....")`` with a literal name counts as an
+    import of that module (yielded as its name)."""
     pending: list[ast.AST] = list(body)
     while pending:
         node = pending.pop()
@@ -212,7 +215,7 @@ def _imports(body: list[ast.stmt], late: bool) -> Iterator[ast.Import | ast.Impo
             ]
             pending.extend(n for n in runs_now if n is not None)
             continue
-        if isinstance(node, ast.If) and _is_type_checking(node.test):
+        if isinstance(node, ast.If) and _is_type_checking(node.test) and not typing:
             pending.extend(node.orelse)
             continue
         if (
@@ -228,13 +231,14 @@ def _imports(body: list[ast.stmt], late: bool) -> Iterator[ast.Import | ast.Impo
         pending.extend(n for n in ast.iter_child_nodes(node) if n is not None)
 
 
-def _import_graph(late: bool) -> dict[str, set[str]]:
-    """Each module of ``studio`` and the modules of ``studio`` it imports."""
+def _import_graph(late: bool, typing: bool = False) -> dict[str, set[str]]:
+    """Each module of ``studio`` and the modules of ``studio`` it imports (with ``typing``, also
+    those it imports for type checking only)."""
     paths = {_module_name(p): p for p in STUDIO.rglob("*.py")}
     graph: dict[str, set[str]] = {name: set() for name in paths}
     for name, path in paths.items():
         package = name if path.name == "__init__.py" else name.rpartition(".")[0]
-        for node in _imports(ast.parse(path.read_text(), str(path)).body, late):
+        for node in _imports(ast.parse(path.read_text(), str(path)).body, late, typing):
             if isinstance(node, str):
                 targets = [node]
             elif isinstance(node, ast.Import):
@@ -378,6 +382,15 @@ def f():
     assert {"studio.learning", "studio.web"} <= names
 
 
+def test_no_import_cycle_through_type_only_imports():
+    """Nor through an import under ``if TYPE_CHECKING:``: it never runs, but the two modules
+    still depend on each other (``learning/tasks/_follow.py`` once named ``ArmReach`` so, while
+    ``_reach.py`` imported it); name what the other offers with a ``Protocol`` instead."""
+    graph = _import_graph(late=True, typing=True)
+    assert "studio.learning._tiles" in graph["studio.learning.tasks._follow"]
+    assert _cycles(graph) == []
+
+
 LATE_AND_EARLY = """
 from typing import TYPE_CHECKING
 import studio.a
@@ -406,9 +419,9 @@ f = lambda: __import__("studio.late_lambda")
 """
 
 
-def _imported(source: str, late: bool) -> set[str]:
+def _imported(source: str, late: bool, typing: bool = False) -> set[str]:
     names = set()
-    for node in _imports(ast.parse(source).body, late):
+    for node in _imports(ast.parse(source).body, late, typing):
         if isinstance(node, str):
             names.add(node)
         elif isinstance(node, ast.Import):
@@ -432,6 +445,7 @@ def test_the_import_scan_finds_every_import_that_runs():
     }
     assert _imported(LATE_AND_EARLY, late=False) == early
     assert _imported(LATE_AND_EARLY, late=True) == early | late
+    assert _imported(LATE_AND_EARLY, late=True, typing=True) == early | late | {"studio.never"}
 
 
 MAX_FILE_LINES = 800

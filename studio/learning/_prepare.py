@@ -96,7 +96,7 @@ def _warm(kind: str) -> None:
         task = ArmReach(joints=3)
         coding = task.features()
         result = run_experiments(
-            lambda: gymnasium.make(ARM_REACH_ID, **task.to_dict()),
+            lambda: gymnasium.make(ARM_REACH_ID, arm_reach=task),
             DynaQConfig(planning_steps=1),
             1,
             1,

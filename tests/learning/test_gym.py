@@ -81,3 +81,13 @@ def test_arm_reach_env_options_start_and_bad_start():
     assert np.array_equal(q, [0.1, 0.2, 0.3])
     with pytest.raises(LearningError, match="inside the limits"):
         env.reset(options={"q": [10.0, 0.0, 0.0]})
+
+
+def test_arm_reach_env_takes_the_task_itself():
+    """A run hands its record's task to the environment as is, not rebuilt from a dict."""
+    task = ArmReach(joints=4, step_deg=1.5, actions="pairs")
+    env = gymnasium.make(ARM_REACH_ID, arm_reach=task)
+    assert env.unwrapped.task is task
+    assert env.action_space.n == task.n_actions
+    with pytest.raises(LearningError, match="give the task or its settings"):
+        gymnasium.make(ARM_REACH_ID, arm_reach=task, joints=3).unwrapped  # noqa: B018

@@ -44,9 +44,9 @@ def train_learner(
 
         from ..tasks._gym import ARM_REACH_ID
 
-        spec = record.arm_reach().to_dict()
+        task = record.arm_reach()
         return run_experiments(
-            lambda: gymnasium.make(ARM_REACH_ID, **spec),
+            lambda: gymnasium.make(ARM_REACH_ID, arm_reach=task),
             record.config,
             record.experiments,
             record.episodes,

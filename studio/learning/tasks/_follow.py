@@ -18,7 +18,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from collections.abc import Sequence
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
 from numba import njit
@@ -29,7 +29,18 @@ from ._reach_layout import _COUNTS, _LOWER, _POINT, _STEP, _TABLE, _UPPER, MAX_J
 
 if TYPE_CHECKING:
     from .._tiles import TileCoder
-    from ._reach import ArmReach
+
+
+class ObservedTask(Protocol):
+    """What :func:`check_observed` reads of a task (an :class:`._reach.ArmReach`, which imports
+    this module: named by what it offers, so the two do not depend on each other)."""
+
+    @property
+    def joints(self) -> int: ...
+
+    @property
+    def observation_bounds(self) -> tuple[np.ndarray, np.ndarray]: ...
+
 
 FOLLOW_KAPPA = 2.0
 """How much more a radian off the demonstrated paths costs the follow action than a radian along
@@ -120,7 +131,7 @@ def with_cost_group(coding: TileCoding, joints: int) -> TileCoding:
     return dataclasses.replace(coding, groups=(*groups, (joints,)))
 
 
-def check_observed(task: ArmReach, coder: TileCoder) -> None:
+def check_observed(task: ObservedTask, coder: TileCoder) -> None:
     """Refuse features bound to another observation than ``task``'s: its joints, and with
     followed paths the follow cost after them. A follow policy written before the cost was
     observed has joint features only: it rolls out as trained.

@@ -114,16 +114,27 @@ class ArmReachEnv(gymnasium.Env):
         paths: the demonstrated joint paths ``"follow"`` follows (:class:`ArmReach`).
         robot: the robot's registry name (``studio robots``; default ``"puma560"``): its first
             ``joints`` joints, limits and forward kinematics.
+        arm_reach: the task itself, instead of its settings (a run passes its record's task as
+            is: ``gymnasium.make(ARM_REACH_ID, arm_reach=task)``).
     """
 
     metadata = {"render_modes": []}
 
-    def __init__(self, render_mode: str | None = None, **task: Unpack[_ReachSettings]) -> None:
+    def __init__(
+        self,
+        render_mode: str | None = None,
+        arm_reach: ArmReach | None = None,
+        **task: Unpack[_ReachSettings],
+    ) -> None:
         if render_mode is not None:
             raise LearningError(
                 f"render_mode is {render_mode!r}; this environment renders nothing, give None."
             )
-        self.task = ArmReach(**task)
+        if arm_reach is not None and task:
+            raise LearningError(
+                f"Both arm_reach and {', '.join(task)} are given; give the task or its settings."
+            )
+        self.task = arm_reach if arm_reach is not None else ArmReach(**task)
         self._params = self.task.params
         self.observation_space = spaces.Box(*self.task.observation_bounds, dtype=np.float64)
         self.action_space = spaces.Discrete(self.task.n_actions)
