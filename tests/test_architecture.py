@@ -114,10 +114,25 @@ FOR_USERS = {
             "studio.learning.likeness_card",
             "studio.learning.LikenessCard",
             "studio.learning.load_policy",
+            "studio.learning.rollout",
+            "studio.learning.greedy_path",
+            "studio.learning.rollout_tile_policy",
+            "studio.learning.DmpPolicyFile",
+            "studio.learning.default_goal",
         ),
         "a user's script calls it as studio/learning/README.md or docs/sweeps.md shows",
     ),
     "studio.learning.policy_likeness_card": "issue 21: the likeness card of any policy kind",
+    **dict.fromkeys(
+        (
+            "studio.learning.Learner",
+            "studio.learning.Rollout",
+            "studio.learning.Evaluation",
+            "studio.learning.learner",
+            "studio.learning.register_learner",
+        ),
+        "issue 37: one learner interface, registered by kind, that issue 40's baselines implement",
+    ),
     "studio.kinematics.PoseFit": "issue 19: fit_pose_landmarks(landmarks, side) -> PoseFit",
     **dict.fromkeys(
         (

@@ -45,16 +45,13 @@ from studio.learning import (
     ROLLOUT_SECONDS_PER_STEP,
     TILE_ROLLOUT_MAX_STEPS,
     TILE_ROLLOUT_SECONDS_PER_STEP,
-    DmpPolicyFile,
+    AnyPolicy,
     LearningError,
-    PolicyFile,
-    TilePolicyFile,
-    greedy_path,
+    Rollout,
+    Start,
+    learner_of,
     likeness_cards,
     load_any_policy,
-    rollout,
-    rollout_dmp_policy,
-    rollout_tile_policy,
     save_trajectory_csv,
 )
 from studio.motion import Motion, demonstration_motion, recording_motion
@@ -164,103 +161,44 @@ def _out_path(args: argparse.Namespace) -> Path:
     )
 
 
-def _rollout_tile(
-    args: argparse.Namespace, policy: TilePolicyFile, seconds_per_step: float | None
-) -> tuple[np.ndarray, np.ndarray, str]:
-    """A tile-coded arm policy's rollout from --start-deg (joint steps, constant speed)."""
+def _rollout(
+    args: argparse.Namespace, policy: AnyPolicy, seconds_per_step: float | None
+) -> tuple[Rollout, str]:
+    """The policy's rollout from --start-state (a grid policy's) or --start-deg (default: its
+    learner's own start: the learned joints at 0, a movement primitive's demonstration's start),
+    and the phrase saying what it did."""
+    learner = learner_of(policy)
+    joints = learner.learned_joints(policy)
     if args.start_state is not None:
-        raise LearningError(
-            "--start-state numbers grid states; a tile-coded policy starts from --start-deg angles."
-        )
-    joints = policy.task.joints if policy.task is not None else 0
-    start = np.radians(_start_degrees(args.start_deg, joints)) if joints else np.zeros(0)
-    times, q, reached = rollout_tile_policy(
+        if not learner.grid_states:
+            raise LearningError(
+                f"--start-state numbers grid states; a {learner.title} starts from --start-deg angles."
+            )
+        start = Start(state=args.start_state)
+    elif args.start_deg is None or joints == 0:
+        start = Start()
+    else:
+        start = Start(q=np.radians(_start_degrees(args.start_deg, joints)))
+    rollout = learner.roll_out(
         policy,
         start,
-        rate_hz=args.rate,
-        max_steps=TILE_ROLLOUT_MAX_STEPS if args.max_steps is None else args.max_steps,
+        args.rate,
+        max_steps=args.max_steps,  # None: the policy's own cap
         seconds_per_step=seconds_per_step,  # None: the policy's own pace
     )
-    return (
-        times,
-        q,
-        f"the greedy policy {'reaches the goal' if reached else 'does NOT reach the goal'}",
-    )
+    return rollout, learner.summary(rollout)
 
 
-def _rollout_dmp(
-    args: argparse.Namespace, policy: DmpPolicyFile
-) -> tuple[np.ndarray, np.ndarray, str]:
-    """A movement primitive's rollout from --start-deg (default: its demonstration's start)."""
-    if args.start_state is not None:
-        raise LearningError(
-            "--start-state numbers grid states; a movement primitive starts from --start-deg angles."
-        )
-    start = (
-        None
-        if args.start_deg is None
-        else np.radians(_start_degrees(args.start_deg, len(policy.goal)))
-    )
-    times, q, reached = rollout_dmp_policy(policy, start, rate_hz=args.rate)
-    return (
-        times,
-        q,
-        f"the movement primitive {'reaches the goal' if reached else 'does NOT reach the goal'}",
-    )
-
-
-def _rollout_grid(
-    args: argparse.Namespace, policy: PolicyFile, seconds_per_step: float | None
-) -> tuple[np.ndarray, np.ndarray, str]:
-    """A grid policy's rollout from --start-state or --start-deg (minimum-jerk grid steps)."""
-    max_steps = ROLLOUT_MAX_STEPS if args.max_steps is None else args.max_steps
-    grid = policy.grid
-    if args.start_state is not None:
-        start = args.start_state
-    else:
-        start = grid.state_of_angles(np.radians(_start_degrees(args.start_deg, grid.joints)))
-    times, q = rollout(
-        policy,
-        start,
-        rate_hz=args.rate,
-        max_steps=max_steps,
-        seconds_per_step=ROLLOUT_SECONDS_PER_STEP if seconds_per_step is None else seconds_per_step,
-    )
-    path = greedy_path(policy, start, max_steps)
-    reached = path[-1] == grid.goal_state
-    return (
-        times,
-        q,
-        (
-            f"{len(path) - 1} grid steps from state {start} "
-            f"{'reach the goal' if reached else 'do NOT reach the goal'}"
-        ),
-    )
-
-
-def _rollout(
-    args: argparse.Namespace,
-    policy: PolicyFile | TilePolicyFile | DmpPolicyFile,
-    seconds_per_step: float | None,
-) -> tuple[np.ndarray, np.ndarray, str]:
-    if isinstance(policy, TilePolicyFile):
-        return _rollout_tile(args, policy, seconds_per_step)
-    if isinstance(policy, DmpPolicyFile):
-        return _rollout_dmp(args, policy)
-    return _rollout_grid(args, policy, seconds_per_step)
-
-
-def _run_legacy(
-    args: argparse.Namespace, policy: PolicyFile | TilePolicyFile | DmpPolicyFile
-) -> int:
+def _run_legacy(args: argparse.Namespace, policy: AnyPolicy) -> int:
     """``studio export POLICY``: the rollout at the policy's own pace, as CSV ``time,q1..q6``."""
-    times, q, summary = _rollout(args, policy, args.seconds_per_step)
+    rollout, summary = _rollout(args, policy, args.seconds_per_step)
+    times, q = rollout.times, rollout.q
     out = _out_path(args)
     try:
         save_trajectory_csv(out, times, q)
     except OSError as err:
         raise LearningError(f"Cannot write {out} ({err.strerror}); choose another --out.") from None
-    if isinstance(policy, PolicyFile):
+    if rollout.states:  # grid steps: each a minimum-jerk segment
         print(
             f"{summary}; wrote {len(times)} samples ({times[-1]:.2f} s at {args.rate:g} Hz) to {out}"
         )
@@ -272,9 +210,7 @@ def _run_legacy(
     return 0
 
 
-def _print_likeness(
-    args: argparse.Namespace, path: Path, policy: PolicyFile | TilePolicyFile | DmpPolicyFile
-) -> None:
+def _print_likeness(args: argparse.Namespace, path: Path, policy: AnyPolicy) -> None:
     """Print the policy's likeness card against each of its demonstrations (or why none)."""
     motions = likeness_motions(path, policy, args.demo, args.data_dir)
     if not motions:
@@ -300,9 +236,9 @@ def _motion(args: argparse.Namespace, source: Path, robot: str) -> tuple[Motion,
         return demonstration_motion(source, robot, args.rate), "demonstration"
     policy = load_any_policy(source)
     arm = check_policy_robot(source, policy.robot, robot)
-    times, q, summary = _rollout(args, policy, args.seconds_per_step)
+    rollout, summary = _rollout(args, policy, args.seconds_per_step)
     timed = args.seconds_per_step is not None
-    return Motion("policy", source.name, arm, times, q, timed, args.rate), summary
+    return Motion("policy", source.name, arm, rollout.times, rollout.q, timed, args.rate), summary
 
 
 def _say_loading(robot: str, cache: Path) -> None:

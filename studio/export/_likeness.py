@@ -16,14 +16,7 @@ import numpy as np
 from studio import StudioError, read_json
 from studio.capture import DEMO_SUFFIX
 from studio.kinematics import DEFAULT_ROBOT
-from studio.learning import (
-    DemonstrationMotion,
-    DmpPolicyFile,
-    LearningError,
-    PolicyFile,
-    RunRecord,
-    TilePolicyFile,
-)
+from studio.learning import AnyPolicy, DemonstrationMotion, LearningError, RunRecord, learner_of
 from studio.motion import MotionError, training_demonstration
 
 from ._errors import ExportError
@@ -59,7 +52,7 @@ def demonstration_of(
 
 def likeness_motions(
     policy_path: Path,
-    policy: PolicyFile | TilePolicyFile | DmpPolicyFile,
+    policy: AnyPolicy,
     demo: str | Path | None = None,
     data_dir: str | Path = ".",
 ) -> list[DemonstrationMotion]:
@@ -77,6 +70,5 @@ def likeness_motions(
             return list(record.demonstration_motions)
         if record is not None and record.demonstration_names:
             return [demonstration_of(n, data_dir, robot) for n in record.demonstration_names]
-    if isinstance(policy, DmpPolicyFile):
-        return [DemonstrationMotion("its demonstration", policy.demo_times, policy.demo_q)]
-    return []
+    own = learner_of(policy).own_demonstration(policy)  # a movement primitive's
+    return [] if own is None else [own]

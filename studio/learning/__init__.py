@@ -24,8 +24,17 @@ from ._errors import ConfigError as ConfigError
 from ._errors import LearningError as LearningError
 from ._errors import PolicyFileError as PolicyFileError
 from ._experiments import run_experiments as run_experiments
+from ._interface import Evaluation as Evaluation
+from ._interface import Learner as Learner
+from ._interface import Rollout as Rollout
+from ._interface import Start as Start
 from ._learner import LiveProgress as LiveProgress
 from ._prepare import prepare_in_background as prepare_in_background
+from ._registry import AnyPolicy as AnyPolicy
+from ._registry import learner as learner
+from ._registry import learner_of as learner_of
+from ._registry import load_any_policy as load_any_policy
+from ._registry import register_learner as register_learner
 from ._tiles import TileCoding as TileCoding
 from .likeness._likeness import LikenessCard as LikenessCard
 from .likeness._likeness import dtw_distance as dtw_distance
@@ -36,12 +45,12 @@ from .likeness._likeness import puma_tool_positions as puma_tool_positions
 from .likeness._likeness import sparc as sparc
 from .likeness._policy import policy_likeness_card as policy_likeness_card
 from .likeness._run import likeness_cards as likeness_cards
+from .linear._learner import REACH_DEFAULTS as REACH_DEFAULTS
 from .linear._linear import greedy_rollout as greedy_rollout
 from .linear._policy import DEFAULT_MAX_STEPS as TILE_ROLLOUT_MAX_STEPS  # noqa: F401 (re-export)
 from .linear._policy import DEFAULT_SECONDS_PER_STEP as TILE_ROLLOUT_SECONDS_PER_STEP  # noqa: F401
 from .linear._policy import TilePolicyFile as TilePolicyFile
 from .linear._policy import demonstrated_pace as demonstrated_pace
-from .linear._policy import load_any_policy as load_any_policy
 from .linear._policy import rollout_tile_policy as rollout_tile_policy
 from .paper._reproduce import generate_demonstrations as generate_demonstrations
 from .paper._reproduce import reproduce as reproduce
@@ -72,7 +81,6 @@ from .runs._notes import read_run_notes as read_run_notes
 from .runs._notes import write_run_notes as write_run_notes
 from .runs._record import TASK_KINDS as TASK_KINDS
 from .runs._record import RunRecord as RunRecord
-from .runs._request import REACH_DEFAULTS as REACH_DEFAULTS
 from .runs._request import DemonstrationPath as DemonstrationPath
 from .runs._request import RunRequest as RunRequest
 from .runs._request import resolve_run as resolve_run

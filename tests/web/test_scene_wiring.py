@@ -30,10 +30,10 @@ class FakeScene:
     def show_hand_handle(self, side, on_move) -> None:
         self.calls.append(("show_hand_handle", (side, on_move)))
 
-    def set_goal(self, q_robot_goal) -> None:
+    def set_goal(self, q_robot_goal, robot=None) -> None:
         self.calls.append(("set_goal", (q_robot_goal,)))
 
-    def show_path(self, name, q_robot_path) -> None:
+    def show_path(self, name, q_robot_path, robot=None) -> None:
         self.calls.append(("show_path", (name, q_robot_path)))
 
     def clear_path(self, name=None) -> None:

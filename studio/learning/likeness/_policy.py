@@ -1,8 +1,9 @@
 """The likeness card of any policy kind, rolled out from a demonstration's own start.
 
-One place that knows how each kind rolls out from given joint angles (a grid policy from the bin
-they fall in, a tile-coded policy from the learned joints, a movement primitive from all six), so
-the page, ``studio export`` and run files score every policy the same way.
+Each learner knows how its kind rolls out from given joint angles (a grid policy from the bin
+they fall in, a tile-coded policy from the learned joints, a movement primitive from all six:
+:meth:`Learner.likeness`); this checks the demonstration once for all, so the page, ``studio
+export`` and run files score every policy the same way.
 """
 
 from __future__ import annotations
@@ -10,15 +11,14 @@ from __future__ import annotations
 import numpy as np
 
 from .._errors import LearningError
-from ..linear._policy import TilePolicyFile, rollout_tile_policy
-from ..primitives._policy import DmpPolicyFile, rollout_dmp_policy
-from ..tabular._policy import ROLLOUT_RATE_HZ, PolicyFile, rollout
+from .._registry import AnyPolicy, learner_of
+from ..tabular._policy import ROLLOUT_RATE_HZ
 from ..tasks._robot import PUMA560, robot_title, task_arm
-from ._likeness import LikenessCard, likeness_card, robot_tool_positions
+from ._likeness import LikenessCard
 
 
 def policy_likeness_card(
-    policy: PolicyFile | TilePolicyFile | DmpPolicyFile,
+    policy: AnyPolicy,
     demo_times: np.ndarray,
     demo_q: np.ndarray,
     rate_hz: float = ROLLOUT_RATE_HZ,
@@ -49,23 +49,4 @@ def policy_likeness_card(
         )
     if not np.all(np.isfinite(q_demo)):
         raise LearningError("The demonstration holds NaN angles; re-record it.")
-    start = q_demo[0]
-    if isinstance(policy, DmpPolicyFile):
-        times, q, _ = rollout_dmp_policy(policy, start, rate_hz)
-        joints = policy.learned_joints
-    elif isinstance(policy, TilePolicyFile):
-        if policy.task is None:
-            raise LearningError(
-                f"This policy was trained on {policy.env_id or 'another environment'}, not the arm; only arm policies have a likeness card."
-            )
-        joints = policy.task.joints
-        times, q, _ = rollout_tile_policy(policy, start[:joints], rate_hz)
-    else:
-        grid = policy.grid
-        joints = grid.joints
-        times, q = rollout(policy, grid.state_of_angles(start[:joints]), rate_hz, hold=start)
-
-    def tool(q: np.ndarray) -> np.ndarray:
-        return robot_tool_positions(robot, q)
-
-    return likeness_card(times, q, demo_times, q_demo, tool, joints=joints)
+    return learner_of(policy).likeness(policy, demo_times, q_demo, rate_hz)

@@ -22,9 +22,7 @@ from pathlib import Path
 
 from ..._files import atomic_write_text
 from .._errors import LearningError
-from ..linear._policy import TilePolicyFile, load_any_policy
-from ..primitives._policy import DmpPolicyFile
-from ..tabular._policy import PolicyFile
+from .._registry import AnyPolicy, load_any_policy
 from ..tasks._demo_motion import DemonstrationMotion
 from ._likeness import LikenessCard
 from ._policy import policy_likeness_card
@@ -39,7 +37,7 @@ LIKENESS_VERSION = 2
 
 
 def likeness_cards(
-    policy: PolicyFile | TilePolicyFile | DmpPolicyFile,
+    policy: AnyPolicy,
     motions: Sequence[DemonstrationMotion],
 ) -> list[tuple[DemonstrationMotion, LikenessCard | str]]:
     """Each demonstration with the policy's card against it, or the sentence saying why none."""
@@ -53,7 +51,7 @@ def likeness_cards(
 
 
 def likeness_document(
-    policy: PolicyFile | TilePolicyFile | DmpPolicyFile,
+    policy: AnyPolicy,
     motions: Sequence[DemonstrationMotion],
     policy_name: str = "",
 ) -> dict[str, object]:

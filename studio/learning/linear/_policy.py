@@ -47,17 +47,10 @@ from .._config import DynaQConfig
 from .._errors import LearningError, PolicyFileError
 from .._tiles import TileCoder, TileCoding
 from ..likeness._likeness import moving_span
-from ..primitives._policy import FORMAT_NAME as DMP_FORMAT_NAME
-from ..primitives._policy import DmpPolicyFile, load_dmp_policy
-from ..tabular._policy import (
-    FORMAT_NAME as TABULAR_FORMAT_NAME,
-)
 from ..tabular._policy import (
     MAX_NPZ_BYTES,
     BoundedNpz,
-    PolicyFile,
     curve_header,
-    load_policy,
     read_curve_header,
     read_header,
 )
@@ -212,7 +205,7 @@ def load_tile_policy(path: str | Path) -> TilePolicyFile:
             f"Policy file {name} does not exist; give the path of a .policy.npz file."
         )
     with BoundedNpz(path, name, MAX_NPZ_BYTES) as archive:
-        header = _read_header(archive, name)
+        header = read_policy_header(archive, name)
         coder, config, task, n_actions = _check_header(name, header)
         pace = header.get("seconds_per_step", DEFAULT_SECONDS_PER_STEP)
         _check_pace(pace, PolicyFileError, f"{name}'s seconds_per_step")
@@ -280,7 +273,9 @@ def demonstrated_pace(task: ArmReach, motions: Sequence[tuple[np.ndarray, np.nda
     return seconds / steps if steps else DEFAULT_SECONDS_PER_STEP
 
 
-def _read_header(archive: BoundedNpz, name: str) -> object:
+def read_policy_header(archive: BoundedNpz, name: str) -> object:
+    """The JSON header of a policy archive of any kind (:func:`._policy.read_header`), refused in
+    one sentence when the archive has none."""
     if "header" not in archive.files:
         raise PolicyFileError(
             f"{name} lacks its header; it is not a Teach Studio policy file, export one again."
@@ -322,32 +317,6 @@ def _check_header(name: str, header: object) -> tuple[TileCoder, DynaQConfig, Ar
     return coder, config, task, n_actions
 
 
-def load_any_policy(path: str | Path) -> PolicyFile | TilePolicyFile | DmpPolicyFile:
-    """Read a policy file of any kind: tabular (:func:`load_policy`), tile-coded, or a
-    movement primitive (:func:`load_dmp_policy`).
-
-    Raises:
-        PolicyFileError: as the two readers do.
-    """
-    path = Path(path)
-    if not path.is_file():
-        raise PolicyFileError(
-            f"Policy file {path.name} does not exist; give the path of a .policy.npz file."
-        )
-    with BoundedNpz(path, path.name, MAX_NPZ_BYTES) as archive:
-        header = _read_header(archive, path.name)
-    kind = header.get("format") if isinstance(header, dict) else None
-    if kind == FORMAT_NAME:
-        return load_tile_policy(path)
-    if kind == TABULAR_FORMAT_NAME:
-        return load_policy(path)
-    if kind == DMP_FORMAT_NAME:
-        return load_dmp_policy(path)
-    raise PolicyFileError(
-        f"{path.name} is not a Teach Studio policy file; export the policy again."
-    )
-
-
 def sample_times(duration: float, rate_hz: float) -> np.ndarray:
     """Sample times ``0, 1/rate_hz, ...`` up to ``duration``, ending exactly once at ``duration``.
 
@@ -387,6 +356,21 @@ def rollout_tile_policy(
     Raises:
         LearningError: a policy of another environment, or a bad start or rate.
     """
+    times, q, reached, _ = tile_rollout(
+        policy, start_q, rate_hz, max_steps, seconds_per_step=seconds_per_step
+    )
+    return times, q, reached
+
+
+def tile_rollout(
+    policy: TilePolicyFile,
+    start_q: np.ndarray,
+    rate_hz: float,
+    max_steps: int = DEFAULT_MAX_STEPS,
+    *,
+    seconds_per_step: float | None = None,
+) -> tuple[np.ndarray, np.ndarray, bool, np.ndarray]:
+    """:func:`rollout_tile_policy`, and the greedy joint path ``(K + 1, joints)`` it samples."""
     task = policy.task
     if task is None:
         raise LearningError(
@@ -407,9 +391,18 @@ def rollout_tile_policy(
     if np.any(start < task.lower) or np.any(start > task.upper):
         raise LearningError("The start lies outside the joint limits; give angles inside them.")
     path, reached = greedy_rollout(task, policy.coder, policy.weights, start, max_steps)
+    times, q = path_trajectory(task, path, rate_hz, seconds_per_step)
+    return times, q, reached, path
+
+
+def path_trajectory(
+    task: ArmReach, path: np.ndarray, rate_hz: float, seconds_per_step: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """A greedy joint path ``(K + 1, joints)`` as the robot's trajectory: ``seconds_per_step`` a
+    step, sampled at ``rate_hz``, the joints beyond the task's at its goal."""
     times = sample_times((path.shape[0] - 1) * seconds_per_step, rate_hz)
     knots = np.arange(path.shape[0]) * seconds_per_step
     q = np.tile(np.asarray(task.goal, dtype=np.float64), (times.shape[0], 1))
     for j in range(task.joints):
         q[:, j] = np.interp(times, knots, path[:, j])
-    return times, q, reached
+    return times, q

@@ -69,8 +69,8 @@ from ..._numbers import is_int
 from .._config import MAX_STEPS_PER_EPISODE, check_budget
 from .._errors import ConfigError, LearningError
 from .._learner import ExperimentResult, LiveProgress
+from .._registry import learner_for_task
 from ..likeness._run import save_run_likeness
-from ..tabular._policy import save_policy
 from ._curves import (
     MAX_CURVES_BYTES_PER_EPISODE,
     curve_statistics,
@@ -79,7 +79,7 @@ from ._curves import (
     read_curve_times,
 )
 from ._owner import OWNER_FILE, OwnerLock, owner_alive, pid_alive, this_host
-from ._record import TASK_ARM_REACH, RunRecord
+from ._record import RunRecord
 from ._train import TrainingThread, watch_training
 
 log = logging.getLogger(__name__)
@@ -520,49 +520,15 @@ class RunFolder:
             self._owner.release()
             self._owner = None
 
-    def _pace(self, result: ExperimentResult) -> float:
-        """The policy's pace: its recorded demonstrations' (:func:`demonstrated_pace`), else the
-        default; a demonstration the task cannot time costs the pace, never the policy."""
-        from ..linear._policy import DEFAULT_SECONDS_PER_STEP, demonstrated_pace
-
-        motions = [(m.times, m.q_robot) for m in self.record.demonstration_motions]
-        try:
-            return demonstrated_pace(result.task, motions)  # type: ignore[union-attr]
-        except LearningError as err:
-            log.warning("run %s: its policy keeps the default pace: %s", self.id, err)
-            return DEFAULT_SECONDS_PER_STEP
-
     def save_policy(self, result: ExperimentResult, compress: bool = True) -> None:
         """Write the best experiment's Q table (or tile-coded weights) as the run's policy
         (``compress`` false for a checkpoint: far quicker to write, read the same)."""
         best = result.best_experiment()
         tmp = self.path / f".{POLICY_FILE}.{secrets.token_hex(4)}.tmp.npz"
         notes = f"run {self.id}: experiment {best} of {self.record.experiments}, seed {self.record.seed}, {len(self.record.demonstrations)} demonstrations"
-        if self.record.kind == TASK_ARM_REACH:
-            from ..linear._policy import save_tile_policy
-
-            pace = self._pace(result)
-            try:
-                save_tile_policy(  # type: ignore[arg-type]
-                    tmp, result, best, notes=notes, compress=compress, seconds_per_step=pace
-                )
-                os.replace(tmp, self.policy_path)
-            except OSError as err:
-                with contextlib.suppress(OSError):
-                    tmp.unlink()
-                raise _disk_error(err, "the run's policy", self.path) from None
-            return
-        grid = self.record.arm_grid()
         try:
-            save_policy(
-                tmp,
-                grid,
-                result.q[best],
-                result.config,
-                result.mean_steps(),
-                experiments=self.record.experiments,
-                notes=notes,
-                compress=compress,
+            learner_for_task(self.record.task).save(
+                tmp, self.record, result, notes=notes, compress=compress
             )
             os.replace(tmp, self.policy_path)
         except OSError as err:

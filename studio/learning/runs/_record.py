@@ -26,7 +26,10 @@ from ..._files import now_iso
 from ..._numbers import is_int, is_number
 from .._config import DEFAULT_SEED, DynaQConfig, check_budget
 from .._errors import ConfigError, LearningError
+from .._registry import learner, learner_for_task
 from .._tiles import TileCoding
+from ..linear._learner import KIND as TILE_KIND
+from ..tabular._learner import KIND as TABULAR_KIND
 from ..tasks._arm import ArmGrid
 from ..tasks._demo_motion import DemonstrationMotion
 from ..tasks._reach import ArmReach
@@ -37,13 +40,14 @@ RUN_VERSION = 1
 """The version of the run folder layout this code writes and reads."""
 ORIGINS = ("cli", "page", "reproduce", "sweep")
 """What made a run: ``studio train``, the page's run queue, ``studio reproduce``, a sweep."""
-TASK_ARM_GRID = "arm-grid"
+TASK_ARM_GRID = TABULAR_KIND
 """``task.kind`` of the paper's arm grid (``task`` also holds the :meth:`ArmGrid.to_dict` spec)."""
-TASK_ARM_REACH = "arm-reach"
+TASK_ARM_REACH = TILE_KIND
 """``task.kind`` of the continuous-joint task (``task`` also holds the :meth:`ArmReach.to_dict`
 fields and ``tile_coding``, the :meth:`TileCoding.to_dict` settings); its demonstrations are
 joint paths ``(N, joints)`` in radians."""
 TASK_KINDS = (TASK_ARM_GRID, TASK_ARM_REACH)
+"""The kinds of task a run trains, each by its learner (:func:`studio.learning.learner`)."""
 CONFIG_FORM_FIELDS = ("planning", "planning_steps", "epsilon", "alpha", "gamma")
 """The :class:`DynaQConfig` fields a person sets for a run (the page's form, ``studio train``)."""
 
@@ -58,12 +62,7 @@ def task_spec(task: ArmGrid | ArmReach, coding: TileCoding | None = None) -> dic
     ``{"kind": "arm-grid", **grid.to_dict()}``, or ``{"kind": "arm-reach", **task.to_dict(),
     "tile_coding": coding.to_dict()}`` for the continuous task.
     """
-    if isinstance(task, ArmGrid):
-        return {"kind": TASK_ARM_GRID, **task.to_dict()}
-    spec: dict[str, object] = {"kind": TASK_ARM_REACH, **task.to_dict()}
-    if coding is not None:
-        spec["tile_coding"] = coding.to_dict()
-    return spec
+    return learner_for_task(task).task_spec(task, coding)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -200,7 +199,7 @@ class RunRecord:
     @property
     def kind(self) -> str:
         """The task's kind: ``"arm-grid"`` (the paper's task) or ``"arm-reach"`` (continuous)."""
-        return TASK_ARM_REACH if isinstance(self.task, ArmReach) else TASK_ARM_GRID
+        return learner_for_task(self.task).kind
 
     def arm_reach(self) -> ArmReach:
         """The task as an :class:`ArmReach` (for kind ``"arm-reach"``)."""
@@ -254,17 +253,7 @@ class RunRecord:
             "task": self.kind,
             "robot": self.task.robot,
         }
-        if isinstance(self.task, ArmGrid):
-            form["bins"] = self.task.bins
-        else:
-            coding = self.tile_coding()
-            form.update(
-                joints=self.task.joints,
-                step_deg=self.task.step_deg,
-                actions=self.task.actions,
-                tilings=coding.tilings,
-                tiles=coding.tiles,
-            )
+        form.update(learner_for_task(self.task).task_form(self.task, self.coding))
         if self.goal_deg is not None:
             form["goal_deg"] = list(self.goal_deg)
         form["demonstrations"] = list(self.demonstration_names)
@@ -403,20 +392,15 @@ def _task_of(task: object) -> tuple[ArmGrid | ArmReach, TileCoding | None]:
     if not isinstance(task, dict):
         raise LearningError(f"config.json's task is {task!r}; it is not a run record.")
     kind = task.get("kind", TASK_ARM_GRID)
+    if kind not in TASK_KINDS:
+        raise LearningError(
+            f"config.json's task kind {kind!r} is none of {', '.join(TASK_KINDS)}; update Teach Studio or delete the run."
+        )
     try:
-        if kind == TASK_ARM_GRID:
-            spec = {k: v for k, v in task.items() if k != "kind"}
-            if spec.get("goal") is not None:
-                spec["goal"] = tuple(spec["goal"])
-            return ArmGrid(**spec), None
-        if kind == TASK_ARM_REACH:
-            spec = {k: v for k, v in task.items() if k not in ("kind", "tile_coding")}
-            return ArmReach.from_dict(spec), TileCoding.from_dict(task["tile_coding"])
+        task, coding = learner(kind).task_from_spec({k: v for k, v in task.items() if k != "kind"})
     except LearningError as err:
         raise LearningError(f"config.json's task is refused: {err}") from None
-    raise LearningError(
-        f"config.json's task kind {kind!r} is none of {', '.join(TASK_KINDS)}; update Teach Studio or delete the run."
-    )
+    return task, coding  # type: ignore[return-value]
 
 
 def _demonstrations_of(paths: object, task: ArmGrid | ArmReach) -> Demonstrations:
@@ -426,9 +410,7 @@ def _demonstrations_of(paths: object, task: ArmGrid | ArmReach) -> Demonstration
         raise LearningError(
             f"config.json's demonstrations are {type(paths).__name__}; delete the run."
         )
-    if isinstance(task, ArmReach):
-        return [[[float(x) for x in row] for row in p] for p in paths]
-    return [list(map(int, p)) for p in paths]
+    return learner_for_task(task).demonstrations_of(paths)  # type: ignore[return-value]
 
 
 def _goal_of(goal: object) -> tuple[float, ...] | None:

@@ -16,16 +16,18 @@ Use::
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
-from typing import Final, cast
+from typing import cast
 
 import numpy as np
 
 from ..._numbers import is_int
 from .._config import DEFAULT_EPISODES, DEFAULT_EXPERIMENTS, DEFAULT_SEED, DynaQConfig
 from .._errors import ConfigError, LearningError
+from .._registry import learner
 from .._tiles import TileCoding
+from ..linear._learner import CODING_SETTINGS, REACH_DEFAULTS
 from ..paper._reproduce import generate_demonstrations
 from ..tasks._arm import ArmGrid
 from ..tasks._demo_motion import DemonstrationMotion, demonstration_grid_path
@@ -42,20 +44,6 @@ from ._record import (
     run_problems,
 )
 
-_FEATURES = ArmReach().features()
-REACH_DEFAULTS: Final = {
-    "joints": ArmReach.joints,
-    "step_deg": ArmReach.step_deg,
-    "actions": ArmReach.actions,
-    "tilings": _FEATURES.tilings,
-    "tiles": None,
-}
-"""The continuous task's settings a person sets, and their defaults (:class:`ArmReach` and its
-default :meth:`ArmReach.features`; ``tiles`` None: the robot's :attr:`ArmReach.default_tiles`,
-32 for the Puma560)."""
-CODING_SETTINGS = ("tilings", "tiles", "size")
-"""The continuous task's tile-coding settings (:meth:`ArmReach.features`); its other settings
-are :class:`ArmReach` fields."""
 GENERATED_DEMO_STREAM = 1
 """Generated demonstrations draw from ``default_rng([seed, 1])`` (``studio train``, sweeps)."""
 
@@ -140,16 +128,14 @@ class RunRequest:
         """The request of a run form's values, in the layout of :meth:`RunRecord.form` (the
         page's ``RunCreate``): its ``task``, Dyna-Q settings, budget, seed, name, goal in degrees
         and the task's settings; the demonstrations named in it are given as their paths."""
-        task = form.get("task") or TASK_ARM_GRID
-        reach = task == TASK_ARM_REACH
+        task = str(form.get("task") or TASK_ARM_GRID)
         given = {key: form[key] for key in ("experiments", "episodes", "seed") if key in form}
         goal = form.get("goal_deg")
         return cls(
-            task=str(task),
+            task=task,
             robot=str(form.get("robot") or PUMA560),
             config={k: form[k] for k in CONFIG_FORM_FIELDS if k in form},
-            grid={"bins": form["bins"]} if not reach and "bins" in form else {},
-            reach={k: form[k] for k in REACH_DEFAULTS if k in form} if reach else {},
+            **task_settings(task, form, "form"),
             goal_deg=None if goal is None else cast(Sequence[float], goal),
             demonstrations=demonstrations,
             name=str(form.get("name") or ""),
@@ -184,9 +170,7 @@ def resolve_run(request: RunRequest) -> RunRecord:
                 ]
             )
     config = _dynaq_config(request.config, problems)
-    if request.task == TASK_ARM_REACH:
-        return _reach_record(request, config, problems)
-    return _grid_record(request, config, problems)
+    return _TASK_RUNS[request.task].record(request, config, problems)
 
 
 BASELINE_SUFFIX = " · no demos"
@@ -207,13 +191,21 @@ def without_demonstrations(request: RunRequest, record: RunRecord) -> RunRequest
     """
     base = request.name or replace(record, demonstrations=[]).label()
     name = base[: 100 - len(BASELINE_SUFFIX)] + BASELINE_SUFFIX
-    if record.kind == TASK_ARM_REACH:
-        goal = record.arm_reach().goal
-        reach = {**request.reach, "goal": goal}
-        return replace(
-            request, demonstrations=(), generated=0, goal_deg=None, reach=reach, name=name
-        )
-    return replace(request, demonstrations=(), grid_paths=(), generated=0, name=name)
+    bare = replace(request, demonstrations=(), grid_paths=(), generated=0, name=name)
+    return _TASK_RUNS[record.kind].twin(bare, record)
+
+
+def task_settings(
+    kind: str, settings: Mapping[str, object], given_by: str
+) -> dict[str, Mapping[str, object]]:
+    """The :class:`RunRequest` field of task ``kind``'s settings among ``settings``: those the
+    page's form sets (``given_by="form"``) or a sweep may set (``"sweep"``); none for a kind no
+    run trains (:func:`resolve_run` refuses it)."""
+    if kind not in TASK_KINDS:
+        return {}
+    task = learner(kind)
+    keys = task.form_keys if given_by == "form" else task.sweep_keys
+    return {task.settings_field: {k: settings[k] for k in keys if k in settings}}
 
 
 def _dynaq_config(
@@ -414,3 +406,25 @@ def _reach_record(
         raise
     raise_problems(problems)
     return record
+
+
+def _reach_twin(bare: RunRequest, record: RunRecord) -> RunRequest:
+    """A continuous run's twin keeps its goal: its first demonstration's final pose."""
+    return replace(bare, goal_deg=None, reach={**bare.reach, "goal": record.arm_reach().goal})
+
+
+@dataclass(frozen=True)
+class _TaskRuns:
+    """How a run of one task kind is resolved (:func:`resolve_run`), and its twin without
+    demonstrations from the request stripped of them (:func:`without_demonstrations`)."""
+
+    record: Callable[[RunRequest, DynaQConfig | None, list[tuple[str, str]]], RunRecord]
+    twin: Callable[[RunRequest, RunRecord], RunRequest]
+
+
+_TASK_RUNS = {
+    TASK_ARM_GRID: _TaskRuns(_grid_record, lambda bare, record: bare),
+    TASK_ARM_REACH: _TaskRuns(_reach_record, _reach_twin),
+}
+"""Each kind of :data:`TASK_KINDS`: what its runs need beyond what :func:`resolve_run` checks for
+all (the task's own settings, its goal, its demonstrations)."""

@@ -9,23 +9,12 @@ from __future__ import annotations
 
 from typing import TypedDict
 
-import numpy as np
-
-from ..linear._policy import TilePolicyFile
-from ..primitives._policy import DmpPolicyFile
-from ..tabular._policy import PolicyFile
+from .._registry import AnyPolicy, learner_of
+from ..tabular._learner import goal_degrees as goal_degrees
 from ..tasks._arm import ArmGrid
-from ._record import task_spec
 
 POLICY_SUFFIX = ".policy.npz"
 """The file suffix of policy files (the format is in :mod:`._policy`)."""
-GOAL_DECIMALS = 6
-"""Goal angles are reported to a micro-degree: exact enough to compare, short enough to read."""
-
-
-def goal_degrees(grid: ArmGrid) -> list[float]:
-    """The centre of ``grid``'s goal bin, one angle in degrees per joint."""
-    return [round(float(x), GOAL_DECIMALS) for x in np.degrees(grid.angles_of(grid.goal_state))]
 
 
 def has_default_goal(grid: ArmGrid) -> bool:
@@ -59,7 +48,7 @@ class PolicySummary(TypedDict):
     notes: str
 
 
-def policy_summary(policy: PolicyFile | TilePolicyFile | DmpPolicyFile) -> PolicySummary:
+def policy_summary(policy: AnyPolicy) -> PolicySummary:
     """JSON-ready facts about a policy file of either kind for listings (the page, scripts).
 
     Returns:
@@ -74,30 +63,9 @@ def policy_summary(policy: PolicyFile | TilePolicyFile | DmpPolicyFile) -> Polic
         (``actions="follow"``) gives their number as ``paths``. A movement primitive's task is
         ``{"kind": "dmp", "basis": ..., "robot": ...}`` and its planning ``"none"``.
     """
-    task: dict[str, object]
-    if isinstance(policy, DmpPolicyFile):
-        task = {"kind": "dmp", "basis": policy.primitive.basis, "robot": policy.robot}
-        grid, joints = {}, len(policy.goal)
-        goal = [round(float(x), GOAL_DECIMALS) for x in np.degrees(policy.goal)]
-    elif isinstance(policy, TilePolicyFile):
-        reach = policy.task
-        if reach is None:
-            task, joints, goal = {"kind": policy.env_id or "gymnasium"}, 0, []
-        else:
-            task, joints = task_spec(reach, policy.coder.coding), reach.joints
-            if reach.paths:  # a listing names how many demonstrations it follows, not their points
-                task["paths"] = len(reach.paths)
-            goal = [round(float(x), GOAL_DECIMALS) for x in np.degrees(reach.goal[:joints])]
-        grid: dict[str, object] = {}
-    else:
-        task, grid, joints = task_spec(policy.grid), policy.grid.to_dict(), policy.grid.joints
-        goal = goal_degrees(policy.grid)
+    facts = learner_of(policy).describe(policy)  # task, grid, joints, goal_deg, planning
     return {
-        "task": task,
-        "grid": grid,
-        "joints": joints,
-        "goal_deg": goal,
-        "planning": "none" if isinstance(policy, DmpPolicyFile) else policy.config.planning,
+        **facts,  # type: ignore[typeddict-item]
         "episodes": int(len(policy.mean_steps)),
         "experiments": int(policy.experiments),
         "created": policy.created,

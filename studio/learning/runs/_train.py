@@ -19,10 +19,10 @@ from collections.abc import Callable
 import numpy as np
 
 from .._errors import LearningError
-from .._experiments import run_experiments
 from .._learner import ExperimentResult, LiveProgress
 from .._prepare import prepare_learner
-from ._record import TASK_ARM_REACH, RunRecord
+from .._registry import learner_for_task
+from ._record import RunRecord
 
 log = logging.getLogger(__name__)
 
@@ -36,36 +36,11 @@ run (20 x 50,000 episodes) spends under a tenth of a core on checkpoints."""
 def train_learner(
     record: RunRecord, live: LiveProgress, workers: int | None = None
 ) -> ExperimentResult:
-    """Run the record's experiments: Dyna-Q on the arm grid, or linear Dyna-Q with tile coding
-    on ``TeachStudio/ArmReach-v0``; the first run on a machine compiles the kernels first."""
+    """Run the record's experiments with its task's learner (:func:`learner_for_task`): Dyna-Q
+    on the arm grid, or linear Dyna-Q with tile coding on ``TeachStudio/ArmReach-v0``; the first
+    run on a machine compiles the kernels first."""
     prepare_learner(record.kind, live)
-    if record.kind == TASK_ARM_REACH:
-        import gymnasium
-
-        from ..tasks._gym import ARM_REACH_ID
-
-        task = record.arm_reach()
-        return run_experiments(
-            lambda: gymnasium.make(ARM_REACH_ID, arm_reach=task),
-            record.config,
-            record.experiments,
-            record.episodes,
-            record.seed,
-            [np.asarray(p, dtype=np.float64) for p in record.demonstrations],
-            record.tile_coding(),
-            workers=workers,
-            live=live,
-        )
-    return run_experiments(
-        record.arm_grid().mdp(),
-        record.config,
-        record.experiments,
-        record.episodes,
-        record.seed,
-        record.demonstrations,
-        workers=workers,
-        live=live,
-    )
+    return learner_for_task(record.task).train(record, live, workers)  # type: ignore[return-value]
 
 
 class TrainingThread:

@@ -29,33 +29,30 @@ from studio import StudioError, read_toml
 from ..._numbers import is_int, is_number
 from .._config import DynaQConfig
 from .._errors import ConfigError, LearningError
+from .._registry import learner
 from ..paper._reproduce import CONVERGENCE_FACTOR
-from ..runs._record import TASK_ARM_GRID, TASK_ARM_REACH, RunRecord
-from ..runs._request import CODING_SETTINGS, RunRequest, resolve_run
-from ..tasks._arm import ArmGrid
-from ..tasks._reach import ArmReach
+from ..runs._record import TASK_KINDS, RunRecord
+from ..runs._request import RunRequest, resolve_run, task_settings
 from ..tasks._robot import PUMA560
 
 SWEEP_ID = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]{0,63}$")
 """A sweep id: a folder name, unique per data folder."""
 
-TASKS = (TASK_ARM_GRID, TASK_ARM_REACH)
+TASKS = TASK_KINDS
 """Tasks a sweep can train (the run record's ``task.kind``): the paper's grid (tabular) and the
 continuous joints (tile-coded linear Dyna-Q)."""
-GRID_FIELDS = tuple(f.name for f in fields(ArmGrid))
-"""Task settings of the arm grid: joints, bins, low_deg, high_deg, goal, robot."""
-REACH_FIELDS = tuple(f.name for f in fields(ArmReach))
-"""Task settings of the continuous joints: joints, step_deg, goal, tolerances, shaping, actions,
-robot (and the tile coding's ``CODING_SETTINGS``)."""
 CONFIG_FIELDS = tuple(f.name for f in fields(DynaQConfig))
 """Learning settings: every :class:`DynaQConfig` field."""
 RUN_SETTINGS = ("demonstrations",)
 """Run settings of the grid: ``demonstrations`` is the number of generated demonstrations replayed
 first (the same generator and seed as ``studio train --generated-demos N``)."""
 TASK_SETTINGS = {
-    TASK_ARM_GRID: GRID_FIELDS + RUN_SETTINGS,
-    TASK_ARM_REACH: REACH_FIELDS + CODING_SETTINGS,
+    kind: learner(kind).sweep_keys + (RUN_SETTINGS if learner(kind).grid_states else ())
+    for kind in TASKS
 }
+"""The settings a sweep of each task may set: its learner's task settings (the arm grid's joints,
+bins, low_deg, high_deg, goal, robot; the continuous task's joints, step_deg, goal, tolerances,
+shaping, actions, robot and tile coding), and the grid's generated demonstrations."""
 SEARCH_KINDS = ("grid", "random")
 DISTRIBUTIONS = ("uniform", "loguniform", "randint")
 """Random-search distributions: ``{uniform = [lo, hi]}``, ``{loguniform = [lo, hi]}``,
@@ -318,8 +315,7 @@ def resolve_trial(
         task=task,
         robot=str(settings.get("robot", PUMA560)),  # both tasks' field, fixed or swept
         config=_pick(settings, CONFIG_FIELDS),
-        grid=_pick(settings, GRID_FIELDS) if task == TASK_ARM_GRID else {},
-        reach=_pick(settings, (*REACH_FIELDS, *CODING_SETTINGS)) if task == TASK_ARM_REACH else {},
+        **task_settings(task, settings, "sweep"),
         experiments=experiments,
         episodes=episodes,
         seed=seed,
@@ -625,7 +621,7 @@ def _metric(table: Mapping[str, object], task: str, source: str) -> tuple[str, f
     level = table.get("level_steps")
     if level is not None and (not is_number(level) or level <= 0):
         raise SweepError(f"{source} [metric] level_steps is {level!r}; give a number above 0.")
-    if metric == "episodes_to_converge" and level is None and task != TASK_ARM_GRID:
+    if metric == "episodes_to_converge" and level is None and not learner(task).shortest_paths:
         raise SweepError(
             f"{source} [metric] episodes_to_converge on the {task} task needs level_steps (mean steps per episode that count as converged); add it, or choose another metric."
         )

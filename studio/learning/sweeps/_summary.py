@@ -20,10 +20,11 @@ import numpy as np
 
 from ..._numbers import is_number
 from .._errors import LearningError
+from .._registry import learner
 from ..paper._reproduce import _standard_error, episodes_to_converge
 from ..runs._curves import curve_statistics
 from ..runs._folder import RunFolder
-from ..runs._record import TASK_ARM_GRID, RunRecord
+from ..runs._record import RunRecord
 from ._folder import (
     FIGURE_STEM,
     SUMMARY_FILE,
@@ -70,10 +71,9 @@ def trial_metrics(
     mean = np.asarray(curve_statistics(steps[:, :done])["mean"], dtype=np.float64)
     if level_steps is not None:
         level = level_steps
-    elif record.kind == TASK_ARM_GRID:
-        level = convergence_factor * record.arm_grid().mean_shortest_steps()
     else:
-        level = math.nan
+        shortest = learner(record.kind).mean_shortest_steps(record.task)
+        level = math.nan if shortest is None else convergence_factor * shortest
     converged = episodes_to_converge(mean, level, start) if not math.isnan(level) else None
     tail = max(1, int(np.ceil(done * FINAL_FRACTION)))
     if math.isnan(level):

@@ -10,19 +10,14 @@ from fastapi import APIRouter, Response
 
 from studio.kinematics import DEFAULT_ROBOT
 from studio.learning import (
+    AnyPolicy,
     DemonstrationMotion,
-    DmpPolicyFile,
     LearningError,
-    PolicyFile,
-    TilePolicyFile,
+    RunRecord,
+    Start,
     check_policy_robot,
-    default_goal,
-    greedy_path,
-    greedy_rollout,
+    learner_of,
     likeness_cards,
-    rollout,
-    rollout_dmp_policy,
-    rollout_tile_policy,
     save_trajectory_csv,
 )
 
@@ -30,9 +25,6 @@ from .._deps import StudioDep
 from .._errors import ConflictError, InvalidError
 from .._schemas import LikenessPublic, WatchCreate, WatchPublic
 from . import file_responses
-
-AnyPolicy = PolicyFile | TilePolicyFile | DmpPolicyFile
-"""A policy of any kind, as the studio loads it."""
 
 router = APIRouter(prefix="/api/watch", tags=["watch"])
 
@@ -43,8 +35,6 @@ ROUND_DECIMALS = 6
 TILE_DEMONSTRATION_PATH = "demonstration"
 """Name of the scene path showing a continuous run's (or a movement primitive's) demonstration
 beside the watched robot."""
-TILE_WATCH_MAX_STEPS = 1_500
-"""Most joint steps of a watched continuous rollout (a minute of motion at 0.04 s per step)."""
 
 
 @router.post("")
@@ -52,6 +42,7 @@ def watch(body: WatchCreate, studio: StudioDep) -> WatchPublic:
     """Roll the greedy policy of a run or an uploaded policy (exactly one; 422 otherwise) out from
     a random or the current pose and play it in the scene (409 if the run has no policy yet)."""
     policy, key = studio.load_policy(body.run, body.policy)
+    learner = learner_of(policy)
     if policy.robot is not None:  # (None: not an arm's policy, refused below)
         try:
             check_policy_robot(
@@ -62,30 +53,62 @@ def watch(body: WatchCreate, studio: StudioDep) -> WatchPublic:
             )
         except LearningError as err:
             raise ConflictError(str(err)) from None
-    if isinstance(policy, TilePolicyFile):
-        watched = _watch_tile_policy(body, studio, policy, key)
-    elif isinstance(policy, DmpPolicyFile):
-        watched = _watch_dmp_policy(body, studio, policy, key)
+    problem = learner.not_an_arm(policy, "can be watched")
+    if problem is not None:
+        raise ConflictError(problem)
+    if body.start == "current":
+        scene = studio.scene
+        now = np.asarray(scene.current_q_robot() if scene else studio.pipeline.q_robot())
+        start = learner.pose_start(policy, now)
     else:
-        watched = _watch_grid_policy(body, studio, policy, key)
+        start = Start(seed=start_seed(body))
+    rollout = learner.roll_out(policy, start, ROLLOUT_RATE_HZ, max_steps=learner.watch_max_steps)
+    studio.keep_rollout(key, rollout.times, rollout.q)
+    if studio.scene is not None:
+        record = _run_record(studio, key)
+        beside = learner.beside(policy, record.demonstrations if record is not None else [])
+        studio.scene.set_goal(rollout.goal, robot=rollout.robot)
+        if beside is not None:  # the demonstration it learned from, beside it
+            studio.scene.show_path(TILE_DEMONSTRATION_PATH, beside, robot=rollout.robot)
+        else:
+            studio.scene.clear_path(TILE_DEMONSTRATION_PATH)
+        states = list(rollout.states) if rollout.states else None
+        studio.scene.play_trajectory(rollout.times, rollout.q, states, robot=rollout.robot)
     likeness, note = likeness_public(body, studio, policy, key)
-    return watched.model_copy(update={"likeness": likeness, "likeness_note": note})
+    return WatchPublic(
+        steps=rollout.steps,
+        seed=rollout.seed,
+        states=list(rollout.states),
+        times=np.round(rollout.times, ROUND_DECIMALS).tolist(),
+        q_robot=np.round(rollout.q, ROUND_DECIMALS).tolist(),
+        reached_goal=rollout.reached,
+        likeness=likeness,
+        likeness_note=note,
+    )
+
+
+def _run_record(studio: StudioDep, key: str) -> RunRecord | None:
+    """The record of the run whose policy ``key`` names (``run:<id>``), None for an upload."""
+    if not key.startswith("run:"):
+        return None
+    return studio.runs.get(key.removeprefix("run:")).folder.record
 
 
 def _demonstration_motions(
     body: WatchCreate, studio: StudioDep, policy: AnyPolicy, key: str
 ) -> list[DemonstrationMotion]:
     """The demonstrations to compare with: the one asked for, else the run's own (kept in its
-    record, or by name from the list for a run recorded before motions were kept), else a
-    movement primitive's."""
+    record, or by name from the list for a run recorded before motions were kept), else the one
+    the policy file holds (a movement primitive's)."""
     names: list[str] = [body.demonstration] if body.demonstration else []
-    if not names and key.startswith("run:"):
-        record = studio.runs.get(key.removeprefix("run:")).folder.record
+    record = _run_record(studio, key) if not names else None
+    if record is not None:
         if record.demonstration_motions:
             return list(record.demonstration_motions)
         names = list(record.demonstration_names)
-    if not names and isinstance(policy, DmpPolicyFile):
-        return [DemonstrationMotion("its demonstration", policy.demo_times, policy.demo_q)]
+    own = learner_of(policy).own_demonstration(policy)
+    if not names and own is not None:
+        return [own]
     robot = policy.robot or DEFAULT_ROBOT
     motions = []
     for name in names:
@@ -115,115 +138,6 @@ def likeness_public(
     if isinstance(card, str):
         return None, card
     return LikenessPublic.model_validate({"name": motion.name, **card.to_dict()}), ""
-
-
-def _watch_grid_policy(
-    body: WatchCreate, studio: StudioDep, policy: PolicyFile, key: str
-) -> WatchPublic:
-    """Play a grid policy from a random start or the current pose's bin."""
-    grid = policy.grid
-    seed = start_seed(body)
-    if body.start == "current":
-        q_now = (
-            studio.scene.current_q_robot()
-            if studio.scene is not None
-            else studio.pipeline.q_robot()
-        )
-        start = grid.state_of_angles(np.asarray(q_now)[: grid.joints])
-    else:
-        starts = grid.mdp().start_states
-        start = int(starts[np.random.default_rng(seed).integers(len(starts))])
-    hold = default_goal(grid.robot)  # the joints beyond the grid's
-    if body.start == "current" and len(q_now) == len(hold):
-        hold[grid.joints :] = np.asarray(q_now)[grid.joints :]
-    times, q = rollout(policy, start, ROLLOUT_RATE_HZ, hold=hold)
-    states = greedy_path(policy, start)
-    studio.keep_rollout(key, times, q)
-    if studio.scene is not None:
-        goal = default_goal(grid.robot)
-        goal[: grid.joints] = grid.angles_of(grid.goal_state)
-        studio.scene.set_goal(goal)
-        studio.scene.play_trajectory(times, q, states, robot=grid.robot)
-    return WatchPublic(
-        steps=len(states) - 1,
-        seed=seed,
-        states=states,
-        times=np.round(times, ROUND_DECIMALS).tolist(),
-        q_robot=np.round(q, ROUND_DECIMALS).tolist(),
-        reached_goal=states[-1] == grid.goal_state,
-    )
-
-
-def _watch_tile_policy(
-    body: WatchCreate, studio: StudioDep, policy: TilePolicyFile, key: str
-) -> WatchPublic:
-    """Play a tile-coded arm policy: one joint step at a time, the run's demonstration beside it."""
-    task = policy.task
-    if task is None:
-        raise ConflictError(
-            f"This policy was trained on {policy.env_id or 'another environment'}, not the arm; only arm policies can be watched."
-        )
-    seed = start_seed(body)
-    if body.start == "current":
-        q_now = np.asarray(
-            studio.scene.current_q_robot()
-            if studio.scene is not None
-            else studio.pipeline.q_robot()
-        )
-        start = np.clip(q_now[: task.joints], task.lower, task.upper)
-    else:
-        start = task.random_start(np.random.default_rng(seed))
-    times, q, reached = rollout_tile_policy(policy, start, ROLLOUT_RATE_HZ, TILE_WATCH_MAX_STEPS)
-    # the joint path the trajectory was sampled from (deterministic: the same greedy steps)
-    path, _ = greedy_rollout(task, policy.coder, policy.weights, start, TILE_WATCH_MAX_STEPS)
-    studio.keep_rollout(key, times, q)
-    if studio.scene is not None:
-        studio.scene.set_goal(np.asarray(task.goal))
-        studio.scene.clear_path(TILE_DEMONSTRATION_PATH)
-        demos = (
-            studio.runs.get(key.removeprefix("run:")).folder.record.demonstrations
-            if key.startswith("run:")
-            else []
-        )
-        if demos:  # its joints on the task's robot, the others at the goal's
-            path = np.tile(np.asarray(task.goal), (len(demos[0]), 1))
-            path[:, : task.joints] = np.asarray(demos[0])[:, : task.joints]
-            studio.scene.show_path(TILE_DEMONSTRATION_PATH, path, robot=task.robot)
-        studio.scene.play_trajectory(times, q, robot=task.robot)
-    return WatchPublic(
-        steps=len(path) - 1,
-        seed=seed,
-        states=[],
-        times=np.round(times, ROUND_DECIMALS).tolist(),
-        q_robot=np.round(q, ROUND_DECIMALS).tolist(),
-        reached_goal=bool(reached),
-    )
-
-
-def _watch_dmp_policy(
-    body: WatchCreate, studio: StudioDep, policy: DmpPolicyFile, key: str
-) -> WatchPublic:
-    """Play a movement primitive from its demonstration's start (or the current pose) to its goal."""
-    start = None
-    if body.start == "current":
-        scene = studio.scene
-        now = np.asarray(scene.current_q_robot() if scene else studio.pipeline.q_robot())
-        start = now if len(now) == len(policy.goal) else None  # another robot's: its own start
-    times, q, reached = rollout_dmp_policy(policy, start, ROLLOUT_RATE_HZ)
-    studio.keep_rollout(key, times, q)
-    if studio.scene is not None:
-        studio.scene.set_goal(policy.goal, robot=policy.robot)
-        # the demonstration it was fitted to, beside it, as a continuous run's
-        studio.scene.show_path(TILE_DEMONSTRATION_PATH, policy.demo_q, robot=policy.robot)
-        studio.scene.play_trajectory(times, q, robot=policy.robot)
-    return WatchPublic(
-        steps=len(times) - 1,
-        seed=None,
-        states=[],
-        times=np.round(times, ROUND_DECIMALS).tolist(),
-        q_robot=np.round(q, ROUND_DECIMALS).tolist(),
-        reached_goal=reached,
-    )
 
 
 @router.post("/stop", status_code=204)
