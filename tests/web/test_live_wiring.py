@@ -9,7 +9,14 @@ import numpy as np
 import pytest
 import viser
 
-from studio.capture import RecordingError, RecordingWriter, read_recording
+from studio.capture import (
+    CameraSource,
+    HandSource,
+    RecordingError,
+    RecordingWriter,
+    SimulatorSource,
+    read_recording,
+)
 from studio.kinematics import HumanArm, HumanBody, TapeConfig, reconstruct, tape_from_arm
 from studio.web._errors import ConflictError
 from studio.web.live._pipeline import Pipeline
@@ -49,6 +56,31 @@ def test_the_operator_is_posed_once_per_live_pose_and_not_in_the_scene_thread(sc
     assert wait_for(lambda: scene._tape.visible and np.allclose(scene.current_q_human(), q))
     assert wait_for(lambda: np.allclose(scene.current_q_robot(), 0.1))
     assert calls == [threading.current_thread().name]  # once, by the caller
+
+
+def test_the_tape_goes_from_the_scene_with_a_source_that_has_none(scene):
+    """The green tape stayed drawn in camera and hand-guide modes: a source without a tape
+    takes it away at once (the hand guide sends nothing until its handle is dragged), and a
+    pose without a tape never brings it back; the next tape source draws it again."""
+    q = np.array([0.5, 0.4, 0.1, 0.8, 0.0, 0.0, 0.0])
+    config = TapeConfig()
+    tape = reconstruct(*tape_from_arm(HumanArm("right"), q, config), config).positions
+    pipeline = Pipeline(scene=scene)
+    pipeline.set_source(SimulatorSource(), "simulator")
+    try:
+        scene.show_live(LivePose(q_human=q, q_robot=np.full(6, 0.1), tape=tape))
+        assert wait_for(lambda: scene._tape.visible)
+        for source, kind in ((HandSource("right"), "hand"), (CameraSource("right"), "camera")):
+            pipeline.set_source(source, kind)
+            assert wait_for(lambda: not scene._tape.visible), kind
+            scene.show_live(LivePose(q_human=q * 0.5, q_robot=np.full(6, 0.2), tape=None))
+            assert wait_for(lambda: np.allclose(scene.current_q_human(), q * 0.5))
+            assert not scene._tape.visible, kind
+            scene.set_side("right")  # a tape source again: its first tape is drawn
+            scene.show_live(LivePose(q_human=q, q_robot=np.full(6, 0.1), tape=tape))
+            assert wait_for(lambda: scene._tape.visible), kind
+    finally:
+        pipeline.clear_source()
 
 
 def test_a_capture_announces_its_recording_when_it_starts_and_when_the_disk_stops_it(tmp_path):

@@ -24,8 +24,8 @@ class FakeScene:
     def update_live(self, q_human, q_robot, tape_positions=None) -> None:
         self.calls.append(("update_live", (q_human, q_robot)))
 
-    def set_side(self, side) -> None:
-        self.calls.append(("set_side", (side,)))
+    def set_side(self, side, taped=True) -> None:
+        self.calls.append(("set_side", (side, taped)))
 
     def show_hand_handle(self, side, on_move) -> None:
         self.calls.append(("show_hand_handle", (side, on_move)))

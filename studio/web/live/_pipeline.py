@@ -35,6 +35,7 @@ from studio.capture import (
     FrameSource,
     Observation,
     ObservationFitter,
+    TapeFrame,
     fitter_for,
 )
 from studio.kinematics import HumanArm, RetargetedPath, Retargeter, RobotArm, TapeConfig
@@ -163,6 +164,8 @@ class Pipeline:
             self._residual = None
             if source is None:
                 return
+            if self.scene is not None and getattr(source, "observation_kind", "tape") != "tape":
+                self.scene.set_side(self.side(), taped=False)  # no tape to draw from now on
             try:
                 source.start()
             except StudioError as err:
@@ -521,7 +524,7 @@ class Pipeline:
                 observation, tape=tape, side=side, mode=self._mode, mirror=self._mirror
             )
             if self.scene is not None:  # the scene draws that arm following (the tape on it)
-                self.scene.set_side(side)
+                self.scene.set_side(side, taped=isinstance(observation, TapeFrame))
             self._fitter = fitter
         return fitter
 

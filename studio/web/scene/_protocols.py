@@ -45,8 +45,9 @@ class LiveScene(Protocol):
     def show_live(self, pose: LivePose) -> None:
         """Show the newest live pose (latest wins, never blocks)."""
 
-    def set_side(self, side: str) -> None:
-        """Make ``side`` the operator's arm that follows the fit."""
+    def set_side(self, side: str, taped: bool = True) -> None:
+        """Make ``side`` the operator's arm that follows the fit, with the tape drawn on it
+        unless the source has none (``taped`` False: the camera, the hand guide)."""
 
 
 class JointLimits(Protocol):

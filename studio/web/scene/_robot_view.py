@@ -12,8 +12,10 @@ reads at the scene's distance from the operator beside it.
 from __future__ import annotations
 
 import logging
+import multiprocessing
 import threading
 from collections.abc import Callable, Sequence
+from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -112,9 +114,46 @@ def arm_tool(arm: RobotArm) -> Callable[[np.ndarray], np.ndarray]:
     return tool
 
 
-def arm_view(arm: RobotArm, config: MeshConfig, cache: Path | None = None) -> RobotView:
+@dataclass(frozen=True)
+class _Geometry:
+    """What :func:`~studio.kinematics.robot_meshes` reads of one of a URDF's visual objects,
+    as plain values a child process is handed (a Pinocchio model does not cross)."""
+
+    name: str
+    meshPath: str  # noqa: N815  (Pinocchio's GeometryObject names)
+    meshScale: tuple[float, ...]  # noqa: N815
+    meshColor: tuple[float, ...]  # noqa: N815
+
+
+@dataclass(frozen=True)
+class _Visuals:
+    geometryObjects: tuple[_Geometry, ...]  # noqa: N815
+
+
+def _simplified(visuals: _Visuals, config: MeshConfig, scale: float) -> list[MeshPart]:
+    """The robot's meshes read and simplified at the size drawn (in a child process)."""
+    return [
+        MeshPart(p.name, p.frame, p.vertices * np.float32(scale), p.faces, p.rgb)
+        for p in robot_meshes(visuals, config)  # type: ignore[arg-type]
+    ]
+
+
+def _simplified_elsewhere(visuals: _Visuals, config: MeshConfig, scale: float) -> list[MeshPart]:
+    """:func:`_simplified` in a child process: reading and simplifying a robot's meshes holds
+    the interpreter for seconds at a time (a Panda: 14 s, with pauses of up to a second in the
+    other threads on a busy machine), and the live scene, the fit and the page's requests must
+    go on meanwhile. Only the simplified parts come back."""
+    spawn = multiprocessing.get_context("spawn")  # a fork would copy the server's threads
+    with ProcessPoolExecutor(max_workers=1, mp_context=spawn) as child:
+        return child.submit(_simplified, visuals, config, scale).result()
+
+
+def arm_view(
+    arm: RobotArm, config: MeshConfig, cache: Path | None = None, elsewhere: bool = False
+) -> RobotView:
     """A robot of :func:`~studio.kinematics.load_robot` drawn from its URDF's meshes (kept
-    simplified in the ``cache`` folder, :mod:`._mesh_cache`, when one is given).
+    simplified in the ``cache`` folder, :mod:`._mesh_cache`, when one is given; read and
+    simplified in a child process when ``elsewhere``, as the studio's scene asks).
 
     Raises:
         KinematicsError: a mesh file is missing or unreadable.
@@ -122,12 +161,20 @@ def arm_view(arm: RobotArm, config: MeshConfig, cache: Path | None = None) -> Ro
     scale, pedestal = arm_framing(arm)
     # simplified at the size drawn: an enlarged arm keeps the detail of a full-size one
     simplified = replace(config, cell_m=config.cell_m / scale)
+    visuals = _Visuals(
+        tuple(
+            _Geometry(
+                g.name,
+                str(g.meshPath),
+                tuple(float(x) for x in np.asarray(g.meshScale, dtype=float)),
+                tuple(float(x) for x in np.asarray(g.meshColor, dtype=float)),
+            )
+            for g in arm.visual_model.geometryObjects
+        )
+    )
 
     def build() -> list[MeshPart]:
-        return [
-            MeshPart(p.name, p.frame, p.vertices * np.float32(scale), p.faces, p.rgb)
-            for p in robot_meshes(arm.visual_model, simplified)
-        ]
+        return (_simplified_elsewhere if elsewhere else _simplified)(visuals, simplified, scale)
 
     files = [str(g.meshPath) for g in arm.visual_model.geometryObjects]
     parts = cached_parts(cache, arm.name, mesh_key(files, simplified.cell_m, scale), build)
@@ -209,7 +256,7 @@ class RobotViews:
 
     def _load(self, arm: RobotArm, ready: Callable[[RobotView], None]) -> None:
         try:
-            view = arm_view(arm, self._config, self._cache)
+            view = arm_view(arm, self._config, self._cache, elsewhere=True)
         except Exception as err:
             log.exception("The %s meshes could not be read; the robot drawn stays.", arm.name)
             with self._lock:

@@ -142,6 +142,7 @@ class StudioScene(ScenePaths, SceneRobot):
         self._bodies = {body.side: body}  # one per taped arm, sharing the meshes
         self._operator = self._operator_for(body, 0)
         self._switch_lock = threading.Lock()  # one set_side at a time
+        self._taped = True  # the source is a tape: the tape is drawn on the sleeve (set_side)
         self._init_robot(RobotViews(self.robot, self.layout.mesh, mesh_cache))
 
         # Inputs, written by any thread under _lock; the loop reads a snapshot.
@@ -501,14 +502,16 @@ class StudioScene(ScenePaths, SceneRobot):
         """:meth:`show_live` of ``LivePose(q_human, q_robot, tape_positions)``."""
         self.show_live(LivePose(q_human, q_robot, tape_positions))
 
-    def set_side(self, side: str) -> None:
+    def set_side(self, side: str, taped: bool = True) -> None:
         """Put the tape on the operator's ``side`` arm: it follows the fit, the other rests.
 
-        Called when a source taped on that arm starts (``TapeConfig.side``). Only the operator
+        Called when a source taped on that arm starts (``TapeConfig.side``); ``taped`` False
+        for a source without a tape (the camera, the hand guide), whose arm is drawn without
+        one: the tape of an earlier source goes at once and stays away. Only the operator
         changes: the same meshes, posed from the new arm's base frame. A live pose given before
         the switch belongs to the other arm and is dropped; the next :meth:`update_live` poses
         the new arm. Returns at once; the scene thread redraws the operator (at rest, the tape
-        hidden until the new arm's first tape). Nothing happens when ``side`` is already taped.
+        hidden until the new arm's first tape). Nothing happens when nothing changes.
 
         Raises:
             KinematicsError: ``side`` is neither ``"right"`` nor ``"left"``.
@@ -520,12 +523,13 @@ class StudioScene(ScenePaths, SceneRobot):
             if body is None:
                 body = current.body.with_side(side)  # checks the side; shares the meshes
                 self._bodies[body.side] = body
-            if body is current.body:
+            if body is current.body and bool(taped) == self._taped:
                 return
             operator = self._operator_for(body, current.version + 1)
             with self._lock:
                 self._operator = operator
                 self._live = None
+                self._taped = bool(taped)
         self._wake.set()
 
     def show_hand_handle(self, side: str | None, on_move: HandMoved | None) -> None:
