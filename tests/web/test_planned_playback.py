@@ -191,3 +191,65 @@ def test_closing_the_studio_stops_the_planning_under_way(ur3, children):
     pipeline.close()
     assert children[0].returncode is not None  # killed and reaped, not left running
     assert children[0].returncode != 0  # stopped before it had planned
+
+
+def test_a_killed_plan_is_tried_again_when_the_recording_is_played_again(playing, monkeypatch):
+    """ "planning … failed (exit code -9)" was kept per recording, file time and robot, so
+    playing the recording again planned nothing until a restart."""
+    pipeline, recording = playing
+    popen, started = subprocess.Popen, []
+
+    def killed_once(*args, **kwargs):
+        child = popen(*args, **kwargs)
+        started.append(child)
+        if len(started) == 1:
+            child.kill()  # as the out-of-memory killer or a user's kill -9 would
+        return child
+
+    monkeypatch.setattr(subprocess, "Popen", killed_once)
+    pipeline.observe(recording.frame_at(0))
+    note = wait_for(pipeline, "failed (exit code -9")
+    assert note.endswith("play the recording again to plan it again.")
+    pipeline.set_source(PlaybackSource(SAMPLE, speed=None), "recording", "sample-reach-2")
+    pipeline.observe(recording.frame_at(0))
+    wait_for(pipeline, "is planned")
+    assert len(started) == 2
+
+
+def test_the_planning_child_quits_and_cleans_up_when_its_studio_is_killed(tmp_path):
+    """After ``kill -9`` of the studio the child planned on, re-parented to init, and its
+    ``studio-plan-*`` folder stayed in the temporary folder."""
+    import os
+    import sys
+    from pathlib import Path
+
+    studio = (
+        "import subprocess, sys\n"
+        "from pathlib import Path\n"
+        "from studio.web.live import _planned_playback\n"
+        "popen = subprocess.Popen\n"
+        "def spy(*args, **kwargs):\n"
+        "    child = popen(*args, **kwargs)\n"
+        "    print(child.pid, flush=True)\n"
+        "    return child\n"
+        "subprocess.Popen = spy\n"
+        f"_planned_playback.plan_recording(Path({str(SAMPLE)!r}), 'ur5', lambda: False)\n"
+    )
+    env = {**os.environ, "TMPDIR": str(tmp_path)}
+    parent = subprocess.Popen([sys.executable, "-c", studio], stdout=subprocess.PIPE, env=env)
+    child = int(parent.stdout.readline())
+    assert list(tmp_path.glob("studio-plan-*"))  # the plan's folder, while it plans
+    parent.kill()
+    parent.wait()
+
+    def gone(pid: int) -> bool:
+        status = Path(f"/proc/{pid}/status")
+        try:
+            return "\nState:\tZ" in status.read_text()  # ended, not yet reaped by init
+        except OSError:
+            return True
+
+    deadline = time.monotonic() + WAIT_S
+    while not gone(child) or list(tmp_path.glob("studio-plan-*")):
+        assert time.monotonic() < deadline, "the planning child outlived its studio"
+        time.sleep(0.02)

@@ -31,7 +31,7 @@ import numpy as np
 from studio.capture import PlaybackSource
 from studio.kinematics import RetargetedPath, RobotArm
 
-from ._plan_child import CANNOT, load_path
+from ._plan_child import CANNOT, TEMP_PREFIX, load_path
 
 log = logging.getLogger(__name__)
 
@@ -45,6 +45,12 @@ LIVE_INSTEAD = "The robot follows the hand as it would live"
 """How a sentence on a plan that could not be made begins."""
 
 _Key = tuple[str, int, str]  # (the recording's path, its mtime in ns, the robot's name)
+
+
+class Mishap(str):
+    """Why a plan was not made this time (the child was killed, crashed or could not start): said
+    while the recording plays, then tried again when it is played again. A recording or robot
+    that cannot be planned (a plain ``str``) is not tried again until its file changes."""
 
 
 class PlannedPlayback:
@@ -89,7 +95,7 @@ class PlannedPlayback:
             with self._lock:
                 self._key, self._source = key, id(source)
                 self._following, self._last, self._title = False, None, arm.spec.title
-                if key not in self._plans:
+                if key not in self._plans or isinstance(self._plans[key], Mishap):
                     self._wanted = key
                     self._start_worker()
         row = source.row_at(t)
@@ -179,38 +185,48 @@ def plan_recording(
     process (:mod:`studio.web.live._plan_child`, which says why it runs apart). Returns the path, or
     one sentence on why there is none, or None once ``abandoned()`` (polled) says it is not
     wanted any more (the child is stopped)."""
-    with tempfile.TemporaryDirectory(prefix="studio-plan-") as folder:
+    with tempfile.TemporaryDirectory(prefix=TEMP_PREFIX) as folder:
         out = Path(folder) / "path.npz"
         command = [sys.executable, "-m", "studio.web.live._plan_child", str(path), robot, str(out)]
+        said_at, errors_at = Path(folder) / "said.txt", Path(folder) / "errors.txt"
         try:
-            child = subprocess.Popen(
-                command,
-                stdin=subprocess.DEVNULL,
-                stdout=subprocess.PIPE,
-                stderr=subprocess.PIPE,
-                text=True,
-            )
+            with said_at.open("w") as said_to, errors_at.open("w") as errors_to:
+                # stdin stays open while the studio lives: its end tells the child to quit
+                child = subprocess.Popen(
+                    command, stdin=subprocess.PIPE, stdout=said_to, stderr=errors_to, text=True
+                )
         except OSError as err:
-            return f"{LIVE_INSTEAD}: its path over the recording could not be planned ({err})."
-        while True:
-            try:
-                said, errors = child.communicate(timeout=POLL_S)
-                break
-            except subprocess.TimeoutExpired:
-                if abandoned():
-                    child.kill()
-                    child.communicate()
-                    return None
+            return Mishap(
+                f"{LIVE_INSTEAD}: its path over the recording could not be planned ({err})."
+            )
+        try:
+            while True:
+                try:
+                    child.wait(timeout=POLL_S)
+                    break
+                except subprocess.TimeoutExpired:
+                    if abandoned():
+                        child.kill()
+                        child.wait()
+                        return None
+        finally:
+            if child.stdin is not None:
+                child.stdin.close()
+        said = said_at.read_text(errors="replace")
+        errors = errors_at.read_text(errors="replace")
         if child.returncode == 0:
             try:
                 return load_path(out)
             except (OSError, ValueError, KeyError) as err:
-                return f"{LIVE_INSTEAD}: its planned path could not be read back ({err})."
+                return Mishap(f"{LIVE_INSTEAD}: its planned path could not be read back ({err}).")
         if child.returncode == CANNOT:
             return f"{LIVE_INSTEAD}: its path over the recording could not be planned ({said.strip()})."
         last = (errors.strip().splitlines() or ["no message"])[-1]
         log.warning("planning %s on the %s failed: %s", path, robot, errors)
-        return f"{LIVE_INSTEAD}: planning its path over the recording failed (exit code {child.returncode}: {last})."
+        return Mishap(
+            f"{LIVE_INSTEAD}: planning its path over the recording failed (exit code "
+            f"{child.returncode}: {last}); play the recording again to plan it again."
+        )
 
 
 def _may_join(
