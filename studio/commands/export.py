@@ -2,8 +2,9 @@
 
 ``studio export SOURCE --robot NAME --format csv|mcap|lerobot --out PATH`` times the motion
 (TOPP-RA, within the robot's limits; a recording keeps its capture times unless ``--retime``),
-checks it (positions, velocities, accelerations, self-collision) and writes it; the
-:mod:`studio.export` package does all three. ``SOURCE`` is a path, or a name in the data folder
+checks it (positions, velocities, accelerations, self-collision), replays it in MuJoCo and
+writes it with the physics report stated in the file; the :mod:`studio.export` package does all
+four. ``SOURCE`` is a path, or a name in the data folder
 or among the shipped samples (``sample-reach-1``).
 
 ``studio export POLICY`` alone (no ``--format``, ``--robot``, ``--unchecked`` nor ``--retime``)
@@ -18,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from studio._layout import robot_cache_dir
+from studio._layout import physics_cache_dir, robot_cache_dir
 from studio.capture import DEMO_SUFFIX, RECORDING_SUFFIXES
 from studio.export import (
     FORMAT_SUFFIXES,
@@ -292,7 +293,14 @@ def run(args: argparse.Namespace) -> int:
     # by default in the current folder (a shipped sample's folder is the installed package)
     out = args.out or Path(f"{stem}.{motion.robot.name}{FORMAT_SUFFIXES[fmt]}")
     done = export_motion(
-        motion, fmt, out, unchecked=args.unchecked, fraction=args.limit_fraction, task=args.task
+        motion,
+        fmt,
+        out,
+        unchecked=args.unchecked,
+        fraction=args.limit_fraction,
+        task=args.task,
+        simulate=True,
+        cache=physics_cache_dir(args.data_dir),
     )
     timing = (
         "timed within the limits (TOPP-RA)" if done.timed_by == "toppra" else "at its own times"
@@ -308,6 +316,9 @@ def run(args: argparse.Namespace) -> int:
     )
     for note in motion.notes:
         print(f"  note: {note}")
+    if done.physics is not None:
+        for line in done.physics.sentences():
+            print(f"  {line}")
     for finding in done.findings:
         print(f"  {finding.sentence}", file=sys.stderr)
     if motion.kind == "policy":

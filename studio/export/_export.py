@@ -6,10 +6,17 @@ anyway, with every finding stated in the file (CSV comment lines, the MCAP ``tea
 metadata, ``info.json``'s ``teach_studio`` key). A motion's notes (the hand went beyond the
 robot's reach while retargeting) are stated in every file, checked or not, and a CSV's comment
 lines always name the robot, the joint order, the units and the source.
+
+``simulate=True`` (what ``studio export`` asks) also replays the written samples in MuJoCo
+(:func:`~._simulate.simulate_trajectory`) and states the report in the file: the CSV's comment
+lines, the MCAP metadata's ``physics`` and ``physics_json``, and
+``info.json``'s ``teach_studio.physics``. The report never refuses an export; a model MuJoCo
+cannot build is stated as not simulated.
 """
 
 from __future__ import annotations
 
+import json
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -19,10 +26,13 @@ import numpy as np
 
 from studio._files import now_iso
 from studio.motion import Finding, Motion
+from studio.physics import PhysicsError, SimulationReport
 
+from ._errors import ExportError
 from ._formats import write_csv, write_mcap
 from ._lerobot import lerobot_conventions, write_lerobot
 from ._safety import COLLISION_MARGIN_M, check_trajectory, refuse
+from ._simulate import simulate_trajectory
 from ._tf import link_transforms
 from ._timing import LIMIT_FRACTION, time_path
 
@@ -49,6 +59,7 @@ class Exported:
         q: the samples' joints (rad).
         findings: the safety findings (empty when checked and passed).
         timed_by: ``"toppra"`` (timed along the path) or ``"source"`` (the source's own times).
+        physics: the samples replayed in MuJoCo (None: not simulated).
     """
 
     path: Path
@@ -56,6 +67,40 @@ class Exported:
     q: np.ndarray
     findings: tuple[Finding, ...]
     timed_by: str
+    physics: SimulationReport | None = None
+
+
+def _samples(motion: Motion, fraction: float) -> tuple[np.ndarray, np.ndarray, str]:
+    """The samples an export writes: the motion's own, or its path timed (and by which)."""
+    if motion.timed:
+        return motion.times, motion.q, "source"
+    times, q = time_path(motion.robot, motion.q, motion.rate_hz, fraction=fraction)
+    return times, q, "toppra"
+
+
+def simulate_motion(
+    motion: Motion, *, fraction: float = LIMIT_FRACTION, cache: Path | None = None
+) -> SimulationReport:
+    """The samples :func:`export_motion` would write for ``motion``, replayed in MuJoCo: the
+    report ``studio export`` states in the file, before anything is exported.
+
+    Raises:
+        PhysicsError: MuJoCo cannot build the robot's model.
+        ExportError: the robot's MuJoCo files cannot be written in ``cache``.
+    """
+    times, q, _ = _samples(motion, fraction)
+    return simulate_trajectory(motion.robot, times, q, cache=cache)
+
+
+def _physics(
+    motion: Motion, times: np.ndarray, q: np.ndarray, cache: Path | None
+) -> tuple[SimulationReport | None, list[str]]:
+    """The samples replayed in MuJoCo, and the report's lines for the file."""
+    try:
+        report = simulate_trajectory(motion.robot, times, q, cache=cache)
+    except (PhysicsError, ExportError) as err:
+        return None, [f"physics: not simulated ({err})"]
+    return report, report.sentences()
 
 
 def _notes(motion: Motion, findings: list[Finding], checked: bool) -> list[str]:
@@ -87,6 +132,8 @@ def export_motion(
     unchecked: bool = False,
     fraction: float = LIMIT_FRACTION,
     task: str = "",
+    simulate: bool = False,
+    cache: Path | None = None,
 ) -> Exported:
     """Time, check and write ``motion`` as ``fmt`` at ``out``.
 
@@ -99,25 +146,25 @@ def export_motion(
         fraction: the share of the limits the timing may use.
         task: the LeRobot task text (default: a sentence for the source's kind, :data:`TASKS`).
 
+        simulate: replay the samples in MuJoCo and state the report in the file.
+        cache: where the robot's MuJoCo files are kept (None: a temporary folder).
+
     Raises:
         SafetyError: the checks found problems (nothing written).
         ExportError: the file cannot be written.
     """
     robot = motion.robot
-    if motion.timed:
-        times, q, timed_by = motion.times, motion.q, "source"
-    else:
-        times, q = time_path(robot, motion.q, motion.rate_hz, fraction=fraction)
-        timed_by = "toppra"
+    times, q, timed_by = _samples(motion, fraction)
     # a recording at its capture times is what the arm did (joint states); timed, a trajectory
     as_captured = motion.kind == "recording" and timed_by == "source"
     findings = check_trajectory(robot, times, q, extra=list(motion.findings))
     if not unchecked:
         refuse(findings, f"{motion.kind} {motion.name}", robot, own_times=as_captured)
     notes = _notes(motion, findings, checked=not unchecked)
+    report, physics = _physics(motion, times, q, cache) if simulate else (None, [])
     names = robot.joint_names
     if fmt == "csv":
-        write_csv(out, names, times, q, notes)
+        write_csv(out, names, times, q, [*notes, *physics])
     elif fmt == "mcap":
         metadata = {
             "source": motion.name,
@@ -128,6 +175,9 @@ def export_motion(
             "findings": "\n".join(f.sentence for f in findings),
             "notes": "\n".join(motion.notes),
         }
+        if simulate:
+            metadata["physics"] = "\n".join(physics)
+            metadata["physics_json"] = json.dumps(report.as_json() if report else None)
         start_ns = int(round((motion.started or time.time()) * 1e9))
         links = link_transforms(robot.model, q)
         write_mcap(
@@ -156,6 +206,11 @@ def export_motion(
                 "notes": list(motion.notes),
             }
         }
+        if simulate:
+            extra["teach_studio"]["physics"] = {
+                "report": report.as_json() if report else None,
+                "sentences": physics,
+            }
         task = task or TASKS[motion.kind]
         write_lerobot(
             out,
@@ -167,4 +222,4 @@ def export_motion(
             task=task,
             extra=extra,
         )
-    return Exported(out, times, q, tuple(findings), timed_by)
+    return Exported(out, times, q, tuple(findings), timed_by, report)

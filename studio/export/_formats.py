@@ -1,8 +1,9 @@
 """The trajectory file formats: CSV with the URDF's joint names, and MCAP with ROS 2 messages.
 
 CSV: ``#`` comment lines first, on every export (the robot, the joint order, the units, the
-source, the checks and any finding; ``numpy.loadtxt`` and pandas' ``comment="#"`` skip them),
-then ``time,<joint names>`` and one row per sample, seconds (to the nanosecond) and radians.
+source, the checks and any finding, the physics report; ``numpy.loadtxt`` and pandas'
+``comment="#"`` skip them, :func:`~._read.read_trajectory` reads them back), then
+``time,<joint names>`` and one row per sample, seconds (to the nanosecond) and radians.
 
 MCAP (``mcap`` + ``mcap-ros2-support``, no ROS installation needed; Foxglove and Lichtblick draw
 the robot moving from it alone):

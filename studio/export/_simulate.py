@@ -54,7 +54,8 @@ def physics_model(robot: RobotArm | str, cache: Path | None = None) -> PhysicsMo
         ExportError: the URDF folder cannot be written.
         PhysicsError: MuJoCo cannot compile it.
     """
-    arm = load_robot(robot) if isinstance(robot, str) else robot
+    # always the model with its collision geometry: the contacts are the studio's pairs
+    arm = load_robot(robot if isinstance(robot, str) else robot.name)
     with _lock:
         model = _models.get(arm.name)
         if model is None:

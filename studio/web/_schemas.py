@@ -690,3 +690,27 @@ class RobotsPublic(BaseModel):
         None, description="the robot the 3D scene has drawn (null without a scene)"
     )
     drawn_meshes: int = Field(0, description="how many meshes the scene draws it with")
+
+
+class ContactPublic(BaseModel):
+    """Two links, or a link and the table, that touched in the simulated replay."""
+
+    kind: Literal["self", "table"]
+    link_a: str
+    link_b: str = Field(description='the other link, or "table"')
+    first_sample: int = Field(description="the first sample they touched at (0-based)")
+    first_time_s: float
+    samples: int = Field(description="how many samples they touched at")
+    depth_m: float = Field(description="the deepest they went into each other (m)")
+
+
+class SimulationPublic(BaseModel):
+    """A trajectory replayed in MuJoCo on the robot (``studio simulate --json``'s keys, and the
+    report in sentences as the exported file states it)."""
+
+    completed: bool = Field(description="the arm came to rest within 1 cm of the motion's end")
+    max_joint_error_rad: float
+    max_tool_error_m: float
+    saturated_samples: int = Field(description="samples where a motor was at its force limit")
+    contacts: list[ContactPublic]
+    sentences: list[str] = Field(description="the report as the exported file states it")

@@ -51,6 +51,7 @@ def test_a_checked_export_states_the_hand_beyond_reach(fmt, tmp_path, capsys):
         comments = [line for line in out.read_text().splitlines() if line.startswith("# ")]
         assert f"# note: {BEYOND}" in "\n".join(comments)
         assert "# safety checks: passed" in "\n".join(comments)
+        assert any(line.startswith("# physics (MuJoCo, ur5") for line in comments)
     elif fmt == "mcap":
         with out.open("rb") as f:
             meta = {m.name: m.metadata for m in make_reader(f).iter_metadata()}

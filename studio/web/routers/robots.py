@@ -9,12 +9,19 @@ from fastapi import APIRouter
 from fastapi.responses import FileResponse
 from starlette.background import BackgroundTask
 
+from studio._layout import physics_cache_dir
 from studio.kinematics import DEFAULT_ROBOT, robot_spec
 
 from .._deps import StudioDep
 from .._errors import ConflictError
-from .._schemas import RobotChoice, RobotsPublic
-from ..services import MEDIA_TYPES, ExportFormat, export_for_robot, export_rollout
+from .._schemas import RobotChoice, RobotsPublic, SimulationPublic
+from ..services import (
+    MEDIA_TYPES,
+    ExportFormat,
+    export_for_robot,
+    export_rollout,
+    simulate_for_robot,
+)
 from . import file_responses
 
 router = APIRouter(tags=["robots"])
@@ -67,6 +74,27 @@ def export_for_the_robot(
         filename=filename,
         background=BackgroundTask(shutil.rmtree, folder, ignore_errors=True),
     )
+
+
+@router.get("/api/robot/simulate/{kind}/{name}")
+def simulate_for_the_robot(
+    kind: Literal["recording", "demonstration"],
+    name: str,
+    studio: StudioDep,
+    robot: str | None = None,
+    retime: bool = False,
+) -> SimulationPublic:
+    """The physics report ``/api/robot/export/{kind}/{name}`` (and ``studio export``) would
+    state in the file, before exporting: the same samples replayed in MuJoCo on the robot's own
+    URDF (its motors' force limits, gravity, the table), as ``studio simulate --json`` reports
+    them, with the report's sentences. For the robot taught unless ``robot`` names another (an
+    unknown name: 422); 404 for no such recording or demonstration."""
+    store = studio.recordings if kind == "recording" else studio.demonstrations
+    path = store.path(name)
+    target = robot_spec(robot).name if robot is not None else studio.pipeline.robot_name
+    cache = physics_cache_dir(studio.settings.data_dir)
+    report = simulate_for_robot(path, target, retime, cache)
+    return SimulationPublic.model_validate({**report.as_json(), "sentences": report.sentences()})
 
 
 @router.get("/api/robot/export/rollout.mcap", responses=file_responses("application/octet-stream"))

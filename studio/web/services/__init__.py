@@ -7,6 +7,7 @@ from ._robot_export import MEDIA_TYPES as MEDIA_TYPES
 from ._robot_export import ExportFormat as ExportFormat
 from ._robot_export import export_for_robot as export_for_robot
 from ._robot_export import export_rollout as export_rollout
+from ._robot_export import simulate_for_robot as simulate_for_robot
 from ._runs import GROUP_SEPARATOR as GROUP_SEPARATOR
 from ._runs import Run as Run
 from ._runs import RunQueue as RunQueue

@@ -17,9 +17,11 @@ from studio.export import (
     FORMATS,
     check_policy_robot,
     export_motion,
+    simulate_motion,
 )
 from studio.learning import ROLLOUT_RATE_HZ
 from studio.motion import Motion, demonstration_motion, recording_motion
+from studio.physics import SimulationReport
 
 ExportFormat = Literal["csv", "mcap", "lerobot"]
 """The formats of :data:`studio.export.FORMATS`, as the API's query parameter."""
@@ -31,6 +33,26 @@ MEDIA_TYPES = {
     "lerobot": "application/zip",
 }
 """What each format's download is (a LeRobot dataset, a folder, comes zipped)."""
+
+
+def _motion(path: Path, robot: str, retime: bool) -> Motion:
+    """A recording's or demonstration's motion on ``robot`` as the page exports it."""
+    if path.name.endswith(DEMO_SUFFIX):
+        return demonstration_motion(path, robot, ROLLOUT_RATE_HZ)
+    motion = recording_motion(path, robot)
+    return motion.retimed(ROLLOUT_RATE_HZ) if retime else motion
+
+
+def simulate_for_robot(
+    path: Path, robot: str, retime: bool = False, cache: Path | None = None
+) -> SimulationReport:
+    """The physics report :func:`export_for_robot` would state in its file, before exporting:
+    the same samples replayed in MuJoCo (``cache``: where the robot's MuJoCo files are kept).
+
+    Raises:
+        PhysicsError, ExportError, KinematicsError: no model can be built, an unknown robot.
+    """
+    return simulate_motion(_motion(path, robot, retime), cache=cache)
 
 
 def export_for_robot(
@@ -51,12 +73,7 @@ def export_for_robot(
     stem = path.name
     for ending in (DEMO_SUFFIX, *RECORDING_SUFFIXES):
         stem = stem.removesuffix(ending)
-    if path.name.endswith(DEMO_SUFFIX):
-        motion = demonstration_motion(path, robot, ROLLOUT_RATE_HZ)
-    else:
-        motion = recording_motion(path, robot)
-        if retime:
-            motion = motion.retimed(ROLLOUT_RATE_HZ)
+    motion = _motion(path, robot, retime)
     folder = Path(tempfile.mkdtemp(prefix="studio-export-"))
     try:
         out = folder / f"{stem}.{robot}{FORMAT_SUFFIXES[fmt]}"
