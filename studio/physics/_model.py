@@ -37,9 +37,14 @@ TIMESTEP_S = 1e-3
 """The simulation's step (s): 1 kHz, a robot joint controller's usual rate."""
 
 SERVO_HZ = 10.0
-"""Each joint servo's natural frequency (Hz): its stiffness is the joint's inertia at home times
-(2 pi f)^2, its damping critical. A 10-Hz servo lags 2.5 mrad behind a 10 rad/s^2 acceleration,
-and stays stable at 1 kHz on every arm the studio offers."""
+"""Each joint servo's natural frequency (Hz) at its largest inertia: its stiffness is that
+inertia times (2 pi f)^2, its damping critical there. A 10-Hz servo lags 2.5 mrad behind a
+10 rad/s^2 acceleration. Where the joint's inertia is smaller the servo is stiffer; its damping
+of at least stiffness times the step, integrated implicitly, keeps it stable at any stiffness."""
+
+INERTIA_POSES = 32
+"""How many poses (home and random ones within the limits) a joint's largest inertia is taken
+over."""
 
 FRICTION_ERROR_RAD = 2e-3
 """The most a joint's dry friction (the URDF's ``<dynamics friction>``) may hold a servo off its
@@ -225,7 +230,7 @@ def build_model(arm: RobotArm, urdf_text: str) -> PhysicsModel:
         )
     qpos = np.array([model.joint(n).qposadr[0] for n in arm.joint_names])
     dofs = np.array([model.joint(n).dofadr[0] for n in arm.joint_names])
-    kp, kv = _gains(model, qpos, dofs, arm.home)
+    kp, kv = _gains(model, qpos, dofs, arm)
     model.actuator_gainprm[:, 0] = kp
     model.actuator_biasprm[:, 1] = -kp
     model.actuator_biasprm[:, 2] = -kv
@@ -250,17 +255,23 @@ def _efforts(arm: RobotArm) -> np.ndarray:
 
 
 def _gains(
-    model: mujoco.MjModel, qpos: np.ndarray, dofs: np.ndarray, home: np.ndarray
+    model: mujoco.MjModel, qpos: np.ndarray, dofs: np.ndarray, arm: RobotArm
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Stiffness and damping of :data:`SERVO_HZ` servos, from the joints' inertia at ``home``."""
+    """Stiffness and damping of :data:`SERVO_HZ` servos, from each joint's largest inertia over
+    :data:`INERTIA_POSES` poses (home and random ones within the limits): a servo tuned at a
+    folded pose lagged seconds behind with the arm stretched out (the Kinova's first joint)."""
     import mujoco
 
     data = mujoco.MjData(model)
-    data.qpos[qpos] = home
-    mujoco.mj_forward(model, data)
     full = np.zeros((model.nv, model.nv))
-    mujoco.mj_fullM(model, data, full)
-    inertia = np.diag(full)[dofs]
+    rng = np.random.default_rng(0)
+    poses = [arm.home, *rng.uniform(arm.lower, arm.upper, size=(INERTIA_POSES - 1, arm.nq))]
+    inertia = np.zeros(len(dofs))
+    for q in poses:
+        data.qpos[qpos] = q
+        mujoco.mj_forward(model, data)
+        mujoco.mj_fullM(model, data, full)
+        inertia = np.maximum(inertia, np.diag(full)[dofs])
     omega = 2.0 * math.pi * SERVO_HZ
     kp = np.maximum(inertia * omega**2, model.dof_frictionloss[dofs] / FRICTION_ERROR_RAD)
     kv = np.maximum(2.0 * np.sqrt(kp * inertia), kp * TIMESTEP_S)
