@@ -6,11 +6,12 @@ what a URDF does not say but a real arm has:
 - **the arm's joints only:** joints beyond :attr:`RobotArm.nq` (fingers, grippers) are locked
   where the studio's model locks them (0, or the nearest limit), as
   :func:`~studio.kinematics.load_robot` does;
-- **a position servo per joint** (:data:`SERVO_HZ`, critically damped, with the trajectory's
-  velocity fed forward) and the arm's own gravity compensation, as a robot's joint controller
-  does; their total force is limited by the URDF's ``effort`` (``actfrcrange``), so a motion that
-  asks more of a joint than its motor gives saturates it; a URDF effort of 0 (not modelled) leaves
-  the joint unlimited;
+- **a position servo per joint** (:data:`SERVO_HZ`, critically damped), a feed-forward motor
+  for the torque the trajectory itself needs (:func:`~._replay.simulate` computes it from the
+  model) and the arm's own gravity compensation, as a robot's joint controller has; their total
+  force is limited by the URDF's ``effort`` (``actfrcrange``), so a motion that asks more of a
+  joint than its motor gives saturates it; a URDF effort of 0 (not modelled) leaves the joint
+  unlimited;
 - **gravity** (9.81 m/s^2 down) and **the table the robot stands on**: the plane of its base, as
   :meth:`RobotArm.table_contacts` models it (the links the first joint turns about the vertical
   stand on it and never touch it; the others can be driven into it);
@@ -52,6 +53,9 @@ target at rest (rad): where the inertia alone gives a softer servo (a light wris
 1 N m friction, the xArm7's), its stiffness is raised to this, and its damping to at least
 stiffness times the step, which keeps the stiffer servo stable (the damping is integrated
 implicitly)."""
+
+FEEDFORWARD = "_feedforward"
+"""The ending of each joint's feed-forward motor's name (its servo has the joint's name)."""
 
 _ROBOT_CONTACT = 1
 """The contact bit every link's geometry has: link against link."""
@@ -214,6 +218,12 @@ def build_model(arm: RobotArm, urdf_text: str) -> PhysicsModel:
         actuator = spec.add_actuator(name=name, target=name, trntype=mujoco.mjtTrn.mjTRN_JOINT)
         actuator.set_to_position(kp=1.0, kv=1.0)
         actuator.ctrllimited = mujoco.mjtLimited.mjLIMITED_FALSE
+    for name in arm.joint_names:  # after the servos: ctrl[nq:] is the feed-forward torque
+        actuator = spec.add_actuator(
+            name=f"{name}{FEEDFORWARD}", target=name, trntype=mujoco.mjtTrn.mjTRN_JOINT
+        )
+        actuator.set_to_motor()
+        actuator.ctrllimited = mujoco.mjtLimited.mjLIMITED_FALSE
     _set_contacts(spec, arm)
     try:
         model = spec.compile()
@@ -231,9 +241,10 @@ def build_model(arm: RobotArm, urdf_text: str) -> PhysicsModel:
     qpos = np.array([model.joint(n).qposadr[0] for n in arm.joint_names])
     dofs = np.array([model.joint(n).dofadr[0] for n in arm.joint_names])
     kp, kv = _gains(model, qpos, dofs, arm)
-    model.actuator_gainprm[:, 0] = kp
-    model.actuator_biasprm[:, 1] = -kp
-    model.actuator_biasprm[:, 2] = -kv
+    servos = slice(0, arm.nq)
+    model.actuator_gainprm[servos, 0] = kp
+    model.actuator_biasprm[servos, 1] = -kp
+    model.actuator_biasprm[servos, 2] = -kv
     return PhysicsModel(
         arm,
         model,

@@ -1,9 +1,11 @@
 """Replay a joint trajectory in MuJoCo: :func:`simulate` gives its :class:`SimulationReport`.
 
-The arm starts at rest at the first sample. Each servo follows the trajectory drawn straight
-between samples (position, with the segment's velocity fed forward, and the force the joint's
-own damping and friction take at that velocity) at :data:`~._model.TIMESTEP_S`
-steps; after the last sample it holds the last pose for :data:`SETTLE_S`. At each sample's time
+The arm starts at rest at the first sample. The trajectory between samples is a cubic spline
+through them (twice differentiable, as a joint trajectory controller interpolates), held at
+the last sample for :data:`SETTLE_S` after it. At every :data:`~._model.TIMESTEP_S` step each
+servo is given the spline's position and velocity, and each feed-forward motor the torque the
+spline's motion takes on the model (inertia, Coriolis, the joint's own damping and friction;
+gravity is the arm's compensation's), as a computed-torque controller does. At each sample's time
 the simulated joints and tool are compared with the trajectory's (the tool's pose from the same
 MuJoCo model at the commanded joints), each motor's total force with its limit, and the contacts
 MuJoCo found are gathered by link pair.
@@ -63,19 +65,44 @@ def _checked(model: PhysicsModel, times: object, q: object) -> tuple[np.ndarray,
     return t - t[0], joints
 
 
-def _reference(t: np.ndarray, q: np.ndarray, steps: int) -> tuple[np.ndarray, np.ndarray]:
-    """The commanded positions and velocities at every step: the samples joined by straight
-    segments, then the last sample held."""
-    clock = np.arange(1, steps + 1) * TIMESTEP_S
-    position = np.column_stack([np.interp(clock, t, q[:, j]) for j in range(q.shape[1])])
-    slopes = np.diff(q, axis=0) / np.diff(t)[:, None]
-    segment = np.searchsorted(t, clock, side="left") - 1
-    velocity = np.where(
-        (segment >= 0)[:, None] & (segment < len(slopes))[:, None],
-        slopes[np.clip(segment, 0, len(slopes) - 1)],
-        0.0,
-    )
-    return position, velocity
+def _reference(
+    t: np.ndarray, q: np.ndarray, steps: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The commanded positions, velocities and accelerations at every step: the samples joined
+    by a cubic spline, then the last sample held at rest."""
+    from scipy.interpolate import CubicSpline
+
+    clock = np.minimum(np.arange(1, steps + 1) * TIMESTEP_S, t[-1])
+    spline = CubicSpline(t, q, axis=0)
+    moving = (np.arange(1, steps + 1) * TIMESTEP_S <= t[-1])[:, None]
+    return spline(clock), spline(clock, 1) * moving, spline(clock, 2) * moving
+
+
+def _feedforward(
+    model: PhysicsModel, position: np.ndarray, velocity: np.ndarray, acceleration: np.ndarray
+) -> np.ndarray:
+    """The torque each joint needs to move as commanded, at every step: inertia and Coriolis
+    (``M qdd + C qd``, gravity left to the arm's compensation) and the joint's own damping and
+    dry friction."""
+    import mujoco
+
+    mj = model.model
+    data = mujoco.MjData(mj)
+    dofs = model.dofs
+    torque = np.empty_like(position)
+    acc = np.zeros(mj.nv)
+    inertial = np.zeros(mj.nv)
+    for k in range(len(position)):
+        data.qpos[model.qpos] = position[k]
+        data.qvel[dofs] = velocity[k]
+        acc[dofs] = acceleration[k]
+        mujoco.mj_fwdPosition(mj, data)
+        mujoco.mj_fwdVelocity(mj, data)  # qfrc_bias = C qd + g; qfrc_gravcomp = g
+        mujoco.mj_mulM(mj, data, inertial, acc)
+        torque[k] = (inertial + data.qfrc_bias - data.qfrc_gravcomp)[dofs]
+    damping = mj.dof_damping[dofs]
+    friction = mj.dof_frictionloss[dofs]
+    return torque + damping * velocity + friction * np.sign(velocity)
 
 
 def simulate(model: PhysicsModel, times: object, q: object) -> SimulationReport:
@@ -93,11 +120,10 @@ def simulate(model: PhysicsModel, times: object, q: object) -> SimulationReport:
     mujoco.mj_forward(mj, data)
     at_sample = np.rint(t / TIMESTEP_S).astype(int)  # the step whose state a sample is judged at
     steps = int(at_sample[-1] + math.ceil(SETTLE_S / TIMESTEP_S))
-    position, velocity = _reference(t, q, steps)
-    # kp (q* - q) + kv (qd* - qd), with the joint's own damping and friction fed forward
-    damping = mj.dof_damping[model.dofs]
-    friction = mj.dof_frictionloss[model.dofs]
-    command = position + (velocity * (model.kv + damping) + np.sign(velocity) * friction) / model.kp
+    position, velocity, acceleration = _reference(t, q, steps)
+    command = position + velocity * (model.kv / model.kp)  # kp (q* - q) + kv (qd* - qd)
+    torque = _feedforward(model, position, velocity, acceleration)
+    servos = len(model.qpos)
     limit = model.effort * (1.0 - _SATURATED)
     joints = np.empty((steps + 1, len(model.qpos)))
     joints[0] = q[0]
@@ -105,7 +131,8 @@ def simulate(model: PhysicsModel, times: object, q: object) -> SimulationReport:
     touching: dict[tuple[str, str], list[tuple[int, float]]] = {}
     stable = True
     for k in range(1, steps + 1):
-        data.ctrl[:] = command[k - 1]
+        data.ctrl[:servos] = command[k - 1]
+        data.ctrl[servos:] = torque[k - 1]
         mujoco.mj_step(mj, data)
         joints[k] = data.qpos[model.qpos]
         saturated[k] = np.abs(data.qfrc_actuator[model.dofs]) >= limit
