@@ -2,8 +2,8 @@
 
 The formats are :mod:`._formats`': a CSV is ``#`` comment lines, a ``time,<joint names>`` header
 and one row per sample; an MCAP holds one ``JointTrajectory`` on ``/joint_trajectory`` (its
-points' ``time_from_start``) or one ``JointState`` per sample on ``/joint_states`` (their stamps),
-and the ``teach_studio`` metadata record. A LeRobot dataset is read by ``lerobot`` itself.
+points' ``time_from_start``, read first) or one ``JointState`` per sample on ``/joint_states``
+(their stamps, real times, read from the first), and the ``teach_studio`` metadata record. A LeRobot dataset is read by ``lerobot`` itself.
 """
 
 from __future__ import annotations
@@ -97,6 +97,10 @@ def _seconds(stamp: object) -> float:
     return float(stamp.sec) + 1e-9 * float(stamp.nanosec)  # type: ignore[attr-defined]
 
 
+def _nanoseconds(stamp: object) -> int:
+    return int(stamp.sec) * 1_000_000_000 + int(stamp.nanosec)  # type: ignore[attr-defined]
+
+
 def _read_mcap(path: Path) -> Trajectory:
     from mcap.exceptions import McapError
     from mcap.reader import make_reader
@@ -125,7 +129,8 @@ def _read_mcap(path: Path) -> Trajectory:
         q = np.array([list(p.positions) for p in message.points], dtype=float)
     elif states:
         names = tuple(states[0].name)
-        times = np.array([_seconds(s.header.stamp) for s in states])
+        stamps = np.array([_nanoseconds(s.header.stamp) for s in states], dtype=np.int64)
+        times = (stamps - stamps[0]) / 1e9  # stamps are real times: from the first sample
         q = np.array([list(s.position) for s in states], dtype=float)
     else:
         raise _malformed(path, f"no {TRAJECTORY_TOPIC} or {STATE_TOPIC} messages")

@@ -34,10 +34,10 @@ def test_the_csv_states_the_report_in_its_comment_lines(motion, cache, tmp_path)
     assert "saturation: none" in notes and "contacts: none (self or table)" in notes
 
 
-def test_without_simulate_a_checked_csv_keeps_no_comment_lines(motion, tmp_path):
+def test_without_simulate_the_file_states_no_physics(motion, tmp_path):
     done = export_motion(motion, "csv", tmp_path / "m.csv")
     assert done.physics is None
-    assert not (tmp_path / "m.csv").read_text().startswith("#")
+    assert not any(n.startswith("physics") for n in read_trajectory(tmp_path / "m.csv").notes)
 
 
 def test_the_mcap_states_the_report_in_its_metadata(motion, cache, tmp_path):

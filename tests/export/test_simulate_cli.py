@@ -27,8 +27,11 @@ def gentle(tmp_path_factory):
     times, q = smooth_move(arm.home, arm.home + 0.2, 1.5)
     folder = tmp_path_factory.mktemp("simulate")
     write_csv(folder / "gentle.csv", arm.joint_names, times, q, ["a note"])
-    write_mcap(folder / "gentle.mcap", arm.joint_names, times, q, states=False, metadata={})
-    write_mcap(folder / "states.mcap", arm.joint_names, times, q, states=True, metadata={})
+    start = 1_765_000_000_123_456_789  # a real time, as exports stamp them
+    for name, states in (("gentle.mcap", False), ("states.mcap", True)):
+        write_mcap(
+            folder / name, arm.joint_names, times, q, states=states, metadata={}, start_ns=start
+        )
     return folder, times, q
 
 
