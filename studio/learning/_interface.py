@@ -161,6 +161,7 @@ class Learner(Protocol):
         sweep_keys: its task's settings a sweep may set.
         shortest_paths: whether its task knows its mean shortest path (the level a sweep's
             ``episodes_to_converge`` reaches by default).
+        prepare_seconds: about how long its compiled kernels take to compile (0: none).
     """
 
     kind: str
@@ -173,9 +174,18 @@ class Learner(Protocol):
     form_keys: tuple[str, ...]
     sweep_keys: tuple[str, ...]
     shortest_paths: bool
+    prepare_seconds: float
 
     def train(self, run: TrainingRun, live: LiveProgress, workers: int | None = None) -> object:
         """Learn what ``run`` asks for; the result :meth:`save` writes."""
+        ...
+
+    def kernels(self) -> list[object]:
+        """Its compiled entry points (numba dispatchers; their callees compile into them)."""
+        ...
+
+    def warm(self) -> None:
+        """Compile (or load from the disk cache) every kernel it runs, with a tiny run."""
         ...
 
     def save(

@@ -24,22 +24,18 @@ import sys
 import threading
 import time
 
-import numpy as np
-
-from ._config import DynaQConfig
-from ._experiments import run_experiments
 from ._learner import LiveProgress
-from .runs._record import TASK_ARM_GRID, TASK_ARM_REACH, TASK_KINDS
-from .tabular._dynaq import _run_experiment
-from .tasks._mdp import TabularMDP
+from ._registry import learner
+from .runs._record import TASK_KINDS
 
 log = logging.getLogger(__name__)
 
-PREPARE_SECONDS = {TASK_ARM_GRID: 8.0, TASK_ARM_REACH: 25.0}
-"""Seconds a task's kernels take to compile, the estimate a first run shows: the CPU seconds
-``python benchmarks/bench_prepare.py`` measured (5.5 s and 19.7 s on a 2-core x86-64 machine),
-rounded up, which is the wall time where nothing else competes for the core; a busy machine
-takes longer (38 s and 256 s of wall time at a load average of 26 there)."""
+PREPARE_SECONDS = {kind: learner(kind).prepare_seconds for kind in TASK_KINDS}
+"""Seconds a task's kernels take to compile, the estimate a first run shows (each learner's
+``prepare_seconds``: the CPU seconds ``python benchmarks/bench_prepare.py`` measured, 5.5 s for
+the arm grid and 19.7 s for the continuous task on a 2-core x86-64 machine, rounded up, which is
+the wall time where nothing else competes for the core; a busy machine takes longer, 38 s and
+256 s of wall time at a load average of 26 there)."""
 BACKGROUND_NICENESS = 0
 """How much lower the background compilation's CPU priority is (Linux ``nice``): none. It runs in
 its own process, so it never holds the studio's GIL; and a first run may wait for it, which must
@@ -54,11 +50,7 @@ _background: tuple[subprocess.Popen | None, str | None] = (None, None)  # child,
 
 def _kernels(kind: str) -> list:
     """The task's compiled entry points (their callees are compiled into them)."""
-    if kind == TASK_ARM_REACH:
-        from .linear._linear import _greedy_episode, _run_compiled
-
-        return [_run_compiled, _greedy_episode]
-    return [_run_experiment]
+    return learner(kind).kernels()
 
 
 def _cached_on_disk(dispatcher: object) -> bool:
@@ -86,32 +78,7 @@ def preparing_note(kind: str) -> str:
 
 def _warm(kind: str) -> None:
     """Compile (or load) every kernel a run of ``kind`` uses, with a one-episode run."""
-    if kind == TASK_ARM_REACH:
-        import gymnasium
-
-        from .linear._linear import greedy_rollout
-        from .tasks._gym import ARM_REACH_ID
-        from .tasks._reach import ArmReach
-
-        task = ArmReach(joints=3)
-        coding = task.features()
-        result = run_experiments(
-            lambda: gymnasium.make(ARM_REACH_ID, arm_reach=task),
-            DynaQConfig(planning_steps=1),
-            1,
-            1,
-            0,
-            None,
-            coding,
-            workers=1,
-        )
-        greedy_rollout(task, result.coder, result.weights[0], np.zeros(3), 1)
-        return
-    corridor = TabularMDP(
-        np.array([[1], [1]]), np.array([[1.0], [0.0]]), np.array([False, True]), np.array([0])
-    )
-    for planning in ("full", "prioritized"):
-        run_experiments(corridor, DynaQConfig(planning=planning, planning_steps=1), 1, 1, 0)
+    learner(kind).warm()
 
 
 def prepare_learner(kind: str, live: LiveProgress | None = None) -> float:

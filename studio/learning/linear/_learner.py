@@ -16,6 +16,7 @@ from typing import Final, cast
 import gymnasium
 import numpy as np
 
+from .._config import DynaQConfig
 from .._errors import LearningError
 from .._interface import Evaluation, Rollout, Start, TrainingRun, listed_degrees
 from .._learner import LiveProgress
@@ -24,7 +25,13 @@ from ..likeness._likeness import LikenessCard, likeness_card, robot_tool_positio
 from ..tasks._demo_motion import DemonstrationMotion
 from ..tasks._gym import ARM_REACH_ID
 from ..tasks._reach import ArmReach
-from ._linear import LinearResult, greedy_rollout, run_linear_experiments
+from ._linear import (
+    LinearResult,
+    _greedy_episode,
+    _run_compiled,
+    greedy_rollout,
+    run_linear_experiments,
+)
 from ._policy import (
     DEFAULT_MAX_STEPS,
     DEFAULT_SECONDS_PER_STEP,
@@ -84,6 +91,7 @@ class TileLearner:
     form_keys = tuple(REACH_DEFAULTS)
     sweep_keys = (*(f.name for f in fields(ArmReach)), *CODING_SETTINGS)
     shortest_paths = False
+    prepare_seconds = 25.0
     watch_max_steps: int | None = WATCH_MAX_STEPS
 
     def train(
@@ -101,6 +109,23 @@ class TileLearner:
             workers=workers,
             live=live,
         )
+
+    def kernels(self) -> list[object]:
+        return [_run_compiled, _greedy_episode]
+
+    def warm(self) -> None:
+        task = ArmReach(joints=3)
+        result = run_linear_experiments(
+            lambda: gymnasium.make(ARM_REACH_ID, arm_reach=task),
+            DynaQConfig(planning_steps=1),
+            1,
+            1,
+            0,
+            None,
+            task.features(),
+            workers=1,
+        )
+        greedy_rollout(task, result.coder, result.weights[0], np.zeros(3), 1)
 
     def save(
         self,

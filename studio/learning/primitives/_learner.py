@@ -45,6 +45,7 @@ class DmpLearner:
     form_keys: tuple[str, ...] = ()
     sweep_keys: tuple[str, ...] = ()
     shortest_paths = False
+    prepare_seconds = 0.0  # (numpy only: nothing to compile)
     watch_max_steps: int | None = None
 
     def train(
@@ -57,6 +58,12 @@ class DmpLearner:
         motion = run.demonstration_motions[0]
         robot = getattr(run.task, "robot", None)
         return fit_dmp_policy(motion.times, motion.q_robot, **({"robot": robot} if robot else {}))
+
+    def kernels(self) -> list[object]:
+        return []
+
+    def warm(self) -> None:
+        return None
 
     def save(
         self,

@@ -12,14 +12,16 @@ from pathlib import Path
 
 import numpy as np
 
+from .._config import DynaQConfig
 from .._errors import LearningError
 from .._interface import Evaluation, Rollout, Start, TrainingRun, listed_degrees
 from .._learner import ExperimentResult, LiveProgress
 from ..likeness._likeness import LikenessCard, likeness_card, robot_tool_positions
 from ..tasks._arm import ArmGrid
 from ..tasks._demo_motion import DemonstrationMotion
+from ..tasks._mdp import TabularMDP
 from ..tasks._robot import default_goal
-from ._dynaq import run_tabular_experiments
+from ._dynaq import _run_experiment, run_tabular_experiments
 from ._policy import (
     FORMAT_NAME,
     ROLLOUT_MAX_STEPS,
@@ -52,6 +54,7 @@ class TabularLearner:
     form_keys = ("bins",)
     sweep_keys = tuple(f.name for f in fields(ArmGrid))
     shortest_paths = True
+    prepare_seconds = 8.0
     watch_max_steps: int | None = ROLLOUT_MAX_STEPS
 
     def train(
@@ -68,6 +71,17 @@ class TabularLearner:
             workers=workers,
             live=live,
         )
+
+    def kernels(self) -> list[object]:
+        return [_run_experiment]
+
+    def warm(self) -> None:
+        corridor = TabularMDP(
+            np.array([[1], [1]]), np.array([[1.0], [0.0]]), np.array([False, True]), np.array([0])
+        )
+        for planning in ("full", "prioritized"):
+            config = DynaQConfig(planning=planning, planning_steps=1)
+            run_tabular_experiments(corridor, config, 1, 1, 0)
 
     def save(
         self,
