@@ -196,3 +196,26 @@ def test_a_capture_stopped_by_a_full_disk_keeps_its_frames_and_says_so(
     # a new capture works once there is room again
     assert client.post("/api/capture/start", json={"name": "take-2"}).status_code == 200
     assert client.post("/api/capture/stop").status_code == 200
+
+
+@pytest.mark.parametrize("fmt", ["csv", "mcap", "lerobot"])
+def test_a_full_temporary_folder_is_blamed_not_the_data_folder(
+    client: TestClient, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, fmt: str
+) -> None:
+    """A download is written in the temporary folder: with that one full, the answer once named
+    the data folder's disk (which had room), or spoke the command line's words (--out)."""
+    import tempfile
+
+    temporary = tmp_path / "temporary"
+    temporary.mkdir()
+    monkeypatch.setattr(tempfile, "tempdir", str(temporary))
+    with disk_full(monkeypatch, temporary):
+        r = client.get(f"/api/robot/export/demonstration/sample-reach-1?format={fmt}")
+    assert r.status_code == 507, r.text
+    detail = r.json()["detail"]
+    assert detail.startswith(f"The disk holding the temporary folder {temporary} is full")
+    assert str(tmp_path / "recordings") not in detail and "--out" not in detail
+    assert "\n" not in detail
+    assert _files(temporary) == []  # nothing half-made left behind
+    ok = client.get(f"/api/robot/export/demonstration/sample-reach-1?format={fmt}")
+    assert ok.status_code == 200  # room again: the same export works

@@ -4,8 +4,10 @@ timing, safety checks and formats as ``studio export``)."""
 
 from __future__ import annotations
 
+import errno
 import shutil
 import tempfile
+from collections.abc import Callable
 from pathlib import Path
 from typing import Literal, get_args
 
@@ -15,6 +17,7 @@ from studio.capture import DEMO_SUFFIX, RECORDING_SUFFIXES
 from studio.export import (
     FORMAT_SUFFIXES,
     FORMATS,
+    ExportError,
     check_policy_robot,
     export_motion,
     simulate_motion,
@@ -22,6 +25,8 @@ from studio.export import (
 from studio.learning import ROLLOUT_RATE_HZ
 from studio.motion import Motion, demonstration_motion, recording_motion
 from studio.physics import SimulationReport
+
+from .._errors import STORAGE_PROBLEMS, StorageError
 
 ExportFormat = Literal["csv", "mcap", "lerobot"]
 """The formats of :data:`studio.export.FORMATS`, as the API's query parameter."""
@@ -74,15 +79,15 @@ def export_for_robot(
     for ending in (DEMO_SUFFIX, *RECORDING_SUFFIXES):
         stem = stem.removesuffix(ending)
     motion = _motion(path, robot, retime)
-    folder = Path(tempfile.mkdtemp(prefix="studio-export-"))
-    try:
+
+    def write(folder: Path) -> Path:
         out = folder / f"{stem}.{robot}{FORMAT_SUFFIXES[fmt]}"
         export_motion(motion, fmt, out, unchecked=unchecked)
         if fmt == "lerobot":
             out = Path(shutil.make_archive(str(out), "zip", root_dir=out))
-    except BaseException:
-        shutil.rmtree(folder, ignore_errors=True)
-        raise
+        return out
+
+    out, folder = _in_a_temporary_folder(write)
     return out, out.name, folder
 
 
@@ -107,11 +112,48 @@ def export_rollout(
     """
     arm = check_policy_robot(policy, robot, robot)
     motion = Motion("policy", policy.name, arm, times, q, True, ROLLOUT_RATE_HZ)
-    folder = Path(tempfile.mkdtemp(prefix="studio-export-"))
-    try:
+
+    def write(folder: Path) -> Path:
         out = folder / f"{name}.rollout{FORMAT_SUFFIXES['mcap']}"
         export_motion(motion, "mcap", out, unchecked=unchecked)
-    except BaseException:
-        shutil.rmtree(folder, ignore_errors=True)
-        raise
+        return out
+
+    out, folder = _in_a_temporary_folder(write)
     return out, out.name, folder
+
+
+def _in_a_temporary_folder(write: Callable[[Path], Path]) -> tuple[Path, Path]:
+    """``(write(folder), folder)`` for a fresh temporary folder, removed if ``write`` fails.
+
+    A download is written in the temporary folder, not the data folder, so a disk that refuses
+    it is that folder's: the sentence names it, in the page's words (the export package's own
+    sentences speak to the command line, naming ``--out``).
+
+    Raises:
+        StorageError: the temporary folder's disk refused the write (full, read-only, ...).
+    """
+    folder: Path | None = None
+    try:
+        folder = Path(tempfile.mkdtemp(prefix="studio-export-"))
+        return write(folder), folder
+    except (OSError, ExportError) as err:
+        if folder is not None:
+            shutil.rmtree(folder, ignore_errors=True)
+        cause = err if isinstance(err, OSError) else err.__context__
+        if not isinstance(cause, OSError):
+            raise
+        what = STORAGE_PROBLEMS.get(cause.errno or 0, (f"failed ({cause.strerror or cause})",))[0]
+        room = "free some space there" if cause.errno in _FULL else "fix that folder"
+        raise StorageError(
+            f"The disk holding the temporary folder {tempfile.gettempdir()} {what}, so the "
+            f"export could not be written (your data folder is untouched); {room}, or start the "
+            "studio with TMPDIR set to a folder on a disk with room, and export again."
+        ) from None
+    except BaseException:
+        if folder is not None:
+            shutil.rmtree(folder, ignore_errors=True)
+        raise
+
+
+_FULL = (errno.ENOSPC, errno.EDQUOT)
+"""Disk failures that free space fixes."""
