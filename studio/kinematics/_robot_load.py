@@ -259,8 +259,14 @@ def _read_kept(folder: Path) -> Parts | None:
         return _read_archives(files)
     except FileNotFoundError:
         return None
-    except (OSError, ValueError, RuntimeError) as err:
-        log.warning("the kept geometry in %s is ignored and built again: %s", folder, err)
+    except Exception as err:  # noqa: BLE001 (a damaged archive raises what Pinocchio's reader
+        # meets: RuntimeError, ValueError, or a MemoryError for a length it cannot allocate)
+        log.warning(
+            "the kept geometry in %s is ignored and built again: %s: %s",
+            folder,
+            type(err).__name__,
+            err,
+        )
         return None
 
 

@@ -181,3 +181,27 @@ def test_another_pinocchio_or_urdf_is_another_cache_entry(tmp_path, monkeypatch)
     assert robot_load._cache_entry(SPEC, "<robot name='other'/>") != entry
     monkeypatch.setattr(robot_load, "_cache", [])
     assert robot_load._cache_entry(SPEC, TEXT) is None
+
+
+def test_a_kept_robot_damaged_with_its_hashes_is_built_again(tmp_path, monkeypatch, caplog):
+    """An archive damaged before its hashes were written (they match it) raised an uncaught
+    ``MemoryError`` in ``loadFromBinary``: ``PUT /api/robot`` answered 500 until ``cache/`` was
+    deleted by hand."""
+    import hashlib
+    import json
+
+    monkeypatch.setattr(robot_load, "_cache", [tmp_path])
+    built = robot_load._built_in_child(SPEC, TEXT)
+    (kept,) = tmp_path.iterdir()
+    archive = kept / "model.bin"
+    data = bytearray(archive.read_bytes())
+    data[0:8] = b"\xff" * 7 + b"\x0f"  # a length no memory holds
+    archive.write_bytes(bytes(data))
+    hashes = json.loads((kept / robot_load._MANIFEST).read_text())
+    hashes["model.bin"] = hashlib.sha256(bytes(data)).hexdigest()
+    (kept / robot_load._MANIFEST).write_text(json.dumps(hashes))
+    again = robot_load._built_in_child(SPEC, TEXT)
+    assert "ignored and built again: MemoryError" in caplog.text
+    _same_robot(built, again)
+    monkeypatch.setattr(robot_load, "_CHILD", FAILING_CHILD)
+    _same_robot(built, robot_load._built_in_child(SPEC, TEXT))  # the rebuilt copy is kept
