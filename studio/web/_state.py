@@ -40,9 +40,8 @@ from studio.kinematics import (
     robot_spec,
 )
 from studio.learning import (
+    AnyPolicy,
     DemonstrationPath,
-    PolicyFile,
-    TilePolicyFile,
     default_goal_deg,
     goal_pose,
 )
@@ -695,9 +694,7 @@ class Studio:
                 return r.policy_path, f"run:{policy}"
         return self.policies.path(policy), f"policy:{policy}"
 
-    def load_policy(
-        self, run: str | None, policy: str | None
-    ) -> tuple[PolicyFile | TilePolicyFile, str]:
+    def load_policy(self, run: str | None, policy: str | None) -> tuple[AnyPolicy, str]:
         """Load the policy of a run or an uploaded policy, of either kind, through the policy
         store's one reader; returns it and its key (see :meth:`policy_file`)."""
         path, key = self.policy_file(run, policy)

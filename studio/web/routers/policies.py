@@ -8,7 +8,7 @@ from fastapi import APIRouter, File, Response, UploadFile
 from fastapi.responses import FileResponse
 from starlette.concurrency import run_in_threadpool
 
-from studio.learning import POLICY_SUFFIX, PolicyFile, TilePolicyFile, policy_summary
+from studio.learning import POLICY_SUFFIX, AnyPolicy, policy_summary
 
 from .._deps import SettingsDep, StudioDep
 from .._schemas import PolicyPublic
@@ -19,7 +19,7 @@ router = APIRouter(prefix="/api/policies", tags=["policies"])
 
 
 def policy_public(
-    entry: StoredFile[PolicyFile | TilePolicyFile], source: Literal["upload", "run"] = "upload"
+    entry: StoredFile[AnyPolicy], source: Literal["upload", "run"] = "upload"
 ) -> PolicyPublic:
     """The list entry of one policy file of either kind, from the learning package's summary.
 

@@ -53,7 +53,7 @@ from studio.capture import (
     summarize_any_recording,
     update_recording_meta,
 )
-from studio.learning import POLICY_SUFFIX, PolicyFile, TilePolicyFile, load_any_policy
+from studio.learning import POLICY_SUFFIX, AnyPolicy, load_any_policy
 from studio.motion import checked_demonstration
 from studio.samples import SAMPLES_DIR
 
@@ -731,7 +731,7 @@ def demonstration_store(
 
 def policy_store(
     folder: Path, on_change: OnChange | None = None, in_use: InUse | None = None
-) -> FolderStore[PolicyFile | TilePolicyFile]:
+) -> FolderStore[AnyPolicy]:
     """Policies ``<folder>/<name>.policy.npz`` of every kind the studio writes, tabular or
     tile-coded (runs keep theirs in their run folder; the store reads those too)."""
     return FolderStore(
