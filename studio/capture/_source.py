@@ -27,6 +27,13 @@ RATE_WINDOW_FRAMES = 110
 RATE_WINDOW_SECONDS = 1.0
 """Only frames that arrived this recently count towards the rate, so a source that goes quiet
 (a paused recording, a silent bridge, a stalled device) reads 0 Hz within a second."""
+SLOW_RATE_WINDOW_SECONDS = 5.0
+"""A source slower than a frame or two a second (the camera's pose model without a GPU: 1-3
+frames a second) is measured over its last frames within this long, while they keep coming at a
+steady pace: else it would read 0 Hz between two of its frames."""
+SLOW_RATE_STEADY = 3.0
+"""The last frames' intervals count as a steady pace when the longest is at most this many times
+the shortest (a frame after a pause is not a rate)."""
 STOP_JOIN_SECONDS = 2.0
 """How long :meth:`ThreadedSource.stop` waits for the producer thread to end."""
 
@@ -103,6 +110,21 @@ class FrameSource(Protocol):
 
 ObservationT = TypeVar("ObservationT", bound=Observation)
 """The kind of observation a source yields (:class:`TapeFrame`, a landmark frame, a hand pose)."""
+
+
+def measured_rate(arrivals: Sequence[float], now: float) -> float:
+    """Frames per second from arrival times (s, oldest first): over the last second's frames
+    (0 with fewer than two, so a source that goes quiet reads 0 Hz within a second), else over
+    the last three frames of a slow source that still comes at a steady pace."""
+    recent = [t for t in arrivals if t >= now - RATE_WINDOW_SECONDS]
+    if len(recent) >= 2:
+        return (len(recent) - 1) / (recent[-1] - recent[0]) if recent[-1] > recent[0] else 0.0
+    slow = [t for t in arrivals if t >= now - SLOW_RATE_WINDOW_SECONDS][-3:]
+    gaps = [b - a for a, b in zip(slow, slow[1:], strict=False)]
+    if len(gaps) < 2 or min(gaps) <= 0 or max(gaps) > SLOW_RATE_STEADY * min(gaps):
+        return 0.0
+    interval = sum(gaps) / len(gaps)
+    return 1.0 / interval if now - slow[-1] <= 2.0 * interval else 0.0
 
 
 class ThreadedSource(Generic[ObservationT]):
@@ -196,10 +218,7 @@ class ThreadedSource(Generic[ObservationT]):
             arrivals = list(self._arrivals)
             frames, dropped, rejected = self._frames, self._dropped, self._rejected
             error, warning = self._error, self._warning
-        recent = [t for t in arrivals if t >= time.monotonic() - RATE_WINDOW_SECONDS]
-        rate = 0.0
-        if len(recent) >= 2 and recent[-1] > recent[0]:
-            rate = (len(recent) - 1) / (recent[-1] - recent[0])
+        rate = measured_rate(arrivals, time.monotonic())
         return SourceStatus(
             self.kind, self.running, rate, frames, dropped, error, rejected, warning
         )

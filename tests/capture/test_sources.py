@@ -340,6 +340,19 @@ def test_the_rate_is_measured_over_the_last_second_and_falls_to_zero_when_frames
         source.stop()
 
 
+def test_a_slow_camera_reads_its_rate_between_frames():
+    """The camera's pose model runs 1-3 frames a second without a GPU: the top bar read "rate
+    0 Hz" between its frames while landmarks arrived. A steady slow source reads its rate; a
+    frame after a pause, or a source gone quiet for two of its intervals, reads 0."""
+    from studio.capture._source import measured_rate
+
+    frames = [10.0, 10.8, 11.6, 12.4]  # 1.25 frames a second, steady
+    assert measured_rate(frames, 12.9) == pytest.approx(1.25)  # half a second after the last
+    assert measured_rate(frames, 12.4 + 1.7) == 0.0  # two intervals of silence
+    assert measured_rate([10.0, 10.01, 10.02, 11.5], 11.5) == 0.0  # one frame after a pause
+    assert measured_rate([10.0, 10.01, 10.02], 10.5) == pytest.approx(100.0)  # the last second
+
+
 def test_a_crashing_producer_reports_its_error():
     from studio.capture._source import ThreadedSource
 

@@ -100,6 +100,38 @@ def test_scrub_a_rollout_change_its_speed_and_step_it(
     assert not page.errors  # type: ignore[attr-defined]
 
 
+def test_a_step_always_moves_the_clock_or_says_it_cannot(
+    page: Any, studio_server: Studio, tmp_path: Any
+) -> None:
+    """Step forward once left the rollout's clock where it was: at the rollout's end a step has
+    nowhere to go, and its button now says so (disabled); anywhere else each step moves the
+    clock by one sample."""
+    scene = _slowest_rollout_shown(page, studio_server, tmp_path)
+    forward = page.get_by_role("button", name="Step forward")
+    back = page.get_by_role("button", name="Step back")
+    clock = page.get_by_test_id("rollout-clock")
+    slider = page.get_by_role("slider", name="Rollout time")
+    slider.focus()
+    slider.press("End")
+    assert _until(lambda: scene()["sample"] == scene()["samples"] - 1)
+    assert _until(forward.is_disabled) and back.is_enabled()
+    at_end = clock.inner_text()
+    back.click()
+    assert _until(lambda: clock.inner_text() != at_end) and _until(forward.is_enabled)
+    before = clock.inner_text()
+    forward.click()
+    assert _until(lambda: clock.inner_text() != before)
+    assert clock.inner_text() == at_end and _until(forward.is_disabled)
+    slider.press("Home")
+    assert _until(lambda: scene()["sample"] == 0)
+    assert _until(back.is_disabled) and forward.is_enabled()
+    start = clock.inner_text()
+    forward.click()
+    assert _until(lambda: clock.inner_text() != start and scene()["sample"] == 1)
+    assert back.is_enabled()
+    assert not page.errors  # type: ignore[attr-defined]
+
+
 def test_keyboard_shortcuts_scrub_the_rollout_but_not_while_typing(
     page: Any, studio_server: Studio, tmp_path: Any
 ) -> None:

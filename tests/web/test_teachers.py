@@ -73,6 +73,8 @@ def test_no_person_is_counted_and_said(client: TestClient) -> None:
     source = client.get("/api/source").json()
     assert source["frames"] == 1 and source["person_detected"] is False
     assert source["camera_fps"] == 3.5 and source["model"] == "lite"
+    # nothing was fitted: no residual to show (it read "0.0 mm", as if the fit were exact)
+    assert source["fit_residual_mm"] is None
 
 
 def test_bad_landmarks_get_one_sentence(client: TestClient) -> None:

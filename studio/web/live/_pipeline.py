@@ -541,7 +541,9 @@ class Pipeline:
                     with self._lock:
                         self._q_human = fitted.q_human
                         self._q_robot = fitted.q_robot
-                        self._residual = fitted.residual
+                        # a frame the fit could not use (no person in view) has no residual
+                        fitted_none = fitted.observable is not None and not fitted.observable.any()
+                        self._residual = None if fitted_none else fitted.residual
                         self._observable = fitted.observable
                         self._last_t = float(observation.t)
                         self._kin_error = None

@@ -15,7 +15,11 @@ export function renderSource() {
   setText("src-frames", s.frames ?? "–");
   setText("src-dropped", s.dropped ?? "–");
   setText("src-residual", fmt(s.fit_residual_mm, 1));
-  setText("src-q", (s.q_robot || []).map((v) => ((v * 180) / Math.PI).toFixed(0).padStart(4)).join(" ") + " °");
+  // The joints of the robot drawn: while another robot's meshes load, the live chain already
+  // drives the new one, whose angles would read as the drawn robot's.
+  const drawn = !s.robot_drawn || !s.robot || s.robot_drawn === s.robot;
+  setText("src-q", drawn ? (s.q_robot || []).map((v) => ((v * 180) / Math.PI).toFixed(0).padStart(4)).join(" ") + " °" : "–");
+  setProp("src-q", "title", drawn ? "" : `the ${robotTitle(s.robot)}'s joints show once it is drawn`);
   // The source's own trouble (no device, a dropped bridge) stays apart from a refused action.
   showError("source-status-error", s.error ? `Source: ${s.error}` : null);
   const rejected = s.rejected ? `${s.rejected} datagram${s.rejected === 1 ? "" : "s"} rejected` : "";

@@ -108,6 +108,9 @@ function render() {
   if (!slider.dataset.dragging) setProp(slider, "value", String(t));
   setText("rollout-clock", `${fmt(t, 2)} / ${fmt(r.duration, 2)} s`);
   const playing = !r.paused && t < r.duration;
+  // A step has nowhere to go at an end: its button says so, rather than leave the clock still.
+  setProp("rollout-forward", "disabled", t >= r.duration);
+  setProp("rollout-back", "disabled", t <= 0);
   setText("rollout-play", playing ? "❚❚" : "▶");
   $("rollout-play").setAttribute("aria-label", playing ? "Pause" : "Play");
   if (!playing) stopTicker();
