@@ -176,8 +176,12 @@ def arm_view(
     def build() -> list[MeshPart]:
         return (_simplified_elsewhere if elsewhere else _simplified)(visuals, simplified, scale)
 
-    files = [str(g.meshPath) for g in arm.visual_model.geometryObjects]
-    parts = cached_parts(cache, arm.name, mesh_key(files, simplified.cell_m, scale), build)
+    geometries = arm.visual_model.geometryObjects
+    files = [str(g.meshPath) for g in geometries]
+    # the parts are attached to the visual model's objects by index: the key covers that model
+    model = [(g.name, int(g.parentJoint), int(g.parentFrame)) for g in geometries]
+    key = mesh_key(files, simplified.cell_m, scale, arm.model.nq, model)
+    parts = cached_parts(cache, arm.name, key, build, frames=range(len(geometries)))
     # Its own scratch data: the arm's own is the retargeting's, in another thread.
     data, geometry_data = arm.model.createData(), arm.visual_model.createData()
     lock = threading.Lock()
