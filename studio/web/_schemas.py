@@ -156,14 +156,16 @@ class SourceUpdate(_Body):
 
 
 class LandmarksFrame(_Body):
-    """One frame of MediaPipe Pose landmarks from the page (see docs/api.md)."""
+    """One frame of MediaPipe Pose landmarks from the page (see docs/api.md), parsed only: the
+    camera source judges its values and sizes, once, with one sentence (its body is bounded by
+    the route's request limit)."""
 
     t: float = Field(description="the page's clock, seconds")
     world: list[list[float]] | None = Field(
-        None, max_length=33, description="33 x [x, y, z, visibility], metres; null: no person"
+        None, description="33 x [x, y, z, visibility], metres; null: no person"
     )
     image: list[list[float]] | None = Field(
-        None, max_length=33, description="33 x [x, y, visibility], normalised image coordinates"
+        None, description="33 x [x, y, visibility], normalised image coordinates"
     )
     width: int = Field(description="image width, pixels")
     height: int = Field(description="image height, pixels")

@@ -29,12 +29,14 @@ def test_the_studio_gets_the_parsed_frame_and_answers_typed(client: TestClient, 
     assert r.json() == answered[0].model_dump()
 
 
-def test_a_bad_value_is_the_camera_sources_one_sentence(client: TestClient):
-    """The schema parses; the values are judged once, by capture (its sentence, 422)."""
+def test_a_wrong_size_is_the_camera_sources_one_sentence(client: TestClient):
+    """The schema parses; the sizes are judged once, by capture (its sentence, 422), whether
+    too few landmarks or too many."""
     camera(client)
-    frame = landmarks()
-    frame["world"] = frame["world"][:32]
-    r = client.post("/api/source/landmarks", json=frame)
-    assert r.status_code == 422
-    detail = r.json()["detail"]
-    assert isinstance(detail, str) and "33 landmarks" in detail
+    for rows in (32, 34):
+        frame = landmarks()
+        frame["world"] = (frame["world"] * 2)[:rows]
+        r = client.post("/api/source/landmarks", json=frame)
+        assert r.status_code == 422
+        detail = r.json()["detail"]
+        assert isinstance(detail, str) and "33 landmarks" in detail, detail
