@@ -2,17 +2,29 @@
 
 In CI (``CI=true``) nothing may be skipped for a missing browser or package: :func:`require`
 turns such a skip into a failure there.
+
+The suite runs on every core (pytest-xdist, ``-n auto --dist loadfile`` in pyproject.toml): a
+test file stays on one worker, in order, so its module fixtures are made once. Before the workers
+start, :func:`pytest_configure` compiles the learners' and the arm IK's numba kernels into numba's
+disk cache (the studio's own start-up preparation), so the workers load them instead of each
+compiling the same kernels at once. Every browser test is marked ``e2e``
+(:func:`pytest_collection_modifyitems` refuses one that is not), so ``-m "not e2e"`` runs the
+fast set; the browser files are handed out first, since they take the longest.
 """
 
 from __future__ import annotations
 
+import functools
 import os
 import socket
 import threading
+from pathlib import Path
 
 import pytest
 
 IN_CI = os.environ.get("CI", "").lower() in ("1", "true", "yes")
+E2E_DIR = Path(__file__).resolve().parent / "e2e"
+"""The browser tests' folder: every test in it drives Chromium."""
 
 
 def require(condition: bool, reason: str) -> None:
@@ -47,3 +59,48 @@ def hold_preparation(monkeypatch: pytest.MonkeyPatch) -> tuple[threading.Event, 
     monkeypatch.setattr(_prepare, "learner_ready", lambda kind: False)
     monkeypatch.setattr(_prepare, "_warm", slow_warm)
     return compiling, compiled
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    """On the controller of xdist workers, fill numba's disk cache before they start."""
+    distributed = getattr(config.option, "dist", "no") != "no"
+    if distributed and not hasattr(config, "workerinput") and not config.option.collectonly:
+        warm_kernels()
+
+
+def warm_kernels() -> None:
+    """Compile (or, when cached, just check) the kernels every studio prepares at start: the
+    learners' and the arm IK's, each in a child process, waiting for both.
+
+    Without it each worker compiles a kernel its tests need at the same moment as the others
+    (tens of CPU seconds each on a fresh clone), and numba's cache index of a function is
+    rewritten by whichever finishes last."""
+    from studio.kinematics import prepare_arm_ik_in_background
+    from studio.learning import prepare_in_background
+
+    for thread in (prepare_in_background(), prepare_arm_ik_in_background()):
+        if thread is not None:
+            thread.join()
+
+
+@functools.cache
+def _drives_chromium(path: Path) -> bool:
+    """Whether the tests of file ``path`` drive Chromium: it is in ``tests/e2e``, or it starts
+    Playwright itself."""
+    return E2E_DIR in path.parents or "sync_playwright" in path.read_text(errors="replace")
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """Refuse a browser test not marked ``e2e``; put the browser files first (stable otherwise:
+    each file keeps its order), so the slowest files start first and no worker idles at the end."""
+
+    def browser(item: pytest.Item) -> bool:
+        return _drives_chromium(item.path.resolve())
+
+    unmarked = [i.nodeid for i in items if browser(i) and not i.get_closest_marker("e2e")]
+    if unmarked:
+        raise pytest.UsageError(
+            f"{len(unmarked)} browser test(s) are not marked e2e ({unmarked[0]}, ...): add "
+            "`pytestmark = pytest.mark.e2e` to the file, so that -m 'not e2e' leaves them out."
+        )
+    items.sort(key=lambda item: not browser(item))

@@ -98,7 +98,10 @@ def test_kill_9_mid_capture_recovers_every_flushed_frame(tmp_path):
             line = child.stdout.readline()
             if int(line) >= 5000:
                 break
-        time.sleep(0.2)
+        deadline = time.monotonic() + 30  # and until they are on disk (flushed every 0.05 s)
+        while path.read_text().count("\n") - 2 < 5000:
+            assert time.monotonic() < deadline, "the child flushed no frames"
+            time.sleep(0.02)
     finally:
         child.send_signal(signal.SIGKILL)
         child.wait()

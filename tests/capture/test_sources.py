@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import dataclasses
 import socket
-import threading
 import time
 
 import numpy as np
@@ -75,8 +74,7 @@ def test_playback_seek_pause_and_loop(tmp_path, frames):
     source.pause()
     source.seek(2.0)
     source.start()
-    time.sleep(0.1)
-    assert source.read() == []  # paused
+    assert source.read(timeout=0.1) == []  # paused: no frame comes while we wait for one
     source.resume()
     got = _drain(source, lambda f: len(f) >= 2 * len(frames))
     source.stop()
@@ -364,7 +362,7 @@ def test_a_crashing_producer_reports_its_error():
 
     source = Broken()
     source.start()
-    threading.Event().wait(0.2)
+    _wait(lambda: not source.running)
     assert not source.running and "wire cut" in source.status().error
 
 

@@ -12,6 +12,7 @@ import os
 import shutil
 import subprocess
 import sys
+import threading
 import time
 import urllib.error
 import urllib.request
@@ -177,6 +178,40 @@ def own_page(
         page.goto(studio.base + "/")
         page.wait_for_selector("body[data-ready='1']", timeout=60_000)
         page.errors = errors
+        yield page
+    finally:
+        context.close()
+
+
+@contextmanager
+def serve_app(app: Any, port: int) -> Iterator[str]:
+    """Serve a studio app made in this process (so a test can reach inside it) with uvicorn on
+    loopback ``port``, in a thread; yields its base URL, and stops it afterwards."""
+    import uvicorn
+
+    from tests.web.conftest import wait_for
+
+    server = uvicorn.Server(uvicorn.Config(app, host="127.0.0.1", port=port, log_level="warning"))
+    thread = threading.Thread(target=server.run, daemon=True)
+    thread.start()
+    try:
+        assert wait_for(lambda: server.started, 60), "the studio app did not start serving"
+        yield f"http://127.0.0.1:{port}"
+    finally:
+        server.should_exit = True
+        thread.join(30)
+
+
+@pytest.fixture
+def blank_page(browser: Any) -> Iterator[Any]:
+    """A page of its own (1440 x 900, downloads allowed) with nothing loaded yet; ``page.errors``
+    holds its script errors. Its browser context is closed afterwards."""
+    context = browser.new_context(viewport={"width": 1440, "height": 900}, accept_downloads=True)
+    page = context.new_page()
+    errors: list[str] = []
+    page.on("pageerror", lambda e: errors.append(str(e)))
+    page.errors = errors
+    try:
         yield page
     finally:
         context.close()

@@ -36,6 +36,8 @@ from tests.e2e.camera_clips import (
 from tests.e2e.conftest import CHROMIUM, CHROMIUM_FLAGS, Studio, shot
 from tests.page_hooks import hook
 
+pytestmark = pytest.mark.e2e
+
 READY_TIMEOUT_MS = 60_000
 ESTIMATE_TIMEOUT_MS = 420_000
 """Loading the model and estimating the first frames: seconds alone, minutes on a shared machine."""

@@ -25,6 +25,8 @@ from tests.e2e.conftest import ARTIFACTS, Studio, own_page
 from tests.page_hooks import hook
 from tests.web.conftest import wait_for
 
+pytestmark = pytest.mark.e2e
+
 T = 20.0  # s: the longest one step of the page may take (the machine may be busy)
 SHOTS = Path(os.environ.get("COMPARE_SHOTS", str(ARTIFACTS)))
 

@@ -13,6 +13,8 @@ import pytest
 
 from tests.e2e.conftest import Studio, shot
 
+pytestmark = pytest.mark.e2e
+
 T = 20_000  # ms: the longest a single UI step may take
 RUN_NAME = "e2e-continuous"
 TRAIN_TIMEOUT_S = 180.0

@@ -17,6 +17,8 @@ import pytest
 from studio.learning import FIGURE_POINTS, curve_statistics, downsample_curve
 from studio.web._app import STATIC_DIR
 
+pytestmark = pytest.mark.e2e
+
 ORIGIN = "http://page.test"
 
 BROWSER_RULE = """async ([curve, points]) => {

@@ -7,8 +7,11 @@ import time
 from typing import Any
 
 import numpy as np
+import pytest
 
 from tests.e2e.conftest import Studio, shot
+
+pytestmark = pytest.mark.e2e
 
 T = 20_000  # ms: the longest a single UI step may take
 

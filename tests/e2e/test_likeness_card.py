@@ -5,8 +5,12 @@ from __future__ import annotations
 
 from typing import Any
 
+import pytest
+
 from tests.e2e.conftest import Studio, shot
 from tests.e2e.test_continuous import _wait
+
+pytestmark = pytest.mark.e2e
 
 T = 20_000  # ms: the longest a single UI step may take
 TRAIN_TIMEOUT_S = 180.0

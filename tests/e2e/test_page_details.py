@@ -16,6 +16,8 @@ import pytest
 from tests.e2e.conftest import Studio, shot
 from tests.web.conftest import wait_for
 
+pytestmark = pytest.mark.e2e
+
 READY_TIMEOUT_MS = 30_000
 T = 20.0  # s: the longest one step of the page may take (the machine may be busy)
 WCAG_AA = 4.5

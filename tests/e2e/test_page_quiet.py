@@ -16,6 +16,8 @@ import pytest
 from tests.e2e.conftest import Studio
 from tests.page_hooks import hook
 
+pytestmark = pytest.mark.e2e
+
 SOURCE_EVENTS = 8
 """Source events to wait for while watching the DOM (the stream sends about four a second)."""
 READY_TIMEOUT_MS = 30_000

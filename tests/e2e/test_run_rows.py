@@ -13,8 +13,12 @@ import socket
 from pathlib import Path
 from typing import Any
 
+import pytest
+
 from studio.learning import ArmGrid, DynaQConfig, RunFolder, RunRecord
 from tests.e2e.conftest import Studio, shot
+
+pytestmark = pytest.mark.e2e
 
 
 def _open(browser_page: Any, studio: Studio) -> Any:

@@ -28,6 +28,8 @@ from studio.web.scene._scene import SceneLayout, StudioScene
 from tests.conftest import free_port
 from tests.web.conftest import wait_for
 
+pytestmark = pytest.mark.e2e
+
 FRAMES_JS = """(n) => new Promise((resolve, reject) => {
   const times = [];
   const step = (t) => { times.push(performance.now()); if (times.length < n) requestAnimationFrame(step); else resolve(times); };

@@ -23,6 +23,8 @@ from tests.conftest import free_port
 from tests.e2e.conftest import shot
 from tests.web.conftest import make_settings, wait_for
 
+pytestmark = pytest.mark.e2e
+
 OUR_INSTANCE = "0123456789abcdef"
 """The instance id the page is told its scene answers."""
 PAGE_READY_TIMEOUT_MS = 15_000

@@ -9,7 +9,11 @@ from __future__ import annotations
 from typing import Any
 from urllib.parse import parse_qs, urlsplit
 
+import pytest
+
 from tests.e2e.conftest import Studio
+
+pytestmark = pytest.mark.e2e
 
 SCENE = "(await import('/static/scene.js'))"
 """The page's scene module (scene.js), as the page runs it."""

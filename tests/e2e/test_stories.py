@@ -57,16 +57,22 @@ def test_story1_scene_renders_and_moves(page: Any, studio_server: Studio) -> Non
     frame = page.frame_locator("[data-testid='scene-frame']")
     frame.locator("canvas").first.wait_for(state="visible", timeout=30_000)
     assert _wait(lambda: float(page.inner_text("[data-testid='source-rate']") or 0) > 10, 20)
-    time.sleep(2.0)  # let the scene's first frames arrive and render
-    first = _pixels(_scene_png(page, "01-scene"))
+    shots: list[np.ndarray] = []
+
+    def drawn() -> bool:  # the scene's first frames arrived and were drawn
+        shots.append(_pixels(_scene_png(page, "01-scene")))
+        # Not blank: a blank canvas is one colour; a floor, a robot and an arm give many.
+        colours = np.unique(shots[-1].reshape(-1, 3).round(-1), axis=0)
+        return shots[-1].std() > 12.0 and len(colours) > 50
+
+    assert _wait(drawn, 20), "the scene stayed blank"
+    first = shots[-1]
     shot(page, "01-page")
-    # Not blank: a blank canvas is one colour; a floor, a robot and an arm give many.
-    assert first.std() > 12.0
-    assert len(np.unique(first.reshape(-1, 3).round(-1), axis=0)) > 50
-    # Moving: the simulator moves the arm (and so the robot) between two screenshots.
-    time.sleep(1.0)
-    second = _pixels(_scene_png(page, "01-scene-later"))
-    assert np.abs(first - second).mean() > 0.05
+
+    def moved() -> bool:  # the simulator moves the arm (and so the robot) between two screenshots
+        return np.abs(first - _pixels(_scene_png(page, "01-scene-later"))).mean() > 0.05
+
+    assert _wait(moved, 20), "the scene did not move"
     assert not page.errors  # type: ignore[attr-defined]
 
 
@@ -177,8 +183,9 @@ def test_story3_record_rename_delete(page: Any, studio_server: Studio) -> None:
     page.fill("[data-testid='capture-name']", "e2e-take")
     page.click("[data-testid='capture-toggle']")
     page.wait_for_selector("[data-testid='capture-toggle'][data-active='1']", timeout=T)
-    time.sleep(2.5)
-    assert float(page.inner_text("[data-testid='capture-elapsed']").split()[0]) > 0.5
+    assert _wait(lambda: studio_server.get("/api/capture")["seconds"] >= 2.5, 30)
+    elapsed = "[data-testid='capture-elapsed']"
+    assert _wait(lambda: float(page.inner_text(elapsed).split()[0]) > 0.5, 10)
     shot(page, "03-recording", "sec-record")
     page.click("[data-testid='capture-toggle']")
     page.wait_for_selector("[data-testid='capture-toggle'][data-active='0']", timeout=T)
@@ -213,15 +220,17 @@ def test_story3_record_rename_delete(page: Any, studio_server: Studio) -> None:
     page.fill("[data-testid='capture-name']", "e2e-scratch")
     page.click("[data-testid='capture-toggle']")
     page.wait_for_selector("[data-testid='capture-toggle'][data-active='1']", timeout=T)
-    time.sleep(1.0)
+    assert _wait(lambda: studio_server.get("/api/capture")["seconds"] >= 1.0, 30)
     page.click("[data-testid='capture-toggle']")
     page.wait_for_selector("[data-testid='capture-toggle'][data-active='0']", timeout=T)
     scratch = page.locator("[data-testid='recording-row'][data-name^='e2e-scratch']")
     scratch.wait_for(timeout=T)
     scratch.locator("[data-testid='recording-delete']").click()
     page.click("[data-testid='confirm-cancel']")
-    time.sleep(0.3)
+    page.wait_for_selector("[data-testid='confirm-ok']", state="hidden", timeout=T)
     assert scratch.count() == 1
+    name = scratch.get_attribute("data-name")
+    assert name in [r["name"] for r in studio_server.get("/api/recordings")]
     scratch.locator("[data-testid='recording-delete']").click()
     shot(page, "03-confirm-delete", "sec-record")
     page.click("[data-testid='confirm-ok']")
@@ -264,8 +273,10 @@ def test_story4_cut_demonstration(page: Any, studio_server: Studio) -> None:
     shot(page, "04-demo-refused", "sec-demos")
 
     # Preview plays it on the robot.
-    page.locator("[data-testid='demo-row']").first.locator("[data-testid='demo-preview']").click()
-    time.sleep(0.5)
+    preview = page.locator("[data-testid='demo-row']").first.locator("[data-testid='demo-preview']")
+    with page.expect_response(lambda r: r.url.endswith("/preview"), timeout=T) as previewed:
+        preview.click()
+    assert previewed.value.ok, previewed.value.text()
     assert not page.is_visible("[data-testid='demo-error']")
 
     # Mark one live while recording: the simulated operator reaches the goal between the marks.
@@ -279,7 +290,13 @@ def test_story4_cut_demonstration(page: Any, studio_server: Studio) -> None:
     page.click("[data-testid='demo-mark']")
     page.wait_for_selector("[data-testid='demo-mark']:has-text('Mark stop')", timeout=T)
     page.click("[data-testid='source-reach']")
-    time.sleep(3.0)
+    goal = np.array(studio_server.get("/api/config")["training"]["goal_deg"])
+
+    def at_goal() -> bool:
+        q = np.degrees(studio_server.get("/api/source")["q_robot"][: len(goal)])
+        return bool(np.abs(q - goal).max() < 10)
+
+    _wait(at_goal, 30)  # (whether the segment then reaches the goal's bin is the studio's call)
     page.click("[data-testid='demo-mark']")
     page.wait_for_selector(
         "[data-testid='demo-ok']:visible, [data-testid='demo-error']:visible", timeout=T
@@ -345,7 +362,7 @@ def test_story5_training_curve_updates_live(page: Any, studio_server: Studio) ->
         if status in ("done", "stopped", "failed"):
             break
         time.sleep(0.1)
-    time.sleep(0.5)
+    _wait(lambda: page.evaluate(POINTS, run_id) == 500, 10)  # the last points are on their way
     counts.append(page.evaluate(POINTS, run_id))
     shot(page, "05-trained", "sec-train")
     assert status == "done", studio_server.get(f"/api/runs/{run_id}")
@@ -366,10 +383,9 @@ def test_story5_training_curve_updates_live(page: Any, studio_server: Studio) ->
     second.locator("[data-testid='run-stop']").click()
     assert _wait(lambda: second.get_attribute("data-status") == "stopped", 30)
     page.click("[data-testid='curve-log']")
-    time.sleep(0.3)
+    drawn_runs = "async () => (await import('/static/chart.js')).drawnRuns()"
+    assert _wait(lambda: {run_id, second_id} <= set(page.evaluate(drawn_runs)), 10)
     shot(page, "05-two-runs", "sec-train")
-    shown = page.evaluate("async () => (await import('/static/chart.js')).drawnRuns()")
-    assert {run_id, second_id} <= set(shown)
     # The chart draws both: its canvas is not blank, and it has a legend row per run.
     legend = page.locator("#curve-plot .u-legend .u-series:visible")
     assert legend.count() >= 3  # the episode readout and one row per plotted run
@@ -404,9 +420,12 @@ def test_story6_watch_policy_moves_robot(page: Any, studio_server: Studio) -> No
     assert runs and runs[0]["has_policy"]
     # The live source is a paused recording (story 5), so only the watched policy moves things.
     assert page.get_attribute("[data-testid='playback-toggle']", "data-playing") == "0"
-    time.sleep(1.0)
-    still = [_pixels(_scene_png(page, "06-still")) for _ in range(2)]
-    assert np.abs(still[0] - still[1]).mean() < 0.5  # nothing moves while paused
+
+    def still() -> bool:  # nothing moves while paused (once the last frames are drawn)
+        shots = [_pixels(_scene_png(page, "06-still")) for _ in range(2)]
+        return np.abs(shots[0] - shots[1]).mean() < 0.5
+
+    assert _wait(still, 20)
 
     page.select_option("[data-testid='watch-policy']", f"run:{runs[0]['id']}")
     page.select_option("[data-testid='watch-start']", "random")
@@ -414,13 +433,14 @@ def test_story6_watch_policy_moves_robot(page: Any, studio_server: Studio) -> No
     page.click("[data-testid='watch-go']")
     page.wait_for_selector("[data-testid='watch-result']:has-text('steps')", timeout=T)
     assert not page.is_visible("[data-testid='watch-error']")
-    frames = []
-    for i in range(4):
-        time.sleep(0.5)
-        frames.append(_pixels(_scene_png(page, f"06-watch-{i}")))
+    frames = [_pixels(_scene_png(page, "06-watch-0"))]
+
+    def moved() -> bool:  # the robot moves along the rollout
+        frames.append(_pixels(_scene_png(page, f"06-watch-{len(frames)}")))
+        return np.abs(frames[-1] - frames[0]).mean() > 0.05
+
+    assert _wait(moved, 20), [np.abs(f - frames[0]).mean() for f in frames]
     shot(page, "06-watch", "sec-watch")
-    moved = [np.abs(a - b).mean() for a, b in zip(frames, frames[1:], strict=False)]
-    assert max(moved) > 0.05, moved
 
 
 def test_story7_export_and_reload(page: Any, studio_server: Studio, tmp_path: Path) -> None:

@@ -8,10 +8,13 @@ import time
 from typing import Any
 
 import numpy as np
+import pytest
 
 from tests.page_hooks import hook
 
 from .conftest import Studio, shot
+
+pytestmark = pytest.mark.e2e
 
 T = 20_000  # ms: the longest a single UI step may take
 AWAY_DEG = [-40.0, 20.0, -40.0]

@@ -5,9 +5,13 @@ from __future__ import annotations
 import json
 from typing import Any
 
+import pytest
+
 from tests.page_hooks import hook
 
 from .conftest import Studio, shot
+
+pytestmark = pytest.mark.e2e
 
 T = 20_000  # ms: the longest a single UI step may take
 

@@ -235,10 +235,16 @@ def test_camera_presets_move_the_scene_camera(page: Any, studio_server: Studio) 
         return studio_server.get("/api/scene/views")["cameras"]
 
     assert _until(lambda: len(cameras()) >= 1, 20)
+    shots = [_pixels(_scene_png(page, "23-4-before-top-view"))]
     page.get_by_role("button", name="Top view").click()
     assert _until(lambda: all(c["position"][2] > 4.0 for c in cameras()))
-    time.sleep(0.5)  # the browser draws the new view (no event to wait for inside WebGL)
-    top = _pixels(_scene_png(page, "23-4-top-view"))
+
+    def drawn() -> bool:  # the browser drew the new view
+        shots.append(_pixels(_scene_png(page, "23-4-top-view")))
+        return np.abs(shots[-1] - shots[0]).mean() > 1.0
+
+    assert _until(drawn)
+    top = shots[-1]
     page.get_by_role("button", name="Side view").click()
     assert _until(lambda: all(c["position"][0] < -2.0 for c in cameras()))
     page.get_by_role("button", name="Front view").click()

@@ -59,6 +59,14 @@ def wait_for(predicate: Callable[[], object], timeout: float = 20.0, step: float
     return False
 
 
+def wait_captured(client: TestClient, seconds: float) -> None:
+    """Wait until the capture under way has taken in ``seconds`` more of the source's time."""
+    start = client.get("/api/capture").json()["seconds"]
+    assert wait_for(lambda: client.get("/api/capture").json()["seconds"] >= start + seconds, 30), (
+        "the capture took in no frames"
+    )
+
+
 def wait_run(client: TestClient, run_id: str, timeout: float = 60.0) -> dict:
     """Block until a run is no longer queued or running; returns its ``RunPublic``."""
     assert client.app.state.studio.runs.wait_idle(timeout), "the run did not finish in time"

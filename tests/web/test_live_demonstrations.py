@@ -2,13 +2,11 @@
 
 from __future__ import annotations
 
-import time
-
 import numpy as np
 
 from studio.capture import read_recording
 from studio.learning import ArmGrid
-from tests.web.conftest import wait_for
+from tests.web.conftest import wait_captured, wait_for
 
 
 def test_record_and_mark_a_demonstration_live(open_client, tmp_path):
@@ -23,14 +21,14 @@ def test_record_and_mark_a_demonstration_live(open_client, tmp_path):
     # start from a known pose, so the segment never wanders to a joint limit
     assert client.post("/api/source/reach", json={"goal_deg": [40, 10, -40]}).status_code == 200
     assert wait_for(lambda: simulator._sim.motion.frames_to_goal() == 0, timeout=10)
-    time.sleep(0.2)
+    wait_captured(client, 0.2)  # a moment at the start pose
     r = client.post("/api/demonstrations/mark", json={"action": "start"})
     assert r.status_code == 200 and r.json()["marking"] is True and r.json()["t0"] > 0
     assert client.get("/api/demonstrations/mark").json()["marking"] is True
     r = client.post("/api/source/reach", json={"goal_deg": [0, 45, -90]})
     assert r.status_code == 200
     assert wait_for(lambda: simulator._sim.motion.frames_to_goal() == 0, timeout=10)
-    time.sleep(0.3)
+    wait_captured(client, 0.3)  # a moment at the goal
     r = client.post("/api/demonstrations/mark", json={"action": "stop", "name": "live-reach"})
     assert r.status_code == 200, r.text
     demo = r.json()["demonstration"]

@@ -13,6 +13,7 @@ from hypothesis import strategies as st
 from studio.capture import RecordingWriter, TapeFrame, read_recording
 from studio.samples import SAMPLES_DIR
 from studio.web.services._store import NAME_PATTERN, SAMPLE_PREFIX, check_name, clean_upload_name
+from tests.web.conftest import wait_captured
 
 REGIONS = 16
 RATE_HZ = 110.0
@@ -231,7 +232,7 @@ def test_a_capture_is_closed_cleanly_when_the_studio_stops(recordings, open_clie
     client = open_client()
     client.put("/api/source", json={"kind": "recording", "recording": "sample-reach"})
     client.post("/api/capture/start", json={"name": "cut-short"})
-    time.sleep(0.2)
+    wait_captured(client, 0.2)
     client.__exit__(None, None, None)
     rec = read_recording(recordings / "cut-short.tape.csv")
     assert rec.recovered is False

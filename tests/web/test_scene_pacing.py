@@ -183,9 +183,18 @@ def test_a_still_scene_is_drawn_rarely_and_the_next_update_frees_the_frames(monk
     try:
         assert wait_for(lambda: page.gap() == STILL_FRAME_GAP_MS), page.scripts[-1:]
         assert sc.frames.still_pages() == 1
-        monkeypatch.setattr(_scene_frames, "LOADING_S", 60.0)
+        asked = threading.Event()
+
+        class Loading(float):
+            """LOADING_S, telling when the pacer's still pass weighs a page's age against it."""
+
+            def __gt__(self, age: object) -> bool:  # `age < LOADING_S` asks this one first
+                asked.set()
+                return float.__gt__(self, age)
+
+        monkeypatch.setattr(_scene_frames, "LOADING_S", Loading(60.0))
         loading = _ScriptWatch(port)  # connects to the still scene: it loads, drawing freely
-        time.sleep(3 * _scene_frames.STILL_AFTER_S)
+        assert asked.wait(20), "the pacer never weighed the loading page"
         assert loading.gap() is None, loading.scripts
         _stream(sc, count=3, gap_s=0.002)  # a pose
         awake = (0.0, SLOW_FRAME_GAP_MS)  # (after a pause a stream starts as a slow one)

@@ -4,14 +4,13 @@ from __future__ import annotations
 
 import re
 import shutil
-import time
 from pathlib import Path
 
 import numpy as np
 
 from studio.capture import Calibration, ShapeTapeEmulator, read_recording
 from studio.samples import SAMPLES_DIR
-from tests.web.conftest import wait_for
+from tests.web.conftest import wait_captured, wait_for
 
 SAMPLE = SAMPLES_DIR / "sample-reach-1.tape.csv"
 GAIN = 2e-4
@@ -39,7 +38,7 @@ def test_a_serial_tape_with_its_calibration_is_captured_in_radians(client, tmp_p
         assert r.json()["kind"] == "serial" and r.json()["error"] is None
         assert wait_for(lambda: client.get("/api/source").json()["frames"] > 10, 10)
         assert client.post("/api/capture/start", json={"name": "serial-take"}).status_code == 200
-        time.sleep(1.0)
+        wait_captured(client, 1.0)
         assert client.post("/api/capture/stop").status_code == 200
     finally:
         emulator.unplug()

@@ -19,7 +19,6 @@ from studio.learning.sweeps._folder import set_status as _set_status
 from studio.learning.sweeps._folder import trial_run_path
 from studio.learning.sweeps._spec import parse_sweep_spec, trial_record
 from studio.learning.sweeps._summary import write_summary
-from tests.page_hooks import hook
 
 SPEC = {
     "name": "tiny",
@@ -111,74 +110,3 @@ def test_an_unknown_sweep_is_404_in_one_sentence(client, sweep_id: str) -> None:
 
 def test_no_sweeps_is_an_empty_list(client) -> None:
     assert client.get("/api/sweeps").json() == []
-
-
-def test_the_page_groups_a_sweep_and_ticking_it_plots_every_trial(tmp_path: Path) -> None:
-    """In Chromium: one group row; ticking it plots all its runs; unfolding shows the table,
-    the figure, the downloads and the trials' own rows."""
-    import os
-    import threading
-
-    import uvicorn
-
-    from studio.web import create_app
-    from tests.conftest import require
-    from tests.e2e.conftest import CHROMIUM, CHROMIUM_FLAGS, free_port
-    from tests.web.conftest import make_settings, wait_for
-
-    require(os.path.exists(CHROMIUM), "Debian's Chromium is not installed")
-    try:
-        from playwright.sync_api import sync_playwright
-    except ImportError:
-        require(False, "playwright is not installed")
-    keys = make_sweep(tmp_path)
-    port = free_port()
-    settings = make_settings(tmp_path, port=port, allowed_hosts=())
-    server = uvicorn.Server(
-        uvicorn.Config(create_app(settings), host="127.0.0.1", port=port, log_level="warning")
-    )
-    thread = threading.Thread(target=server.run, daemon=True)
-    thread.start()
-    try:
-        assert wait_for(lambda: server.started, timeout=30), "the server did not start"
-        with sync_playwright() as p:
-            browser = p.chromium.launch(
-                executable_path=CHROMIUM, args=CHROMIUM_FLAGS, headless=True
-            )
-            try:
-                page = browser.new_page()
-                page.goto(f"http://127.0.0.1:{port}/")
-                row = page.locator('[data-testid="sweep-row"]')
-                row.wait_for()
-                assert row.count() == 1 and row.get_attribute("data-id") == "tiny"
-                assert page.locator('[data-testid="run-row"]').count() == 0  # folded
-                run_ids = {f"tiny~tiny-{key}" for key in keys}
-                row.locator('[data-testid="sweep-show"]').uncheck()  # the newest runs are shown
-                p = hook(page)
-                page.wait_for_function("p => p.chart.drawnRuns().length === 0", arg=p)
-                page.evaluate("p => p.S.curves.clear()", p)
-                row.locator('[data-testid="sweep-show"]').check()
-                page.wait_for_function(  # the chart overlays exactly the sweep's runs
-                    "([p, ids]) => JSON.stringify([...p.chart.drawnRuns()].sort())"
-                    " === JSON.stringify(ids)",
-                    arg=[p, sorted(run_ids)],
-                )
-                row.locator('[data-testid="sweep-open"]').click()
-                table = page.locator('[data-testid="sweep-table"] tbody tr')
-                table.first.wait_for()
-                assert table.count() == len(keys)
-                assert page.locator('[data-testid="run-row"]').count() == len(keys)
-                figure = page.locator('[data-testid="sweep-figure"]')
-                page.wait_for_function(
-                    "img => img.complete && img.naturalWidth > 0", arg=figure.element_handle()
-                )
-                with page.expect_download() as download:
-                    page.locator('[data-testid="sweep-csv"]').click()
-                saved = tmp_path / "downloaded.csv"
-                download.value.save_as(saved)
-                assert saved.read_text() == (tmp_path / "sweeps" / "tiny" / "sweep.csv").read_text()
-            finally:
-                browser.close()
-    finally:
-        server.should_exit = True
-        thread.join(30)

@@ -11,18 +11,10 @@ import pytest
 
 from studio.capture import TAKES_FILE, read_takes, write_takes
 from studio.samples import SAMPLES_DIR
+from tests.web.conftest import wait_captured
 
 AWAY_DEG = [-40.0, 20.0, -40.0]
 """Robot joints 1-3 (degrees) the simulated operator waits at before a take, far from the goal."""
-
-
-def _wait_frames(client, seconds: float) -> None:
-    """Let the capture take in frames (the simulator streams at about 100 Hz)."""
-    start = client.get("/api/capture").json()["seconds"]
-    deadline = time.monotonic() + 30
-    while client.get("/api/capture").json()["seconds"] < start + seconds:
-        assert time.monotonic() < deadline, "the capture took in no frames"
-        time.sleep(0.05)
 
 
 def _away_from_the_goal(client) -> None:
@@ -44,7 +36,7 @@ def test_a_session_of_takes_becomes_demonstrations(open_client, tmp_path):
 
     first = client.post("/api/takes/start", json={}).json()["takes"][0]["recording"]
     assert client.post("/api/takes/start").status_code == 409  # one take at a time
-    _wait_frames(client, 0.8)
+    wait_captured(client, 0.8)
     review = client.post("/api/takes/stop").json()
     assert review["takes"][0]["state"] == "review"
     assert client.post("/api/takes/start").status_code == 409  # keep or redo it first
@@ -56,9 +48,9 @@ def test_a_session_of_takes_becomes_demonstrations(open_client, tmp_path):
         # whatever the simulated operator's wandering did before
         _away_from_the_goal(client)
         client.post("/api/takes/start")
-        _wait_frames(client, 0.3)
+        wait_captured(client, 0.3)
         client.post("/api/source/reach", json={"action": "reach"})
-        _wait_frames(client, 2.5)
+        wait_captured(client, 2.5)
         client.post("/api/takes/stop")
         assert client.post("/api/takes/review").status_code == 202
         client.post("/api/takes/keep")
