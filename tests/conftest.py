@@ -3,28 +3,35 @@
 In CI (``CI=true``) nothing may be skipped for a missing browser or package: :func:`require`
 turns such a skip into a failure there.
 
-The suite runs on every core (pytest-xdist, ``-n auto --dist loadfile`` in pyproject.toml): a
-test file stays on one worker, in order, so its module fixtures are made once. Before the workers
-start, :func:`pytest_configure` compiles the learners' and the arm IK's numba kernels into numba's
-disk cache (the studio's own start-up preparation), so the workers load them instead of each
-compiling the same kernels at once. Every browser test is marked ``e2e``
-(:func:`pytest_collection_modifyitems` refuses one that is not), so ``-m "not e2e"`` runs the
-fast set; the browser files are handed out first, since they take the longest.
+The suite runs on every core (pytest-xdist, ``-n auto`` in pyproject.toml), handed out by file
+(:func:`pytest_xdist_make_scheduler`): a file's tests run on one worker, in order, so its module
+fixtures are made once; the browser files on the studio's one shared page (the ``page`` fixture)
+go to one worker together, as one visit, so that one studio and one live page serve them all.
+Before the workers start, :func:`pytest_configure` compiles the learners' and the arm IK's numba
+kernels into numba's disk cache (the studio's own start-up preparation), so the workers load them
+instead of each compiling the same kernels at once. Every browser test is marked ``e2e``
+(:func:`pytest_collection_modifyitems` refuses one that is not), so ``-m "not e2e"`` runs the fast
+set; the browser files are handed out first, since they take the longest.
 """
 
 from __future__ import annotations
 
+import ast
 import functools
 import os
 import socket
 import threading
 from pathlib import Path
+from typing import Any
 
 import pytest
 
 IN_CI = os.environ.get("CI", "").lower() in ("1", "true", "yes")
-E2E_DIR = Path(__file__).resolve().parent / "e2e"
+ROOT = Path(__file__).resolve().parent.parent
+E2E_DIR = ROOT / "tests" / "e2e"
 """The browser tests' folder: every test in it drives Chromium."""
+SHARED_PAGE = "tests/e2e (the shared page)"
+"""The work unit of the browser files that use the studio's one shared page."""
 
 
 def require(condition: bool, reason: str) -> None:
@@ -90,9 +97,37 @@ def _drives_chromium(path: Path) -> bool:
     return E2E_DIR in path.parents or "sync_playwright" in path.read_text(errors="replace")
 
 
+@functools.cache
+def _on_the_shared_page(path: Path) -> bool:
+    """Whether a test or fixture of file ``path`` takes the shared ``page`` of tests/e2e."""
+    if E2E_DIR not in path.parents:
+        return False
+    for node in ast.walk(ast.parse(path.read_text())):
+        if not isinstance(node, ast.FunctionDef) or "page" not in [a.arg for a in node.args.args]:
+            continue
+        decorators = [ast.unparse(d) for d in node.decorator_list]
+        if node.name.startswith("test_") or any("fixture" in d for d in decorators):
+            return True
+    return False
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_xdist_make_scheduler(config: pytest.Config, log: Any) -> Any:
+    """Hand the workers whole files, in collection order; the files on the shared page as one."""
+    from xdist.scheduler import LoadScopeScheduling
+
+    class ByFile(LoadScopeScheduling):
+        def _split_scope(self, nodeid: str) -> str:
+            path = nodeid.split("::", 1)[0]
+            return SHARED_PAGE if _on_the_shared_page((ROOT / path).resolve()) else path
+
+    return ByFile(config, log)
+
+
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
-    """Refuse a browser test not marked ``e2e``; put the browser files first (stable otherwise:
-    each file keeps its order), so the slowest files start first and no worker idles at the end."""
+    """Refuse a browser test not marked ``e2e``; put the shared page's files first, then the other
+    browser files (stable otherwise: each file keeps its order), so the slowest work starts first
+    and no worker idles at the end."""
 
     def browser(item: pytest.Item) -> bool:
         return _drives_chromium(item.path.resolve())
@@ -103,4 +138,4 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
             f"{len(unmarked)} browser test(s) are not marked e2e ({unmarked[0]}, ...): add "
             "`pytestmark = pytest.mark.e2e` to the file, so that -m 'not e2e' leaves them out."
         )
-    items.sort(key=lambda item: not browser(item))
+    items.sort(key=lambda i: (not _on_the_shared_page(i.path.resolve()), not browser(i)))

@@ -38,6 +38,7 @@ from studio.capture._network import FrameSender
 from studio.capture._recording_format import MAX_HEADER_BYTES, MAX_REGIONS
 from studio.capture._recording_reader import read_header, summarize_recording
 from studio.cli import main
+from tests.conftest import require
 
 from .conftest import synthetic_frames
 
@@ -316,7 +317,9 @@ def test_devices_and_pipes_are_refused_unread(tmp_path, fifo):
 
 
 def test_a_serial_source_refuses_dev_zero_as_its_calibration():
-    pytest.importorskip("serial")
+    import importlib.util
+
+    require(importlib.util.find_spec("serial") is not None, "pyserial is not installed")
     from studio.capture import SerialSource
 
     with pytest.raises(CaptureError, match="calibration /dev/zero is a device"):
