@@ -59,11 +59,21 @@ class TakeFlow:
             write_takes(self.path, sessions)
             return session
 
+    def _not_elsewhere(self, take: Take) -> None:
+        """Refuse a take another studio on this data folder is recording (its own Stop ends it;
+        stopped here, its recording would go on under a take made into demonstrations)."""
+        if self.studio.recordings.captured_elsewhere(take.recording):
+            raise ConflictError(
+                f"Take {take.recording} is being recorded by another studio on this data folder; "
+                "stop, keep or redo it in that studio."
+            )
+
     def stop(self) -> TakeSession:
         """Stop the take being recorded and play it on the robot for review."""
         with self._lock:
             sessions = self._sessions()
             take = _last(sessions, "recording", "No take is being recorded; start a take first.")
+            self._not_elsewhere(take)
             if self.studio.pipeline.capture_name == take.recording:
                 self.studio.stop_capture()
             take.state = "review"
@@ -100,6 +110,7 @@ class TakeFlow:
             if session is None or not session.takes or session.takes[-1].state == "kept":
                 raise ConflictError("No take to redo: the last take is kept; start a new take.")
             take = session.takes[-1]
+            self._not_elsewhere(take)
             if self.studio.pipeline.capture_name == take.recording:
                 self.studio.stop_capture()
             self.studio.recordings.delete(take.recording)

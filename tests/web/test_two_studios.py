@@ -115,3 +115,23 @@ def test_queued_runs_of_a_studio_that_closed_read_as_stopped(open_client, tmp_pa
     assert "before this run started" in listed[queued]["error"]
     assert listed[long]["status"] == "stopped"
     assert b.delete(f"/api/runs/{queued}").status_code == 204
+
+
+def test_a_take_another_studio_records_is_refused(open_client, tmp_path):
+    """Studio B could stop A's take, keep it and make demonstrations of the part recorded so
+    far; A's own Stop then answered 409 "No take is being recorded"."""
+    a, b = open_client(), open_client()
+    sample = sorted(SAMPLES_DIR.glob("*.tape.csv"))[0].name.removesuffix(".tape.csv")
+    a.put("/api/source", json={"kind": "recording", "recording": sample, "loop": True})
+    take = a.post("/api/takes/start", json={}).json()["takes"][0]["recording"]
+    assert wait_for(lambda: a.get("/api/capture").json()["frames"] >= 20)
+    for path in ("/api/takes/stop", "/api/takes/redo"):
+        refused = b.post(path)
+        assert refused.status_code == 409, refused.text
+        assert refused.json()["detail"].startswith(f"Take {take} is being recorded by another")
+    assert b.post("/api/takes/keep").status_code == 409
+    assert b.post("/api/takes/demonstrations", json={"goal_from_end": True}).status_code == 409
+    stopped = a.post("/api/takes/stop")  # A's own Stop still ends A's take
+    assert stopped.status_code == 200, stopped.text
+    assert stopped.json()["takes"][0]["state"] == "review"
+    assert _names(a)[take]["frames"] >= 20 and not _names(a)[take]["capturing"]
