@@ -7,6 +7,11 @@ The public names (see ``docs/architecture.md`` and this package's ``README.md``)
     grid = ArmGrid()  # the paper's 3 joints x 11 bins, 27 actions
     result = run_experiments(grid.mdp(), DynaQConfig(planning="full"), experiments=20, episodes=100, seed=0)
     result.mean_steps()  # the learning curve
+
+Subpackages by responsibility: ``tasks`` (what is learned), ``tabular``, ``linear`` and
+``primitives`` (the learners, each behind the one ``Learner`` interface, registered by kind:
+``learner_of(policy).roll_out(policy, Start(seed=0), 50.0)``), ``likeness``, ``runs``, ``sweeps``
+and ``paper``. Import every public name from here.
 """
 
 from __future__ import annotations
