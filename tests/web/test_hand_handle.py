@@ -73,3 +73,51 @@ def test_a_drag_released_out_of_reach_puts_the_handle_back_on_the_hand(scene_cli
     hand = worldMbase @ HumanArm("right").forward(q_human).hand
     assert np.allclose(gizmo.position, hand[:3, 3], atol=1e-6)
     assert np.linalg.norm(hand[:3, 3] - far[:3, 3]) > 1.0  # the arm stopped short, as it must
+
+
+@pytest.mark.parametrize(
+    ("position", "wxyz"),
+    [
+        ((float("nan"), 0.0, 0.0), (1.0, 0.0, 0.0, 0.0)),
+        ((0.1, float("inf"), 0.0), (1.0, 0.0, 0.0, 0.0)),
+        ((0.1, 0.0, 0.0), (0.0, 0.0, 0.0, 0.0)),
+    ],
+)
+def test_a_pose_that_is_not_one_is_put_back_and_never_passed_on(
+    scene_client, monkeypatch, position, wxyz
+) -> None:
+    """The studio refused a scene client's NaN pose for the handle, but viser still passed
+    ``[nan, 0, 0]`` on to the other browsers, and the handle was not put back."""
+    import asyncio
+
+    from viser import _messages
+
+    from studio.web.scene._hand_handle import HANDLE_NAME
+
+    client, scene = scene_client
+    assert client.put("/api/source", json={"kind": "hand"}).status_code == 200
+    gizmo = scene.hand_handle._handle
+    before = (np.array(gizmo.position), np.array(gizmo.wxyz))
+    api = scene.server.scene
+    sent: list = []
+    real_queue = api._queue_scene_message
+    monkeypatch.setattr(api, "_queue_scene_message", lambda m: sent.append(m) or real_queue(m))
+    message = _messages.TransformControlsUpdateMessage(
+        name=HANDLE_NAME, wxyz=wxyz, position=position
+    )
+    # what viser does when a browser drags the handle: apply, call back, pass on to the others
+    asyncio.run(api._handle_transform_controls_updates("a-browser", message))
+    poses = [
+        m
+        for m in sent
+        if isinstance(m, _messages.SetPositionMessage | _messages.SetOrientationMessage)
+    ]
+    assert poses, "nothing was sent back"
+    for m in poses:
+        value = np.array(getattr(m, "position", None) or m.wxyz, dtype=float)
+        assert np.isfinite(value).all() and np.linalg.norm(value) > 0, m
+    assert np.allclose(gizmo.position, before[0]) and np.allclose(gizmo.wxyz, before[1])
+    put_back = [m for m in poses if getattr(m, "excluded_self_client", None) is None]
+    assert put_back, "the sender's own handle was not put back"
+    assert scene.hand_handle.refused == 1
+    assert client.get("/api/source").json()["frames"] == 0  # nothing reached the arm

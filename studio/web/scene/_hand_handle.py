@@ -4,6 +4,10 @@ Shown only while the hand guide is the source. Dragging it (in any browser showi
 hands the new hand pose, in the operator's arm frame, to the same function ``POST
 /api/source/hand`` calls (:meth:`studio.web._state.Studio.hand_moved`): the arm follows by IK and
 the robot mirrors it through the live pipeline.
+
+A pose a browser sends that is not a pose (NaN, infinite, a zero quaternion) is refused before
+viser passes it on to the other browsers showing the scene: the handle is put back where it was,
+in every browser.
 """
 
 from __future__ import annotations
@@ -59,7 +63,12 @@ class HandHandle:
         self._on_move: HandMoved | None = None
         self._hand_of: HandOf | None = None
         self.moves = 0  # drags handed on, for tests
+        self.refused = 0  # poses that were not poses, put back
         self._last_move = 0.0
+        self._good: tuple[np.ndarray, np.ndarray] | None = None  # the last pose that was one
+        # updates put back, by id: their drag callback (run next, the event alive till then)
+        # hands nothing on
+        self._put_back: set[int] = set()
 
     @property
     def visible(self) -> bool:
@@ -91,8 +100,11 @@ class HandHandle:
                 wxyz=vtf.SO3.from_matrix(worldMhand[:3, :3]).wxyz,
                 depth_test=False,
             )
+            # first, and awaited: viser passes the pose on to the other browsers only after it
+            handle.on_update(self._checked)
             handle.on_update(self._dragged)
             self._handle = handle
+            self._good = (np.array(handle.position), np.array(handle.wxyz))
 
     def hide(self) -> None:
         """Remove the handle (another source is live)."""
@@ -105,7 +117,26 @@ class HandHandle:
             self._handle = None
         self._on_move = None
 
+    async def _checked(self, event: viser.TransformControlsEvent) -> None:
+        """Put the handle back where it was when a browser sent a pose that is not one, before
+        viser passes it on to the other browsers (it sends the handle's pose once this returns)."""
+        handle = event.target
+        position = np.asarray(handle.position, dtype=float)
+        wxyz = np.asarray(handle.wxyz, dtype=float)
+        if _is_pose(position, wxyz):
+            self._good = (position, wxyz)
+            return
+        good = self._good
+        self.refused += 1
+        log.warning("A scene client sent the hand handle to %s %s; put back.", position, wxyz)
+        if good is not None:
+            handle.position, handle.wxyz = good  # to every browser, the sender's too
+        self._put_back.add(id(event))
+
     def _dragged(self, event: viser.TransformControlsEvent) -> None:
+        if id(event) in self._put_back:
+            self._put_back.discard(id(event))
+            return
         now = time.monotonic()
         if getattr(event, "phase", "update") == "update" and now - self._last_move < MIN_INTERVAL_S:
             return
@@ -125,6 +156,7 @@ class HandHandle:
         worldMhand = worldMbase @ hand_of(np.asarray(answer["q_human"], dtype=float))
         handle.position = worldMhand[:3, 3]
         handle.wxyz = vtf.SO3.from_matrix(worldMhand[:3, :3]).wxyz
+        self._good = (np.array(handle.position), np.array(handle.wxyz))
 
     def move(self, position: np.ndarray, wxyz: np.ndarray) -> Mapping[str, object] | None:
         """The handle was dragged to a world pose: hand it on in the arm frame.
@@ -143,3 +175,13 @@ class HandHandle:
             return None
         self.moves += 1
         return answer if isinstance(answer, Mapping) else None
+
+
+def _is_pose(position: np.ndarray, wxyz: np.ndarray) -> bool:
+    """Whether a handle's position and quaternion make a pose (finite, a non-zero quaternion)."""
+    return (
+        position.shape == (3,)
+        and wxyz.shape == (4,)
+        and bool(np.isfinite(position).all() and np.isfinite(wxyz).all())
+        and float(np.linalg.norm(wxyz)) > 1e-9
+    )
