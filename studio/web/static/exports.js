@@ -6,12 +6,14 @@
  *
  * Recordings and demonstrations export for the robot chosen above (GET
  * /api/robot/export/{recording|demonstration}/{name}: retargeted, timed and checked as `studio
- * export --robot` does); a rollout, the one last watched of the policy chosen under Watch, for the
+ * export --robot` does), and "Check in physics" shows, before exporting, the report the file
+ * will state (GET /api/robot/simulate/{recording|demonstration}/{name}: the same samples replayed
+ * in MuJoCo, as `studio simulate` does); a rollout, the one last watched of the policy chosen under Watch, for the
  * robot it was learnt on (CSV as ever from /api/watch/trajectory.csv, MCAP from
  * /api/robot/export/rollout.mcap).
  */
 
-import { download } from "./api.js";
+import { api, download, guarded } from "./api.js";
 import { $, el, enc, fillSelect, setProp, showError } from "./dom.js";
 import { watchTarget } from "./policies.js";
 import { S } from "./state.js";
@@ -20,6 +22,7 @@ const ALL_FORMATS = [["csv", "CSV"], ["mcap", "MCAP (ROS 2)"], ["lerobot", "LeRo
 const ENDINGS = { csv: "csv", mcap: "mcap", lerobot: "lerobot.zip" };
 const ANYWAY = "Export anyway, findings written in the file";
 const RETIME = "Time it within the robot's limits";
+const PHYSICS = "replay the motion the export would write in physics (MuJoCo: the robot's motors and their force limits, gravity, the table) and say whether it completes, how closely the robot follows it, where a motor saturates and what touches";
 const HOW = "retargeted onto the robot chosen under Source, timed within its limits and checked for safety, as `studio export --robot` writes it";
 
 const KINDS = {
@@ -49,6 +52,9 @@ export function buildExportControl(kind) {
   parts.push(el("select", { id: `${kind}-export-format`, testid: `${kind}-export-format`, class: "export-format", "aria-label": `${noun} export format` },
     ...k.formats.map(([value, label]) => el("option", { value, text: label }))));
   parts.push(el("button", { id: `${kind}-export-go`, testid: k.testid || `${kind}-export-go`, title: k.title, onclick: () => exportNow(kind, { unchecked: false, retime: false }) }, `Export ${k.noun}`));
+  if (k.items) {
+    parts.push(el("button", { id: `${kind}-physics-go`, testid: `${kind}-physics-go`, title: PHYSICS, onclick: () => checkPhysics(kind) }, "Check in physics"));
+  }
   const anyway = el("button", { id: `${kind}-export-anyway`, testid: `${kind}-export-anyway`, hidden: true, title: "write the file even though the safety checks refuse it; every finding is stated in it", onclick: () => exportNow(kind, { unchecked: true, retime: retimed[kind] }) }, ANYWAY);
   const fixes = [anyway];
   if (k.retimes) {
@@ -58,6 +64,7 @@ export function buildExportControl(kind) {
     el("div", { class: "row" }, ...parts),
     el("div", { class: "err", id: `${kind}-export-error`, testid: `${kind}-export-error`, role: "alert", hidden: true }),
     el("div", { class: "row" }, ...fixes),
+    el("div", { class: "hint", id: `${kind}-physics`, testid: `${kind}-physics`, role: "status", hidden: true }),
   );
   fillExportItems(kind);
 }
@@ -117,4 +124,19 @@ async function exportNow(kind, how) {
   } finally {
     button.disabled = false;
   }
+}
+
+/** Replay the chosen item as its export would write it, in physics, and show the report. */
+async function checkPhysics(kind) {
+  const errId = `${kind}-export-error`;
+  const box = $(`${kind}-physics`);
+  const name = $(`${kind}-export-item`).value;
+  setProp(box, "hidden", true);
+  if (!name) { showError(errId, `Choose a ${KINDS[kind].noun} to check first.`); return; }
+  const query = new URLSearchParams();
+  if (retimed[kind]) query.set("retime", "true");
+  const report = await guarded(errId, () => api("GET", `/api/robot/simulate/${kind}/${enc(name)}?${query}`), $(`${kind}-physics-go`));
+  if (!report) return;
+  box.replaceChildren(...report.sentences.map((line) => el("div", { text: line })));
+  setProp(box, "hidden", false);
 }
