@@ -1,7 +1,8 @@
 """``studio export``: a policy, a demonstration or a recording as a robot's joint trajectory.
 
 ``studio export SOURCE --robot NAME --format csv|mcap|lerobot --out PATH`` times the motion
-(TOPP-RA, within the robot's limits; a recording keeps its capture times unless ``--retime``),
+(at the person's pace, slower only where the robot's limits need it, from rest to rest; as fast
+as the limits allow with ``--fastest``; a recording keeps its capture times unless ``--retime``),
 checks it (positions, velocities, accelerations, self-collision), replays it in MuJoCo and
 writes it with the physics report stated in the file; the :mod:`studio.export` package does all
 four. ``SOURCE`` is a path, or a name in the data folder
@@ -58,6 +59,12 @@ from studio.learning import (
 from studio.motion import Motion, demonstration_motion, recording_motion
 
 NAME = "export"
+TIMINGS = {
+    "pace": "at the person's pace where the limits allow",
+    "toppra": "timed within the limits (TOPP-RA)",
+    "source": "at its own times",
+}
+"""How ``studio export`` names each timing (``Exported.timed_by``)."""
 HELP = "Export a policy, demonstration or recording as a robot trajectory checked for safety (CSV, MCAP, LeRobot)."
 
 
@@ -88,8 +95,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--retime",
         action="store_true",
-        help="time a recording's path within the robot's limits (TOPP-RA) at --rate, as a "
-        "demonstration is, instead of keeping its capture times: a recording to send to a robot",
+        help="time a recording's path within the robot's limits at --rate, as a demonstration "
+        "is (at the person's pace, slower only where needed), instead of keeping its capture "
+        "times: a recording to send to a robot",
+    )
+    parser.add_argument(
+        "--fastest",
+        action="store_true",
+        help="time the path as fast as the robot's limits allow (TOPP-RA, time-optimal) instead "
+        "of at the person's pace",
     )
     parser.add_argument(
         "--limit-fraction",
@@ -301,10 +315,9 @@ def run(args: argparse.Namespace) -> int:
         task=args.task,
         simulate=True,
         cache=physics_cache_dir(args.data_dir),
+        fastest=args.fastest,
     )
-    timing = (
-        "timed within the limits (TOPP-RA)" if done.timed_by == "toppra" else "at its own times"
-    )
+    timing = TIMINGS[done.timed_by]
     checks = (
         "passed the safety checks"
         if not done.findings
@@ -316,6 +329,8 @@ def run(args: argparse.Namespace) -> int:
     )
     for note in motion.notes:
         print(f"  note: {note}")
+    for slowdown in done.slowdowns:
+        print(f"  note: {slowdown.sentence}")
     if done.physics is not None:
         for line in done.physics.sentences():
             print(f"  {line}")

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import json
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Literal
 
@@ -34,7 +34,7 @@ from ._lerobot import lerobot_conventions, write_lerobot
 from ._safety import COLLISION_MARGIN_M, check_trajectory, refuse
 from ._simulate import simulate_trajectory
 from ._tf import link_transforms
-from ._timing import LIMIT_FRACTION, time_path
+from ._timing import LIMIT_FRACTION, PacedPath, Slowdown, pace_path, time_path
 
 Format = Literal["csv", "mcap", "lerobot"]
 FORMATS: tuple[Format, ...] = ("csv", "mcap", "lerobot")
@@ -58,8 +58,10 @@ class Exported:
         times: the samples' times (s).
         q: the samples' joints (rad).
         findings: the safety findings (empty when checked and passed).
-        timed_by: ``"toppra"`` (timed along the path) or ``"source"`` (the source's own times).
+        timed_by: ``"pace"`` (the source's pace, slower only where the limits need it),
+            ``"toppra"`` (as fast as the limits allow) or ``"source"`` (the source's own times).
         physics: the samples replayed in MuJoCo (None: not simulated).
+        slowdowns: where a timing at the source's pace runs slower than the source did.
     """
 
     path: Path
@@ -68,18 +70,58 @@ class Exported:
     findings: tuple[Finding, ...]
     timed_by: str
     physics: SimulationReport | None = None
+    slowdowns: tuple[Slowdown, ...] = ()
 
 
-def _samples(motion: Motion, fraction: float) -> tuple[np.ndarray, np.ndarray, str]:
-    """The samples an export writes: the motion's own, or its path timed (and by which)."""
+@dataclass(frozen=True)
+class _Samples:
+    """The samples an export writes, how they were timed, and what the timing did."""
+
+    times: np.ndarray
+    q: np.ndarray
+    timed_by: str
+    paced: PacedPath | None = None
+
+
+def _samples(motion: Motion, fraction: float, fastest: bool = False) -> _Samples:
+    """The samples an export writes: the motion's own; or its path at the person's pace where
+    the limits allow (a demonstration, a retimed recording); or as fast as they allow."""
     if motion.timed:
-        return motion.times, motion.q, "source"
-    times, q = time_path(motion.robot, motion.q, motion.rate_hz, fraction=fraction)
-    return times, q, "toppra"
+        return _Samples(motion.times, motion.q, "source")
+    if fastest or not _has_pace(motion):
+        times, q = time_path(motion.robot, motion.q, motion.rate_hz, fraction=fraction)
+        return _Samples(times, q, "toppra")
+    paced = pace_path(motion.robot, motion.times, motion.q, motion.rate_hz, fraction=fraction)
+    return _Samples(paced.times, paced.q, "pace", paced)
+
+
+def _has_pace(motion: Motion) -> bool:
+    """Whether the motion's times are a person's own pace, sample by sample (a demonstration's
+    or a recording's; a policy's rollout has no pace of its own to keep)."""
+    times = np.asarray(motion.times, dtype=float)
+    return (
+        motion.kind != "policy"
+        and times.shape == (len(motion.q),)
+        and len(times) > 1
+        and bool((np.diff(times) > 0).all())
+    )
+
+
+def _pace_note(paced: PacedPath) -> str:
+    """What a timing at the source's pace did, in one note: the durations and each stretch it
+    had to slow down."""
+    took = f"at the source's pace: {paced.source_seconds:.2f} s, run in {paced.times[-1]:.2f} s"
+    if not paced.slowdowns:
+        return f"{took}, from rest to rest"
+    return f"{took}, from rest to rest; " + "; ".join(s.sentence for s in paced.slowdowns)
 
 
 def simulate_motion(
-    motion: Motion, *, fraction: float = LIMIT_FRACTION, cache: Path | None = None
+    motion: Motion,
+    *,
+    fraction: float = LIMIT_FRACTION,
+    cache: Path | None = None,
+    fastest: bool = False,
 ) -> SimulationReport:
     """The samples :func:`export_motion` would write for ``motion``, replayed in MuJoCo: the
     report ``studio export`` states in the file, before anything is exported.
@@ -88,8 +130,8 @@ def simulate_motion(
         PhysicsError: MuJoCo cannot build the robot's model.
         ExportError: the robot's MuJoCo files cannot be written in ``cache``.
     """
-    times, q, _ = _samples(motion, fraction)
-    return simulate_trajectory(motion.robot, times, q, cache=cache)
+    samples = _samples(motion, fraction, fastest)
+    return simulate_trajectory(motion.robot, samples.times, samples.q, cache=cache)
 
 
 def _physics(
@@ -134,6 +176,7 @@ def export_motion(
     task: str = "",
     simulate: bool = False,
     cache: Path | None = None,
+    fastest: bool = False,
 ) -> Exported:
     """Time, check and write ``motion`` as ``fmt`` at ``out``.
 
@@ -145,16 +188,19 @@ def export_motion(
         unchecked: write even when the checks find problems, stating them in the file.
         fraction: the share of the limits the timing may use.
         task: the LeRobot task text (default: a sentence for the source's kind, :data:`TASKS`).
-
         simulate: replay the samples in MuJoCo and state the report in the file.
         cache: where the robot's MuJoCo files are kept (None: a temporary folder).
+        fastest: time a path as fast as the limits allow, not at its source's pace.
 
     Raises:
         SafetyError: the checks found problems (nothing written).
         ExportError: the file cannot be written.
     """
     robot = motion.robot
-    times, q, timed_by = _samples(motion, fraction)
+    samples = _samples(motion, fraction, fastest)
+    times, q, timed_by = samples.times, samples.q, samples.timed_by
+    if samples.paced is not None:
+        motion = replace(motion, notes=(*motion.notes, _pace_note(samples.paced)))
     # a recording at its capture times is what the arm did (joint states); timed, a trajectory
     as_captured = motion.kind == "recording" and timed_by == "source"
     findings = check_trajectory(robot, times, q, extra=list(motion.findings))
@@ -222,4 +268,5 @@ def export_motion(
             task=task,
             extra=extra,
         )
-    return Exported(out, times, q, tuple(findings), timed_by, report)
+    slowdowns = samples.paced.slowdowns if samples.paced is not None else ()
+    return Exported(out, times, q, tuple(findings), timed_by, report, slowdowns)

@@ -24,6 +24,7 @@ export.
 from __future__ import annotations
 
 import io
+import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import BinaryIO
@@ -160,7 +161,7 @@ def write_mcap(
     *,
     states: bool,
     metadata: dict[str, str],
-    start_ns: int,
+    start_ns: int | None = None,
     urdf: str = "",
     links: LinkTransforms | None = None,
 ) -> None:
@@ -174,7 +175,7 @@ def write_mcap(
         states: a recording at its capture times: joint states only, no trajectory to follow.
         metadata: the ``teach_studio`` metadata record's key-value pairs.
         start_ns: the first sample's time, nanoseconds since the Unix epoch (the recording's own
-            time, or the export's): every log time and stamp counts from it.
+            time; None: now): every log time and stamp counts from it.
         urdf: the robot's URDF, latched on ``/robot_description`` at the start.
         links: every link's transform per sample (:func:`link_transforms`), on ``/tf``; its
             root link is the frame id of the joint messages.
@@ -183,6 +184,7 @@ def write_mcap(
 
     names = list(names)
     velocity = np.gradient(q, times, axis=0) if len(times) > 1 else np.zeros_like(q)
+    start_ns = time.time_ns() if start_ns is None else start_ns
     at = [start_ns + int(round(float(t) * 1e9)) for t in times]
     frame_id = links.root if links is not None else ""
 

@@ -1,8 +1,12 @@
-"""Time-parametrisation: a joint path timed as fast as the robot's limits allow, then sampled.
+"""Time-parametrisation: a joint path timed at its source's pace where the robot's limits allow,
+slower only where they do not, from rest to rest (:func:`pace_path`); or as fast as the limits
+allow (:func:`time_path`).
 
-A policy rollout or a demonstration is a *path* (where the joints go); how fast it is run is set
-here with TOPP-RA (``toppra``): the time-optimal timing along the path that keeps every joint's
-velocity and acceleration within a fraction of the URDF's limits. The path is first cleared of
+A policy rollout or a demonstration is a *path* (where the joints go) with the times its source
+took; how it is run is set here with TOPP-RA (``toppra``): the fastest timing along the path that
+keeps every joint's velocity and acceleration within a fraction of the URDF's limits and, at the
+person's pace, never goes faster than the source did (``_topp.PaceBound``), so it runs at the
+person's pace wherever the robot can, and :class:`Slowdown` says where it could not. The path is first cleared of
 steps shorter than :data:`STILL_RAD` and thinned to the waypoints that matter (no sample of the
 original path is further than :data:`PATH_TOLERANCE_RAD` from the thinned one, joint by joint),
 so the capture noise of a demonstration does not force the arm to crawl. The curve through the
@@ -17,6 +21,8 @@ nearly stop anyway, and 2.3x on a smooth arc); TOPP-RA times a given path, which
 """
 
 from __future__ import annotations
+
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -42,6 +48,64 @@ RETIME_TRIES = 4
 """How many times the timing is run before the samples go to the checks as they are."""
 
 
+PACE_WINDOW_S = 0.1
+"""The source's pace at a sample is the rate it moved over this long around it (s)."""
+SLOWEST_PACE = 0.002
+"""The slowest the source's pace is taken to be, as a share of its median: where the source
+paused, the robot moves on slowly rather than stopping for good."""
+SLOWED_SECONDS = 0.01
+"""A stretch of the source taking this much longer (s) is slowed down; less is rounding."""
+
+
+@dataclass(frozen=True)
+class Slowdown:
+    """A stretch of the source the robot runs slower than the source did.
+
+    Attributes:
+        t0, t1: the stretch, in the source's own time (s from its first sample).
+        added: how much longer the robot takes over it (s).
+        start, end: whether it is where the robot starts from rest or comes to rest (the source
+            was moving there).
+    """
+
+    t0: float
+    t1: float
+    added: float
+    start: bool = False
+    end: bool = False
+
+    @property
+    def sentence(self) -> str:
+        """The stretch in words, for a file's notes and the page."""
+        why = (
+            "to start from rest"
+            if self.start
+            else "to come to rest"
+            if self.end
+            else "to stay within the joints' velocity and acceleration limits"
+        )
+        return (
+            f"slowed from {self.t0:.2f} s to {self.t1:.2f} s of the source by "
+            f"{self.added:.2f} s, {why}"
+        )
+
+
+@dataclass(frozen=True)
+class PacedPath:
+    """A path timed at its source's pace where the robot's limits allow.
+
+    Attributes:
+        times, q: the samples (s from 0; rad), at rest at both ends.
+        source_seconds: how long the source took.
+        slowdowns: where the robot runs slower than the source, in the source's time.
+    """
+
+    times: np.ndarray
+    q: np.ndarray
+    source_seconds: float
+    slowdowns: tuple[Slowdown, ...]
+
+
 def _thin(q: np.ndarray, tolerance: float) -> np.ndarray:
     """Indices of the waypoints kept (Ramer-Douglas-Peucker in joint space, max-norm)."""
     keep = np.zeros(len(q), dtype=bool)
@@ -62,6 +126,49 @@ def _thin(q: np.ndarray, tolerance: float) -> np.ndarray:
     return np.flatnonzero(keep)
 
 
+def _checked(rate_hz: float, fraction: float) -> None:
+    if not (np.isfinite(rate_hz) and rate_hz > 0):
+        raise ExportError(
+            f"The rate is {rate_hz!r} Hz; give a positive number of samples a second."
+        )
+    if not 0 < fraction <= 1:
+        raise ExportError(f"The limit fraction is {fraction!r}; give a number in (0, 1].")
+
+
+def _waypoints(q: np.ndarray, tolerance: float) -> np.ndarray:
+    """The rows of ``q`` the timing passes through: moving on, thinned within ``tolerance``."""
+    kept = _moving(q, np.arange(len(q)))
+    # thinned, a path that comes back within the tolerance can leave a step of zero length
+    return _moving(q, kept[_thin(q[kept], tolerance)])
+
+
+def _timed(
+    robot: RobotArm,
+    q: np.ndarray,
+    kept: np.ndarray,
+    rate_hz: float,
+    fraction: float,
+    pace: np.ndarray | None,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """TOPP-RA through the waypoints ``q[kept]``, timed again with a smaller share of the limits
+    while the samples still exceed them between its grid points; then held at rest one sample
+    period at each end, so the samples themselves start and end at zero velocity."""
+    from ._topp import GRID_TURN_RAD, topp  # imports toppra: seconds, so only when timing
+
+    turn = GRID_TURN_RAD
+    times, samples, at = topp(robot, q[kept], rate_hz, fraction, turn, kept, pace)
+    for _ in range(RETIME_TRIES - 1):
+        if within_limits(robot, times, samples):
+            break
+        fraction *= RETIME_FACTOR
+        turn /= 4
+        times, samples, at = topp(robot, q[kept], rate_hz, fraction, turn, kept, pace)
+    period = 1.0 / rate_hz
+    times = np.r_[0.0, times + period, times[-1] + 2 * period]
+    samples = np.vstack([samples[:1], samples, samples[-1:]])
+    return times, samples, at + period
+
+
 def time_path(
     robot: RobotArm,
     q: np.ndarray,
@@ -70,7 +177,8 @@ def time_path(
     fraction: float = LIMIT_FRACTION,
     tolerance: float = PATH_TOLERANCE_RAD,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """The path ``q`` (N, nq) timed by TOPP-RA and sampled at ``rate_hz``.
+    """The path ``q`` (N, nq) timed by TOPP-RA as fast as the limits allow, sampled at
+    ``rate_hz``.
 
     Args:
         robot: whose velocity and acceleration limits bound the timing.
@@ -80,34 +188,101 @@ def time_path(
         tolerance: how far the thinned path may pass from the given one (rad).
 
     Returns:
-        ``(times (M,), q (M, nq))``, from t = 0 at rest to the end at rest.
+        ``(times (M,), q (M, nq))``, from t = 0 at rest to the end at rest (the first and last
+        samples held one period).
 
     Raises:
         ExportError: a rate or fraction out of range, or a path TOPP-RA cannot time.
     """
-    if not (np.isfinite(rate_hz) and rate_hz > 0):
-        raise ExportError(
-            f"The rate is {rate_hz!r} Hz; give a positive number of samples a second."
-        )
-    if not 0 < fraction <= 1:
-        raise ExportError(f"The limit fraction is {fraction!r}; give a number in (0, 1].")
+    _checked(rate_hz, fraction)
     q = np.asarray(q, dtype=float)
-    kept = _moving(q, np.arange(len(q)))
-    # thinned, a path that comes back within the tolerance can leave a step of zero length
-    kept = _moving(q, kept[_thin(q[kept], tolerance)])
+    kept = _waypoints(q, tolerance)
     if len(kept) < 2:  # it never leaves its start by more than STILL_RAD: held still there
         return np.zeros(1), q[kept[:1]].copy()
-    from ._topp import GRID_TURN_RAD, topp  # imports toppra: seconds, so only when timing
-
-    turn = GRID_TURN_RAD
-    times, samples = topp(robot, q[kept], rate_hz, fraction, turn, kept)
-    for _ in range(RETIME_TRIES - 1):
-        if within_limits(robot, times, samples):
-            break
-        fraction *= RETIME_FACTOR
-        turn /= 4
-        times, samples = topp(robot, q[kept], rate_hz, fraction, turn, kept)
+    times, samples, _ = _timed(robot, q, kept, rate_hz, fraction, None)
     return times, samples
+
+
+def pace_path(
+    robot: RobotArm,
+    times: np.ndarray,
+    q: np.ndarray,
+    rate_hz: float,
+    *,
+    fraction: float = LIMIT_FRACTION,
+    tolerance: float = PATH_TOLERANCE_RAD,
+) -> PacedPath:
+    """The path ``q`` (N, nq) at the pace its source took (``times``), slower only where the
+    robot's limits need it, from rest to rest, sampled at ``rate_hz``.
+
+    Args:
+        robot: whose velocity and acceleration limits bound the timing.
+        times: when the source was at each row of ``q`` (s, increasing).
+        q: the path's joint angles (rad), one row per sample.
+        rate_hz: the rate of the returned samples.
+        fraction: the share of the limits the timing may use (0-1].
+        tolerance: how far the thinned path may pass from the given one (rad).
+
+    Raises:
+        ExportError: a rate or fraction out of range, times that do not increase, or a path
+            TOPP-RA cannot time.
+    """
+    _checked(rate_hz, fraction)
+    q = np.asarray(q, dtype=float)
+    times = np.asarray(times, dtype=float) - float(times[0])
+    if times.shape != (len(q),) or not (np.diff(times) > 0).all():
+        raise ExportError(
+            "The path's times do not increase sample by sample, so its pace is unknown; export "
+            "it as fast as the robot's limits allow instead."
+        )
+    kept = _waypoints(q, tolerance)
+    if len(kept) < 2:
+        return PacedPath(np.zeros(1), q[kept[:1]].copy(), float(times[-1]), ())
+    timed, samples, at = _timed(robot, q, kept, rate_hz, fraction, _pace(times, q, kept))
+    return PacedPath(timed, samples, float(times[-1]), _slowdowns(times[kept], at))
+
+
+def _pace(times: np.ndarray, q: np.ndarray, kept: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The source's pace sample by sample, along the thinned path's arc length: each sample is
+    placed on it in proportion to the distance it had come between two waypoints, and its speed
+    is the rate it moved along it then (never below :data:`SLOWEST_PACE` of its median, so that
+    a pause in the source does not stop the timing)."""
+    from ._topp import arc_length
+
+    along = arc_length(q)
+    s = np.interp(along, along[kept], arc_length(q[kept]))
+    # the rate over PACE_WINDOW_S around each sample: a pace, not one noisy step
+    half = max(1, int(round(PACE_WINDOW_S / 2 / float(np.median(np.diff(times))))))
+    before = np.maximum(np.arange(len(s)) - half, 0)
+    after = np.minimum(np.arange(len(s)) + half, len(s) - 1)
+    speed = (s[after] - s[before]) / (times[after] - times[before])
+    moving = speed[speed > 0]
+    floor = SLOWEST_PACE * (float(np.median(moving)) if len(moving) else 1.0)
+    return s, np.maximum(speed, floor)
+
+
+def _slowdowns(source: np.ndarray, robot: np.ndarray) -> tuple[Slowdown, ...]:
+    """The runs of steps between waypoints the robot takes longer over than the source did."""
+    added = np.diff(robot) - np.diff(source)
+    added[0] += robot[0] - source[0]  # the held first sample: part of starting from rest
+    slow = added > SLOWED_SECONDS / 4
+    found = []
+    k = 0
+    while k < len(slow):
+        if not slow[k]:
+            k += 1
+            continue
+        end = k
+        while end + 1 < len(slow) and slow[end + 1]:
+            end += 1
+        total = float(added[k : end + 1].sum())
+        if total >= SLOWED_SECONDS:
+            first, last = k == 0, end == len(slow) - 1
+            found.append(
+                Slowdown(float(source[k]), float(source[end + 1]), total, first, last and not first)
+            )
+        k = end + 1
+    return tuple(found)
 
 
 def _moving(q: np.ndarray, rows: np.ndarray) -> np.ndarray:

@@ -130,6 +130,28 @@ class ImpliedBounds(toppra.constraint.LinearConstraint):  # type: ignore[misc]
         )
 
 
+Pace = tuple[np.ndarray, np.ndarray]
+"""The source's own pace along a path: places on it (arc length, rad, increasing) and the path
+speed there (rad/s)."""
+
+
+class PaceBound(toppra.constraint.LinearConstraint):  # type: ignore[misc]
+    """The path speed never above the source's own there: ``x <= pace(s)^2`` (the person's pace,
+    :data:`Pace`). TOPP-RA's fastest timing under it runs at the source's pace wherever the limits
+    allow it, and slower only where they do not."""
+
+    def __init__(self, pace: Pace) -> None:
+        super().__init__()
+        self._s, self._speed = pace
+
+    def compute_constraint_params(
+        self, path: AbstractGeometricPath, gridpoints: np.ndarray, *args: Any, **kwargs: Any
+    ) -> tuple[None, None, None, None, None, None, np.ndarray]:
+        speed = np.interp(gridpoints, self._s, self._speed)
+        x_high = np.minimum(speed**2, BOUND_CEILING)
+        return None, None, None, None, None, None, np.column_stack([np.zeros_like(x_high), x_high])
+
+
 def arc_length(q: np.ndarray) -> np.ndarray:
     """The path parameter at each waypoint: the joint-space distance travelled (rad)."""
     return np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(q, axis=0), axis=1))]
@@ -186,7 +208,8 @@ def topp(
     fraction: float,
     turn: float,
     samples: np.ndarray | None = None,
-) -> tuple[np.ndarray, np.ndarray]:
+    pace: Pace | None = None,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The waypoints ``q`` (N >= 2, no two alike in a row) timed by TOPP-RA within ``fraction``
     of the robot's limits, on a grid of ``turn`` (:func:`gridpoints`), sampled at ``rate_hz``.
 
@@ -196,6 +219,13 @@ def topp(
 
     Args:
         samples: each waypoint's sample in the path given to the export, to name it.
+        pace: the source's own pace along the waypoints' arc length (:data:`Pace`): the timing
+            is then never faster than the source (:class:`PaceBound`); None: as fast as the
+            limits allow.
+
+    Returns:
+        ``(times, samples, at)``: the sample times and joints, and when the timing passes each
+        waypoint.
 
     Raises:
         ExportError: TOPP-RA found no timing for one step between two waypoints (never seen on
@@ -205,7 +235,7 @@ def topp(
     velocity = fraction * robot.velocity
     acceleration = fraction * robot.acceleration
     toppra.setup_logging("ERROR")  # a failure is handled here, and said in one sentence
-    parts = _timed_parts(robot, q, velocity, acceleration, turn, samples)
+    parts = _timed_parts(robot, q, velocity, acceleration, turn, samples, pace)
     ends = np.cumsum([part.duration for part in parts])
     # whole sample periods, the last one held at the end (at rest): the samples stay on the
     # rate's grid, which players and LeRobot's timestamp checks expect
@@ -217,7 +247,13 @@ def topp(
         at = which == k
         if at.any():
             out[at] = part(np.clip(times[at] - starts[k], 0.0, part.duration))
-    return times, out
+    # when each part passes its waypoints (ParametrizeConstAccel keeps its grid's path
+    # positions and times); a waypoint where two parts meet is passed when the first ends
+    passed = []
+    for k, (start, part) in enumerate(zip(starts, parts, strict=True)):
+        at = start + np.interp(part._path.waypoints[0], part._ss, part._ts)
+        passed.append(at if k == len(parts) - 1 else at[:-1])
+    return times, out, np.concatenate(passed)
 
 
 def _timed_parts(
@@ -227,19 +263,23 @@ def _timed_parts(
     acceleration: np.ndarray,
     turn: float,
     samples: np.ndarray,
+    pace: Pace | None = None,
 ) -> list[Any]:  # toppra trajectories, each from rest to rest
     """TOPP-RA's trajectories along ``q``, one, or one per part where the whole fails."""
     s = arc_length(q)
     curve = waypoint_curve(robot, s, q)
     path = PiecewiseCubicPath(s, q, curve)
+    constraints = [
+        toppra.constraint.JointVelocityConstraint(np.column_stack([-velocity, velocity])),
+        toppra.constraint.JointAccelerationConstraint(
+            np.column_stack([-acceleration, acceleration])
+        ),
+        ImpliedBounds(velocity, acceleration),
+    ]
+    if pace is not None:
+        constraints.append(PaceBound(pace))
     instance = toppra.algorithm.TOPPRA(
-        [
-            toppra.constraint.JointVelocityConstraint(np.column_stack([-velocity, velocity])),
-            toppra.constraint.JointAccelerationConstraint(
-                np.column_stack([-acceleration, acceleration])
-            ),
-            ImpliedBounds(velocity, acceleration),
-        ],
+        constraints,
         path,
         gridpoints=gridpoints(path, s, turn),
         parametrizer="ParametrizeConstAccel",
@@ -254,6 +294,9 @@ def _timed_parts(
             "smooth the path there and export it again."
         )
     cut = 1 + int(np.argmin(np.abs(curve(s[1:-1], 1)).max(axis=1)))
+    first = second = None
+    if pace is not None:  # the second part's arc length starts from 0 at the cut
+        first, second = pace, (pace[0] - s[cut], pace[1])
     return _timed_parts(
-        robot, q[: cut + 1], velocity, acceleration, turn, samples[: cut + 1]
-    ) + _timed_parts(robot, q[cut:], velocity, acceleration, turn, samples[cut:])
+        robot, q[: cut + 1], velocity, acceleration, turn, samples[: cut + 1], first
+    ) + _timed_parts(robot, q[cut:], velocity, acceleration, turn, samples[cut:], second)

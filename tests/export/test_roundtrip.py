@@ -139,7 +139,8 @@ def test_an_unchecked_export_states_its_findings_in_the_file(fmt, tmp_path, caps
 @pytest.mark.parametrize("fmt", ["csv", "mcap", "lerobot"])
 def test_a_refused_recording_exports_timed_within_the_limits_with_retime(fmt, tmp_path, capsys):
     """At its capture times a recording breaks the robot's limits, and the refusal says how to
-    send it to a robot: --retime times its path within them (TOPP-RA), and it passes."""
+    send it to a robot: --retime times its path within them, at the person's pace where the
+    limits allow (issue 39), and it passes."""
     out = tmp_path / f"rec.{fmt}"
     sample = str(SAMPLES_DIR / "sample-reach-1.tape.csv")
     argv = ["export", sample, "--robot", "ur5", "--format", fmt, "--out", str(out)]
@@ -147,7 +148,7 @@ def test_a_refused_recording_exports_timed_within_the_limits_with_retime(fmt, tm
     assert "pass --retime to time its path within the limits" in capsys.readouterr().err
     assert main([*argv, "--retime", "--rate", "100"]) == 0, capsys.readouterr().err
     said = capsys.readouterr().out
-    assert "timed within the limits (TOPP-RA), passed the safety checks" in said
+    assert "at the person's pace where the limits allow, passed the safety checks" in said
     ur5 = load_robot("ur5")
     if fmt == "csv":
         header, rows = read_csv(out)
@@ -158,7 +159,7 @@ def test_a_refused_recording_exports_timed_within_the_limits_with_retime(fmt, tm
         assert schema == JOINT_TRAJECTORY and names == list(ur5.joint_names)
     else:
         info = json.loads((out / "meta/info.json").read_text())
-        assert info["fps"] == 100 and info["teach_studio"]["timed_by"] == "toppra"
+        assert info["fps"] == 100 and info["teach_studio"]["timed_by"] == "pace"
         table = pq.read_table(out / "data/chunk-000/file-000.parquet")
         times = np.array(table.column("timestamp").to_pylist())
         q = np.array(table.column("observation.state").to_pylist())
