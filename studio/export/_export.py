@@ -208,65 +208,85 @@ def export_motion(
         refuse(findings, f"{motion.kind} {motion.name}", robot, own_times=as_captured)
     notes = _notes(motion, findings, checked=not unchecked)
     report, physics = _physics(motion, times, q, cache) if simulate else (None, [])
-    names = robot.joint_names
+    written = _Written(motion, times, q, timed_by, findings, report, physics if simulate else None)
     if fmt == "csv":
-        write_csv(out, names, times, q, [*notes, *physics])
+        write_csv(out, robot.joint_names, times, q, [*notes, *physics])
     elif fmt == "mcap":
-        metadata = {
-            "source": motion.name,
-            "kind": motion.kind,
-            "robot": robot.name,
-            "timed_by": timed_by,
-            "checked": "passed" if not findings else "no (--unchecked)",
-            "findings": "\n".join(f.sentence for f in findings),
-            "notes": "\n".join(motion.notes),
-        }
-        if simulate:
-            metadata["physics"] = "\n".join(physics)
-            metadata["physics_json"] = json.dumps(report.as_json() if report else None)
-        start_ns = int(round((motion.started or time.time()) * 1e9))
-        links = link_transforms(robot.model, q)
-        write_mcap(
-            out,
-            names,
-            times,
-            q,
-            states=as_captured,
-            metadata=metadata,
-            start_ns=start_ns,
-            urdf=robot.urdf_text,
-            links=links,
-        )
+        _mcap(written, out, as_captured)
     else:
-        fps = int(round(motion.rate_hz))
-        layout = lerobot_conventions(robot.name, names, robot.lower, robot.upper)
-        extra = {
-            "teach_studio": {
-                "source": motion.name,
-                "kind": motion.kind,
-                "robot": robot.name,
-                "units": dict(zip(layout.names, layout.units, strict=True)),
-                "timed_by": timed_by,
-                "checked": not findings,
-                "findings": [f.sentence for f in findings],
-                "notes": list(motion.notes),
-            }
-        }
-        if simulate:
-            extra["teach_studio"]["physics"] = {
-                "report": report.as_json() if report else None,
-                "sentences": physics,
-            }
-        task = task or TASKS[motion.kind]
-        write_lerobot(
-            out,
-            layout.names,
-            times,
-            layout.values(q),
-            fps=fps,
-            robot_type=layout.robot_type,
-            task=task,
-            extra=extra,
-        )
+        _lerobot(written, out, task or TASKS[motion.kind])
     slowdowns = samples.paced.slowdowns if samples.paced is not None else ()
     return Exported(out, times, q, tuple(findings), timed_by, report, slowdowns)
+
+
+@dataclass(frozen=True)
+class _Written:
+    """What an export writes into a file beside the samples: its source, timing, checks and
+    physics (``physics`` None: not simulated)."""
+
+    motion: Motion
+    times: np.ndarray
+    q: np.ndarray
+    timed_by: str
+    findings: list[Finding]
+    report: SimulationReport | None
+    physics: list[str] | None
+
+
+def _mcap(written: _Written, out: Path, as_captured: bool) -> None:
+    motion, findings, report = written.motion, written.findings, written.report
+    robot = motion.robot
+    metadata = {
+        "source": motion.name,
+        "kind": motion.kind,
+        "robot": robot.name,
+        "timed_by": written.timed_by,
+        "checked": "passed" if not findings else "no (--unchecked)",
+        "findings": "\n".join(f.sentence for f in findings),
+        "notes": "\n".join(motion.notes),
+    }
+    if written.physics is not None:
+        metadata["physics"] = "\n".join(written.physics)
+        metadata["physics_json"] = json.dumps(report.as_json() if report else None)
+    write_mcap(
+        out,
+        robot.joint_names,
+        written.times,
+        written.q,
+        states=as_captured,
+        metadata=metadata,
+        start_ns=int(round((motion.started or time.time()) * 1e9)),
+        urdf=robot.urdf_text,
+        links=link_transforms(robot.model, written.q),
+    )
+
+
+def _lerobot(written: _Written, out: Path, task: str) -> None:
+    motion, findings, report = written.motion, written.findings, written.report
+    robot = motion.robot
+    layout = lerobot_conventions(robot.name, robot.joint_names, robot.lower, robot.upper)
+    about: dict[str, object] = {
+        "source": motion.name,
+        "kind": motion.kind,
+        "robot": robot.name,
+        "units": dict(zip(layout.names, layout.units, strict=True)),
+        "timed_by": written.timed_by,
+        "checked": not findings,
+        "findings": [f.sentence for f in findings],
+        "notes": list(motion.notes),
+    }
+    if written.physics is not None:
+        about["physics"] = {
+            "report": report.as_json() if report else None,
+            "sentences": written.physics,
+        }
+    write_lerobot(
+        out,
+        layout.names,
+        written.times,
+        layout.values(written.q),
+        fps=int(round(motion.rate_hz)),
+        robot_type=layout.robot_type,
+        task=task,
+        extra={"teach_studio": about},
+    )
