@@ -20,7 +20,9 @@ import ast
 import functools
 import os
 import socket
+import sys
 import threading
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -66,6 +68,20 @@ def hold_preparation(monkeypatch: pytest.MonkeyPatch) -> tuple[threading.Event, 
     monkeypatch.setattr(_prepare, "learner_ready", lambda kind: False)
     monkeypatch.setattr(_prepare, "_warm", slow_warm)
     return compiling, compiled
+
+
+@pytest.fixture(autouse=True)
+def _robots_load_in_this_process() -> Iterator[None]:
+    """Each test starts as a fresh process would: robots built in this process. A command that
+    tests call in-process (``studio export``) makes every later robot load of the process go
+    through a child process (``isolate_robot_loading``) with that test's cache folder, so every
+    robot first loaded by a later test on the worker would pay a child's start and write a cache
+    nobody reads."""
+    yield
+    robot_load = sys.modules.get("studio.kinematics._robot_load")  # (not imported: nothing to undo)
+    if robot_load is not None:
+        robot_load._isolated.clear()
+        robot_load._cache.clear()
 
 
 def pytest_configure(config: pytest.Config) -> None:
