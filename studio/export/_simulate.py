@@ -79,7 +79,8 @@ def simulate_trajectory(
         robot: the robot or its name.
         times: seconds, one per sample.
         q: radians, one row per sample.
-        names: the joint names the trajectory gives, checked against the robot's.
+        names: the joint names the trajectory gives, checked against the robot's (``q1`` ..
+            ``qN``, a policy rollout's columns, stand for its joints in order).
         cache: the folder the robot's MuJoCo files are kept in (None: a temporary one).
 
     Raises:
@@ -88,7 +89,9 @@ def simulate_trajectory(
     """
     # the joints are checked on the model without geometry: a wrong robot is refused at once
     light = load_robot(robot, geometry=False) if isinstance(robot, str) else robot
-    if names is not None and tuple(names) != light.joint_names:
+    # a policy's rollout as `studio export POLICY` alone writes it names its joints q1..qN
+    positional = tuple(f"q{i + 1}" for i in range(light.nq))
+    if names is not None and tuple(names) not in (light.joint_names, positional):
         raise ExportError(
             f"The trajectory's joints ({', '.join(names)}) are not the {light.spec.title}'s "
             f"({', '.join(light.joint_names)}); give the --robot it was exported for."

@@ -88,3 +88,14 @@ def test_a_bad_input_is_one_sentence_and_exit_2(gentle, capsys, name, content, r
     captured = capsys.readouterr()
     assert captured.out == ""
     assert problem in captured.err and captured.err.count("\n") == 1, captured.err
+
+
+def test_a_policy_rollouts_q_columns_are_the_robots_joints_in_order(tmp_path, capsys):
+    """``studio export POLICY`` alone writes ``time,q1..q6``: simulated on the Puma560."""
+    arm = load_robot("puma560")
+    times, q = smooth_move(arm.home, arm.home + 0.1, 1.0)
+    names = [f"q{i + 1}" for i in range(arm.nq)]
+    write_csv(tmp_path / "rollout.csv", names, times, q)
+    args = ["simulate", str(tmp_path / "rollout.csv"), "--robot", "puma560", "--json"]
+    assert main([*args, "--data-dir", str(tmp_path)]) == 0
+    assert json.loads(capsys.readouterr().out)["completed"] is True
