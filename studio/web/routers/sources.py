@@ -66,8 +66,8 @@ def simulator_reach(body: ReachAction, studio: StudioDep) -> SourcePublic:
 @router.post("/landmarks")
 def post_landmarks(body: LandmarksFrame, studio: StudioDep) -> LandmarksPublic:
     """One frame of pose landmarks from the page's camera: fitted, shown, and recorded while a
-    capture runs (409 unless the source is the camera; 422 for NaN or wrong sizes; 429 for a
-    flood, the frame dropped and the studio running on)."""
+    capture runs (409 unless the source is the camera, or while another page sends frames; 422
+    for NaN or wrong sizes; 429 for a flood, the frame dropped and the studio running on)."""
     return studio.post_landmarks(body)
 
 
