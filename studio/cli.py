@@ -9,12 +9,15 @@ this file only collects them, so adding a verb never touches another's code. Wit
 from __future__ import annotations
 
 import argparse
+import ast
+import contextlib
 import importlib
 import os
 import pkgutil
 import re
 import sys
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
+from pathlib import Path
 from types import ModuleType
 from typing import NoReturn
 
@@ -25,14 +28,31 @@ from ._json import unpaired_surrogate
 DEFAULT_VERB = "serve"
 
 
-def _verb_modules() -> dict[str, ModuleType]:
-    modules: dict[str, ModuleType] = {}
+def _verb_table() -> dict[str, tuple[str, str]]:
+    """Each verb's name -> its module's name and its one-line help, read from the module's
+    source without importing it: ``studio --help`` and a mistyped verb then cost none of the
+    verbs' imports (Pinocchio, numba, SciPy: seconds), only the verb that runs is imported."""
+    table: dict[str, tuple[str, str]] = {}
+    folder = Path(commands.__path__[0])
     for info in sorted(pkgutil.iter_modules(commands.__path__), key=lambda m: m.name):
         if info.name.startswith("_"):
             continue
-        module = importlib.import_module(f"{commands.__name__}.{info.name}")
-        modules[module.NAME] = module
-    return modules
+        found: dict[str, object] = {}
+        for node in ast.parse((folder / f"{info.name}.py").read_text()).body:
+            if isinstance(node, ast.Assign) and len(node.targets) == 1:
+                target = node.targets[0]
+                if isinstance(target, ast.Name) and target.id in ("NAME", "HELP"):
+                    with contextlib.suppress(ValueError):
+                        found[target.id] = ast.literal_eval(node.value)
+        if not (isinstance(found.get("NAME"), str) and isinstance(found.get("HELP"), str)):
+            module = _verb_module(info.name)  # not literal text: ask the module itself
+            found = {"NAME": module.NAME, "HELP": module.HELP}
+        table[str(found["NAME"])] = (info.name, str(found["HELP"]))
+    return table
+
+
+def _verb_module(name: str) -> ModuleType:
+    return importlib.import_module(f"{commands.__name__}.{name}")
 
 
 NUMBERS = re.compile(r"^-\.?\d[\d.,eE+\- ]*$")
@@ -55,8 +75,15 @@ class _Parser(argparse.ArgumentParser):
         self.exit(2, f"{self.prog}: {message}; see {self.prog} --help.\n")
 
 
-def build_parser() -> tuple[argparse.ArgumentParser, dict[str, ModuleType]]:
-    """The argument parser with one sub-parser per verb."""
+def build_parser(
+    verbs: Iterable[str] | None = None,
+) -> tuple[argparse.ArgumentParser, dict[str, ModuleType]]:
+    """The argument parser with one sub-parser per verb, and the verb modules it imported.
+
+    Args:
+        verbs: the verbs whose arguments are added (their modules imported); the others are
+            listed with their help only. None: every verb.
+    """
     parser = _Parser(
         prog="studio",
         description="Teach Studio: teach a robot arm by showing it a motion. "
@@ -64,19 +91,23 @@ def build_parser() -> tuple[argparse.ArgumentParser, dict[str, ModuleType]]:
     )
     parser.add_argument("--version", action="version", version=f"teach-studio {__version__}")
     sub = parser.add_subparsers(dest="verb", metavar="VERB")
-    modules = _verb_modules()
-    for name, module in modules.items():
-        verb_parser = sub.add_parser(name, help=module.HELP, description=module.HELP)
-        module.add_arguments(verb_parser)
+    table = _verb_table()
+    wanted = set(table) if verbs is None else set(verbs)
+    modules: dict[str, ModuleType] = {}
+    for name, (module_name, text) in table.items():
+        verb_parser = sub.add_parser(name, help=text, description=text)
+        if name in wanted:
+            modules[name] = _verb_module(module_name)
+            modules[name].add_arguments(verb_parser)
     return parser, modules
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``studio`` console script."""
     argv = list(sys.argv[1:] if argv is None else argv)
-    parser, modules = build_parser()
     if not argv or (argv[0].startswith("-") and argv[0] not in ("-h", "--help", "--version")):
         argv = [DEFAULT_VERB, *argv]
+    parser, modules = build_parser(argv[:1])
     args, unknown = parser.parse_known_args(argv)
     if unknown:
         where = f"studio {args.verb}"

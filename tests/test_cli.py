@@ -168,3 +168,25 @@ def test_a_name_a_latin1_shell_sent_is_refused_in_one_sentence(
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and err.startswith(f"studio {argv[0]}: {option} is not UTF-8")
     assert not list(tmp_path.iterdir())
+
+
+HEAVY = ("studio.learning", "studio.kinematics", "studio.capture", "pinocchio", "numba", "scipy")
+
+
+@pytest.mark.parametrize(
+    "argv", [["--help"], ["no-such-verb"], ["robots", "--help"], ["simulate", "--help"]]
+)
+def test_help_and_a_mistyped_verb_import_none_of_the_heavy_packages(argv):
+    """``studio --help`` lists the verbs from their modules' source, and a verb's own help
+    imports only that verb: none of Pinocchio, numba or SciPy (seconds of CPU) for a light one."""
+    import subprocess
+
+    code = (
+        "import sys\nfrom studio.cli import main\n"
+        f"try:\n    main({argv!r})\nexcept SystemExit:\n    pass\n"
+        f"print(sorted(m for m in {HEAVY!r} if m in sys.modules))"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, timeout=120, check=True
+    )
+    assert done.stdout.strip().splitlines()[-1] == "[]", done.stdout
