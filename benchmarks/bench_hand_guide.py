@@ -1,6 +1,6 @@
 """Hand-guide latency: a handle update to the robot's new joints, against the bare arm IK.
 
-Ours: ``POST /api/source/hand``'s function (:meth:`Studio.hand_moved`: check and count the pose,
+Ours: ``POST /api/source/hand``'s function (:meth:`Sources.hand_moved`: check and count the pose,
 fit the arm by IK seeded with the last pose, retarget onto the Puma560, record it), called in
 process, as the scene's handle calls it. Baseline: :func:`studio.kinematics.fit_hand_pose` alone
 with the same seeds. The two are interleaved update by update (the machine is shared: figures
@@ -35,8 +35,8 @@ def main() -> None:
     args = parser.parse_args()
     with tempfile.TemporaryDirectory() as tmp:
         studio = Studio(Settings(data_dir=Path(tmp), source=None))
-        studio.set_source("hand")
-        studio.start_capture("bench", None, None)
+        studio.sources.switch("hand")
+        studio.capture.start("bench", None, None)
         rest = HumanArm("right").forward(np.zeros(7)).hand
         q_seed = np.zeros(7)
         ours, bare = [], []
@@ -46,13 +46,13 @@ def main() -> None:
             t0 = time.perf_counter()
             fit = fit_hand_pose(oMhand, side="right", q_seed=q_seed)
             t1 = time.perf_counter()
-            studio.hand_moved(p)
+            studio.sources.hand_moved(p)
             t2 = time.perf_counter()
             q_seed = fit.q_human
             bare.append(t1 - t0)
             ours.append(t2 - t1)
             time.sleep(1.0 / 100)  # under the flood limit, as a 60 Hz drag
-        studio.stop_capture()
+        studio.capture.stop()
         studio.close()
     ours_ms, bare_ms = np.array(ours) * 1e3, np.array(bare) * 1e3
     print(f"hand updates: {args.updates} (interleaved; the machine is shared, figures are noisy)")

@@ -8,6 +8,7 @@ whose one-sentence messages the API passes on as 422.
 
 from __future__ import annotations
 
+from collections.abc import Mapping, Sequence
 from typing import Annotated, Literal
 
 from pydantic import (
@@ -29,7 +30,9 @@ from studio.learning import (
     REACH_DEFAULTS,
     TASK_KINDS,
     ArmGrid,
+    DemonstrationPath,
     DynaQConfig,
+    RunRequest,
 )
 
 PlanningName = Literal["zero", "full", "soft", "prioritized"]
@@ -446,6 +449,34 @@ class _RunCreateBase(_Body):
     demonstrations: list[str] = Field(default_factory=list)
     seed: int = DEFAULT_SEED
 
+    def request(self, robot: str, demonstrations: Sequence[DemonstrationPath] = ()) -> RunRequest:
+        """The learning package's request of this run on ``robot`` (the one named here, or the
+        one the page teaches when it names none), replaying ``demonstrations`` (the named ones'
+        joint paths on that robot); :func:`studio.learning.resolve_run` checks it."""
+        return RunRequest(
+            task=self.task,
+            robot=robot,
+            config={
+                "planning": self.planning,
+                "planning_steps": self.planning_steps,
+                "epsilon": self.epsilon,
+                "alpha": self.alpha,
+                "gamma": self.gamma,
+            },
+            goal_deg=self.goal_deg,
+            experiments=self.experiments,
+            episodes=self.episodes,
+            seed=self.seed,
+            demonstrations=demonstrations,
+            name=self.name or "",
+            origin="page",
+            **self._task_settings(),
+        )
+
+    def _task_settings(self) -> dict[str, Mapping[str, object]]:
+        """The task's own settings, as :class:`~studio.learning.RunRequest` takes them."""
+        raise NotImplementedError
+
 
 class GridRunCreate(_RunCreateBase):
     """A run on the paper's arm grid, tabular (``task`` may be left out)."""
@@ -460,6 +491,9 @@ class GridRunCreate(_RunCreateBase):
         if task not in TASK_KINDS:
             raise ValueError(f"Input should be {' or '.join(map(repr, TASK_KINDS))}")
         return task
+
+    def _task_settings(self) -> dict[str, Mapping[str, object]]:
+        return {"grid": {"bins": self.bins}}
 
 
 class ReachRunCreate(_RunCreateBase):
@@ -481,6 +515,17 @@ class ReachRunCreate(_RunCreateBase):
     degrees)."""
     bins: int | None = None
     """Not used by this task: the page's form sends its grid field along with every run."""
+
+    def _task_settings(self) -> dict[str, Mapping[str, object]]:
+        return {
+            "reach": {
+                "joints": self.joints,
+                "step_deg": self.step_deg,
+                "actions": self.actions,
+                "tilings": self.tilings,
+                "tiles": self.tiles,
+            }
+        }
 
 
 def _task_of(body: object) -> str:

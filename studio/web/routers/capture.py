@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from fastapi import APIRouter, Response
 
-from .._deps import StudioDep
+from .._deps import CaptureDep, RecordingsDep
 from .._schemas import CapturePublic, CaptureStart, RecordingPublic
 from .recordings import read_public
 
@@ -12,27 +12,27 @@ router = APIRouter(prefix="/api/capture", tags=["capture"])
 
 
 @router.get("")
-def read_capture(studio: StudioDep) -> CapturePublic:
+def read_capture(capture: CaptureDep) -> CapturePublic:
     """The capture in progress (``active`` false when none)."""
-    return CapturePublic.model_validate(studio.pipeline.capture_status())
+    return CapturePublic.model_validate(capture.status())
 
 
 @router.post("/start")
-def start_capture(body: CaptureStart, studio: StudioDep) -> CapturePublic:
+def start_capture(body: CaptureStart, capture: CaptureDep) -> CapturePublic:
     """Start recording (409 if a recording is already running, there is no running source, or
     the name is taken; 422 for a bad name or one starting with ``sample-``)."""
-    studio.start_capture(body.name, body.operator, body.notes)
-    return CapturePublic.model_validate(studio.pipeline.capture_status())
+    capture.start(body.name, body.operator, body.notes)
+    return CapturePublic.model_validate(capture.status())
 
 
 @router.delete("/error", status_code=204)
-def dismiss_capture_error(studio: StudioDep) -> Response:
+def dismiss_capture_error(capture: CaptureDep) -> Response:
     """Dismiss the reason the last capture stopped by itself (the page's close button)."""
-    studio.pipeline.dismiss_capture_error()
+    capture.dismiss_error()
     return Response(status_code=204)
 
 
 @router.post("/stop")
-def stop_capture(studio: StudioDep) -> RecordingPublic:
+def stop_capture(capture: CaptureDep, recordings: RecordingsDep) -> RecordingPublic:
     """Stop recording; the file is closed cleanly and listed (409 if none is running)."""
-    return read_public(studio, studio.stop_capture())
+    return read_public(recordings, capture.stop())

@@ -16,9 +16,8 @@ from collections.abc import AsyncIterator
 from fastapi import APIRouter, Request
 from fastapi.responses import StreamingResponse
 
-from .._deps import StudioDep
-from .._state import Studio
-from ..services import Run
+from .._deps import CaptureDep, ChangesDep, RunsDep, SourcesDep
+from ..services import Capture, ListChanges, Run, RunQueue, Sources
 
 router = APIRouter(prefix="/api/events", tags=["events"])
 
@@ -38,17 +37,25 @@ def sse(event: str, data: object) -> str:
 
 
 async def stream_events(
-    studio: Studio, request: Request | None = None, max_seconds: float | None = None
+    changes: ListChanges,
+    sources: Sources,
+    capture: Capture,
+    runs: RunQueue,
+    request: Request | None = None,
+    max_seconds: float | None = None,
 ) -> AsyncIterator[str]:
     """The event stream of one client (see ``docs/api.md``).
 
     Args:
-        studio: the studio state to watch.
+        changes: the lists' versions.
+        sources: the live source (its status).
+        capture: the capture in progress.
+        runs: the runs (their progress while training).
         request: the client's request, to notice a disconnect.
         max_seconds: end the stream after this long (None: until the client leaves).
     """
     start = time.monotonic()
-    versions = studio.changes.versions()
+    versions = changes.versions()
     run_seen: dict[str, int] = {}  # per run: the curve version this client has
     last = {"source": -1e9, "run": -1e9, "keepalive": start, "capture": -1e9}
     capture_was_active = False
@@ -61,21 +68,21 @@ async def stream_events(
             return
         if now - last["source"] >= SOURCE_EVERY_S:
             last["source"] = now
-            yield sse("source", studio.source_public())
-            capture = studio.pipeline.capture_status()
-            if capture["active"] or capture_was_active:
-                yield sse("capture", capture)
-            capture_was_active = capture["active"]
+            yield sse("source", sources.public())
+            status = capture.status()
+            if status["active"] or capture_was_active:
+                yield sse("capture", status)
+            capture_was_active = bool(status["active"])
         if now - last["run"] >= RUN_EVERY_S:
             last["run"] = now
-            for run in studio.runs.running():
+            for run in runs.running():
                 yield sse("run", run_event(run, run_seen))
-        current = studio.changes.versions()
+        current = changes.versions()
         for name, version in current.items():
             if version != versions.get(name):
                 if name == "runs":
                     for run_id in list(run_seen):
-                        final = _final_run(studio, run_id, run_seen)
+                        final = _final_run(runs, run_id, run_seen)
                         if final is not None:
                             yield sse("run", final)
                 yield sse("lists", {"changed": name})
@@ -110,10 +117,10 @@ def run_event(run: Run, seen: dict[str, int]) -> dict[str, object]:
     return event
 
 
-def _final_run(studio: Studio, run_id: str, seen: dict[str, int]) -> dict[str, object] | None:
+def _final_run(runs: RunQueue, run_id: str, seen: dict[str, int]) -> dict[str, object] | None:
     """The last event of a run that stopped training since the previous tick."""
     try:
-        run = studio.runs.get(run_id)
+        run = runs.get(run_id)
     except Exception:
         seen.pop(run_id, None)
         return None
@@ -126,14 +133,19 @@ def _final_run(studio: Studio, run_id: str, seen: dict[str, int]) -> dict[str, o
 
 @router.get("", response_class=StreamingResponse)
 async def events(
-    request: Request, studio: StudioDep, max_seconds: float | None = None
+    request: Request,
+    changes: ChangesDep,
+    sources: SourcesDep,
+    capture: CaptureDep,
+    runs: RunsDep,
+    max_seconds: float | None = None,
 ) -> StreamingResponse:
     """Server-Sent Events: ``source`` (~4/s), ``capture``, ``run`` (>= 5/s while training), ``lists``.
 
     ``max_seconds`` ends the stream after that long (scripts, tests); browsers leave it out.
     """
     return StreamingResponse(
-        stream_events(studio, request, max_seconds),
+        stream_events(changes, sources, capture, runs, request, max_seconds),
         media_type="text/event-stream",
         headers={"Cache-Control": "no-cache", "X-Accel-Buffering": "no"},
     )

@@ -15,9 +15,8 @@ from starlette.concurrency import run_in_threadpool
 
 from studio.capture import DEFAULT_SERIES_POINTS, MAX_SERIES_POINTS, RecordingError, recording_bytes
 
-from .._deps import SettingsDep, StudioDep
+from .._deps import RecordingsDep, ReviewerDep, SettingsDep
 from .._errors import ConflictError, NotFoundError
-from .._review import ReviewerDep
 from .._schemas import (
     RecordingCopy,
     RecordingPublic,
@@ -26,8 +25,7 @@ from .._schemas import (
     TimelinePublic,
     TimelineSignal,
 )
-from .._state import Studio
-from ..services import RecordingSummary, StoredFile, receive_upload
+from ..services import RecordingStore, RecordingSummary, StoredFile, receive_upload
 from . import file_responses
 
 router = APIRouter(prefix="/api/recordings", tags=["recordings"])
@@ -56,14 +54,14 @@ def recording_public(entry: StoredFile[RecordingSummary]) -> RecordingPublic:
     )
 
 
-def read_public(studio: Studio, name: str) -> RecordingPublic:
+def read_public(recordings: RecordingStore, name: str) -> RecordingPublic:
     """One recording's list entry by name (404 if none).
 
     A file another process is capturing is shown as such, not read (it grows, and without its
     ``# end`` line a reader would call it recovered).
     """
-    if studio.recordings.captured_elsewhere(name):
-        path = studio.recordings.path(name)
+    if recordings.captured_elsewhere(name):
+        path = recordings.path(name)
         return RecordingPublic(
             name=name,
             frames=0,
@@ -78,23 +76,20 @@ def read_public(studio: Studio, name: str) -> RecordingPublic:
             sample=False,
             capturing=True,
         )
-    return recording_public(studio.recordings.entry(name))
+    return recording_public(recordings.entry(name))
 
 
 @router.get("")
-def list_recordings(studio: StudioDep) -> list[RecordingPublic]:
+def list_recordings(recordings: RecordingsDep) -> list[RecordingPublic]:
     """Every recording, the shipped samples first; a damaged file is listed with the reason.
 
     The file this studio's capture is writing appears once the capture stops; one another
     studio on the same data folder is capturing is listed as ``capturing``.
     """
-    capturing = studio.pipeline.capture_name
     listed = []
-    for name in studio.recordings.names():
-        if name == capturing:  # never read the growing file: O(1) whatever its length
-            continue
+    for name in recordings.listed():
         try:
-            listed.append(read_public(studio, name))
+            listed.append(read_public(recordings, name))
         except (NotFoundError, FileNotFoundError):  # deleted meanwhile
             continue
     return listed
@@ -102,31 +97,31 @@ def list_recordings(studio: StudioDep) -> list[RecordingPublic]:
 
 @router.post("", status_code=201)
 async def upload_recording(
-    studio: StudioDep, settings: SettingsDep, file: Annotated[UploadFile, File()]
+    recordings: RecordingsDep, settings: SettingsDep, file: Annotated[UploadFile, File()]
 ) -> RecordingPublic:
     """Upload a ``.tape.csv`` (413 over the limit, 422 if it is not a recording).
 
     The name comes from the file name; a taken name gets ``-2``, ``-3``, ... appended.
     """
-    tmp = await receive_upload(file, studio.recordings.folder, settings.upload_limit_bytes)
+    tmp = await receive_upload(file, recordings.folder, settings.upload_limit_bytes)
 
     def adopt() -> RecordingPublic:  # parsing a long recording takes seconds: not on the loop
-        return read_public(studio, studio.recordings.adopt(tmp, file.filename))
+        return read_public(recordings, recordings.adopt(tmp, file.filename))
 
     return await run_in_threadpool(adopt)
 
 
 @router.get("/{name}")
-def read_recording(name: str, studio: StudioDep) -> RecordingPublic:
+def read_recording(name: str, recordings: RecordingsDep) -> RecordingPublic:
     """One recording's summary."""
-    return read_public(studio, name)
+    return read_public(recordings, name)
 
 
 @router.get("/{name}/file", response_class=StreamingResponse, responses=file_responses("text/csv"))
-def download_recording(name: str, studio: StudioDep) -> StreamingResponse:
+def download_recording(name: str, recordings: RecordingsDep) -> StreamingResponse:
     """The ``.tape.csv`` (``.pose.csv``, ``.hand.csv``) file, up to its last complete line (a capture in progress may be
     downloaded: its length is fixed when the download starts, so it is a valid recovered file)."""
-    path = studio.recordings.path(name)
+    path = recordings.path(name)
     snapshot = recording_bytes(path)
     return StreamingResponse(
         snapshot,
@@ -140,33 +135,35 @@ def download_recording(name: str, studio: StudioDep) -> StreamingResponse:
 
 @router.post("/{name}/copy", status_code=201)
 def copy_recording(
-    name: str, studio: StudioDep, body: RecordingCopy | None = None
+    name: str, recordings: RecordingsDep, body: RecordingCopy | None = None
 ) -> RecordingPublic:
     """Copy a recording (a shipped sample, typically) into your own recordings, to rename and annotate.
 
     The copy is named ``body.name`` (409 if taken), else the original's name without
     ``sample-``, made free with ``-2``, ``-3``, ...
     """
-    return read_public(studio, studio.recordings.copy(name, body.name if body else None))
+    return read_public(recordings, recordings.copy(name, body.name if body else None))
 
 
 @router.patch("/{name}")
-def update_recording(name: str, body: RecordingUpdate, studio: StudioDep) -> RecordingPublic:
+def update_recording(
+    name: str, body: RecordingUpdate, recordings: RecordingsDep
+) -> RecordingPublic:
     """Rename (409 if in use or the name is taken) and/or set the operator and notes.
 
     The header is changed by an atomic replace, the frames are never touched; a rename also
     updates the demonstrations cut from the recording. Samples are refused (409).
     """
-    new = studio.recordings.update(name, body.name, notes=body.notes, operator=body.operator)
-    return read_public(studio, new)
+    new = recordings.update(name, body.name, notes=body.notes, operator=body.operator)
+    return read_public(recordings, new)
 
 
 @router.delete("/{name}", status_code=204)
-def delete_recording(name: str, studio: StudioDep) -> Response:
+def delete_recording(name: str, recordings: RecordingsDep) -> Response:
     """Delete a recording (409 while it is the live source or being captured, here or by
     another studio on the same data folder, or a sample)."""
     try:  # under the capture's lock: a capture that started meanwhile is refused too
-        studio.recordings.delete(name)
+        recordings.delete(name)
     except RecordingError as err:
         raise ConflictError(str(err)) from None
     return Response(status_code=204)

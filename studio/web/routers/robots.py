@@ -10,10 +10,9 @@ from fastapi.responses import FileResponse
 from starlette.background import BackgroundTask
 
 from studio._layout import physics_cache_dir
-from studio.kinematics import DEFAULT_ROBOT, robot_spec
+from studio.kinematics import robot_spec
 
-from .._deps import StudioDep
-from .._errors import ConflictError
+from .._deps import DemonstrationsDep, PoliciesDep, RecordingsDep, RobotsDep, SettingsDep
 from .._schemas import RobotChoice, RobotsPublic, SimulationPublic
 from ..services import (
     MEDIA_TYPES,
@@ -28,18 +27,18 @@ router = APIRouter(tags=["robots"])
 
 
 @router.get("/api/robots")
-def read_robots(studio: StudioDep) -> RobotsPublic:
+def read_robots(robots: RobotsDep) -> RobotsPublic:
     """The offered robots (the Puma560 first, the default) with their joints, and the one taught."""
-    return RobotsPublic.model_validate(studio.robots_public())
+    return RobotsPublic.model_validate(robots.public())
 
 
 @router.put("/api/robot")
-def set_robot(body: RobotChoice, studio: StudioDep) -> RobotsPublic:
+def set_robot(body: RobotChoice, robots: RobotsDep) -> RobotsPublic:
     """Teach another robot: the scene draws it from its own meshes and the live source drives it
     from the next frame (cartesian retargeting; joint mode is the Puma560's). An unknown name is
     refused (422) and changes nothing."""
-    studio.set_robot(body.name)
-    return RobotsPublic.model_validate(studio.robots_public())
+    robots.choose(body.name)
+    return RobotsPublic.model_validate(robots.public())
 
 
 @router.get(
@@ -49,7 +48,9 @@ def set_robot(body: RobotChoice, studio: StudioDep) -> RobotsPublic:
 def export_for_the_robot(
     kind: Literal["recording", "demonstration"],
     name: str,
-    studio: StudioDep,
+    recordings: RecordingsDep,
+    demonstrations: DemonstrationsDep,
+    robots: RobotsDep,
     format: ExportFormat = "csv",
     unchecked: bool = False,
     robot: str | None = None,
@@ -64,9 +65,9 @@ def export_for_the_robot(
     limits, as a demonstration's is (``studio export --retime``). For the robot taught unless
     ``robot`` names another (an unknown name: 422 with the list). 404 for no such recording or
     demonstration."""
-    store = studio.recordings if kind == "recording" else studio.demonstrations
+    store = recordings if kind == "recording" else demonstrations.store
     path = store.path(name)
-    target = robot_spec(robot).name if robot is not None else studio.pipeline.robot_name
+    target = robot_spec(robot).name if robot is not None else robots.taught
     out, filename, folder = export_for_robot(path, target, format, unchecked, retime)
     return FileResponse(
         out,
@@ -80,7 +81,10 @@ def export_for_the_robot(
 def simulate_for_the_robot(
     kind: Literal["recording", "demonstration"],
     name: str,
-    studio: StudioDep,
+    recordings: RecordingsDep,
+    demonstrations: DemonstrationsDep,
+    robots: RobotsDep,
+    settings: SettingsDep,
     robot: str | None = None,
     retime: bool = False,
 ) -> SimulationPublic:
@@ -89,17 +93,17 @@ def simulate_for_the_robot(
     URDF (its motors' force limits, gravity, the table), as ``studio simulate --json`` reports
     them, with the report's sentences. For the robot taught unless ``robot`` names another (an
     unknown name: 422); 404 for no such recording or demonstration."""
-    store = studio.recordings if kind == "recording" else studio.demonstrations
+    store = recordings if kind == "recording" else demonstrations.store
     path = store.path(name)
-    target = robot_spec(robot).name if robot is not None else studio.pipeline.robot_name
-    cache = physics_cache_dir(studio.settings.data_dir)
+    target = robot_spec(robot).name if robot is not None else robots.taught
+    cache = physics_cache_dir(settings.data_dir)
     report = simulate_for_robot(path, target, retime, cache)
     return SimulationPublic.model_validate({**report.as_json(), "sentences": report.sentences()})
 
 
 @router.get("/api/robot/export/rollout.mcap", responses=file_responses("application/octet-stream"))
 def export_the_rollout(
-    studio: StudioDep,
+    policies: PoliciesDep,
     run: str | None = None,
     policy: str | None = None,
     unchecked: bool = False,
@@ -110,18 +114,10 @@ def export_the_rollout(
     (``/api/watch/trajectory.csv`` is the same rollout as CSV). Failed checks answer 422 with
     one sentence (``reason`` "safety"); ``unchecked`` writes it anyway with the findings stated
     in it. 409 when that policy has not been watched yet."""
-    path, key = studio.policy_file(run, policy)
-    last = studio.watched_rollout(key)
-    kind, name = key.split(":", 1)
-    if last is None:
-        raise ConflictError(
-            f"{'Run' if kind == 'run' else 'Policy'} {name} has not been watched yet; watch it "
-            "first, then export its rollout."
-        )
-    _, times, q = last
-    watched, _ = studio.load_policy(run, policy)
-    robot = watched.robot or DEFAULT_ROBOT  # (None: not an arm's policy; never watched)
-    out, filename, folder = export_rollout(path, robot, name, times, q, unchecked)
+    watched = policies.watched(run, policy)
+    out, filename, folder = export_rollout(
+        watched.path, watched.robot, watched.name, watched.times, watched.q, unchecked
+    )
     return FileResponse(
         out,
         media_type=MEDIA_TYPES["mcap"],

@@ -14,16 +14,14 @@ from fastapi import APIRouter, Query, Response
 from pydantic import BaseModel, ConfigDict, Field
 
 from studio.learning import (
-    RunBusyError,
     RunNotes,
     RunNotesError,
     read_run_notes,
     write_curves_csv,
-    write_run_notes,
 )
 
-from .._deps import StudioDep
-from .._errors import ConflictError, InvalidError
+from .._deps import RunsDep
+from .._errors import InvalidError
 from . import file_responses
 
 router = APIRouter(tags=["runs"])
@@ -61,10 +59,10 @@ def _notes_public(path: Path) -> RunNotesPublic:
 
 
 @router.get("/api/run-notes", response_model=dict[str, RunNotesPublic])
-def list_run_notes(studio: StudioDep) -> dict[str, RunNotesPublic]:
+def list_run_notes(runs: RunsDep) -> dict[str, RunNotesPublic]:
     """Every run's tags and notes, by run id (runs without any are left out)."""
     out: dict[str, RunNotesPublic] = {}
-    for run in studio.runs.list():
+    for run in runs.list():
         notes = _notes_public(run.folder.path)
         if notes.tags or notes.notes or notes.error:
             out[run.id] = notes
@@ -72,27 +70,21 @@ def list_run_notes(studio: StudioDep) -> dict[str, RunNotesPublic]:
 
 
 @router.get("/api/runs/{run_id}/notes", response_model=RunNotesPublic)
-def read_notes(run_id: str, studio: StudioDep) -> RunNotesPublic:
+def read_notes(run_id: str, runs: RunsDep) -> RunNotesPublic:
     """A run's tags and notes (empty when it has none)."""
-    return _notes_public(studio.runs.get(run_id).folder.path)
+    return _notes_public(runs.get(run_id).folder.path)
 
 
 @router.put("/api/runs/{run_id}/notes", response_model=RunNotesPublic)
-def write_notes(run_id: str, body: RunNotesUpdate, studio: StudioDep) -> RunNotesPublic:
+def write_notes(run_id: str, body: RunNotesUpdate, runs: RunsDep) -> RunNotesPublic:
     """Replace a run's tags and notes, stored in ``<run>/notes.json`` beside its ``config.json``
     (422 naming the limit broken; 409 while the run folder is being created or deleted)."""
-    run = studio.runs.get(run_id)
-    try:
-        stored = write_run_notes(run.folder.path, body.tags, body.notes)
-    except RunBusyError as err:
-        raise ConflictError(str(err)) from None
-    studio.runs.on_change("runs")  # other pages show the new tags
-    return _public(stored)
+    return _public(runs.write_notes(run_id, body.tags, body.notes))
 
 
 @router.get("/api/run-curves.csv", response_class=Response, responses=file_responses("text/csv"))
 def download_curves(
-    studio: StudioDep,
+    runs: RunsDep,
     run: Annotated[list[str], Query(description="run ids, in the order wanted")] = [],  # noqa: B006
 ) -> Response:
     """Several runs' curves in one CSV: the one curve layout with a first ``configuration``
@@ -103,7 +95,7 @@ def download_curves(
         raise InvalidError(
             f"{len(run)} runs given, more than the {MAX_CSV_RUNS} one file takes; export fewer."
         )
-    runs = [studio.runs.get(run_id) for run_id in dict.fromkeys(run)]
+    runs = [runs.get(run_id) for run_id in dict.fromkeys(run)]
     names = [r.name for r in runs]
     out = io.StringIO()
     write_curves_csv(

@@ -15,10 +15,11 @@ from pydantic import BaseModel, Field
 
 from studio.kinematics import RobotArm, load_robot
 
-from .._deps import StudioDep
+from .._deps import RobotsDep, RolloutsDep, SceneDep
 from .._errors import ConflictError, InvalidError
 from .._schemas import _Body
 from ..scene import PLAYBACK_SPEEDS, VIEW_NAMES, Playback, Scene
+from ..services import Robots
 
 router = APIRouter(prefix="/api/scene", tags=["scene"])
 
@@ -111,10 +112,11 @@ class JogPublic(BaseModel):
     title: str = Field("", description="its name as people read it")
 
 
-def _scene(studio: StudioDep) -> Scene:
-    if studio.scene is None:
+def _shown(scene: Scene | None) -> Scene:
+    """The scene (409 when the studio runs without one)."""
+    if scene is None:
         raise ConflictError("This studio runs without a 3D scene; start it with its scene.")
-    return studio.scene
+    return scene
 
 
 def _public(scene: Scene, playback: Playback | None, t: float) -> PlaybackPublic:
@@ -144,18 +146,18 @@ def _public(scene: Scene, playback: Playback | None, t: float) -> PlaybackPublic
 
 
 @router.get("/playback")
-def read_playback(studio: StudioDep) -> PlaybackPublic:
+def read_playback(scene: SceneDep) -> PlaybackPublic:
     """Where the playback stands (``active`` false before anything was watched)."""
-    scene = _scene(studio)
+    scene = _shown(scene)
     now = scene.scrub()
     return _public(scene, None, 0.0) if now is None else _public(scene, *now)
 
 
 @router.post("/playback")
-def change_playback(body: PlaybackChange, studio: StudioDep) -> PlaybackPublic:
+def change_playback(body: PlaybackChange, scene: SceneDep) -> PlaybackPublic:
     """Scrub (``t``), pause or resume, change the speed or step by samples; 409 before a watch,
     422 for a time outside the rollout."""
-    scene = _scene(studio)
+    scene = _shown(scene)
     now = scene.scrub()
     if now is None:
         raise ConflictError("Nothing has been watched yet; watch a policy first, then scrub it.")
@@ -171,9 +173,10 @@ def change_playback(body: PlaybackChange, studio: StudioDep) -> PlaybackPublic:
 
 
 @router.get("/views")
-def read_views(studio: StudioDep) -> ViewsPublic:
+def read_views(scene: SceneDep) -> ViewsPublic:
     """The presets, whether the cameras follow the tool, and each browser's camera."""
-    camera = _scene(studio).camera
+    scene = _shown(scene)
+    camera = scene.camera
     return ViewsPublic(
         views=list(VIEW_NAMES),
         following=camera.following,
@@ -182,20 +185,21 @@ def read_views(studio: StudioDep) -> ViewsPublic:
 
 
 @router.post("/view")
-def change_view(body: ViewChange, studio: StudioDep) -> ViewsPublic:
+def change_view(body: ViewChange, scene: SceneDep) -> ViewsPublic:
     """Put every connected browser's camera on the preset (front, top or side)."""
-    _scene(studio).camera.show(body.view)
-    return read_views(studio)
+    scene = _shown(scene)
+    scene.camera.show(body.view)
+    return read_views(scene)
 
 
 @router.post("/follow")
-def change_follow(body: FollowChange, studio: StudioDep) -> ViewsPublic:
+def change_follow(body: FollowChange, scene: SceneDep) -> ViewsPublic:
     """Make every browser's camera follow the robot's tool (``on``), or stop following."""
-    scene = _scene(studio)
+    scene = _shown(scene)
     scene.camera.following = body.on
     if body.on:
         scene.camera.follow(scene.tool_positions(scene.current_q_robot(), scene.robot_name)[0])
-    return read_views(studio)
+    return read_views(scene)
 
 
 def _joints(arm: RobotArm) -> list[JointPublic]:
@@ -209,17 +213,17 @@ def _joints(arm: RobotArm) -> list[JointPublic]:
     ]
 
 
-def _posed(studio: StudioDep) -> RobotArm:
+def _posed(robots: Robots) -> RobotArm:
     """The arm posed by hand: the robot taught (the scene draws it, once its meshes are read)."""
-    return load_robot(studio.pipeline.robot_name, geometry=False)
+    return load_robot(robots.taught, geometry=False)
 
 
 @router.get("/jog")
-def read_jog(studio: StudioDep) -> JogPublic:
+def read_jog(scene: SceneDep, robots: RobotsDep) -> JogPublic:
     """The taught robot's joints with their limits (deg), and the joints the scene shows (its
     home pose while the scene still draws another robot)."""
-    scene = _scene(studio)
-    arm = _posed(studio)
+    scene = _shown(scene)
+    arm = _posed(robots)
     q = scene.current_q_robot()
     if scene.robot_name != arm.name or len(q) != arm.nq:
         q = np.asarray(arm.home, dtype=float)
@@ -228,11 +232,11 @@ def read_jog(studio: StudioDep) -> JogPublic:
 
 
 @router.post("/jog")
-def jog(body: JogChange, studio: StudioDep) -> JogPublic:
+def jog(body: JogChange, scene: SceneDep, robots: RobotsDep, rollouts: RolloutsDep) -> JogPublic:
     """Show the taught robot at the given joints (deg, one per joint of that robot, each within
     its limits; 422 otherwise) until the next watch or Stop."""
-    scene = _scene(studio)
-    arm = _posed(studio)
+    scene = _shown(scene)
+    arm = _posed(robots)
     joints = _joints(arm)
     if len(body.q_deg) != len(joints):
         raise InvalidError(
@@ -243,7 +247,6 @@ def jog(body: JogChange, studio: StudioDep) -> JogPublic:
             raise InvalidError(
                 f"{j.name} is {value:g}°, outside its limits {j.lower_deg:g}° to {j.upper_deg:g}°; choose an angle within them."
             )
-    with studio.watch_lock:
-        studio.watching = None  # a pose by hand replaces the policy being watched
+    rollouts.release()  # a pose by hand replaces the policy being watched
     scene.hold_pose(np.radians(body.q_deg), robot=arm.name)
     return JogPublic(joints=joints, q_deg=list(body.q_deg), robot=arm.name, title=arm.spec.title)

@@ -7,8 +7,8 @@ from fastapi import APIRouter, Response
 
 from studio.capture import TakeSession
 
+from .._deps import TakesDep
 from .._schemas import TakePublic, TakesFinish, TakesPublic, TakeStart
-from .._takes import TakesDep
 
 router = APIRouter(prefix="/api/takes", tags=["takes"])
 

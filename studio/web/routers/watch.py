@@ -41,7 +41,7 @@ beside the watched robot."""
 def watch(body: WatchCreate, studio: StudioDep) -> WatchPublic:
     """Roll the greedy policy of a run or an uploaded policy (exactly one; 422 otherwise) out from
     a random or the current pose and play it in the scene (409 if the run has no policy yet)."""
-    policy, key = studio.load_policy(body.run, body.policy)
+    policy, key = studio.policies.load(body.run, body.policy)
     learner = learner_of(policy)
     if policy.robot is not None:  # (None: not an arm's policy, refused below)
         try:
@@ -63,7 +63,7 @@ def watch(body: WatchCreate, studio: StudioDep) -> WatchPublic:
     else:
         start = Start(seed=start_seed(body))
     rollout = learner.roll_out(policy, start, ROLLOUT_RATE_HZ, max_steps=learner.watch_max_steps)
-    studio.keep_rollout(key, rollout.times, rollout.q)
+    studio.rollouts.keep(key, rollout.times, rollout.q)
     if studio.scene is not None:
         record = _run_record(studio, key)
         beside = learner.beside(policy, record.demonstrations if record is not None else [])
@@ -112,9 +112,9 @@ def _demonstration_motions(
     robot = policy.robot or DEFAULT_ROBOT
     motions = []
     for name in names:
-        studio.demonstrations.load(name)  # 404 with the store's sentence
+        studio.demonstrations.store.load(name)  # 404 with the store's sentence
         # on the policy's robot: the Puma560's stored path, another's retargeted (422 if not)
-        demo = studio.demonstration_path(name, robot)
+        demo = studio.demonstrations.path_on(name, robot)
         times = demo.times if demo.times is not None else np.zeros(0)
         try:
             motions.append(DemonstrationMotion.checked(name, times, demo.q_robot))
@@ -143,10 +143,7 @@ def likeness_public(
 @router.post("/stop", status_code=204)
 def stop_watch(studio: StudioDep) -> Response:
     """Stop the playback; the robot follows the live source again."""
-    with studio.watch_lock:
-        studio.watching = None
-    if studio.scene is not None:
-        studio.scene.stop_playback()
+    studio.rollouts.stop()
     return Response(status_code=204)
 
 
@@ -158,8 +155,8 @@ def download_trajectory(
     (``?policy=<name>``), or with neither the last rollout watched, as CSV: ``time,q1..q6``
     (seconds, radians), named ``<run id or policy name>.rollout.csv`` as ``studio export``
     names it. 409 when that policy has not been watched yet."""
-    key = None if run is None and policy is None else studio.policy_file(run, policy)[1]
-    last = studio.watched_rollout(key)
+    key = None if run is None and policy is None else studio.policies.file(run, policy)[1]
+    last = studio.rollouts.last(key)
     if last is None:
         if key is None:
             raise ConflictError(

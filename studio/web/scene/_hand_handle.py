@@ -2,7 +2,7 @@
 
 Shown only while the hand guide is the source. Dragging it (in any browser showing the scene)
 hands the new hand pose, in the operator's arm frame, to the same function ``POST
-/api/source/hand`` calls (:meth:`studio.web._state.Studio.hand_moved`): the arm follows by IK and
+/api/source/hand`` calls (:meth:`studio.web.services.Sources.hand_moved`): the arm follows by IK and
 the robot mirrors it through the live pipeline.
 
 A pose a browser sends that is not a pose (NaN, infinite, a zero quaternion) is refused before

@@ -27,28 +27,25 @@ from pathlib import Path
 from pydantic import TypeAdapter
 
 from studio._files import now_iso
-from studio.kinematics import DEFAULT_ROBOT
 from studio.learning import (
     DEFAULT_GOAL_JOINTS_DEG,
-    ConfigError,
-    DemonstrationPath,
     LearningError,
     LiveCurve,
     LiveProgress,
+    RunBusyError,
     RunFolder,
+    RunNotes,
     RunRecord,
-    RunRequest,
     delete_run_folder,
     find_runs,
     goal_degrees,
-    resolve_run,
-    without_demonstrations,
+    write_run_notes,
 )
 
 from .._errors import ConflictError, InvalidError, NotFoundError
 from .._schemas import GridRunCreate, RunCreate, RunPublic
 
-__all__ = ["Run", "RunQueue", "prepare_run"]
+__all__ = ["Run", "RunQueue"]
 
 log = logging.getLogger(__name__)
 
@@ -276,34 +273,6 @@ def run_create_of(record: RunRecord) -> RunCreate:
     return RUN_CREATE.validate_python(form)
 
 
-def run_request(
-    create: RunCreate, demonstration_path: Callable[[str, str], DemonstrationPath]
-) -> RunRequest:
-    """The learning package's request of a ``RunCreate``, its demonstrations by their paths on
-    the run's robot."""
-    robot = create.robot or DEFAULT_ROBOT
-    demonstrations = [demonstration_path(name, robot) for name in create.demonstrations]
-    return RunRequest.from_form(create.model_dump(), demonstrations=demonstrations)
-
-
-def prepare_run(
-    create: RunCreate, demonstration_path: Callable[[str, str], DemonstrationPath]
-) -> RunRecord:
-    """Check a ``RunCreate`` with the learning package's rules, reporting every bad field at once.
-
-    Args:
-        create: the request.
-        demonstration_path: a demonstration by name, on a robot: its joint path and times.
-
-    Returns:
-        The run's record (:func:`studio.learning.resolve_run`).
-
-    Raises:
-        ConfigError: one sentence per bad field, keyed by field (answered as 422).
-    """
-    return resolve_run(run_request(create, demonstration_path))
-
-
 class RunQueue:
     """The runs under ``<data_dir>/runs`` and the worker thread that trains the page's, in turn.
 
@@ -441,33 +410,9 @@ class RunQueue:
                     return run
         return None
 
-    def submit(
-        self, create: RunCreate, demonstration_path: Callable[[str, str], DemonstrationPath]
-    ) -> Run:
-        """Validate a run, write its folder (atomically) and queue it."""
-        return self._queue_record(prepare_run(create, demonstration_path))
-
-    def submit_pair(
-        self, create: RunCreate, demonstration_path: Callable[[str, str], DemonstrationPath]
-    ) -> tuple[Run, Run]:
-        """Queue a run with demonstrations and its twin without them (same settings, seed and
-        goal: :func:`studio.learning.without_demonstrations`), both checked before either is
-        queued.
-
-        Raises:
-            ConfigError: a bad field of the run (as :meth:`submit`), or no demonstration picked.
-        """
-        if not create.demonstrations:
-            raise ConfigError(
-                ["Pick at least one demonstration to compare a run with them against one without."],
-                ["demonstrations"],
-            )
-        request = run_request(create, demonstration_path)
-        record = resolve_run(request)
-        baseline = resolve_run(without_demonstrations(request, record))
-        return self._queue_record(record), self._queue_record(baseline)
-
-    def _queue_record(self, record: RunRecord) -> Run:
+    def queue(self, record: RunRecord) -> Run:
+        """Write a checked run's folder (atomically) and queue it; it trains when the runs
+        before it are done."""
         folder = RunFolder.create(self.folder, record)
         # the kernels' threads run at a lower priority: training must never starve the studio
         live = LiveProgress(record.experiments, record.episodes, niceness=self.niceness)
@@ -524,6 +469,22 @@ class RunQueue:
         run._mtime = _status_mtime(run.folder.path)
         self.on_change("runs")
         return run
+
+    def write_notes(self, run_id: str, tags: list[str], notes: str) -> RunNotes:
+        """Replace run ``run_id``'s tags and notes (``<run>/notes.json``) and announce it, so
+        other pages show them.
+
+        Raises:
+            ConflictError: the run folder is being created or deleted.
+            RunNotesError: a limit broken (422).
+        """
+        run = self.get(run_id)
+        try:
+            stored = write_run_notes(run.folder.path, tags, notes)
+        except RunBusyError as err:
+            raise ConflictError(str(err)) from None
+        self.on_change("runs")
+        return stored
 
     def delete(self, run_id: str) -> None:
         """Delete a run and its folder (409 while it is training; 507-like 409 naming what could

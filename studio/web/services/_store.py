@@ -58,6 +58,7 @@ from studio.motion import checked_demonstration
 from studio.samples import SAMPLES_DIR
 
 from .._errors import ConflictError, InvalidError, NotFoundError, TooLargeError
+from ._changes import OnChange
 
 log = logging.getLogger(__name__)
 
@@ -70,8 +71,6 @@ DEMONSTRATION_SUFFIX = DEMO_SUFFIX
 """Demonstrations lie next to their recordings: ``<name>.demo.json`` (the capture package's)."""
 
 T = TypeVar("T")
-OnChange = Callable[[str], None]
-"""Called with a list's name (``"recordings"``, ``"demonstrations"``, ...) when it changed."""
 InUse = Callable[[str], "str | None"]
 """Why a file cannot be deleted or renamed now (one sentence with the fix), or None."""
 RecordingSummary = dict[str, object]
@@ -631,6 +630,12 @@ class RecordingStore(FolderStore[RecordingSummary]):
         if reason is None and self.captured_elsewhere(name):
             return f"Recording {name!r} is being captured by another studio or `studio record` on this data folder; stop that capture first."
         return reason
+
+    def listed(self) -> list[str]:
+        """The recordings to list: all but the one this studio is capturing (it is listed once
+        the capture stops; its growing file is never read)."""
+        capturing = self._capturing()
+        return [name for name in self.names() if name != capturing]
 
     def captured_elsewhere(self, name: str) -> bool:
         """Whether another process (a second studio, ``studio record``) is capturing ``name``."""

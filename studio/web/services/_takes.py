@@ -1,8 +1,8 @@
 """Recording in takes: start a take, stop it, review it on the robot, keep or redo it, and make
 the kept takes of a session into demonstrations in one go.
 
-Each take is an ordinary capture (:meth:`Studio.start_capture`); each kept take becomes a
-demonstration through :meth:`Studio.cut_demonstration`, the one cutting there is. The sessions
+Each take is an ordinary capture (:meth:`Capture.start`); each kept take becomes a
+demonstration through :meth:`Demonstrations.cut`, the one cutting there is. The sessions
 persist in ``recordings/takes.json`` (:func:`studio.capture.read_takes`).
 """
 
@@ -10,26 +10,35 @@ from __future__ import annotations
 
 import threading
 from datetime import UTC, datetime
-from typing import Annotated
-
-from fastapi import Depends, Request
+from pathlib import Path
 
 from studio._errors import StudioError
 from studio._files import now_iso
 from studio.capture import TAKES_FILE, Take, TakeSession, read_takes, write_takes
 
-from ._errors import ConflictError
-from ._review import Reviewer, get_reviewer
-from ._state import Studio
+from .._errors import ConflictError
+from ._capture import Capture
+from ._demonstrations import Demonstrations
+from ._review import Reviewer
+from ._store import RecordingStore
 
 
 class TakeFlow:
     """The take session of a studio (one at a time), kept in its data folder's takes file."""
 
-    def __init__(self, studio: Studio, reviewer: Reviewer) -> None:
-        self.studio = studio
+    def __init__(
+        self,
+        folder: Path,
+        recordings: RecordingStore,
+        capture: Capture,
+        demonstrations: Demonstrations,
+        reviewer: Reviewer,
+    ) -> None:
+        self.recordings = recordings
+        self.capture = capture
+        self.demonstrations = demonstrations
         self.reviewer = reviewer
-        self.path = studio.settings.recordings_dir / TAKES_FILE
+        self.path = folder / TAKES_FILE
         self._lock = threading.Lock()
 
     def _sessions(self) -> list[TakeSession]:
@@ -54,7 +63,7 @@ class TakeFlow:
                     f"Take {last.recording} is still {'being recorded' if last.state == 'recording' else 'under review'}; stop it, then keep or redo it."
                 )
             base = f"take-{datetime.now(UTC):%Y%m%d-%H%M%S}-{len(session.takes) + 1}"
-            name = self.studio.start_capture(self.studio.recordings.new_name(base), operator, None)
+            name = self.capture.start(self.recordings.new_name(base), operator, None)
             session.takes.append(Take(recording=name))
             write_takes(self.path, sessions)
             return session
@@ -62,7 +71,7 @@ class TakeFlow:
     def _not_elsewhere(self, take: Take) -> None:
         """Refuse a take another studio on this data folder is recording (its own Stop ends it;
         stopped here, its recording would go on under a take made into demonstrations)."""
-        if self.studio.recordings.captured_elsewhere(take.recording):
+        if self.recordings.captured_elsewhere(take.recording):
             raise ConflictError(
                 f"Take {take.recording} is being recorded by another studio on this data folder; "
                 "stop, keep or redo it in that studio."
@@ -74,8 +83,8 @@ class TakeFlow:
             sessions = self._sessions()
             take = _last(sessions, "recording", "No take is being recorded; start a take first.")
             self._not_elsewhere(take)
-            if self.studio.pipeline.capture_name == take.recording:
-                self.studio.stop_capture()
+            if self.capture.recording == take.recording:
+                self.capture.stop()
             take.state = "review"
             write_takes(self.path, sessions)
             session = _open(sessions)
@@ -111,9 +120,9 @@ class TakeFlow:
                 raise ConflictError("No take to redo: the last take is kept; start a new take.")
             take = session.takes[-1]
             self._not_elsewhere(take)
-            if self.studio.pipeline.capture_name == take.recording:
-                self.studio.stop_capture()
-            self.studio.recordings.delete(take.recording)
+            if self.capture.recording == take.recording:
+                self.capture.stop()
+            self.recordings.delete(take.recording)
             session.takes.pop()
             write_takes(self.path, sessions)
             return session
@@ -139,9 +148,9 @@ class TakeFlow:
                 if take.demonstration is not None:
                     continue
                 try:
-                    entry = self.studio.recordings.entry(take.recording)
+                    entry = self.recordings.entry(take.recording)
                     duration = float((entry.value or {}).get("duration", 0.0))
-                    take.demonstration = self.studio.cut_demonstration(
+                    take.demonstration = self.demonstrations.cut(
                         take.recording, 0.0, duration, goal_from_end
                     )
                     take.error = None
@@ -161,18 +170,3 @@ def _last(sessions: list[TakeSession], state: str, missing: str) -> Take:
     if session is None or not session.takes or session.takes[-1].state != state:
         raise ConflictError(missing)
     return session.takes[-1]
-
-
-_create_lock = threading.Lock()
-
-
-def get_takes(request: Request, reviewer: Annotated[Reviewer, Depends(get_reviewer)]) -> TakeFlow:
-    """The take flow of the app serving this request (made on first use)."""
-    state = request.app.state
-    with _create_lock:
-        if getattr(state, "takes", None) is None:
-            state.takes = TakeFlow(state.studio, reviewer)
-        return state.takes
-
-
-TakesDep = Annotated[TakeFlow, Depends(get_takes)]

@@ -3,27 +3,26 @@ timeline's cursor, and a segment's robot path drawn and played in the scene.
 
 The joints come from :func:`studio.capture.recording_series` (the capture package's fitters);
 this module only caches them per file and hands them to the scene. On a robot other than the
-Puma560 the human arm's joints are retargeted onto it by :func:`studio.export.series_motion` (the
+Puma560 the human arm's joints are retargeted onto it by :func:`studio.motion.series_motion` (the
 path an export takes): the timeline plots that robot's joints and its cursor holds the robot at
 them; a played stretch is retargeted in the background by the studio's
-:class:`~._robot_playback.RobotPlayer`.
+:class:`~studio.web.scene.RobotPlayer`.
 """
 
 from __future__ import annotations
 
 import threading
 from collections import OrderedDict
-from typing import Annotated
 
 import numpy as np
-from fastapi import Depends, Request
 
 from studio.capture import RecordingSeries, recording_series
 from studio.kinematics import load_robot
 from studio.motion import Motion, recording_motion, series_motion
 
-from ._state import Studio
-from .scene import PREVIEW_FRAMES
+from ..live import Pipeline
+from ..scene import PREVIEW_FRAMES, RobotPlayer, Scene
+from ._store import RecordingStore
 
 REVIEW_PATH = "review"
 """The scene path that shows the segment under review (one at a time, replaced by the next)."""
@@ -32,10 +31,26 @@ CACHED_SERIES = 8
 
 
 class Reviewer:
-    """Series of a studio's recordings, cached until their file changes, and shown on its robot."""
+    """Series of a studio's recordings, cached until their file changes, and shown on its robot.
 
-    def __init__(self, studio: Studio) -> None:
-        self.studio = studio
+    Args:
+        recordings: the recordings reviewed.
+        pipeline: the live pipeline (the robot taught, the retargeting mode).
+        scene: the scene a review plays in, or None (headless).
+        player: what plays a stretch on a robot other than the Puma560 (None without a scene).
+    """
+
+    def __init__(
+        self,
+        recordings: RecordingStore,
+        pipeline: Pipeline,
+        scene: Scene | None,
+        player: RobotPlayer | None,
+    ) -> None:
+        self.recordings = recordings
+        self.pipeline = pipeline
+        self.scene = scene
+        self.player = player
         self._lock = threading.Lock()
         self._cache: OrderedDict[tuple[object, ...], RecordingSeries] = OrderedDict()
         self._plotted: dict[str, RecordingSeries] = {}
@@ -45,9 +60,9 @@ class Reviewer:
         self, name: str, points: int, t0: float | None = None, t1: float | None = None
     ) -> RecordingSeries:
         """The joints of recording ``name`` (404 if none) over ``[t0, t1]`` at ``points`` frames."""
-        path = self.studio.recordings.path(name)
+        path = self.recordings.path(name)
         stat = path.stat()
-        mode = self.studio.pipeline.retarget_mode
+        mode = self.pipeline.retarget_mode
         key = (str(path), stat.st_mtime_ns, stat.st_size, mode, points, t0, t1)
         with self._lock:
             found = self._cache.get(key)
@@ -70,12 +85,12 @@ class Reviewer:
 
     def timeline(self, name: str, points: int) -> tuple[RecordingSeries, Motion]:
         """The series a timeline plots and its joints on the robot taught
-        (:func:`studio.export.series_motion`), kept while the series is."""
+        (:func:`studio.motion.series_motion`), kept while the series is."""
         series = self.plotted(name, points)
         return series, self._robot_path(name, series)
 
     def _robot_path(self, name: str, series: RecordingSeries) -> Motion:
-        robot = self.studio.pipeline.robot_name
+        robot = self.pipeline.robot_name
         with self._lock:
             kept = self._on_robot.get((name, robot))
         if kept is not None and kept[0] is series:
@@ -103,7 +118,7 @@ class Reviewer:
         if not len(series.times):
             return np.zeros(load_robot(robot, geometry=False).nq)
         q = np.array([np.interp(t, motion.times, col) for col in motion.q.T])
-        scene = self.studio.scene
+        scene = self.scene
         if scene is not None:
             scene.play_trajectory(np.zeros(1), q[None, :], robot=robot)
         return q
@@ -112,10 +127,10 @@ class Reviewer:
         """Draw the robot's tool path of ``[t0, t1]`` (the whole recording by default) and play
         it on the robot taught in real time (on another robot than the Puma560, once retargeted
         in the background)."""
-        scene, player = self.studio.scene, self.studio.player
-        robot = self.studio.pipeline.robot_name
+        scene, player = self.scene, self.player
+        robot = self.pipeline.robot_name
         if robot != "puma560" and scene is not None and player is not None:
-            path = self.studio.recordings.path(name)
+            path = self.recordings.path(name)
             stat = path.stat()
             player.play(
                 robot,
@@ -131,18 +146,3 @@ class Reviewer:
             scene.play_trajectory(series.times, series.q_robot)
             if player is not None:
                 player.clear_note()
-
-
-_create_lock = threading.Lock()
-
-
-def get_reviewer(request: Request) -> Reviewer:
-    """The one reviewer of the app serving this request (made on first use)."""
-    state = request.app.state
-    with _create_lock:
-        if getattr(state, "reviewer", None) is None:
-            state.reviewer = Reviewer(state.studio)
-        return state.reviewer
-
-
-ReviewerDep = Annotated[Reviewer, Depends(get_reviewer)]
