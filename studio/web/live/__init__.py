@@ -4,5 +4,5 @@ along the path planned over all of it."""
 
 from __future__ import annotations
 
-from ._pipeline import CaptureWriter as CaptureWriter
 from ._pipeline import Pipeline as Pipeline
+from ._recorder import CaptureWriter as CaptureWriter

@@ -25,7 +25,6 @@ import threading
 import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import Protocol
 
 import numpy as np
 
@@ -40,9 +39,10 @@ from studio.capture import (
 )
 from studio.kinematics import HumanArm, RetargetedPath, Retargeter, RobotArm, TapeConfig
 
-from .._errors import ConflictError, storage_sentence
+from .._errors import ConflictError
 from ..scene import LivePose, LiveScene
 from ._planned_playback import PlannedPlayback
+from ._recorder import CaptureWriter, Recorder
 
 log = logging.getLogger(__name__)
 
@@ -55,23 +55,8 @@ IDLE_SLEEP_S = 0.05
 ROBOT_JOINTS = 6
 
 
-class CaptureWriter(Protocol):
-    """What the pipeline asks of a recording's writer (:class:`studio.capture.AppendWriter`)."""
-
-    path: Path
-
-    def write_many(self, frames: Sequence[Observation]) -> None:
-        """Append observations."""
-
-    def flush(self) -> None:
-        """Make the written observations durable now."""
-
-    def close(self) -> None:
-        """Finish the file cleanly."""
-
-
 class Pipeline:
-    """The live source, its kinematics, the capture writer, and live demonstration marking.
+    """The live source, its kinematics, and its capture (a :class:`Recorder`).
 
     Args:
         scene: the :class:`studio.web.scene._scene.StudioScene` to feed, or None (headless, tests).
@@ -83,7 +68,6 @@ class Pipeline:
         self, scene: LiveScene | None = None, on_change: Callable[[str], None] | None = None
     ) -> None:
         self.scene = scene
-        self._on_change = on_change
         self._lock = threading.RLock()
         self._fit_lock = threading.Lock()  # one fit at a time (the thread, or a fed source's call)
         self._source: FrameSource | None = None
@@ -102,16 +86,9 @@ class Pipeline:
         self._residual: float | None = None
         self._last_t: float | None = None
         self._observable: np.ndarray | None = None  # what the camera's fit could see
-        self._writer: CaptureWriter | None = None
-        self._capture_name: str | None = None
-        self._capture_path: Path | None = None
-        self._capture_frames = 0
-        self._capture_rejected = 0  # frames of another tape width, left out of the recording
-        self._capture_t0: float | None = None
-        self._capture_last_t: float | None = None
+        self._recorder = Recorder(self._lock, on_change)
         self._kin_error: str | None = None
         self._fit_warning: str | None = None
-        self._capture_error: str | None = None  # kept until dismissed: fits never clear it
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
 
@@ -132,8 +109,7 @@ class Pipeline:
             self._thread = None
         self._planned.close()  # no planning child outlives the studio
         with self._lock:
-            if self._writer is not None:
-                self._close_writer()
+            self._recorder.close()
             self._stop_source()
 
     # ------------------------------------------------------------------ source
@@ -147,7 +123,7 @@ class Pipeline:
             ConflictError: a capture is running (stop it before switching).
         """
         with self._lock:
-            if self._writer is not None:
+            if self._recorder.active:
                 raise ConflictError(
                     "A recording is being captured from the current source; stop the recording before switching the source."
                 )
@@ -297,8 +273,8 @@ class Pipeline:
                 "error": error,
                 "warning": getattr(st, "warning", None)
                 or self._fit_warning
-                or self._rejected_warning(),
-                "rejected": int(getattr(st, "rejected", 0) or 0) + self._capture_rejected,
+                or self._recorder.rejected_warning(),
+                "rejected": int(getattr(st, "rejected", 0) or 0) + self._recorder.rejected,
                 "recording": self._recording,
                 "retarget": {
                     "mode": self._mode if self._arm is None else "cartesian",
@@ -308,7 +284,7 @@ class Pipeline:
                 "robot_warning": self._robot_note,
                 "fit_residual_mm": None if self._residual is None else self._residual * 1000.0,
                 "q_robot": [float(x) for x in self._q_robot],
-                "recording_active": self._writer is not None,
+                "recording_active": self._recorder.active,
                 "side": self.side() if source is not None else None,
                 "person_detected": getattr(source, "person_detected", None),
                 "observable": None
@@ -347,107 +323,33 @@ class Pipeline:
     # ------------------------------------------------------------------ capture
 
     def start_capture(self, writer: CaptureWriter, name: str, path: Path) -> None:
-        """Send every raw frame to ``writer`` from now on.
-
-        Raises:
-            ConflictError: a capture is already running, or there is no running source.
-        """
-        with self._lock:
-            if self._writer is not None:
-                writer.close()
-                raise ConflictError(
-                    f"Recording {self._capture_name!r} is already running; stop it before starting another."
-                )
-            self._writer, self._capture_name, self._capture_path = writer, name, path
-            self._capture_frames = 0
-            self._capture_rejected = 0
-            self._capture_error = None
-            self._capture_t0 = None
-            self._capture_last_t = None
-        self._changed()
+        """Send every raw frame to ``writer`` from now on (:meth:`Recorder.start`)."""
+        self._recorder.start(writer, name, path)
 
     def stop_capture(self) -> tuple[str, Path]:
-        """Close the capture file cleanly; returns its name and path.
-
-        Raises:
-            ConflictError: no capture is running.
-        """
-        with self._lock:
-            if self._writer is None:
-                raise ConflictError("No recording is running; press Record to start one.")
-            name, path = self._capture_name, self._capture_path
-            self._close_writer()
-        assert name is not None and path is not None
-        return name, path
+        """Close the capture file cleanly; returns its name and path (:meth:`Recorder.stop`)."""
+        return self._recorder.stop()
 
     def flush_capture(self) -> None:
         """Write the capture's buffered frames to disk now (for cutting a demonstration)."""
-        with self._lock:
-            if self._writer is not None:
-                self._writer.flush()
-
-    def _close_writer(self) -> None:
-        writer = self._writer
-        if writer is None:
-            return
-        try:
-            writer.close()
-        except Exception as err:  # the file's flushed frames are still there, marked recovered
-            log.warning("closing the capture %s failed: %s", self._capture_name, err)
-            self._capture_error = self._capture_failure(err)
-        self._writer = None
-        self._capture_name = None
-        self._changed()  # the recording is complete (or kept as far as it got)
-
-    def _changed(self) -> None:
-        if self._on_change is not None:
-            self._on_change("recordings")
-
-    def _capture_failure(self, err: Exception) -> str:
-        """One sentence for a capture the disk (or the writer) stopped, with the frames kept."""
-        kept = getattr(self._writer, "frames_on_disk", self._capture_frames)
-        folder = self._capture_path.parent if self._capture_path is not None else Path(".")
-        sentence = storage_sentence(
-            err, folder.resolve(), f"the recording stopped, {kept} frames kept", "record again"
-        )
-        if sentence is not None:
-            return sentence
-        return f"Writing the recording {self._capture_name!r} failed ({err}); it was stopped, its first {kept} frames are kept."
+        self._recorder.flush()
 
     def dismiss_capture_error(self) -> None:
         """Forget the last capture failure (the user has read it)."""
-        with self._lock:
-            self._capture_error = None
+        self._recorder.dismiss_error()
 
     def capture_status(self) -> dict[str, object]:
         """The ``CapturePublic`` fields."""
-        with self._lock:
-            active = self._writer is not None
-            seconds = 0.0
-            if active and self._capture_t0 is not None and self._capture_last_t is not None:
-                seconds = self._capture_last_t - self._capture_t0
-            return {
-                "active": active,
-                "name": self._capture_name,
-                "seconds": round(float(seconds), 3),
-                "frames": self._capture_frames if active else 0,
-                "rejected": self._capture_rejected,
-                "error": self._capture_error,
-            }
+        return self._recorder.status()
 
     def capture_time(self) -> float | None:
         """Seconds since the capture started (in the recording's own time), or None."""
-        with self._lock:
-            if self._writer is None:
-                return None
-            if self._capture_t0 is None or self._capture_last_t is None:
-                return 0.0
-            return self._capture_last_t - self._capture_t0
+        return self._recorder.time()
 
     @property
     def capture_name(self) -> str | None:
         """Name of the recording being captured, if any."""
-        return self._capture_name
+        return self._recorder.name
 
     # ------------------------------------------------------------------ the thread
 
@@ -476,43 +378,9 @@ class Pipeline:
             if source is self._source:
                 self._fit(source, frames[-MAX_FITS_PER_BATCH:])
 
-    def _rejected_warning(self) -> str | None:
-        if not self._capture_rejected:
-            return None
-        return f"{self._capture_rejected} frames of another tape width were left out of the recording; check that one tape sends."
-
     def _record(self, frames: Sequence[Observation]) -> None:
-        """Append frames to the capture; a frame of another width than the recording's is left
-        out and counted (one odd frame never ends a capture); a failed write ends it, with the
-        reason kept in ``capture_status()["error"]`` until dismissed."""
-        with self._lock:
-            writer = self._writer
-            if writer is None:
-                return
-            regions = getattr(writer, "regions", None)
-            if regions is not None:
-                fits = [
-                    f
-                    for f in frames
-                    if np.shape(getattr(f, "bend", None)) == (regions,) == np.shape(f.twist)
-                ]
-                self._capture_rejected += len(frames) - len(fits)
-                frames = fits
-                if not frames:
-                    return
-            try:
-                writer.write_many(frames)
-            except Exception as err:
-                log.warning("writing the capture %s failed: %s", self._capture_name, err)
-                self._capture_error = self._capture_failure(err)
-                error = self._capture_error
-                self._close_writer()  # says nothing more: the writer reported its failure once
-                self._capture_error = error
-                return
-            if self._capture_t0 is None:
-                self._capture_t0 = float(frames[0].t)
-            self._capture_last_t = float(frames[-1].t)
-            self._capture_frames += len(frames)
+        """Append frames to the capture, if one runs (:meth:`Recorder.write`)."""
+        self._recorder.write(frames)
 
     def _live_fitter(self, observation: Observation) -> ObservationFitter:
         """The fitter for the current source's observations, built on its first one."""
