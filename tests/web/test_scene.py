@@ -25,6 +25,7 @@ from studio.kinematics import (
     tape_from_arm,
 )
 from studio.kinematics._meshes import simplify
+from studio.web.scene._robot_view import wxyz_of
 from studio.web.scene._scene import (
     Mode,
     Playback,
@@ -32,7 +33,6 @@ from studio.web.scene._scene import (
     StudioScene,
     camera_projection,
     pose_at,
-    wxyz_of,
 )
 from tests.conftest import free_port as _free_port
 from tests.web.conftest import wait_for
