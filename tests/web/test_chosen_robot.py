@@ -77,7 +77,7 @@ def test_the_timeline_cursor_holds_the_chosen_robot_where_its_timeline_says(
 ) -> None:
     client.put("/api/robot", json={"name": "panda"})
     timeline = client.get(f"/api/recordings/{recording}/timeline?points=60").json()
-    reviewer = client.app.state.reviewer
+    reviewer = client.app.state.studio.reviewer
     k = len(timeline["times"]) // 2
     held = reviewer.hold(recording, timeline["times"][k])
     # the plot's points are downsampled and served to 0.01 degree; the cursor interpolates the
