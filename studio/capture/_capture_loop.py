@@ -38,6 +38,12 @@ MAX_PORT = 65535
 """The largest UDP port number."""
 
 
+FIRST_FRAME_SECONDS = 30.0
+"""The least a capture waits for its first frame, whatever ``give_up_seconds`` says: a sender
+started at the same moment (``studio bridge`` beside ``studio record --source udp``) takes
+seconds to start on a busy machine, and the recorder used to give up on it after 10 s."""
+
+
 def source_from_spec(
     spec: str,
     *,
@@ -176,7 +182,8 @@ def capture(
         on_progress: called with ``(frames written, source status)`` after each batch.
         stop: polled after each batch; true ends the capture.
         give_up_seconds: end with an error when no frame arrives for this long (a network
-            sender that never starts or went away). A capture that fails before its first frame
+            sender that never starts or went away); the first frame is waited for at least
+            :data:`FIRST_FRAME_SECONDS`. A capture that fails before its first frame
             leaves no file.
 
     Returns:
@@ -218,7 +225,10 @@ def capture(
             if status.error and not status.running:  # a running source may recover (network)
                 raise CaptureError(f"{status.error} ({kept()})")
             quiet = time.monotonic() - last_frame
-            if give_up_seconds is not None and quiet >= give_up_seconds:
+            limit = give_up_seconds
+            if limit is not None and first_t is None:  # a sender started beside us may be slow
+                limit = max(limit, FIRST_FRAME_SECONDS)
+            if limit is not None and quiet >= limit:
                 raise CaptureError(
                     f"no frame arrived from the {source.kind} source for {quiet:.0f} s, so the capture gave up ({kept()}); start the sender first (for the network bridge: studio bridge --to HOST:PORT)."
                 )

@@ -52,7 +52,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         type=float,
         default=WAIT_SECONDS,
         help=f"give up when no frame arrives for this many seconds, e.g. a network sender that "
-        f"never starts (default: {WAIT_SECONDS:g})",
+        f"never starts (default: {WAIT_SECONDS:g}; the first frame is waited for at least "
+        "30 s, so a sender started at the same time has time to start)",
     )
     parser.add_argument(
         "--token",
