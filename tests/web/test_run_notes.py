@@ -121,7 +121,8 @@ def test_several_runs_export_in_one_csv_in_the_one_layout(client, two_runs):
 
 
 def test_notes_saved_while_the_run_is_deleted_leave_nothing_behind(tmp_path, monkeypatch):
-    from studio.learning import RunBusyError, _run_notes, write_run_notes
+    from studio.learning import RunBusyError, write_run_notes
+    from studio.learning.runs import _notes as _run_notes
 
     folder = tmp_path / "run"
     folder.mkdir()

@@ -366,7 +366,7 @@ def test_a_failing_run_shows_why_and_the_queue_goes_on(client, monkeypatch):
     import studio.learning.runs._train
     from studio.learning import LearningError
 
-    real = studio.learning.runs._train.run_experiments
+    real = studio.learning.runs._train.train_learner
     calls = []
 
     def flaky(*args, **kwargs):
@@ -377,7 +377,7 @@ def test_a_failing_run_shows_why_and_the_queue_goes_on(client, monkeypatch):
             raise RuntimeError("boom")
         return real(*args, **kwargs)
 
-    monkeypatch.setattr(studio.learning.runs._train, "run_experiments", flaky)
+    monkeypatch.setattr(studio.learning.runs._train, "train_learner", flaky)
     first = client.post("/api/runs", json=TINY_RUN).json()
     second = client.post("/api/runs", json=TINY_RUN).json()
     third = client.post("/api/runs", json=TINY_RUN).json()
