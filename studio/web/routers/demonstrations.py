@@ -76,10 +76,7 @@ def read_public(demonstrations: Demonstrations, name: str) -> DemonstrationPubli
 def list_demonstrations(demonstrations: DemonstrationsDep) -> list[DemonstrationPublic]:
     """Every demonstration: the shipped samples, then yours newest first; a damaged file is
     listed with the reason."""
-    listed = [demonstration_public(e) for e in demonstrations.store.entries()]
-    samples = [d for d in listed if d.sample]
-    mine = sorted((d for d in listed if not d.sample), key=lambda d: (d.created, d.name))
-    return samples + mine[::-1]
+    return [demonstration_public(e) for e in demonstrations.listed()]
 
 
 @router.post("", status_code=201)

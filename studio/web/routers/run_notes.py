@@ -95,13 +95,8 @@ def download_curves(
         raise InvalidError(
             f"{len(run)} runs given, more than the {MAX_CSV_RUNS} one file takes; export fewer."
         )
-    runs = [runs.get(run_id) for run_id in dict.fromkeys(run)]
-    names = [r.name for r in runs]
     out = io.StringIO()
-    write_curves_csv(
-        out,
-        [(r.name if names.count(r.name) == 1 else f"{r.name} ({r.id})", r.curve()) for r in runs],
-    )
+    write_curves_csv(out, runs.labelled_curves(run))
     return Response(
         out.getvalue(),
         media_type="text/csv",

@@ -21,7 +21,7 @@ from ..scene import RobotPlayer, Scene
 from ._changes import OnChange
 from ._policies import Policies
 from ._runs import RunQueue
-from ._store import FolderStore, RecordingStore, demonstration_store
+from ._store import FolderStore, RecordingStore, StoredFile, demonstration_store
 
 
 class Demonstrations:
@@ -64,6 +64,17 @@ class Demonstrations:
         if run is None:
             return None
         return f"Demonstration {name!r} is used by run {run.id}, which is {run.status}; stop that run first."
+
+    def listed(self) -> list[StoredFile[Demonstration]]:
+        """Every demonstration: the shipped samples, then the user's newest first (by when each
+        was cut, then by name); a damaged file is listed too, with the reason."""
+        entries = self.store.entries()
+        samples = [e for e in entries if e.sample]
+        mine = sorted(
+            (e for e in entries if not e.sample),
+            key=lambda e: ((e.value.created or "") if e.value is not None else "", e.name),
+        )
+        return samples + mine[::-1]
 
     def path_on(self, name: str, robot: str = DEFAULT_ROBOT) -> DemonstrationPath:
         """A demonstration's joint path on ``robot`` (rad) and times, for training runs: its

@@ -20,7 +20,7 @@ import re
 import threading
 import time
 from collections import deque
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Sequence
 from datetime import UTC, datetime
 from pathlib import Path
 
@@ -396,6 +396,15 @@ class RunQueue:
         if run.refresh():
             self.on_change("runs")
         return run
+
+    def labelled_curves(self, run_ids: Sequence[str]) -> list[tuple[str, dict[str, list]]]:
+        """Each run's curve in the order given (a repeated id once), labelled by the run's name,
+        with its id after it where two of them share a name (404 for an unknown id)."""
+        runs = [self.get(run_id) for run_id in dict.fromkeys(run_ids)]
+        names = [r.name for r in runs]
+        return [
+            (r.name if names.count(r.name) == 1 else f"{r.name} ({r.id})", r.curve()) for r in runs
+        ]
 
     def running(self) -> list[Run]:
         """Runs this studio is training now (at most one)."""
