@@ -1,8 +1,10 @@
 """Browser-test set-up: the real ``studio serve`` in a subprocess and Debian's Chromium.
 
 The server gets random free ports and a temporary data directory (with the repo's sample
-recordings copied in); one browser and one page serve the whole session, so the stories run in
-order like a user's visit. Screenshots of each step go to ``test-artifacts/e2e/``.
+recordings copied in); one browser and one page serve the whole session of a worker, so the
+stories run in order like a user's visit (the files that take the shared ``page`` all run on one
+worker: ``tests/conftest.py`` hands them out as one unit). Screenshots of each step go to
+``test-artifacts/e2e/``.
 """
 
 from __future__ import annotations
