@@ -1,6 +1,6 @@
 """The first switch to a robot whose meshes are not yet kept: the live source goes on while they
-load, and "q robot" never shows one robot's angles while another is drawn (the Panda's seven
-values showed on the six-joint UR5 that was still drawn)."""
+load, the robot drawn keeps following the operator, and "q robot" is always the drawn robot's
+(the Panda's seven values showed on the six-joint UR5 that was still drawn, which stood still)."""
 
 from __future__ import annotations
 
@@ -24,7 +24,8 @@ LOAD_TIMEOUT_S = 600.0
 RECORD_JS = """p => {
     window.__statuses = [];
     p.listen("source", (s) => window.__statuses.push(
-        [s.robot, s.robot_drawn, s.frames, document.getElementById("src-q").textContent]));
+        [s.robot, s.robot_drawn, s.frames, document.getElementById("src-q").textContent,
+         s.q_robot]));
 }"""
 """Keep every status the page draws, with the "q robot" it drew for it."""
 
@@ -34,6 +35,7 @@ def test_q_robot_is_the_drawn_robots_and_the_source_goes_on_while_meshes_load(
 ) -> None:
     studio_server.send("PUT", "/api/source", {"kind": "simulator"})
     joints = load_robot(ROBOT, geometry=False).nq
+    puma = load_robot("puma560", geometry=False).nq
     with own_page(browser, studio_server) as page:
         try:
             page.evaluate(RECORD_JS, hook(page))
@@ -52,9 +54,11 @@ def test_q_robot_is_the_drawn_robots_and_the_source_goes_on_while_meshes_load(
         # while its meshes loaded the live stream went on: statuses with frames counting up
         assert len(loading) >= 2, statuses
         assert loading[-1][2] > loading[0][2]
-        # and "q robot" showed no angles meanwhile: they would have been the new robot's
-        for robot, shown, _, q in loading:
-            assert not re.search(r"\d", q), (robot, shown, q)
+        # the Puma560 drawn meanwhile kept following, and "q robot" showed its six angles
+        for robot, shown, _, text, q in loading:
+            assert shown == "puma560" and len(q) == puma, (robot, shown, q)
+            assert len(re.findall(r"-?\d+", text)) == puma, text
+        assert len({tuple(s[4]) for s in loading}) >= 2, "the robot drawn stood still"
         # once drawn, its own joints
-        assert len(drawn[-1][3].split()) == joints + 1  # the angles and "°"
+        assert len(drawn[-1][4]) == joints and len(drawn[-1][3].split()) == joints + 1
         assert not page.errors

@@ -77,7 +77,9 @@ class Pipeline:
         self._mode = "joint"
         self._mirror = True
         self._fitter: ObservationFitter | None = None  # the live chain for the source's kind
-        self._arm: RobotArm | None = None  # the robot taught, when not the Puma560
+        self._arm: RobotArm | None = None  # the robot the live chain drives, when not the Puma560
+        self._chosen: RobotArm | None = None  # a robot chosen, driven once drawn (choose_robot)
+        self._choosing = False
         self._arm_retargeter: Retargeter | None = None  # the fitted arm onto it (cartesian)
         self._planned = PlannedPlayback()  # a recording played: its path planned over all of it
         self._robot_note: str | None = None  # why it does not follow the hand now
@@ -214,6 +216,24 @@ class Pipeline:
             if self._arm_retargeter is not None:
                 self._arm_retargeter.mirror = self._mirror
 
+    def choose_robot(self, arm: RobotArm | None) -> Callable[[], None]:
+        """Teach ``arm`` (as :meth:`set_robot`) once it is drawn: it is the robot taught from
+        now on (:attr:`robot_name`), while the live chain drives the robot drawn until the
+        returned call, which the scene makes once it has drawn ``arm``. Meanwhile the robot drawn
+        keeps following the operator, and ``q_robot`` stays its joints."""
+        if arm is not None and arm.name == "puma560":
+            arm = None
+        with self._lock:
+            self._chosen, self._choosing = arm, True
+
+        def drive() -> None:
+            with self._lock:
+                if not self._choosing or self._chosen is not arm:
+                    return  # another robot was chosen meanwhile
+            self.set_robot(arm)
+
+        return drive
+
     def set_robot(self, arm: RobotArm | None) -> None:
         """Teach ``arm`` (None or the ``puma560``: the Puma560, in the chosen mode) from the next
         frame: the fitted human arm is retargeted onto it in cartesian mode
@@ -221,6 +241,7 @@ class Pipeline:
         if arm is not None and arm.name == "puma560":
             arm = None
         with self._fit_lock, self._lock:
+            self._chosen, self._choosing = None, False
             self._arm = arm
             self._arm_retargeter = None
             self._planned.forget()
@@ -245,7 +266,8 @@ class Pipeline:
     @property
     def robot_name(self) -> str:
         """The robot taught (``puma560`` unless another was chosen)."""
-        arm = self._arm
+        with self._lock:
+            arm = self._chosen if self._choosing else self._arm
         return "puma560" if arm is None else arm.name
 
     @property

@@ -85,8 +85,8 @@ class Scene(LiveScene, Protocol):
     def stop_playback(self) -> None:
         """Stop a playback."""
 
-    def set_robot(self, arm: RobotArm | None) -> None:
-        """Draw ``arm`` (None: the Puma560) from its own meshes."""
+    def set_robot(self, arm: RobotArm | None, drawn: Callable[[], None] | None = None) -> None:
+        """Draw ``arm`` (None: the Puma560) from its own meshes; ``drawn()`` once it is."""
 
     @property
     def robot_name(self) -> str:

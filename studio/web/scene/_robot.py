@@ -10,6 +10,7 @@ only on that robot. What cannot be shown on the robot drawn is said by :meth:`ro
 from __future__ import annotations
 
 import threading
+from collections.abc import Callable
 
 import numpy as np
 import viser
@@ -43,6 +44,7 @@ class SceneRobot:
         self._views = views
         self._view = views.puma  # the robot drawn
         self._next_view: RobotView | None = None  # a robot chosen, for the scene thread to draw
+        self._next_drawn: Callable[[], None] | None = None  # called once it is drawn
         self._goals: dict[str, np.ndarray] = {}  # each robot's goal (set_goal)
         self._pedestal: viser.SceneNodeHandle | None = None
 
@@ -125,19 +127,19 @@ class SceneRobot:
 
     # ------------------------------------------------------------------ the robot
 
-    def set_robot(self, arm: RobotArm | None) -> None:
+    def set_robot(self, arm: RobotArm | None, drawn: Callable[[], None] | None = None) -> None:
         """Draw ``arm`` (a robot of :func:`~studio.kinematics.load_robot`; None or the
         ``puma560``: the Puma560) from its own meshes, framed where the Puma560 stands.
 
         Returns at once: its meshes are read in the background (from the mesh cache after the
         first time) and the scene thread then draws it (:attr:`robot_name` names it once drawn,
-        :attr:`robot_loading` meanwhile).
+        :attr:`robot_loading` meanwhile), and calls ``drawn()`` once it has.
         """
-        self._views.request(arm, self._draw_next)
+        self._views.request(arm, lambda view: self._draw_next(view, drawn))
 
-    def _draw_next(self, view: RobotView) -> None:
+    def _draw_next(self, view: RobotView, drawn: Callable[[], None] | None = None) -> None:
         with self._lock:
-            self._next_view = view
+            self._next_view, self._next_drawn = view, drawn
         self._wake.set()
 
     @property

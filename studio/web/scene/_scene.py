@@ -281,11 +281,14 @@ class StudioScene(ScenePaths, SceneRobot, SceneOperator):
             operator, slow = self._operator, self._live_gap >= self.layout.slow_live_s
             streaming = now - self._live_at < STREAM_STOPPED_S
             view, self._next_view = self._next_view, None
+            drawn, self._next_drawn = self._next_drawn, None
         self.frames.slow(slow and streaming and playback is None)
         if view is not None:
             with self.server.atomic():
                 self._draw_robot(view)
             shown.q_robot = None
+            if drawn is not None:
+                drawn()  # the live chain drives it from now on
         if playback is not None and playback.robot != self._view.name:
             playback = None  # another robot's joints: the robot drawn follows the live pose
         if (

@@ -35,7 +35,7 @@ class Robots:
 
     def choose(self, name: str) -> None:
         """Teach robot ``name``: the scene draws it from its meshes, and the live chain
-        retargets the operator onto it from the next frame.
+        retargets the operator onto it once it is drawn (the robot drawn follows meanwhile).
 
         Raises:
             KinematicsError: an unknown name, or a model or mesh that cannot be read (the
@@ -47,9 +47,12 @@ class Robots:
                 arm = load_robot(self._switching)  # seconds the first time
             finally:
                 self._switching = None
-            if self.scene is not None:
-                self.scene.set_robot(arm)  # its meshes are read in the background
-            self.pipeline.set_robot(arm.scratch_copy())  # the live thread's own scratch data
+            live = arm.scratch_copy()  # the live thread's own scratch data
+            if self.scene is None:
+                self.pipeline.set_robot(live)
+                return
+            # its meshes are read in the background; the live chain drives it once it is drawn
+            self.scene.set_robot(arm, drawn=self.pipeline.choose_robot(live))
 
     def state(self) -> dict[str, object]:
         """The robot the scene draws, the one whose meshes it reads, and one sentence for each

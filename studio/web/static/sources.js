@@ -15,11 +15,12 @@ export function renderSource() {
   setText("src-frames", s.frames ?? "–");
   setText("src-dropped", s.dropped ?? "–");
   setText("src-residual", fmt(s.fit_residual_mm, 1));
-  // The joints of the robot drawn: while another robot's meshes load, the live chain already
-  // drives the new one, whose angles would read as the drawn robot's.
-  const drawn = !s.robot_drawn || !s.robot || s.robot_drawn === s.robot;
-  setText("src-q", drawn ? (s.q_robot || []).map((v) => ((v * 180) / Math.PI).toFixed(0).padStart(4)).join(" ") + " °" : "–");
-  setProp("src-q", "title", drawn ? "" : `the ${robotTitle(s.robot)}'s joints show once it is drawn`);
+  // The joints of the robot drawn (the live chain drives another robot once it is drawn): never
+  // angles of another width than the drawn robot's.
+  const drawn = (S.robots || []).find((r) => r.name === s.robot_drawn);
+  const q = s.q_robot || [];
+  const fits = !drawn || drawn.joints.length === q.length;
+  setText("src-q", fits ? q.map((v) => ((v * 180) / Math.PI).toFixed(0).padStart(4)).join(" ") + " °" : "–");
   // The source's own trouble (no device, a dropped bridge) stays apart from a refused action.
   showError("source-status-error", s.error ? `Source: ${s.error}` : null);
   const rejected = s.rejected ? `${s.rejected} datagram${s.rejected === 1 ? "" : "s"} rejected` : "";
