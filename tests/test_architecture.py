@@ -118,6 +118,7 @@ FOR_USERS = {
             "studio.learning.greedy_path",
             "studio.learning.rollout_tile_policy",
             "studio.learning.DmpPolicyFile",
+            "studio.learning.PolicyFile",
             "studio.learning.default_goal",
         ),
         "a user's script calls it as studio/learning/README.md or docs/sweeps.md shows",
