@@ -4,8 +4,8 @@ Mesh references (``package://example-robot-data/robots/...`` in example-robot-da
 copied under ``meshes/`` and rewritten relative to the URDF, so RViz, Pinocchio, yourdfpy or
 Foxglove load the folder without a ROS package path. The URDF is the one the studio's model and
 checks are built from (:attr:`RobotArm.urdf_text`): continuous joints bounded to +-2 pi and
-joint names the exported trajectories use. The Puma560's URDF, generated from its DH table,
-carries the link meshes of ``rtb-data`` (the scene's) instead of its primitive shapes.
+joint names the exported trajectories use (the Puma560's is generated from its DH table, with
+the link meshes of ``rtb-data``, the scene's).
 
 The folder is built next to ``out`` and renamed into place; a mesh that cannot be found refuses
 the export with one sentence and leaves nothing behind.
@@ -17,24 +17,13 @@ import re
 import shutil
 from pathlib import Path
 
-import numpy as np
-import pinocchio as pin
-
 from studio._files import make_temp_dir
-from studio.kinematics import (
-    KinematicsError,
-    MeshConfig,
-    Puma560,
-    RobotArm,
-    load_robot,
-    puma560_meshes,
-)
+from studio.kinematics import RobotArm, load_robot
 
 from ._errors import ExportError
 
 MESH_DIR = "meshes"
 _MESH = re.compile(r'(<mesh\b[^>]*\bfilename=")([^"]+)(")')
-_VISUAL = re.compile(r"\s*<visual\b.*?</visual>", re.S)
 
 
 def _resolve(reference: str, share: Path, base: Path | None) -> Path:
@@ -48,7 +37,11 @@ def _resolve(reference: str, share: Path, base: Path | None) -> Path:
 
 
 def portable_urdf(
-    urdf_text: str, share: Path, folder: Path, base: Path | None = None
+    urdf_text: str,
+    share: Path,
+    folder: Path,
+    base: Path | None = None,
+    package: str = "example-robot-data",
 ) -> tuple[str, list[Path]]:
     """``urdf_text`` with every mesh copied into ``folder/meshes`` and referenced relatively.
 
@@ -57,6 +50,7 @@ def portable_urdf(
         share: the folder ``package://`` references are relative to.
         folder: where the URDF will live (the meshes go to ``folder/meshes/...``).
         base: the folder relative references are relative to (default: none allowed).
+        package: the installed package the meshes come from, named when one is missing.
 
     Returns:
         The rewritten URDF and the meshes copied.
@@ -88,7 +82,7 @@ def portable_urdf(
         raise ExportError(
             f"The URDF names the mesh {missing[0]}, which is not installed"
             f"{f' ({len(missing) - 1} more missing)' if len(missing) > 1 else ''}; reinstall the "
-            "robot's description (example-robot-data) so the exported folder can draw it."
+            f"robot's description ({package}) so the exported folder can draw it."
         )
     if not copied:
         raise ExportError(
@@ -96,46 +90,6 @@ def portable_urdf(
             "robot from `studio robots`."
         )
     return text, list(copied.values())
-
-
-def _puma560(folder: Path) -> str:
-    """The Puma560 URDF whose links carry the scene's ``rtb-data`` meshes, written whole (not
-    simplified) as ``folder/meshes/link{j}.stl``.
-
-    Mesh ``link{j}`` is drawn in DH frame j; URDF link ``link{j}`` is the frame of joint j
-    before its DH row's fixed part, so each mesh gets that part as its ``<origin>``.
-    """
-    import trimesh
-
-    puma = Puma560()
-    q = np.zeros(puma.nq)
-    frames = puma.joint_frames(q)
-    pin.forwardKinematics(puma.model, puma.data, q)
-    text = _VISUAL.sub("", puma.urdf())
-    (folder / MESH_DIR).mkdir(parents=True, exist_ok=True)
-    for part in puma560_meshes(MeshConfig(cell_m=0.0)):
-        j = int(part.frame)
-        name = f"{MESH_DIR}/{part.name}.stl"
-        trimesh.Trimesh(part.vertices, part.faces, process=False).export(folder / name)
-        joint_frame = np.eye(4) if j == 0 else puma.data.oMi[j].homogeneous
-        local = np.linalg.solve(joint_frame, frames[j])
-        xyz = " ".join(repr(float(v)) for v in local[:3, 3])
-        rpy = " ".join(repr(float(v)) for v in pin.rpy.matrixToRpy(local[:3, :3]))
-        rgba = " ".join(f"{c:.3f}" for c in (*part.rgb, 1.0))
-        visual = (
-            f'\n    <visual name="{part.name}_mesh">\n      <origin xyz="{xyz}" rpy="{rpy}"/>\n'
-            f'      <geometry><mesh filename="{name}"/></geometry>\n'
-            f'      <material name="{part.name}_colour"><color rgba="{rgba}"/></material>\n'
-            "    </visual>"
-        )
-        link = "base_link" if j == 0 else f"link{j}"
-        if f'<link name="{link}"/>' in text:
-            text = text.replace(
-                f'<link name="{link}"/>', f'<link name="{link}">{visual}\n  </link>'
-            )
-        else:
-            text = text.replace(f'<link name="{link}">', f'<link name="{link}">{visual}', 1)
-    return text
 
 
 def _share(arm: RobotArm) -> Path:
@@ -174,16 +128,11 @@ def export_urdf(robot: RobotArm | str, out: Path) -> Path:
             f"Cannot write the folder {out} ({err.strerror or err}); choose a writable --out."
         ) from None
     try:
-        if arm.name == "puma560":
-            portable = _puma560(tmp)
-        else:
-            portable, _ = portable_urdf(arm.urdf_text, _share(arm), tmp)
+        portable, _ = portable_urdf(arm.urdf_text, _share(arm), tmp, package=arm.spec.package)
         (tmp / f"{arm.name}.urdf").write_text(portable, encoding="utf-8")
         if out.is_dir():
             out.rmdir()
         tmp.rename(out)
-    except KinematicsError as err:  # the Puma560 meshes (rtb-data) are not installed
-        raise ExportError(str(err)) from None
     except OSError as err:
         raise ExportError(
             f"Cannot write the folder {out} ({err.strerror or err}); choose a writable --out."

@@ -21,10 +21,8 @@ from typing import Literal
 import numpy as np
 import pinocchio as pin
 
-from ._checks import positive_number, real_array, whole_number
-from ._dh import DHRow, LinkVisual
-from ._errors import KinematicsError
-from ._urdf import urdf_from_dh
+from ._checks import KinematicsError, positive_number, real_array, whole_number
+from ._dh import DH_TABLE, DHRow, LinkVisual, urdf_from_dh
 
 __all__ = [
     "DH_TABLE",
@@ -39,16 +37,6 @@ __all__ = [
     "Puma560",
 ]
 
-
-#: Corke's Puma560 (Robotics Toolbox, ``models/DH/Puma560.py``), all joint offsets zero.
-DH_TABLE: tuple[DHRow, ...] = (
-    DHRow(0.67183, 0.0, math.pi / 2, math.radians(-160), math.radians(160)),
-    DHRow(0.0, 0.4318, 0.0, math.radians(-110), math.radians(110)),
-    DHRow(0.15005, 0.0203, -math.pi / 2, math.radians(-135), math.radians(135)),
-    DHRow(0.4318, 0.0, math.pi / 2, math.radians(-266), math.radians(266)),
-    DHRow(0.0, 0.0, -math.pi / 2, math.radians(-100), math.radians(100)),
-    DHRow(0.0, 0.0, 0.0, math.radians(-266), math.radians(266)),
-)
 
 #: Zero angles: upper arm horizontal, forearm vertical.
 PUMA_QZ = np.zeros(6)
@@ -456,6 +444,8 @@ class Puma560:
         model.addFrame(pin.Frame("tool", parent, self.dh[-1].fixed(), pin.FrameType.OP_FRAME))
         model.lowerPositionLimit = np.array([row.lower for row in self.dh])
         model.upperPositionLimit = np.array([row.upper for row in self.dh])
+        model.velocityLimit = np.array([row.velocity for row in self.dh])
+        model.effortLimit = np.array([row.effort for row in self.dh])
         return model
 
     # ----------------------------------------------------------------------------- kinematics
@@ -696,5 +686,7 @@ class Puma560:
         return frames[self._visual_joints] @ self._visual_offsets
 
     def urdf(self) -> str:
-        """A URDF of this robot (joints, limits and visuals) that Pinocchio and yourdfpy load."""
+        """A URDF of this robot that Pinocchio and yourdfpy load: its joints with their position,
+        speed and torque limits, and :meth:`visuals` as its visual and collision shapes (a file
+        that needs no mesh; the robot registry's ``load_robot("puma560")`` carries the meshes)."""
         return urdf_from_dh(self.dh, self.visuals())

@@ -41,8 +41,8 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
-from ._errors import KinematicsError
-from ._robots import PUMA_VELOCITY, RobotArm, RobotSpec, _bounded_urdf, robot_spec, robots_folder
+from ._checks import KinematicsError
+from ._robots import RobotArm, RobotSpec, _bounded_urdf, robot_spec, robots_folder
 
 log = logging.getLogger(__name__)
 
@@ -120,8 +120,6 @@ def load_robot(name: str, geometry: bool = True) -> RobotArm:
 
 
 def _load(spec: RobotSpec, geometry: bool) -> RobotArm:
-    if spec.name == "puma560":
-        return _puma_arm(spec)
     text = _urdf_text(spec)
     if geometry and _isolated.is_set():
         model, visual, collision = _built_in_child(spec, text)
@@ -132,6 +130,8 @@ def _load(spec: RobotSpec, geometry: bool) -> RobotArm:
 
 
 def _urdf_text(spec: RobotSpec) -> str:
+    if spec.generate is not None:
+        return _bounded_urdf(spec.generate())
     urdf_path = robots_folder() / spec.urdf
     try:
         return _bounded_urdf(urdf_path.read_text())
@@ -147,7 +147,7 @@ def _built(
 ) -> tuple[pin.Model, pin.GeometryModel, pin.GeometryModel]:
     """The arm's reduced model, its visual geometry (mesh files, no triangles) and its collision
     geometry (convex hulls), from the URDF ``text``."""
-    package_dirs = [str(robots_folder().parent.parent)]
+    package_dirs = _package_dirs()
     try:
         model = pin.buildModelFromXML(text)
         if geometry:
@@ -163,7 +163,7 @@ def _built(
     except (RuntimeError, ValueError) as err:
         raise KinematicsError(
             f"The {spec.title} model cannot be built ({err}); its URDF or meshes are missing: "
-            "reinstall example-robot-data."
+            f"reinstall {spec.package}."
         ) from None
     model, (visual, collision) = _reduce(model, geoms, spec.arm_joints)
     _convex(collision)
@@ -197,7 +197,7 @@ def _built_in_child(spec: RobotSpec, text: str) -> Parts:
         except subprocess.TimeoutExpired:
             raise KinematicsError(
                 f"Loading the {spec.title} model took over {LOAD_TIMEOUT_S:.0f} s and was given "
-                "up; try again, or reinstall example-robot-data if it stays so."
+                f"up; try again, or reinstall {spec.package} if it stays so."
             ) from None
         except OSError as err:  # no child process here: load it in this one, holding the lock
             log.warning("the %s model loads in this process: %s", spec.name, err)
@@ -210,7 +210,7 @@ def _built_in_child(spec: RobotSpec, text: str) -> Parts:
             last = done.stderr.decode(errors="replace").strip().splitlines()[-1:] or ["no message"]
             raise KinematicsError(
                 f"The {spec.title} model could not be built: its loading process ended with "
-                f"code {done.returncode} ({last[0]}); reinstall example-robot-data."
+                f"code {done.returncode} ({last[0]}); reinstall {spec.package}."
             )
         parts = _read_archives(files)
         if kept is not None:
@@ -347,6 +347,17 @@ def _convex(geom: pin.GeometryModel) -> None:
             obj.geometry = shape.convex
 
 
+def _package_dirs() -> list[str]:
+    """The folders a URDF's ``package://NAME/...`` meshes are looked up in: the one holding
+    ``example-robot-data/`` and the site-packages folders (``rtbdata/``, the Puma560's)."""
+    import sysconfig
+
+    folders = [sysconfig.get_paths()[key] for key in ("purelib", "platlib")]
+    with contextlib.suppress(KinematicsError):  # a robot that does not need them
+        folders.insert(0, str(robots_folder().parent.parent))
+    return list(dict.fromkeys(folders))
+
+
 def _reduce(
     model: pin.Model, geoms: list[pin.GeometryModel], keep: int
 ) -> tuple[pin.Model, list[pin.GeometryModel]]:
@@ -357,16 +368,6 @@ def _reduce(
     q_ref = np.clip(np.zeros(model.nq), model.lowerPositionLimit, model.upperPositionLimit)
     reduced, reduced_geoms = pin.buildReducedModel(model, geoms, locked, q_ref)
     return reduced, list(reduced_geoms)
-
-
-def _puma_arm(spec: RobotSpec) -> RobotArm:
-    from ._puma import Puma560
-
-    puma = Puma560()
-    empty = pin.GeometryModel()
-    model = puma.model.copy()
-    model.velocityLimit = np.full(6, PUMA_VELOCITY)
-    return RobotArm(spec, model, empty, pin.GeometryModel(), puma.urdf())
 
 
 def prepare_arm_ik() -> float:

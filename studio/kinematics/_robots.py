@@ -1,7 +1,8 @@
 """Today's arms from example-robot-data: one model per robot, with limits, IK and self-collision.
 
-The studio teaches the Puma560 (the paper's robot, built from its DH table in :mod:`._puma`) and
-the arms that ``example-robot-data`` ships with a URDF and meshes: the Franka Panda, the UR3, UR5
+The studio teaches the Puma560 (the paper's robot, whose URDF is built from its DH table with the
+link meshes of ``rtb-data``, :mod:`._dh`) and the arms that ``example-robot-data`` ships with a
+URDF and meshes: the Franka Panda, the UR3, UR5
 and UR10, the SO-100 and SO-101 of the LeRobot community, the xArm7, the Unitree Z1 and the
 Kinova Jaco (j2s6s200). :func:`load_robot` gives a :class:`RobotArm` for any of them:
 
@@ -14,7 +15,8 @@ Kinova Jaco (j2s6s200). :func:`load_robot` gives a :class:`RobotArm` for any of 
   (:meth:`RobotArm.self_collisions`), adjacent links and the SRDF's disabled pairs excluded.
 
 URDFs give no acceleration limits; :attr:`RobotSpec.acceleration` holds the makers' figures where
-published (Panda) and otherwise twice the velocity limit per second, a conservative rule.
+published (Panda) and otherwise twice the velocity limit per second, a conservative rule (the
+Puma560's too: the sources of its speed and torque limits give none).
 """
 
 from __future__ import annotations
@@ -24,6 +26,7 @@ import importlib.metadata
 import math
 import re
 import sysconfig
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -31,8 +34,8 @@ import numpy as np
 import pinocchio as pin
 
 from ._chain_ik import ChainSolve, SerialChain, solve
-from ._checks import real_array
-from ._errors import KinematicsError
+from ._checks import KinematicsError, real_array
+from ._dh import puma560_urdf
 
 ROBOTS_RELATIVE = Path("cmeel.prefix/share/example-robot-data/robots")
 """Where the ``example-robot-data`` wheel installs its robots, relative to site-packages."""
@@ -49,7 +52,7 @@ class RobotSpec:
     Attributes:
         name: the name users type (``--robot panda``).
         title: the name people read.
-        urdf: the URDF, relative to the robots folder (empty for the Puma560, built from DH).
+        urdf: the URDF, relative to the robots folder (empty when ``generate`` builds it).
         srdf: the SRDF whose disabled collision pairs are honoured (empty: none).
         tool: the frame whose pose is the tool's.
         arm_joints: how many of the URDF's first joints form the arm (the rest are locked).
@@ -72,6 +75,13 @@ class RobotSpec:
             whatever orientation) that the retargeting maps the operator's reach onto, times
             :attr:`RetargetConfig.reach_fraction`: less than 1 for an arm whose tool reaches
             that far only at a few orientations.
+        generate: builds the URDF's text, for a robot whose URDF is made from a description in
+            code rather than read from a file (the Puma560's, from its DH table).
+        package: the installed package whose files (meshes) the URDF names, for the sentence
+            that says what to reinstall when one is missing.
+        joint_mode: whether its joints can follow the operator's one by one (the paper's joint
+            mode, :data:`studio.kinematics._retarget.JOINT_MAP`: the Puma560's); every robot
+            follows the hand in cartesian mode.
     """
 
     name: str
@@ -88,6 +98,9 @@ class RobotSpec:
     facing: float = 0.0
     hollow: float = 0.0
     usable_reach: float = 1.0
+    generate: Callable[[], str] | None = None
+    package: str = "example-robot-data"
+    joint_mode: bool = False
 
 
 UR_READY_DEG = (0.0, -90.0, 90.0, -90.0, -90.0, 0.0)
@@ -122,7 +135,17 @@ TOOL_AXES = {
 ROBOT_SPECS: dict[str, RobotSpec] = {
     spec.name: spec
     for spec in (
-        RobotSpec("puma560", "Puma560 (the paper's robot)", "", "", "tool", 6),
+        RobotSpec(
+            "puma560",
+            "Puma560 (the paper's robot)",
+            "",
+            "",
+            "tool",
+            6,
+            generate=puma560_urdf,
+            package="rtb-data",
+            joint_mode=True,
+        ),
         RobotSpec(
             "panda",
             "Franka Emika Panda",
@@ -217,10 +240,6 @@ ROBOT_SPECS: dict[str, RobotSpec] = {
 """Every offered robot by name; the Puma560 first (the default, the paper's)."""
 
 DEFAULT_ROBOT = "puma560"
-
-PUMA_VELOCITY = 1.0
-"""Velocity limit of every Puma560 joint (rad/s). The DH model carries none; 1 rad/s is a
-conservative figure for an export meant for a real arm."""
 
 
 def robot_names() -> tuple[str, ...]:
@@ -344,8 +363,8 @@ class RobotArm:
         spec: the :class:`RobotSpec`.
         name: ``spec.name``.
         model, data: the Pinocchio model of the arm joints and its scratch data.
-        visual_model, collision_model: geometry (``collision_model`` may be empty: the Puma560's
-            DH model has no collision geometry).
+        visual_model, collision_model: geometry (both empty for a robot loaded without it,
+            ``load_robot(name, geometry=False)``).
         joint_names: the URDF's names of the arm joints.
         nq: number of arm joints.
         lower, upper: position limits (rad).
@@ -583,7 +602,7 @@ class RobotArm:
     def self_collisions(self, q: object, margin: float = 0.0) -> list[Collision]:
         """The link pairs closer than ``margin`` at ``q`` (overlaps have negative distances).
 
-        An arm without collision geometry (the Puma560's DH model) reports none.
+        An arm loaded without collision geometry (``geometry=False``) reports none.
         """
         arr = self.check_q(q)
         if self._collision_data is None:
@@ -609,8 +628,8 @@ class RobotArm:
 
         A robot of :func:`load_robot` is mounted on a table whose top is that plane; the links
         the first joint turns about the vertical (and the base) stay where they stand, the
-        others (an elbow, a wrist, the hand) can be driven into it. An arm without collision
-        geometry (the Puma560's DH model) reports none.
+        others (an elbow, a wrist, the hand) can be driven into it. An arm loaded without collision
+        geometry (``geometry=False``) reports none.
         """
         arr = self.check_q(q)
         if not self._table_points:

@@ -33,10 +33,13 @@ def test_a_robots_folder_loads_elsewhere_with_its_meshes(robot, tmp_path, capsys
 def test_the_puma560_folder_carries_its_meshes_where_the_scene_draws_them(tmp_path):
     out = tmp_path / "puma"
     assert main(["export-urdf", "--robot", "puma560", "--out", str(out)]) == 0
-    model, _, visual = pin.buildModelsFromUrdf(str(out / "puma560.urdf"), str(out))
-    assert [Path(o.meshPath).name for o in visual.geometryObjects] == [
-        f"link{j}.stl" for j in range(7)
-    ]
+    model, collision, visual = pin.buildModelsFromUrdf(str(out / "puma560.urdf"), str(out))
+    for geometry in (visual, collision):
+        assert [Path(o.meshPath).name for o in geometry.geometryObjects] == [
+            f"link{j}.stl" for j in range(7)
+        ]
+    # real limits: the joints' published speed and torque limits, none left at 0
+    assert np.all(model.velocityLimit > 0) and np.all(model.effortLimit > 0)
     data, gdata = model.createData(), pin.GeometryData(visual)
     puma = Puma560()
     q = np.random.default_rng(0).uniform(puma.lower, puma.upper)

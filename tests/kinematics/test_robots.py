@@ -209,4 +209,4 @@ def test_the_links_a_joint_can_drive_into_the_table_are_found_and_the_base_is_no
     # the margin widens what counts; contacts() holds them with the self-collisions
     assert len(panda.table_contacts(q, 0.3)) >= len(under)
     assert set(panda.contacts(q)) == set(panda.self_collisions(q)) | set(under)
-    assert load_robot("puma560").table_contacts(np.zeros(6)) == []  # no collision geometry
+    assert load_robot("puma560").table_contacts(np.zeros(6)) == []  # upright, clear of the floor

@@ -12,7 +12,7 @@ import pinocchio as pin
 import pytest
 
 from studio.cli import main
-from studio.kinematics import Puma560
+from studio.kinematics import Puma560, load_robot
 from tests.conftest import require
 
 ROBOT = Puma560()
@@ -27,17 +27,54 @@ def random_q(n: int = SAMPLES) -> np.ndarray:
     return np.vstack([rng.uniform(ROBOT.lower, ROBOT.upper, size=(n, 6)), ROBOT.lower, ROBOT.upper])
 
 
+#: The published speed (rad/s) and torque (N m) limits the URDF carries (see ``_dh``).
+SPEEDS = (1.92, 1.51, 2.40, 5.34, 5.09, 5.74)
+TORQUES = (97.6, 186.4, 89.4, 24.2, 20.1, 21.3)
+
+
 def test_urdf_is_well_formed_xml_with_the_joint_limits() -> None:
     root = ET.fromstring(TEXT)
     assert root.tag == "robot"
     joints = [j for j in root.iter("joint") if j.get("type") == "revolute"]
     assert [j.get("name") for j in joints] == [f"joint{i}" for i in range(1, 7)]
-    for joint, lower, upper in zip(joints, ROBOT.lower, ROBOT.upper, strict=True):
+    for joint, lower, upper, speed, torque in zip(
+        joints, ROBOT.lower, ROBOT.upper, SPEEDS, TORQUES, strict=True
+    ):
         limit = joint.find("limit")
         assert limit is not None
         assert float(limit.get("lower")) == lower
         assert float(limit.get("upper")) == upper
+        assert float(limit.get("velocity")) == speed and float(limit.get("effort")) == torque
     assert len(list(root.iter("visual"))) == len(ROBOT.visuals())
+    assert len(list(root.iter("collision"))) == len(ROBOT.visuals())  # the same solids
+
+
+def test_the_registry_loads_the_puma560_from_its_urdf_with_standard_dh_kinematics() -> None:
+    """``load_robot("puma560")`` is built from the URDF made of the DH table, like every arm:
+    Corke's standard-DH tool positions at qz and qn, the DH model's pose everywhere else."""
+    arm = load_robot("puma560")
+    assert arm.urdf_text.count("<collision") == 7 and "package://rtbdata/" in arm.urdf_text
+    np.testing.assert_allclose(arm.forward(ROBOT.qz)[:3, 3], (0.4521, -0.15005, 1.1036), atol=5e-5)
+    np.testing.assert_allclose(arm.forward(ROBOT.qn)[:3, 3], (0.5963, -0.1501, 0.6575), atol=5e-5)
+    for q in random_q(20):
+        np.testing.assert_allclose(arm.forward(q), ROBOT.forward(q), atol=1e-12)
+    np.testing.assert_array_equal(arm.lower, ROBOT.lower)
+    np.testing.assert_array_equal(arm.upper, ROBOT.upper)
+    np.testing.assert_array_equal(arm.velocity, SPEEDS)
+    np.testing.assert_array_equal(arm.model.effortLimit, TORQUES)
+
+
+def test_the_puma560_checks_self_collision_and_the_floor_on_its_link_meshes() -> None:
+    arm = load_robot("puma560")
+    assert arm.checks_collisions and arm.collision_model.ngeoms == 7
+    for q in (ROBOT.qz, ROBOT.qr, ROBOT.qn, ROBOT.qs):
+        assert arm.contacts(q) == [], q
+    # the forearm folded back onto the upper arm (joint 3 near its limit)
+    folded = np.radians([-5.0, 86.0, 117.0, -76.0, 14.0, -95.0])
+    assert ("link2", "link4") in {(c.link_a, c.link_b) for c in arm.self_collisions(folded)}
+    # the arm bent down through the floor it stands on
+    down = np.radians([44.0, -51.0, -124.0, -257.0, 63.0, 220.0])
+    assert "link6" in {c.link_a for c in arm.table_contacts(down)}
 
 
 def dimensions(shape: str, sizes: tuple[float, ...]) -> tuple[str, tuple[float, ...]]:
@@ -179,9 +216,10 @@ def _kinematics_imports() -> dict[str, set[str]]:
 
 
 def test_the_kinematics_modules_import_one_way() -> None:
-    """Issue 9: ``_puma`` imported ``_urdf`` inside a function while ``_urdf`` imported ``_puma``."""
+    """Issue 9: ``_puma`` imported the URDF writer inside a function while the writer imported
+    ``_puma``; the description and its URDF (``_dh``) import neither the model nor the registry."""
     graph = _kinematics_imports()
-    assert "_puma" not in graph["_urdf"] and "_urdf" in graph["_puma"]
+    assert not {"_puma", "_robots"} & graph["_dh"] and "_dh" in graph["_puma"]
     done: set[str] = set()
 
     def visit(module: str, stack: tuple[str, ...]) -> None:
