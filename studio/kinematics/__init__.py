@@ -3,31 +3,37 @@
 The public names are listed in ``docs/architecture.md``.
 """
 
-from ._errors import KinematicsError as KinematicsError
+from ._checks import KinematicsError as KinematicsError
 from ._fit import ArmFitter as ArmFitter
 from ._fit import FitConfig as FitConfig
 from ._hand_ik import HandIKConfig as HandIKConfig
 from ._hand_ik import fit_hand_pose as fit_hand_pose
 from ._human import HumanArm as HumanArm
+from ._meshes import SLEEVE_LIFT_M as SLEEVE_LIFT_M
 from ._meshes import HumanBody as HumanBody
 from ._meshes import MeshConfig as MeshConfig
 from ._meshes import MeshPart as MeshPart
+from ._meshes import PosedBody as PosedBody
+from ._meshes import pose_body as pose_body
 from ._meshes import puma560_meshes as puma560_meshes
 from ._meshes import robot_meshes as robot_meshes
 from ._pose import PoseConfig as PoseConfig
 from ._pose import PoseFit as PoseFit
 from ._pose import fit_pose_landmarks as fit_pose_landmarks
+from ._pose_stream import BodyShape as BodyShape
 from ._pose_stream import PoseStreamFitter as PoseStreamFitter
 from ._pose_stream import StreamConfig as StreamConfig
+from ._pose_stream import arm_motion as arm_motion
+from ._pose_stream import landmarks_from_arm as landmarks_from_arm
 from ._pose_stream import smooth_landmarks as smooth_landmarks
 from ._puma import IKConfig as IKConfig
 from ._puma import Puma560 as Puma560
-from ._reach import reachable as reachable
-from ._reach import tool_reaches as tool_reaches
 from ._retarget import RetargetConfig as RetargetConfig
 from ._retarget import Retargeter as Retargeter
 from ._retarget_path import RetargetedPath as RetargetedPath
+from ._retarget_path import reachable as reachable
 from ._retarget_path import retarget_path as retarget_path
+from ._retarget_path import tool_reaches as tool_reaches
 from ._robot_load import isolate_robot_loading as isolate_robot_loading
 from ._robot_load import load_robot as load_robot
 from ._robot_load import prepare_arm_ik_in_background as prepare_arm_ik_in_background
@@ -37,12 +43,6 @@ from ._robots import TABLE as TABLE
 from ._robots import RobotArm as RobotArm
 from ._robots import robot_names as robot_names
 from ._robots import robot_spec as robot_spec
-from ._sleeve import SLEEVE_LIFT_M as SLEEVE_LIFT_M
-from ._sleeve import PosedBody as PosedBody
-from ._sleeve import pose_body as pose_body
-from ._synthetic import BodyShape as BodyShape
-from ._synthetic import arm_motion as arm_motion
-from ._synthetic import landmarks_from_arm as landmarks_from_arm
 from ._tape import TapeConfig as TapeConfig
 from ._tape import reconstruct as reconstruct
 from ._tape import tape_from_arm as tape_from_arm

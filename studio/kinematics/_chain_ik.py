@@ -19,7 +19,7 @@ import numpy as np
 import pinocchio as pin
 from numba import njit
 
-from ._errors import KinematicsError
+from ._checks import KinematicsError
 
 _AXES = {"RX": (1.0, 0.0, 0.0), "RY": (0.0, 1.0, 0.0), "RZ": (0.0, 0.0, 1.0)}
 

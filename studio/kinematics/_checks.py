@@ -1,4 +1,9 @@
-"""Input checks shared by the kinematics models, so that bad values never reach Pinocchio.
+"""The kinematics package's error, and the input checks that raise it, so that bad values never
+reach Pinocchio.
+
+:class:`KinematicsError` is raised for bad input to any kinematics function (wrong array shapes,
+NaN or infinite angles, inconsistent configurations), always with one sentence naming the problem
+and the fix, so that no bad value reaches Pinocchio and no silently wrong answer comes back.
 
 Every public function of the package turns its array and number arguments into plain float
 arrays here first: text, ``None``, ragged lists and complex numbers (whose imaginary part a cast
@@ -12,7 +17,12 @@ import math
 
 import numpy as np
 
-from ._errors import KinematicsError
+from .._errors import StudioError
+
+
+class KinematicsError(StudioError):
+    """Bad input to a kinematics model; ``str(err)`` says what is wrong and how to fix it."""
+
 
 SIDES = ("right", "left")
 """The arms a tape can be strapped to (``human.urdf``'s link prefixes)."""

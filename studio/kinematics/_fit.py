@@ -43,8 +43,7 @@ import numpy as np
 import pinocchio as pin
 from numba import njit
 
-from ._checks import instance_of, positive_number, real_array, whole_number
-from ._errors import KinematicsError
+from ._checks import KinematicsError, instance_of, positive_number, real_array, whole_number
 from ._human import HumanArm
 from ._tape import TapeConfig, TapeShape, reconstruct
 
@@ -243,6 +242,7 @@ class ArmFitter:
         self.model = arm.model
         self.data = arm.model.createData()
         self._hand = arm.hand_frame
+        self._joints = arm.joints
         self._lower = np.asarray(arm.lower)
         self._upper = np.asarray(arm.upper)
         self._damping = np.eye(arm.nq) * self.settings.damping**2
@@ -304,7 +304,9 @@ class ArmFitter:
         f = _unit(W - E)
         q[3] = math.acos(float(np.clip(d @ f, -1.0, 1.0)))
         pin.forwardKinematics(self.model, self.data, q)
-        fA = self.data.oMi[2].rotation.T @ f  # forearm in the frame before humeral rotation
+        joints = self._joints
+        # the forearm in the frame before humeral rotation
+        fA = self.data.oMi[joints.shoulder_X].rotation.T @ f
         if math.sin(q[3]) > _SEEN:  # humeral rotation is seen only with a bent elbow
             q[2] = math.atan2(sign * fA[2], fA[0])
         q = np.minimum(np.maximum(q, self._lower), self._upper)
@@ -313,14 +315,14 @@ class ArmFitter:
             # Hand direction after forearm rotation: (sin q5 cos q6, -cos q5 cos q6, -sign sin q6).
             q[4] = min(max(forearm_rotation, lower[4]), upper[4])
             pin.forwardKinematics(self.model, self.data, q)
-            h = self.data.oMi[5].rotation.T @ _unit(H - W)
+            h = self.data.oMi[joints.elbow_Y].rotation.T @ _unit(H - W)
             q[6] = math.asin(float(np.clip(sign * h[2], -1.0, 1.0)))
             q[5] = math.atan2(h[0], -h[1])
             return np.minimum(np.maximum(q, lower), upper)
         # No deviation: the hand's direction in the elbow frame is
         # (cos q4 sin q5, -cos q5, sign sin q4 sin q5).
         pin.forwardKinematics(self.model, self.data, q)
-        h = self.data.oMi[4].rotation.T @ _unit(H - W)
+        h = self.data.oMi[joints.elbow_Z].rotation.T @ _unit(H - W)
         q5 = math.acos(float(np.clip(-h[1], -1.0, 1.0)))
         # A straight wrist leaves forearm rotation unseen: keep it at zero then.
         q4 = math.atan2(sign * h[2], h[0]) if math.sin(q5) > _SEEN else 0.0
@@ -341,17 +343,18 @@ class ArmFitter:
         frame = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
         J, e = self._J, self._e
         lower, upper = self._lower, self._upper
+        elbow, wrist = self._joints.elbow_Z, self._joints.wrist_Z
         err = math.inf
         for it in range(iterations + 1):
             pin.computeJointJacobians(model, data, q)
-            e[0:3] = target[0:3] - data.oMi[4].translation
-            e[3:6] = target[3:6] - data.oMi[6].translation
+            e[0:3] = target[0:3] - data.oMi[elbow].translation
+            e[3:6] = target[3:6] - data.oMi[wrist].translation
             e[6:9] = target[6:9] - pin.updateFramePlacement(model, data, hand).translation
             err = math.sqrt(float(e @ e))
             if err < cfg.tolerance or it == iterations:
                 return q, err, it
-            J[0:3] = pin.getJointJacobian(model, data, 4, frame)[:3]
-            J[3:6] = pin.getJointJacobian(model, data, 6, frame)[:3]
+            J[0:3] = pin.getJointJacobian(model, data, elbow, frame)[:3]
+            J[3:6] = pin.getJointJacobian(model, data, wrist, frame)[:3]
             J[6:9] = pin.getFrameJacobian(model, data, hand, frame)[:3]
             dq = np.linalg.solve(J.T @ J + self._damping, J.T @ e)
             largest = max(float(dq.max()), -float(dq.min()))
@@ -523,8 +526,8 @@ class ArmFitter:
     def _quality(self, positions: np.ndarray, points: np.ndarray, last: int) -> tuple[float, float]:
         """(residual, landmark error) of the arm at ``self.data``'s pose against the tape."""
         arm_points = np.zeros((4, 3))  # shoulder at the origin of the arm base frame
-        arm_points[1] = self.data.oMi[4].translation
-        arm_points[2] = self.data.oMi[6].translation
+        arm_points[1] = self.data.oMi[self._joints.elbow_Z].translation
+        arm_points[2] = self.data.oMi[self._joints.wrist_Z].translation
         arm_points[3] = self.data.oMf[self._hand].translation
         vertices = positions[self.config.shoulder_region : last + 1]
         residual = float(_rms_polyline_distance(vertices, arm_points))

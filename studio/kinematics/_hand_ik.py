@@ -20,8 +20,14 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from ._checks import check_side, instance_of, positive_number, real_array, whole_number
-from ._errors import KinematicsError
+from ._checks import (
+    KinematicsError,
+    check_side,
+    instance_of,
+    positive_number,
+    real_array,
+    whole_number,
+)
 from ._human import HumanArm, _as_q
 from ._pose import _closed_form, _cross, _Reading, default_arm
 

@@ -20,13 +20,12 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Literal
+from typing import Literal, NamedTuple
 
 import numpy as np
 import pinocchio as pin
 
-from ._checks import check_side, positive_number, real_array
-from ._errors import KinematicsError
+from ._checks import KinematicsError, check_side, positive_number, real_array
 from ._robots import robots_folder
 
 URDF_IN_ROBOTS = Path("human_description/robots/human.urdf")
@@ -92,6 +91,19 @@ def mirror_human_q(q_human: object) -> np.ndarray:
     return _as_q(q_human, len(ARM_JOINTS), "q_human").copy()
 
 
+class ArmJoints(NamedTuple):
+    """The arm's Pinocchio joint ids by name (``model.getJointId("right_elbow_Z")``), so that
+    code reads ``data.oMi[joints.elbow_Z]`` (the elbow) rather than a bare index."""
+
+    shoulder_Z: int
+    shoulder_X: int
+    shoulder_Y: int
+    elbow_Z: int
+    elbow_Y: int
+    wrist_Z: int
+    wrist_X: int
+
+
 @dataclass(frozen=True)
 class ArmPose:
     """Poses of the arm's landmarks in the arm base frame (4x4 each).
@@ -126,6 +138,7 @@ class HumanArm:
         model: the reduced Pinocchio model (immutable after construction); its root placement
             already maps into the arm base frame, so ``data.oMi`` are arm-base poses.
         data: scratch space for :meth:`forward` (not thread-safe).
+        joints: the model's joint ids by name (:class:`ArmJoints`).
         side, nq (7), joint_names, lower, upper, neutral (zeros: arm hanging),
         upper_arm_length, forearm_length, hand_length.
     """
@@ -147,9 +160,10 @@ class HumanArm:
         model = pin.buildReducedModel(full, lock, pin.neutral(full))
         if model.nq != self.nq:  # pragma: no cover - guards a changed URDF
             raise KinematicsError("human.urdf no longer has the expected arm joints; reinstall it.")
-        ids = [model.getJointId(name) for name in self.joint_names]
-        if ids != list(range(1, self.nq + 1)):  # pragma: no cover
+        joints = ArmJoints(*(model.getJointId(name) for name in self.joint_names))
+        if list(joints) != list(range(1, self.nq + 1)):  # pragma: no cover
             raise KinematicsError("human.urdf's arm joints are not one chain; reinstall it.")
+        self.joints = joints
 
         # Move the root into the arm base frame: Z-up, shoulder at the origin.
         oMshoulder = model.jointPlacements[1]
@@ -158,8 +172,8 @@ class HumanArm:
 
         hand_body = full.inertias[full.getJointId(f"{side}_wrist_X")]
         defaults = {
-            "upper_arm": -model.jointPlacements[4].translation[1],
-            "forearm": -model.jointPlacements[6].translation[1],
+            "upper_arm": -model.jointPlacements[joints.elbow_Z].translation[1],
+            "forearm": -model.jointPlacements[joints.wrist_Z].translation[1],
             "hand": -hand_body.lever[1],
         }
         lengths = {"upper_arm": upper_arm, "forearm": forearm, "hand": hand}
@@ -171,7 +185,10 @@ class HumanArm:
         self.upper_arm_length = float(lengths["upper_arm"])
         self.forearm_length = float(lengths["forearm"])
         self.hand_length = float(lengths["hand"])
-        for joint, length in ((4, self.upper_arm_length), (6, self.forearm_length)):
+        for joint, length in (
+            (joints.elbow_Z, self.upper_arm_length),
+            (joints.wrist_Z, self.forearm_length),
+        ):
             placement = model.jointPlacements[joint]
             model.jointPlacements[joint] = pin.SE3(
                 placement.rotation, np.array([0.0, -length, 0.0])
@@ -179,7 +196,7 @@ class HumanArm:
         self.hand_frame = model.addFrame(
             pin.Frame(
                 "hand",
-                self.nq,
+                joints.wrist_X,
                 pin.SE3(np.eye(3), np.array([0.0, -self.hand_length, 0.0])),
                 pin.FrameType.OP_FRAME,
             )
@@ -209,11 +226,12 @@ class HumanArm:
             raise KinematicsError(f"q_human must have shape (7,); got shape {q.shape}.")
         pin.forwardKinematics(self.model, self.data, q)
         oMi = self.data.oMi
-        hand = oMi[self.nq] * self.model.frames[self.hand_frame].placement
+        joints = self.joints
+        hand = oMi[joints.wrist_X] * self.model.frames[self.hand_frame].placement
         return ArmPose(
-            shoulder=oMi[3].homogeneous,
-            elbow=oMi[5].homogeneous,
-            wrist=oMi[7].homogeneous,
+            shoulder=oMi[joints.shoulder_Y].homogeneous,
+            elbow=oMi[joints.elbow_Y].homogeneous,
+            wrist=oMi[joints.wrist_X].homogeneous,
             hand=hand.homogeneous,
         )
 

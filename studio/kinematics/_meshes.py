@@ -1,4 +1,5 @@
-"""Meshes to draw the two bodies: Gepetto's whole human and the Puma560's Toolbox link meshes.
+"""Meshes to draw the two bodies (Gepetto's whole human and the Puma560's Toolbox link meshes),
+and the operator's body posed with the tape on its sleeve.
 
 Both come from installed data packages, never from the network:
 
@@ -15,6 +16,12 @@ Both come from installed data packages, never from the network:
 Meshes are simplified by vertex clustering (one vertex per cubic cell of
 :attr:`MeshConfig.cell_m`), which keeps the shape to within a cell and cuts the triangle count
 several times, so the scene stays smooth under software WebGL.
+
+The operator at one live pose: the fit models the tape along the arm's bones, and drawn there it
+would hide inside the arm's mesh. :func:`tape_on_sleeve` lifts every tape point closer to the
+upper arm's (forearm's) axis than a sleeve's radius out onto it, radially; points away from the arm (on the back) stay.
+:func:`pose_body` does one forward-kinematics pass per pose for both the meshes and the tape's
+sleeve, so a viewer only places what it is given.
 """
 
 from __future__ import annotations
@@ -29,23 +36,9 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
-from ._checks import check_side
-from ._errors import KinematicsError
+from ._checks import KinematicsError, check_side
+from ._dh import PUMA_LINK_COLORS, PUMA_MESH_DIR
 from ._human import ARM_JOINTS, YUP_TO_ZUP, find_human_urdf
-
-PUMA_MESH_DIR = Path("meshes/UNIMATE/puma560")
-"""Where ``rtb-data`` keeps the Puma560 link meshes, relative to its package folder."""
-
-PUMA_LINK_COLORS = (
-    (0.55, 0.56, 0.60),
-    (0.80, 0.80, 0.82),
-    (0.86, 0.86, 0.88),
-    (0.80, 0.80, 0.82),
-    (0.40, 0.42, 0.46),
-    (0.40, 0.42, 0.46),
-    (0.25, 0.26, 0.30),
-)
-"""Link colours (rgb in [0, 1]): the Unimate's grey castings, a darker wrist."""
 
 HUMAN_COLORS = {
     "skin": (0.89, 0.72, 0.60),
@@ -348,3 +341,99 @@ class HumanBody:
         with self._lock:
             pin.framesForwardKinematics(self.model, self.data, q)
             return np.stack([self._baseMurdf @ self.data.oMf[fid].homogeneous for fid in fids])
+
+
+# ----------------------------------------------------------------- the body at one pose
+
+SLEEVE_LIFT_M = (0.055, 0.045)
+"""How far the tape lies from the upper arm's and the forearm's axis (m): on the sleeve, where
+it is strapped, rather than inside the arm's mesh."""
+SLEEVE_ROUNDS = 3
+"""Rounds of pushing tape points off the arm's segments: a point pushed off one segment near
+the elbow may land inside the other, and a few rounds settle it."""
+ARM_LINKS = ("upperarm", "lowerarm", "hand")
+"""The ``human.urdf`` links whose origins (shoulder, elbow, wrist) make the sleeve's axis."""
+
+
+@dataclass(frozen=True, eq=False)
+class PosedBody:
+    """The operator's meshes and tape at one pose, in the taped arm's base frame.
+
+    Attributes:
+        parts: ``(len(body.parts), 4, 4)`` pose of every mesh.
+        tape: ``(N, 3)`` tape points on the sleeve (m), or None without a tape.
+    """
+
+    parts: np.ndarray
+    tape: np.ndarray | None
+
+
+def tape_on_sleeve(
+    tape: np.ndarray,
+    axis: np.ndarray,
+    lift_m: tuple[float, float] = SLEEVE_LIFT_M,
+    rounds: int = SLEEVE_ROUNDS,
+) -> np.ndarray:
+    """Tape points lifted off the arm's axis onto its surface.
+
+    Args:
+        tape: ``(N, 3)`` tape points (m).
+        axis: ``(3, 3)`` shoulder, elbow and wrist positions (m), in the tape's frame.
+        lift_m: the sleeve's radius around the upper arm and around the forearm (m).
+        rounds: passes over both segments.
+
+    Returns:
+        ``(N, 3)``: each point closer to a segment than its ``lift_m`` pushed out radially to
+        that distance (a point on the axis itself goes to any side); the others unchanged.
+    """
+    axis = np.asarray(axis, dtype=float)
+    out = np.array(tape, dtype=float)
+    for _ in range(rounds):  # all points at once: this runs for every live pose shown
+        for k, (a, b, lift) in enumerate(zip(axis[:-1], axis[1:], lift_m, strict=True)):
+            ab = b - a
+            along = (out - a) @ ab / (ab @ ab)
+            t = np.clip(along, 0.0, 1.0)
+            c = a + t[:, None] * ab
+            away = out - c
+            d = np.linalg.norm(away, axis=1)
+            # Past the elbow, a point is the other segment's: pushed out of this one's end, a
+            # point on the axis would go along it, then across the other, twice as far.
+            beyond_elbow = (along > 1.0) if k == 0 else (along < 0.0)
+            inside = (d < lift) & ~beyond_elbow
+            if not inside.any():
+                continue
+            on_axis = inside & (d <= 1e-9)
+            if on_axis.any():  # any direction across the axis
+                across = np.cross(ab, np.eye(3)[int(np.argmin(np.abs(ab)))])
+                away[on_axis] = across
+                d[on_axis] = np.linalg.norm(across)
+            out[inside] = c[inside] + away[inside] / d[inside, None] * lift
+    return out
+
+
+def sleeve_axis(body: HumanBody, parts: np.ndarray) -> np.ndarray:
+    """The taped arm's shoulder, elbow and wrist ``(3, 3)`` from the mesh poses ``parts``
+    (each arm link carries a mesh, posed at the link's frame)."""
+    frames = [part.frame for part in body.parts]
+    return np.stack([parts[frames.index(f"{body.side}_{link}"), :3, 3] for link in ARM_LINKS])
+
+
+def pose_body(
+    body: HumanBody,
+    q_human: np.ndarray | None,
+    tape: np.ndarray | None = None,
+    lift_m: tuple[float, float] = SLEEVE_LIFT_M,
+) -> PosedBody:
+    """The body's meshes with the taped arm at ``q_human`` and ``tape`` on its sleeve, from one
+    forward-kinematics pass.
+
+    Args:
+        body: the operator's meshes; ``body.side`` is the taped arm.
+        q_human: the taped arm's seven joints (rad), or None for the neutral pose.
+        tape: ``(N, 3)`` tape points in the arm base frame (m), or None.
+        lift_m: the sleeve's radius around the upper arm and the forearm (m).
+    """
+    parts = body.poses(q_human)
+    if tape is None or len(tape) < 2:
+        return PosedBody(parts, None)
+    return PosedBody(parts, tape_on_sleeve(tape, sleeve_axis(body, parts), lift_m))

@@ -69,8 +69,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pinocchio as pin
 
-from ._checks import check_side, positive_number, real_array, whole_number
-from ._errors import KinematicsError
+from ._checks import KinematicsError, check_side, positive_number, real_array, whole_number
 from ._human import HumanArm
 
 N_LANDMARKS = 33
@@ -494,7 +493,7 @@ def _axis_sign(model: pin.Model, data: pin.Data, joint: int, axis: int) -> float
     q = np.zeros(model.nq)
     pin.forwardKinematics(model, data, q)
     R0 = data.oMi[joint].rotation.copy()
-    q[joint - 1] = 0.1
+    q[model.joints[joint].idx_q] = 0.1
     pin.forwardKinematics(model, data, q)
     return float(np.sign(pin.log3(R0.T @ data.oMi[joint].rotation)[axis]))
 
@@ -503,11 +502,11 @@ def _axis_sign(model: pin.Model, data: pin.Data, joint: int, axis: int) -> float
 def _signs(side: str) -> tuple[float, float, float]:
     """Axis signs of humeral rotation (y), forearm rotation (y) and wrist deviation (x)."""
     arm = default_arm(side)
-    data = arm.model.createData()
+    data, joints = arm.model.createData(), arm.joints
     return (
-        _axis_sign(arm.model, data, 3, 1),
-        _axis_sign(arm.model, data, 5, 1),
-        _axis_sign(arm.model, data, 7, 0),
+        _axis_sign(arm.model, data, joints.shoulder_Y, 1),
+        _axis_sign(arm.model, data, joints.elbow_Y, 1),
+        _axis_sign(arm.model, data, joints.wrist_X, 0),
     )
 
 
@@ -520,7 +519,7 @@ def _closed_form(
 ) -> np.ndarray:
     """The arm angles that give ``reading``'s directions on one shoulder branch, clamped."""
     s2, s4, s6 = _signs(arm.side)
-    model, lower, upper = arm.model, arm.lower, arm.upper
+    model, lower, upper, joints = arm.model, arm.lower, arm.upper, arm.joints
     q = q_hold.copy()
     u = reading.upper
     lateral = -1.0 if arm.side == "right" else 1.0  # abduction moves the arm along -y / +y
@@ -533,7 +532,7 @@ def _closed_form(
     if math.sin(q[3]) > _SEEN:  # read even when weakly observable; a stream weighs it
         q[2] = 0.0
         pin.forwardKinematics(model, data, q)
-        fA = data.oMi[2].rotation.T @ reading.fore
+        fA = data.oMi[joints.shoulder_X].rotation.T @ reading.fore
         q[2] = s2 * math.atan2(-fA[2], fA[0])
     elif overhead:
         q[2] += math.pi
@@ -545,14 +544,14 @@ def _closed_form(
         hand_axes = np.column_stack(
             [reading.palm, -reading.hand, _cross(reading.palm, -reading.hand)]
         )
-        rel = data.oMi[4].rotation.T @ hand_axes  # = Ry(s4 q4) Rz(q5) Rx(s6 q6)
+        rel = data.oMi[joints.elbow_Z].rotation.T @ hand_axes  # = Ry(s4 q4) Rz(q5) Rx(s6 q6)
         q[5] = math.asin(_clamp(rel[1, 0]))
         q[6] = s6 * math.atan2(-rel[1, 2], rel[1, 1])
         q[4] = s4 * math.atan2(-rel[2, 0], rel[0, 0])
     else:  # the hand's direction only: forearm rotation held, the wrist follows
         q[4] = min(max(q[4], lower[4]), upper[4])
         pin.forwardKinematics(model, data, q)
-        h = data.oMi[5].rotation.T @ reading.hand  # = Rz(q5) Rx(s6 q6) (0, -1, 0)
+        h = data.oMi[joints.elbow_Y].rotation.T @ reading.hand  # = Rz(q5) Rx(s6 q6) (0, -1, 0)
         q[6] = s6 * math.asin(_clamp(-h[2]))
         q[5] = math.atan2(h[0], -h[1])
     return np.clip(q, lower, upper)
@@ -561,15 +560,16 @@ def _closed_form(
 def _fitted_points(arm: HumanArm, data: pin.Data, q: np.ndarray, reading: _Reading) -> np.ndarray:
     """The arm at ``q`` drawn at the measured limb lengths from the origin: (4, 3)."""
     pin.forwardKinematics(arm.model, data, q)
-    E = data.oMi[4].translation / arm.upper_arm_length
-    W = (data.oMi[6].translation - data.oMi[4].translation) / arm.forearm_length
+    elbow, wrist = data.oMi[arm.joints.elbow_Z], data.oMi[arm.joints.wrist_Z]
+    E = elbow.translation / arm.upper_arm_length
+    W = (wrist.translation - elbow.translation) / arm.forearm_length
     lengths = np.linalg.norm(np.diff(reading.points, axis=0), axis=1)
     out = np.zeros((4, 3))
     out[1] = lengths[0] * E
     out[2] = out[1] + lengths[1] * W
     out[3] = out[2]
     if reading.hand is not None:
-        hand_axis = -data.oMi[7].rotation[:, 1]
+        hand_axis = -data.oMi[arm.joints.wrist_X].rotation[:, 1]
         out[3] = out[2] + lengths[2] * hand_axis
     return out
 

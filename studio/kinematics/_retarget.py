@@ -54,9 +54,8 @@ from typing import Literal
 
 import numpy as np
 
-from ._checks import instance_of, positive_number, whole_number
+from ._checks import KinematicsError, instance_of, positive_number, whole_number
 from ._clearance import ClearanceGuard
-from ._errors import KinematicsError
 from ._hand_ik import fit_hand_pose
 from ._human import SAGITTAL_MIRROR, HumanArm, _as_q
 from ._puma import IKConfig, IKResult, Puma560
@@ -366,12 +365,20 @@ class Retargeter:
     def mode(self, value: Mode) -> None:
         if value not in ("joint", "cartesian"):  # a caller without a type checker
             raise KinematicsError(f'Retarget mode must be "joint" or "cartesian"; got {value!r}.')
-        if value == "joint" and not isinstance(self.robot, Puma560):
+        if value == "joint" and not self.joint_mode_possible:
             raise KinematicsError(
                 f"Joint mode maps the human arm onto the Puma560's joints; the "
                 f"{self.robot.spec.title} follows the hand in cartesian mode: choose cartesian."
             )
         self._mode = value
+
+    @property
+    def joint_mode_possible(self) -> bool:
+        """Whether the robot's joints can follow the operator's one by one (joint mode): the
+        Puma560's can (:attr:`RobotSpec.joint_mode`), as its analytic model or its registry
+        arm."""
+        robot = self.robot
+        return isinstance(robot, Puma560) or robot.spec.joint_mode
 
     @property
     def mirror(self) -> bool:

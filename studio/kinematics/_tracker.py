@@ -21,8 +21,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ._checks import instance_of, positive_number
-from ._errors import KinematicsError
+from ._checks import KinematicsError, instance_of, positive_number
 from ._filter import OneEuroFilter, smooth_constant_velocity, white_noise
 from ._fit import ArmFit, ArmFitter, FitConfig
 from ._human import HumanArm

@@ -38,7 +38,7 @@ from studio.kinematics import (
     robot_names,
     tool_reaches,
 )
-from studio.kinematics._reach import reach_errors
+from studio.kinematics._retarget_path import reach_errors
 from studio.samples import SAMPLES_DIR
 
 SIMULATOR_SECONDS = 60.0

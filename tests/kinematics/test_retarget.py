@@ -295,7 +295,7 @@ def test_near_a_singularity_a_ur_arm_does_not_flip_between_two_answers() -> None
     answer swung between two poses about 12 degrees apart, frame after frame (about 530
     turn-backs); damped more there, the arm moves through smoothly and reaches as often."""
     from studio.capture import human_angles, read_any_recording
-    from studio.kinematics._reach import tool_reaches
+    from studio.kinematics._retarget_path import tool_reaches
     from studio.samples import SAMPLES_DIR
 
     ur5 = load_robot("ur5")

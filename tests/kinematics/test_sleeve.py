@@ -17,7 +17,7 @@ from studio.kinematics import (
     reconstruct,
     tape_from_arm,
 )
-from studio.kinematics._sleeve import tape_on_sleeve
+from studio.kinematics._meshes import tape_on_sleeve
 
 AXIS = np.array([[0.0, 0.0, 0.0], [0.3, 0.0, 0.0], [0.55, 0.0, 0.0]])
 """A straight arm along +x: shoulder, elbow, wrist (m)."""
