@@ -238,7 +238,7 @@ class Pipeline:
         """Teach ``arm`` (None or the ``puma560``: the Puma560, in the chosen mode) from the next
         frame: the fitted human arm is retargeted onto it in cartesian mode
         (:class:`~studio.kinematics.Retargeter`), starting from its home pose."""
-        if arm is not None and arm.name == "puma560":
+        if arm is not None and arm.spec.joint_mode:  # the tracker's own robot, either mode
             arm = None
         with self._fit_lock, self._lock:
             self._chosen, self._choosing = None, False

@@ -89,7 +89,7 @@ def arm_framing(arm: RobotArm) -> tuple[float, float]:
     Enlarged to the Puma560's reach (never shrunk), and raised so its shoulder is at the
     Puma560's shoulder height.
     """
-    puma = load_robot("puma560")
+    puma = load_robot("puma560", geometry=False)  # its reach and shoulder: no meshes needed
     scale = max(1.0, puma.reach / arm.reach)
     pedestal = max(0.0, float(puma.shoulder[2]) - scale * float(arm.shoulder[2]))
     return scale, pedestal
@@ -98,9 +98,7 @@ def arm_framing(arm: RobotArm) -> tuple[float, float]:
 def arm_tool(arm: RobotArm) -> Callable[[np.ndarray], np.ndarray]:
     """Joint angles -> world position of ``arm``'s tool, framed as :func:`arm_view` draws it
     (needs no meshes: a path's tool line is ready before its robot is drawn)."""
-    if arm.name == "puma560":
-        return puma_view_tool(Puma560())
-    scale, pedestal = arm_framing(arm)
+    scale, pedestal = arm_framing(arm)  # the Puma560's own: 1 and 0
     data = arm.model.createData()  # its own scratch data, as the retargeting has its own
     lock = threading.Lock()
     lift = np.array([0.0, 0.0, pedestal])
