@@ -81,11 +81,10 @@ def isolate_robot_loading(cache: Path | None = None) -> None:
 
 def robot_is_kept(name: str) -> bool:
     """Whether loading ``name`` with its geometry is quick: it is loaded in this process already,
-    it has no meshes to build, or the cache folder :func:`isolate_robot_loading` was given keeps
-    its built geometry. Otherwise its first load builds its collision hulls (a minute or more on
+    or the cache folder :func:`isolate_robot_loading` was given keeps its built geometry. Otherwise its first load builds its collision hulls (a minute or more on
     a busy machine), which is worth telling a person who waits."""
     spec = robot_spec(name)
-    if (spec.name, True) in _arms or not spec.urdf:
+    if (spec.name, True) in _arms:
         return True
     kept = _cache_entry(spec, _urdf_text(spec))
     return kept is not None and kept.is_dir()

@@ -45,7 +45,6 @@ from studio.kinematics import Puma560
 from ..._numbers import is_number
 from .._errors import LearningError
 from ..tasks._reach import tool_positions
-from ..tasks._robot import PUMA560
 
 MOVING_SPEED_FRACTION = 0.05
 """A joint counts as moving when its speed exceeds this fraction of the path's peak joint speed
@@ -513,11 +512,9 @@ def likeness_card(
 
 
 def robot_tool_positions(robot: str, q: np.ndarray) -> np.ndarray:
-    """``robot``'s tool positions ``(N, 3)`` (m) for its joint angles ``(N, nq)`` (rad): the
-    Puma560's by :func:`puma_tool_positions`, another arm's by the tasks' compiled forward
-    kinematics (:func:`._reach.tool_positions`, held equal to Pinocchio's by a test)."""
-    if robot == PUMA560:
-        return puma_tool_positions(q)
+    """``robot``'s tool positions ``(N, 3)`` (m) for its joint angles ``(N, nq)`` (rad), by the
+    tasks' compiled forward kinematics of its registry model (:func:`._reach.tool_positions`,
+    held equal to Pinocchio's by a test; the Puma560's equal :func:`puma_tool_positions`)."""
     return tool_positions(robot, q)
 
 

@@ -27,7 +27,7 @@ from studio.capture import (
     SimulatorSource,
     source_from_spec,
 )
-from studio.kinematics import DEFAULT_ROBOT
+from studio.kinematics import robot_spec
 from studio.learning import default_goal_deg, goal_pose
 
 from .._errors import ConflictError, InvalidError, TooManyRequestsError
@@ -203,7 +203,7 @@ class Sources:
             return
         robot = self.pipeline.robot_name
         q = goal_pose(default_goal_deg(robot) if goal_deg is None else goal_deg, robot)
-        if robot == DEFAULT_ROBOT:  # the Puma560: its joints mirror the arm's one by one
+        if robot_spec(robot).joint_mode:  # the Puma560: its joints mirror the arm's one by one
             source.reach(q)
         else:
             source.reach_human(self.pipeline.human_reaching(q))
