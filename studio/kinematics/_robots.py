@@ -82,6 +82,9 @@ class RobotSpec:
         joint_mode: whether its joints can follow the operator's one by one (the paper's joint
             mode, :data:`studio.kinematics._retarget.JOINT_MAP`: the Puma560's); every robot
             follows the hand in cartesian mode.
+        close_by_design: link pairs never checked against each other, as an SRDF's
+            ``disable_collisions`` lists them, for a robot without an SRDF whose links sit
+            within the checks' margin of each other at every pose (:data:`PUMA_WRIST_PAIRS`).
     """
 
     name: str
@@ -101,6 +104,7 @@ class RobotSpec:
     generate: Callable[[], str] | None = None
     package: str = "example-robot-data"
     joint_mode: bool = False
+    close_by_design: tuple[tuple[str, str], ...] = ()
 
 
 UR_READY_DEG = (0.0, -90.0, 90.0, -90.0, -90.0, 0.0)
@@ -125,6 +129,12 @@ also on 20 s of ``arm_motion`` (4.5-5% -> 0%) and 30 s of simulator, seed 5 (8-9
 with the hand's target drawn back into the reach as often as before. The UR3 gains on one
 motion and loses on another, so it keeps 1."""
 
+PUMA_WRIST_PAIRS = (("link4", "link6"),)
+"""The Puma560's :attr:`RobotSpec.close_by_design`: its wrist links 4 and 6 (rtb-data's meshes)
+both hug the wrist centre, 2.5 mm apart at every pose (at rest, and over the three sample
+demonstrations), so a clearance of more than that refused every motion; joint 5 between them
+turns within its +-100 degrees without the two meeting."""
+
 TOOL_AXES = {
     "z": np.eye(3),
     # tool x along the fingers, tool y kept, tool z opposite the studio's tool x
@@ -145,6 +155,7 @@ ROBOT_SPECS: dict[str, RobotSpec] = {
             generate=puma560_urdf,
             package="rtb-data",
             joint_mode=True,
+            close_by_design=PUMA_WRIST_PAIRS,
         ),
         RobotSpec(
             "panda",
@@ -580,6 +591,12 @@ class RobotArm:
             b = geom.geometryObjects[pair.second].parentJoint
             if a == b or parents[a] == b or parents[b] == a:
                 continue  # the same link, or adjacent links: they touch by design
+            links = {
+                _link_of(geom.geometryObjects[pair.first].name),
+                _link_of(geom.geometryObjects[pair.second].name),
+            }
+            if any(links == set(close) for close in self.spec.close_by_design):
+                continue
             keep.append(pair)
         geom.removeAllCollisionPairs()
         for pair in keep:
