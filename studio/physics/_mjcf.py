@@ -2,9 +2,10 @@
 
 MuJoCo compiles a URDF directly (``mujoco.MjSpec.from_string``) once three things are true of it:
 
-- its meshes are files MuJoCo reads (STL or OBJ) at paths it can find: a relative reference is
-  made absolute against the URDF's folder, and a mesh in another format (the Kinova's Collada
-  ``.dae``) is converted once with ``trimesh`` into the cache folder and referenced there;
+- its meshes are files MuJoCo reads (binary STL or OBJ) at paths it can find: a relative
+  reference is made absolute against the URDF's folder, and a mesh in another format (the
+  Kinova's Collada ``.dae``, the Puma560's ASCII STL) is converted once with ``trimesh`` into the
+  cache folder and referenced there;
 - the ``<visual>`` elements are gone (the simulation collides the ``<collision>`` geometry only,
   and visual meshes are often Collada), and so are the ROS-only ``<gazebo>`` and
   ``<transmission>`` blocks;
@@ -25,7 +26,8 @@ from pathlib import Path
 from ._errors import PhysicsError
 
 MUJOCO_MESHES = (".stl", ".obj")
-"""The mesh formats MuJoCo reads itself; any other is converted to STL."""
+"""The mesh formats MuJoCo reads itself (an STL in binary form only); any other is converted to
+a binary STL."""
 
 MIN_MASS_KG = 1e-3
 """The mass MuJoCo gives a moving link whose URDF states none (``boundmass``): enough to compile
@@ -42,6 +44,25 @@ _COMPILER = (
     f'balanceinertia="true" boundmass="{MIN_MASS_KG}" boundinertia="{MIN_INERTIA_KG_M2}"/>'
     "</mujoco>"
 )
+
+
+def mujoco_reads(path: Path) -> bool:
+    """Whether MuJoCo reads the mesh file ``path`` itself: an OBJ, or an STL in binary form (it
+    refuses an ASCII STL, the form of rtb-data's Puma560 links). A binary STL is an 80-byte
+    header, a face count, and 50 bytes a face: its size says which it is."""
+    suffix = path.suffix.lower()
+    if suffix not in MUJOCO_MESHES:
+        return False
+    if suffix != ".stl":
+        return True
+    try:
+        with path.open("rb") as file:
+            head = file.read(84)
+        size = path.stat().st_size
+    except OSError:
+        return True  # unreadable: the compile says so in its own sentence
+    faces = int.from_bytes(head[80:84], "little") if len(head) == 84 else -1
+    return size == 84 + 50 * faces
 
 
 def converted_mesh(source: Path, cache: Path) -> Path:
@@ -104,7 +125,7 @@ def mujoco_urdf(urdf: Path, cache: Path) -> str:
     def readable(match: re.Match[str]) -> str:
         path = Path(match.group(2).removeprefix("file://"))
         path = path if path.is_absolute() else urdf.parent / path
-        if path.suffix.lower() not in MUJOCO_MESHES:
+        if not mujoco_reads(path):
             path = converted_mesh(path, cache)
         return f"{match.group(1)}{path}{match.group(3)}"
 
