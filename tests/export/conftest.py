@@ -38,5 +38,9 @@ def smooth_arm(frames: int = 165, speed: float = 1.0) -> np.ndarray:
 
 @pytest.fixture(scope="session")
 def slow_recording(tmp_path_factory) -> Path:
-    """1.5 s of a slow, smooth reach: within the Puma560's limits at the capture rate."""
-    return write_arm_recording(tmp_path_factory.mktemp("rec") / "slow.tape.csv", smooth_arm(165))
+    """1.5 s of a slow, smooth reach: within the Puma560's limits at the capture rate, the arm
+    raised forward (1.2 rad) so that the Puma560, mirroring it joint by joint, keeps its arm above
+    the floor it stands on (hanging, the arm drove the Puma560's wrist 42 cm into it)."""
+    q = smooth_arm(165)
+    q[:, 0] += 1.2  # shoulder flexion
+    return write_arm_recording(tmp_path_factory.mktemp("rec") / "slow.tape.csv", q)
