@@ -221,7 +221,7 @@ class Pipeline:
         now on (:attr:`robot_name`), while the live chain drives the robot drawn until the
         returned call, which the scene makes once it has drawn ``arm``. Meanwhile the robot drawn
         keeps following the operator, and ``q_robot`` stays its joints."""
-        if arm is not None and arm.name == "puma560":
+        if arm is not None and arm.spec.joint_mode:  # the tracker's own robot, either mode
             arm = None
         with self._lock:
             self._chosen, self._choosing = arm, True
