@@ -28,6 +28,7 @@ from ._config import check_budget as check_budget
 from ._errors import ConfigError as ConfigError
 from ._errors import LearningError as LearningError
 from ._errors import PolicyFileError as PolicyFileError
+from ._evaluate import evaluate_policy as evaluate_policy
 from ._experiments import run_experiments as run_experiments
 from ._interface import Evaluation as Evaluation
 from ._interface import Learner as Learner
