@@ -364,8 +364,8 @@ def test_a_frame_posted_meanwhile_is_written_after_the_one_being_fitted(
             assert second_arrived.wait(30)
         return real_fit(src, observations)
 
-    lock = getattr(studio, "_fed_lock", threading.Lock())
-    monkeypatch.setattr(studio, "_fed_lock", Announcing(lock), raising=False)
+    sources = studio.sources  # the fed frames' lock is the sources service's
+    monkeypatch.setattr(sources, "_fed_lock", Announcing(sources._fed_lock))
     monkeypatch.setattr(source, "submit", submit)
     monkeypatch.setattr(pipeline, "_fit", slow_fit)
     first = threading.Thread(
