@@ -551,3 +551,14 @@ def test_the_narrow_packages_export_only_what_is_used_outside_them():
     )
     stale = [k for k in FOR_USERS if k.rpartition(".")[2] not in _exports(k.rpartition(".")[0])]
     assert stale == [], "FOR_USERS names what is no longer exported"
+
+
+def test_the_data_flow_diagram_names_every_teacher_package_and_file_format():
+    """The diagram once showed tape sources and a six-joint robot only (issue 37): it names each
+    teacher, each package a motion passes through, and each export format."""
+    text = DOC.read_text()
+    diagram = text[text.index("## Data flow") : text.index("## What a newcomer reads first")]
+    for word in ("tape", "camera", "hand guide", "q_robot(n)", "motion", "learning", "physics",
+                 "MCAP", "LeRobot", "CSV", "studio evaluate"):  # fmt: skip
+        assert word in diagram, f"the data-flow diagram does not mention {word!r}"
+    assert "q_robot(6)" not in diagram
