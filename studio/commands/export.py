@@ -35,6 +35,7 @@ from studio.export import (
 )
 from studio.kinematics import (
     DEFAULT_ROBOT,
+    RobotArm,
     isolate_robot_loading,
     robot_is_kept,
     robot_names,
@@ -126,7 +127,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     start.add_argument("--start-state", type=int, help="grid state number to start from")
     start.add_argument(
         "--start-deg",
-        help="start joint angles in degrees, comma-separated, e.g. -90,0,0 (default: all 0)",
+        help="start joint angles in degrees, comma-separated, one per learned joint or one per "
+        "joint of the robot, e.g. -90,0,0 (default: the robot's home pose with --robot or "
+        "--format, within its limits; else the learned joints at 0)",
     )
     parser.add_argument(
         "--rate",
@@ -154,18 +157,20 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
 
 
-def _start_degrees(text: str | None, joints: int) -> list[float]:
-    """The --start-deg angles (default all 0), checked to be one per joint."""
-    text = text or ",".join(["0"] * joints)
+def _start_degrees(text: str, counts: tuple[int, ...]) -> list[float]:
+    """The --start-deg angles, checked to be as many as one of ``counts`` (the learned joints,
+    or every joint of the robot)."""
+    wanted = " or ".join(str(n) for n in dict.fromkeys(counts))
     try:
         degrees = [float(v) for v in text.split(",")]
     except ValueError:
         raise LearningError(
-            f"--start-deg is {text!r}; give {joints} angles in degrees separated by commas."
+            f"--start-deg is {text!r}; give {wanted} angles in degrees separated by commas."
         ) from None
-    if len(degrees) != joints:
+    if len(degrees) not in counts:
         raise LearningError(
-            f"--start-deg has {len(degrees)} angles; give {joints}, one per learned joint."
+            f"--start-deg has {len(degrees)} angles; give {wanted}, one per learned joint or "
+            "one per joint of the robot."
         )
     return degrees
 
@@ -177,11 +182,15 @@ def _out_path(args: argparse.Namespace) -> Path:
 
 
 def _rollout(
-    args: argparse.Namespace, policy: AnyPolicy, seconds_per_step: float | None
+    args: argparse.Namespace,
+    policy: AnyPolicy,
+    seconds_per_step: float | None,
+    arm: RobotArm | None = None,
 ) -> tuple[Rollout, str]:
-    """The policy's rollout from --start-state (a grid policy's) or --start-deg (default: its
-    learner's own start: the learned joints at 0, a movement primitive's demonstration's start),
-    and the phrase saying what it did."""
+    """The policy's rollout from --start-state (a grid policy's) or --start-deg (the learned
+    joints, or every joint of ``arm``; default: ``arm``'s home pose, within its limits, or
+    without ``arm`` its learner's own start: the learned joints at 0, a movement primitive's
+    demonstration's start), and the phrase saying what it did."""
     learner = learner_of(policy)
     joints = learner.learned_joints(policy)
     if args.start_state is not None:
@@ -190,10 +199,14 @@ def _rollout(
                 f"--start-state numbers grid states; a {learner.title} starts from --start-deg angles."
             )
         start = Start(state=args.start_state)
-    elif args.start_deg is None or joints == 0:
+    elif joints == 0 or (args.start_deg is None and arm is None):
         start = Start()
+    elif args.start_deg is None:
+        start = learner.pose_start(policy, np.array(arm.home))
     else:
-        start = Start(q=np.radians(_start_degrees(args.start_deg, joints)))
+        counts = (joints,) if arm is None else (joints, arm.nq)
+        q = np.radians(_start_degrees(args.start_deg, counts))
+        start = Start(q=q) if len(q) == joints else learner.pose_start(policy, q)
     rollout = learner.roll_out(
         policy,
         start,
@@ -251,7 +264,7 @@ def _motion(args: argparse.Namespace, source: Path, robot: str) -> tuple[Motion,
         return demonstration_motion(source, robot, args.rate), "demonstration"
     policy = load_any_policy(source)
     arm = check_policy_robot(source, policy.robot, robot)
-    rollout, summary = _rollout(args, policy, args.seconds_per_step)
+    rollout, summary = _rollout(args, policy, args.seconds_per_step, arm)
     timed = args.seconds_per_step is not None
     return Motion("policy", source.name, arm, rollout.times, rollout.q, timed, args.rate), summary
 

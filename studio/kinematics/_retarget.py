@@ -26,9 +26,12 @@ J6    wrist_X (wrist deviation)            +1 (*)  0          the remaining wris
 already describe the mirror image). Humeral rotation (shoulder_Y) has no Puma counterpart and is
 dropped; :meth:`Retargeter.human_from_robot` sets it to zero.
 
-*cartesian* - the hand-centre pose relative to the shoulder is mirrored, scaled by the ratio of
-the robot's reach to the arm's (times ``reach_fraction``), placed at the robot's shoulder and
-solved by the robot's IK, warm-started from the previous solution; when the full pose is out of
+*cartesian* - the hand-centre pose relative to the shoulder is mirrored and placed in the
+robot's workspace (a robot of :func:`load_robot`: the operator's reach, relative to their arm's
+length, mapped direction by direction into the robot's reach above its table,
+:class:`~studio.kinematics._workspace.Workspace`; the Puma560's analytic model: scaled by the
+ratio of its reach to the arm's, times ``reach_fraction``, at its shoulder), and solved by the
+robot's IK, warm-started from the previous solution; when the full pose is out of
 reach of the wrist, the position alone is solved. While the arm moves, no joint turns more than
 ``max_joint_step`` a frame: a pose within that step that reaches the target (1 cm and 5 deg,
 :meth:`RetargetConfig.within_reach`) is looked for first, and only when there is none does the
@@ -36,7 +39,8 @@ IK look on other branches, whose answer is then walked to over several frames.
 
 On a robot standing on a table the target is kept above the table, out of the column around
 the first axis that an arm with a sideways shoulder offset cannot enter (``RobotSpec.hollow``,
-the UR arms') and within the arm's reach, each softly (:class:`RetargetConfig`).
+the UR arms': their workspace's centre sits in front of it) and within the arm's reach, each
+softly (:class:`RetargetConfig`); the workspace already keeps a human arm's targets there.
 
 The hand's target is placed in the robot's base frame turned by ``RobotArm.base_rotation``,
 so an arm whose URDF faces elsewhere than +x (the SO-100's faces -y) faces the operator, as the
@@ -61,6 +65,15 @@ from ._human import SAGITTAL_MIRROR, HumanArm, _as_q
 from ._puma import IKConfig, IKResult, Puma560
 from ._robot_load import load_robot
 from ._robots import IK_DAMPING, RobotArm, RobotIK, tool_errors
+from ._workspace import (
+    Workspace,
+    into_hollow,
+    out_of_hollow,
+    soft_ceiling,
+    soft_floor,
+    unbent,
+    unfloored,
+)
 
 Mode = Literal["joint", "cartesian"]
 
@@ -91,7 +104,15 @@ class RetargetConfig:
 
     Attributes:
         reach_fraction: the arm's full reach maps to this fraction of the robot's, keeping
-            cartesian targets off the Puma's outstretched singularity.
+            cartesian targets off the Puma's outstretched singularity; for a robot of
+            :func:`load_robot`, the ball the soft ceiling keeps targets within (its radius
+            ``reach_fraction`` of the usable reach, :attr:`RobotSpec.usable_reach`).
+        reach_share: ... and the operator's outstretched arm reaches this share of that radius
+            (:class:`Workspace`: the operator's reach, relative to their arm's length, mapped
+            direction by direction into the robot's ball above the table), so a person's natural
+            reach is the robot's and no target of a human arm is drawn back. Measured on the
+            three samples: every arm's reach is then followed in at least 95% of the frames
+            (``benchmarks/bench_retarget.py --samples``).
         ik_iterations: IK iterations per attempt on the live path (warm starts need few).
         restart_iterations: IK iterations of each further attempt, when the warm-started solve
             of a robot of :func:`load_robot` misses the pose.
@@ -159,6 +180,7 @@ class RetargetConfig:
     """
 
     reach_fraction: float = 0.95
+    reach_share: float = 0.85
     ik_iterations: int = 20
     restart_iterations: int = 60
     floor_height: float = 0.05
@@ -180,6 +202,12 @@ class RetargetConfig:
 
     def __post_init__(self) -> None:
         positive_number(self.reach_fraction, "RetargetConfig.reach_fraction")
+        positive_number(self.reach_share, "RetargetConfig.reach_share")
+        if self.reach_share > 1.0:
+            raise KinematicsError(
+                f"RetargetConfig.reach_share must be at most 1 (a share of the robot's reach); "
+                f"got {self.reach_share}."
+            )
         whole_number(self.ik_iterations, "RetargetConfig.ik_iterations", 1)
         whole_number(self.restart_iterations, "RetargetConfig.restart_iterations", 1)
         positive_number(self.floor_height, "RetargetConfig.floor_height")
@@ -202,75 +230,6 @@ class RetargetConfig:
     def within_reach(self, position_error: float, rotation_error: float) -> bool:
         """Whether a tool this far (m) and this turned (rad) from its target has reached it."""
         return position_error <= self.reach_tolerance and rotation_error <= self.reach_angle
-
-
-def _soft_floor(z: float, floor: float, width: float) -> float:
-    """``z`` kept above ``floor`` smoothly: a softplus of width ``width`` (equal to ``z`` well above)."""
-    x = (z - floor) / width
-    return floor + width * (x + math.log1p(math.exp(-x)) if x > 0 else math.log1p(math.exp(x)))
-
-
-def _soft_ceiling(r: float, ceiling: float, width: float) -> float:
-    """``r`` kept below ``ceiling`` smoothly: unchanged up to ``ceiling - width``, then bent
-    (continuous slope) towards ``ceiling``, which it never reaches."""
-    knee = ceiling - width
-    return r if r <= knee else knee + width * math.tanh((r - knee) / width)
-
-
-def _unfloored(z: float, floor: float, width: float) -> float:
-    """The ``z`` that :func:`_soft_floor` keeps at ``z`` (a height at the floor or below: as far
-    below it as the softplus allows, ``width`` times the float's smallest log)."""
-    y = max((z - floor) / width, 1e-300)
-    return floor + width * (y + math.log(-math.expm1(-y)) if y > 30.0 else math.log(math.expm1(y)))
-
-
-def _unbent(r: float, ceiling: float, width: float) -> float:
-    """The ``r`` that :func:`_soft_ceiling` bends to ``r`` (one at the ceiling or beyond: far out)."""
-    knee = ceiling - width
-    return r if r <= knee else knee + width * math.atanh(min((r - knee) / width, 1.0 - 1e-12))
-
-
-def out_of_hollow(
-    across: np.ndarray, hollow: float, width: float, forward: np.ndarray
-) -> np.ndarray:
-    """A target's level offset from a robot's first axis (m, (2,)) moved out of its hollow.
-
-    An offset nearer the axis than ``hollow + width`` is moved to the radius
-    ``-_soft_ceiling(-r, -hollow, width)`` (beyond ``hollow``, smoothly: a further one stays
-    exactly where it is), along ``across + (hollow + width / 2) * forward``, not straight out
-    from the axis. Straight out, the direction of a hand held just above or below the shoulder
-    turns with every millimetre of its noise, and the robot's base would turn with it. Any
-    continuous way out of a disc tears somewhere (the disc's edge cannot shrink onto a point
-    around the hollow); this one tears at a single point behind the axis (``forward`` the way
-    the arm faces, towards the operator), where a hand rarely stays.
-    """
-    radius = float(np.linalg.norm(across))
-    kept = -_soft_ceiling(-radius, -hollow, width)
-    if kept <= radius:
-        return across
-    way = across + (hollow + width / 2) * forward
-    norm = float(np.linalg.norm(way))
-    way = forward if norm == 0.0 else way / norm
-    along = float(across @ way)
-    return across + (math.sqrt(along * along + kept * kept - radius * radius) - along) * way
-
-
-def into_hollow(moved: np.ndarray, hollow: float, width: float, forward: np.ndarray) -> np.ndarray:
-    """An offset that :func:`out_of_hollow` moves to ``moved``, found by fixed-point steps (one
-    within 0.1 mm, or the nearest found; ``moved`` itself from beyond the hollow's edge)."""
-    if float(np.linalg.norm(moved)) >= hollow + width:
-        return moved
-    best, miss = moved, math.inf
-    guess = moved.copy()
-    for _ in range(50):
-        error = out_of_hollow(guess, hollow, width, forward) - moved
-        size = float(np.linalg.norm(error))
-        if size < miss:
-            best, miss = guess.copy(), size
-        if size < 1e-4:
-            break
-        guess = guess - error
-    return best
 
 
 PINNED = 0.01
@@ -343,6 +302,7 @@ class Retargeter:
         configuration within the limits."""
         self._guard: ClearanceGuard | None = None
         self._draws: dict[str, np.ndarray] = {}
+        self._workspace: tuple[tuple, Workspace] | None = None
         self.pulled_in = 0.0
         """How far (m) the last cartesian-mode hand target was drawn back into the robot's reach
         (0 while the scaled hand lies within it; see ``RetargetConfig.reach_softness`` and
@@ -427,16 +387,51 @@ class Retargeter:
     def _shoulder(self) -> np.ndarray:
         """Where the operator's shoulder is placed in the robot's base frame.
 
-        The Puma560's shoulder; for a robot on a table, its shoulder raised to at least half its
-        reach (:meth:`_reach`) above the table, so the operator's hand at shoulder height (a
-        reach forward) lands mid-workspace and a lowered hand near the table, not under it.
+        The Puma560's shoulder; for a robot on a table, its :attr:`workspace`'s centre, halfway
+        up its reach above the table, so the operator's hand at shoulder height (a reach
+        forward) lands mid-workspace and a lowered hand near the table, not under it.
         """
         robot = self.robot
         if isinstance(robot, Puma560):
             return np.array([0.0, 0.0, robot.dh[0].d])
-        lifted = robot.shoulder.copy()
-        lifted[2] = max(lifted[2], 0.5 * self._reach())
-        return lifted
+        return self.workspace.centre.copy()
+
+    @property
+    def workspace(self) -> Workspace:
+        """The robot's workspace the operator's reach maps into (a robot of :func:`load_robot`;
+        :class:`Workspace`): its ball ``config.reach_share`` of the soft ceiling's, above the
+        table's floor."""
+        robot = self.robot
+        if not isinstance(robot, RobotArm):
+            raise KinematicsError("The Puma560's analytic model has no table workspace.")
+        config = self.config
+        key = (robot.name, config.reach_fraction, config.reach_share, config.floor_height)
+        if self._workspace is None or self._workspace[0] != key:
+            floor = config.floor_height + config.floor_softness
+            radius = config.reach_share * self._ceiling()
+            ahead = None  # an arm with a hollow: its centre in front of it, out of the soft band
+            if robot.spec.hollow > 0.0:
+                out = robot.spec.hollow * robot.reach + 2.0 * config.hollow_softness
+                ahead = out * _forward(robot)
+            self._workspace = (key, Workspace.of(robot, radius, floor, ahead))
+        return self._workspace[1]
+
+    def _ceiling(self) -> float:
+        """The radius (m) the soft ceiling keeps targets within, around the robot's shoulder."""
+        return self.config.reach_fraction * self._reach()
+
+    def _ceiling_width(self) -> float:
+        """The soft ceiling's band (m): ``reach_softness``, narrowed to end at the workspace's
+        edge, so a target the workspace placed is never bent."""
+        return min(self.config.reach_softness, (1.0 - self.config.reach_share) * self._ceiling())
+
+    def _placed(self, p: np.ndarray) -> np.ndarray:
+        """A point of the operator's arm (m, from their shoulder, mirrored and turned into the
+        robot's base frame) placed in the robot's base frame: into its :attr:`workspace`
+        (the Puma560's analytic model: scaled, at its shoulder)."""
+        if not isinstance(self.robot, RobotArm):
+            return self._shoulder() + self._scale() * p
+        return self.workspace.into(p / self._arm_reach())
 
     def _reach(self) -> float:
         """How far the robot's tool reaches (m), as the retargeting maps the operator's reach
@@ -445,9 +440,12 @@ class Retargeter:
         return robot.reach * (robot.spec.usable_reach if isinstance(robot, RobotArm) else 1.0)
 
     def _scale(self) -> float:
+        return self.config.reach_fraction * self._reach() / self._arm_reach()
+
+    def _arm_reach(self) -> float:
+        """The operator's reach (m): shoulder to hand centre, the arm outstretched."""
         arm = self.arm
-        human_reach = arm.upper_arm_length + arm.forearm_length + arm.hand_length
-        return self.config.reach_fraction * self._reach() / human_reach
+        return arm.upper_arm_length + arm.forearm_length + arm.hand_length
 
     def _mirrored(self, p: np.ndarray) -> np.ndarray:
         return SAGITTAL_MIRROR @ p if self._mirror else p
@@ -458,7 +456,7 @@ class Retargeter:
         elbow = self._mirrored(self.arm.forward(q_human).elbow[:3, 3])
         if isinstance(self.robot, RobotArm):
             elbow = self.robot.base_rotation.T @ elbow
-        return self._shoulder() + self._scale() * elbow
+        return self._placed(elbow)
 
     def hand_target(self, q_human: object) -> np.ndarray:
         """The robot tool pose (4x4, robot base frame) that cartesian mode aims at.
@@ -488,10 +486,10 @@ class Retargeter:
             p, R = robot.base_rotation.T @ p, robot.base_rotation.T @ R @ robot.tool_axes
         oMdes = np.eye(4)
         oMdes[:3, :3] = R
-        oMdes[:3, 3] = self._shoulder() + self._scale() * p
+        oMdes[:3, 3] = self._placed(p)
         if not isinstance(robot, RobotArm):
             return oMdes, 0.0, 0.0
-        oMdes[2, 3] = _soft_floor(float(oMdes[2, 3]), config.floor_height, config.floor_softness)
+        oMdes[2, 3] = soft_floor(float(oMdes[2, 3]), config.floor_height, config.floor_softness)
         pushed = 0.0
         if robot.spec.hollow > 0.0:  # out of the column around the first axis, level
             across = oMdes[:2, 3] - robot.shoulder[:2]
@@ -503,7 +501,7 @@ class Retargeter:
         # Between two points above the table, so the drawn-back target stays above it too.
         offset = oMdes[:3, 3] - robot.shoulder
         distance = float(np.linalg.norm(offset))
-        kept = _soft_ceiling(distance, config.reach_fraction * self._reach(), config.reach_softness)
+        kept = soft_ceiling(distance, self._ceiling(), self._ceiling_width())
         if kept < distance:
             oMdes[:3, 3] = robot.shoulder + offset * (kept / distance)
         return oMdes, pushed + distance - kept, pushed
@@ -776,17 +774,15 @@ class Retargeter:
         offset = t - robot.shoulder
         distance = float(np.linalg.norm(offset))
         if distance > 0.0:
-            ceiling = config.reach_fraction * self._reach()
-            t = robot.shoulder + offset * (
-                _unbent(distance, ceiling, config.reach_softness) / distance
-            )
+            unbent_distance = unbent(distance, self._ceiling(), self._ceiling_width())
+            t = robot.shoulder + offset * (unbent_distance / distance)
         if robot.spec.hollow > 0.0:
             hollow = robot.spec.hollow * robot.reach
             across = t[:2] - robot.shoulder[:2]
             found = into_hollow(across, hollow, config.hollow_softness, _forward(robot))
             t[:2] = robot.shoulder[:2] + found
-        t[2] = _unfloored(float(t[2]), config.floor_height, config.floor_softness)
-        p = turn @ (t - self._shoulder()) / self._scale()
+        t[2] = unfloored(float(t[2]), config.floor_height, config.floor_softness)
+        p = turn @ self.workspace.out_of(t) * self._arm_reach()
         if self._mirror:  # both mirrors are their own inverses
             R = SAGITTAL_MIRROR @ R @ URDF_LATERAL_MIRROR
         oMhand = np.eye(4)

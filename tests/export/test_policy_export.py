@@ -69,3 +69,33 @@ def test_a_movement_primitive_exports_timed_and_checked(tmp_path, capsys):
     header, rows = read_csv(out)
     assert header == ["time", *load_robot("puma560").joint_names]
     assert np.allclose(rows[0, 1:], demo.q_robot[0], atol=1e-6)  # from the demonstration's start
+
+
+@pytest.fixture(scope="module")
+def panda_policy(tmp_path_factory):
+    run = tmp_path_factory.mktemp("panda") / "run"
+    argv = ["train", "--task", "arm-reach", "--robot", "panda", "--planning", "zero",
+            "--episodes", "3", "--experiments", "1", "--out", str(run), "--no-progress"]  # fmt: skip
+    assert main(argv) == 0
+    return run / "policy.policy.npz"
+
+
+def test_a_panda_policy_starts_within_its_limits_and_takes_a_start_per_joint(
+    panda_policy, tmp_path, capsys
+):
+    # issue 39: the README's export failed, its default start (all 0) outside panda_joint4's range
+    panda = load_robot("panda")
+    out = tmp_path / "p.csv"
+    base = ["export", str(panda_policy), "--robot", "panda", "--format", "csv", "--unchecked"]
+    base += ["--max-steps", "5"]
+    assert main([*base, "--out", str(out)]) == 0, capsys.readouterr().err
+    _, rows = read_csv(out)
+    np.testing.assert_allclose(rows[0, 1:], panda.home, atol=1e-6)  # its home pose
+    # seven angles, one per joint of the Panda (the seventh, not learned, holds its goal angle)
+    seven = "--start-deg=0,-20,0,-100,0,90,30"
+    assert main([*base, seven, "--out", str(out)]) == 0, capsys.readouterr().err
+    _, rows = read_csv(out)
+    np.testing.assert_allclose(np.degrees(rows[0, 1:7]), [0, -20, 0, -100, 0, 90], atol=1e-6)
+    assert main([*base, "--start-deg=0,0", "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "--start-deg has 2 angles; give 6 or 7" in err and "\n" not in err

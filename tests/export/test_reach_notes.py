@@ -1,7 +1,8 @@
 """A hand beyond the robot's reach is stated in the export, not only on the page.
 
 Cartesian retargeting draws a hand target beyond the robot's reach back into it (the page says so
-live). The motion the robot makes there is its own and safe, so the export is not refused, but it
+live). The operator's reach maps into the robot's workspace, so a human arm's target is never
+beyond it; these tests widen the workspace past the reach to see the guard at work. The motion the robot makes there is its own and safe, so the export is not refused, but it
 is not the hand's: the export says how many frames, the first one and how far, in the MCAP
 metadata, the LeRobot ``info.json`` and the CLI's output. A checked CSV keeps no comment lines.
 """
@@ -18,13 +19,25 @@ from studio.capture import human_angles, read_any_recording
 from studio.cli import main
 from studio.export import recording_motion
 from studio.kinematics import RetargetConfig, load_robot, retarget_path
+from studio.kinematics._workspace import Workspace
 from studio.samples import SAMPLES_DIR
 
 RECORDING = SAMPLES_DIR / "sample-reach-1.tape.csv"
 BEYOND = "the hand went beyond the Universal Robots UR5's reach in"
 
 
-def test_the_retargeted_path_says_where_the_target_was_drawn_in():
+@pytest.fixture
+def wide_workspace(monkeypatch):
+    """The operator's reach mapped twice as far as the robot's workspace, beyond its reach."""
+    into = Workspace.into
+
+    def wider(self, reach):
+        return self.centre + 2.0 * (into(self, reach) - self.centre)
+
+    monkeypatch.setattr(Workspace, "into", wider)
+
+
+def test_the_retargeted_path_says_where_the_target_was_drawn_in(wide_workspace):
     motion = recording_motion(RECORDING, "ur5")
     assert len(motion.notes) == 1 and motion.notes[0].startswith(BEYOND)
     rec = read_any_recording(RECORDING)
@@ -39,7 +52,7 @@ def test_the_retargeted_path_says_where_the_target_was_drawn_in():
 
 
 @pytest.mark.parametrize("fmt", ["csv", "mcap", "lerobot"])
-def test_a_checked_export_states_the_hand_beyond_reach(fmt, tmp_path, capsys):
+def test_a_checked_export_states_the_hand_beyond_reach(fmt, tmp_path, capsys, wide_workspace):
     out = tmp_path / f"demo.{fmt}"
     args = ["export", "sample-reach-1", "--robot", "ur5", "--format", fmt, "--out", str(out)]
     assert main(args) == 0

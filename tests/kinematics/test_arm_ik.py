@@ -111,17 +111,20 @@ def test_a_table_arms_target_stays_within_its_reach_and_points_its_tool_along_th
     np.testing.assert_allclose(np.linalg.det(target[:3, :3]), 1.0)
 
 
-def test_a_hand_within_reach_is_not_moved_and_one_beyond_is_drawn_in_smoothly():
+def test_a_hand_within_reach_is_not_moved_and_one_behind_the_arms_axis_is_moved_out_smoothly():
     retargeter = Retargeter(robot=load_robot("ur5", geometry=False))
     forward = np.array([1.2, 0.0, 0.0, 0.2, 0.0, 0.0, 0.0])  # the arm raised forward: far
     folded = np.array([0.6, 0.3, 0.0, 1.8, 0.5, 0.0, 0.0])
+    behind = np.array([-1.0, 0.0, 0.0, 0.2, 0.0, 0.0, 0.0])  # the arm stretched back
     retargeter.robot_from_human(folded)
     assert retargeter.pulled_in == 0.0
     retargeter.robot_from_human(forward)
-    assert retargeter.pulled_in > 0.0
-    path = np.linspace(folded, forward, 200)
+    assert retargeter.pulled_in == 0.0, "an outstretched arm lands within the robot's reach"
+    retargeter.robot_from_human(behind)
+    assert retargeter.pulled_in > 0.0 and retargeter.pushed_out == retargeter.pulled_in
+    path = np.linspace(folded, behind, 200)
     targets = np.array([retargeter.hand_target(q)[:3, 3] for q in path])
-    assert np.abs(np.diff(targets, axis=0)).max() < 0.02  # no jump where the drawing-in starts
+    assert np.abs(np.diff(targets, axis=0)).max() < 0.02  # no jump where the moving-out starts
 
 
 @pytest.fixture(scope="module")

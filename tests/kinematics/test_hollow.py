@@ -51,15 +51,23 @@ def test_a_hand_still_over_the_axis_keeps_its_target_still():
     assert np.linalg.norm(radial[:, None] - radial[None], axis=2).max() > 2 * HOLLOW - 1e-9
 
 
-def test_a_ur5_reaches_a_hand_hanging_below_the_shoulder_and_the_page_says_it_moved():
+def test_a_ur5_reaches_a_hand_hanging_below_the_shoulder_in_front_of_its_hollow():
     ur5 = load_robot("ur5", geometry=False)
     hanging = HumanArm().neutral
     retargeter = Retargeter(robot=ur5)
     for _ in range(60):  # settle, as a live session does
         q = retargeter.robot_from_human(hanging)
     target = retargeter.hand_target(hanging)
-    assert retargeter.pushed_out > 0.1
+    # its workspace's centre stands in front of the hollow: the hand lands there, not moved
+    assert retargeter.pushed_out == 0.0
+    assert np.hypot(*target[:2, 3]) > ur5.spec.hollow * ur5.reach
     assert tool_reaches(ur5, q, target)
+    assert robot_note(ur5, retargeter) is None
+    # an arm stretched back, over the base, is moved out and the page says so
+    behind = np.array([-1.0, 0.0, 0.0, 0.2, 0.0, 0.0, 0.0])
+    for _ in range(60):
+        retargeter.robot_from_human(behind)
+    assert retargeter.pushed_out > 0.1
     note = robot_note(ur5, retargeter)
     assert note is not None and "straight above or below the shoulder" in note, note
     # without the hollow the target lies where no pose of the UR5 reaches

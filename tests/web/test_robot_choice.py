@@ -10,7 +10,7 @@ import numpy as np
 import viser
 from fastapi.testclient import TestClient
 
-from studio.kinematics import RetargetConfig, Retargeter, load_robot, robot_names
+from studio.kinematics import RetargetConfig, Retargeter, Workspace, load_robot, robot_names
 from studio.web.live._pipeline import robot_note
 from studio.web.scene._model import SceneLayout
 from studio.web.scene._protocols import LivePose
@@ -99,7 +99,10 @@ def test_the_page_is_told_when_the_hand_is_out_of_reach_or_the_pose_is_held() ->
     assert held is not None and held.startswith("The Franka Emika Panda holds its last pose")
 
 
-def test_the_page_is_told_when_the_hand_is_drawn_back_into_reach() -> None:
+def test_the_page_is_told_when_the_hand_is_drawn_back_into_reach(monkeypatch) -> None:
+    # a human arm's targets lie within the workspace; mapped twice as far, they go beyond reach
+    into = Workspace.into
+    monkeypatch.setattr(Workspace, "into", lambda w, r: w.centre + 2.0 * (into(w, r) - w.centre))
     ur5 = load_robot("ur5", geometry=False)
     retargeter = Retargeter(robot=ur5)
     raised = np.array([1.2, 0.0, 0.0, 0.2, 0.0, 0.0, 0.0])  # the arm raised forward, outstretched
