@@ -49,4 +49,3 @@ from ._tape import tape_from_arm as tape_from_arm
 from ._tracker import ArmTracker as ArmTracker
 from ._tracker import TrackerConfig as TrackerConfig
 from ._tracker import smooth_recorded_arm as smooth_recorded_arm
-from ._workspace import Workspace as Workspace

@@ -12,7 +12,8 @@ import numpy as np
 import pytest
 
 from studio.capture import human_angles, read_any_recording
-from studio.kinematics import HumanArm, Retargeter, Workspace, load_robot, robot_names
+from studio.kinematics import HumanArm, Retargeter, load_robot, robot_names
+from studio.kinematics._workspace import Workspace
 from studio.motion import checked_demonstration
 from studio.samples import SAMPLES_DIR
 

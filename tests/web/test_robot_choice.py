@@ -10,7 +10,8 @@ import numpy as np
 import viser
 from fastapi.testclient import TestClient
 
-from studio.kinematics import RetargetConfig, Retargeter, Workspace, load_robot, robot_names
+from studio.kinematics import RetargetConfig, Retargeter, load_robot, robot_names
+from studio.kinematics._workspace import Workspace
 from studio.web.live._pipeline import robot_note
 from studio.web.scene._model import SceneLayout
 from studio.web.scene._protocols import LivePose
