@@ -15,7 +15,8 @@ map, the one every live, cut, played-back and exported motion uses) and exported
   aligned sample), and the largest over the motions;
 - ``duration x``: the export's duration over the person's, smallest and largest;
 - ``rest``: the largest joint speed at the first and last samples (rad/s);
-- ``margin``: the closest any joint comes to its hard limit (rad);
+- ``margin``: the closest any joint comes to its hard (URDF) limit (rad; plans keep
+  ``LIMIT_MARGIN_RAD``);
 - with ``--physics``: ``studio.export.simulate_motion`` (MuJoCo) completed on every motion, the
   largest tool error (mm), saturated samples and contacts.
 
@@ -86,7 +87,8 @@ def measure(name: str, motion, physics: bool, folder: Path) -> dict:
     speed = np.abs(np.diff(done.q, axis=0)) / np.diff(done.times)[:, None]
     figures["duration"] = float(done.times[-1] / times[-1])
     figures["rest"] = float(max(speed[0].max(), speed[-1].max()))
-    figures["margin"] = float(min((done.q - robot.lower).min(), (robot.upper - done.q).min()))
+    hard = (robot.hard_lower, robot.hard_upper)
+    figures["margin"] = float(min((done.q - hard[0]).min(), (hard[1] - done.q).min()))
     figures["findings"] = len(done.findings)
     if done.physics is not None:
         report = done.physics

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -35,6 +36,8 @@ from studio.export import (
 )
 from studio.kinematics import (
     DEFAULT_ROBOT,
+    LIMIT_MARGIN_RAD,
+    KinematicsError,
     RobotArm,
     isolate_robot_loading,
     robot_is_kept,
@@ -113,6 +116,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help=f"share of the velocity and acceleration limits the timing uses (default: {LIMIT_FRACTION:g})",
     )
     parser.add_argument(
+        "--limit-margin",
+        type=float,
+        default=None,
+        metavar="RAD",
+        help=f"margin kept from every joint's hard limit by the checks and the timing "
+        f"(default: {LIMIT_MARGIN_RAD:g} rad, as the retargeting and the learners keep)",
+    )
+    parser.add_argument(
         "--data-dir", type=Path, default=Path("."), help="data folder names are looked up in"
     )
     parser.add_argument("--task", default="", help="LeRobot task text (default: from the source)")
@@ -128,8 +139,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     start.add_argument(
         "--start-deg",
         help="start joint angles in degrees, comma-separated, one per learned joint or one per "
-        "joint of the robot, e.g. -90,0,0 (default: the robot's home pose with --robot or "
-        "--format, within its limits; else the learned joints at 0)",
+        "joint of the robot, e.g. -90,0,0 (default: the learned joints at 0, or with --robot "
+        "or --format the robot's home pose where 0 is outside its limits)",
     )
     parser.add_argument(
         "--rate",
@@ -181,6 +192,14 @@ def _out_path(args: argparse.Namespace) -> Path:
     )
 
 
+def _zero_outside(arm: RobotArm | None, joints: int) -> bool:
+    """Whether a learner's own start, its learned joints at 0, lies outside ``arm``'s limits
+    (the Panda's joint 4 never reaches 0): then the robot's home pose starts the rollout."""
+    if arm is None:
+        return False
+    return bool(np.any((arm.lower[:joints] > 0.0) | (arm.upper[:joints] < 0.0)))
+
+
 def _rollout(
     args: argparse.Namespace,
     policy: AnyPolicy,
@@ -188,9 +207,9 @@ def _rollout(
     arm: RobotArm | None = None,
 ) -> tuple[Rollout, str]:
     """The policy's rollout from --start-state (a grid policy's) or --start-deg (the learned
-    joints, or every joint of ``arm``; default: ``arm``'s home pose, within its limits, or
-    without ``arm`` its learner's own start: the learned joints at 0, a movement primitive's
-    demonstration's start), and the phrase saying what it did."""
+    joints, or every joint of ``arm``; default: its learner's own start, the learned joints at
+    0 or a movement primitive's demonstration's start, or ``arm``'s home pose where 0 lies
+    outside its limits), and the phrase saying what it did."""
     learner = learner_of(policy)
     joints = learner.learned_joints(policy)
     if args.start_state is not None:
@@ -199,7 +218,7 @@ def _rollout(
                 f"--start-state numbers grid states; a {learner.title} starts from --start-deg angles."
             )
         start = Start(state=args.start_state)
-    elif joints == 0 or (args.start_deg is None and arm is None):
+    elif joints == 0 or (args.start_deg is None and not _zero_outside(arm, joints)):
         start = Start()
     elif args.start_deg is None:
         start = learner.pose_start(policy, np.array(arm.home))
@@ -314,6 +333,11 @@ def run(args: argparse.Namespace) -> int:
     robot = args.robot or robot_names()[0]
     _say_loading(robot, robot_cache_dir(args.data_dir))
     motion, summary = _motion(args, source, robot)
+    if args.limit_margin is not None:
+        try:
+            motion = replace(motion, robot=motion.robot.with_limit_margin(args.limit_margin))
+        except KinematicsError as err:
+            raise ExportError(f"--limit-margin: {err}") from None
     stem = source.name
     for ending in (POLICY_SUFFIX, DEMO_SUFFIX, *RECORDING_SUFFIXES):
         stem = stem.removesuffix(ending)

@@ -30,16 +30,22 @@ def run(args: argparse.Namespace) -> int:
                 "velocity_deg_s": round(math.degrees(v), 1),
             }
             for joint, lo, hi, v in zip(
-                arm.joint_names, arm.lower, arm.upper, arm.velocity, strict=True
+                arm.joint_names, arm.hard_lower, arm.hard_upper, arm.velocity, strict=True
             )
         ]
-        robots.append({"name": name, "title": arm.spec.title, "joints": joints})
+        margin = round(float(arm.limit_margin.max()), 3)
+        robots.append(
+            {"name": name, "title": arm.spec.title, "joints": joints, "limit_margin_rad": margin}
+        )
     if args.json:
         print(json.dumps(robots, indent=1))
         return 0
     for i, robot in enumerate(robots):
         default = "  (default)" if i == 0 else ""
-        print(f"{robot['name']}: {robot['title']}, {len(robot['joints'])} joints{default}")
+        print(
+            f"{robot['name']}: {robot['title']}, {len(robot['joints'])} joints{default}; "
+            f"plans keep {robot['limit_margin_rad']:g} rad from each hard limit"
+        )
         for joint in robot["joints"]:
             print(
                 f"  {joint['name']:<22} {joint['lower_deg']:>7.1f} .. {joint['upper_deg']:>6.1f} deg"

@@ -2,7 +2,7 @@
 
 Every sample is checked against the robot's URDF limits (:class:`studio.kinematics.RobotArm`):
 
-- positions within ``lower``/``upper``;
+- positions within ``lower``/``upper`` (the hard limits less ``RobotArm.limit_margin``);
 - velocities, by finite differences between consecutive samples, within ``velocity``;
 - accelerations, by finite differences of those velocities, within ``acceleration``;
 - self-collision: :meth:`RobotArm.self_collisions` (Pinocchio and coal on the URDF's collision
@@ -68,7 +68,8 @@ def limit_findings(robot: RobotArm, times: np.ndarray, q: np.ndarray) -> list[Fi
                     "position",
                     name,
                     f"sample {i} (t = {times[i]:.3f} s): joint {name} at {q[i, j]:.4f} rad is "
-                    f"{abs(q[i, j] - bound):.4f} rad beyond its limit {bound:.4f} rad",
+                    f"{abs(q[i, j] - bound):.4f} rad beyond its limit {bound:.4f} rad (its hard "
+                    f"limit less a {robot.limit_margin[j]:.3f} rad margin)",
                 )
             )
     if len(times) < 2:

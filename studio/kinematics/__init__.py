@@ -39,6 +39,7 @@ from ._robot_load import load_robot as load_robot
 from ._robot_load import prepare_arm_ik_in_background as prepare_arm_ik_in_background
 from ._robot_load import robot_is_kept as robot_is_kept
 from ._robots import DEFAULT_ROBOT as DEFAULT_ROBOT
+from ._robots import LIMIT_MARGIN_RAD as LIMIT_MARGIN_RAD
 from ._robots import TABLE as TABLE
 from ._robots import RobotArm as RobotArm
 from ._robots import robot_names as robot_names

@@ -44,6 +44,13 @@ ROBOTS_RELATIVE = Path("cmeel.prefix/share/example-robot-data/robots")
 IK_DAMPING = 1e-2
 """The damping (lambda, m) of :meth:`RobotArm.inverse`'s least-squares steps by default."""
 
+LIMIT_MARGIN_RAD = 0.02
+"""The margin (rad) every plan keeps from each joint's hard (URDF) limit, by default: a robot's
+:attr:`RobotArm.lower` and :attr:`RobotArm.upper` are its hard limits less this (less a tenth of
+a joint's range where that is smaller), and the retargeting's IK, the learners' tasks and the
+export's checks all use them; an exported URDF keeps the hard ones
+(:meth:`RobotArm.with_limit_margin` gives another margin)."""
+
 
 @dataclass(frozen=True)
 class RobotSpec:
@@ -378,7 +385,11 @@ class RobotArm:
             ``load_robot(name, geometry=False)``).
         joint_names: the URDF's names of the arm joints.
         nq: number of arm joints.
-        lower, upper: position limits (rad).
+        hard_lower, hard_upper: the URDF's position limits (rad), which an exported URDF keeps.
+        limit_margin: how far (rad, per joint) every plan keeps from them
+            (:data:`LIMIT_MARGIN_RAD`, :meth:`with_limit_margin`).
+        lower, upper: the usable position limits (rad): the hard ones less ``limit_margin``,
+            which the IK, the learners and the export's checks keep to.
         velocity: velocity limits (rad/s).
         acceleration: acceleration limits (rad/s^2).
         home: a pose inside the limits the arm starts from (the middle of each joint's range,
@@ -415,14 +426,15 @@ class RobotArm:
         self.urdf_text = urdf_text
         self.nq = model.nq
         self.joint_names = tuple(model.names[i] for i in range(1, model.njoints))
-        self.lower = np.array(model.lowerPositionLimit, dtype=float)
-        self.upper = np.array(model.upperPositionLimit, dtype=float)
+        self.hard_lower = np.array(model.lowerPositionLimit, dtype=float)
+        self.hard_upper = np.array(model.upperPositionLimit, dtype=float)
+        self._set_margin(LIMIT_MARGIN_RAD)
         self.velocity = np.array(model.velocityLimit, dtype=float)
         if spec.acceleration:
             self.acceleration = np.array(spec.acceleration, dtype=float)
         else:
             self.acceleration = 2.0 * self.velocity
-        for array in (self.lower, self.upper, self.velocity, self.acceleration):
+        for array in (self.hard_lower, self.hard_upper, self.velocity, self.acceleration):
             array.setflags(write=False)
         self._tool = _frame_id(model, spec)
         self.home = _home(self.joint_names, self.lower, self.upper, srdf)
@@ -441,6 +453,30 @@ class RobotArm:
         self._table_data: pin.GeometryData | None = None  # made at first use
         if len(collision_model.geometryObjects):
             self._set_collision_pairs(srdf)
+
+    def _set_margin(self, margin: float) -> None:
+        """Usable limits :attr:`lower`, :attr:`upper`: the hard ones less ``margin`` (rad), or
+        less a tenth of the joint's range where that is smaller."""
+        span = self.hard_upper - self.hard_lower
+        self.limit_margin = np.minimum(float(margin), 0.1 * span)
+        self.lower = self.hard_lower + self.limit_margin
+        self.upper = self.hard_upper - self.limit_margin
+        for array in (self.limit_margin, self.lower, self.upper):
+            array.setflags(write=False)
+
+    def with_limit_margin(self, margin: float) -> RobotArm:
+        """The same robot planning ``margin`` (rad, >= 0) from each hard limit instead of
+        :data:`LIMIT_MARGIN_RAD` (its own scratch data, as :meth:`scratch_copy`)."""
+        if not (isinstance(margin, int | float) and math.isfinite(margin) and margin >= 0.0):
+            raise KinematicsError(
+                f"The limit margin is {margin!r}; give a finite number of radians, 0 or more."
+            )
+        other = self.scratch_copy()
+        other._set_margin(float(margin))
+        home = np.clip(self.home, other.lower, other.upper)
+        home.setflags(write=False)
+        other.home = home
+        return other
 
     def scratch_copy(self) -> RobotArm:
         """The same robot with scratch data of its own, for another thread: the model and the

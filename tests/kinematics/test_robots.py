@@ -39,7 +39,7 @@ def test_each_robot_has_finite_limits_inside_which_its_home_lies(name):
 def test_continuous_joints_get_one_angle_each_with_a_full_turn_either_way():
     arm = load_robot("kinova", geometry=False)
     assert arm.nq == arm.model.nv == 6
-    assert arm.upper[0] == pytest.approx(2 * math.pi, abs=1e-5)
+    assert arm.hard_upper[0] == pytest.approx(2 * math.pi, abs=1e-5)
 
 
 def test_locked_grippers_are_not_arm_joints():
@@ -181,7 +181,7 @@ def test_a_lowered_hand_is_kept_above_the_table_smoothly():
 def test_a_pose_near_contact_reads_the_same_every_time_it_is_checked():
     arm = load_robot("kinova")
     rng = np.random.default_rng(11)
-    poses = [rng.uniform(arm.lower, arm.upper) for _ in range(60)]
+    poses = [rng.uniform(arm.hard_lower, arm.hard_upper) for _ in range(60)]
     first = [
         [(c.link_a, c.link_b, round(c.distance, 6)) for c in arm.self_collisions(q)] for q in poses
     ]

@@ -279,7 +279,10 @@ def test_studio_train_takes_a_robot_for_both_tasks(tmp_path, capsys):
         == 0
     )
     task = RunFolder.load(grid).record.arm_grid()
-    assert task.robot == "ur5" and np.allclose(task.low_deg, (-360.0, -360.0, -180.0))
+    # binned over the UR5's usable limits: its hard ones less the margin every plan keeps
+    ur5 = load_robot("ur5", geometry=False)
+    assert task.robot == "ur5" and np.allclose(task.low_deg, np.degrees(ur5.lower[:3]))
+    assert np.allclose(np.degrees(ur5.hard_lower[:3]), (-360.0, -360.0, -180.0))
     assert main(["train", "--robot", "nosuch", "--episodes", "1"]) == 2
     err = capsys.readouterr().err.strip()
     assert "Unknown robot 'nosuch'" in err and "\n" not in err
