@@ -27,6 +27,11 @@ class _Terminal:
 
 
 def test_the_first_export_onto_a_robot_says_it_builds_it_and_keeps_it(tmp_path, monkeypatch):
+    from studio.kinematics import _robot_load
+
+    # as a fresh `studio export` process: no robot loaded yet (another test on this worker may
+    # have loaded the SO-100 already)
+    monkeypatch.setattr(_robot_load, "_arms", {})
     terminal = _Terminal()
     monkeypatch.setattr(sys, "stderr", terminal)
     monkeypatch.chdir(tmp_path)
