@@ -457,10 +457,8 @@ class RobotArm:
     def _set_margin(self, margin: float) -> None:
         """Usable limits :attr:`lower`, :attr:`upper`: the hard ones less ``margin`` (rad), or
         less a tenth of the joint's range where that is smaller."""
-        span = self.hard_upper - self.hard_lower
-        self.limit_margin = np.minimum(float(margin), 0.1 * span)
-        self.lower = self.hard_lower + self.limit_margin
-        self.upper = self.hard_upper - self.limit_margin
+        self.lower, self.upper = usable_limits(self.hard_lower, self.hard_upper, margin)
+        self.limit_margin = self.lower - self.hard_lower
         for array in (self.limit_margin, self.lower, self.upper):
             array.setflags(write=False)
 
@@ -473,9 +471,8 @@ class RobotArm:
             )
         other = self.scratch_copy()
         other._set_margin(float(margin))
-        home = np.clip(self.home, other.lower, other.upper)
-        home.setflags(write=False)
-        other.home = home
+        other.home = np.clip(self.home, other.lower, other.upper)
+        other.home.setflags(write=False)
         return other
 
     def scratch_copy(self) -> RobotArm:
@@ -722,6 +719,12 @@ def _shoulder(model: pin.Model, data: pin.Data, axis: np.ndarray) -> np.ndarray:
     origin, direction = np.array(base.translation), base.rotation @ axis
     second = np.array(data.oMi[min(2, model.njoints - 1)].translation)
     return origin + direction * float(direction @ (second - origin))
+
+
+def usable_limits(lower: np.ndarray, upper: np.ndarray, margin: float = LIMIT_MARGIN_RAD) -> tuple:
+    """Hard limits less ``margin`` (rad), or less a tenth of a joint's range where smaller."""
+    kept = np.minimum(float(margin), 0.1 * (np.asarray(upper) - np.asarray(lower)))
+    return np.asarray(lower) + kept, np.asarray(upper) - kept
 
 
 def _home(

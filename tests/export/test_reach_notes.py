@@ -89,16 +89,16 @@ def test_the_puma560s_export_has_no_note(tmp_path, capsys):
 
 
 def test_the_frames_the_robot_turns_between_ik_branches_are_stated():
-    # Sample 2 takes the UR3 from one IK branch to another even as planned: its tool is off the
-    # hand's target while it turns over, and the export says where and how often.
+    # The Z1 cannot turn its tool as far as the hand turns in sample 2: its tool is off the
+    # hand's target there, and the export says where and how often.
     recording = SAMPLES_DIR / "sample-reach-2.tape.csv"
-    motion = recording_motion(recording, "ur3")
+    motion = recording_motion(recording, "z1")
     rec = read_any_recording(recording)
-    path = retarget_path(load_robot("ur3"), human_angles(rec, slice(None)))
+    path = retarget_path(load_robot("z1"), human_angles(rec, slice(None)))
     off = np.flatnonzero(~path.reached & ~path.out_of_reach)
     assert len(off) > 0
     [note] = [n for n in motion.notes if "off the hand's target" in n]
-    assert note.startswith("the Universal Robots UR3's tool is more than 1 cm or 5 deg off")
+    assert note.startswith("the Unitree Z1's tool is more than 1 cm or 5 deg off")
     assert f"in {len(off)} of {len(rec)} frames (first at frame {off[0]}," in note
     # the UR5 follows sample 1 throughout: no such note
     assert not [n for n in recording_motion(RECORDING, "ur5").notes if "off the hand's" in n]
