@@ -93,8 +93,10 @@ def test_the_timeline_goal_and_jog_sliders_follow_the_robot_chosen(
         names = page.get_by_test_id("jog-name").all_inner_texts()
         assert names == list(panda.joint_names)
         joint4 = rows.nth(3)
-        assert joint4.get_by_test_id("jog-min").inner_text() == "-176°"
-        assert joint4.get_by_test_id("jog-max").inner_text() == "-4°"
+        # the usable limits, 0.02 rad inside the URDF's -176..-4 degrees (issue 39's margin)
+        assert joint4.get_by_test_id("jog-min").inner_text() == "-175°"
+        assert joint4.get_by_test_id("jog-max").inner_text() == "-5°"
+        assert round(float(np.degrees(panda.lower[3]))) == -175
         assert "Franka Emika Panda" in page.get_by_test_id("jog-robot").inner_text()
         joint2 = page.get_by_role("slider", name="Joint 2")
         joint2.focus()
