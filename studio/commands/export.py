@@ -218,8 +218,11 @@ def _rollout(
                 f"--start-state numbers grid states; a {learner.title} starts from --start-deg angles."
             )
         start = Start(state=args.start_state)
-    elif joints == 0 or (args.start_deg is None and not _zero_outside(arm, joints)):
-        start = Start()
+    elif joints == 0 or (
+        args.start_deg is None
+        and (not _zero_outside(arm, joints) or learner.own_demonstration(policy) is not None)
+    ):
+        start = Start()  # its learner's own: zeros, or a primitive's demonstration's start
     elif args.start_deg is None:
         start = learner.pose_start(policy, np.array(arm.home))
     else:
