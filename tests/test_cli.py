@@ -17,6 +17,22 @@ def test_help_lists_every_verb(capsys: pytest.CaptureFixture[str]) -> None:
         assert verb in out
 
 
+def test_the_cli_page_lists_every_verb_and_every_serve_flag() -> None:
+    """``docs/cli.md`` is where the README sends a reader for the verbs: none may be missing."""
+    from pathlib import Path
+
+    page = (Path(__file__).resolve().parents[1] / "docs" / "cli.md").read_text()
+    parser, modules = build_parser()
+    for verb in modules:
+        assert f"| `studio {verb}` |" in page, verb
+    serve = next(
+        action.choices["serve"] for action in parser._actions if getattr(action, "choices", None)
+    )
+    for action in serve._actions:
+        flag = max(action.option_strings, key=len)
+        assert flag == "--help" or f"`{flag}" in page, flag
+
+
 def test_unknown_verb_is_a_usage_error() -> None:
     with pytest.raises(SystemExit) as exc:
         main(["no-such-verb"])

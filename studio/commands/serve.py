@@ -76,7 +76,7 @@ def run(args: argparse.Namespace) -> int:
         print(
             f"studio serve: WARNING: binding {args.host} makes the studio reachable from other "
             "machines: it answers only requests carrying its token (an SSH tunnel to a loopback "
-            "studio is safer still; see the README).",
+            "studio is safer still; see docs/remote.md).",
             file=sys.stderr,
         )
     opened = not is_loopback(args.host) or not is_loopback(args.bridge_host)

@@ -436,7 +436,7 @@ def test_a_datagram_built_from_the_readme_layout_decodes():
 
     rng = np.random.default_rng(3)
     bend, twist = rng.normal(0, 1, 16), rng.normal(0, 1, 16)
-    # the README's recipe, written independently of the encoder
+    # docs/network-bridge.md's recipe, written independently of the encoder
     datagram = (
         struct.pack("!4sBBHIdH", b"STAP", 1, 0, 16, 4242, 1.25, 0x20)
         + np.concatenate([bend, twist]).astype(">f4").tobytes()

@@ -82,7 +82,7 @@ def test_runs_read_apart_and_the_compare_table_fits_at_1280x720(
     taught, twin = studio_server.send(
         "POST", "/api/runs/pair", {**same, "demonstrations": ["sample-reach-1"]}
     )
-    assert twin["name"] == "zero x2 · no demos"  # as the README names the twin
+    assert twin["name"] == "zero x2 · no demos"  # as docs/learning.md names the twin
     ours = [first["id"], second["id"], taught["id"], twin["id"]]
     with own_page(browser, studio_server, 1280, 720) as page:
         page.get_by_role("button", name="Compare runs").first.click()
