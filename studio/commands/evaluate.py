@@ -3,7 +3,8 @@
 ``studio evaluate RUN|POLICY [--starts N] [--seed S] [--json]`` rolls the policy out greedily from
 N random starts (drawn as its task draws its episodes' starts, from ``--seed``) on its own robot
 and goal, and says the share of starts that reach the goal, the share whose rollout would touch
-the robot itself or the table, and the mean steps and seconds to the goal. For a continuous run
+the robot itself, the table or one of the task's boxes (its obstacles, checked along the whole
+rollout), and the mean steps and seconds to the goal. For a continuous run
 taught from demonstrations it says the same of the teacher (the demonstrations followed, no
 learning) on the very same starts: the baseline the policy has to beat.
 """
@@ -12,6 +13,7 @@ from __future__ import annotations
 
 import argparse
 import json
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -73,20 +75,32 @@ def _policy_file(given: str, data_dir: Path) -> Path:
     return found
 
 
-def _collides(robot: str, q: np.ndarray) -> bool:
-    from studio.kinematics import load_robot
+def _collides_with(obstacles: tuple) -> Callable[[str, np.ndarray], bool]:
+    """Whether a rollout touches the robot itself or the table at a sample, or the task's
+    boxes anywhere along it (its samples joined by straight moves)."""
 
-    arm = load_robot(robot)
-    return any(arm.contacts(row) for row in np.atleast_2d(q))
+    def collides(robot: str, q: np.ndarray) -> bool:
+        from studio.kinematics import load_robot
+        from studio.learning import obstacle_guard
+
+        arm = load_robot(robot)
+        path = np.atleast_2d(q)
+        if obstacles and obstacle_guard(robot, obstacles).path_collides(path):
+            return True
+        return any(arm.contacts(row) for row in path)
+
+    return collides
 
 
 def run(args: argparse.Namespace) -> int:
     if not 1 <= args.starts <= MAX_STARTS:
         raise StudioError(f"--starts is {args.starts}; give a whole number from 1 to {MAX_STARTS}.")
-    from studio.learning import evaluate_policy, load_any_policy
+    from studio.learning import evaluate_policy, load_any_policy, policy_obstacles
 
     path = _policy_file(args.policy, args.data_dir)
-    result = evaluate_policy(load_any_policy(path), args.starts, args.seed, _collides)
+    policy = load_any_policy(path)
+    collides = _collides_with(policy_obstacles(policy))
+    result = evaluate_policy(policy, args.starts, args.seed, collides)
     if args.json:
         out = {"policy": result.policy.as_json()}
         if result.teacher is not None:

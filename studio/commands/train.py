@@ -16,7 +16,10 @@ is a run's ``config.json`` (to repeat a run) or looks like::
      "experiments": 20, "episodes": 100, "seed": 0,
      "demonstrations": [[12, 133, ...], ...]}
 
-Demonstrations may also come from ``--demos FILE.json``: a JSON list of state lists, an object with
+Boxes no move may touch come from ``--obstacle CX,CY,CZ,SX,SY,SZ`` (centre and full sizes in
+metres, in the robot's base frame; repeatable), for either task.
+
+Demonstrations may also come from ``--demos FILE.json`` (repeatable: each adds its demonstrations): a JSON list of state lists, an object with
 a ``"demonstrations"`` list, or a cut ``*.demo.json``, whose grid path is computed from its joint
 trajectory on the run's grid by the one demonstration-to-grid-path function
 (:meth:`ArmGrid.path_from_joints`), as the page does; or be generated with ``--generated-demos N``
@@ -34,7 +37,7 @@ from typing import cast
 from studio import StudioError, read_json
 from studio._layout import RECORDINGS_DIR
 from studio.capture import DEMO_FORMAT, DEMO_SUFFIX
-from studio.kinematics import DEFAULT_ROBOT, robot_names, robot_spec
+from studio.kinematics import DEFAULT_ROBOT, KinematicsError, Obstacle, robot_names, robot_spec
 from studio.learning import (
     ACTION_SETS,
     DEFAULT_EPISODES,
@@ -148,12 +151,29 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--demos",
         type=Path,
+        action="append",
         help="a cut demonstration (a *.demo.json file, or the name of one in recordings/ or of a "
-        "shipped sample such as sample-reach-2), or a JSON file of grid state lists",
+        "shipped sample such as sample-reach-2), or a JSON file of grid state lists; repeatable",
+    )
+    parser.add_argument(
+        "--obstacle",
+        type=_obstacle,
+        action="append",
+        metavar="CX,CY,CZ,SX,SY,SZ",
+        help="a box no move may touch, centre and full sizes in metres in the robot's base frame "
+        "(e.g. 0.56,0.18,1.08,0.12,0.12,0.12); repeatable",
     )
     parser.add_argument("--generated-demos", type=int, help="replay N generated demonstrations")
     parser.add_argument("--workers", type=int, default=None, help="threads (default: all cores)")
     parser.add_argument("--no-progress", action="store_true", help="hide the progress bar")
+
+
+def _obstacle(text: str) -> Obstacle:
+    """``--obstacle``'s value as a box, or argparse's one-line refusal."""
+    try:
+        return Obstacle.parse(text)
+    except KinematicsError as err:
+        raise argparse.ArgumentTypeError(str(err).rstrip(".")) from None
 
 
 def _read_json(path: Path, what: str) -> object:
@@ -243,6 +263,7 @@ def _spec_of(args: argparse.Namespace) -> dict[str, object]:
             "episodes": record.episodes,
             "seed": record.seed,
             "demonstrations": record.demonstrations,
+            "obstacles": list(record.arm_grid().obstacles),
         }
     return spec
 
@@ -293,13 +314,15 @@ def run_request(args: argparse.Namespace) -> RunRequest:
     if "demonstrations" in spec:
         grid_paths = _grid_paths(spec["demonstrations"], args.config)
     recorded: list[DemonstrationPath] = []
-    if args.demos is not None:
-        demo_file = demonstration_file(args.demos)
-        data = _read_json(demo_file, "demonstrations")
-        if isinstance(data, dict) and data.get("format") == DEMO_FORMAT:
-            grid_paths, recorded = [], [_recorded(demo_file, robot)]
-        else:
-            grid_paths = _grid_paths(data, demo_file)
+    if args.demos:
+        grid_paths = []
+        for given in args.demos:
+            demo_file = demonstration_file(given)
+            data = _read_json(demo_file, "demonstrations")
+            if isinstance(data, dict) and data.get("format") == DEMO_FORMAT:
+                recorded.append(_recorded(demo_file, robot))
+            else:
+                grid_paths += _grid_paths(data, demo_file)
     if args.generated_demos:
         grid_paths, recorded = [], []
     goal_deg = None
@@ -316,6 +339,7 @@ def run_request(args: argparse.Namespace) -> RunRequest:
         generated=args.generated_demos or 0,
         name=args.name or "",
         origin="cli",
+        obstacles=args.obstacle or spec.get("obstacles") or (),
         problems=problems,
     )
 
@@ -338,14 +362,14 @@ def _reach_request(args: argparse.Namespace) -> RunRequest:
     if args.goal_deg is not None:
         goal_deg = _numbers(args.goal_deg, "--goal-deg", float, "0,45,-90")
     recorded = []
-    if args.demos is not None:
-        demo_file = demonstration_file(args.demos)
+    for given in args.demos or ():
+        demo_file = demonstration_file(given)
         data = _read_json(demo_file, "demonstrations")
         if not isinstance(data, dict) or data.get("format") != DEMO_FORMAT:
             raise LearningError(
                 f"{demo_file} is not a cut demonstration; the continuous task replays a *.demo.json (its joint path)."
             )
-        recorded = [_recorded(demo_file, robot)]
+        recorded.append(_recorded(demo_file, robot))
     return RunRequest(
         task=args.task,
         robot=robot,
@@ -356,6 +380,7 @@ def _reach_request(args: argparse.Namespace) -> RunRequest:
         demonstrations=recorded,
         name=args.name or "",
         origin="cli",
+        obstacles=args.obstacle or (),
         problems=problems,
     )
 

@@ -4,6 +4,10 @@ The public names are listed in ``docs/architecture.md``.
 """
 
 from ._checks import KinematicsError as KinematicsError
+from ._clearance import OBSTACLE_TOUCH_M as OBSTACLE_TOUCH_M
+from ._clearance import Obstacle as Obstacle
+from ._clearance import ObstacleGuard as ObstacleGuard
+from ._clearance import check_obstacles as check_obstacles
 from ._fit import ArmFitter as ArmFitter
 from ._fit import FitConfig as FitConfig
 from ._hand_ik import HandIKConfig as HandIKConfig

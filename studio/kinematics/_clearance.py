@@ -1,4 +1,6 @@
-"""The self-collision guard of a pose stream: only the link pairs that may have come close are measured.
+"""Clearance: the self-collision guard of a pose stream, and boxes in the robot's workspace.
+
+Self-collision: only the link pairs that may have come close are measured.
 
 Retargeting checks every frame's pose for self-collision before taking it. Measuring all of an
 arm's link pairs with coal costs 0.4 to 8 ms a pose, more than the rest of the frame. Between two
@@ -10,14 +12,23 @@ measured ``d`` apart at ``q_ref``, it is still at least ``margin`` apart at ``q`
 ``d - sum_i |q_i - q_ref_i| * r_i >= margin``, a certificate, not a guess. :class:`ClearanceGuard`
 measures only the pairs without that certificate, so a pose stream costs a few pairs a frame,
 and every pose it lets through is as clear as a full check would have found it.
+
+Obstacles (:class:`Obstacle`, boxes in the robot's base frame): :class:`ObstacleGuard` checks the
+robot's collision geometry against them at a pose and along a straight joint-space move, by the
+same motion bounds (conservative advancement).
 """
 
 from __future__ import annotations
 
+import math
+from dataclasses import dataclass
+
+import coal
 import numpy as np
 import pinocchio as pin
 
-from ._robots import Collision, RobotArm, _link_of
+from ._checks import KinematicsError
+from ._robots import Collision, RobotArm, _link_of, shape_points
 
 
 def _bounding_radius(obj: pin.GeometryObject) -> float:
@@ -107,3 +118,306 @@ class ClearanceGuard:
             )
         found += arm.table_contacts(q, self.margin)
         return sorted(found, key=lambda c: c.distance)
+
+
+# --------------------------------------------------------------------------------- obstacles
+
+MAX_OBSTACLES = 16
+"""Most boxes a task may hold."""
+MAX_OBSTACLE_REACH_M = 10.0
+"""No box's centre lies further than this from the robot's base, nor is any side longer (m)."""
+OBSTACLE_TOUCH_M = 1e-4
+"""Closer than this (m) to a box counts as touching it: the conservative advancement along a
+move (:meth:`ObstacleGuard.move_collides`) stops there instead of creeping closer."""
+
+
+@dataclass(frozen=True)
+class Obstacle:
+    """A box in the robot's base frame: its centre and its full sizes along x, y and z (m).
+
+    ``Obstacle.parse("0.5,-0.2,0.9,0.2,0.2,0.4")`` reads the ``--obstacle`` form.
+    """
+
+    centre: tuple[float, float, float]
+    size: tuple[float, float, float]
+
+    def __post_init__(self) -> None:
+        values = _obstacle_numbers([*self.centre, *self.size], f"The obstacle {self}")
+        object.__setattr__(self, "centre", tuple(values[:3]))
+        object.__setattr__(self, "size", tuple(values[3:]))
+
+    @classmethod
+    def parse(cls, text: str) -> Obstacle:
+        """The box of ``CX,CY,CZ,SX,SY,SZ`` (centre, then full sizes, metres).
+
+        Raises:
+            KinematicsError: not six finite numbers, or a size not above zero.
+        """
+        parts = str(text).split(",")
+        try:
+            values = [float(v) for v in parts]
+        except ValueError:
+            values = []
+        if len(values) != 6:
+            raise KinematicsError(
+                f"The obstacle {text!r} is not six numbers; give its centre and full sizes in "
+                "metres as CX,CY,CZ,SX,SY,SZ, e.g. 0.5,-0.2,0.9,0.2,0.2,0.4."
+            )
+        return cls((values[0], values[1], values[2]), (values[3], values[4], values[5]))
+
+    @classmethod
+    def from_value(cls, value: object, what: str = "An obstacle") -> Obstacle:
+        """The box of :meth:`to_dict`'s form (``{"centre": [x, y, z], "size": [x, y, z]}``), or of
+        six numbers in a list.
+
+        Raises:
+            KinematicsError: any other value.
+        """
+        if isinstance(value, Obstacle):
+            return value
+        if isinstance(value, dict) and set(value) == {"centre", "size"}:
+            value = [*_three(value["centre"], what), *_three(value["size"], what)]
+        if not isinstance(value, list | tuple) or len(value) != 6:
+            raise KinematicsError(
+                f'{what} is {value!r}; give {{"centre": [x, y, z], "size": [x, y, z]}} in metres.'
+            )
+        values = _obstacle_numbers(value, what)
+        return cls((values[0], values[1], values[2]), (values[3], values[4], values[5]))
+
+    def to_dict(self) -> dict[str, list[float]]:
+        """``{"centre": [x, y, z], "size": [x, y, z]}`` (m): how files and the API store it."""
+        return {"centre": list(self.centre), "size": list(self.size)}
+
+    def text(self) -> str:
+        """The ``--obstacle`` form of the box."""
+        return ",".join(f"{v:g}" for v in (*self.centre, *self.size))
+
+
+def _three(value: object, what: str) -> list[object]:
+    if not isinstance(value, list | tuple) or len(value) != 3:
+        raise KinematicsError(
+            f"{what} has {value!r} where three numbers belong; give "
+            '{"centre": [x, y, z], "size": [x, y, z]} in metres.'
+        )
+    return list(value)
+
+
+def _obstacle_numbers(values: list, what: str) -> list[float]:
+    """Six finite numbers: a centre within reach and sizes above zero, else one sentence."""
+    out = []
+    for v in values:
+        if isinstance(v, bool) or not isinstance(v, int | float | np.integer | np.floating):
+            raise KinematicsError(
+                f"{what} holds {v!r}, not a number; give its centre and sizes in metres."
+            )
+        out.append(float(v))
+    if not all(math.isfinite(v) for v in out):
+        raise KinematicsError(
+            f"{what} holds NaN or an infinite value; give finite metres for its centre and sizes."
+        )
+    if any(abs(v) > MAX_OBSTACLE_REACH_M for v in out):
+        raise KinematicsError(
+            f"{what} lies or reaches beyond {MAX_OBSTACLE_REACH_M:g} m; give a box within the "
+            "robot's workspace (metres, not millimetres)."
+        )
+    if any(v <= 0 for v in out[3:]):
+        raise KinematicsError(
+            f"{what} has a size of {min(out[3:]):g} m; give each full size above zero."
+        )
+    return out
+
+
+def check_obstacles(value: object, what: str = "obstacles") -> tuple[Obstacle, ...]:
+    """A list of boxes (:class:`Obstacle`, their dicts or six numbers each) as a tuple.
+
+    Raises:
+        KinematicsError: not a list, more than :data:`MAX_OBSTACLES`, or a bad box.
+    """
+    if value is None:
+        return ()
+    if not isinstance(value, list | tuple):
+        raise KinematicsError(f"{what} is {value!r}; give a list of boxes.")
+    if len(value) > MAX_OBSTACLES:
+        raise KinematicsError(f"{what} holds {len(value)} boxes; give at most {MAX_OBSTACLES}.")
+    return tuple(Obstacle.from_value(v, f"Obstacle {i + 1}") for i, v in enumerate(value))
+
+
+def obstacle_bounds(arm: RobotArm) -> np.ndarray:
+    """Per collision geometry and joint, how far (m per rad) turning the joint can move any
+    point of the geometry: shape (geometries, nq), zero for joints after its link (or for the
+    base, which no joint moves)."""
+    model, geom = arm.model, arm.collision_model
+    link_length = np.array([np.linalg.norm(p.translation) for p in model.jointPlacements])
+    bounds = np.zeros((len(geom.geometryObjects), arm.nq))
+    for k, obj in enumerate(geom.geometryObjects):
+        b = obj.parentJoint
+        radius = _bounding_radius(obj)
+        for i in range(1, b + 1):
+            bounds[k, i - 1] = link_length[i + 1 : b + 1].sum() + radius
+    return bounds
+
+
+class ObstacleGuard:
+    """The robot's collision geometry against boxes in its base frame, at a pose and along a
+    straight joint-space move.
+
+    The boxes are coal boxes fixed in the base frame, checked against every link geometry a
+    joint moves (the base stands where it stands) by coal's distance, as the self-collision
+    check is. Along a move, conservative advancement (Mirtich 1996): at each point the nearest
+    distance ``d`` of a link to a box bounds how far the move may go before they can touch,
+    since turning joint i by ``dq`` moves a point of a link beyond it by at most
+    ``|dq| * r_i`` (:func:`obstacle_bounds`); so the check is exact (no move through a box is
+    missed however thin the box) and costs one distance query where the arm is far from every
+    box. Not thread-safe (one scratch data).
+
+    Args:
+        arm: a robot loaded with its geometry (``load_robot(name)``).
+        obstacles: the boxes.
+    """
+
+    def __init__(self, arm: RobotArm, obstacles: tuple[Obstacle, ...] | list[Obstacle]) -> None:
+        self.arm = arm
+        self.obstacles = tuple(obstacles)
+        self.queries = 0
+        """How many poses were measured so far (for benchmarks and tests)."""
+        source = arm.collision_model
+        geom = pin.GeometryModel()
+        moving = []
+        for obj in source.geometryObjects:
+            if obj.parentJoint >= 1:
+                moving.append(geom.addGeometryObject(pin.GeometryObject(obj)))
+        boxes = []
+        for i, box in enumerate(self.obstacles):
+            placement = pin.SE3(np.eye(3), np.asarray(box.centre, dtype=float))
+            shape = coal.Box(*box.size)
+            boxes.append(
+                geom.addGeometryObject(pin.GeometryObject(f"obstacle_{i + 1}", 0, placement, shape))
+            )
+        for b in boxes:
+            for m in moving:
+                geom.addCollisionPair(pin.CollisionPair(m, b))
+        self._geom = geom
+        self._gdata = pin.GeometryData(geom)
+        self._data = arm.model.createData()
+        kept = [k for k, obj in enumerate(source.geometryObjects) if obj.parentJoint >= 1]
+        all_bounds = obstacle_bounds(arm)
+        # per pair, the bound of its moving geometry
+        self._bounds = np.array(
+            [
+                all_bounds[kept[geom.collisionPairs[k].first]]
+                for k in range(len(geom.collisionPairs))
+            ]
+        ).reshape(len(geom.collisionPairs), arm.nq)
+
+    def distances(self, q: np.ndarray) -> np.ndarray:
+        """Each (link, box) pair's distance at ``q`` (m, negative inside), shape (pairs,)."""
+        if not len(self._geom.collisionPairs):
+            return np.zeros(0)
+        self.queries += 1
+        pin.computeDistances(self.arm.model, self._data, self._geom, self._gdata, q)
+        return np.array([r.min_distance for r in self._gdata.distanceResults])
+
+    def contacts(self, q: object, margin: float = 0.0) -> list[Collision]:
+        """The links closer than ``margin`` to a box at ``q``: ``Collision(link, "obstacle_<i>",
+        distance)``, closest first."""
+        arr = self.arm.check_q(q)
+        found = []
+        for k, d in enumerate(self.distances(arr)):
+            if d < margin:
+                pair = self._geom.collisionPairs[k]
+                found.append(
+                    Collision(
+                        _link_of(self._geom.geometryObjects[pair.first].name),
+                        self._geom.geometryObjects[pair.second].name,
+                        float(d),
+                    )
+                )
+        return sorted(found, key=lambda c: c.distance)
+
+    def move_collides(
+        self,
+        q_from: np.ndarray,
+        q_to: np.ndarray,
+        gap_from: np.ndarray | None = None,
+        gap_to: np.ndarray | None = None,
+    ) -> bool:
+        """Whether the straight joint-space move from ``q_from`` to ``q_to`` (both ``nq``
+        angles, rad) brings a link within :data:`OBSTACLE_TOUCH_M` of a box anywhere along it, its
+        ends included.
+
+        Advances from both ends: a pair measured ``g0`` apart at one end and ``g1`` at the
+        other cannot touch in between while ``g0 + g1`` exceeds how far its link can move over
+        the rest of the move, so a move well clear of every box costs its two ends only.
+
+        Args:
+            q_from: the start.
+            q_to: the end.
+            gap_from: :meth:`distances` at ``q_from`` when known (saves a query).
+            gap_to: :meth:`distances` at ``q_to`` when known.
+        """
+        if not len(self._geom.collisionPairs):
+            return False
+        q0 = np.asarray(q_from, dtype=float)
+        dq = np.asarray(q_to, dtype=float) - q0
+        speed = self._bounds @ np.abs(dq)  # per pair, how far its link can move per unit t
+        t0, t1 = 0.0, 1.0
+        g0 = self.distances(q0) if gap_from is None else np.asarray(gap_from)
+        g1 = self.distances(q0 + dq) if gap_to is None else np.asarray(gap_to)
+        while True:
+            if min(g0.min(), g1.min()) < OBSTACLE_TOUCH_M:
+                return True
+            if np.all(g0 + g1 > speed * (t1 - t0)):
+                return False  # every pair is certified clear from one end or the other
+            moving = speed > 0
+            t0 += float(np.min(g0[moving] / speed[moving]))
+            t1 -= float(np.min(g1[moving] / speed[moving]))
+            if t0 >= t1:
+                return False
+            g0 = self.distances(q0 + t0 * dq)
+            g1 = self.distances(q0 + t1 * dq)
+
+    def path_collides(self, q_path: np.ndarray) -> bool:
+        """Whether a joint path ``(N, nq)``, its samples joined by straight moves, touches a box."""
+        path = np.atleast_2d(np.asarray(q_path, dtype=float))
+        if len(path) == 1:
+            return (
+                bool(len(self._geom.collisionPairs))
+                and self.distances(path[0]).min() < OBSTACLE_TOUCH_M
+            )
+        return any(self.move_collides(a, b) for a, b in zip(path[:-1], path[1:], strict=True))
+
+
+def sphere_cover(arm: RobotArm) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Spheres that together hold every moving link's collision geometry, for compiled checks
+    that cannot call coal (the continuous learning task's).
+
+    Each geometry's points (a convex hull's vertices, else its bounding box's corners) are
+    wrapped in a capsule along their principal axis (its radius the farthest point from the
+    axis), and the capsule in spheres ``h <= r`` apart of radius ``sqrt(r**2 + (h / 2)**2)``:
+    a superset of the geometry, so a pose the spheres find clear of a box is clear of it.
+
+    Returns:
+        ``(joint (n,) int: the Pinocchio joint each sphere moves with (1 = the first),
+        centre (n, 3): in that joint's frame (m), radius (n,) (m))``.
+    """
+    joints, centres, radii = [], [], []
+    for obj in arm.collision_model.geometryObjects:
+        if obj.parentJoint < 1:
+            continue
+        points = shape_points(obj.geometry)
+        placement = obj.placement
+        points = points @ np.asarray(placement.rotation).T + np.asarray(placement.translation)
+        middle = points.mean(axis=0)
+        _, _, axes = np.linalg.svd(points - middle, full_matrices=False)
+        axis = axes[0]
+        along = (points - middle) @ axis
+        low, high = float(along.min()), float(along.max())
+        off = points - middle - np.outer(along, axis)
+        radius = max(float(np.linalg.norm(off, axis=1).max()), 1e-3)
+        count = max(2, math.ceil((high - low) / radius) + 1)
+        spacing = (high - low) / (count - 1)
+        for u in np.linspace(low, high, count):
+            joints.append(obj.parentJoint)
+            centres.append(middle + u * axis)
+            radii.append(math.hypot(radius, 0.5 * spacing))
+    return np.array(joints, dtype=np.int64), np.array(centres).reshape(-1, 3), np.array(radii)

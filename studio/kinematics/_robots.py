@@ -772,26 +772,24 @@ def _table_points(
     for k, obj in enumerate(geom.geometryObjects):
         if obj.parentJoint < 2:  # the base, or a link turned about the vertical first axis
             continue
-        shape = obj.geometry
-        if hasattr(shape, "points") and callable(shape.points):
-            points = np.array([np.array(p, dtype=float) for p in shape.points()])
-        else:
-            shape.computeLocalAABB()
-            box = shape.aabb_local
-            low, high = np.array(box.min_), np.array(box.max_)
-            points = np.array(
-                [
-                    [x, y, z]
-                    for x in (low[0], high[0])
-                    for y in (low[1], high[1])
-                    for z in (low[2], high[2])
-                ]
-            )
+        points = shape_points(obj.geometry)
         if len(points):
             centre = 0.5 * (points.min(axis=0) + points.max(axis=0))
             radius = float(np.linalg.norm(points - centre, axis=1).max())
             found.append((k, points, centre, radius))
     return found
+
+
+def shape_points(shape: object) -> np.ndarray:
+    """A collision shape's points in its own frame: a convex hull's vertices, else its box's."""
+    if hasattr(shape, "points") and callable(shape.points):
+        return np.array([np.array(p, dtype=float) for p in shape.points()])
+    shape.computeLocalAABB()
+    low, high = np.array(shape.aabb_local.min_), np.array(shape.aabb_local.max_)
+    corners = [
+        (x, y, z) for x in (low[0], high[0]) for y in (low[1], high[1]) for z in (low[2], high[2])
+    ]
+    return np.array(corners)
 
 
 def _link_of(geometry_name: str) -> str:

@@ -124,6 +124,8 @@ from .tasks._goal import goal_pose as goal_pose
 from .tasks._goal import grid_for_goal as grid_for_goal
 from .tasks._gym import register as _register_environments
 from .tasks._mdp import TabularMDP as TabularMDP
+from .tasks._obstacles import obstacle_guard as obstacle_guard
+from .tasks._obstacles import policy_obstacles as policy_obstacles
 from .tasks._reach import ACTION_SETS as ACTION_SETS
 from .tasks._reach import ArmReach as ArmReach
 from .tasks._robot import DEFAULT_GOAL_DEG as DEFAULT_GOAL_DEG

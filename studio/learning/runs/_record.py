@@ -256,6 +256,9 @@ class RunRecord:
         form.update(learner_for_task(self.task).task_form(self.task, self.coding))
         if self.goal_deg is not None:
             form["goal_deg"] = list(self.goal_deg)
+        obstacles = getattr(self.task, "obstacles", ())
+        if obstacles:
+            form["obstacles"] = [box.to_dict() for box in obstacles]
         form["demonstrations"] = list(self.demonstration_names)
         form["seed"] = self.seed
         return form

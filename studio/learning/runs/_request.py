@@ -32,6 +32,7 @@ from ..paper._reproduce import generate_demonstrations
 from ..tasks._arm import ArmGrid
 from ..tasks._demo_motion import DemonstrationMotion, demonstration_grid_path
 from ..tasks._goal import goal_pose, goal_problems, grid_for_goal
+from ..tasks._obstacles import task_obstacles
 from ..tasks._reach import ArmReach
 from ..tasks._robot import PUMA560, check_robot, robot_title, task_arm
 from ._record import (
@@ -96,6 +97,8 @@ class RunRequest:
         name: a label for the run.
         origin: what makes the run (``"page"``, ``"cli"``, ``"sweep"``, ``"reproduce"``).
         group: runs made together share it.
+        obstacles: boxes in the robot's base frame (:class:`studio.kinematics.Obstacle`, their
+            dicts or six numbers each) that no move of the task may touch.
         problems: ``(field, sentence)`` the caller found already (a flag that does not apply),
             reported with the others.
     """
@@ -115,6 +118,7 @@ class RunRequest:
     name: str = ""
     origin: str = "cli"
     group: str | None = None
+    obstacles: Sequence[object] = ()
     problems: Sequence[tuple[str, str]] = ()
 
     @classmethod
@@ -140,6 +144,7 @@ class RunRequest:
             demonstrations=demonstrations,
             name=str(form.get("name") or ""),
             origin=origin,
+            obstacles=cast(Sequence[object], form.get("obstacles") or ()),
             **given,  # type: ignore[arg-type]
         )
 
@@ -225,6 +230,25 @@ def _grid(request: RunRequest, problems: list[tuple[str, str]]) -> ArmGrid | Non
     spec = {**request.grid, "robot": request.robot}
     if spec.get("goal") is not None:
         spec["goal"] = tuple(cast(Sequence[int], spec["goal"]))
+    try:
+        obstacles = task_obstacles(list(request.obstacles))
+    except ConfigError as err:
+        problems += list(err.by_field.items())
+        return None
+    grid = _bare_grid(request, spec, problems)
+    if grid is None or not obstacles:
+        return grid
+    try:
+        return replace(grid, obstacles=obstacles)
+    except ConfigError as err:
+        problems += list(err.by_field.items())
+    return None
+
+
+def _bare_grid(
+    request: RunRequest, spec: dict[str, object], problems: list[tuple[str, str]]
+) -> ArmGrid | None:
+    """:func:`_grid` before its obstacles."""
     try:
         if request.goal_deg is None:
             return ArmGrid(**spec)  # type: ignore[arg-type]

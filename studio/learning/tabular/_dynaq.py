@@ -364,7 +364,7 @@ def demonstration_actions(
             raise LearningError(
                 f"Demonstration {i} ends in state {int(path[-1])}, which is not terminal; extend it to the goal."
             )
-        links = mdp.next_state[path[:-1]] == path[1:, None]
+        links = mdp.intended[path[:-1]] == path[1:, None]  # a move an obstacle blocks is tried
         broken = np.flatnonzero(~links.any(axis=1))
         if broken.size:
             k = int(broken[0])

@@ -5,7 +5,10 @@ paper's [-180, 180] degrees for every joint; another robot's: each joint's own l
 bin centre is a pose the arm can take); a state is one bin per
 joint, and an action moves every joint by -1, 0 or +1 bin at once (3**J actions). A move that would
 leave the range leaves that joint where it is. Reaching the goal pays +100 and ends the episode,
-every other transition pays -1. Episodes start uniformly from every state but the goal. With the
+every other transition pays -1. Episodes start uniformly from every state but the goal. Boxes in
+the robot's workspace (``obstacles``) refuse every move whose path touches one: the arm stays
+where it is and pays the step's -1 (:mod:`._obstacles`); a state whose pose touches one is no
+start. With the
 defaults (3 joints, 11 bins over [-180, 180] degrees) this is the paper's 1331-state, 27-action
 task.
 
@@ -21,14 +24,18 @@ robot's default goal is the bins nearest its default goal pose (:func:`default_g
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
 
+from studio.kinematics import Obstacle
+
 from .._errors import LearningError
 from ._mdp import TabularMDP
+from ._obstacles import blocked_grid_moves, check_goal_clear, task_obstacles
 from ._robot import PUMA560, check_robot, default_goal, task_arm
 
 MAX_JOINTS = 6
@@ -59,6 +66,8 @@ class ArmGrid:
         goal: the goal's bin per joint; default: the bins nearest the robot's default goal
             (:data:`DEFAULT_GOAL_DEG` for the Puma560).
         robot: the robot's registry name (``studio robots``).
+        obstacles: boxes in the robot's base frame (:class:`studio.kinematics.Obstacle`, or
+            their dicts): a move whose path touches one does not happen (:mod:`._obstacles`).
 
     Raises:
         LearningError: for a bad value, or a grid whose table would not fit in memory.
@@ -70,9 +79,11 @@ class ArmGrid:
     high_deg: float | tuple[float, ...] | None = None
     goal: tuple[int, ...] | None = None
     robot: str = PUMA560
+    obstacles: tuple[Obstacle, ...] = ()
 
     def __post_init__(self) -> None:
         arm = task_arm(check_robot(self.robot))
+        object.__setattr__(self, "obstacles", task_obstacles(self.obstacles))
         for name in ("joints", "bins"):
             value = getattr(self, name)
             if not isinstance(value, int | np.integer) or isinstance(value, bool):
@@ -120,6 +131,8 @@ class ArmGrid:
                     f"goal {self.goal!r} has a bin outside [0, {self.bins - 1}]; give bins in range."
                 )
         object.__setattr__(self, "goal", tuple(int(b) for b in goal))
+        if self.obstacles:
+            check_goal_clear(self.robot, self.obstacles, self.poses()[self.goal_state])
 
     # ------------------------------------------------------------------ sizes and numbering
 
@@ -168,6 +181,7 @@ class ArmGrid:
             "high_deg": self.high_deg if isinstance(self.high_deg, float) else list(self.high_deg),
             "goal": list(self.goal),
             "robot": self.robot,
+            **({"obstacles": [o.to_dict() for o in self.obstacles]} if self.obstacles else {}),
         }
 
     def state_of(self, bins: Sequence[int] | np.ndarray) -> int:
@@ -237,6 +251,9 @@ class ArmGrid:
 
     @cached_property
     def _table(self) -> TabularMDP:
+        return _grid_table(self)
+
+    def _build_table(self) -> TabularMDP:
         shape = (self.bins,) * self.joints
         state_bins = np.unravel_index(np.arange(self.n_states), shape)  # J arrays (S,)
         deltas = self.action_deltas()  # (A, J)
@@ -246,11 +263,33 @@ class ArmGrid:
             moved = np.where((moved >= 0) & (moved < self.bins), moved, state_bins[j][:, None])
             next_state += moved * self.bins ** (self.joints - 1 - j)
         goal = self.goal_state
+        colliding = np.zeros(self.n_states, np.bool_)
+        intended = next_state
+        if self.obstacles:
+            blocked, colliding = blocked_grid_moves(
+                self.robot, self.obstacles, self.poses(), next_state
+            )
+            next_state = np.where(blocked, np.arange(self.n_states)[:, None], next_state)
         reward = np.where(next_state == goal, GOAL_REWARD, STEP_REWARD)
         terminal = np.zeros(self.n_states, np.bool_)
         terminal[goal] = True
-        starts = np.flatnonzero(~terminal)
-        return TabularMDP(next_state, reward, terminal, starts)
+        starts = np.flatnonzero(~terminal & ~colliding)
+        return TabularMDP(next_state, reward, terminal, starts, intended)
+
+    @property
+    def hold(self) -> np.ndarray:
+        """The angles of every robot joint the grid does not cover, rad (one per robot joint:
+        the robot's default goal's, as rollouts hold them)."""
+        return default_goal(self.robot)
+
+    def poses(self) -> np.ndarray:
+        """Every state's whole robot pose ``(n_states, nq)``, rad: its bin centres, the other
+        joints at :attr:`hold`."""
+        shape = (self.bins,) * self.joints
+        bins = np.array(np.unravel_index(np.arange(self.n_states), shape)).T
+        poses = np.tile(self.hold, (self.n_states, 1))
+        poses[:, : self.joints] = self._centres(bins)
+        return poses
 
     def shortest_steps(self, state: int) -> int:
         """Fewest actions from ``state`` to the goal: the largest bin distance over the joints."""
@@ -340,6 +379,13 @@ class ArmGrid:
             states, samples = states[:end], samples[:end]
         states, samples = _erase_loops(states, samples)
         return GridPath(states=states, samples=samples, reaches_goal=reaches_goal)
+
+
+@functools.lru_cache(maxsize=4)
+def _grid_table(grid: ArmGrid) -> TabularMDP:
+    """A grid's table, built once per process for equal grids (with obstacles it takes
+    seconds: every move is checked against the boxes)."""
+    return grid._build_table()
 
 
 def _range_end(name: str, value: object, joints: int) -> float | tuple[float, ...]:

@@ -23,6 +23,10 @@ class TabularMDP:
         reward: float array ``(S, A)``; the reward of taking ``a`` in ``s``.
         terminal: bool array ``(S,)``; an episode ends on entering a terminal state.
         start_states: int array of the states an episode may start from, drawn uniformly.
+        intended: int array ``(S, A)`` or None: where each action would lead if nothing stood in
+            its way (a grid's moves without its obstacles). A demonstration is a path of these
+            moves: its replay tries each, and one that ``next_state`` refuses leaves the agent
+            where it is. None: ``next_state``.
 
     The arrays are copied into C-contiguous ``int64`` / ``float64`` / ``bool`` arrays and made
     read-only, so one MDP can be shared by many threads.
@@ -32,6 +36,7 @@ class TabularMDP:
     reward: np.ndarray
     terminal: np.ndarray
     start_states: np.ndarray
+    intended: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         next_state = np.asarray(self.next_state)
@@ -75,7 +80,13 @@ class TabularMDP:
             raise LearningError(
                 f"start_states holds values outside [0, {n_states - 1}]; every entry must be a state index."
             )
+        intended = next_state if self.intended is None else np.asarray(self.intended)
+        if intended.shape != next_state.shape or not np.issubdtype(intended.dtype, np.integer):
+            raise LearningError(
+                f"intended has shape {intended.shape}; give an integer array shaped as next_state."
+            )
         for name, value, dtype in (
+            ("intended", intended, np.int64),
             ("next_state", next_state, np.int64),
             ("reward", reward, np.float64),
             ("terminal", terminal, np.bool_),
@@ -96,10 +107,11 @@ class TabularMDP:
         return int(self.next_state.shape[1])
 
     def action_between(self, state: int, next_state: int) -> int:
-        """The action that leads from ``state`` to ``next_state``, or -1 if none does.
+        """The action that leads from ``state`` to ``next_state`` (:attr:`intended`: where
+        nothing stands in its way), or -1 if none does.
 
         When several actions connect the two states, the lowest index wins, so a replayed
         demonstration is the same on every run.
         """
-        hits = np.flatnonzero(self.next_state[state] == next_state)
+        hits = np.flatnonzero(self.intended[state] == next_state)
         return int(hits[0]) if hits.size else -1

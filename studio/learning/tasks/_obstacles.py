@@ -1,0 +1,98 @@
+"""Obstacles in a learning task: boxes in the robot's base frame that no move may touch.
+
+A task (:class:`ArmGrid`, :class:`ArmReach`) holds its boxes (``obstacles``, each a
+:class:`studio.kinematics.Obstacle`). A move whose path would bring the robot's collision
+geometry into a box does not happen: the arm stays where it is, the step costs the paper's -1
+(the goal's +100 cannot be reached by a refused move), and the episode goes on. The check runs
+along the whole move, not only at its end (:class:`studio.kinematics.ObstacleGuard`: coal's
+distances and conservative advancement, so a move that passes through a box between two free
+ends is refused too).
+
+On the grid every move is known beforehand, so the refused ones are found once per grid and
+written into its transition table (:func:`blocked_grid_moves`): learning runs as fast as without
+obstacles.
+"""
+
+from __future__ import annotations
+
+import functools
+
+import numpy as np
+
+from studio.kinematics import (
+    OBSTACLE_TOUCH_M,
+    KinematicsError,
+    Obstacle,
+    ObstacleGuard,
+    check_obstacles,
+    load_robot,
+)
+
+from .._errors import ConfigError
+
+
+def task_obstacles(value: object) -> tuple[Obstacle, ...]:
+    """A task's boxes, checked, or a ConfigError (field ``obstacles``) naming the bad one."""
+    try:
+        return check_obstacles(value)
+    except KinematicsError as err:
+        raise ConfigError([str(err)], ["obstacles"]) from None
+
+
+@functools.lru_cache(maxsize=8)
+def obstacle_guard(robot: str, obstacles: tuple[Obstacle, ...]) -> ObstacleGuard:
+    """The guard of ``robot``'s collision geometry against ``obstacles`` (made once per pair;
+    not thread-safe: callers on other threads make their own)."""
+    return ObstacleGuard(load_robot(robot), obstacles)
+
+
+def check_goal_clear(robot: str, obstacles: tuple[Obstacle, ...], q_goal: np.ndarray) -> None:
+    """Refuse a goal pose that touches a box (ConfigError, field ``obstacles``)."""
+    touching = obstacle_guard(robot, obstacles).contacts(q_goal, OBSTACLE_TOUCH_M)
+    if touching:
+        box = int(touching[0].link_b.rpartition("_")[2])
+        raise ConfigError(
+            [
+                f"Obstacle {box} ({obstacles[box - 1].text()}) touches the robot's {touching[0].link_a} at the goal; move or shrink the box, or choose another goal."
+            ],
+            ["obstacles"],
+        )
+
+
+def blocked_grid_moves(
+    robot: str, obstacles: tuple[Obstacle, ...], poses: np.ndarray, next_state: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Which of a grid's moves touch its obstacles, and which states do.
+
+    Args:
+        robot: the robot's registry name.
+        obstacles: the boxes.
+        poses: every state's whole pose ``(S, nq)`` (rad).
+        next_state: the transition table without obstacles ``(S, A)``.
+
+    Returns:
+        ``(blocked (S, A) bool, colliding (S,) bool)``: a move blocked when its straight
+        joint-space path from one bin centre to the next touches a box; a state colliding when
+        its pose does (it is no start, and every move into it is blocked).
+    """
+    guard = obstacle_guard(robot, obstacles)
+    gaps = np.array([guard.distances(q) for q in poses])  # (S, pairs)
+    colliding = gaps.min(axis=1) < OBSTACLE_TOUCH_M
+    blocked = np.zeros(next_state.shape, np.bool_)
+    checked: dict[tuple[int, int], bool] = {}
+    for s, a in zip(*np.nonzero(next_state != np.arange(len(poses))[:, None]), strict=True):
+        t = int(next_state[s, a])
+        key = (min(int(s), t), max(int(s), t))
+        hit = checked.get(key)
+        if hit is None:
+            hit = guard.move_collides(poses[s], poses[t], gaps[s], gaps[t])
+            checked[key] = hit
+        blocked[s, a] = hit
+    return blocked, colliding
+
+
+def policy_obstacles(policy: object) -> tuple[Obstacle, ...]:
+    """The boxes a policy's task holds (a grid policy's grid, a tile-coded policy's task; none
+    for a policy whose task holds none)."""
+    task = getattr(policy, "grid", None) or getattr(policy, "task", None)
+    return tuple(getattr(task, "obstacles", ()))

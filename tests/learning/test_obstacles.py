@@ -1,0 +1,148 @@
+"""Obstacles (issue 40): boxes in the robot's base frame that no move of a task may touch,
+checked along the whole move, stored with a run and counted by ``studio evaluate``."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from studio.cli import build_parser, main
+from studio.kinematics import Obstacle, ObstacleGuard, load_robot
+from studio.learning import (
+    ArmGrid,
+    ConfigError,
+    RunFolder,
+    RunRequest,
+    load_any_policy,
+    policy_obstacles,
+    resolve_run,
+)
+
+REACH = np.radians([0.0, 45.0, -90.0, 0.0, 0.0, 0.0])
+"""The Puma560's default goal pose: the tool forward and up, clear of the table."""
+
+
+def _swing(degrees: float) -> np.ndarray:
+    q = REACH.copy()
+    q[0] = np.radians(degrees)
+    return q
+
+
+@pytest.fixture(scope="module")
+def arm():
+    return load_robot("puma560")
+
+
+@pytest.fixture(scope="module")
+def in_the_way(arm):
+    """A 2 cm box where the tool passes when joint 1 swings from -60 to +60 degrees."""
+    return Obstacle(tuple(arm.forward(REACH)[:3, 3]), (0.02, 0.02, 0.02))
+
+
+def test_a_move_through_a_box_is_refused_though_both_ends_are_clear(arm, in_the_way):
+    guard = ObstacleGuard(arm, [in_the_way])
+    start, end = _swing(-60), _swing(60)
+    assert not guard.contacts(start) and not guard.contacts(end)
+    assert not arm.contacts(start) and not arm.contacts(end)  # nothing else in the way
+    assert guard.move_collides(start, end)
+    assert guard.move_collides(end, start)
+    # a box 10 cm above the tool's arc lets the same swing through
+    above = Obstacle((*in_the_way.centre[:2], in_the_way.centre[2] + 0.25), in_the_way.size)
+    assert not ObstacleGuard(arm, [above]).move_collides(start, end)
+
+
+def test_a_grid_move_through_a_box_leaves_the_arm_where_it_is(arm):
+    grid = ArmGrid(bins=5)
+    s = grid.state_of((1, 2, 2))
+    t = grid.state_of((2, 2, 2))
+    a = grid.mdp().action_between(s, t)
+    q_s, q_t = grid.poses()[s], grid.poses()[t]
+    middle = 0.5 * (q_s + q_t)
+    box = Obstacle(tuple(arm.forward(middle)[:3, 3]), (0.01, 0.01, 0.01))
+    guard = ObstacleGuard(arm, [box])
+    assert not guard.contacts(q_s) and not guard.contacts(q_t)  # both ends clear of it
+    blocked = ArmGrid(bins=5, obstacles=(box,)).mdp()
+    assert grid.mdp().next_state[s, a] == t
+    assert blocked.next_state[s, a] == s  # refused along the move: the arm stays
+    assert blocked.reward[s, a] == -1.0
+    assert blocked.intended[s, a] == t  # a demonstration may still try it
+    assert blocked.action_between(s, t) == a
+
+
+def test_a_goal_inside_a_box_is_refused_in_one_sentence(arm):
+    goal = ArmGrid(bins=5)
+    q_goal = goal.poses()[goal.goal_state]
+    box = Obstacle(tuple(arm.forward(q_goal)[:3, 3]), (0.1, 0.1, 0.1))
+    with pytest.raises(ConfigError) as err:
+        ArmGrid(bins=5, obstacles=(box,))
+    assert list(err.value.by_field) == ["obstacles"] and "at the goal" in str(err.value)
+
+
+@pytest.mark.parametrize(
+    ("value", "says"),
+    [
+        ("1,2,3", "not six numbers"),
+        ("0.5,0,1,0.1,0.1", "not six numbers"),
+        ("0.5,0,1,nan,0.1,0.1", "NaN"),
+        ("0.5,0,1,0.1,0,0.1", "above zero"),
+        ("0.5,0,1,0.1,-0.2,0.1", "above zero"),
+        ("a,b,c,d,e,f", "not six numbers"),
+    ],
+)
+def test_a_malformed_obstacle_is_one_sentence_and_exit_2(value, says, capsys):
+    with pytest.raises(SystemExit) as stop:
+        main(["train", f"--obstacle={value}"])
+    assert stop.value.code == 2
+    err = capsys.readouterr().err
+    assert says in err and err.count("\n") == 1
+
+
+def test_obstacles_repeat_and_a_negative_centre_parses():
+    parser, _ = build_parser(["train"])
+    args = parser.parse_args(
+        ["train", "--obstacle", "-0.3,0.2,0.9,0.1,0.1,0.1", "--obstacle", "0.5,-0.2,1,0.2,0.2,0.2"]
+    )
+    assert args.obstacle == [
+        Obstacle((-0.3, 0.2, 0.9), (0.1, 0.1, 0.1)),
+        Obstacle((0.5, -0.2, 1.0), (0.2, 0.2, 0.2)),
+    ]
+    args = parser.parse_args(["train", "--demos", "sample-reach-1", "--demos", "sample-reach-2"])
+    assert [str(d) for d in args.demos] == ["sample-reach-1", "sample-reach-2"]
+
+
+def test_a_run_stores_its_obstacles_and_its_policy_keeps_them(tmp_path, in_the_way):
+    far = Obstacle((-0.6, 0.4, 0.3), (0.2, 0.1, 0.3))
+    request = RunRequest(
+        grid={"bins": 5}, obstacles=[far.to_dict()], experiments=1, episodes=3, origin="cli"
+    )
+    record = resolve_run(request)
+    assert record.arm_grid().obstacles == (far,)
+    folder = RunFolder.create(tmp_path, record)
+    stored = json.loads((folder.path / "config.json").read_text())
+    assert stored["task"]["obstacles"] == [far.to_dict()]
+    assert RunFolder.load(folder.path).record.arm_grid().obstacles == (far,)
+    folder.train()
+    assert policy_obstacles(load_any_policy(folder.path / "policy.policy.npz")) == (far,)
+
+
+def test_several_demonstrations_and_an_obstacle_from_the_command_line(tmp_path):
+    out = tmp_path / "runs/taught"
+    argv = ["train", "--demos", "sample-reach-1", "--demos", "sample-reach-3", "--bins", "11"]
+    box = "-0.6,0.4,0.3,0.2,0.1,0.3"
+    argv += ["--obstacle", box, "--episodes", "3", "--experiments", "1", "--no-progress"]
+    assert main([*argv, "--out", str(out)]) == 0
+    stored = json.loads((out / "config.json").read_text())
+    assert len(stored["demonstrations"]) == 2
+    assert stored["task"]["obstacles"] == [Obstacle.parse(box).to_dict()]
+
+
+def test_evaluate_counts_a_rollout_through_a_box_as_a_collision(arm, in_the_way):
+    from studio.commands.evaluate import _collides_with
+
+    swing = np.array([_swing(d) for d in np.linspace(-60, 60, 7)])
+    clear = swing[[0, -1]]  # its ends only: nothing between them is skipped by the check
+    assert not _collides_with(())("puma560", swing)
+    assert _collides_with((in_the_way,))("puma560", swing)
+    assert _collides_with((in_the_way,))("puma560", clear)
