@@ -18,7 +18,9 @@ while it walks. A recording is known whole, so :func:`retarget_path` plans the b
    frames. Staying on a track costs nothing. Leaving track k at frame a for track j at frame b
    costs the b - a - 1 frames between, walked in a straight line in joint space, and is allowed
    when no joint has further to go than b - a steps. A walk that would bring the robot's links
-   closer than ``RetargetConfig.clearance`` is struck out and the route found again.
+   closer than ``RetargetConfig.clearance`` is struck out and the route found again. A hop
+   from one track to another in a frame is eased: spread over the frames around it where both
+   tracks hold poses, wherever the blend still reaches every frame (``_eased``).
 4. Through the frames the route still misses: between the reached frames either side of each
    run, the walk goes through poses that reach some of its frames, found frame by frame within
    the step cap of the last pose kept and of the reached frame after (``_through_misses``).
@@ -184,6 +186,10 @@ MID_WALK = 40
 WALK_BAN = 10
 """A walk that brings links into contact is struck out from the departures this many frames
 either side of it too (their walks pass the same poses)."""
+
+EASE = 16
+"""Frames a hop from one track to another is spread over (:func:`_eased`), half before it and
+half after, where both tracks hold poses."""
 
 WALK_RETRIES = 8
 """Routes found again after a walk was struck out for a collision, before the live pass is
@@ -432,7 +438,7 @@ def _plan(
             if first <= last:
                 q = track.q[first - track.start : last - track.start + 1]
                 tracks.append(_Track(first - lo, q))
-        piece = _chunk_path(tracks, c1 - lo, arm, config, anchored=c0 > 0)
+        piece = _chunk_path(tracks, targets[lo:c1], arm, config, anchored=c0 > 0)
         if piece is None:
             return live
         path[lo:c1] = piece
@@ -440,19 +446,25 @@ def _plan(
 
 
 def _chunk_path(
-    tracks: list[_Track], frames: int, arm: RobotArm, config: RetargetConfig, anchored: bool
+    tracks: list[_Track],
+    targets: list[np.ndarray],
+    arm: RobotArm,
+    config: RetargetConfig,
+    anchored: bool,
 ) -> np.ndarray | None:
-    """The joints of the route through ``tracks`` over ``frames`` frames whose walks keep the
-    links clear (None if none is found in ``WALK_RETRIES`` tries); ``anchored``: it starts on
-    the first track, at frame 0."""
+    """The joints of the route through ``tracks`` over the frames of ``targets`` (the hand's
+    target on each) whose walks keep the links clear, its hops eased (:func:`_eased`); None if
+    none is found in ``WALK_RETRIES`` tries. ``anchored``: it starts on the first track, at
+    frame 0."""
     if not tracks:
         return None
+    frames = len(targets)
     banned: set[tuple[int, int, int]] = set()
     for _ in range(WALK_RETRIES):
         route = _route(tracks, frames, config.max_joint_step, banned, anchored)
         path, clash = _walked(tracks, route, frames, arm, config.clearance)
         if clash is None:
-            return path
+            return _eased(tracks, route, path, targets, arm, config)
         k, t, j = clash  # its neighbours would mostly touch too
         banned |= {(k, t + dt, j) for dt in range(-WALK_BAN, WALK_BAN + 1)}
     return None
@@ -565,6 +577,47 @@ def _route(
             legs.append([int(pk), int(pt), int(pt)])
         k, t = int(pk), int(pt)
     return [(k, a, b) for k, a, b in reversed(legs)]
+
+
+def _eased(
+    tracks: list[_Track],
+    route: list[tuple[int, int, int]],
+    path: np.ndarray,
+    targets: list[np.ndarray],
+    arm: RobotArm,
+    config: RetargetConfig,
+) -> np.ndarray:
+    """``path`` with each hop between two tracks (one leg's last frame, the next leg's first
+    frame after it) spread over the frames around it where both tracks hold poses: there the
+    path blends from the one to the other, ``EASE`` frames at most.
+
+    Two tracks a step apart are two IK answers moving differently; hopping from one to the
+    other in a frame turns the joints back (a step one way, then the track's the other). The
+    blend moves the joints by the tracks' difference a little each frame instead. It is kept
+    only where every blended pose still reaches its target clear of contact and no joint steps
+    further than ``max_joint_step``: so the eased path reaches as many frames as the hop did.
+    """
+    path = path.copy()
+    for (k, a, b), (j, c, d) in zip(route, route[1:], strict=False):
+        if c != b + 1:
+            continue  # a walk, not a hop
+        one, other = tracks[k], tracks[j]
+        first = max(other.start, a, b + 1 - EASE // 2, 1)
+        last = min(one.end, d, b + EASE // 2, len(path) - 2)
+        if last - first < 1:
+            continue
+        frames = np.arange(first, last + 1)
+        weight = ((frames - first + 1) / (last - first + 2))[:, None]
+        blend = (1.0 - weight) * one.q[frames - one.start] + weight * other.q[frames - other.start]
+        eased = np.vstack([path[first - 1], blend, path[last + 1]])
+        if np.abs(np.diff(eased, axis=0)).max() > config.max_joint_step + 1e-9:
+            continue
+        if all(
+            tool_reaches(arm, q, targets[i], config) and not arm.contacts(q, config.clearance)
+            for i, q in zip(frames, blend, strict=True)
+        ):
+            path[first : last + 1] = blend
+    return path
 
 
 def _walked(
