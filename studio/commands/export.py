@@ -120,8 +120,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         type=float,
         default=None,
         metavar="RAD",
-        help=f"margin kept from every joint's hard limit by the checks and the timing "
-        f"(default: {LIMIT_MARGIN_RAD:g} rad, as the retargeting and the learners keep)",
+        help=f"margin kept from every joint's hard limit by the retargeting, the timing and "
+        f"the checks (default: {LIMIT_MARGIN_RAD:g} rad, as the learners keep)",
     )
     parser.add_argument(
         "--data-dir", type=Path, default=Path("."), help="data folder names are looked up in"
@@ -279,11 +279,12 @@ def _motion(args: argparse.Namespace, source: Path, robot: str) -> tuple[Motion,
     kind = source_kind(source)
     if kind in ("recording", "demonstration"):
         _say_retargeting(source, robot)
+    margin = args.limit_margin  # the retargeting keeps it too, not only the timing and checks
     if kind == "recording":
-        motion = recording_motion(source, robot)
+        motion = recording_motion(source, robot, limit_margin=margin)
         return (motion.retimed(args.rate) if args.retime else motion), "recording"
     if kind == "demonstration":
-        return demonstration_motion(source, robot, args.rate), "demonstration"
+        return demonstration_motion(source, robot, args.rate, margin), "demonstration"
     policy = load_any_policy(source)
     arm = check_policy_robot(source, policy.robot, robot)
     rollout, summary = _rollout(args, policy, args.seconds_per_step, arm)

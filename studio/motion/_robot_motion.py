@@ -29,6 +29,7 @@ from studio.capture import (
     read_any_recording,
 )
 from studio.kinematics import (
+    KinematicsError,
     RetargetConfig,
     RetargetedPath,
     RobotArm,
@@ -172,12 +173,30 @@ def _capture_rate(rec: Recording | ObservationRecording, times: np.ndarray) -> f
     return float(1.0 / np.median(np.diff(times))) if len(times) > 1 else 1.0
 
 
+def _motion_robot(robot_name: str, limit_margin: float | None = None) -> RobotArm:
+    """The robot ``robot_name`` a motion is retargeted onto, timed and checked for, with scratch
+    data of its own (any thread), planning ``limit_margin`` (rad) from each hard limit (None:
+    :data:`studio.kinematics.LIMIT_MARGIN_RAD`).
+
+    Raises:
+        MotionError: a margin that is not a finite number of radians, 0 or more.
+    """
+    robot = load_robot(robot_name)
+    if limit_margin is None:
+        return robot.scratch_copy()
+    try:
+        return robot.with_limit_margin(limit_margin)
+    except KinematicsError as err:
+        raise MotionError(str(err)) from None
+
+
 def recording_motion(
     path: Path,
     robot_name: str,
     t0: float | None = None,
     t1: float | None = None,
     most_frames: int | None = None,
+    limit_margin: float | None = None,
 ) -> Motion:
     """A recording (its ``[t0, t1]`` s, the whole by default) retargeted onto ``robot_name`` at
     its capture times, from 0.
@@ -186,8 +205,11 @@ def recording_motion(
         most_frames: take every k-th frame when the segment holds more than this (a preview of
             a long take); the retargeting's step cap then grows k-fold, so the robot follows
             as it would frame by frame. None: every frame, as an export needs.
+        limit_margin: how far (rad) the retargeting keeps every joint from its hard limit
+            (None: :data:`studio.kinematics.LIMIT_MARGIN_RAD`); the motion's robot keeps it,
+            so its timing and checks do too.
     """
-    robot = load_robot(robot_name).scratch_copy()  # its own scratch data: any thread
+    robot = _motion_robot(robot_name, limit_margin)
     rec = read_any_recording(path)
     rows = rec.segment(0.0 if t0 is None else t0, rec.duration if t1 is None else t1)
     start, stop, _ = rows.indices(len(rec))
@@ -262,10 +284,13 @@ def series_motion(series: RecordingSeries, robot_name: str, name: str = "") -> M
     )
 
 
-def demonstration_motion(path: Path, robot_name: str, rate_hz: float) -> Motion:
+def demonstration_motion(
+    path: Path, robot_name: str, rate_hz: float, limit_margin: float | None = None
+) -> Motion:
     """A demonstration's path on ``robot_name`` (its stored Puma560 trajectory, or its
-    recording's segment retargeted onto another robot), to be timed."""
-    robot = load_robot(robot_name).scratch_copy()  # its own scratch data: any thread
+    recording's segment retargeted onto another robot, keeping ``limit_margin`` as
+    :func:`recording_motion` does), to be timed."""
+    robot = _motion_robot(robot_name, limit_margin)
     demo = checked_demonstration(path)
     if robot.name == PUMA560:
         times = demo.times - demo.times[0]

@@ -737,6 +737,10 @@ class RobotsPublic(BaseModel):
         None, description="the robot the 3D scene has drawn (null without a scene)"
     )
     drawn_meshes: int = Field(0, description="how many meshes the scene draws it with")
+    limit_margin_rad: float = Field(
+        description="how far (rad) plans keep every joint from its hard limit by default; an "
+        "export may ask for another (its limit_margin, `studio export --limit-margin`)"
+    )
 
 
 class ContactPublic(BaseModel):

@@ -3,9 +3,9 @@
 from __future__ import annotations
 
 import shutil
-from typing import Literal
+from typing import Annotated, Literal
 
-from fastapi import APIRouter
+from fastapi import APIRouter, Query
 from fastapi.responses import FileResponse
 from starlette.background import BackgroundTask
 
@@ -55,6 +55,7 @@ def export_for_the_robot(
     unchecked: bool = False,
     robot: str | None = None,
     retime: bool = False,
+    limit_margin: Annotated[float | None, Query(ge=0.0)] = None,
 ) -> FileResponse:
     """A recording or demonstration as the chosen robot's joint trajectory, retargeted, timed
     and checked for safety as ``studio export SOURCE --robot NAME --format FORMAT`` does: CSV,
@@ -62,13 +63,15 @@ def export_for_the_robot(
     sentence naming the sample, joint and margin; ``unchecked`` writes the file anyway with the
     findings stated in it (``reason`` "safety" in the 422 says the checks refused it). A
     recording keeps its capture times unless ``retime`` times its path within the robot's
-    limits, as a demonstration's is (``studio export --retime``). For the robot taught unless
+    limits, as a demonstration's is (``studio export --retime``). ``limit_margin`` (rad) is kept
+    from every joint's hard limit by the retargeting, the timing and the checks (``studio export
+    --limit-margin``; default ``LIMIT_MARGIN_RAD``). For the robot taught unless
     ``robot`` names another (an unknown name: 422 with the list). 404 for no such recording or
     demonstration."""
     store = recordings if kind == "recording" else demonstrations.store
     path = store.path(name)
     target = robot_spec(robot).name if robot is not None else robots.taught
-    out, filename, folder = export_for_robot(path, target, format, unchecked, retime)
+    out, filename, folder = export_for_robot(path, target, format, unchecked, retime, limit_margin)
     return FileResponse(
         out,
         media_type=MEDIA_TYPES[format],
@@ -87,17 +90,18 @@ def simulate_for_the_robot(
     settings: SettingsDep,
     robot: str | None = None,
     retime: bool = False,
+    limit_margin: Annotated[float | None, Query(ge=0.0)] = None,
 ) -> SimulationPublic:
     """The physics report ``/api/robot/export/{kind}/{name}`` (and ``studio export``) would
     state in the file, before exporting: the same samples replayed in MuJoCo on the robot's own
     URDF (its motors' force limits, gravity, the table), as ``studio simulate --json`` reports
-    them, with the report's sentences. For the robot taught unless ``robot`` names another (an
+    them, with the report's sentences (``limit_margin`` as the export's). For the robot taught unless ``robot`` names another (an
     unknown name: 422); 404 for no such recording or demonstration."""
     store = recordings if kind == "recording" else demonstrations.store
     path = store.path(name)
     target = robot_spec(robot).name if robot is not None else robots.taught
     cache = physics_cache_dir(settings.data_dir)
-    report = simulate_for_robot(path, target, retime, cache)
+    report = simulate_for_robot(path, target, retime, cache, limit_margin)
     return SimulationPublic.model_validate({**report.as_json(), "sentences": report.sentences()})
 
 

@@ -40,16 +40,21 @@ MEDIA_TYPES = {
 """What each format's download is (a LeRobot dataset, a folder, comes zipped)."""
 
 
-def _motion(path: Path, robot: str, retime: bool) -> Motion:
-    """A recording's or demonstration's motion on ``robot`` as the page exports it."""
+def _motion(path: Path, robot: str, retime: bool, limit_margin: float | None = None) -> Motion:
+    """A recording's or demonstration's motion on ``robot`` as the page exports it, keeping
+    ``limit_margin`` (rad; None: the default) from every joint's hard limit."""
     if path.name.endswith(DEMO_SUFFIX):
-        return demonstration_motion(path, robot, ROLLOUT_RATE_HZ)
-    motion = recording_motion(path, robot)
+        return demonstration_motion(path, robot, ROLLOUT_RATE_HZ, limit_margin)
+    motion = recording_motion(path, robot, limit_margin=limit_margin)
     return motion.retimed(ROLLOUT_RATE_HZ) if retime else motion
 
 
 def simulate_for_robot(
-    path: Path, robot: str, retime: bool = False, cache: Path | None = None
+    path: Path,
+    robot: str,
+    retime: bool = False,
+    cache: Path | None = None,
+    limit_margin: float | None = None,
 ) -> SimulationReport:
     """The physics report :func:`export_for_robot` would state in its file, before exporting:
     the same samples replayed in MuJoCo (``cache``: where the robot's MuJoCo files are kept).
@@ -57,16 +62,23 @@ def simulate_for_robot(
     Raises:
         PhysicsError, ExportError, KinematicsError: no model can be built, an unknown robot.
     """
-    return simulate_motion(_motion(path, robot, retime), cache=cache)
+    return simulate_motion(_motion(path, robot, retime, limit_margin), cache=cache)
 
 
 def export_for_robot(
-    path: Path, robot: str, fmt: ExportFormat, unchecked: bool = False, retime: bool = False
+    path: Path,
+    robot: str,
+    fmt: ExportFormat,
+    unchecked: bool = False,
+    retime: bool = False,
+    limit_margin: float | None = None,
 ) -> tuple[Path, str, Path]:
     """Export a recording or demonstration ``path`` for ``robot`` as ``fmt`` into a fresh
     temporary folder (``unchecked``: written despite failed checks, the findings stated in it;
     a demonstration timed within the limits at the rollout rate, a recording at its capture
-    times, or timed as a demonstration is with ``retime``).
+    times, or timed as a demonstration is with ``retime``; ``limit_margin``: rad kept from
+    every joint's hard limit by the retargeting, the timing and the checks, as ``studio export
+    --limit-margin`` keeps it; None: the default).
 
     Returns:
         ``(file, download name, folder)``: the file to send and the folder to remove after.
@@ -78,7 +90,7 @@ def export_for_robot(
     stem = path.name
     for ending in (DEMO_SUFFIX, *RECORDING_SUFFIXES):
         stem = stem.removesuffix(ending)
-    motion = _motion(path, robot, retime)
+    motion = _motion(path, robot, retime, limit_margin)
 
     def write(folder: Path) -> Path:
         out = folder / f"{stem}.{robot}{FORMAT_SUFFIXES[fmt]}"

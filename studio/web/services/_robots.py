@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import threading
 
-from studio.kinematics import load_robot, robot_names, robot_spec
+from studio.kinematics import LIMIT_MARGIN_RAD, load_robot, robot_names, robot_spec
 from studio.learning import default_goal_deg
 
 from ..live import Pipeline
@@ -92,4 +92,5 @@ class Robots:
             "robot": self.pipeline.robot_name,
             "drawn": None if scene is None else scene.robot_name,
             "drawn_meshes": 0 if scene is None else scene.robot_mesh_count,
+            "limit_margin_rad": LIMIT_MARGIN_RAD,
         }

@@ -16,13 +16,14 @@
 import { api, download, guarded } from "./api.js";
 import { $, el, enc, fillSelect, setProp, showError } from "./dom.js";
 import { watchTarget } from "./policies.js";
-import { S } from "./state.js";
+import { S, listen } from "./state.js";
 
 const ALL_FORMATS = [["csv", "CSV"], ["mcap", "MCAP (ROS 2)"], ["lerobot", "LeRobot dataset (zip)"]];
 const ENDINGS = { csv: "csv", mcap: "mcap", lerobot: "lerobot.zip" };
 const ANYWAY = "Export anyway, findings written in the file";
 const RETIME = "Time it within the robot's limits";
 const PHYSICS = "replay the motion the export would write in physics (MuJoCo: the robot's motors and their force limits, gravity, the table) and say whether it completes, how closely the robot follows it, where a motor saturates and what touches";
+const MARGIN = "how far (rad) the robot keeps every joint from its hard limit: the retargeting, the timing and the safety checks all keep it (empty: the default, as `studio export --limit-margin` sets it)";
 const HOW = "retargeted onto the robot chosen under Source, timed within its limits and checked for safety, as `studio export --robot` writes it";
 
 const KINDS = {
@@ -53,6 +54,7 @@ export function buildExportControl(kind) {
     ...k.formats.map(([value, label]) => el("option", { value, text: label }))));
   parts.push(el("button", { id: `${kind}-export-go`, testid: k.testid || `${kind}-export-go`, title: k.title, onclick: () => exportNow(kind, { unchecked: false, retime: false }) }, `Export ${k.noun}`));
   if (k.items) {
+    parts.push(el("input", { id: `${kind}-export-margin`, testid: `${kind}-export-margin`, type: "number", min: "0", step: "0.01", class: "export-margin", "aria-label": "Margin from each joint's limit (rad)", placeholder: marginHint(), title: MARGIN }));
     parts.push(el("button", { id: `${kind}-physics-go`, testid: `${kind}-physics-go`, title: PHYSICS, onclick: () => checkPhysics(kind) }, "Check in physics"));
   }
   const anyway = el("button", { id: `${kind}-export-anyway`, testid: `${kind}-export-anyway`, hidden: true, title: "write the file even though the safety checks refuse it; every finding is stated in it", onclick: () => exportNow(kind, { unchecked: true, retime: retimed[kind] }) }, ANYWAY);
@@ -78,6 +80,24 @@ export function fillExportItems(kind) {
   fillSelect(select, items.length ? items : [["", `(no ${k.noun} yet)`]]);
 }
 
+/** The margin field's hint: the default margin, once GET /api/robots said it. */
+function marginHint() {
+  return S.limitMargin == null ? "margin, rad" : `margin ${S.limitMargin} rad`;
+}
+
+listen("robot", () => {
+  for (const kind of ["recording", "demonstration"]) {
+    const field = $(`${kind}-export-margin`);
+    if (field) field.placeholder = marginHint();
+  }
+});
+
+/** The export's limit margin, when the field gives one (the default otherwise). */
+function margin(kind, query) {
+  const field = $(`${kind}-export-margin`);
+  if (field && field.value !== "") query.set("limit_margin", field.value);
+}
+
 /** Whether each kind's last export asked for its path timed within the limits. */
 const retimed = {};
 
@@ -98,6 +118,7 @@ function target(kind, { unchecked, retime }) {
   query.set("format", format);
   if (unchecked) query.set("unchecked", "true");
   if (retime) query.set("retime", "true");
+  margin(kind, query);
   const robot = (S.source && S.source.robot) || "robot";
   return { url: `/api/robot/export/${kind}/${enc(name)}?${query}`, name: `${name}.${robot}.${ENDINGS[format]}` };
 }
@@ -135,6 +156,7 @@ async function checkPhysics(kind) {
   if (!name) { showError(errId, `Choose a ${KINDS[kind].noun} to check first.`); return; }
   const query = new URLSearchParams();
   if (retimed[kind]) query.set("retime", "true");
+  margin(kind, query);
   const report = await guarded(errId, () => api("GET", `/api/robot/simulate/${kind}/${enc(name)}?${query}`), $(`${kind}-physics-go`));
   if (!report) return;
   box.replaceChildren(...report.sentences.map((line) => el("div", { text: line })));

@@ -182,6 +182,7 @@ export async function loadRobots() {
     }));
     select.value = body.robot;
     S.robots = body.robots;
+    S.limitMargin = body.limit_margin_rad;
     showTrainedRobot();
     announceRobot(body.robot);
   });

@@ -25,6 +25,7 @@ export const S = Object.seal({
   policies: [], // GET /api/policies (policies.js)
   robots: null, // the offered robots with their joints and default goals (GET /api/robots)
   robot: null, // the robot taught, as the page last announced it (set: sources.js)
+  limitMargin: null, // rad plans keep from each joint's hard limit by default (GET /api/robots)
   curves: new Map(), // run id -> {episodes, mean, std, min, max, count}
   shown: new Set(), // run ids plotted
   shownTouched: false, // the user changed which runs are plotted
