@@ -100,11 +100,15 @@ def test_the_timeline_goal_and_jog_sliders_follow_the_robot_chosen(
         assert "Franka Emika Panda" in page.get_by_test_id("jog-robot").inner_text()
         joint2 = page.get_by_role("slider", name="Joint 2")
         joint2.focus()
-        joint2.press("Home")  # the Panda's joint 2 at its lower limit
+        joint2.press("Home")  # the Panda's joint 2 at its lower (usable) limit
         assert wait_for(
             lambda: (
                 studio_server.get("/api/scene/playback")["robot"] == "panda"
-                and abs(studio_server.get("/api/scene/playback")["q_robot_deg"][1] + 101) < 0.5
+                and abs(
+                    studio_server.get("/api/scene/playback")["q_robot_deg"][1]
+                    - np.degrees(panda.lower[1])
+                )
+                < 0.5
             ),
             timeout=LOAD_MS / 1000,
         ), studio_server.get("/api/scene/playback")

@@ -12,7 +12,7 @@ import pinocchio as pin
 import pytest
 
 from studio.cli import main
-from studio.kinematics import Puma560, load_robot
+from studio.kinematics import LIMIT_MARGIN_RAD, Puma560, load_robot
 from tests.conftest import require
 
 ROBOT = Puma560()
@@ -58,8 +58,11 @@ def test_the_registry_loads_the_puma560_from_its_urdf_with_standard_dh_kinematic
     np.testing.assert_allclose(arm.forward(ROBOT.qn)[:3, 3], (0.5963, -0.1501, 0.6575), atol=5e-5)
     for q in random_q(20):
         np.testing.assert_allclose(arm.forward(q), ROBOT.forward(q), atol=1e-12)
-    np.testing.assert_array_equal(arm.lower, ROBOT.lower)
-    np.testing.assert_array_equal(arm.upper, ROBOT.upper)
+    # Corke's limits are the URDF's hard ones; the usable ones keep the margin inside them.
+    np.testing.assert_array_equal(arm.hard_lower, ROBOT.lower)
+    np.testing.assert_array_equal(arm.hard_upper, ROBOT.upper)
+    np.testing.assert_allclose(arm.lower, ROBOT.lower + LIMIT_MARGIN_RAD)
+    np.testing.assert_allclose(arm.upper, ROBOT.upper - LIMIT_MARGIN_RAD)
     np.testing.assert_array_equal(arm.velocity, SPEEDS)
     np.testing.assert_array_equal(arm.model.effortLimit, TORQUES)
 

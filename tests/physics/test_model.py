@@ -33,8 +33,8 @@ def test_the_model_has_the_arms_joints_limits_and_force_limits(name, physics_cac
     mj = model.model
     assert mj.nq == arm.nq, "fingers and grippers are locked as the studio locks them"
     assert [mj.joint(i).name for i in range(mj.njnt)] == list(arm.joint_names)
-    np.testing.assert_allclose(mj.jnt_range[:, 0], arm.lower, atol=1e-9)
-    np.testing.assert_allclose(mj.jnt_range[:, 1], arm.upper, atol=1e-9)
+    np.testing.assert_allclose(mj.jnt_range[:, 0], arm.hard_lower, atol=1e-9)
+    np.testing.assert_allclose(mj.jnt_range[:, 1], arm.hard_upper, atol=1e-9)
     effort = np.array(arm.model.effortLimit)
     limited = effort > 0
     np.testing.assert_allclose(mj.jnt_actfrcrange[limited, 1], effort[limited])

@@ -12,7 +12,7 @@ from .test_teachers import camera, landmarks
 
 def test_the_studio_gets_the_parsed_frame_and_answers_typed(client: TestClient, monkeypatch):
     camera(client)
-    studio = client.app.state.studio
+    studio = client.app.state.studio.sources  # the service the route hands the frame to
     handed: list[object] = []
     answered: list[object] = []
     post = studio.post_landmarks

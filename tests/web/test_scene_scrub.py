@@ -11,6 +11,7 @@ from fastapi.testclient import TestClient
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from studio.kinematics import load_robot
 from studio.web import create_app
 from studio.web.scene._model import Mode, playback_time, pose_at, rescheduled
 from studio.web.scene._scene import SceneLayout, StudioScene
@@ -167,9 +168,11 @@ def test_jog_the_robot_within_its_limits(scene_api):
     client, scene, _ = scene_api
     jog = client.get("/api/scene/jog").json()
     assert [j["name"] for j in jog["joints"]] == [f"joint {i}" for i in range(1, 7)]
-    assert jog["joints"][0]["lower_deg"] == pytest.approx(-160) and jog["joints"][1][
-        "upper_deg"
-    ] == pytest.approx(110)
+    # The sliders span the usable limits: Corke's hard limits less the margin.
+    puma = load_robot("puma560")
+    assert jog["joints"][0]["lower_deg"] == pytest.approx(np.degrees(puma.lower[0]))
+    assert jog["joints"][1]["upper_deg"] == pytest.approx(np.degrees(puma.upper[1]))
+    assert -160 < jog["joints"][0]["lower_deg"] < -158 and 108 < jog["joints"][1]["upper_deg"] < 110
     q = [30.0, -20.0, 45.0, 0.0, 10.0, 0.0]
     assert client.post("/api/scene/jog", json={"q_deg": q}).status_code == 200
     assert wait_for(lambda: np.allclose(scene.current_q_robot(), np.radians(q), atol=1e-6), 5)
