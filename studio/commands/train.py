@@ -40,14 +40,19 @@ from studio.capture import DEMO_FORMAT, DEMO_SUFFIX
 from studio.kinematics import DEFAULT_ROBOT, KinematicsError, Obstacle, robot_names, robot_spec
 from studio.learning import (
     ACTION_SETS,
+    CLONING_KIND,
     DEFAULT_EPISODES,
     DEFAULT_EXPERIMENTS,
     DEFAULT_GOAL_JOINTS_DEG,
     DEFAULT_SEED,
+    DEMO_SHAPING,
+    OWN_LEARNER,
     PLANNERS,
     REACH_DEFAULTS,
     TASK_KINDS,
+    TEACHER_KIND,
     ArmGrid,
+    ArmReach,
     DemonstrationPath,
     DynaQConfig,
     LearningError,
@@ -62,6 +67,8 @@ from studio.samples import SAMPLES_DIR
 
 NAME = "train"
 HELP = "Train Dyna-Q on the arm grid or the arm's continuous joints: a run folder with curves and a policy out."
+REACH_REWARD_FLAGS = ("shaping", "demo_potential")
+"""The continuous task's reward settings ``studio train`` sets (:class:`ArmReach` fields)."""
 _DYNAQ = DynaQConfig()
 _GRID = ArmGrid()
 
@@ -115,29 +122,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         f"(default: {REACH_DEFAULTS['joints']})",
     )
     parser.add_argument("--bins", type=int, help=f"bins per joint (default: {_GRID.bins})")
-    parser.add_argument(
-        "--step-deg",
-        type=float,
-        help=f"arm-reach: joint increment per action, degrees (default: {REACH_DEFAULTS['step_deg']:g})",
-    )
-    parser.add_argument(
-        "--actions",
-        choices=ACTION_SETS,
-        help="arm-reach: what one action moves: one joint, also two joints together, any "
-        "joints at once, or one joint or all of them along the --demos (follow) "
-        f"(default: {REACH_DEFAULTS['actions']})",
-    )
-    parser.add_argument(
-        "--tilings",
-        type=int,
-        help=f"arm-reach: offset tilings of each joint (default: {REACH_DEFAULTS['tilings']})",
-    )
-    parser.add_argument(
-        "--tiles",
-        type=int,
-        help="arm-reach: tiles per joint in each tiling (default: 32, or more for a robot whose "
-        "joints 1-3 turn further, so none of their tiles is wider than 10 degrees)",
-    )
+    _add_reach_arguments(parser)
     goal = parser.add_mutually_exclusive_group()
     goal.add_argument(
         "--goal",
@@ -166,6 +151,55 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--generated-demos", type=int, help="replay N generated demonstrations")
     parser.add_argument("--workers", type=int, default=None, help="threads (default: all cores)")
     parser.add_argument("--no-progress", action="store_true", help="hide the progress bar")
+
+
+def _add_reach_arguments(parser: argparse.ArgumentParser) -> None:
+    """The continuous task's flags (``--task arm-reach``) and the learner's."""
+    parser.add_argument(
+        "--step-deg",
+        type=float,
+        help=f"arm-reach: joint increment per action, degrees (default: {REACH_DEFAULTS['step_deg']:g})",
+    )
+    parser.add_argument(
+        "--actions",
+        choices=ACTION_SETS,
+        help="arm-reach: what one action moves: one joint, also two joints together, any "
+        "joints at once, or one joint or all of them along the --demos (follow) "
+        f"(default: {REACH_DEFAULTS['actions']})",
+    )
+    parser.add_argument(
+        "--tilings",
+        type=int,
+        help=f"arm-reach: offset tilings of each joint (default: {REACH_DEFAULTS['tilings']})",
+    )
+    parser.add_argument(
+        "--tiles",
+        type=int,
+        help="arm-reach: tiles per joint in each tiling (default: 32, or more for a robot whose "
+        "joints 1-3 turn further, so none of their tiles is wider than 10 degrees)",
+    )
+    parser.add_argument(
+        "--shaping",
+        type=float,
+        help="arm-reach: weight of the shaping potential toward the goal's joint angles, reward "
+        "per joint step; 0 leaves the paper's reward, +100 at the goal and -1 a step "
+        f"(default: {ArmReach.shaping:g})",
+    )
+    parser.add_argument(
+        "--demo-potential",
+        type=float,
+        help="arm-reach: weight of the --demos' shaping potential (Brys et al. 2015: the joint "
+        "distance to the demonstrated end pose), reward per joint step; 0 switches it off "
+        f"(default: {DEMO_SHAPING:g} less --shaping, so {DEMO_SHAPING:g} under the paper's reward)",
+    )
+    parser.add_argument(
+        "--learner",
+        choices=(OWN_LEARNER, TEACHER_KIND, CLONING_KIND),
+        help=f"what learns: {OWN_LEARNER} (the task's own: tabular on the grid, tile-coded on "
+        f"arm-reach), or a baseline of arm-reach that learns nothing from reward: {TEACHER_KIND} "
+        f"(the --demos followed at every step) or {CLONING_KIND} (behaviour cloning: the nearest "
+        f"demonstrated state's move) (default: {OWN_LEARNER})",
+    )
 
 
 def _obstacle(text: str) -> Obstacle:
@@ -301,7 +335,7 @@ def run_request(args: argparse.Namespace) -> RunRequest:
             flag,
             f"--{flag.replace('_', '-')} sets the continuous task; add --task {TASK_KINDS[1]} or leave it out.",
         )
-        for flag in REACH_DEFAULTS
+        for flag in (*REACH_DEFAULTS, *REACH_REWARD_FLAGS)
         if flag != "joints" and getattr(args, flag, None) is not None
     ]
     spec = _spec_of(args)
@@ -341,6 +375,7 @@ def run_request(args: argparse.Namespace) -> RunRequest:
         origin="cli",
         obstacles=args.obstacle or spec.get("obstacles") or (),
         problems=problems,
+        learner=args.learner or "",
     )
 
 
@@ -374,7 +409,11 @@ def _reach_request(args: argparse.Namespace) -> RunRequest:
         task=args.task,
         robot=robot,
         config=_dynaq_flags(args),
-        reach={k: getattr(args, k) for k in REACH_DEFAULTS if getattr(args, k) is not None},
+        reach={
+            k: getattr(args, k)
+            for k in (*REACH_DEFAULTS, *REACH_REWARD_FLAGS)
+            if getattr(args, k) is not None
+        },
         goal_deg=goal_deg,
         **_picked(args, {}),  # type: ignore[arg-type]
         demonstrations=recorded,
@@ -382,6 +421,7 @@ def _reach_request(args: argparse.Namespace) -> RunRequest:
         origin="cli",
         obstacles=args.obstacle or (),
         problems=problems,
+        learner=args.learner or "",
     )
 
 

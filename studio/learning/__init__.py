@@ -36,12 +36,15 @@ from ._interface import Rollout as Rollout
 from ._interface import Start as Start
 from ._learner import LiveProgress as LiveProgress
 from ._prepare import prepare_in_background as prepare_in_background
+from ._registry import OWN_LEARNER as OWN_LEARNER
 from ._registry import AnyPolicy as AnyPolicy
 from ._registry import learner as learner
 from ._registry import learner_of as learner_of
 from ._registry import load_any_policy as load_any_policy
 from ._registry import register_learner as register_learner
 from ._tiles import TileCoding as TileCoding
+from .baselines import CLONING_KIND as CLONING_KIND
+from .baselines import TEACHER_KIND as TEACHER_KIND
 from .likeness._likeness import LikenessCard as LikenessCard
 from .likeness._likeness import dtw_distance as dtw_distance
 from .likeness._likeness import frechet_distance as frechet_distance
@@ -117,6 +120,7 @@ from .tasks._arm import MAX_TABLE_ENTRIES as MAX_TABLE_ENTRIES
 from .tasks._arm import ArmGrid as ArmGrid
 from .tasks._demo_motion import DemonstrationMotion as DemonstrationMotion
 from .tasks._demo_motion import motion_problem as motion_problem
+from .tasks._demo_shaping import DEMO_SHAPING as DEMO_SHAPING
 from .tasks._goal import DEFAULT_GOAL_JOINTS_DEG as DEFAULT_GOAL_JOINTS_DEG
 from .tasks._goal import check_goal_deg as check_goal_deg
 from .tasks._goal import default_goal_deg as default_goal_deg

@@ -10,12 +10,12 @@ learning, :mod:`.linear._teacher`) is rolled out from the very same starts.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
-from dataclasses import asdict, dataclass
+from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
 
-from ._interface import Start
+from ._interface import Evaluation, Start
 from ._registry import learner_of
 from .linear._policy import DEFAULT_MAX_STEPS, TilePolicyFile
 from .linear._teacher import follows_demonstrations, teacher_walk
@@ -23,45 +23,6 @@ from .tabular._policy import ROLLOUT_RATE_HZ
 
 Collides = Callable[[str, np.ndarray], bool]
 """Whether the named robot touches itself or the table anywhere along the joints ``(N, nq)``."""
-
-
-@dataclass(frozen=True)
-class Judged:
-    """How a controller did from the starts.
-
-    Attributes:
-        success: the share of starts from which it reaches the goal.
-        collisions: the share of starts whose rollout would collide (self or table).
-        mean_steps: its mean steps to the goal over the starts that reach it (NaN if none).
-        mean_seconds: the same in seconds of motion at the policy's pace (NaN if none).
-    """
-
-    success: float
-    collisions: float
-    mean_steps: float
-    mean_seconds: float
-
-    @classmethod
-    def of(
-        cls,
-        reached: Sequence[bool],
-        collided: Sequence[bool],
-        steps: Sequence[int],
-        seconds: Sequence[float],
-    ) -> Judged:
-        hit = np.asarray(reached, dtype=bool)
-        taken = np.asarray(steps, dtype=np.float64)[hit]
-        took = np.asarray(seconds, dtype=np.float64)[hit]
-        return cls(
-            success=float(hit.mean()) if hit.size else 0.0,
-            collisions=float(np.mean(collided)) if len(collided) else 0.0,
-            mean_steps=float(taken.mean()) if taken.size else float("nan"),
-            mean_seconds=float(took.mean()) if took.size else float("nan"),
-        )
-
-    def as_json(self) -> dict[str, float | None]:
-        """Its fields for JSON (NaN as null)."""
-        return {k: (None if v != v else v) for k, v in asdict(self).items()}
 
 
 @dataclass(frozen=True)
@@ -77,8 +38,8 @@ class Evaluated:
 
     starts: int
     seed: int
-    policy: Judged
-    teacher: Judged | None
+    policy: Evaluation
+    teacher: Evaluation | None
 
 
 def evaluate_policy(
@@ -95,11 +56,11 @@ def evaluate_policy(
         collided.append(collides(rollout.robot, rollout.q))
         steps.append(rollout.steps)
         seconds.append(float(rollout.times[-1]) if len(rollout.times) else 0.0)
-    judged = Judged.of(reached, collided, steps, seconds)
+    judged = Evaluation.of(reached, steps, seconds=seconds, collided=collided)
     return Evaluated(starts, seed, judged, _teacher(policy, seeds, collides))
 
 
-def _teacher(policy: object, seeds: np.ndarray, collides: Collides) -> Judged | None:
+def _teacher(policy: object, seeds: np.ndarray, collides: Collides) -> Evaluation | None:
     """The demonstrations followed from each start (a tile-coded policy that follows them)."""
     if not isinstance(policy, TilePolicyFile) or policy.task is None:
         return None
@@ -114,4 +75,4 @@ def _teacher(policy: object, seeds: np.ndarray, collides: Collides) -> Judged | 
         collided.append(collides(task.robot, np.array([task.full_q(q) for q in path])))
         steps.append(len(path) - 1)
         seconds.append((len(path) - 1) * policy.seconds_per_step)
-    return Judged.of(reached, collided, steps, seconds)
+    return Evaluation.of(reached, steps, seconds=seconds, collided=collided)

@@ -92,34 +92,63 @@ class Rollout:
 
 @dataclass(frozen=True)
 class Evaluation:
-    """A policy rolled out from given starts (:meth:`Learner.evaluate`).
+    """A policy (or a controller: the teacher) rolled out from given starts
+    (:meth:`Learner.evaluate`, ``studio evaluate``, ``benchmarks/bench_teacher.py``).
 
     Attributes:
         starts: how many starts.
         success: the share of starts from which it reaches the goal.
         mean_steps: its mean steps to the goal over the starts that reach it (NaN if none).
         mean_seconds: the same in seconds of motion at the policy's pace (NaN if none).
+        collisions: the share of starts whose rollout would collide (self or table; 0 where
+            nobody checked).
     """
 
     starts: int
     success: float
     mean_steps: float
     mean_seconds: float
+    collisions: float = 0.0
 
     @classmethod
     def of(
-        cls, reached: Sequence[bool], steps: Sequence[int], seconds_per_step: float
+        cls,
+        reached: Sequence[bool],
+        steps: Sequence[int],
+        seconds_per_step: float | None = None,
+        *,
+        seconds: Sequence[float] | None = None,
+        collided: Sequence[bool] = (),
     ) -> Evaluation:
-        """The evaluation of per-start outcomes (each start's reached flag and steps)."""
+        """The evaluation of per-start outcomes: each start's reached flag and steps, and its
+        seconds of motion (``seconds``) or one pace for every step (``seconds_per_step``), and
+        whether its rollout collided."""
         hit = np.asarray(reached, dtype=bool)
         taken = np.asarray(steps, dtype=np.float64)[hit]
         mean = float(taken.mean()) if taken.size else float("nan")
+        if seconds is not None:
+            took = np.asarray(seconds, dtype=np.float64)[hit]
+            mean_seconds = float(took.mean()) if took.size else float("nan")
+        else:
+            mean_seconds = mean * (seconds_per_step or 0.0)
         return cls(
             starts=int(hit.size),
             success=float(hit.mean()) if hit.size else 0.0,
             mean_steps=mean,
-            mean_seconds=mean * seconds_per_step,
+            mean_seconds=mean_seconds,
+            collisions=float(np.mean(collided)) if len(collided) else 0.0,
         )
+
+    def as_json(self) -> dict[str, float | None]:
+        """``success``, ``collisions``, ``mean_steps`` and ``mean_seconds`` for JSON (NaN as
+        null), as ``studio evaluate --json`` prints them."""
+        figures = {
+            "success": self.success,
+            "collisions": self.collisions,
+            "mean_steps": self.mean_steps,
+            "mean_seconds": self.mean_seconds,
+        }
+        return {k: (None if v != v else v) for k, v in figures.items()}
 
 
 class TrainingRun(Protocol):
@@ -162,6 +191,9 @@ class Learner(Protocol):
         shortest_paths: whether its task knows its mean shortest path (the level a sweep's
             ``episodes_to_converge`` reaches by default).
         prepare_seconds: about how long its compiled kernels take to compile (0: none).
+        trains: the task class whose runs it trains (None: no run trains it, a movement
+            primitive); a run picks a learner other than its task's own by kind
+            (:func:`studio.learning.run_learner`).
     """
 
     kind: str
@@ -175,6 +207,7 @@ class Learner(Protocol):
     sweep_keys: tuple[str, ...]
     shortest_paths: bool
     prepare_seconds: float
+    trains: type | None
 
     def train(self, run: TrainingRun, live: LiveProgress, workers: int | None = None) -> object:
         """Learn what ``run`` asks for; the result :meth:`save` writes."""

@@ -12,6 +12,8 @@ from pathlib import Path
 
 from ._errors import LearningError, PolicyFileError
 from ._interface import Learner
+from .baselines._learner import CloningLearner, TeacherLearner
+from .baselines._policy import CloningPolicyFile, TeacherPolicyFile
 from .linear._learner import TileLearner
 from .linear._policy import TilePolicyFile, read_policy_header
 from .primitives._learner import DmpLearner
@@ -21,7 +23,7 @@ from .tabular._policy import MAX_NPZ_BYTES, BoundedNpz, PolicyFile
 from .tasks._arm import ArmGrid
 from .tasks._reach import ArmReach
 
-AnyPolicy = PolicyFile | TilePolicyFile | DmpPolicyFile
+AnyPolicy = PolicyFile | TilePolicyFile | DmpPolicyFile | TeacherPolicyFile | CloningPolicyFile
 """A policy of any kind registered here, as :func:`load_any_policy` returns it."""
 
 _LEARNERS: dict[str, Learner] = {}
@@ -74,6 +76,31 @@ def learner_for_task(task: object) -> Learner:
     )
 
 
+OWN_LEARNER = "dyna-q"
+"""How a run names its task's own learner (tabular Dyna-Q on the grid, linear Dyna-Q with tile
+coding on the continuous task), as ``studio train --learner`` takes it; the default."""
+
+
+def run_learner(kind: str, task: object) -> Learner:
+    """The learner a run of ``task`` trains with: its task's own (``kind`` "" or
+    :data:`OWN_LEARNER`), or the registered learner ``kind`` that trains such a task (its
+    ``trains``: the baselines train the continuous task)."""
+    if kind in ("", OWN_LEARNER):
+        return learner_for_task(task)
+    chosen = _LEARNERS.get(kind)
+    trains = getattr(chosen, "trains", None)
+    if chosen is None or trains is None or not isinstance(task, trains):
+        able = [OWN_LEARNER] + [
+            k
+            for k, each in _LEARNERS.items()
+            if k not in _TASKS and each.trains and isinstance(task, each.trains)
+        ]
+        raise LearningError(
+            f"learner is {kind!r}; give one of {', '.join(able)} for a run of the {type(task).__name__} task."
+        )
+    return chosen
+
+
 def load_any_policy(path: str | Path) -> AnyPolicy:
     """Read a policy file of any registered kind: tabular (:func:`load_policy`), tile-coded, or a
     movement primitive (:func:`load_dmp_policy`), by the ``format`` of its header.
@@ -100,3 +127,5 @@ def load_any_policy(path: str | Path) -> AnyPolicy:
 register_learner(TabularLearner(), ArmGrid)
 register_learner(TileLearner(), ArmReach)
 register_learner(DmpLearner())
+register_learner(TeacherLearner())
+register_learner(CloningLearner())

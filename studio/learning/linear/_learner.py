@@ -92,6 +92,7 @@ class TileLearner:
     sweep_keys = (*(f.name for f in fields(ArmReach)), *CODING_SETTINGS)
     shortest_paths = False
     prepare_seconds = 25.0
+    trains: type | None = ArmReach
     watch_max_steps: int | None = WATCH_MAX_STEPS
 
     def train(
@@ -143,7 +144,7 @@ class TileLearner:
             result.best_experiment(),
             notes=notes,
             compress=compress,
-            seconds_per_step=_pace(run, result),
+            seconds_per_step=run_pace(run, result.task),
         )
 
     def load(self, path: str | Path) -> TilePolicyFile:
@@ -188,16 +189,7 @@ class TileLearner:
             seconds_per_step=seconds_per_step,  # None: the policy's own pace
         )
         assert task is not None  # (tile_rollout refuses another environment's policy)
-        return Rollout(
-            times=times,
-            q=q,
-            reached=bool(reached),
-            steps=len(path) - 1,
-            states=(),
-            seed=start.seed,
-            goal=np.asarray(task.goal, dtype=np.float64),
-            robot=task.robot,
-        )
+        return path_rollout(task, times, q, path, bool(reached), start.seed)
 
     def summary(self, rollout: Rollout) -> str:
         return f"the greedy policy {'reaches the goal' if rollout.reached else 'does NOT reach the goal'}"
@@ -299,12 +291,35 @@ class TileLearner:
         return None
 
 
-def _pace(run: TrainingRun, result: LinearResult) -> float:
-    """The policy's pace: its recorded demonstrations' (:func:`demonstrated_pace`), else the
-    default; a demonstration the task cannot time costs the pace, never the policy."""
+def path_rollout(
+    task: ArmReach,
+    times: np.ndarray,
+    q: np.ndarray,
+    path: np.ndarray,
+    reached: bool,
+    seed: int | None,
+) -> Rollout:
+    """The :class:`Rollout` of a joint path ``(K + 1, joints)`` on the continuous ``task``,
+    sampled as ``times`` and ``q`` (:func:`path_trajectory`)."""
+    return Rollout(
+        times=times,
+        q=q,
+        reached=reached,
+        steps=len(path) - 1,
+        states=(),
+        seed=seed,
+        goal=np.asarray(task.goal, dtype=np.float64),
+        robot=task.robot,
+    )
+
+
+def run_pace(run: TrainingRun, task: ArmReach | None) -> float:
+    """The pace of a policy ``run`` makes on ``task``: its recorded demonstrations'
+    (:func:`demonstrated_pace`), else the default; a demonstration the task cannot time costs the
+    pace, never the policy."""
     motions = [(m.times, m.q_robot) for m in run.demonstration_motions]
     try:
-        return demonstrated_pace(result.task, motions)  # type: ignore[arg-type]
+        return demonstrated_pace(task, motions)  # type: ignore[arg-type]
     except LearningError as err:
         log.warning("a run's policy keeps the default pace: %s", err)
         return DEFAULT_SECONDS_PER_STEP

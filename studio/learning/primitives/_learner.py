@@ -46,6 +46,7 @@ class DmpLearner:
     sweep_keys: tuple[str, ...] = ()
     shortest_paths = False
     prepare_seconds = 0.0  # (numpy only: nothing to compile)
+    trains: type | None = None
     watch_max_steps: int | None = None
 
     def train(

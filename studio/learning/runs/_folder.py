@@ -69,7 +69,6 @@ from ..._numbers import is_int
 from .._config import MAX_STEPS_PER_EPISODE, check_budget
 from .._errors import ConfigError, LearningError
 from .._learner import ExperimentResult, LiveProgress
-from .._registry import learner_for_task
 from ..likeness._run import save_run_likeness
 from ._curves import (
     MAX_CURVES_BYTES_PER_EPISODE,
@@ -527,9 +526,7 @@ class RunFolder:
         tmp = self.path / f".{POLICY_FILE}.{secrets.token_hex(4)}.tmp.npz"
         notes = f"run {self.id}: experiment {best} of {self.record.experiments}, seed {self.record.seed}, {len(self.record.demonstrations)} demonstrations"
         try:
-            learner_for_task(self.record.task).save(
-                tmp, self.record, result, notes=notes, compress=compress
-            )
+            self.record.trained_by().save(tmp, self.record, result, notes=notes, compress=compress)
             os.replace(tmp, self.policy_path)
         except OSError as err:
             with contextlib.suppress(OSError):

@@ -26,7 +26,8 @@ from ..._files import now_iso
 from ..._numbers import is_int, is_number
 from .._config import DEFAULT_SEED, DynaQConfig, check_budget
 from .._errors import ConfigError, LearningError
-from .._registry import learner, learner_for_task
+from .._interface import Learner
+from .._registry import OWN_LEARNER, learner, learner_for_task, run_learner
 from .._tiles import TileCoding
 from ..linear._learner import KIND as TILE_KIND
 from ..tabular._learner import KIND as TABULAR_KIND
@@ -91,6 +92,8 @@ class RunRecord:
             that made the run chose them by name (the page).
         demonstration_motions: the recorded demonstrations' own motions (times and joints),
             when known, so the run's likeness card is scored without the demonstration files.
+        learner: the learner that trains it, by kind: "" for its task's own (Dyna-Q), else a
+            baseline such as ``"teacher"`` or ``"cloning"`` (:func:`studio.learning.run_learner`).
     """
 
     task: ArmGrid | ArmReach
@@ -107,6 +110,7 @@ class RunRecord:
     goal_deg: tuple[float, ...] | None = None
     demonstration_names: tuple[str, ...] = ()
     demonstration_motions: tuple[DemonstrationMotion, ...] = ()
+    learner: str = ""
 
     @classmethod
     def for_arm_grid(
@@ -201,6 +205,10 @@ class RunRecord:
         """The task's kind: ``"arm-grid"`` (the paper's task) or ``"arm-reach"`` (continuous)."""
         return learner_for_task(self.task).kind
 
+    def trained_by(self) -> Learner:
+        """The learner that trains the run: its task's own, or the baseline it names."""
+        return run_learner(self.learner, self.task)
+
     def arm_reach(self) -> ArmReach:
         """The task as an :class:`ArmReach` (for kind ``"arm-reach"``)."""
         if not isinstance(self.task, ArmReach):
@@ -237,6 +245,8 @@ class RunRecord:
             return self.name
         demos = len(self.demonstrations)
         extra = f", {demos} demos" if demos else ""
+        if self.learner not in ("", OWN_LEARNER):
+            return f"{self.learner} x{self.experiments}{extra}"
         return f"{self.config.planning} x{self.experiments}{extra}"
 
     def form(self) -> dict[str, object]:
@@ -281,6 +291,8 @@ class RunRecord:
         }
         if self.demonstration_motions:
             data["demonstration_motions"] = [m.to_dict() for m in self.demonstration_motions]
+        if self.learner:
+            data["learner"] = self.learner
         if self.origin == "page":
             data["request"] = self.form()
         return data
@@ -335,6 +347,11 @@ class RunRecord:
         group = data.get("group")
         if group is not None and not isinstance(group, str):
             raise LearningError(f"config.json's group is {group!r}; delete the run.")
+        chosen = data.get("learner", "")
+        try:
+            run_learner(chosen if isinstance(chosen, str) else repr(chosen), grid_or_reach)
+        except LearningError as err:
+            raise LearningError(f"config.json's learner is refused: {err}") from None
         return cls(
             task=grid_or_reach,
             coding=coding,
@@ -354,6 +371,7 @@ class RunRecord:
             demonstration_motions=tuple(
                 DemonstrationMotion.from_dict(m) for m in data.get("demonstration_motions") or ()
             ),
+            learner=str(chosen),
         )
 
 

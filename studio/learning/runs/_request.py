@@ -25,7 +25,7 @@ import numpy as np
 from ..._numbers import is_int
 from .._config import DEFAULT_EPISODES, DEFAULT_EXPERIMENTS, DEFAULT_SEED, DynaQConfig
 from .._errors import ConfigError, LearningError
-from .._registry import learner
+from .._registry import OWN_LEARNER, learner, run_learner
 from .._tiles import TileCoding
 from ..linear._learner import CODING_SETTINGS, REACH_DEFAULTS
 from ..paper._reproduce import generate_demonstrations
@@ -101,6 +101,8 @@ class RunRequest:
             dicts or six numbers each) that no move of the task may touch.
         problems: ``(field, sentence)`` the caller found already (a flag that does not apply),
             reported with the others.
+        learner: the learner that trains it: "" or ``"dyna-q"`` for its task's own, or a
+            baseline (``"teacher"``, ``"cloning"``; :func:`studio.learning.run_learner`).
     """
 
     task: str = TASK_ARM_GRID
@@ -120,6 +122,7 @@ class RunRequest:
     group: str | None = None
     obstacles: Sequence[object] = ()
     problems: Sequence[tuple[str, str]] = ()
+    learner: str = ""
 
     @classmethod
     def from_form(
@@ -175,7 +178,29 @@ def resolve_run(request: RunRequest) -> RunRecord:
                 ]
             )
     config = _dynaq_config(request.config, problems)
-    return _TASK_RUNS[request.task].record(request, config, problems)
+    record = _TASK_RUNS[request.task].record(request, config, problems)
+    return _with_learner(record, request.learner)
+
+
+def _with_learner(record: RunRecord, kind: str) -> RunRecord:
+    """``record`` trained by the learner ``kind`` asks for (its task's own by default).
+
+    Raises:
+        ConfigError: a learner that does not train the run's task, or a baseline (which learns
+            from demonstrations) without any.
+    """
+    if kind in ("", OWN_LEARNER):
+        return record
+    try:
+        chosen = run_learner(kind, record.task)
+    except LearningError as err:
+        raise ConfigError([str(err)], ["learner"]) from None
+    if not record.demonstrations:
+        raise ConfigError(
+            [f"The {chosen.title} learns from demonstrations; give the run at least one."],
+            ["learner"],
+        )
+    return replace(record, learner=chosen.kind)
 
 
 BASELINE_SUFFIX = " · no demos"

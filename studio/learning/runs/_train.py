@@ -21,7 +21,6 @@ import numpy as np
 from .._errors import LearningError
 from .._learner import ExperimentResult, LiveProgress
 from .._prepare import prepare_learner
-from .._registry import learner_for_task
 from ._record import RunRecord
 
 log = logging.getLogger(__name__)
@@ -36,11 +35,12 @@ run (20 x 50,000 episodes) spends under a tenth of a core on checkpoints."""
 def train_learner(
     record: RunRecord, live: LiveProgress, workers: int | None = None
 ) -> ExperimentResult:
-    """Run the record's experiments with its task's learner (:func:`learner_for_task`): Dyna-Q
-    on the arm grid, or linear Dyna-Q with tile coding on ``TeachStudio/ArmReach-v0``; the first
-    run on a machine compiles the kernels first."""
-    prepare_learner(record.kind, live)
-    return learner_for_task(record.task).train(record, live, workers)  # type: ignore[return-value]
+    """Run the record's experiments with its learner (:meth:`RunRecord.trained_by`): its task's
+    own, Dyna-Q on the arm grid or linear Dyna-Q with tile coding on ``TeachStudio/ArmReach-v0``,
+    or the baseline it names; the first run on a machine compiles the kernels first."""
+    chosen = record.trained_by()
+    prepare_learner(chosen.kind, live)
+    return chosen.train(record, live, workers)  # type: ignore[return-value]
 
 
 class TrainingThread:

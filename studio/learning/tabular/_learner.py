@@ -55,6 +55,7 @@ class TabularLearner:
     sweep_keys = tuple(f.name for f in fields(ArmGrid))
     shortest_paths = True
     prepare_seconds = 8.0
+    trains: type | None = ArmGrid
     watch_max_steps: int | None = ROLLOUT_MAX_STEPS
 
     def train(

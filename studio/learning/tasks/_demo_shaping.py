@@ -73,11 +73,14 @@ def demo_potential(
 ) -> DemoPotential:
     """The potential of the demonstrations' walks (each a start and its one-joint actions).
 
-    Its weight is what the task's own shaping leaves of ``weight`` (``weight - reach.shaping``,
-    at least 0): the two potentials are alike, and stacked (10 in all under the default
-    shaping) they lowered greedy success (measured, package README).
+    Its weight is the task's :attr:`ArmReach.demo_potential` when set (0: no potential), else
+    what the task's own shaping leaves of ``weight`` (``weight - reach.shaping``, at least 0):
+    the two potentials are alike, and stacked (10 in all under the default shaping) they
+    lowered greedy success (measured, package README).
     """
-    if reach is not None:
+    if reach is not None and reach.demo_potential is not None:
+        weight = reach.demo_potential
+    elif reach is not None:
         weight = max(weight - reach.shaping, 0.0)
     if reach is None or not actions or any(s is None for s in starts) or weight == 0.0:
         return no_potential(dims)

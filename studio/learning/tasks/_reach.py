@@ -43,7 +43,6 @@ Dynamics are defined once, here, in numba functions (:func:`reach_step`, :func:`
 from __future__ import annotations
 
 import dataclasses
-import itertools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -92,6 +91,7 @@ from ._reach_layout import (
     _UPPER,
     MAX_CHAIN,
     MAX_JOINTS,
+    action_directions,
 )
 from ._robot import PUMA560, check_robot, default_goal, task_arm
 
@@ -194,6 +194,10 @@ class ArmReach:
             can move as the demonstrations did.
             :func:`run_experiments` fills them from its demonstrations; without any the task
             is one joint per action.
+        demo_potential: weight of the demonstrations' shaping potential (Brys et al. 2015,
+            :mod:`._demo_shaping`), in reward per joint step; 0 switches it off; None (the
+            default) gives what :data:`._demo_shaping.DEMO_SHAPING` leaves beside ``shaping``
+            (5 under the paper's reward ``shaping=0``, 0 under the default shaping).
 
     Raises:
         LearningError: a bad value, or a goal outside the joint limits.
@@ -208,6 +212,7 @@ class ArmReach:
     actions: str = DEFAULT_ACTIONS
     robot: str = PUMA560
     paths: tuple[tuple[tuple[float, ...], ...], ...] = ()
+    demo_potential: float | None = None
 
     def __post_init__(self) -> None:
         arm = task_arm(check_robot(self.robot))
@@ -236,8 +241,11 @@ class ArmReach:
             ("position_tolerance", 1e-4, 1.0),
             ("angle_tolerance_deg", 0.1, 180.0),
             ("shaping", 0.0, MAX_SHAPING),
+            ("demo_potential", 0.0, MAX_SHAPING),
         ):
             value = getattr(self, name)
+            if name == "demo_potential" and value is None:
+                continue
             if (
                 not isinstance(value, int | float | np.integer | np.floating)
                 or isinstance(value, bool)
@@ -318,7 +326,7 @@ class ArmReach:
 
     def to_dict(self) -> dict:
         """JSON-ready settings (the inverse of ``ArmReach(**d)``; ``paths`` only when there are
-        any)."""
+        any, ``demo_potential`` only when set)."""
         return {
             "joints": self.joints,
             "step_deg": self.step_deg,
@@ -333,6 +341,7 @@ class ArmReach:
                 if self.paths
                 else {}
             ),
+            **({} if self.demo_potential is None else {"demo_potential": self.demo_potential}),
         }
 
     @classmethod
@@ -515,26 +524,6 @@ class ArmReach:
                 f"Demonstration {index} never brings the tool within {self.position_tolerance * 100:g} cm and {self.angle_tolerance_deg:g} deg of the goal; end it at the goal or make the goal its final pose."
             )
         return q[0].copy(), actions[:n].copy()
-
-
-def action_directions(joints: int, actions: str = DEFAULT_ACTIONS) -> np.ndarray:
-    """The moves of action set ``actions`` over ``joints`` joints: int8 ``(n, joints)``, -1/0/+1.
-
-    Singles first (joint 1 up, joint 1 down, joint 2 up, ...), then with ``"pairs"`` or ``"all"``
-    each pair of joints ``j < k`` as (+, +), (+, -), (-, +), (-, -), then with ``"all"`` the
-    moves of three or more joints (in ``itertools.product((1, 0, -1), repeat=joints)`` order).
-    """
-    rows: list[tuple[int, ...]] = []
-    for j in range(joints):
-        for d in (1, -1):
-            rows.append(tuple(d if i == j else 0 for i in range(joints)))
-    if actions in ("pairs", "all"):
-        for j, k in itertools.combinations(range(joints), 2):
-            for dj, dk in ((1, 1), (1, -1), (-1, 1), (-1, -1)):
-                rows.append(tuple(dj if i == j else dk if i == k else 0 for i in range(joints)))
-    if actions == "all":
-        rows += [m for m in itertools.product((1, 0, -1), repeat=joints) if sum(map(abs, m)) > 2]
-    return np.array(rows, dtype=np.int8).reshape(-1, joints)
 
 
 def tool_positions(robot: str, q: np.ndarray) -> np.ndarray:

@@ -1,8 +1,13 @@
 """The flat float64 parameter array the arm task's compiled functions take: its layout.
 
 One definition for :mod:`._reach` (the task, its dynamics and forward kinematics) and
-:mod:`._follow` (the follow action), which both read it.
+:mod:`._follow` (the follow action), which both read it; and the rows of its action table
+(:func:`action_directions`).
 """
+
+import itertools
+
+import numpy as np
 
 MAX_JOINTS = 6
 """Most joints a task learns (the first six of a seven-joint arm such as the Panda)."""
@@ -31,3 +36,23 @@ _COUNTS = _TOOL + 12  # the action table's rows, then the followed paths' points
 _TABLE = _COUNTS + 2  # per action, MAX_JOINTS directions -1/0/+1; then the followed points
 _N_PARAMS = _TABLE
 _POINT = MAX_JOINTS + 2  # a followed point: its joints, its path's last point, the path left (rad)
+
+
+def action_directions(joints: int, actions: str = "single") -> np.ndarray:
+    """The moves of action set ``actions`` over ``joints`` joints: int8 ``(n, joints)``, -1/0/+1.
+
+    Singles first (joint 1 up, joint 1 down, joint 2 up, ...), then with ``"pairs"`` or ``"all"``
+    each pair of joints ``j < k`` as (+, +), (+, -), (-, +), (-, -), then with ``"all"`` the
+    moves of three or more joints (in ``itertools.product((1, 0, -1), repeat=joints)`` order).
+    """
+    rows: list[tuple[int, ...]] = []
+    for j in range(joints):
+        for d in (1, -1):
+            rows.append(tuple(d if i == j else 0 for i in range(joints)))
+    if actions in ("pairs", "all"):
+        for j, k in itertools.combinations(range(joints), 2):
+            for dj, dk in ((1, 1), (1, -1), (-1, 1), (-1, -1)):
+                rows.append(tuple(dj if i == j else dk if i == k else 0 for i in range(joints)))
+    if actions == "all":
+        rows += [m for m in itertools.product((1, 0, -1), repeat=joints) if sum(map(abs, m)) > 2]
+    return np.array(rows, dtype=np.int8).reshape(-1, joints)
