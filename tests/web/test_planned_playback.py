@@ -69,19 +69,28 @@ def play(pipeline: Pipeline, recording, rows) -> tuple[np.ndarray, list[str | No
     return np.array(q), notes
 
 
-def test_played_from_its_start_the_robot_follows_the_planned_path(playing, ur3):
-    pipeline, recording = playing
-    pipeline.observe(recording.frame_at(0))  # the first frame asks for the plan
-    assert "Planning the Universal Robots UR3's path" in pipeline.plan_note()
-    wait_for(pipeline, "is planned")
-    q, notes = play(pipeline, recording, range(len(recording)))
-    exported = recording_motion(SAMPLE, "ur3")
+def test_played_from_its_start_the_robot_follows_the_planned_path():
+    """On a recording whose live retargeting misses frames the plan reaches: the SO-101 on
+    sample 3 (the UR3 reaches every frame of sample 2 live, since the workspace map)."""
+    so101, path = load_robot("so101"), SAMPLES_DIR / "sample-reach-3.tape.csv"
+    recording = read_any_recording(path)
+    pipeline = Pipeline()
+    pipeline.set_robot(so101)
+    pipeline.set_source(PlaybackSource(path, speed=None), "recording", "sample-reach-3")
+    try:
+        pipeline.observe(recording.frame_at(0))  # the first frame asks for the plan
+        assert f"Planning the {so101.spec.title}'s path" in pipeline.plan_note()
+        wait_for(pipeline, "is planned")
+        q, notes = play(pipeline, recording, range(len(recording)))
+        assert "follows the path planned over the whole recording" in pipeline.plan_note()
+    finally:
+        pipeline.close()
+    exported = recording_motion(path, "so101")
     np.testing.assert_array_equal(q, exported.q)  # from the first frame: the arm jumped there
-    assert "follows the path planned over the whole recording" in pipeline.plan_note()
     assert exported.path is not None
     # more frames on the hand's target than the live retargeting gives the same recording
     q_human = human_angles(recording, slice(0, len(recording)))
-    live = retarget_path(ur3, q_human, side=recording.side, as_live=True)
+    live = retarget_path(so101, q_human, side=recording.side, as_live=True)
     assert exported.path.reached.sum() > live.reached.sum()
     # where the plan turns between IK branches, the page says so, frame by frame
     turning = ~exported.path.reached & ~exported.path.out_of_reach
@@ -90,14 +99,19 @@ def test_played_from_its_start_the_robot_follows_the_planned_path(playing, ur3):
     np.testing.assert_array_equal(said, turning)
 
 
-@pytest.mark.parametrize("sample", ["sample-reach-3", "sample-reach-2"])
+@pytest.mark.parametrize(
+    ("sample", "robot"), [("sample-reach-3", "ur3"), ("sample-reach-2", "kinova")]
+)
 def test_the_robot_moves_onto_the_plan_where_it_meets_it_or_at_the_loop_never_jumping(
-    ur3, monkeypatch, sample
+    monkeypatch, sample, robot
 ):
+    """The UR3's live path on sample 3 meets its plan mid-way; the Kinova's on sample 2 never
+    does (the UR3 reaches every frame of sample 2 live since the workspace map: its plan is the
+    live path, met at once)."""
     path = SAMPLES_DIR / f"{sample}.tape.csv"
     recording = read_any_recording(path)
     pipeline = Pipeline()
-    pipeline.set_robot(ur3)
+    pipeline.set_robot(load_robot(robot))
     pipeline.set_source(PlaybackSource(path, speed=None, loop=True), "recording", sample)
     release = threading.Event()
     plan = _planned_playback.plan_recording
@@ -118,7 +132,7 @@ def test_the_robot_moves_onto_the_plan_where_it_meets_it_or_at_the_loop_never_ju
         pipeline.close()
     q = np.vstack([q_live, q_rest])
     assert np.abs(np.diff(q, axis=0)).max() <= STEP + 1e-9  # it never jumped onto the plan
-    planned = recording_motion(path, "ur3").q
+    planned = recording_motion(path, robot).q
     on_plan = np.flatnonzero(np.all(q == planned, axis=1))
     if sample == "sample-reach-3":  # the live pose meets the plan's mid-way: it joins there
         assert len(on_plan) and on_plan[0] > 40
