@@ -19,6 +19,7 @@ from ._export import FORMAT_SUFFIXES as FORMAT_SUFFIXES
 from ._export import FORMATS as FORMATS
 from ._export import Exported as Exported
 from ._export import export_motion as export_motion
+from ._export import fit_timing as fit_timing
 from ._export import simulate_motion as simulate_motion
 from ._formats import DESCRIPTION_TOPIC as DESCRIPTION_TOPIC
 from ._formats import JOINT_STATE as JOINT_STATE

@@ -31,7 +31,7 @@ from studio.physics import PhysicsError, SimulationReport
 from ._errors import ExportError
 from ._formats import write_csv, write_mcap
 from ._lerobot import lerobot_conventions, write_lerobot
-from ._safety import COLLISION_MARGIN_M, check_trajectory, refuse
+from ._safety import COLLISION_MARGIN_M, check_trajectory, limit_findings, refuse, timing_findings
 from ._simulate import simulate_trajectory
 from ._tf import link_transforms
 from ._timing import LIMIT_FRACTION, PacedPath, Slowdown, pace_path, time_path
@@ -114,6 +114,25 @@ def _pace_note(paced: PacedPath) -> str:
     if not paced.slowdowns:
         return f"{took}, from rest to rest"
     return f"{took}, from rest to rest; " + "; ".join(s.sentence for s in paced.slowdowns)
+
+
+def fit_timing(motion: Motion, rate_hz: float) -> tuple[Motion, tuple[Finding, ...]]:
+    """The motion as a person means it exported: at its own times when they keep the robot's
+    velocity and acceleration limits, else its path at the person's pace, slowed only where the
+    limits need it (:meth:`Motion.retimed` at ``rate_hz``, which :func:`export_motion` times).
+
+    A motion whose times are not final (a demonstration, a path) is returned as it is.
+
+    Returns:
+        ``(motion to export, the findings that made it slower)``: the velocity and
+        acceleration findings of its own times (empty when it kept them).
+    """
+    if not motion.timed or len(motion.times) < 2:
+        return motion, ()
+    too_fast = timing_findings(limit_findings(motion.robot, motion.times, motion.q))
+    if not too_fast:
+        return motion, ()
+    return motion.retimed(rate_hz), tuple(too_fast)
 
 
 def simulate_motion(

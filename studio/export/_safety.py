@@ -163,12 +163,22 @@ def check_trajectory(
     return sorted(findings, key=lambda f: (f.sample, f.what))
 
 
+TIMING = ("velocity", "acceleration")
+"""The kinds of finding a slower timing of the same path mends (a pose or a collision it cannot)."""
 RETIME_HINT = "pass --retime to time its path within the limits (TOPP-RA)"
 """What a refusal of a motion kept at its own times (a recording's capture times) suggests."""
 
 
+def timing_findings(findings: list[Finding]) -> list[Finding]:
+    """The findings a slower timing of the same path mends (:data:`TIMING`)."""
+    return [f for f in findings if f.what in TIMING]
+
+
 def refuse(findings: list[Finding], source: str, robot: RobotArm, *, own_times: bool) -> None:
     """Raise a :class:`SafetyError` naming the first finding, or return when there is none.
+
+    The error carries the refusal twice: for the command line, with its flags, and in plain
+    words for a page (``in_words``); the findings are the same.
 
     Args:
         own_times: the samples are at the source's own times (a recording's capture times),
@@ -180,14 +190,20 @@ def refuse(findings: list[Finding], source: str, robot: RobotArm, *, own_times: 
         return
     more = len(findings) - 1
     rest = f" (and {more} more finding{'s' if more > 1 else ''})" if more else ""
-    too_fast = any(f.what in ("velocity", "acceleration") for f in findings)
-    fix = (
-        RETIME_HINT
-        if own_times and too_fast
-        else "export a slower or other motion or for another robot"
+    problem = f"Refused: {source} for the {robot.spec.title}: {findings[0].sentence}{rest}"
+    retimes = own_times and bool(timing_findings(findings))
+    fix = RETIME_HINT if retimes else "export a slower or other motion or for another robot"
+    in_words = (
+        "at its own times it moves faster than the robot may; exported at the person's pace, "
+        "slowed only where the robot needs it, it keeps to the limits"
+        if retimes
+        else f"the {robot.spec.title} cannot make this motion as it is: export another motion "
+        "or for another robot"
     )
+    anyway = "write it anyway with every finding stated in the file"
     raise SafetyError(
-        f"Refused: {source} for the {robot.spec.title}: {findings[0].sentence}{rest}; {fix}, "
-        "or pass --unchecked to write it anyway with the findings stated in the file.",
+        f"{problem}; {fix}, or pass --unchecked to {anyway}.",
         [f.sentence for f in findings],
+        found=tuple(findings),
+        in_words=f"{problem}; {in_words}, or {anyway}.",
     )

@@ -23,6 +23,7 @@ from starlette.middleware.trustedhost import TrustedHostMiddleware
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from studio import StudioError, __version__, human_size
+from studio.export import SafetyError
 
 from ._deps import refuse_broken_text
 from ._errors import (
@@ -30,6 +31,7 @@ from ._errors import (
     StorageError,
     WebError,
     document_errors,
+    findings_public,
     os_error_answer,
 )
 from ._guard import GuardMiddleware, SiteRule
@@ -148,6 +150,9 @@ def answer_errors(app: FastAPI, settings: Settings) -> None:
     async def studio_error(request: Request, err: StudioError) -> JSONResponse:
         status = err.status_code if isinstance(err, WebError) else 422
         body: dict[str, object] = {"detail": str(err)}
+        if isinstance(err, SafetyError):  # the refusal in words (no command-line flags)
+            body["detail"] = err.in_words
+            body["findings"] = findings_public(err.found)
         reason = getattr(err, "reason", None)
         if isinstance(reason, str):
             body["reason"] = reason  # e.g. a refused demonstration: "never_reaches_goal"

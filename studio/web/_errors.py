@@ -9,14 +9,17 @@ path (:func:`storage_sentence`), answered as 507.
 
 from __future__ import annotations
 
+import dataclasses
 import errno
 import os
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
 from pydantic import BaseModel, Field
 
 from studio import StudioError
+from studio.motion import Finding
 
 
 class WebError(StudioError):
@@ -129,6 +132,21 @@ def os_error_answer(err: OSError, data_dir: Path) -> tuple[int, str]:
     return 500, f"The studio could not read or write a file ({reason}); see the server log."
 
 
+class FindingPublic(BaseModel):
+    """One problem at one sample of a robot's motion, as the safety checks found it."""
+
+    sample: int = Field(description="the sample's index (0-based row of the file)")
+    time: float = Field(description="its time (s)")
+    what: str = Field(description="position, velocity, acceleration, collision or reach")
+    where: str = Field(description="the joint's name, or the link pair a/b")
+    sentence: str = Field(description="the problem in words, with the margin")
+
+
+def findings_public(findings: Sequence[Finding]) -> list[dict[str, object]]:
+    """The findings as the API answers them (:class:`FindingPublic`)."""
+    return [FindingPublic.model_validate(dataclasses.asdict(f)).model_dump() for f in findings]
+
+
 class ErrorPublic(BaseModel):
     """What every refused request answers: one sentence, and for a refused form every bad field."""
 
@@ -138,6 +156,9 @@ class ErrorPublic(BaseModel):
     )
     problems: list[str] | None = Field(None, description="every bad field of a refused form")
     by_field: dict[str, str] | None = Field(None, description="the problems keyed by field")
+    findings: list[FindingPublic] | None = Field(
+        None, description="an export the safety checks refused (reason safety): every finding"
+    )
 
 
 ERROR_RESPONSE = "An error: one sentence saying what is wrong and how to fix it."

@@ -4,6 +4,7 @@ told when it cannot follow the hand."""
 from __future__ import annotations
 
 import io
+import json
 import zipfile
 
 import numpy as np
@@ -160,17 +161,50 @@ def test_a_demonstration_downloads_for_the_robot_in_each_format(client: TestClie
     assert "meta/info.json" in names and "data/chunk-000/file-000.parquet" in names
 
 
+def test_a_recording_too_fast_for_the_robot_exports_at_the_persons_pace_when_fitted(
+    client: TestClient,
+) -> None:
+    """The page's export (``fit``): where the capture times break the robot's limits, the path
+    goes out at the person's pace, slowed only where needed, and the answer says so in words;
+    the file states the physics report, as ``studio export``'s does."""
+    url = "/api/robot/export/recording/sample-reach-1"
+    fitted = client.get(url, params={"format": "csv", "fit": "true"})
+    assert fitted.status_code == 200, fitted.text
+    assert "# safety checks: passed" in fitted.text
+    assert "# note: at the source's pace" in fitted.text
+    assert "# physics (MuJoCo, puma560" in fitted.text
+    about = json.loads(fitted.headers["x-studio-export"])
+    assert about["timed_by"] == "pace" and about["slowed_because"]
+    assert about["slowed_because"][0]["what"] in ("velocity", "acceleration")
+    assert "person's pace" in about["said"] and "--" not in about["said"]
+    assert about["physics"] and about["physics"][0].startswith("physics (MuJoCo, puma560")
+    assert about["findings"] == []
+    # the physics check before it replays the very samples the export writes
+    report = client.get("/api/robot/simulate/recording/sample-reach-1", params={"fit": "true"})
+    assert report.status_code == 200 and report.json()["sentences"] == about["physics"]
+    # a demonstration, already at the person's pace, is not slowed for its own times
+    demo = client.get("/api/robot/export/demonstration/sample-reach-1", params={"fit": "true"})
+    assert demo.status_code == 200
+    assert json.loads(demo.headers["x-studio-export"])["slowed_because"] == []
+
+
 def test_a_recording_failing_the_checks_is_refused_in_one_sentence_unless_unchecked(
     client: TestClient,
 ) -> None:
     url = "/api/robot/export/recording/sample-reach-1"
     refused = client.get(url, params={"format": "csv"})
     assert refused.status_code == 422
-    detail = refused.json()["detail"]
+    body = refused.json()
+    detail = body["detail"]
     assert isinstance(detail, str) and detail.startswith("Refused") and " joint joint" in detail
+    # in plain words, with every finding as a structured list (the command line's flags are
+    # the CLI's rendering of the same refusal)
+    assert "--" not in detail and "person's pace" in detail
+    assert body["reason"] == "safety" and body["findings"]
+    assert {"sample", "time", "what", "where", "sentence"} <= set(body["findings"][0])
+    assert body["findings"][0]["sentence"] in detail
     written = client.get(url, params={"format": "csv", "unchecked": "true"})
     assert written.status_code == 200 and "NOT checked" in written.text
-    assert "--retime" in detail  # the page offers it as "Time it within the robot's limits"
     timed = client.get(url, params={"format": "csv", "retime": "true"})
     assert timed.status_code == 200 and "# safety checks: passed" in timed.text
     data = [line for line in timed.text.splitlines() if not line.startswith(("#", "time"))]

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import shutil
 from typing import Annotated, Literal
 
@@ -15,7 +16,9 @@ from studio.kinematics import robot_spec
 from .._deps import DemonstrationsDep, PoliciesDep, RecordingsDep, RobotsDep, SettingsDep
 from .._schemas import RobotChoice, RobotsPublic, SimulationPublic
 from ..services import (
+    EXPORT_HEADER,
     MEDIA_TYPES,
+    Download,
     ExportFormat,
     export_for_robot,
     export_rollout,
@@ -51,32 +54,47 @@ def export_for_the_robot(
     recordings: RecordingsDep,
     demonstrations: DemonstrationsDep,
     robots: RobotsDep,
+    settings: SettingsDep,
     format: ExportFormat = "csv",
     unchecked: bool = False,
     robot: str | None = None,
     retime: bool = False,
+    fit: bool = False,
     limit_margin: Annotated[float | None, Query(ge=0.0)] = None,
 ) -> FileResponse:
-    """A recording or demonstration as the chosen robot's joint trajectory, retargeted, timed
-    and checked for safety as ``studio export SOURCE --robot NAME --format FORMAT`` does: CSV,
-    MCAP (ROS 2 messages) or a zipped LeRobotDataset v3.0. Failed checks answer 422 with one
-    sentence naming the sample, joint and margin; ``unchecked`` writes the file anyway with the
-    findings stated in it (``reason`` "safety" in the 422 says the checks refused it). A
-    recording keeps its capture times unless ``retime`` times its path within the robot's
-    limits, as a demonstration's is (``studio export --retime``). ``limit_margin`` (rad) is kept
-    from every joint's hard limit by the retargeting, the timing and the checks (``studio export
-    --limit-margin``; default ``LIMIT_MARGIN_RAD``). For the robot taught unless
-    ``robot`` names another (an unknown name: 422 with the list). 404 for no such recording or
-    demonstration."""
+    """A recording or demonstration as the chosen robot's joint trajectory, retargeted, timed,
+    checked for safety and replayed in physics as ``studio export SOURCE --robot NAME --format
+    FORMAT`` does, the physics report stated in the file: CSV, MCAP (ROS 2 messages) or a
+    zipped LeRobotDataset v3.0.
+
+    Failed checks answer 422 with one sentence in plain words naming the sample, joint and
+    margin, ``reason`` "safety" and every finding (``findings``); ``unchecked`` writes the file
+    anyway with the findings stated in it. A recording keeps its capture times unless
+    ``retime`` times its path as a demonstration's is (at the person's pace, slower only where
+    the robot's limits need it), or ``fit`` does so only where its capture times break those
+    limits (what the page asks). The ``X-Studio-Export`` header says in words what the export
+    did (JSON: ``said``, ``timed_by``, ``slowed_because``, ``slowdowns``, ``findings``,
+    ``physics``). For the robot taught unless ``robot`` names another (an unknown name: 422 with
+    the list). 404 for no such recording or demonstration."""
     store = recordings if kind == "recording" else demonstrations.store
     path = store.path(name)
     target = robot_spec(robot).name if robot is not None else robots.taught
-    out, filename, folder = export_for_robot(path, target, format, unchecked, retime, limit_margin)
+    cache = physics_cache_dir(settings.data_dir)
+    done = export_for_robot(
+        path, target, format, unchecked, retime, limit_margin, fit=fit, cache=cache
+    )
+    return _send(done, MEDIA_TYPES[format])
+
+
+def _send(done: Download, media_type: str) -> FileResponse:
+    """The download, with what the export did in its ``X-Studio-Export`` header (ASCII JSON),
+    its temporary folder removed once sent."""
     return FileResponse(
-        out,
-        media_type=MEDIA_TYPES[format],
-        filename=filename,
-        background=BackgroundTask(shutil.rmtree, folder, ignore_errors=True),
+        done.file,
+        media_type=media_type,
+        filename=done.name,
+        headers={EXPORT_HEADER: json.dumps(done.about)},
+        background=BackgroundTask(shutil.rmtree, done.folder, ignore_errors=True),
     )
 
 
@@ -90,41 +108,49 @@ def simulate_for_the_robot(
     settings: SettingsDep,
     robot: str | None = None,
     retime: bool = False,
+    fit: bool = False,
     limit_margin: Annotated[float | None, Query(ge=0.0)] = None,
 ) -> SimulationPublic:
     """The physics report ``/api/robot/export/{kind}/{name}`` (and ``studio export``) would
     state in the file, before exporting: the same samples replayed in MuJoCo on the robot's own
     URDF (its motors' force limits, gravity, the table), as ``studio simulate --json`` reports
-    them, with the report's sentences (``limit_margin`` as the export's). For the robot taught unless ``robot`` names another (an
-    unknown name: 422); 404 for no such recording or demonstration."""
+    them, with the report's sentences. For the robot taught unless ``robot`` names another (an
+    unknown name: 422); ``retime``, ``fit`` and ``limit_margin`` as the export's. 404 for no
+    such recording or demonstration."""
     store = recordings if kind == "recording" else demonstrations.store
     path = store.path(name)
     target = robot_spec(robot).name if robot is not None else robots.taught
     cache = physics_cache_dir(settings.data_dir)
-    report = simulate_for_robot(path, target, retime, cache, limit_margin)
+    report = simulate_for_robot(path, target, retime, cache, limit_margin, fit=fit)
     return SimulationPublic.model_validate({**report.as_json(), "sentences": report.sentences()})
 
 
 @router.get("/api/robot/export/rollout.mcap", responses=file_responses("application/octet-stream"))
 def export_the_rollout(
     policies: PoliciesDep,
+    settings: SettingsDep,
     run: str | None = None,
     policy: str | None = None,
     unchecked: bool = False,
+    fit: bool = False,
 ) -> FileResponse:
     """The rollout last watched of a run's policy (``?run=<id>``) or an uploaded one
     (``?policy=<name>``) as an MCAP of ROS 2 ``trajectory_msgs/msg/JointTrajectory`` for the
-    robot it was learnt on, at its own times, checked for safety as ``studio export`` checks it
-    (``/api/watch/trajectory.csv`` is the same rollout as CSV). Failed checks answer 422 with
-    one sentence (``reason`` "safety"); ``unchecked`` writes it anyway with the findings stated
-    in it. 409 when that policy has not been watched yet."""
+    robot it was learnt on, at its own times (``fit``: timed within the robot's limits where
+    those times break them), checked for safety and replayed in physics as ``studio export``
+    does, the report stated in the file (``/api/watch/trajectory.csv`` is the same rollout as
+    CSV). Failed checks answer 422 with one sentence (``reason`` "safety", ``findings``);
+    ``unchecked`` writes it anyway with the findings stated in it. The ``X-Studio-Export``
+    header says what the export did. 409 when that policy has not been watched yet."""
     watched = policies.watched(run, policy)
-    out, filename, folder = export_rollout(
-        watched.path, watched.robot, watched.name, watched.times, watched.q, unchecked
+    done = export_rollout(
+        watched.path,
+        watched.robot,
+        watched.name,
+        watched.times,
+        watched.q,
+        unchecked,
+        fit=fit,
+        cache=physics_cache_dir(settings.data_dir),
     )
-    return FileResponse(
-        out,
-        media_type=MEDIA_TYPES["mcap"],
-        filename=filename,
-        background=BackgroundTask(shutil.rmtree, folder, ignore_errors=True),
-    )
+    return _send(done, MEDIA_TYPES["mcap"])

@@ -11,7 +11,9 @@ from ._demonstrations import Demonstrations as Demonstrations
 from ._policies import Policies as Policies
 from ._policies import PolicySource as PolicySource
 from ._review import Reviewer as Reviewer
+from ._robot_export import EXPORT_HEADER as EXPORT_HEADER
 from ._robot_export import MEDIA_TYPES as MEDIA_TYPES
+from ._robot_export import Download as Download
 from ._robot_export import ExportFormat as ExportFormat
 from ._robot_export import export_for_robot as export_for_robot
 from ._robot_export import export_rollout as export_rollout

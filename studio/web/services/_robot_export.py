@@ -8,6 +8,7 @@ import errno
 import shutil
 import tempfile
 from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Literal, get_args
 
@@ -17,16 +18,18 @@ from studio.capture import DEMO_SUFFIX, RECORDING_SUFFIXES
 from studio.export import (
     FORMAT_SUFFIXES,
     FORMATS,
+    Exported,
     ExportError,
     check_policy_robot,
     export_motion,
+    fit_timing,
     simulate_motion,
 )
 from studio.learning import ROLLOUT_RATE_HZ
-from studio.motion import Motion, demonstration_motion, recording_motion
+from studio.motion import Finding, Motion, demonstration_motion, recording_motion
 from studio.physics import SimulationReport
 
-from .._errors import STORAGE_PROBLEMS, StorageError
+from .._errors import STORAGE_PROBLEMS, StorageError, findings_public
 
 ExportFormat = Literal["csv", "mcap", "lerobot"]
 """The formats of :data:`studio.export.FORMATS`, as the API's query parameter."""
@@ -40,13 +43,74 @@ MEDIA_TYPES = {
 """What each format's download is (a LeRobot dataset, a folder, comes zipped)."""
 
 
-def _motion(path: Path, robot: str, retime: bool, limit_margin: float | None = None) -> Motion:
+@dataclass(frozen=True)
+class Download:
+    """An export written for the page to download.
+
+    Attributes:
+        file: the file to send.
+        name: its download name.
+        folder: the temporary folder to remove after sending it.
+        about: what the export did, in words (:func:`_about`), for the page to show beside its
+            buttons: the timing, why it is slower than its source, the findings written in it,
+            and the physics report the file states.
+    """
+
+    file: Path
+    name: str
+    folder: Path
+    about: dict[str, object]
+
+
+EXPORT_HEADER = "X-Studio-Export"
+"""The download's header that says in words what the export did (:attr:`Download.about`)."""
+MOST_FINDINGS = 20
+"""The most findings :attr:`Download.about` lists (the file states every one)."""
+
+
+def _motion(
+    path: Path, robot: str, retime: bool, fit: bool, limit_margin: float | None = None
+) -> tuple[Motion, tuple[Finding, ...]]:
     """A recording's or demonstration's motion on ``robot`` as the page exports it, keeping
-    ``limit_margin`` (rad; None: the default) from every joint's hard limit."""
+    ``limit_margin`` (rad; None: the default) from every joint's hard limit, and the findings of
+    its own times that made it slower (``fit``: :func:`studio.export.fit_timing`)."""
     if path.name.endswith(DEMO_SUFFIX):
-        return demonstration_motion(path, robot, ROLLOUT_RATE_HZ, limit_margin)
+        return demonstration_motion(path, robot, ROLLOUT_RATE_HZ, limit_margin), ()
     motion = recording_motion(path, robot, limit_margin=limit_margin)
-    return motion.retimed(ROLLOUT_RATE_HZ) if retime else motion
+    if retime:
+        return motion.retimed(ROLLOUT_RATE_HZ), ()
+    return fit_timing(motion, ROLLOUT_RATE_HZ) if fit else (motion, ())
+
+
+def _about(motion: Motion, done: Exported, too_fast: tuple[Finding, ...]) -> dict[str, object]:
+    """What an export did, said in words with no command-line flag, for the page."""
+    title = motion.robot.spec.title
+    if too_fast:
+        said = (
+            f"At its own times the {motion.kind} moves faster than the {title} may "
+            f"({too_fast[0].sentence}), so it was exported at the person's pace, slowed only "
+            "where the robot needs it, from rest to rest."
+        )
+    elif done.timed_by == "pace":
+        slowed = ", slowed only where the robot needs it," if done.slowdowns else ""
+        said = f"Exported at the person's pace{slowed} from rest to rest."
+    elif done.timed_by == "source":
+        said = "Exported at its own times."
+    else:
+        said = f"Exported as fast as the {title}'s limits allow, from rest to rest."
+    if done.findings:
+        said += (
+            f" Not safe for the {title} as it is: {len(done.findings)} finding(s), each stated "
+            "in the file."
+        )
+    return {
+        "said": said,
+        "timed_by": done.timed_by,
+        "slowed_because": findings_public(too_fast[:MOST_FINDINGS]),
+        "slowdowns": [s.sentence for s in done.slowdowns],
+        "findings": findings_public(done.findings[:MOST_FINDINGS]),
+        "physics": done.physics.sentences() if done.physics is not None else [],
+    }
 
 
 def simulate_for_robot(
@@ -55,6 +119,8 @@ def simulate_for_robot(
     retime: bool = False,
     cache: Path | None = None,
     limit_margin: float | None = None,
+    *,
+    fit: bool = False,
 ) -> SimulationReport:
     """The physics report :func:`export_for_robot` would state in its file, before exporting:
     the same samples replayed in MuJoCo (``cache``: where the robot's MuJoCo files are kept).
@@ -62,7 +128,7 @@ def simulate_for_robot(
     Raises:
         PhysicsError, ExportError, KinematicsError: no model can be built, an unknown robot.
     """
-    return simulate_motion(_motion(path, robot, retime, limit_margin), cache=cache)
+    return simulate_motion(_motion(path, robot, retime, fit, limit_margin)[0], cache=cache)
 
 
 def export_for_robot(
@@ -72,16 +138,22 @@ def export_for_robot(
     unchecked: bool = False,
     retime: bool = False,
     limit_margin: float | None = None,
-) -> tuple[Path, str, Path]:
+    *,
+    fit: bool = False,
+    cache: Path | None = None,
+) -> Download:
     """Export a recording or demonstration ``path`` for ``robot`` as ``fmt`` into a fresh
-    temporary folder (``unchecked``: written despite failed checks, the findings stated in it;
-    a demonstration timed within the limits at the rollout rate, a recording at its capture
-    times, or timed as a demonstration is with ``retime``; ``limit_margin``: rad kept from
-    every joint's hard limit by the retargeting, the timing and the checks, as ``studio export
-    --limit-margin`` keeps it; None: the default).
+    temporary folder, with the physics report stated in it as ``studio export`` states it.
 
-    Returns:
-        ``(file, download name, folder)``: the file to send and the folder to remove after.
+    Args:
+        unchecked: written despite failed checks, the findings stated in it.
+        retime: a recording timed as a demonstration is (at the person's pace, slower only
+            where the limits need it), not at its capture times.
+        fit: a recording at its capture times where they keep the robot's limits, else timed
+            as with ``retime`` (:func:`studio.export.fit_timing`): what the page's export asks.
+        limit_margin: rad kept from every joint's hard limit by the retargeting, the timing and
+            the checks, as ``studio export --limit-margin`` keeps it (None: the default).
+        cache: where the robot's MuJoCo files are kept (None: a temporary folder).
 
     Raises:
         SafetyError: the trajectory fails the safety checks (nothing is written).
@@ -90,17 +162,20 @@ def export_for_robot(
     stem = path.name
     for ending in (DEMO_SUFFIX, *RECORDING_SUFFIXES):
         stem = stem.removesuffix(ending)
-    motion = _motion(path, robot, retime, limit_margin)
+    motion, too_fast = _motion(path, robot, retime, fit, limit_margin)
+    done: list[Exported] = []
 
     def write(folder: Path) -> Path:
         out = folder / f"{stem}.{robot}{FORMAT_SUFFIXES[fmt]}"
-        export_motion(motion, fmt, out, unchecked=unchecked)
+        done.append(
+            export_motion(motion, fmt, out, unchecked=unchecked, simulate=True, cache=cache)
+        )
         if fmt == "lerobot":
             out = Path(shutil.make_archive(str(out), "zip", root_dir=out))
         return out
 
     out, folder = _in_a_temporary_folder(write)
-    return out, out.name, folder
+    return Download(out, out.name, folder, _about(motion, done[0], too_fast))
 
 
 def export_rollout(
@@ -110,13 +185,14 @@ def export_rollout(
     times: np.ndarray,
     q: np.ndarray,
     unchecked: bool = False,
-) -> tuple[Path, str, Path]:
+    *,
+    fit: bool = False,
+    cache: Path | None = None,
+) -> Download:
     """A policy's watched rollout ``(times, q)`` as an MCAP of its robot's
-    ``JointTrajectory``, at the rollout's own times, checked for safety first (``unchecked``:
-    written despite failed checks, the findings stated in it).
-
-    Returns:
-        ``(file, download name, folder)``, as :func:`export_for_robot`.
+    ``JointTrajectory``, at the rollout's own times (``fit``: unless they break the robot's
+    limits, then timed within them), checked for safety first (``unchecked``: written despite
+    failed checks, the findings stated in it), with the physics report stated in it.
 
     Raises:
         SafetyError: the rollout fails the safety checks (nothing is written).
@@ -124,14 +200,18 @@ def export_rollout(
     """
     arm = check_policy_robot(policy, robot, robot)
     motion = Motion("policy", policy.name, arm, times, q, True, ROLLOUT_RATE_HZ)
+    motion, too_fast = fit_timing(motion, ROLLOUT_RATE_HZ) if fit else (motion, ())
+    done: list[Exported] = []
 
     def write(folder: Path) -> Path:
         out = folder / f"{name}.rollout{FORMAT_SUFFIXES['mcap']}"
-        export_motion(motion, "mcap", out, unchecked=unchecked)
+        done.append(
+            export_motion(motion, "mcap", out, unchecked=unchecked, simulate=True, cache=cache)
+        )
         return out
 
     out, folder = _in_a_temporary_folder(write)
-    return out, out.name, folder
+    return Download(out, out.name, folder, _about(motion, done[0], too_fast))
 
 
 def _in_a_temporary_folder(write: Callable[[Path], Path]) -> tuple[Path, Path]:

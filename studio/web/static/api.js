@@ -71,8 +71,9 @@ export function inTurn() {
 }
 
 /** Fetch a file and save it, so that a refusal (409, 404) shows up as a message, not a page.
- * Returns the refusal's body (``{detail, reason}``) when the studio refused, else null. */
-export async function download(url, fallbackName, errId) {
+ * Returns the refusal's body (``{detail, reason}``) when the studio refused, else null;
+ * ``onSaved`` (optional) is given the response of a file saved (its headers). */
+export async function download(url, fallbackName, errId, onSaved) {
   showError(errId, null);
   let resp;
   try {
@@ -98,6 +99,7 @@ export async function download(url, fallbackName, errId) {
   document.body.appendChild(a);
   a.click();
   setTimeout(() => { URL.revokeObjectURL(a.href); a.remove(); }, 1000);
+  if (onSaved) onSaved(resp);
   return null;
 }
 
