@@ -205,10 +205,13 @@ async function loadJog() {
   });
 }
 
+/** One joint's slider, from its usable lower to its upper limit. Any step: Home and End put the
+ * joint at its limit exactly (a step counted from a limit such as -158.85° stops short of the
+ * other end). */
 function jointRow(j, value) {
   const label = j.name[0].toUpperCase() + j.name.slice(1);
   const v = Math.min(Math.max(value, j.lower_deg), j.upper_deg);
-  const input = el("input", { type: "range", class: "grow", min: String(j.lower_deg), max: String(j.upper_deg), step: "0.5", value: String(v), "aria-label": label, title: j.joint, testid: "jog-joint" });
+  const input = el("input", { type: "range", class: "grow", min: String(j.lower_deg), max: String(j.upper_deg), step: "any", value: String(v), "aria-label": label, title: j.joint, testid: "jog-joint" });
   const shown = el("span", { class: "mono w5", testid: "jog-value", text: `${fmt(v, 1)}°` });
   input.addEventListener("input", () => { setText(shown, `${fmt(Number(input.value), 1)}°`); jog(); });
   return el("div", { class: "row jog-row" },
