@@ -1,6 +1,6 @@
 """Every baseline beside Dyna-Q on one split: what did the work when a robot learns from demonstrations?
 
-``python benchmarks/bench_teacher.py [--episodes 400] [--starts 200] [--planning-steps 0]
+``python benchmarks/bench_teacher.py [--episodes 1000] [--starts 200] [--planning-steps 0]
 [--seed 0] [--quick]``
 
 The split, the same for every row:
@@ -190,7 +190,7 @@ def dyna_rows(task, demos, starts, pace, arm, budgets, seed, planning_steps) -> 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--episodes", type=int, default=400, help="the largest budget")
+    parser.add_argument("--episodes", type=int, default=1000, help="the largest budget")
     parser.add_argument("--starts", type=int, default=200)
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--planning-steps", type=int, default=0, help="0: zero planning")

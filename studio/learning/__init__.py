@@ -54,6 +54,7 @@ from .likeness._likeness import puma_tool_positions as puma_tool_positions
 from .likeness._likeness import sparc as sparc
 from .likeness._policy import policy_likeness_card as policy_likeness_card
 from .likeness._run import likeness_cards as likeness_cards
+from .linear._learner import FORM_ACTIONS as FORM_ACTIONS
 from .linear._learner import REACH_DEFAULTS as REACH_DEFAULTS
 from .linear._linear import greedy_rollout as greedy_rollout
 from .linear._policy import DEFAULT_MAX_STEPS as TILE_ROLLOUT_MAX_STEPS  # noqa: F401 (re-export)

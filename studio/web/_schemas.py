@@ -27,6 +27,7 @@ from studio.learning import (
     DEFAULT_EXPERIMENTS,
     DEFAULT_GOAL_JOINTS_DEG,
     DEFAULT_SEED,
+    FORM_ACTIONS,
     REACH_DEFAULTS,
     TASK_KINDS,
     ArmGrid,
@@ -545,11 +546,12 @@ RUN_TASK_TAGS = TASK_KINDS
 
 
 class RunDefaults(GridRunCreate):
-    """The train form's defaults (every task's fields, the learning package's defaults)."""
+    """The train form's defaults (every task's fields, the learning package's defaults; the
+    continuous task's actions the form's own, :data:`studio.learning.FORM_ACTIONS`)."""
 
     joints: int = REACH_DEFAULTS["joints"]
     step_deg: float = REACH_DEFAULTS["step_deg"]
-    actions: str = REACH_DEFAULTS["actions"]
+    actions: str = FORM_ACTIONS
     tilings: int = REACH_DEFAULTS["tilings"]
     tiles: int | None = REACH_DEFAULTS["tiles"]
 

@@ -63,6 +63,14 @@ REACH_DEFAULTS: Final = {
 """The continuous task's settings a person sets, and their defaults (:class:`ArmReach` and its
 default :meth:`ArmReach.features`; ``tiles`` None: the robot's :attr:`ArmReach.default_tiles`,
 32 for the Puma560)."""
+FORM_ACTIONS = "single"
+"""The action set the page's train form starts the continuous task with: one joint per action.
+With the follow action (:data:`REACH_DEFAULTS`' ``"follow"``, the default of ``studio train`` and
+the API) a run taught by a demonstration presses the teacher's button from its first own episode:
+its curve starts at the teacher's level and stays there, so a person who ticks a sample and
+presses Start sees nothing learn (issue 40). With one joint per action the curve falls within the
+first episodes with or without a sample (``tests/web/test_form_curve.py``); the follow
+action stays the form's other choice, "one joint, or follow the demonstrations"."""
 CODING_SETTINGS = ("tilings", "tiles", "size")
 """The continuous task's tile-coding settings (:meth:`ArmReach.features`); its other settings
 are :class:`ArmReach` fields."""
