@@ -39,6 +39,7 @@ class SceneRobot:
     _wake: threading.Event
     _q_robot_shown: np.ndarray
     _playback: Playback | None
+    _place_reach: Callable[[], None]  # SceneReach's
 
     def _init_robot(self, views: RobotViews) -> None:
         self._views = views
@@ -75,6 +76,7 @@ class SceneRobot:
             self._q_robot_shown = view.q0.copy()
         self._view = view  # last: readers of the name see its meshes and its pose
         self._place_goal()  # this robot's goal, if it has one
+        self._place_reach()  # its workspace
         if view.pedestal > 0:
             self._pedestal = self.server.scene.add_box(
                 "/robot_pedestal",

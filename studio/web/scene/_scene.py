@@ -47,6 +47,7 @@ from ._model import camera_projection as camera_projection
 from ._operator import SceneOperator, _placed
 from ._paths import ScenePaths
 from ._protocols import LivePose
+from ._reach import SceneReach
 from ._robot import PUMA, SceneRobot
 from ._robot_view import RobotViews
 from ._views import SceneCamera
@@ -87,7 +88,7 @@ class _Live:
     version: int
 
 
-class StudioScene(ScenePaths, SceneRobot, SceneOperator):
+class StudioScene(ScenePaths, SceneRobot, SceneOperator, SceneReach):
     """The studio's viser scene, fed by the live pipeline and by playbacks.
 
     The operator wears one tape: the taped arm follows the fit, the other arm rests (there is no
@@ -216,6 +217,7 @@ class StudioScene(ScenePaths, SceneRobot, SceneOperator):
             precision="float32",
             visible=False,
         )
+        self._build_reach()
         reset = self.server.gui.add_button("Reset view", hint="Frame both bodies again")
         reset.on_click(lambda event: self.reset_view(event.client))
         # viser's control panel floats over the scene by default (its connection status and
@@ -328,6 +330,8 @@ class StudioScene(ScenePaths, SceneRobot, SceneOperator):
                 self._push_operator(operator, live.posed, whole=operator_changed)
             elif operator_changed:
                 self._push_operator(operator, operator.rest, whole=True)
+            if operator_changed:
+                self._place_reach()  # the other shoulder
             if robot_changed and pose.q_robot is not None:
                 self._push_robot(self._robot_handles, pose.q_robot)
                 if self.camera.following and len(pose.q_robot) == self._view.nq:
