@@ -156,6 +156,19 @@ def test_an_so_arm_is_written_as_lerobots_own_follower_records_it(robot, tmp_pat
     assert info["teach_studio"]["units"]["gripper.pos"] == "percent open"
 
 
+def test_the_so101s_wrist_joints_move_in_its_file(tmp_path):
+    """Every joint that moves in the source moves in the file: the SO-101 follows the hand's
+    position with all five joints, its wrist's two included (they stayed at 0 once)."""
+    motion = demonstration_motion(SAMPLES_DIR / "sample-reach-2.demo.json", "so101", 30.0)
+    out = tmp_path / "reach"
+    export_motion(motion, "lerobot", out, unchecked=True)
+    names = json.loads((out / "meta/info.json").read_text())["features"]["action"]["names"]
+    data = pq.read_table(out / "data/chunk-000/file-000.parquet").to_pydict()
+    state = np.array(data["observation.state"], dtype=float)
+    for motor in ("wrist_flex.pos", "wrist_roll.pos"):
+        assert np.ptp(state[:, names.index(motor)]) > 10.0  # degrees
+
+
 def test_another_arm_keeps_its_urdf_names_in_radians_and_says_so(tmp_path):
     motion = demonstration_motion(SAMPLES_DIR / "sample-reach-1.demo.json", "panda", 30.0)
     out = tmp_path / "reach"
