@@ -23,6 +23,7 @@ from ._capture_loop import describe as describe
 from ._capture_loop import parse_host_port as parse_host_port
 from ._capture_loop import source_from_spec as source_from_spec
 from ._demonstration import DEMO_FORMAT as DEMO_FORMAT
+from ._demonstration import DEMO_ROBOT as DEMO_ROBOT
 from ._demonstration import Demonstration as Demonstration
 from ._demonstration import load_demonstration as load_demonstration
 from ._demonstration import track_segment as track_segment

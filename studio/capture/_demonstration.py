@@ -53,8 +53,10 @@ DEMO_FORMAT = "teach-studio-demonstration"
 """The ``format`` value of demonstration files."""
 DEMO_VERSION = 2
 """The version this code writes and the newest it reads (2 adds ``robot``)."""
-DEMO_ROBOT = "puma560"
-"""The robot a demonstration's ``q_robot`` is for (the learning tasks' arm)."""
+DEMO_ROBOT = Puma560.name
+"""The robot a demonstration's ``q_robot`` is for: the one the capture chain
+(:class:`studio.kinematics.ArmTracker`) mirrors the arm onto, whose path a recording's series holds
+too. A motion on this robot uses that stored path; on any other it is retargeted."""
 MAX_FIT_RESIDUAL_M = 0.03
 """Largest RMS landmark residual (m) of any frame's arm fit before a segment counts as a bad fit:
 3 cm is well above the fit of a well-placed tape with sensor noise, and well below a misplaced

@@ -35,7 +35,6 @@ from studio.export import (
     source_kind,
 )
 from studio.kinematics import (
-    DEFAULT_ROBOT,
     LIMIT_MARGIN_RAD,
     KinematicsError,
     RobotArm,
@@ -311,9 +310,9 @@ def _say_retargeting(source: Path, robot: str) -> None:
     """Tell a person at a terminal that a human-arm motion is being retargeted onto ``robot``:
     with its IK branches planned, that takes seconds a minute of recording, and a long one
     would otherwise look stuck. Said only to a terminal, so a script's stderr still holds
-    nothing but the one sentence of a refusal. The Puma560 (the default robot) maps joint to
-    joint, at once."""
-    if robot == DEFAULT_ROBOT or not sys.stderr.isatty() or robot not in robot_names():
+    nothing but the one sentence of a refusal. A robot whose joints follow the arm's one by one
+    (joint mode: the Puma560's) takes the motion at once."""
+    if not sys.stderr.isatty() or robot not in robot_names() or robot_spec(robot).joint_mode:
         return
     print(
         f"Retargeting {source.name} onto the {robot_spec(robot).title}, its IK branches planned "

@@ -43,7 +43,6 @@ from studio.learning import (
     CLONING_KIND,
     DEFAULT_EPISODES,
     DEFAULT_EXPERIMENTS,
-    DEFAULT_GOAL_JOINTS_DEG,
     DEFAULT_SEED,
     DEMO_SHAPING,
     OWN_LEARNER,
@@ -392,8 +391,7 @@ def _reach_request(args: argparse.Namespace) -> RunRequest:
         if getattr(args, flag) is not None
     ]
     robot = args.robot or DEFAULT_ROBOT
-    # the Puma560's goal in degrees as the page sends it; another robot's default goal pose whole
-    goal_deg = list(DEFAULT_GOAL_JOINTS_DEG) if robot == DEFAULT_ROBOT else None
+    goal_deg = None  # the robot's default goal pose, whole
     if args.goal_deg is not None:
         goal_deg = _numbers(args.goal_deg, "--goal-deg", float, "0,45,-90")
     recorded = []

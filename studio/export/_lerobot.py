@@ -29,6 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from studio._files import make_temp_dir
+from studio.kinematics import robot_names, robot_spec
 
 from ._errors import ExportError
 
@@ -47,8 +48,6 @@ QUANTILES = (0.01, 0.10, 0.50, 0.90, 0.99)
 """The quantiles lerobot's stats carry (``q01`` ... ``q99``)."""
 
 
-SO_FOLLOWERS = {"so100": "so100_follower", "so101": "so101_follower"}
-"""The robots LeRobot drives itself, by the ``robot_type`` its driver registers."""
 GRIPPER_OPEN = 100.0
 """The SO followers' ``gripper.pos`` while the studio teaches no gripper: open. LeRobot's
 calibration maps the gripper's range onto 0 (closed) .. 100 (open) (``MotorNormMode.RANGE_0_100``)."""
@@ -94,10 +93,12 @@ def lerobot_conventions(
     names in radians.
     """
     names = tuple(joint_names)
-    if robot in SO_FOLLOWERS:
+    # the driver LeRobot drives the arm with (the registry's ``lerobot_driver``), if any
+    driver = robot_spec(robot).lerobot_driver if robot in robot_names() else ""
+    if driver:
         middle = (np.asarray(lower, dtype=float) + np.asarray(upper, dtype=float)) / 2.0
         return LeRobotConventions(
-            SO_FOLLOWERS[robot],
+            driver,
             (*(f"{name}.pos" for name in names), "gripper.pos"),
             (*("deg" for _ in names), "percent open"),
             middle,

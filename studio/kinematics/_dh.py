@@ -24,6 +24,21 @@ from xml.sax.saxutils import quoteattr
 import numpy as np
 import pinocchio as pin
 
+PUMA_READY_DEG = (0.0, 45.0, -90.0, 0.0, 0.0, 0.0)
+"""The Puma560's ``RobotSpec.ready``, the paper's goal: the paper shows its goal only as a picture
+(Fig. 7), so joints 1-3 at (0, 45, -90) (an arm reaching forward and down, inside the limits), the
+wrist at 0."""
+
+PAPER_GRID_RANGE_DEG = (-180.0, 180.0)
+"""The paper's range of every joint, degrees (its task space: 11 bins over [-180, 180] for joints
+1-3, giving 1331 states): the Puma560's ``RobotSpec.grid_range_deg``."""
+
+PUMA_WRIST_PAIRS = (("link4", "link6"),)
+"""The Puma560's ``RobotSpec.close_by_design``: its wrist links 4 and 6 (rtb-data's meshes) both
+hug the wrist centre, 2.5 mm apart at every pose (at rest, and over the three sample
+demonstrations), so a clearance of more than that refused every motion; joint 5 between them
+turns within its +-100 degrees without the two meeting."""
+
 
 @dataclass(frozen=True)
 class DHRow:

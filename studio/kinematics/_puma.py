@@ -401,8 +401,11 @@ class Puma560:
         lower, upper: joint limits (rad, shape (6,), read-only).
         qz, qr, qn, qs: Corke's named poses (see ``PUMA_QZ`` etc.).
         reach: largest distance from the shoulder (joint 2's axis on joint 1's) to the tool (m).
+        name: its name in the robot registry (:func:`studio.kinematics.load_robot` loads the
+            same robot, built from the same DH table, as a ``RobotArm``).
     """
 
+    name = "puma560"
     nq = 6
     qz = PUMA_QZ
     qr = PUMA_QR
@@ -434,7 +437,7 @@ class Puma560:
 
     def _build_model(self) -> pin.Model:
         model = pin.Model()
-        model.name = "puma560"
+        model.name = self.name
         parent, placement = 0, pin.SE3.Identity()
         for i, row in enumerate(self.dh, start=1):
             parent = model.addJoint(parent, pin.JointModelRZ(), placement, f"joint{i}")

@@ -29,7 +29,9 @@ import contextlib
 import hashlib
 import json
 import logging
+import math
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -42,7 +44,7 @@ import numpy as np
 import pinocchio as pin
 
 from ._checks import KinematicsError
-from ._robots import RobotArm, RobotSpec, _bounded_urdf, robot_spec, robots_folder
+from ._robots import RobotArm, RobotSpec, robot_spec, robots_folder
 
 log = logging.getLogger(__name__)
 
@@ -65,6 +67,42 @@ _PARTS = ("model", "visual", "collision")
 """The files a child writes, one Pinocchio binary archive each."""
 _REFUSED = "refused.txt"
 """The file a child writes instead: the sentence of the error that refused the robot."""
+
+
+_CONTINUOUS = re.compile(r'(<joint\b[^>]*\btype=")continuous(")')
+
+
+def _bounded_urdf(text: str) -> str:
+    """``text`` with every ``continuous`` joint made ``revolute`` with limits of +-2 pi.
+
+    Pinocchio gives a continuous joint two coordinates (cos, sin); one angle per joint is what
+    limits, trajectories and exports speak, and +-2 pi is a full turn each way.
+    """
+
+    def revolute(match: re.Match[str]) -> str:
+        return f"{match.group(1)}revolute{match.group(2)}"
+
+    text = _CONTINUOUS.sub(revolute, text)
+    links = set(re.findall(r'<link\s+name="([^"]+)"', text))
+    for name in set(re.findall(r'<joint\s+name="([^"]+)"', text)) & links:
+        # A joint named like a link (SO-100's "gripper") makes Pinocchio's frame lookups ambiguous.
+        text = text.replace(f'<joint name="{name}"', f'<joint name="{name}_joint"')
+
+    def add_limit(joint: re.Match[str]) -> str:
+        body = joint.group(0)
+        if 'type="revolute"' not in body:
+            return body
+        limit = re.search(r"<limit\b[^>]*/>", body)
+        bounds = f'lower="{-2 * math.pi:.6f}" upper="{2 * math.pi:.6f}"'
+        if limit is None:
+            return body.replace(
+                "</joint>", f'<limit {bounds} effort="100" velocity="1.0"/></joint>'
+            )
+        if "lower=" in limit.group(0):
+            return body
+        return body.replace(limit.group(0), limit.group(0).replace("<limit", f"<limit {bounds}"))
+
+    return re.sub(r"<joint\b.*?</joint>", add_limit, text, flags=re.S)
 
 
 def isolate_robot_loading(cache: Path | None = None) -> None:

@@ -35,7 +35,7 @@ import pinocchio as pin
 
 from ._chain_ik import ChainSolve, SerialChain, solve
 from ._checks import KinematicsError, real_array
-from ._dh import puma560_urdf
+from ._dh import PAPER_GRID_RANGE_DEG, PUMA_READY_DEG, PUMA_WRIST_PAIRS, puma560_urdf
 
 ROBOTS_RELATIVE = Path("cmeel.prefix/share/example-robot-data/robots")
 """Where the ``example-robot-data`` wheel installs its robots, relative to site-packages."""
@@ -68,7 +68,8 @@ class RobotSpec:
         acceleration: joint acceleration limits (rad/s^2), or empty for twice the velocity limit.
         elbow: the joint (1-based) whose origin is the arm's elbow, for the null-space task.
         ready: a pose in the middle of the workspace (degrees) that tasks aim for by default,
-            where :attr:`RobotArm.home` is a poor aim; empty: ``home``.
+            where :attr:`RobotArm.home` is a poor aim (the Puma560's: the paper's goal,
+            :data:`PUMA_READY_DEG`); empty: ``home``.
         approach: the tool frame's axis that points out of the tool, along its fingers
             (``"z"``, the ROS convention, or ``"x"`` where the URDF's tool frame has it so).
         facing: the direction the arm faces in its URDF's base frame, as an angle about z from
@@ -92,6 +93,11 @@ class RobotSpec:
         close_by_design: link pairs never checked against each other, as an SRDF's
             ``disable_collisions`` lists them, for a robot without an SRDF whose links sit
             within the checks' margin of each other at every pose (:data:`PUMA_WRIST_PAIRS`).
+        grid_range_deg: the ``(low, high)`` range, degrees, over which the learning grid bins
+            every joint (the paper's task space, :data:`PAPER_GRID_RANGE_DEG`, the Puma560's);
+            empty: each joint's own limits.
+        lerobot_driver: the LeRobot driver that drives this arm itself (the ``robot_type`` it
+            registers, whose joint conventions the arm's LeRobot datasets follow); empty: none.
     """
 
     name: str
@@ -112,6 +118,8 @@ class RobotSpec:
     package: str = "example-robot-data"
     joint_mode: bool = False
     close_by_design: tuple[tuple[str, str], ...] = ()
+    grid_range_deg: tuple[float, float] | tuple[()] = ()
+    lerobot_driver: str = ""
 
 
 UR_READY_DEG = (0.0, -90.0, 90.0, -90.0, -90.0, 0.0)
@@ -136,12 +144,6 @@ also on 20 s of ``arm_motion`` (4.5-5% -> 0%) and 30 s of simulator, seed 5 (8-9
 with the hand's target drawn back into the reach as often as before. The UR3 gains on one
 motion and loses on another, so it keeps 1."""
 
-PUMA_WRIST_PAIRS = (("link4", "link6"),)
-"""The Puma560's :attr:`RobotSpec.close_by_design`: its wrist links 4 and 6 (rtb-data's meshes)
-both hug the wrist centre, 2.5 mm apart at every pose (at rest, and over the three sample
-demonstrations), so a clearance of more than that refused every motion; joint 5 between them
-turns within its +-100 degrees without the two meeting."""
-
 TOOL_AXES = {
     "z": np.eye(3),
     # tool x along the fingers, tool y kept, tool z opposite the studio's tool x
@@ -161,8 +163,10 @@ ROBOT_SPECS: dict[str, RobotSpec] = {
             6,
             generate=puma560_urdf,
             package="rtb-data",
+            ready=PUMA_READY_DEG,
             joint_mode=True,
             close_by_design=PUMA_WRIST_PAIRS,
+            grid_range_deg=PAPER_GRID_RANGE_DEG,
         ),
         RobotSpec(
             "panda",
@@ -216,6 +220,7 @@ ROBOT_SPECS: dict[str, RobotSpec] = {
             5,
             orientation=False,
             facing=-math.pi / 2,
+            lerobot_driver="so100_follower",
         ),
         RobotSpec(
             "so101",
@@ -225,6 +230,7 @@ ROBOT_SPECS: dict[str, RobotSpec] = {
             "gripper_frame_link",
             5,
             orientation=False,
+            lerobot_driver="so101_follower",
         ),
         RobotSpec(
             "xarm7",
@@ -293,42 +299,6 @@ def robots_folder() -> Path:
         "The robot models of example-robot-data were not found; install them with "
         "`pip install example-robot-data`."
     )
-
-
-_CONTINUOUS = re.compile(r'(<joint\b[^>]*\btype=")continuous(")')
-
-
-def _bounded_urdf(text: str) -> str:
-    """``text`` with every ``continuous`` joint made ``revolute`` with limits of +-2 pi.
-
-    Pinocchio gives a continuous joint two coordinates (cos, sin); one angle per joint is what
-    limits, trajectories and exports speak, and +-2 pi is a full turn each way.
-    """
-
-    def revolute(match: re.Match[str]) -> str:
-        return f"{match.group(1)}revolute{match.group(2)}"
-
-    text = _CONTINUOUS.sub(revolute, text)
-    links = set(re.findall(r'<link\s+name="([^"]+)"', text))
-    for name in set(re.findall(r'<joint\s+name="([^"]+)"', text)) & links:
-        # A joint named like a link (SO-100's "gripper") makes Pinocchio's frame lookups ambiguous.
-        text = text.replace(f'<joint name="{name}"', f'<joint name="{name}_joint"')
-
-    def add_limit(joint: re.Match[str]) -> str:
-        body = joint.group(0)
-        if 'type="revolute"' not in body:
-            return body
-        limit = re.search(r"<limit\b[^>]*/>", body)
-        bounds = f'lower="{-2 * math.pi:.6f}" upper="{2 * math.pi:.6f}"'
-        if limit is None:
-            return body.replace(
-                "</joint>", f'<limit {bounds} effort="100" velocity="1.0"/></joint>'
-            )
-        if "lower=" in limit.group(0):
-            return body
-        return body.replace(limit.group(0), limit.group(0).replace("<limit", f"<limit {bounds}"))
-
-    return re.sub(r"<joint\b.*?</joint>", add_limit, text, flags=re.S)
 
 
 def tool_errors(

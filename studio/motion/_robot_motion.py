@@ -22,6 +22,7 @@ from typing import Literal
 import numpy as np
 
 from studio.capture import (
+    DEMO_ROBOT,
     ObservationRecording,
     Recording,
     RecordingSeries,
@@ -42,9 +43,6 @@ from ._demonstrations import checked_demonstration
 from ._errors import MotionError
 
 SourceKind = Literal["policy", "demonstration", "recording"]
-PUMA560 = "puma560"
-"""The paper's robot: a demonstration keeps its stored trajectory for it, and joint mode maps the
-human arm onto it."""
 
 
 @dataclass(frozen=True)
@@ -273,8 +271,8 @@ def series_motion(series: RecordingSeries, robot_name: str, name: str = "") -> M
     robot = load_robot(robot_name).scratch_copy()  # its own scratch data: any thread
     times = np.asarray(series.times, dtype=float)
     rate = float(1.0 / np.median(np.diff(times))) if len(times) > 1 else 1.0
-    if robot.name == PUMA560 or not len(times):
-        q = series.q_robot if robot.name == PUMA560 else np.zeros((0, robot.nq))
+    if robot.name == DEMO_ROBOT or not len(times):  # the series' own path is this robot's
+        q = series.q_robot if robot.name == DEMO_ROBOT else np.zeros((0, robot.nq))
         return Motion("recording", name, robot, times, q, True, rate)
     gaps = np.diff(np.asarray(series.frames))
     stride = int(gaps.max()) if len(gaps) else 1
@@ -292,7 +290,7 @@ def demonstration_motion(
     :func:`recording_motion` does), to be timed."""
     robot = _motion_robot(robot_name, limit_margin)
     demo = checked_demonstration(path)
-    if robot.name == PUMA560:
+    if robot.name == DEMO_ROBOT:  # the path the file stores is this robot's
         times = demo.times - demo.times[0]
         return Motion("demonstration", path.name, robot, times, demo.q_robot, False, rate_hz)
     recording = demo.recording  # the file name it was cut from, next to the demonstration
@@ -339,7 +337,7 @@ def training_demonstration(
         DemonstrationError: the file is not a usable demonstration.
         KinematicsError: an unknown robot.
     """
-    if robot_name == PUMA560:
+    if robot_name == DEMO_ROBOT:  # the path the file stores is this robot's
         demo = checked_demonstration(path)
         return DemonstrationPath(label, demo.q_robot, name, demo.times)
     times, q = _retargeted(path, path.stat().st_mtime_ns, robot_name)

@@ -728,6 +728,10 @@ class RobotInfo(BaseModel):
         default_factory=list,
         description="its default goal, joints 1-3 in degrees: the train form's goal for it, the goal `studio train --robot NAME` trains towards",
     )
+    joint_mode: bool = Field(
+        False,
+        description="whether its joints can follow the operator's one by one (retargeting's joint mode); every robot follows the hand",
+    )
 
 
 class RobotsPublic(BaseModel):

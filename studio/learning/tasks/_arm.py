@@ -40,8 +40,6 @@ from ._robot import PUMA560, check_robot, default_goal, task_arm
 
 MAX_JOINTS = 6
 """Most joints a grid covers (the Puma560 has six)."""
-PAPER_RANGE_DEG = (-180.0, 180.0)
-"""The paper's range of every joint, degrees: the Puma560's grid spans it."""
 MAX_TABLE_ENTRIES = 12_000_000
 """Largest states x actions table a grid may have: one Q table is then 96 MB, the task's tables
 200 MB, and each running experiment's working memory (Q, visit list, model; prioritized sweeping's
@@ -61,7 +59,8 @@ class ArmGrid:
             the paper used 3).
         bins: bins per joint (the paper used 11).
         low_deg: lower end of every joint's range, degrees, or one per joint; default: the
-            paper's -180 for the Puma560, each joint's lower limit for another robot.
+            robot's grid range (its registry's ``grid_range_deg``: the paper's -180 on the
+            Puma560), else each joint's lower limit.
         high_deg: upper end, likewise (the paper's 180, or each joint's upper limit).
         goal: the goal's bin per joint; default: the bins nearest the robot's default goal
             (:data:`DEFAULT_GOAL_DEG` for the Puma560).
@@ -95,15 +94,14 @@ class ArmGrid:
             )
         if self.bins < 2:
             raise LearningError(f"bins is {self.bins}; give at least 2 bins per joint.")
-        paper = self.robot == PUMA560
+        span = arm.spec.grid_range_deg  # the paper's range on the Puma560, else the limits
         ends = []
-        for name, own, limit in (
-            ("low_deg", PAPER_RANGE_DEG[0], arm.lower),
-            ("high_deg", PAPER_RANGE_DEG[1], arm.upper),
-        ):
+        for end, (name, limit) in enumerate((("low_deg", arm.lower), ("high_deg", arm.upper))):
             value = getattr(self, name)
             if value is None:
-                value = own if paper else tuple(float(x) for x in np.degrees(limit[: self.joints]))
+                value = (
+                    span[end] if span else tuple(float(x) for x in np.degrees(limit[: self.joints]))
+                )
             ends.append(_range_end(name, value, self.joints))
             object.__setattr__(self, name, ends[-1])
         low, high = (np.broadcast_to(np.asarray(e, np.float64), (self.joints,)) for e in ends)

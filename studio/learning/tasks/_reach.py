@@ -30,11 +30,10 @@ function approximation its estimate can stick above the moves' and freeze the ar
 The goal is judged where a user sees it: the robot's tool frame (the Puma560's DH frame 6) within
 ``position_tolerance`` metres and ``angle_tolerance_deg`` degrees of the goal's tool pose, by
 forward kinematics. :func:`tool_pose` is a numba twin of the robot's forward kinematics, so the
-kernels can call it: for the Puma560 the product of its DH table's transforms (the paper's robot,
-computed as it always was), for every other arm the serial chain Pinocchio builds from its URDF
-(each joint's fixed placement and rotation axis, then the tool frame's placement:
-:attr:`studio.kinematics.RobotArm.chain`). A test holds both equal to Pinocchio's
-forward kinematics for every offered robot.
+kernels can call it: for every arm, the Puma560 (its URDF built from its DH table) as any other,
+the serial chain Pinocchio builds from its URDF (each joint's fixed placement and rotation axis,
+then the tool frame's placement: :attr:`studio.kinematics.RobotArm.chain`). A test holds it equal
+to Pinocchio's forward kinematics for every offered robot.
 
 Dynamics are defined once, here, in numba functions (:func:`reach_step`, :func:`reach_success`): the learner's compiled kernel and the Gymnasium environment
 ``TeachStudio/ArmReach-v0`` both call them.
@@ -51,8 +50,6 @@ from functools import cached_property
 import numpy as np
 from numba import njit
 
-from studio.kinematics import Puma560
-
 from .._errors import ConfigError, LearningError
 from .._tiles import TileCoding
 from ._arm import GOAL_REWARD, STEP_REWARD
@@ -65,13 +62,10 @@ from ._follow import (
     with_cost_group,
 )
 from ._reach_layout import (
-    _A,
-    _ALPHA,
     _ANG_TOL,
     _CHAIN,
     _CHAIN_N,
     _COUNTS,
-    _D,
     _GOAL_P,
     _GOAL_R,
     _HOLD,
@@ -426,16 +420,9 @@ class ArmReach:
         p[_SHAPING] = self.shaping
         p[_POS_TOL] = self.position_tolerance
         p[_ANG_TOL] = math.radians(self.angle_tolerance_deg)
-        if self.robot == PUMA560:
-            robot = Puma560()
-            p[_D : _D + 6] = [row.d for row in robot.dh]
-            p[_A : _A + 6] = [row.a for row in robot.dh]
-            p[_ALPHA : _ALPHA + 6] = [row.alpha for row in robot.dh]
-            oMgoal = robot.forward(np.asarray(self.goal))
-        else:
-            _put_chain(p, self.robot)
-            oMgoal = np.empty((4, 4))
-            tool_pose(p, np.asarray(self.goal[: self.joints]), oMgoal)
+        _put_chain(p, self.robot)
+        oMgoal = np.empty((4, 4))
+        tool_pose(p, np.asarray(self.goal[: self.joints]), oMgoal)
         p[_GOAL_P : _GOAL_P + 3] = oMgoal[:3, 3]
         p[_GOAL_R : _GOAL_R + 9] = oMgoal[:3, :3].reshape(-1)
         p.flags.writeable = False
@@ -581,40 +568,7 @@ def _walk_capacity(q: np.ndarray, step: float) -> int:
 def tool_pose(params, state, out):
     """The tool pose ``oMtool`` at ``state`` into ``out`` (4x4): the numba twin of the robot's
     forward kinematics. ``state`` holds the learned joints, the others come from the held goal
-    angles in ``params``."""
-    if params[_CHAIN_N] == 0.0:
-        _dh_pose(params, state, out)
-    else:
-        _chain_pose(params, state, out)
-
-
-@njit(nogil=True, cache=True)
-def _dh_pose(params, state, out):
-    """Standard-DH forward kinematics ``prod_i Rz(q_i) Tz(d_i) Tx(a_i) Rx(alpha_i)`` into ``out``.
-
-    The numba twin of :meth:`studio.kinematics.Puma560.forward`.
-    """
-    joints = int(params[_J])
-    for i in range(4):
-        for k in range(4):
-            out[i, k] = 1.0 if i == k else 0.0
-    for i in range(MAX_JOINTS):
-        theta = state[i] if i < joints else params[_HOLD + i]
-        ct, st = math.cos(theta), math.sin(theta)
-        ca, sa = math.cos(params[_ALPHA + i]), math.sin(params[_ALPHA + i])
-        a, d = params[_A + i], params[_D + i]
-        # A = [[ct, -st ca, st sa, a ct], [st, ct ca, -ct sa, a st], [0, sa, ca, d]]
-        for r in range(3):
-            x, y, z, p = out[r, 0], out[r, 1], out[r, 2], out[r, 3]
-            out[r, 0] = x * ct + y * st
-            out[r, 1] = -x * st * ca + y * ct * ca + z * sa
-            out[r, 2] = x * st * sa - y * ct * sa + z * ca
-            out[r, 3] = x * a * ct + y * a * st + z * d + p
-
-
-@njit(nogil=True, cache=True)
-def _chain_pose(params, state, out):
-    """Serial-chain forward kinematics into ``out``: per joint its fixed placement, then the
+    angles in ``params``. Serial-chain forward kinematics: per joint its fixed placement, then the
     rotation by its angle about its axis (Rodrigues), then the tool frame's placement; the
     composition of Pinocchio's ``oMi = oMparent * jointPlacement * M(q)``."""
     joints = int(params[_J])

@@ -20,14 +20,12 @@ _GOAL_P = 4  # 3 values
 _GOAL_R = 7  # 9 values, row-major
 _LOWER = 16  # MAX_JOINTS values
 _UPPER = 22
-_D = 28  # the Puma560's DH table, MAX_JOINTS values each
-_A = 34
-_ALPHA = 40
+# 28-45: free (the Puma560's DH table was here; every arm's forward kinematics is its chain now)
 _SHAPING = 46
 _POS_TOL = 47
 _ANG_TOL = 48
 _MULTI = 49  # 0: one joint per action (the fast path), else the table below
-_CHAIN_N = 50  # 0: the DH product above; else the serial chain's joints that move the tool
+_CHAIN_N = 50  # the serial chain's joints that move the tool
 _HOLD = 51  # MAX_CHAIN values: every joint's angle when not learned (the goal's)
 _CHAIN = _HOLD + MAX_CHAIN  # per joint: placement rotation (9, row-major), translation, axis
 _LINK = 15

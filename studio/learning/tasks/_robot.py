@@ -19,9 +19,9 @@ from .._errors import ConfigError, LearningError
 
 PUMA560 = DEFAULT_ROBOT
 """The paper's robot, and the robot of every task or file that names none."""
-DEFAULT_GOAL_DEG = (0.0, 45.0, -90.0, 0.0, 0.0, 0.0)
-"""The Puma560's default goal, degrees: the paper shows its goal only as a picture (Fig. 7), so
-joints 1-3 at (0, 45, -90) (an arm reaching forward and down, inside the limits), the wrist at 0."""
+DEFAULT_GOAL_DEG: tuple[float, ...] = tuple(robot_spec(DEFAULT_ROBOT).ready)
+"""The default robot's default goal, degrees: its registry's ``ready`` pose (the Puma560's is the
+paper's goal: joints 1-3 at (0, 45, -90), an arm reaching forward and down, the wrist at 0)."""
 
 
 def check_robot(name: object) -> str:
@@ -54,13 +54,11 @@ def robot_title(name: str) -> str:
 def default_goal(name: str) -> np.ndarray:
     """The default goal of robot ``name``'s tasks, radians ``(nq,)``.
 
-    The Puma560's is the paper's (:data:`DEFAULT_GOAL_DEG`). Another arm's is its registry's
-    ``ready`` pose where it names one (the UR arms': their ``home`` is the arm stretched out level,
-    where a degree of the shoulder moves the tool furthest), else its ``home``: the maker's ready
-    pose where the SRDF gives one (the Panda's), else zero where the limits allow.
+    Its registry's ``ready`` pose where it names one (the Puma560's is the paper's goal,
+    :data:`DEFAULT_GOAL_DEG`; the UR arms': their ``home`` is the arm stretched out level, where a
+    degree of the shoulder moves the tool furthest), else its ``home``: the maker's ready pose
+    where the SRDF gives one (the Panda's), else zero where the limits allow.
     """
-    if name == PUMA560:
-        return np.radians(DEFAULT_GOAL_DEG)
     arm = task_arm(name)
     if arm.spec.ready:
         return np.radians(np.asarray(arm.spec.ready, dtype=np.float64))

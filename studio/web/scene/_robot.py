@@ -15,13 +15,14 @@ from collections.abc import Callable
 import numpy as np
 import viser
 
-from studio.kinematics import Puma560, RobotArm, load_robot
+from studio.kinematics import DEFAULT_ROBOT, Puma560, RobotArm, load_robot
 
 from ._model import Playback, SceneLayout
 from ._robot_view import RobotView, RobotViews, add_robot, arm_tool, wxyz_of
 
-PUMA = "puma560"
-"""The robot a joint path belongs to when it names none (policies, the grid's goals)."""
+PUMA = DEFAULT_ROBOT
+"""The robot a joint path belongs to when it names none (policies, the grid's goals): the
+default robot, as a policy file that names none is its."""
 
 
 class SceneRobot:
@@ -188,9 +189,11 @@ class SceneRobot:
                 "follows the live source meanwhile: play the demonstration or recording again to "
                 f"see it on the {title(drawn)} (a policy plays on the robot it was learnt on)."
             )
-        if not self.goal_shown and drawn != PUMA and loading is None:
+        with self._lock:  # the robot whose pose the goal is, when it is not the one drawn
+            owner = next((name for name in self._goals if name != drawn), None)
+        if not self.goal_shown and owner is not None and loading is None:
             notes.append(
-                f"The training goal is a {title(PUMA)} pose, so the {title(drawn)} shows a goal "
+                f"The training goal is a {title(owner)} pose, so the {title(drawn)} shows a goal "
                 "once a demonstration plays on it: the demonstration's end pose, retargeted."
             )
         return notes

@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from studio import StudioError
-from studio.capture import Demonstration
+from studio.capture import DEMO_ROBOT, Demonstration
 from studio.kinematics import DEFAULT_ROBOT, KinematicsError, robot_spec
 from studio.learning import DemonstrationPath, LearningError, fit_dmp_policy, save_dmp_policy
 from studio.motion import MotionError, training_demonstration
@@ -167,7 +167,7 @@ class Demonstrations:
         if scene is None or player is None:
             return
         robot = self.pipeline.robot_name
-        if robot == "puma560":
+        if robot == DEMO_ROBOT:  # the path the file stores is this robot's
             q = np.asarray(demo.q_robot, dtype=float)
             scene.show_path(f"demo-{name}", q)
             if play:

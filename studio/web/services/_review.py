@@ -16,7 +16,7 @@ from collections import OrderedDict
 
 import numpy as np
 
-from studio.capture import RecordingSeries, recording_series
+from studio.capture import DEMO_ROBOT, RecordingSeries, recording_series
 from studio.kinematics import load_robot
 from studio.motion import Motion, recording_motion, series_motion
 
@@ -129,7 +129,8 @@ class Reviewer:
         in the background)."""
         scene, player = self.scene, self.player
         robot = self.pipeline.robot_name
-        if robot != "puma560" and scene is not None and player is not None:
+        # the series holds the path of the capture chain's robot; any other is retargeted
+        if robot != DEMO_ROBOT and scene is not None and player is not None:
             path = self.recordings.path(name)
             stat = path.stat()
             player.play(

@@ -83,6 +83,7 @@ class Robots:
                 "title": robot_spec(name).title,
                 "joints": list(load_robot(name, geometry=False).joint_names),
                 "goal_deg": list(default_goal_deg(name)),
+                "joint_mode": robot_spec(name).joint_mode,
             }
             for name in robot_names()
         ]

@@ -121,9 +121,11 @@ function renderRobot(s) {
     announceRobot(s.robot);
   }
   showTrainedRobot();
-  // Joint mode maps the arm onto the Puma560's joints; any other robot follows the hand.
+  // Joint mode maps the arm's joints onto a robot that offers it (GET /api/robots' joint_mode:
+  // the Puma560); any other robot follows the hand.
   const joint = $("retarget-mode").querySelector('option[value="joint"]');
-  if (joint) setProp(joint, "disabled", !!s.robot && s.robot !== "puma560");
+  const taught = (S.robots || []).find((r) => r.name === s.robot);
+  if (joint) setProp(joint, "disabled", !!taught && !taught.joint_mode);
   setProp("robot-warning", "hidden", !s.robot_warning);
   setText("robot-warning", s.robot_warning || "");
   renderRobotNotes(s.robot_notes || []);
