@@ -33,6 +33,7 @@ from .services import (
     Sources,
     TakeFlow,
     Training,
+    Watching,
 )
 
 
@@ -119,6 +120,11 @@ def get_rollouts(studio: StudioDep) -> Rollouts:
     return studio.rollouts
 
 
+def get_watching(studio: StudioDep) -> Watching:
+    """A policy watched in the scene: its rollout, likeness card and CSV."""
+    return studio.watching
+
+
 def get_reviewer(studio: StudioDep) -> Reviewer:
     """A recording's timeline and its review on the robot."""
     return studio.reviewer
@@ -153,6 +159,7 @@ RunsDep = Annotated[RunQueue, Depends(get_runs)]
 TrainingDep = Annotated[Training, Depends(get_training)]
 PoliciesDep = Annotated[Policies, Depends(get_policies)]
 RolloutsDep = Annotated[Rollouts, Depends(get_rollouts)]
+WatchingDep = Annotated[Watching, Depends(get_watching)]
 ReviewerDep = Annotated[Reviewer, Depends(get_reviewer)]
 TakesDep = Annotated[TakeFlow, Depends(get_takes)]
 PipelineDep = Annotated[Pipeline, Depends(get_pipeline)]

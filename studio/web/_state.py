@@ -26,6 +26,7 @@ from .services import (
     Sources,
     TakeFlow,
     Training,
+    Watching,
     recording_store,
 )
 
@@ -64,6 +65,9 @@ class Studio:
         self.sources = Sources(settings, self.pipeline, scene, self.recordings, self.robots)
         self.capture = Capture(settings, self.pipeline, self.recordings, self.demonstrations)
         self.training = Training(self.runs, self.demonstrations, self.pipeline, self.rollouts)
+        self.watching = Watching(
+            self.policies, self.rollouts, self.runs, self.demonstrations, self.pipeline, scene
+        )
         self.reviewer = Reviewer(self.recordings, self.pipeline, scene, self.player)
         self.takes = TakeFlow(
             settings.recordings_dir,

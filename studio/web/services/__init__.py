@@ -1,7 +1,7 @@
 """What the routers act on, one service per resource: the live source, the robot taught, the
 capture, recordings (a folder store), demonstrations, training runs (the run queue and the
-page's way to it), policies, watched rollouts, a recording's review and its takes, and the
-downloads on a robot. Each list's owner announces its changes through :class:`ListChanges`."""
+page's way to it), policies, watched rollouts and the watching of a policy, a recording's review
+and its takes, and the downloads on a robot. Each list's owner announces its changes through :class:`ListChanges`."""
 
 from __future__ import annotations
 
@@ -31,3 +31,4 @@ from ._store import receive_upload as receive_upload
 from ._store import recording_store as recording_store
 from ._takes import TakeFlow as TakeFlow
 from ._training import Training as Training
+from ._watching import Watching as Watching
