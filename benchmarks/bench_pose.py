@@ -15,22 +15,28 @@
     The filter's lag: ``lag_s`` as reported, and as measured (the time shift that best aligns the
     noise-free stream's elbow angle with the truth). Where the cell misses come from: how many
     lie within 2 degrees of a bin edge (a true angle that near an edge is missed by any noise).
-    The cell goal's ceiling at this noise (``causal_ceiling``): an ideal estimate of each frame
-    (the truth plus Gaussian noise of the Cramer-Rao bound of the elbow and wrist points, the
-    shoulder, torso and limb lengths known exactly), through a joint-space constant-velocity
-    Kalman filter whose motion noise is tuned per joint on the very stream it is judged on; and
-    the same smoothed with the future (a Rauch-Tung-Striebel smoother: not causal, so not
-    available live). Every assumption favours it, so no causal filter of a smooth motion of
-    unknown shape does better than its figure.
-(b) Hand-guide IK time per target, ``fit_hand_pose`` against a baseline measured interleaved in
+(b) The same-cell share of the live fit over several noise draws (``--draws``, seeds 0, 1, ...;
+    mean +- s.d. and range, as one draw moves it by a few points), world landmarks alone and
+    with image landmarks: before (the torso as fast as the arm, no rigid hand: ``BEFORE``, run on
+    the same frames), with the torso's shape slow only, and now; the ratio now / before. Beside
+    them the cell goal's ceiling *estimate* at this noise (``ceiling_estimate``): an ideal
+    estimate of each frame (the truth plus Gaussian noise of the Cramer-Rao bound of the elbow,
+    wrist and hand (pinky, index, thumb) points, the wrist's angles unknown, the shoulder, torso
+    and limb lengths known exactly), through a joint-space constant-velocity Kalman filter whose
+    motion noise is tuned per joint on the very draw it is judged on; and the same smoothed with
+    the future (Rauch-Tung-Striebel: not causal, so not available live). Every assumption
+    favours it, yet it is an estimate, not a bound: it is one filter's figure on finitely many
+    draws, and a fit that reads the landmarks otherwise (a different motion model) may pass it.
+(c) Hand-guide IK time per target, ``fit_hand_pose`` against a baseline measured interleaved in
     the same run: Pinocchio's plain CLIK loop (its ``examples/inverse-kinematics.py``: damped
     pseudo-inverse steps from the neutral arm, no limits, no closed-form start). Goal: median
     < 5 ms; the hand within 1 cm of every reachable target.
 
 The machine is shared: absolute times drift, the ratio much less.
 
-Run: ``python benchmarks/bench_pose.py`` (about two minutes; ``--seconds`` sets the stream length,
-``--seed`` the noisy streams' noise).
+Run: ``python benchmarks/bench_pose.py`` (about 15 minutes on a busy 2-core machine;
+``--seconds`` sets the stream length, ``--seed`` the noise of (a)'s streams, ``--draws`` and
+``--sides right,left`` those of (b)).
 """
 
 from __future__ import annotations
@@ -47,6 +53,7 @@ from studio.kinematics import (
     HumanArm,
     PoseStreamFitter,
     Retargeter,
+    StreamConfig,
     arm_motion,
     fit_hand_pose,
     fit_pose_landmarks,
@@ -209,26 +216,35 @@ def edge_distance_deg(grid: ArmGrid, angles: np.ndarray) -> np.ndarray:
     return np.degrees(np.minimum(inside, grid.bin_width - inside))
 
 
+CEILING_POINTS = {"right": [14, 16, 18, 20, 22], "left": [13, 15, 17, 19, 21]}
+"""BlazePose indices of the points the ceiling estimate measures, per side: elbow, wrist and the
+hand's pinky, index and thumb (the shoulder is taken as known)."""
+
+
 def frame_jacobian(arm: HumanArm, q: np.ndarray) -> np.ndarray:
-    """d(elbow, wrist points) / d(shoulder and elbow angles) at ``q``: (6, 4), m per rad."""
-    jac, step = np.zeros((6, 4)), 1e-6
-    for i in range(4):
+    """d(elbow, wrist and hand points) / d(the seven angles) at ``q``: (15, 7), m per rad, in
+    MediaPipe's world axes (x, y across the picture, z depth), the points as
+    ``landmarks_from_arm`` draws them."""
+    rows, step = CEILING_POINTS[arm.side], 1e-6
+    jac = np.zeros((3 * len(rows), arm.nq))
+    for i in range(arm.nq):
         dq = np.zeros(arm.nq)
         dq[i] = step
-        jac[:, i] = (arm.points(q + dq)[1:3] - arm.points(q - dq)[1:3]).reshape(-1) / (2 * step)
+        ahead, back = (landmarks_from_arm(q + s * dq, arm)[0][rows, :3] for s in (1.0, -1.0))
+        jac[:, i] = (ahead - back).reshape(-1) / (2 * step)
     return jac
 
 
 def frame_covariance(jac: np.ndarray, xy_m: float, depth_m: float) -> np.ndarray:
     """The Cramer-Rao bound (4 x 4, rad^2) of the shoulder and elbow angles from one frame.
 
-    From the elbow and wrist points alone (``jac`` from :func:`frame_jacobian`), measured with
-    s.d. ``xy_m`` across the picture and ``depth_m`` in depth (the arm base frame's x for a
-    person facing the camera), the shoulder fixed: the least any unbiased estimate of that frame
-    can reach.
+    From the elbow, wrist and hand points (``jac`` from :func:`frame_jacobian`), measured with
+    s.d. ``xy_m`` across the picture and ``depth_m`` in depth, the shoulder fixed: the least any
+    unbiased estimate of that frame can reach, the wrist's three angles unknown (marginalised).
     """
-    weights = np.tile([depth_m**-2, xy_m**-2, xy_m**-2], 2)
-    return np.linalg.inv(jac.T @ (weights[:, None] * jac) + 1e-12 * np.eye(4))
+    weights = np.tile([xy_m**-2, xy_m**-2, depth_m**-2], len(jac) // 3)
+    fisher = jac.T @ (weights[:, None] * jac) + 1e-12 * np.eye(jac.shape[1])
+    return np.linalg.inv(fisher)[:4, :4]
 
 
 def kalman_angles(measured: list, covs: list, densities: list, smooth: bool) -> np.ndarray:
@@ -256,16 +272,16 @@ def kalman_angles(measured: list, covs: list, densities: list, smooth: bool) -> 
     return np.array([x[:4] for x, _ in filtered])
 
 
-def causal_ceiling(
-    arm: HumanArm, seconds: float, seed: int, noises: list[tuple[float, float]]
-) -> list[tuple[float, float, tuple[float, ...]]]:
-    """Per (xy, depth) noise (m): (same-cell fraction of the ideal causal filter, of the same
-    smoothed, its motion noise per joint).
+def ceiling_estimate(
+    arm: HumanArm, seconds: float, seeds: list[int], noises: list[tuple[float, float]]
+) -> list[list[tuple[float, float]]]:
+    """Per (xy, depth) noise (m), per seed (one noise draw each): the same-cell fraction of the
+    ideal causal filter and of the same smoothed with the future.
 
-    See the module docstring: every frame measured at its Cramer-Rao bound, the motion noise
-    searched per joint over ``CEILING_DENSITIES`` for the best causal figure.
+    See the module docstring: every frame measured at its Cramer-Rao bound from the elbow,
+    wrist and hand points, the motion noise searched per joint over ``CEILING_DENSITIES`` for the
+    best causal figure on each draw.
     """
-    rng = np.random.default_rng(seed)
     truth = arm_motion(np.arange(0.0, seconds, 1.0 / RATE_HZ), arm)
     jacobians = [frame_jacobian(arm, q) for q in truth]
     retarget, grid = Retargeter("joint", arm=HumanArm(arm.side)), ArmGrid()
@@ -281,20 +297,22 @@ def causal_ceiling(
     out = []
     for xy_m, depth_m in noises:
         covs = [frame_covariance(jac, xy_m, depth_m) for jac in jacobians]
-        measured = [
-            q[:4] + np.linalg.cholesky(c) @ rng.normal(size=4)
-            for q, c in zip(truth, covs, strict=True)
-        ]
-        densities = [0.5] * 4
-        for joint in range(4):
-            scores = []
-            for value in CEILING_DENSITIES:
-                trial = densities[:joint] + [value] + densities[joint + 1 :]
-                scores.append((same_cell(kalman_angles(measured, covs, trial, False)), value))
-            densities[joint] = max(scores)[1]
-        causal = same_cell(kalman_angles(measured, covs, densities, False))
-        smoothed = same_cell(kalman_angles(measured, covs, densities, True))
-        out.append((causal, smoothed, tuple(densities)))
+        roots = [np.linalg.cholesky(c) for c in covs]
+        draws = []
+        for seed in seeds:
+            rng = np.random.default_rng(seed)
+            measured = [q[:4] + r @ rng.normal(size=4) for q, r in zip(truth, roots, strict=True)]
+            densities = [0.5] * 4
+            for joint in range(4):
+                scores = []
+                for value in CEILING_DENSITIES:
+                    trial = densities[:joint] + [value] + densities[joint + 1 :]
+                    scores.append((same_cell(kalman_angles(measured, covs, trial, False)), value))
+                densities[joint] = max(scores)[1]
+            causal = same_cell(kalman_angles(measured, covs, densities, False))
+            smoothed = same_cell(kalman_angles(measured, covs, densities, True))
+            draws.append((causal, smoothed))
+        out.append(draws)
     return out
 
 
@@ -343,20 +361,73 @@ def print_recorded(side: str, same: float) -> None:
     )
 
 
-def print_ceiling(arm: HumanArm, seconds: float, seed: int) -> None:
-    """The cell goal's ceiling for world landmarks alone and with image landmarks."""
+BEFORE = StreamConfig(torso_acceleration=StreamConfig().acceleration, rigid_hand=False)
+"""The live fit as it was before the torso's shape was filtered slowly and the hand pinned the
+wrist: the baseline of :func:`draws`, run on the same frames."""
+
+
+def cell_shares(
+    arm: HumanArm,
+    seconds: float,
+    seed: int,
+    image_px: float | None,
+    configs: list[StreamConfig],
+    noise: tuple[float, float] = (0.03, 0.08),
+) -> list[float]:
+    """Per stream config, the share of frames after the warm-up whose Puma cell is the true
+    arm's, every config fed the same noisy frames (``noise``: sigma x, y and depth, m)."""
+    fitters = [PoseStreamFitter(arm.side, config) for config in configs]
+    retarget, grid = Retargeter("joint", arm=HumanArm(arm.side)), ArmGrid()
+    same: list[list[bool]] = [[] for _ in configs]
+    for t, q, world, image in zip(*noisy_frames(arm, seconds, noise, seed, image_px), strict=True):
+        size = None if image is None else IMAGE_SIZE
+        fits = [fitter.update(float(t), world, image, size) for fitter in fitters]
+        if t < WARM_UP_S:
+            continue
+        true_cell = grid.bins_of_angles(retarget.robot_from_human(q)[:3])
+        for shares, fit in zip(same, fits, strict=True):
+            cell = grid.bins_of_angles(retarget.robot_from_human(fit.q_human)[:3])
+            shares.append(bool(np.array_equal(true_cell, cell)))
+    return [float(np.mean(shares)) for shares in same]
+
+
+def spread(values: list[float]) -> str:
+    """``mean +- s.d. (min-max)`` of shares, in percent."""
+    v = 100 * np.asarray(values)
+    return f"{v.mean():.1f} +- {v.std(ddof=1):.1f}% ({v.min():.1f}-{v.max():.1f})"
+
+
+def draws(seconds: float, seeds: list[int], sides: list[str]) -> None:
+    """The live fit, before and now, against the ceiling estimate, over several noise draws."""
     world_xy = 0.03
     image_xy = image_metres(IMAGE_NOISE_PX)
     both_xy = (world_xy**-2 + image_xy**-2) ** -0.5  # an ideal fit weighs the two together
-    labels = ("3/8 cm", f"3/8 cm + image {IMAGE_NOISE_PX:.0f} px")
-    ceilings = causal_ceiling(arm, seconds, seed, [(world_xy, 0.08), (both_xy, 0.08)])
-    for label, (causal, smoothed, densities) in zip(labels, ceilings, strict=True):
-        print(
-            f"  {arm.side:5s} ceiling, {label}: ideal causal filter {100 * causal:.1f}% same "
-            f"cell, smoothed with the future {100 * smoothed:.1f}% (motion noise per joint "
-            + ", ".join(f"{d:g}" for d in densities)
-            + " rad/s^2/sqrt(Hz))"
-        )
+    print(
+        f"(b) Puma joints 1-3 in the true arm's cell, live, over {len(seeds)} noise draws "
+        f"(seeds {seeds[0]}-{seeds[-1]}; mean +- s.d. (range)):"
+    )
+    for side in sides:
+        arm = HumanArm(side, **PERSON)
+        ceilings = ceiling_estimate(arm, seconds, seeds, [(world_xy, 0.08), (both_xy, 0.08)])
+        for image_px, ceiling in zip((None, IMAGE_NOISE_PX), ceilings, strict=True):
+            label = "3/8 cm" if image_px is None else f"3/8 cm + image {image_px:.0f} px"
+            configs = [BEFORE, StreamConfig(rigid_hand=False), StreamConfig()]
+            shares = [cell_shares(arm, seconds, seed, image_px, configs) for seed in seeds]
+            before, torso, now = ([row[k] for row in shares] for k in range(3))
+            causal, smoothed = ([row[k] for row in ceiling] for k in (0, 1))
+            print(f"  {side:5s} {label}:")
+            print(f"        before (torso as fast as the arm, no rigid hand): {spread(before)}")
+            print(f"        the torso's shape slow only: {spread(torso)}")
+            print(f"        now (torso's shape slow, the rigid hand pins the wrist): {spread(now)}")
+            print(
+                f"        ratio now / before {np.mean(now) / np.mean(before):.3f}x, "
+                f"{100 * (np.mean(now) - np.mean(before)):+.1f} points"
+            )
+            print(
+                f"        ceiling estimate (ideal causal filter, shoulder known, elbow, wrist and "
+                f"hand points at their Cramer-Rao bound): {spread(causal)}; smoothed with the "
+                f"future {spread(smoothed)}; now / estimate {np.mean(now) / np.mean(causal):.3f}x"
+            )
 
 
 def accuracy(seconds: float, seed: int) -> None:
@@ -401,7 +472,6 @@ def accuracy(seconds: float, seed: int) -> None:
             f"  {side:5s} same cell for the true arm only delayed: "
             + ", ".join(f"{1e3 * lag:.0f} ms {100 * v:.1f}%" for lag, v in ceiling.items())
         )
-        print_ceiling(arm, seconds, seed)
 
 
 def clik(arm: HumanArm, data: pin.Data, oMdes: pin.SE3) -> tuple[np.ndarray, float]:
@@ -440,7 +510,7 @@ def ik_speed(targets: int) -> None:
         base_err.append(err)
         within.append(bool(np.all(q_clik >= arm.lower) and np.all(q_clik <= arm.upper)))
     med_ours, med_base = float(np.median(ours)), float(np.median(base))
-    print(f"(b) hand IK, {targets} random reachable targets (cold start), interleaved:")
+    print(f"(c) hand IK, {targets} random reachable targets (cold start), interleaved:")
     print(
         f"  fit_hand_pose: median {1e3 * med_ours:.2f} ms, p90 {1e3 * np.percentile(ours, 90):.2f}"
         f" ms, within 1 cm {100 * np.mean(np.array(ours_err) <= 0.01):.1f}%, within limits 100%"
@@ -466,8 +536,15 @@ def main() -> None:
     parser.add_argument("--seconds", type=float, default=30.0, help="motion length per case")
     parser.add_argument("--targets", type=int, default=200, help="IK targets")
     parser.add_argument("--seed", type=int, default=2, help="the noisy streams' noise seed")
+    parser.add_argument(
+        "--draws", type=int, default=5, help="noise draws of the before/now/ceiling figures"
+    )
+    parser.add_argument(
+        "--sides", default="right", help="arms of the before/now/ceiling figures: right,left"
+    )
     args = parser.parse_args()
     accuracy(args.seconds, args.seed)
+    draws(args.seconds, list(range(args.draws)), args.sides.split(","))
     ik_speed(args.targets)
 
 

@@ -26,7 +26,10 @@ decides the elbow angle unless depth clearly says otherwise.
 elbow and wrist are moved to the nearest chain (depth weighed ``1 / PoseConfig.depth_noise``)
 whose limbs have the person's lengths: one frame alone measures them on both arms (people are
 nearly symmetric) and takes the mean; a stream takes the running median. A limb's known length
-then pulls its depth toward what its image-plane length implies.
+then pulls its depth toward what its image-plane length implies. A stream also knows the
+person's hand shape (the index, pinky and thumb in the hand's own frame, the median of recent
+frames': :func:`hand_shape`) and fits those three points as one rigid hand on the wrist, turned
+freely, so they pin the wrist beside its own landmark (each weighed ``PoseConfig.hand_weight``).
 
 **Closed form.** Shoulder flexion and abduction follow from the upper arm's direction, elbow
 flexion from the angle between the limbs, humeral rotation from the forearm's direction about
@@ -124,6 +127,9 @@ class PoseConfig:
             elbow off the shoulder-wrist line when the arm is straight (it reads flat arms bent
             by 20 degrees and more). An elbow that the image shows on that line is bent in
             depth only by what exceeds this: nothing up to it, in full from twice it on.
+        hand_weight: with the person's hand shape known (a stream), how much each of the rigid
+            hand's points counts against the wrist's own landmark: below 1, as filtered hand
+            points, swinging on a longer radius than the wrist, trail it by more.
         overhead_abduction: the shoulder's first branch (abduction within +-90 degrees) is
             taken whenever it meets the landmarks as well as the second and its abduction is
             within this (rad); beyond it, near the gimbal lock at 90, the branch nearer the
@@ -144,6 +150,7 @@ class PoseConfig:
     depth_bend_noise: float = 0.04
     straight_image: float = 0.95
     overhead_abduction: float = math.radians(60.0)
+    hand_weight: float = 0.5
 
     def __post_init__(self) -> None:
         whole_number(self.refine_iterations, "PoseConfig.refine_iterations", 0)
@@ -157,6 +164,7 @@ class PoseConfig:
             "depth_bend_noise",
             "straight_image",
             "overhead_abduction",
+            "hand_weight",
         ):
             positive_number(getattr(self, name), f"PoseConfig.{name}")
         if self.straight_image >= 1.0:
@@ -200,6 +208,7 @@ class _Reading:
     palm_sine: float  # how clearly the palm's width axis lies across the hand (0 to 1)
     points: np.ndarray  # shoulder, elbow, wrist, hand centre (arm base frame, m)
     lengths: np.ndarray  # this frame's upper-arm and forearm lengths (m, both arms' mean)
+    hand_shape: np.ndarray | None = None  # this frame's hand_shape(), None with a hand unseen
 
 
 @functools.lru_cache(maxsize=2)
@@ -381,39 +390,97 @@ def check_arm_seen(visibility: np.ndarray | None, side: str, cfg: PoseConfig) ->
             )
 
 
-def _refine_limbs(
-    points: np.ndarray, lengths: np.ndarray, weights: np.ndarray, iterations: int
-) -> np.ndarray:
-    """Shoulder, elbow and wrist ``(3, 3)`` on limbs of ``lengths``, nearest ``points``.
+HAND_SHAPE_POINTS = ("index", "pinky", "thumb")
+"""The hand points the stream fits as one rigid hand with the wrist (:func:`hand_shape`)."""
 
-    The maximum-likelihood chain under anisotropic noise (``weights``: one over each camera
-    axis's noise): Gauss-Newton over the shoulder and the two limb directions, each direction
-    moved in its tangent plane. With MediaPipe's depth several times noisier than x and y, the
-    known limb lengths pull a limb's depth toward what its image-plane length implies.
+
+def _skew(v: np.ndarray) -> np.ndarray:
+    """The cross-product matrix of ``v``: ``_skew(v) @ w == v x w``."""
+    return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
+
+
+def hand_axes(wrist: np.ndarray, index: np.ndarray, pinky: np.ndarray) -> np.ndarray | None:
+    """The hand's own frame from its points (columns: across the palm toward the index, from the
+    knuckles toward the wrist, and their cross product), or None when they give none."""
+    along = wrist - (index + pinky) / 2
+    width = index - pinky
+    if np.linalg.norm(along) < 1e-6:
+        return None
+    y = _unit(along)
+    across = width - (width @ y) * y
+    if np.linalg.norm(across) < 1e-6:
+        return None
+    x = _unit(across)
+    return np.column_stack([x, y, _cross(x, y)])
+
+
+def hand_shape(points: np.ndarray) -> np.ndarray | None:
+    """Index, pinky and thumb in the hand's own frame (:func:`hand_axes`), (3, 3) m, from the
+    wrist, index, pinky and thumb points ``(4, 3)``: one frame's measure of the person's hand."""
+    axes = hand_axes(points[0], points[1], points[2])
+    if axes is None:
+        return None
+    return (points[1:] - points[0]) @ axes
+
+
+def _refine_limbs(
+    points: np.ndarray,
+    lengths: np.ndarray,
+    weights: np.ndarray,
+    iterations: int,
+    hand: np.ndarray | None = None,
+) -> np.ndarray:
+    """Shoulder, elbow and wrist (and the hand points) on limbs of ``lengths``, nearest ``points``.
+
+    The maximum-likelihood chain under anisotropic noise (``weights``: one over each point's
+    noise per camera axis, (n, 3)): Gauss-Newton over the shoulder and the two limb directions,
+    each direction moved in its tangent plane. With MediaPipe's depth several times noisier than
+    x and y, the known limb lengths pull a limb's depth toward what its image-plane length implies.
+
+    With ``hand`` (the index, pinky and thumb in the hand's own frame, :func:`hand_shape`, (3, 3)),
+    ``points`` also holds the measured index, pinky and thumb (rows 3-5), and the hand is a rigid
+    body on the wrist, turned freely: its three points pin the wrist as well as the wrist's own
+    landmark does.
+
+    Returns:
+        ``(3, 3)``, or ``(6, 3)`` with ``hand``: the fitted points, in ``points``' order.
     """
     S = points[0].copy()
     dirs = [_unit(points[1] - points[0]), _unit(points[2] - points[1])]
-    J = np.zeros((9, 7))
-    for _ in range(iterations):
+    R = None if hand is None else hand_axes(points[2], points[3], points[4])
+    if R is None:
+        hand, points, weights = None, points[:3], weights[:3]
+    n = len(points)
+    J = np.zeros((3 * n, 7 if hand is None else 10))
+
+    def chain() -> np.ndarray:
         E = S + lengths[0] * dirs[0]
         W = E + lengths[1] * dirs[1]
-        r = (np.stack([S, E, W]) - points) * weights
+        fitted = [S, E, W] if R is None else [S, E, W, *(W + hand @ R.T)]
+        return np.stack(fitted)
+
+    for _ in range(iterations):
+        fitted = chain()
+        r = (fitted - points) * weights
         J[:] = 0.0
-        for k in range(3):
-            J[3 * k : 3 * k + 3, 0:3] = np.diag(weights)
+        for k in range(n):
+            J[3 * k : 3 * k + 3, 0:3] = np.diag(weights[k])
         for d, u in enumerate(dirs):
             basis = np.linalg.svd(u[None, :])[2][1:]  # two unit vectors across u
-            for k in range(d + 1, 3):
-                J[3 * k : 3 * k + 3, 3 + 2 * d : 5 + 2 * d] = (weights * lengths[d])[
+            for k in range(d + 1, n):
+                J[3 * k : 3 * k + 3, 3 + 2 * d : 5 + 2 * d] = (weights[k] * lengths[d])[
                     :, None
                 ] * basis.T
+        for k in range(3, n):  # a turn of the hand about the wrist moves its points
+            J[3 * k : 3 * k + 3, 7:10] = -weights[k][:, None] * _skew(fitted[k] - fitted[2])
         step = np.linalg.lstsq(J, -r.reshape(-1), rcond=None)[0]
         S = S + step[:3]
         for d in range(2):
             basis = np.linalg.svd(dirs[d][None, :])[2][1:]
             dirs[d] = _unit(dirs[d] + step[3 + 2 * d : 5 + 2 * d] @ basis)
-    E = S + lengths[0] * dirs[0]
-    return np.stack([S, E, E + lengths[1] * dirs[1]])
+        if R is not None:
+            R = pin.exp3(step[7:10]) @ R
+    return chain()
 
 
 def measured_lengths(points: np.ndarray, seen: Callable[[int], bool], side: str) -> np.ndarray:
@@ -437,12 +504,15 @@ def _read(
     cfg: PoseConfig,
     lengths: np.ndarray | None = None,
     torso: np.ndarray | None = None,
+    hand: np.ndarray | None = None,
 ) -> _Reading:
     """The limb directions in the arm base frame, or a KinematicsError for a missing arm.
 
     ``lengths`` (m, upper arm and forearm) replace this frame's measured ones, and ``torso``
     (world landmarks, (33, 3)) this frame's points for the torso's frame: a stream smooths both
-    more than the arm, as the body turns and the limbs change length slowly or never.
+    more than the arm, as the body turns and the limbs change length slowly or never. ``hand``
+    (the person's hand shape, :func:`hand_shape`, from recent frames) fits the index, pinky and
+    thumb as one rigid hand on the wrist when all three are seen (:func:`_refine_limbs`).
     """
     idx = LANDMARKS[side]
 
@@ -454,7 +524,6 @@ def _read(
         points = world
     else:
         points = doubt_depth_bends(_merge_image(world, pixels, size, cfg), cfg)
-    arm_points = points[[idx[name] for name in ARM_POINTS]]
     for (a, b), what in zip(LIMBS, ("upper arm", "forearm"), strict=True):
         if np.linalg.norm(points[idx[b]] - points[idx[a]]) < cfg.min_segment:
             raise KinematicsError(
@@ -462,15 +531,28 @@ def _read(
                 "a person's landmarks."
             )
     frame_lengths = measured_lengths(points, seen, side)
-    weights = np.array([1.0, 1.0, 1.0 / cfg.depth_noise])
-    arm_points = _refine_limbs(
-        arm_points, frame_lengths if lengths is None else lengths, weights, cfg.refine_iterations
+    hand_points = [idx[name] for name in ("wrist", *HAND_SHAPE_POINTS)]
+    frame_hand = hand_shape(points[hand_points]) if all(map(seen, hand_points)) else None
+    if frame_hand is None:
+        hand = None
+    names = ARM_POINTS if hand is None else (*ARM_POINTS, *HAND_SHAPE_POINTS)
+    weights = np.tile([1.0, 1.0, 1.0 / cfg.depth_noise], (len(names), 1))
+    weights[len(ARM_POINTS) :] *= cfg.hand_weight
+    fitted = _refine_limbs(
+        points[[idx[name] for name in names]],
+        frame_lengths if lengths is None else lengths,
+        weights,
+        cfg.refine_iterations,
+        hand,
     )
+    if len(fitted) > len(ARM_POINTS):  # the hand's points as the rigid hand puts them
+        points = points.copy()
+        points[[idx[name] for name in HAND_SHAPE_POINTS]] = fitted[len(ARM_POINTS) :]
     R = _torso_rotation(
         points if torso is None else torso, seen(HIPS["left"]) and seen(HIPS["right"])
     )
-    S, E, W = arm_points @ R
-    hand = palm = None
+    S, E, W = fitted[: len(ARM_POINTS)] @ R
+    hand_dir = palm = None
     palm_sine = 0.0
     H = W
     if seen(idx["index"]) and seen(idx["pinky"]):
@@ -478,14 +560,16 @@ def _read(
         knuckles = (index + pinky) / 2
         if np.linalg.norm(knuckles - W) >= cfg.min_segment:
             H = knuckles
-            hand = _unit(knuckles - W)
+            hand_dir = _unit(knuckles - W)
             width = index - pinky
-            across = width - (width @ hand) * hand
+            across = width - (width @ hand_dir) * hand_dir
             if np.linalg.norm(across) > _SEEN * np.linalg.norm(width):
                 palm = _unit(across)
                 palm_sine = float(np.linalg.norm(across) / np.linalg.norm(width))
     rel = np.stack([S, E, W, H]) - S
-    return _Reading(_unit(E - S), _unit(W - E), hand, palm, palm_sine, rel, frame_lengths)
+    return _Reading(
+        _unit(E - S), _unit(W - E), hand_dir, palm, palm_sine, rel, frame_lengths, frame_hand
+    )
 
 
 def _axis_sign(model: pin.Model, data: pin.Data, joint: int, axis: int) -> float:

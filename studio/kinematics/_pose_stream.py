@@ -12,8 +12,14 @@ toward their reading only by a fraction that shrinks with how weakly they are se
 seen at all (the wrist with the hand out of view) hold the previous frame's angle. So the arm
 never jumps where the landmarks say little.
 
-The torso's frame is read from a second, slower filter of the same landmarks: the body turns
-slowly, and its yaw, read from depth differences across the shoulders and hips, is noisy.
+The torso moves far more slowly than the arm, and every arm angle is read from the shoulder: the
+torso's shape (its shoulders and hips about their centre) is filtered with the much lower
+``StreamConfig.torso_acceleration``, while the body's place in the picture (that centre) keeps
+the arm's pace, so a person who steps aside is followed at once and one who turns, leans or
+shrugs within :attr:`PoseStreamFitter.torso_lag_s`. The torso's frame is read from a second,
+slower filter of the same landmarks: its yaw, read from depth differences across the shoulders
+and hips, is noisy. The hand's index, pinky and thumb are fitted as one rigid hand in the
+person's own shape (the median over recent frames, as the limb lengths), which pins the wrist.
 
 Lag: a steady motion passes without delay; a change of speed is taken up within the depth
 filter's time constant, :attr:`PoseStreamFitter.lag_s` (0.38 s at 30 Hz by default). Measured on
@@ -81,6 +87,14 @@ class StreamConfig:
             (the body turns slowly; its yaw, read from depth differences across the shoulders,
             is noisy).
         d_cutoff_hz: cutoff of that filter's speed estimate.
+        torso_acceleration: ``acceleration`` for the torso's shape, its shoulders and hips about
+            their centre (in the picture, that centre, the body's place, keeps the arm's
+            ``acceleration``): the torso turns, leans and shrugs far more slowly than the arm
+            swings, and every arm angle is read from the shoulder. Its lag is
+            :attr:`PoseStreamFitter.torso_lag_s`.
+        rigid_hand: fit the index, pinky and thumb as one rigid hand on the wrist, in the
+            person's own hand shape (the median of recent frames'), so the hand's points pin the
+            wrist as well as its own landmark does.
         max_gap_s: a gap between frames longer than this restarts the filter (the person left
             and came back: no smoothing across).
         length_frames: the limb lengths are the median over this many recent frames.
@@ -96,6 +110,8 @@ class StreamConfig:
     image_acceleration_px: float = 22.0
     torso_cutoff_hz: float = 0.3
     d_cutoff_hz: float = 1.0
+    torso_acceleration: float = 0.005
+    rigid_hand: bool = True
     max_gap_s: float = 1.0
     length_frames: int = 90
     weak_gain: float = 0.2
@@ -110,6 +126,7 @@ class StreamConfig:
             "image_acceleration_px",
             "torso_cutoff_hz",
             "d_cutoff_hz",
+            "torso_acceleration",
             "max_gap_s",
         ):
             positive_number(getattr(self, name), f"StreamConfig.{name}")
@@ -117,7 +134,60 @@ class StreamConfig:
         if not (isinstance(value, int | float) and math.isfinite(value) and value >= 0):
             raise KinematicsError(f"StreamConfig.weak_gain must be a number >= 0; got {value!r}.")
         whole_number(self.length_frames, "StreamConfig.length_frames", 1)
+        if not isinstance(self.rigid_hand, bool):
+            raise KinematicsError(
+                f"StreamConfig.rigid_hand must be True or False; got {self.rigid_hand!r}."
+            )
         instance_of(self.pose, PoseConfig, "StreamConfig.pose")
+
+
+TORSO = (
+    LANDMARKS["left"]["shoulder"],
+    LANDMARKS["right"]["shoulder"],
+    HIPS["left"],
+    HIPS["right"],
+)
+"""MediaPipe Pose's indices of the torso's landmarks: the shoulders and the hips."""
+
+
+def _filter_model(cfg: StreamConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The landmark filters' model: the world landmarks' noise (33, 3) and acceleration (33, 1),
+    and the image landmarks' acceleration (34, 1), for the image landmarks about the torso's
+    centre and that centre last (:func:`_about_torso`).
+
+    World landmarks are hip-centred already, so a body that steps aside does not move them; in
+    the picture it moves every landmark at once, so there only the torso's shape about its
+    centre is slow and the centre keeps the arm's pace.
+    """
+    noise = np.empty((N_LANDMARKS, 3))
+    noise[:, :2] = cfg.xy_noise_m
+    noise[:, 2] = cfg.depth_noise_m
+    slow = cfg.torso_acceleration / cfg.acceleration
+    world = np.full((N_LANDMARKS, 1), cfg.acceleration)
+    world[list(TORSO)] *= slow
+    image = np.full((N_LANDMARKS + 1, 1), cfg.image_acceleration_px)
+    image[list(TORSO)] *= slow
+    return noise, world, image
+
+
+def _about_torso(points: np.ndarray) -> np.ndarray:
+    """Landmarks ``(..., 33, k)`` about the torso landmarks' mean, and that mean as a 34th row.
+
+    A linear change of variables: the arm's landmarks, filtered at the centre's pace, come
+    back exactly as filtered on their own (:func:`_from_torso`); only the torso's rows change.
+    """
+    centre = points[..., TORSO, :].mean(axis=-2, keepdims=True)
+    return np.concatenate([points - centre, centre], axis=-2)
+
+
+def _from_torso(about: np.ndarray) -> np.ndarray:
+    """The landmarks back from :func:`_about_torso`'s rows."""
+    return about[..., :-1, :] + about[..., -1:, :]
+
+
+def _kalman_lag_s(noise: float, acceleration: float, dt: float) -> float:
+    """:meth:`ConstantVelocityFilter.lag_s` of one element of that noise and acceleration."""
+    return ConstantVelocityFilter(noise, acceleration).lag_s(dt)
 
 
 class PoseStreamFitter:
@@ -138,13 +208,12 @@ class PoseStreamFitter:
         self.arm = default_arm(self.side)
         self._data = self.arm.model.createData()
         cfg = self.config
-        noise = np.empty((N_LANDMARKS, 3))
-        noise[:, :2] = cfg.xy_noise_m
-        noise[:, 2] = cfg.depth_noise_m
-        self._world = ConstantVelocityFilter(noise, cfg.acceleration)
-        self._image = ConstantVelocityFilter(cfg.image_noise_px, cfg.image_acceleration_px)
+        world_noise, world_acceleration, image_acceleration = _filter_model(cfg)
+        self._world = ConstantVelocityFilter(world_noise, world_acceleration)
+        self._image = ConstantVelocityFilter(cfg.image_noise_px, image_acceleration)
         self._torso = OneEuroFilter(cfg.torso_cutoff_hz, 0.0, cfg.d_cutoff_hz)
         self._lengths: deque[np.ndarray] = deque(maxlen=cfg.length_frames)
+        self._hands: deque[np.ndarray] = deque(maxlen=cfg.length_frames)
         self.reset()
 
     @property
@@ -157,7 +226,18 @@ class PoseStreamFitter:
         torso's frame, filtered more, follows a turning body with ``1 / (2 pi
         torso_cutoff_hz)`` (0.53 s); the arm's own motion is not delayed by it.
         """
-        return self._world.lag_s(self._dt)
+        return _kalman_lag_s(self.config.depth_noise_m, self.config.acceleration, self._dt)
+
+    @property
+    def torso_lag_s(self) -> float:
+        """The same for the torso's shape (its shoulders and hips about their centre):
+        ``StreamConfig.torso_acceleration``'s time constant in the world landmarks' depth, the
+        slowest (1.7 s with the defaults; 0.71 s in the picture, whose landmarks decide the
+        shoulder's place when the page sends them). A body that steps aside is followed as fast
+        as the arm; one that turns, leans or shrugs within about this time.
+        """
+        cfg = self.config
+        return _kalman_lag_s(cfg.depth_noise_m, cfg.torso_acceleration, self._dt)
 
     def reset(self) -> None:
         """Forget the past frames: a new person, a new source."""
@@ -165,6 +245,7 @@ class PoseStreamFitter:
         self._image.reset()
         self._torso.reset()
         self._lengths.clear()
+        self._hands.clear()
         self._t: float | None = None
         self._dt = 1.0 / 30.0
         self._q: np.ndarray | None = None
@@ -217,13 +298,16 @@ class PoseStreamFitter:
         if not smoothed:
             world = self._world(t, world)
             if pixels is not None:
-                pixels = self._image(t, pixels)
+                pixels = _from_torso(self._image(t, _about_torso(pixels)))
         if self._t is not None:
             self._dt = float(t) - self._t
         self._t = float(t)
         lengths = np.median(self._lengths, axis=0) if self._lengths else None
-        reading = _read(world, pixels, size, visibility, self.side, cfg.pose, lengths, torso)
+        hand = np.median(self._hands, axis=0) if self._hands and cfg.rigid_hand else None
+        reading = _read(world, pixels, size, visibility, self.side, cfg.pose, lengths, torso, hand)
         self._lengths.append(reading.lengths)
+        if reading.hand_shape is not None:
+            self._hands.append(reading.hand_shape)
         q_hold = self.arm.neutral.copy() if self._q is None else self._q
         fit = fit_reading(reading, self.arm, self._data, cfg.pose, q_hold)
         q = fit.q_human.copy()
@@ -301,11 +385,9 @@ def smooth_landmarks(
             f"smooth_landmarks needs one time per frame ({len(world)}) and finite landmarks; "
             f"got {t.shape[0] if t.ndim else 0} times."
         )
-    noise = np.empty((N_LANDMARKS, 3))
-    noise[:, :2] = cfg.xy_noise_m
-    noise[:, 2] = cfg.depth_noise_m
+    noise, world_acceleration, image_acceleration = _filter_model(cfg)
     world = world.copy()
-    world[..., :3] = smooth_constant_velocity(t, world[..., :3], noise, cfg.acceleration)
+    world[..., :3] = smooth_constant_velocity(t, world[..., :3], noise, world_acceleration)
     if image_landmarks is None:
         return world, None
     image = real_array(image_landmarks, "The image landmark frames", "pass (N, 33, 2 or 3)")
@@ -324,7 +406,9 @@ def smooth_landmarks(
         )
     image = image.copy()
     pixels = image[..., :2] * size[:, None, :]
-    pixels = smooth_constant_velocity(t, pixels, cfg.image_noise_px, cfg.image_acceleration_px)
+    pixels = _from_torso(
+        smooth_constant_velocity(t, _about_torso(pixels), cfg.image_noise_px, image_acceleration)
+    )
     image[..., :2] = pixels / size[:, None, :]
     return world, image
 

@@ -210,7 +210,10 @@ def test_bad_frames_raise_and_leave_the_stream_as_it_was() -> None:
         with pytest.raises(KinematicsError, match=words):
             fitter.update(t, frame)
     np.testing.assert_allclose(fitter.update(0.1, world).q_human, first.q_human, atol=1e-9)
-    assert fitter.lag_s == pytest.approx(fitter._world.lag_s(0.1))
+    cfg = fitter.config  # the lags at the last frame interval, 0.1 s
+    assert fitter.lag_s == pytest.approx((cfg.depth_noise_m**2 * 0.1 / cfg.acceleration**2) ** 0.25)
+    torso = (cfg.depth_noise_m**2 * 0.1 / cfg.torso_acceleration**2) ** 0.25
+    assert fitter.torso_lag_s == pytest.approx(torso) and torso > fitter.lag_s
 
 
 def test_a_long_gap_restarts_the_filter() -> None:
