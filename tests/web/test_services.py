@@ -23,6 +23,7 @@ class FixedRobots:
             "robot": "toy",
             "drawn": None,
             "drawn_meshes": 0,
+            "limit_margin_rad": 0.02,
         }
 
 
