@@ -449,6 +449,10 @@ class _RunCreateBase(_Body):
     demonstration: then the first demonstration's end is its goal)."""
     demonstrations: list[str] = Field(default_factory=list)
     seed: int = DEFAULT_SEED
+    learner: str | None = None
+    """What trains the run: left out (or ``"dyna-q"``), the task's own Dyna-Q; ``"teacher"`` (the
+    demonstrations followed at every step) or ``"cloning"`` (behaviour cloning), baselines of the
+    continuous task that learn nothing from reward (``studio train --learner``)."""
 
     def request(self, robot: str, demonstrations: Sequence[DemonstrationPath] = ()) -> RunRequest:
         """The learning package's request of this run on ``robot`` (the one named here, or the
@@ -471,6 +475,7 @@ class _RunCreateBase(_Body):
             demonstrations=demonstrations,
             name=self.name or "",
             origin="page",
+            learner=self.learner or "",
             **self._task_settings(),
         )
 

@@ -17,6 +17,7 @@ ROWS = (
     "Dyna-Q + follow option",
     "Dyna-Q + demonstration potential",
     "Dyna-Q + follow + potential (default)",
+    "Dyna-Q + potential, any joints at once",
 )
 
 

@@ -35,3 +35,18 @@ def test_a_follow_run_follows_its_demonstrations_and_one_without_any_moves_one_j
     alone = wait_run(client, r.json()["id"])
     listed = next(p for p in client.get("/api/policies").json() if p["name"] == alone["id"])
     assert alone["status"] == "done" and "paths" not in listed["task"]
+
+
+def test_the_page_launches_a_baseline_that_compare_runs_tells_apart(client):
+    """A run trained by the teacher (the demonstrations followed, no learning; issue 40) from the
+    API: its settings say so, its policy is listed and watched like any other."""
+    body = {**PAGE_REACH, "episodes": 3, "experiments": 1, "learner": "teacher"}
+    r = client.post("/api/runs", json={**body, "demonstrations": ["sample-reach-1"]})
+    assert r.status_code == 201, r.text
+    run = wait_run(client, r.json()["id"])
+    assert run["status"] == "done" and run["config"]["learner"] == "teacher"
+    listed = next(p for p in client.get("/api/policies").json() if p["name"] == run["id"])
+    assert listed["task"]["learner"] == "teacher" and listed["planning"] == "none"
+    assert client.post("/api/watch", json={"run": run["id"]}).status_code == 200
+    r = client.post("/api/runs", json=body)  # nothing to follow: one sentence on the field
+    assert r.status_code == 422 and "learns from demonstrations" in r.json()["detail"]

@@ -271,6 +271,8 @@ class RunRecord:
             form["obstacles"] = [box.to_dict() for box in obstacles]
         form["demonstrations"] = list(self.demonstration_names)
         form["seed"] = self.seed
+        if self.learner:
+            form["learner"] = self.learner
         return form
 
     def to_dict(self) -> dict[str, object]:

@@ -148,6 +148,7 @@ class RunRequest:
             name=str(form.get("name") or ""),
             origin=origin,
             obstacles=cast(Sequence[object], form.get("obstacles") or ()),
+            learner=str(form.get("learner") or ""),
             **given,  # type: ignore[arg-type]
         )
 

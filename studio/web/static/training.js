@@ -119,6 +119,7 @@ function readTrainForm() {
     // an empty tiles field leaves the robot's default (the API's null)
     for (const k of REACH_FIELDS) if (k !== "tiles" || f[k].value.trim() !== "") body[k] = num(k);
     body.actions = f.actions.value;
+    if (f.learner.value) body.learner = f.learner.value; // a baseline; none: Dyna-Q
   }
   const robot = $("robot-name").value; // the robot chosen under Source, shown in the form
   if (robot) body.robot = robot;
