@@ -28,7 +28,7 @@ import numpy as np
 import pinocchio as pin
 
 from ._checks import KinematicsError
-from ._robots import Collision, RobotArm, _link_of, shape_points
+from ._robots import TABLE, Collision, RobotArm, _link_of, shape_points
 
 
 def _bounding_radius(obj: pin.GeometryObject) -> float:
@@ -273,11 +273,20 @@ class ObstacleGuard:
     Args:
         arm: a robot loaded with its geometry (``load_robot(name)``).
         obstacles: the boxes.
+        table_margin: also keep every link a joint after the first moves at least this far
+            (m) above the table the robot stands on (the plane of its base, as
+            :meth:`RobotArm.table_contacts` measures it); None: the table is not checked.
     """
 
-    def __init__(self, arm: RobotArm, obstacles: tuple[Obstacle, ...] | list[Obstacle]) -> None:
+    def __init__(
+        self,
+        arm: RobotArm,
+        obstacles: tuple[Obstacle, ...] | list[Obstacle],
+        table_margin: float | None = None,
+    ) -> None:
         self.arm = arm
         self.obstacles = tuple(obstacles)
+        self.table_margin = table_margin
         self.queries = 0
         """How many poses were measured so far (for benchmarks and tests)."""
         source = arm.collision_model
@@ -308,22 +317,51 @@ class ObstacleGuard:
                 for k in range(len(geom.collisionPairs))
             ]
         ).reshape(len(geom.collisionPairs), arm.nq)
+        # the table: each link a joint after the first moves, its lowest point's height above
+        # the base's plane less the margin, as one more "pair" with the same motion bounds
+        self._table = arm._table_points if table_margin is not None else []
+        if self._table:
+            rows = all_bounds[[k for k, *_ in self._table]].copy()
+            rows[:, 0] = 0.0  # the first joint turns about the vertical: no height changes
+            self._bounds = np.vstack([self._bounds, rows])
+            self._source = pin.GeometryData(source)
+
+    @property
+    def _pairs(self) -> int:
+        """How many distances :meth:`distances` gives: the (link, box) pairs, then the table's."""
+        return len(self._geom.collisionPairs) + len(self._table)
 
     def distances(self, q: np.ndarray) -> np.ndarray:
-        """Each (link, box) pair's distance at ``q`` (m, negative inside), shape (pairs,)."""
-        if not len(self._geom.collisionPairs):
+        """Each (link, box) pair's distance at ``q`` (m, negative inside), then, with a
+        ``table_margin``, each moving link's height above the table less that margin; shape
+        (pairs,)."""
+        if not self._pairs:
             return np.zeros(0)
         self.queries += 1
-        pin.computeDistances(self.arm.model, self._data, self._geom, self._gdata, q)
-        return np.array([r.min_distance for r in self._gdata.distanceResults])
+        found = []
+        if len(self._geom.collisionPairs):
+            pin.computeDistances(self.arm.model, self._data, self._geom, self._gdata, q)
+            found = [r.min_distance for r in self._gdata.distanceResults]
+        if self._table:
+            source = self.arm.collision_model
+            pin.updateGeometryPlacements(self.arm.model, self._data, source, self._source, q)
+            for k, points, _, _ in self._table:
+                placement = self._source.oMg[k]
+                lowest = float((points @ placement.rotation[2]).min() + placement.translation[2])
+                found.append(lowest - self.table_margin)
+        return np.array(found, dtype=float)
 
     def contacts(self, q: object, margin: float = 0.0) -> list[Collision]:
         """The links closer than ``margin`` to a box at ``q``: ``Collision(link, "obstacle_<i>",
         distance)``, closest first."""
         arr = self.arm.check_q(q)
         found = []
+        boxes = len(self._geom.collisionPairs)
         for k, d in enumerate(self.distances(arr)):
-            if d < margin:
+            if k >= boxes and d < margin:  # the table (its margin already taken off)
+                name = self.arm.collision_model.geometryObjects[self._table[k - boxes][0]].name
+                found.append(Collision(_link_of(name), TABLE, float(d)))
+            elif d < margin:
                 pair = self._geom.collisionPairs[k]
                 found.append(
                     Collision(
@@ -355,7 +393,7 @@ class ObstacleGuard:
             gap_from: :meth:`distances` at ``q_from`` when known (saves a query).
             gap_to: :meth:`distances` at ``q_to`` when known.
         """
-        if not len(self._geom.collisionPairs):
+        if not self._pairs:
             return False
         q0 = np.asarray(q_from, dtype=float)
         dq = np.asarray(q_to, dtype=float) - q0
@@ -380,10 +418,7 @@ class ObstacleGuard:
         """Whether a joint path ``(N, nq)``, its samples joined by straight moves, touches a box."""
         path = np.atleast_2d(np.asarray(q_path, dtype=float))
         if len(path) == 1:
-            return (
-                bool(len(self._geom.collisionPairs))
-                and self.distances(path[0]).min() < OBSTACLE_TOUCH_M
-            )
+            return bool(self._pairs) and self.distances(path[0]).min() < OBSTACLE_TOUCH_M
         return any(self.move_collides(a, b) for a, b in zip(path[:-1], path[1:], strict=True))
 
 

@@ -345,4 +345,7 @@ def test_the_grid_environment_takes_a_robot():
     env = gymnasium.make("TeachStudio/ArmGrid-v0", robot="panda")
     assert env.unwrapped.grid == ArmGrid(robot="panda")
     assert has_default_goal(ArmGrid(robot="panda"))
-    assert not has_default_goal(ArmGrid(robot="panda", goal=(0, 0, 0)))
+    assert not has_default_goal(ArmGrid(robot="panda", goal=(5, 5, 5)))
+    # a goal that would lay the arm on the table it stands on is refused, in one sentence
+    with pytest.raises(LearningError, match="table it stands on"):
+        ArmGrid(robot="panda", goal=(0, 0, 0))

@@ -131,8 +131,10 @@ class TabularLearner:
         elif start.seed is not None:
             starts = grid.mdp().start_states
             state = int(starts[np.random.default_rng(start.seed).integers(len(starts))])
+        elif start.q is None:  # its own: the zero pose, or the start nearest it off the table
+            state = grid.nearest_start(np.zeros(grid.joints))
         else:
-            q = np.zeros(grid.joints) if start.q is None else np.asarray(start.q, np.float64)
+            q = np.asarray(start.q, np.float64)
             state = grid.state_of_angles(q[: grid.joints])
             if len(q) == len(hold):  # a whole pose: its other joints hold where they are
                 hold[grid.joints :] = q[grid.joints :]

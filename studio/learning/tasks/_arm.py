@@ -8,7 +8,8 @@ leave the range leaves that joint where it is. Reaching the goal pays +100 and e
 every other transition pays -1. Episodes start uniformly from every state but the goal. Boxes in
 the robot's workspace (``obstacles``) refuse every move whose path touches one: the arm stays
 where it is and pays the step's -1 (:mod:`._obstacles`); a state whose pose touches one is no
-start. With the
+start. The table a robot stands on is such an obstacle on every robot's grid but the Puma560's
+(the paper's, on its pedestal, with no table in its task): no learned path runs through it. With the
 defaults (3 joints, 11 bins over [-180, 180] degrees) this is the paper's 1331-state, 27-action
 task.
 
@@ -129,8 +130,16 @@ class ArmGrid:
                     f"goal {self.goal!r} has a bin outside [0, {self.bins - 1}]; give bins in range."
                 )
         object.__setattr__(self, "goal", tuple(int(b) for b in goal))
-        if self.obstacles:
-            check_goal_clear(self.robot, self.obstacles, self.poses()[self.goal_state])
+        if self.obstacles or self.keeps_off_table:
+            check_goal_clear(
+                self.robot, self.obstacles, self.poses()[self.goal_state], self.keeps_off_table
+            )
+
+    @property
+    def keeps_off_table(self) -> bool:
+        """Whether no move may bring the robot within :data:`._obstacles.TABLE_MARGIN_M` of
+        the table it stands on: every robot's grid but the Puma560's (the paper's task)."""
+        return self.robot != PUMA560
 
     # ------------------------------------------------------------------ sizes and numbering
 
@@ -223,6 +232,20 @@ class ArmGrid:
     def _centres(self, bins: np.ndarray) -> np.ndarray:
         return self._lows + (bins + 0.5) * self._widths
 
+    def nearest_start(self, q_rad: Sequence[float] | np.ndarray) -> int:
+        """The state of the angles ``q_rad``, or, where that state is no start (its pose
+        touches an obstacle, or comes near the table the robot stands on), the start state
+        nearest to it (fewest bins away, then nearest in angle)."""
+        state = self.state_of_angles(q_rad)
+        starts = self.mdp().start_states
+        if state == self.goal_state or state in starts:
+            return state
+        bins = np.array(np.unravel_index(starts, (self.bins,) * self.joints)).T
+        own = np.array(self.bins_of(state))
+        away = np.abs(bins - own)
+        order = np.lexsort(((away**2).sum(axis=1), away.max(axis=1)))
+        return int(starts[order[0]])
+
     def _check_state(self, state: int) -> None:
         if (
             not isinstance(state, int | np.integer)
@@ -263,15 +286,15 @@ class ArmGrid:
         goal = self.goal_state
         colliding = np.zeros(self.n_states, np.bool_)
         intended = next_state
-        if self.obstacles:
+        if self.obstacles or self.keeps_off_table:
             blocked, colliding = blocked_grid_moves(
-                self.robot, self.obstacles, self.poses(), next_state
+                self.robot, self.obstacles, self.poses(), next_state, self.keeps_off_table
             )
             next_state = np.where(blocked, np.arange(self.n_states)[:, None], next_state)
         reward = np.where(next_state == goal, GOAL_REWARD, STEP_REWARD)
         terminal = np.zeros(self.n_states, np.bool_)
         terminal[goal] = True
-        starts = np.flatnonzero(~terminal & ~colliding)
+        starts = np.flatnonzero(~terminal & ~colliding & _reaches(next_state, goal))
         return TabularMDP(next_state, reward, terminal, starts, intended)
 
     @property
@@ -377,6 +400,18 @@ class ArmGrid:
             states, samples = states[:end], samples[:end]
         states, samples = _erase_loops(states, samples)
         return GridPath(states=states, samples=samples, reaches_goal=reaches_goal)
+
+
+def _reaches(next_state: np.ndarray, goal: int) -> np.ndarray:
+    """Which states some sequence of moves takes to ``goal`` (S,) bool: walled off by boxes or
+    the table, a state is no start (its episodes could never end)."""
+    reached = np.zeros(len(next_state), np.bool_)
+    reached[goal] = True
+    while True:  # every state one move from a reached one, until nothing new
+        more = reached[next_state].any(axis=1) & ~reached
+        if not more.any():
+            return reached
+        reached |= more
 
 
 @functools.lru_cache(maxsize=4)

@@ -21,6 +21,7 @@ import numpy as np
 
 from studio.kinematics import (
     OBSTACLE_TOUCH_M,
+    TABLE,
     KinematicsError,
     Obstacle,
     ObstacleGuard,
@@ -39,16 +40,34 @@ def task_obstacles(value: object) -> tuple[Obstacle, ...]:
         raise ConfigError([str(err)], ["obstacles"]) from None
 
 
+TABLE_MARGIN_M = 0.01
+"""How far (m) a grid keeps every link above the table its robot stands on: more than an
+export's contact margin (5 mm), so a learned path passes the export's checks."""
+
+
 @functools.lru_cache(maxsize=8)
-def obstacle_guard(robot: str, obstacles: tuple[Obstacle, ...]) -> ObstacleGuard:
-    """The guard of ``robot``'s collision geometry against ``obstacles`` (made once per pair;
-    not thread-safe: callers on other threads make their own)."""
-    return ObstacleGuard(load_robot(robot), obstacles)
+def obstacle_guard(
+    robot: str, obstacles: tuple[Obstacle, ...], table: bool = False
+) -> ObstacleGuard:
+    """The guard of ``robot``'s collision geometry against ``obstacles`` (and, with ``table``,
+    the table it stands on, kept :data:`TABLE_MARGIN_M` away); made once per pair; not
+    thread-safe: callers on other threads make their own."""
+    return ObstacleGuard(load_robot(robot), obstacles, TABLE_MARGIN_M if table else None)
 
 
-def check_goal_clear(robot: str, obstacles: tuple[Obstacle, ...], q_goal: np.ndarray) -> None:
-    """Refuse a goal pose that touches a box (ConfigError, field ``obstacles``)."""
-    touching = obstacle_guard(robot, obstacles).contacts(q_goal, OBSTACLE_TOUCH_M)
+def check_goal_clear(
+    robot: str, obstacles: tuple[Obstacle, ...], q_goal: np.ndarray, table: bool = False
+) -> None:
+    """Refuse a goal pose that touches a box (ConfigError, field ``obstacles``) or, with
+    ``table``, comes within :data:`TABLE_MARGIN_M` of the table (field ``goal``)."""
+    touching = obstacle_guard(robot, obstacles, table).contacts(q_goal, OBSTACLE_TOUCH_M)
+    if touching and touching[0].link_b == TABLE:
+        raise ConfigError(
+            [
+                f"The goal brings the robot's {touching[0].link_a} within {TABLE_MARGIN_M * 100:.0f} cm of the table it stands on; choose a goal above the table."
+            ],
+            ["goal"],
+        )
     if touching:
         box = int(touching[0].link_b.rpartition("_")[2])
         raise ConfigError(
@@ -60,13 +79,18 @@ def check_goal_clear(robot: str, obstacles: tuple[Obstacle, ...], q_goal: np.nda
 
 
 def blocked_grid_moves(
-    robot: str, obstacles: tuple[Obstacle, ...], poses: np.ndarray, next_state: np.ndarray
+    robot: str,
+    obstacles: tuple[Obstacle, ...],
+    poses: np.ndarray,
+    next_state: np.ndarray,
+    table: bool = False,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Which of a grid's moves touch its obstacles, and which states do.
+    """Which of a grid's moves touch its obstacles (or the table), and which states do.
 
     Args:
         robot: the robot's registry name.
         obstacles: the boxes.
+        table: keep every link :data:`TABLE_MARGIN_M` above the table the robot stands on too.
         poses: every state's whole pose ``(S, nq)`` (rad).
         next_state: the transition table without obstacles ``(S, A)``.
 
@@ -75,7 +99,7 @@ def blocked_grid_moves(
         joint-space path from one bin centre to the next touches a box; a state colliding when
         its pose does (it is no start, and every move into it is blocked).
     """
-    guard = obstacle_guard(robot, obstacles)
+    guard = obstacle_guard(robot, obstacles, table)
     gaps = np.array([guard.distances(q) for q in poses])  # (S, pairs)
     colliding = gaps.min(axis=1) < OBSTACLE_TOUCH_M
     blocked = np.zeros(next_state.shape, np.bool_)
