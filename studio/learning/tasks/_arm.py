@@ -138,8 +138,9 @@ class ArmGrid:
     @property
     def keeps_off_table(self) -> bool:
         """Whether no move may bring the robot within :data:`._obstacles.TABLE_MARGIN_M` of
-        the table it stands on: every robot's grid but the Puma560's (the paper's task)."""
-        return self.robot != PUMA560
+        the table it stands on: every robot's grid but one binned over the paper's range
+        (its registry's ``grid_range_deg``: the Puma560's, the paper's task, with no table)."""
+        return not task_arm(self.robot).spec.grid_range_deg
 
     # ------------------------------------------------------------------ sizes and numbering
 
