@@ -61,7 +61,9 @@ def _exports(module: str) -> list[str]:
     """The public names a package's ``__init__`` makes (not submodules, not third-party helpers
     such as ``Path`` that it merely imports)."""
     names = []
-    for name, value in vars(importlib.import_module(module)).items():
+    package = importlib.import_module(module)
+    for name in dir(package):  # a lazy package's too (studio/_lazy.py): all it lists
+        value = getattr(package, name)
         if name.startswith("_") or name == "annotations" or isinstance(value, types.ModuleType):
             continue
         owner = getattr(value, "__module__", None)
@@ -209,14 +211,16 @@ def _module_name(path: Path) -> str:
 
 
 def _imports(
-    body: list[ast.stmt], late: bool, typing: bool = False
+    body: list[ast.stmt], late: bool, typing: bool = False, lazy: bool = False
 ) -> Iterator[ast.Import | ast.ImportFrom | str]:
     """The imports that run when a module is imported (anywhere in its body and in its class
     bodies, which run then too, inside any ``if``/``try``/``with``/loop/``match``) and, if
     ``late``, also those in its functions, methods and lambdas, which run when called. Those
     under ``if TYPE_CHECKING:``, which never run, only if ``typing``: the module still depends
     on what they name. ``importlib.import_module("studio....")`` with a literal name counts as an
-    import of that module (yielded as its name)."""
+    import of that module (yielded as its name). In a ``lazy`` package's ``__init__``
+    (``studio/_lazy.py``) those under ``if TYPE_CHECKING:`` do run, late: when a name is first
+    used."""
     pending: list[ast.AST] = list(body)
     while pending:
         node = pending.pop()
@@ -232,7 +236,7 @@ def _imports(
             pending.extend(n for n in runs_now if n is not None)
             continue
         if isinstance(node, ast.If) and _is_type_checking(node.test) and not typing:
-            pending.extend(node.orelse)
+            pending.extend(node.orelse + (node.body if lazy and late else []))
             continue
         if (
             isinstance(node, ast.Call)
@@ -254,7 +258,9 @@ def _import_graph(late: bool, typing: bool = False) -> dict[str, set[str]]:
     graph: dict[str, set[str]] = {name: set() for name in paths}
     for name, path in paths.items():
         package = name if path.name == "__init__.py" else name.rpartition(".")[0]
-        for node in _imports(ast.parse(path.read_text(), str(path)).body, late, typing):
+        text = path.read_text()
+        lazy = path.name == "__init__.py" and "lazy_exports(" in text
+        for node in _imports(ast.parse(text, str(path)).body, late, typing, lazy):
             if isinstance(node, str):
                 targets = [node]
             elif isinstance(node, ast.Import):
@@ -435,9 +441,9 @@ f = lambda: __import__("studio.late_lambda")
 """
 
 
-def _imported(source: str, late: bool, typing: bool = False) -> set[str]:
+def _imported(source: str, late: bool, typing: bool = False, lazy: bool = False) -> set[str]:
     names = set()
-    for node in _imports(ast.parse(source).body, late, typing):
+    for node in _imports(ast.parse(source).body, late, typing, lazy):
         if isinstance(node, str):
             names.add(node)
         elif isinstance(node, ast.Import):
@@ -462,6 +468,9 @@ def test_the_import_scan_finds_every_import_that_runs():
     assert _imported(LATE_AND_EARLY, late=False) == early
     assert _imported(LATE_AND_EARLY, late=True) == early | late
     assert _imported(LATE_AND_EARLY, late=True, typing=True) == early | late | {"studio.never"}
+    # a lazy package's TYPE_CHECKING names load when first used: late imports
+    assert _imported(LATE_AND_EARLY, late=False, lazy=True) == early
+    assert _imported(LATE_AND_EARLY, late=True, lazy=True) == early | late | {"studio.never"}
 
 
 MAX_FILE_LINES = 800

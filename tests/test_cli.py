@@ -1,5 +1,6 @@
 from __future__ import annotations
 
+import json
 import sys
 
 import pytest
@@ -186,23 +187,91 @@ def test_a_name_a_latin1_shell_sent_is_refused_in_one_sentence(
     assert not list(tmp_path.iterdir())
 
 
-HEAVY = ("studio.learning", "studio.kinematics", "studio.capture", "pinocchio", "numba", "scipy")
-
-
-@pytest.mark.parametrize(
-    "argv", [["--help"], ["no-such-verb"], ["robots", "--help"], ["simulate", "--help"]]
+HEAVY = (
+    "scipy",
+    "numba",
+    "pinocchio",
+    "mujoco",
+    "toppra",
+    "matplotlib",
+    "ray",
+    "fastapi",
+    "viser",
+    "studio.learning.tabular._dynaq",
+    "studio.learning.linear._linear",
+    "studio.kinematics._robot_load",
+    "studio.web",
 )
-def test_help_and_a_mistyped_verb_import_none_of_the_heavy_packages(argv):
-    """``studio --help`` lists the verbs from their modules' source, and a verb's own help
-    imports only that verb: none of Pinocchio, numba or SciPy (seconds of CPU) for a light one."""
+"""What `studio --help` once loaded (1.4 s of CPU) and a verb's parser once did (up to 2.5 s)."""
+ARGUMENT_ERRORS = {
+    "serve": ["serve", "--port", "x"],
+    "record": ["record", "--seconds", "x", "--out", "x.tape.csv"],
+    "bridge": ["bridge", "--no-such-flag"],
+    "import-raw": ["import-raw", "raw.txt"],
+    "train": ["train", "--episodes", "x"],
+    "sweep": ["sweep", "--workers", "x"],
+    "reproduce": ["reproduce", "--experiments", "x"],
+    "export": ["export"],
+    "export-urdf": ["export-urdf", "--no-such-flag"],
+    "info": ["info"],
+    "robots": ["robots", "--no-such-flag"],
+    "evaluate": ["evaluate"],
+    "simulate": ["simulate"],
+}
+"""One usage error per verb: a value that is not a number, a missing file, an unknown flag."""
+
+
+def _loaded_after(*argvs: list[str]) -> tuple[list[str], list[int]]:
+    """The modules of ``HEAVY`` that running ``studio`` on each argv loaded (in one fresh
+    interpreter), and each run's exit status."""
     import subprocess
 
     code = (
-        "import sys\nfrom studio.cli import main\n"
-        f"try:\n    main({argv!r})\nexcept SystemExit:\n    pass\n"
-        f"print(sorted(m for m in {HEAVY!r} if m in sys.modules))"
+        "import sys\nfrom studio.cli import main\ncodes = []\n"
+        f"for argv in {list(argvs)!r}:\n"
+        "    try:\n        codes.append(main(argv))\n"
+        "    except SystemExit as end:\n        codes.append(end.code)\n"
+        f"print(json.dumps([[m for m in {HEAVY!r} if m in sys.modules], codes]))"
     )
     done = subprocess.run(
-        [sys.executable, "-c", code], capture_output=True, text=True, timeout=120, check=True
+        [sys.executable, "-c", "import json\n" + code],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=True,
     )
-    assert done.stdout.strip().splitlines()[-1] == "[]", done.stdout
+    loaded, codes = json.loads(done.stdout.strip().splitlines()[-1])
+    return loaded, codes
+
+
+def test_every_verb_has_an_argument_error_checked():
+    _, modules = build_parser()
+    assert set(ARGUMENT_ERRORS) == set(modules)
+
+
+@pytest.mark.parametrize("argv", [["--help"], ["no-such-verb"], ["--no-such-flag", "x"]])
+def test_help_and_a_mistyped_verb_import_none_of_the_heavy_packages(argv):
+    """``studio --help`` lists the verbs from their modules' source: none is imported."""
+    loaded, _ = _loaded_after(argv)
+    assert loaded == []
+
+
+PENDING = {"train", "reproduce", "export"}
+"""Verbs whose parsers still read defaults from the heavy modules (being moved)."""
+
+
+@pytest.mark.parametrize(
+    "verb",
+    [
+        pytest.param(v, marks=pytest.mark.xfail(strict=True)) if v in PENDING else v
+        for v in sorted(ARGUMENT_ERRORS)
+    ],
+)
+def test_a_verbs_help_and_its_usage_errors_import_none_of_the_heavy_packages(verb):
+    """A verb's parser is built from light modules (its flags' defaults and choices included),
+    its heavy imports wait for its run: ``studio VERB --help``, a value that is not a number and
+    a missing argument answer in a fraction of a second, not after seconds of Pinocchio, numba
+    and SciPy."""
+    loaded, codes = _loaded_after([verb, "--help"], ARGUMENT_ERRORS[verb])
+    assert codes == [0, 2]
+    assert loaded == [], f"studio {verb} --help or a usage error imported {loaded}"

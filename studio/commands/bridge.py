@@ -12,14 +12,7 @@ import sys
 import time
 
 from studio import StudioError
-from studio.capture import (
-    DEFAULT_PORT,
-    check_seconds,
-    cli_speed,
-    parse_host_port,
-    source_from_spec,
-    stream_source,
-)
+from studio.capture import DEFAULT_PORT
 
 from ._options import add_playback_options
 from .serve import TOKEN_ENV
@@ -59,6 +52,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    # imported here, not with the flags: `studio bridge --help` and a mistyped flag stay fast
+    from studio.capture import (
+        check_seconds,
+        cli_speed,
+        parse_host_port,
+        source_from_spec,
+        stream_source,
+    )
+
     host, port = parse_host_port(args.to)
     check_seconds(args.seconds)
     token = args.token if args.token is not None else os.environ.get(TOKEN_ENV) or None

@@ -5,8 +5,6 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from studio.capture import describe, import_raw, read_recording
-
 NAME = "import-raw"
 HELP = "Import a Measurand raw text file with a calibration JSON into a *.tape.csv recording."
 
@@ -27,6 +25,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from studio.capture import describe, import_raw, read_recording  # here: --help stays fast
+
     path = import_raw(
         args.raw, args.calibration, args.out, operator=args.operator, notes=args.notes
     )

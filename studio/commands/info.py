@@ -7,9 +7,6 @@ import argparse
 import json
 from pathlib import Path
 
-from studio.capture import RECORDING_SUFFIXES, being_recorded, describe, summarize_any_recording
-from studio.export import ExportError, find_source
-
 NAME = "info"
 HELP = "Show a recording's or demonstration's metadata, length and any problems."
 
@@ -33,6 +30,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    # imported here, not with the flags: `studio info --help` and a mistyped flag stay fast
+    from studio.capture import being_recorded, describe, summarize_any_recording
+
     for given in args.files:
         path = _file(given)
         if path.name.endswith(".demo.json"):
@@ -56,6 +56,9 @@ def run(args: argparse.Namespace) -> int:
 def _file(given: Path) -> Path:
     """The recording or demonstration ``given`` names: a path, or a name as ``studio export`` and
     ``studio train --demos`` take it (the data folder's, then the samples')."""
+    from studio.capture import RECORDING_SUFFIXES
+    from studio.export import ExportError, find_source
+
     if given.exists():
         return given
     path = find_source(given)

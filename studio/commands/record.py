@@ -10,20 +10,13 @@ import os
 import sys
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from studio import StudioError
-from studio.capture import (
-    DEFAULT_RATE_HZ,
-    SOURCE_SPECS,
-    SourceStatus,
-    capture,
-    check_seconds,
-    cli_speed,
-    describe,
-    recording_path,
-    source_from_spec,
-    summarize_any_recording,
-)
+from studio.capture import SOURCE_SPECS
+
+if TYPE_CHECKING:
+    from studio.capture import SourceStatus
 
 from ._options import add_playback_options
 from .serve import TOKEN_ENV
@@ -71,6 +64,18 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    # imported here, not with the flags: `studio record --help` and a mistyped flag stay fast
+    from studio.capture import (
+        DEFAULT_RATE_HZ,
+        capture,
+        check_seconds,
+        cli_speed,
+        describe,
+        recording_path,
+        source_from_spec,
+        summarize_any_recording,
+    )
+
     check_seconds(args.seconds)
     check_seconds(args.wait, "--wait")
     token = args.token if args.token is not None else os.environ.get(TOKEN_ENV) or None

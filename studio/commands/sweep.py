@@ -12,15 +12,10 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-from studio.learning import (
-    SweepError,
-    SweepProgress,
-    SweepSpec,
-    load_sweep_spec,
-    resume_target,
-    run_sweep,
-)
+if TYPE_CHECKING:
+    from studio.learning import SweepProgress, SweepSpec
 
 NAME = "sweep"
 HELP = "Run a parameter sweep (a TOML spec) on Ray Tune; each trial is an ordinary run."
@@ -49,6 +44,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _spec(args: argparse.Namespace) -> SweepSpec:
+    from studio.learning import SweepError, load_sweep_spec, resume_target
+
     if args.spec is None:
         if not args.resume:
             raise SweepError(
@@ -62,6 +59,9 @@ def _spec(args: argparse.Namespace) -> SweepSpec:
 
 
 def run(args: argparse.Namespace) -> int:
+    # imported here, not with the flags: `studio sweep --help` and a mistyped flag stay fast
+    from studio.learning import run_sweep
+
     spec = _spec(args)
     bar = None
     if not args.no_progress:
