@@ -28,13 +28,13 @@ def _is_type_checking(test: ast.expr) -> bool:
 
 def listed_names(init_file: str | Path) -> dict[str, tuple[str, str]]:
     """Each public name an ``__init__`` lists under ``if TYPE_CHECKING:`` -> the module it comes
-    from (relative, such as ``._config``) and its name there."""
+    from (``._config``, or another package such as ``studio.motion``) and its name there."""
     found: dict[str, tuple[str, str]] = {}
     for node in ast.parse(Path(init_file).read_text()).body:
         if not (isinstance(node, ast.If) and _is_type_checking(node.test)):
             continue
         for statement in node.body:
-            if isinstance(statement, ast.ImportFrom) and statement.level:
+            if isinstance(statement, ast.ImportFrom):
                 module = "." * statement.level + (statement.module or "")
                 for alias in statement.names:
                     found[alias.asname or alias.name] = (module, alias.name)

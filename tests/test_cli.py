@@ -256,17 +256,7 @@ def test_help_and_a_mistyped_verb_import_none_of_the_heavy_packages(argv):
     assert loaded == []
 
 
-PENDING = {"train", "reproduce", "export"}
-"""Verbs whose parsers still read defaults from the heavy modules (being moved)."""
-
-
-@pytest.mark.parametrize(
-    "verb",
-    [
-        pytest.param(v, marks=pytest.mark.xfail(strict=True)) if v in PENDING else v
-        for v in sorted(ARGUMENT_ERRORS)
-    ],
-)
+@pytest.mark.parametrize("verb", sorted(ARGUMENT_ERRORS))
 def test_a_verbs_help_and_its_usage_errors_import_none_of_the_heavy_packages(verb):
     """A verb's parser is built from light modules (its flags' defaults and choices included),
     its heavy imports wait for its run: ``studio VERB --help``, a value that is not a number and

@@ -18,48 +18,35 @@ import argparse
 import sys
 from dataclasses import replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
+# Only light modules here: the flags' defaults and choices. What an export needs (the robot
+# models, the learners, TOPP-RA, MuJoCo) is imported where it runs, so `studio export --help` and
+# a mistyped flag answer at once.
 from studio._layout import physics_cache_dir, robot_cache_dir
 from studio.capture import DEMO_SUFFIX, RECORDING_SUFFIXES
-from studio.export import (
-    FORMAT_SUFFIXES,
-    FORMATS,
-    LIMIT_FRACTION,
-    ExportError,
-    check_policy_robot,
-    export_motion,
-    find_source,
-    likeness_motions,
-    source_kind,
-)
+from studio.export import FORMAT_SUFFIXES, FORMATS, LIMIT_FRACTION, ExportError
 from studio.kinematics import (
     LIMIT_MARGIN_RAD,
     KinematicsError,
-    RobotArm,
-    isolate_robot_loading,
-    robot_is_kept,
     robot_names,
     robot_spec,
 )
 from studio.learning import (
-    POLICY_SUFFIX,
     ROLLOUT_MAX_STEPS,
     ROLLOUT_RATE_HZ,
     ROLLOUT_SECONDS_PER_STEP,
     TILE_ROLLOUT_MAX_STEPS,
     TILE_ROLLOUT_SECONDS_PER_STEP,
-    AnyPolicy,
     LearningError,
-    Rollout,
-    Start,
-    learner_of,
-    likeness_cards,
-    load_any_policy,
-    save_trajectory_csv,
 )
-from studio.motion import Motion, demonstration_motion, recording_motion
+
+if TYPE_CHECKING:
+    from studio.kinematics import RobotArm
+    from studio.learning import AnyPolicy, Rollout
+    from studio.motion import Motion
 
 NAME = "export"
 TIMINGS = {
@@ -209,6 +196,8 @@ def _rollout(
     joints, or every joint of ``arm``; default: its learner's own start, the learned joints at
     0 or a movement primitive's demonstration's start, or ``arm``'s home pose where 0 lies
     outside its limits), and the phrase saying what it did."""
+    from studio.learning import Start, learner_of
+
     learner = learner_of(policy)
     joints = learner.learned_joints(policy)
     if args.start_state is not None:
@@ -240,6 +229,8 @@ def _rollout(
 
 def _run_legacy(args: argparse.Namespace, policy: AnyPolicy) -> int:
     """``studio export POLICY``: the rollout at the policy's own pace, as CSV ``time,q1..q6``."""
+    from studio.learning import save_trajectory_csv
+
     rollout, summary = _rollout(args, policy, args.seconds_per_step)
     times, q = rollout.times, rollout.q
     out = _out_path(args)
@@ -261,6 +252,9 @@ def _run_legacy(args: argparse.Namespace, policy: AnyPolicy) -> int:
 
 def _print_likeness(args: argparse.Namespace, path: Path, policy: AnyPolicy) -> None:
     """Print the policy's likeness card against each of its demonstrations (or why none)."""
+    from studio.export import likeness_motions
+    from studio.learning import likeness_cards
+
     motions = likeness_motions(path, policy, args.demo, args.data_dir)
     if not motions:
         print(
@@ -275,6 +269,10 @@ def _print_likeness(args: argparse.Namespace, path: Path, policy: AnyPolicy) -> 
 
 def _motion(args: argparse.Namespace, source: Path, robot: str) -> tuple[Motion, str]:
     """The source's motion on ``robot``, and a phrase saying what it is."""
+    from studio.export import check_policy_robot, source_kind
+    from studio.learning import load_any_policy
+    from studio.motion import Motion, demonstration_motion, recording_motion
+
     kind = source_kind(source)
     if kind in ("recording", "demonstration"):
         _say_retargeting(source, robot)
@@ -295,6 +293,8 @@ def _say_loading(robot: str, cache: Path) -> None:
     """Keep ``robot``'s built geometry in the data folder's cache, as ``studio serve`` does, and
     tell a person at a terminal when its first load will build it (a minute or more), so the
     export does not look stuck. Said only to a terminal, as :func:`_say_retargeting` is."""
+    from studio.kinematics import isolate_robot_loading, robot_is_kept
+
     isolate_robot_loading(cache)
     if robot not in robot_names() or robot_is_kept(robot) or not sys.stderr.isatty():
         return
@@ -323,6 +323,9 @@ def _say_retargeting(source: Path, robot: str) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from studio.export import export_motion, find_source
+    from studio.learning import POLICY_SUFFIX, load_any_policy
+
     if args.retime and args.seconds_per_step is not None:
         raise ExportError(
             "--retime times the path within the robot's limits and --seconds-per-step sets a "

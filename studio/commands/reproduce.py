@@ -6,7 +6,7 @@ from __future__ import annotations
 import argparse
 import time
 
-from studio.learning import DEFAULT_EPISODES, DEFAULT_EXPERIMENTS, DEFAULT_SEED, reproduce
+from studio.learning import DEFAULT_EPISODES, DEFAULT_EXPERIMENTS, DEFAULT_SEED
 
 NAME = "reproduce"
 HELP = (
@@ -46,6 +46,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from studio.learning import reproduce  # here, not with the flags: --help stays fast
+
     start = time.perf_counter()
     result = reproduce(
         args.out,

@@ -32,18 +32,22 @@ import argparse
 import time
 from collections.abc import Callable
 from pathlib import Path
-from typing import cast
+from typing import TYPE_CHECKING, cast
 
+# Only light modules here: the flags' defaults and choices. What a run needs (the learners,
+# numba, the robot models) is imported where it runs, so `studio train --help` and a mistyped
+# flag answer at once.
 from studio import StudioError, read_json
 from studio._layout import RECORDINGS_DIR
-from studio.capture import DEMO_FORMAT, DEMO_SUFFIX
-from studio.kinematics import DEFAULT_ROBOT, KinematicsError, Obstacle, robot_names, robot_spec
+from studio.capture import DEMO_SUFFIX
+from studio.kinematics import DEFAULT_ROBOT, KinematicsError, robot_names, robot_spec
 from studio.learning import (
     ACTION_SETS,
     CLONING_KIND,
     DEFAULT_EPISODES,
     DEFAULT_EXPERIMENTS,
     DEFAULT_SEED,
+    DEFAULT_SHAPING,
     DEMO_SHAPING,
     OWN_LEARNER,
     PLANNERS,
@@ -51,25 +55,20 @@ from studio.learning import (
     TASK_KINDS,
     TEACHER_KIND,
     ArmGrid,
-    ArmReach,
-    DemonstrationPath,
     DynaQConfig,
     LearningError,
-    LiveProgress,
-    RunFolder,
-    RunRecord,
-    RunRequest,
-    resolve_run,
 )
-from studio.motion import MotionError, training_demonstration
 from studio.samples import SAMPLES_DIR
+
+if TYPE_CHECKING:
+    from studio.kinematics import Obstacle
+    from studio.learning import DemonstrationPath, LiveProgress, RunRecord, RunRequest
 
 NAME = "train"
 HELP = "Train Dyna-Q on the arm grid or the arm's continuous joints: a run folder with curves and a policy out."
 REACH_REWARD_FLAGS = ("shaping", "demo_potential")
 """The continuous task's reward settings ``studio train`` sets (:class:`ArmReach` fields)."""
 _DYNAQ = DynaQConfig()
-_GRID = ArmGrid()
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -117,15 +116,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--joints",
         type=int,
-        help=f"grid joints (default: {_GRID.joints}); with --task arm-reach, joints 1..J learnt "
+        help=f"grid joints (default: {ArmGrid.joints}); with --task arm-reach, joints 1..J learnt "
         f"(default: {REACH_DEFAULTS['joints']})",
     )
-    parser.add_argument("--bins", type=int, help=f"bins per joint (default: {_GRID.bins})")
+    parser.add_argument("--bins", type=int, help=f"bins per joint (default: {ArmGrid.bins})")
     _add_reach_arguments(parser)
     goal = parser.add_mutually_exclusive_group()
     goal.add_argument(
         "--goal",
-        help=f"goal bins, comma-separated (default: {','.join(map(str, _GRID.goal))})",
+        help="goal bins, comma-separated (default: the bins nearest the robot's default goal)",
     )
     goal.add_argument(
         "--goal-deg",
@@ -182,7 +181,7 @@ def _add_reach_arguments(parser: argparse.ArgumentParser) -> None:
         type=float,
         help="arm-reach: weight of the shaping potential toward the goal's joint angles, reward "
         "per joint step; 0 leaves the paper's reward, +100 at the goal and -1 a step "
-        f"(default: {ArmReach.shaping:g})",
+        f"(default: {DEFAULT_SHAPING:g})",
     )
     parser.add_argument(
         "--demo-potential",
@@ -203,6 +202,8 @@ def _add_reach_arguments(parser: argparse.ArgumentParser) -> None:
 
 def _obstacle(text: str) -> Obstacle:
     """``--obstacle``'s value as a box, or argparse's one-line refusal."""
+    from studio.kinematics import Obstacle  # with coal and Pinocchio: only when one is given
+
     try:
         return Obstacle.parse(text)
     except KinematicsError as err:
@@ -258,6 +259,8 @@ def _recorded(source: Path, robot: str) -> DemonstrationPath:
     Puma560 one, or its recording's segment retargeted onto another robot), which the run
     replays along the path the page replays, never the file's stored ``grid_path`` (written by
     older code, or edited by hand); its times too, for the run's likeness card."""
+    from studio.motion import MotionError, training_demonstration
+
     try:
         return training_demonstration(source, robot, f"The demonstration {source}")
     except MotionError as err:
@@ -284,6 +287,8 @@ def _spec_of(args: argparse.Namespace) -> dict[str, object]:
             f"The config file {args.config} holds no JSON object; give an object with 'grid' and 'config'."
         )
     if "task" in spec or "format" in spec:  # a run's own config.json: repeat that run
+        from studio.learning import RunRecord
+
         record = RunRecord.from_dict(spec)
         if record.kind != TASK_KINDS[0]:
             raise LearningError(
@@ -327,6 +332,9 @@ def run_request(args: argparse.Namespace) -> RunRequest:
     Raises:
         LearningError: a file that cannot be read (bad settings are the resolver's to report).
     """
+    from studio.capture import DEMO_FORMAT
+    from studio.learning import RunRequest
+
     if getattr(args, "task", TASK_KINDS[0]) != TASK_KINDS[0]:
         return _reach_request(args)
     problems = [
@@ -380,6 +388,9 @@ def run_request(args: argparse.Namespace) -> RunRequest:
 
 def _reach_request(args: argparse.Namespace) -> RunRequest:
     """:func:`run_request` for ``--task arm-reach``: the page's continuous-task settings."""
+    from studio.capture import DEMO_FORMAT
+    from studio.learning import RunRequest
+
     problems = [
         (flag, f"--{flag.replace('_', '-')} {why}; leave it out with --task {args.task}.")
         for flag, why in (
@@ -430,11 +441,15 @@ def resolve(args: argparse.Namespace) -> RunRecord:
     Raises:
         LearningError: a bad file or flag (a :class:`ConfigError` lists every bad field).
     """
+    from studio.learning import resolve_run
+
     return resolve_run(run_request(args))
 
 
 def run(args: argparse.Namespace) -> int:
     """Train into a new run folder; Ctrl-C stops at the next episode and keeps what was learnt."""
+    from studio.learning import LiveProgress, RunFolder
+
     record = resolve(args)
     if args.out is None:
         folder = RunFolder.create(Path("runs"), record, status="running")

@@ -2,8 +2,12 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 from studio import StudioError
-from studio.motion import Finding
+
+if TYPE_CHECKING:
+    from studio.motion import Finding
 
 
 class ExportError(StudioError):

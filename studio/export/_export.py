@@ -20,7 +20,6 @@ import json
 import time
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Literal
 
 import numpy as np
 
@@ -29,24 +28,19 @@ from studio.motion import Finding, Motion
 from studio.physics import PhysicsError, SimulationReport
 
 from ._errors import ExportError
-from ._formats import write_csv, write_mcap
+from ._formats import Format, write_csv, write_mcap
 from ._lerobot import lerobot_conventions, write_lerobot
 from ._safety import COLLISION_MARGIN_M, check_trajectory, limit_findings, refuse, timing_findings
 from ._simulate import simulate_trajectory
 from ._tf import link_transforms
 from ._timing import LIMIT_FRACTION, PacedPath, Slowdown, pace_path, time_path
 
-Format = Literal["csv", "mcap", "lerobot"]
-FORMATS: tuple[Format, ...] = ("csv", "mcap", "lerobot")
-"""The trajectory formats ``studio export --format`` writes."""
 TASKS = {
     "demonstration": "Reach the goal the way the person showed it.",
     "recording": "Move the arm the way the person moved theirs.",
     "policy": "Reach the goal.",
 }
 """A LeRobot episode's task text by what the motion came from, as a person would write it."""
-FORMAT_SUFFIXES: dict[Format, str] = {"csv": ".csv", "mcap": ".mcap", "lerobot": ".lerobot"}
-"""Each format's default ending after the source's name (a LeRobot dataset is a folder)."""
 
 
 @dataclass(frozen=True)

@@ -27,14 +27,22 @@ import io
 import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import BinaryIO
+from typing import TYPE_CHECKING, BinaryIO, Literal
 
 import numpy as np
 
 from studio._files import atomic_write
 
 from ._errors import ExportError
-from ._tf import LinkTransforms
+
+if TYPE_CHECKING:
+    from ._tf import LinkTransforms
+
+Format = Literal["csv", "mcap", "lerobot"]
+FORMATS: tuple[Format, ...] = ("csv", "mcap", "lerobot")
+"""The trajectory formats ``studio export --format`` writes."""
+FORMAT_SUFFIXES: dict[Format, str] = {"csv": ".csv", "mcap": ".mcap", "lerobot": ".lerobot"}
+"""Each format's default ending after the source's name (a LeRobot dataset is a folder)."""
 
 JOINT_TRAJECTORY = "trajectory_msgs/msg/JointTrajectory"
 JOINT_STATE = "sensor_msgs/msg/JointState"

@@ -23,13 +23,14 @@ nearly stop anyway, and 2.3x on a smooth arc); TOPP-RA times a given path, which
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from studio.kinematics import RobotArm
-
 from ._errors import ExportError
-from ._safety import differences
+
+if TYPE_CHECKING:
+    from studio.kinematics import RobotArm
 
 PATH_TOLERANCE_RAD = np.radians(0.5)
 """How far (rad, per joint) the thinned path may pass from a sample of the original one."""
@@ -306,6 +307,8 @@ def within_limits(robot: RobotArm, times: np.ndarray, q: np.ndarray) -> bool:
     """Whether the samples' finite-difference velocities and accelerations are within limits."""
     if len(times) < 3:
         return True
+    from ._safety import differences  # imports studio.motion: only when checking
+
     velocity, acceleration = differences(times, q)
     return bool(
         (np.abs(velocity) <= robot.velocity).all()

@@ -18,11 +18,16 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import PurePosixPath
-from typing import Literal
+from typing import TYPE_CHECKING, Literal
 from xml.sax.saxutils import quoteattr
 
 import numpy as np
-import pinocchio as pin
+
+if TYPE_CHECKING:
+    import pinocchio as pin
+
+# Pinocchio is imported where a pose is built, not with this module: the robot registry reads
+# the Puma560's ready pose and grid range here without loading it.
 
 PUMA_READY_DEG = (0.0, 45.0, -90.0, 0.0, 0.0, 0.0)
 """The Puma560's ``RobotSpec.ready``, the paper's goal: the paper shows its goal only as a picture
@@ -64,6 +69,8 @@ class DHRow:
 
     def fixed(self) -> pin.SE3:
         """The joint-independent part ``Tz(d) Tx(a) Rx(alpha)`` of this row."""
+        import pinocchio as pin
+
         c, s = math.cos(self.alpha), math.sin(self.alpha)
         rotation = np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
         return pin.SE3(rotation, np.array([self.a, 0.0, self.d]))
@@ -173,6 +180,8 @@ def _num(value: float) -> str:
 
 def _origin(pose: np.ndarray) -> str:
     """A URDF ``<origin>`` element for a 4x4 pose (rpy is fixed-axis x, y, z)."""
+    import pinocchio as pin
+
     xyz = " ".join(_num(v) for v in pose[:3, 3])
     rpy = " ".join(_num(v) for v in pin.rpy.matrixToRpy(pose[:3, :3]))
     return f'<origin xyz="{xyz}" rpy="{rpy}"/>'

@@ -7,11 +7,16 @@ can show the messages next to its form fields.
 
 :func:`check_budget` refuses runs too big to finish on a workstation (for example a billion
 episodes) before any work starts.
+
+Also here, with their defaults, the other settings a person chooses for a run (the task's kind;
+the continuous task's joints, step, actions and tilings) and a tile-coded rollout's pace: this
+module imports neither numba nor the robot models, so ``studio train --help`` reads them at once.
 """
 
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass, fields
+from typing import Final
 
 import numpy as np
 
@@ -40,6 +45,88 @@ DEFAULT_SEED = 0
 """Seed of a run when none is given (every random draw derives from it)."""
 MAX_Q_ENTRIES = 200_000_000
 """Upper bound on experiments x states x actions: the final Q tables (8 bytes each, 1.6 GB)."""
+
+TASK_ARM_GRID = "arm-grid"
+"""``task.kind`` of the paper's arm grid (``task`` also holds the :meth:`ArmGrid.to_dict` spec)."""
+TASK_ARM_REACH = "arm-reach"
+"""``task.kind`` of the continuous-joint task (``task`` also holds the :meth:`ArmReach.to_dict`
+fields and ``tile_coding``, the :meth:`TileCoding.to_dict` settings); its demonstrations are
+joint paths ``(N, joints)`` in radians."""
+TASK_KINDS = (TASK_ARM_GRID, TASK_ARM_REACH)
+"""The kinds of task a run trains, each by its learner (:func:`studio.learning.learner`)."""
+DEFAULT_JOINTS = 6
+"""All six joints, so the tool's orientation is learned too."""
+DEFAULT_STEP_DEG = 2.0
+"""Joint increment per action, degrees (no coarser than 2 degrees)."""
+DEFAULT_TILINGS = 8
+"""Offset tilings of the arm's default features."""
+ACTION_SETS = ("single", "pairs", "all", "follow")
+"""What one action may move: one joint (2J actions), one joint or two together (2J**2), any
+joints at once (3**J - 1), or one joint or all of them along the demonstrated paths (2J + 1, see
+:attr:`ArmReach.paths`); each of the first three begins with the one before it, in the same
+order, and ``"follow"`` with the singles."""
+DEFAULT_ACTIONS = "follow"
+"""One joint per action, and with demonstrations one more that follows them (without any, the
+task is ``"single"``'s bit for bit). With 3 demonstrations at six joints (package README): under
+the paper's reward its first 20 own episodes take 0.037 of the real steps without them (one
+joint per action: 0.204), 16 points ahead after 1,000 episodes and 4 after 4,000 (0.995); under
+the default shaping greedy success from random starts is higher or level (+8.4 points after
+1,000 episodes, +0.4 after 4,000, no planning; the learner's common value, :mod:`.linear._common_value`);
+a policy taught by one demonstration moves like it (DTW 0.028-0.047 rad a sample, one joint per
+action 0.17-0.39).
+``"pairs"``, learned with the factored action value (:mod:`.linear._factored`), reaches 95% greedy
+success in fewer real steps without demonstrations (81 k against 321 k at six joints), but its
+greedy success swings as training goes on: at six joints, 2 experiments, Puma560 93% / 78% /
+99% / 92% after 500 / 1,000 / 2,000 / 4,000 episodes and UR5 70% / 81% / 63% / 42%, where one
+joint per action ends at 100% on the Puma560, the Panda and the UR5. A default that gets worse
+with more training is the wrong default."""
+
+REACH_DEFAULTS: Final = {
+    "joints": DEFAULT_JOINTS,
+    "step_deg": DEFAULT_STEP_DEG,
+    "actions": DEFAULT_ACTIONS,
+    "tilings": DEFAULT_TILINGS,
+    "tiles": None,
+}
+"""The continuous task's settings a person sets, and their defaults (:class:`ArmReach` and its
+default :meth:`ArmReach.features`; ``tiles`` None: the robot's :attr:`ArmReach.default_tiles`,
+32 for the Puma560)."""
+TILE_ROLLOUT_SECONDS_PER_STEP = 0.04
+"""Time the arm takes for one step of a tile-coded rollout (2 degrees in 0.04 s: 50 deg/s) when
+the policy was not taught from timed demonstrations (:func:`studio.learning.demonstrated_pace`)."""
+TILE_ROLLOUT_MAX_STEPS = 5_000
+"""Default cap on greedy steps of a tile-coded rollout."""
+DEFAULT_SHAPING = 5.0
+"""Weight of the potential-based shaping reward (Ng, Harada & Russell 1999): ``shaping`` times the
+change of :func:`.tasks._reach.reach_potential` (minus the joints' distance to the goal's angles, in steps). It
+gives every step a direction toward the goal, without which a 6-joint random start almost never
+finds the goal's few-degree region; 0 gives the paper's bare +100 / -1. With gamma = 1 the terms of
+an episode telescope to a constant per start, so the optimal policies are unchanged; with the
+paper's gamma = 0.95 the term also charges ``(1 - gamma) x shaping x distance``, which only pulls
+harder toward the goal.
+
+Why 5 and not 1. A joint step toward the goal pays ``shaping - 1``, one away ``-shaping - 1``.
+With 1 the step cost cancels exactly: every move toward the goal pays 0, so which joint to move is
+told apart only by the discounted +100, ``100 x 0.95 ** (sum of the joints' distances)``, a
+*product* of per-joint factors that no sum of per-joint (or pair) tile weights represents; the
+fitted error exceeds the true gaps and the greedy policy steps a near-goal joint back and forth
+(measured at six joints: 16% greedy success after 4,000 episodes, 32% after 16,000). With 5, the
+value is dominated by a sum over joints of per-joint terms (+4 per step toward the goal, -6 per
+step away), which per-joint tilings represent exactly, and the +100 only settles the last steps:
+100% after 4,000 episodes (package README). A cycle still costs (toward then away:
+``4 - 0.95 x 6 < 0``), so no loop pays; that holds while ``shaping < (1 + gamma) / (1 - gamma)``
+(39 at gamma = 0.95)."""
+DEMO_SHAPING = 5.0
+"""Weight of the demonstrations' potential, in reward per joint step: the task's own
+:data:`DEFAULT_SHAPING`, for the same reason (with 1 a step toward the goal pays 0 and
+the joints are told apart only by the discounted +100)."""
+OWN_LEARNER = "dyna-q"
+"""How a run names its task's own learner (tabular Dyna-Q on the grid, linear Dyna-Q with tile
+coding on the continuous task), as ``studio train --learner`` takes it; the default."""
+TEACHER_KIND = "teacher"
+"""The teacher's kind (``studio train --learner teacher``)."""
+CLONING_KIND = "cloning"
+"""Behaviour cloning's kind (``studio train --learner cloning``)."""
 
 
 @dataclass(frozen=True)

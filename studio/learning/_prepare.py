@@ -24,9 +24,9 @@ import sys
 import threading
 import time
 
+from ._config import TASK_KINDS
 from ._learner import LiveProgress
 from ._registry import learner
-from .runs._record import TASK_KINDS
 
 log = logging.getLogger(__name__)
 

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from ._config import OWN_LEARNER as OWN_LEARNER
 from ._errors import LearningError, PolicyFileError
 from ._interface import Learner
 from .baselines._learner import CloningLearner, TeacherLearner
@@ -74,11 +75,6 @@ def learner_for_task(task: object) -> Learner:
     raise LearningError(
         f"No learner learns a {type(task).__name__}; give an ArmGrid or an ArmReach."
     )
-
-
-OWN_LEARNER = "dyna-q"
-"""How a run names its task's own learner (tabular Dyna-Q on the grid, linear Dyna-Q with tile
-coding on the continuous task), as ``studio train --learner`` takes it; the default."""
 
 
 def run_learner(kind: str, task: object) -> Learner:

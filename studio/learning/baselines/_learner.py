@@ -17,6 +17,8 @@ from pathlib import Path
 
 import numpy as np
 
+from .._config import CLONING_KIND as CLONING_KIND
+from .._config import TEACHER_KIND as TEACHER_KIND
 from .._errors import LearningError
 from .._interface import Evaluation, Rollout, Start, TrainingRun, listed_degrees
 from .._learner import ExperimentResult, LiveProgress, result_so_far
@@ -31,7 +33,8 @@ from ..linear._learner import (
 )
 from ..linear._policy import DEFAULT_MAX_STEPS, path_trajectory
 from ..tasks._demo_motion import DemonstrationMotion
-from ..tasks._reach import DEFAULT_MAX_EPISODE_STEPS, ArmReach
+from ..tasks._gym_ids import DEFAULT_MAX_EPISODE_STEPS
+from ..tasks._reach import ArmReach
 from ._cloning import clone_walk, fit_cloning
 from ._policy import (
     CLONING_FORMAT,
@@ -42,11 +45,6 @@ from ._policy import (
     load_baseline_policy,
     save_baseline_policy,
 )
-
-TEACHER_KIND = "teacher"
-"""The teacher's kind (``studio train --learner teacher``)."""
-CLONING_KIND = "cloning"
-"""Behaviour cloning's kind (``studio train --learner cloning``)."""
 
 
 @dataclass(frozen=True, eq=False)

@@ -11,12 +11,12 @@ import logging
 from collections.abc import Sequence
 from dataclasses import fields
 from pathlib import Path
-from typing import Final, cast
+from typing import cast
 
 import gymnasium
 import numpy as np
 
-from .._config import DynaQConfig
+from .._config import REACH_DEFAULTS, TASK_ARM_REACH, DynaQConfig
 from .._errors import LearningError
 from .._interface import Evaluation, Rollout, Start, TrainingRun, listed_degrees
 from .._learner import LiveProgress
@@ -46,23 +46,12 @@ from ._policy import (
 
 log = logging.getLogger(__name__)
 
-KIND = "arm-reach"
+KIND = TASK_ARM_REACH
 """The tile-coded learner's kind: the continuous-joint arm task (a run record's ``task.kind``)."""
 WATCH_MAX_STEPS = 1_500
 """Most joint steps of a watched rollout (a minute of motion at 0.04 s per step)."""
 
 
-_FEATURES = ArmReach().features()
-REACH_DEFAULTS: Final = {
-    "joints": ArmReach.joints,
-    "step_deg": ArmReach.step_deg,
-    "actions": ArmReach.actions,
-    "tilings": _FEATURES.tilings,
-    "tiles": None,
-}
-"""The continuous task's settings a person sets, and their defaults (:class:`ArmReach` and its
-default :meth:`ArmReach.features`; ``tiles`` None: the robot's :attr:`ArmReach.default_tiles`,
-32 for the Puma560)."""
 FORM_ACTIONS = "single"
 """The action set the page's train form starts the continuous task with: one joint per action.
 With the follow action (:data:`REACH_DEFAULTS`' ``"follow"``, the default of ``studio train`` and

@@ -43,6 +43,8 @@ from pathlib import Path
 import numpy as np
 
 from ..._numbers import is_number
+from .._config import TILE_ROLLOUT_MAX_STEPS as DEFAULT_MAX_STEPS
+from .._config import TILE_ROLLOUT_SECONDS_PER_STEP as DEFAULT_SECONDS_PER_STEP
 from .._config import DynaQConfig
 from .._errors import LearningError, PolicyFileError
 from .._tiles import TileCoder, TileCoding
@@ -59,11 +61,6 @@ from ._linear import LinearResult, greedy_rollout
 
 FORMAT_NAME = "teach-studio-tile-policy"
 FORMAT_VERSION = 1
-DEFAULT_SECONDS_PER_STEP = 0.04
-"""Time the arm takes for one step of a tile-coded rollout (2 degrees in 0.04 s: 50 deg/s) when
-the policy was not taught from timed demonstrations (:func:`demonstrated_pace`)."""
-DEFAULT_MAX_STEPS = 5_000
-"""Default cap on greedy steps of a tile-coded rollout."""
 
 
 @dataclass(frozen=True, eq=False)

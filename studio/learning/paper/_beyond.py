@@ -30,7 +30,8 @@ import numpy as np
 from .._config import DynaQConfig
 from ..linear._linear import LinearResult, greedy_success
 from ..tasks._gym import ARM_REACH_ID
-from ..tasks._reach import DEFAULT_MAX_EPISODE_STEPS, ArmReach
+from ..tasks._gym_ids import DEFAULT_MAX_EPISODE_STEPS
+from ..tasks._reach import ArmReach
 
 BEYOND_JOINTS = (3, 4, 5, 6)
 """Joint counts compared."""

@@ -24,13 +24,17 @@ import numpy as np
 
 from ..._files import now_iso
 from ..._numbers import is_int, is_number
-from .._config import DEFAULT_SEED, DynaQConfig, check_budget
+from .._config import (
+    DEFAULT_SEED,
+    TASK_ARM_GRID,
+    TASK_KINDS,
+    DynaQConfig,
+    check_budget,
+)
 from .._errors import ConfigError, LearningError
 from .._interface import Learner
 from .._registry import OWN_LEARNER, learner, learner_for_task, run_learner
 from .._tiles import TileCoding
-from ..linear._learner import KIND as TILE_KIND
-from ..tabular._learner import KIND as TABULAR_KIND
 from ..tasks._arm import ArmGrid
 from ..tasks._demo_motion import DemonstrationMotion
 from ..tasks._reach import ArmReach
@@ -41,14 +45,6 @@ RUN_VERSION = 1
 """The version of the run folder layout this code writes and reads."""
 ORIGINS = ("cli", "page", "reproduce", "sweep")
 """What made a run: ``studio train``, the page's run queue, ``studio reproduce``, a sweep."""
-TASK_ARM_GRID = TABULAR_KIND
-"""``task.kind`` of the paper's arm grid (``task`` also holds the :meth:`ArmGrid.to_dict` spec)."""
-TASK_ARM_REACH = TILE_KIND
-"""``task.kind`` of the continuous-joint task (``task`` also holds the :meth:`ArmReach.to_dict`
-fields and ``tile_coding``, the :meth:`TileCoding.to_dict` settings); its demonstrations are
-joint paths ``(N, joints)`` in radians."""
-TASK_KINDS = (TASK_ARM_GRID, TASK_ARM_REACH)
-"""The kinds of task a run trains, each by its learner (:func:`studio.learning.learner`)."""
 CONFIG_FORM_FIELDS = ("planning", "planning_steps", "epsilon", "alpha", "gamma")
 """The :class:`DynaQConfig` fields a person sets for a run (the page's form, ``studio train``)."""
 

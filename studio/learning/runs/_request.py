@@ -23,11 +23,20 @@ from typing import cast
 import numpy as np
 
 from ..._numbers import is_int
-from .._config import DEFAULT_EPISODES, DEFAULT_EXPERIMENTS, DEFAULT_SEED, DynaQConfig
+from .._config import (
+    DEFAULT_EPISODES,
+    DEFAULT_EXPERIMENTS,
+    DEFAULT_SEED,
+    REACH_DEFAULTS,
+    TASK_ARM_GRID,
+    TASK_ARM_REACH,
+    TASK_KINDS,
+    DynaQConfig,
+)
 from .._errors import ConfigError, LearningError
 from .._registry import OWN_LEARNER, learner, run_learner
 from .._tiles import TileCoding
-from ..linear._learner import CODING_SETTINGS, REACH_DEFAULTS
+from ..linear._learner import CODING_SETTINGS
 from ..paper._reproduce import generate_demonstrations
 from ..tasks._arm import ArmGrid
 from ..tasks._demo_motion import DemonstrationMotion, demonstration_grid_path
@@ -37,9 +46,6 @@ from ..tasks._reach import ArmReach
 from ..tasks._robot import PUMA560, check_robot, robot_title, task_arm
 from ._record import (
     CONFIG_FORM_FIELDS,
-    TASK_ARM_GRID,
-    TASK_ARM_REACH,
-    TASK_KINDS,
     RunRecord,
     raise_problems,
     run_problems,

@@ -27,11 +27,11 @@ import numpy as np
 from studio import StudioError, read_toml
 
 from ..._numbers import is_int, is_number
-from .._config import DynaQConfig
+from .._config import TASK_KINDS, DynaQConfig
 from .._errors import ConfigError, LearningError
 from .._registry import learner
 from ..paper._reproduce import CONVERGENCE_FACTOR
-from ..runs._record import TASK_KINDS, RunRecord
+from ..runs._record import RunRecord
 from ..runs._request import RunRequest, resolve_run, task_settings
 from ..tasks._robot import PUMA560
 

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .._config import DynaQConfig
+from .._config import TASK_ARM_GRID, DynaQConfig
 from .._errors import LearningError
 from .._interface import Evaluation, Rollout, Start, TrainingRun, listed_degrees
 from .._learner import ExperimentResult, LiveProgress
@@ -33,7 +33,7 @@ from ._policy import (
     save_policy,
 )
 
-KIND = "arm-grid"
+KIND = TASK_ARM_GRID
 """The tabular learner's kind: the paper's arm grid (a run record's ``task.kind``)."""
 
 

@@ -29,15 +29,17 @@ import functools
 from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cached_property
+from typing import TYPE_CHECKING
 
 import numpy as np
-
-from studio.kinematics import Obstacle
 
 from .._errors import LearningError
 from ._mdp import TabularMDP
 from ._obstacles import blocked_grid_moves, check_goal_clear, task_obstacles
 from ._robot import PUMA560, check_robot, default_goal, task_arm
+
+if TYPE_CHECKING:
+    from studio.kinematics import Obstacle
 
 MAX_JOINTS = 6
 """Most joints a grid covers (the Puma560 has six)."""

@@ -15,7 +15,7 @@ gains ``phi(s') - phi(s)``, in the replayed demonstrations, the agent's own epis
 the planners replay alike.
 
 Why ``phi(s') - phi(s)`` and not Ng's ``gamma phi(s') - phi(s)``: the same form as the task's own
-shaping (:data:`._reach.DEFAULT_SHAPING`, which says why). With ``gamma = 0.95`` and a potential of
+shaping (:data:`studio.learning.DEFAULT_SHAPING`, which says why). With ``gamma = 0.95`` and a potential of
 hundreds of steps, Ng's form pays ``(1 - gamma) x weight x distance`` (+75 a step six joints
 away) for every step taken far from the goal: measured, every own episode then ran to the cap,
 with the default shaping too. Ours charges that amount instead, which only pulls toward the
@@ -23,7 +23,7 @@ demonstrated goal; with gamma = 1 the two forms agree and the optimal policies a
 
 With ``kappa = 1`` the minimum is reached at a demonstration's last state (the triangle
 inequality), so ``phi`` is the joint distance to the nearest demonstrated final pose: the task's
-own shaping (:data:`._reach.DEFAULT_SHAPING`) with the goal's joint angles read from the
+own shaping (:data:`studio.learning.DEFAULT_SHAPING`) with the goal's joint angles read from the
 demonstrations instead of given. ``kappa > 1`` makes a valley along the demonstrated paths.
 With ``kappa = 1`` only the demonstrations' last states are kept (the potential is the same,
 each step costs a few more additions instead of ``M``). What each gave is measured by
@@ -41,12 +41,9 @@ from collections.abc import Sequence
 import numpy as np
 from numba import njit
 
+from .._config import DEMO_SHAPING as DEMO_SHAPING
 from ._reach import ArmReach, reach_step
 
-DEMO_SHAPING = 5.0
-"""Weight of the demonstrations' potential, in reward per joint step: the task's own
-:data:`._reach.DEFAULT_SHAPING`, for the same reason (with 1 a step toward the goal pays 0 and
-the joints are told apart only by the discounted +100)."""
 DEMO_KAPPA = 1.0
 """Cost of a step away from the demonstrated states against one along them (see the module)."""
 MAX_POINTS_PER_DEMO = 64

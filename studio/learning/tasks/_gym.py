@@ -1,4 +1,5 @@
-"""Gymnasium environments of the studio's two arm tasks, registered on ``import studio.learning``.
+"""Gymnasium environments of the studio's two arm tasks, registered on ``import studio.learning``
+(by :mod:`._gym_ids`, which names them).
 
 - ``TeachStudio/ArmGrid-v0`` (:class:`ArmGridEnv`): the paper's tabular task, a Discrete
   observation (the grid state number) and Discrete actions; its dynamics are the table of
@@ -23,12 +24,9 @@ from numpy.typing import NDArray
 
 from .._errors import LearningError
 from ._arm import ArmGrid
-from ._reach import DEFAULT_MAX_EPISODE_STEPS, ArmReach, reach_step
-
-ARM_GRID_ID = "TeachStudio/ArmGrid-v0"
-ARM_REACH_ID = "TeachStudio/ArmReach-v0"
-ARM_GRID_MAX_EPISODE_STEPS = 10_000
-"""Episode cap of the registered grid environment (the paper's first episodes take ~2500)."""
+from ._gym_ids import ARM_GRID_ID as ARM_GRID_ID
+from ._gym_ids import ARM_REACH_ID as ARM_REACH_ID
+from ._reach import ArmReach, reach_step
 
 
 class _GridSettings(TypedDict, total=False):
@@ -175,20 +173,3 @@ class ArmReachEnv(gymnasium.Env):
         """Move the action's joints by one step each; ``terminated`` at the goal."""
         reward, terminated = reach_step(self._params, self.q, int(action))
         return self.task.observe(self.q), float(reward), bool(terminated), False, {}
-
-
-def register() -> None:
-    """Register both environments with Gymnasium (idempotent)."""
-    registry = gymnasium.envs.registration.registry
-    if ARM_GRID_ID not in registry:
-        gymnasium.register(
-            ARM_GRID_ID,
-            entry_point=f"{__name__}:ArmGridEnv",
-            max_episode_steps=ARM_GRID_MAX_EPISODE_STEPS,
-        )
-    if ARM_REACH_ID not in registry:
-        gymnasium.register(
-            ARM_REACH_ID,
-            entry_point=f"{__name__}:ArmReachEnv",
-            max_episode_steps=DEFAULT_MAX_EPISODE_STEPS,
-        )

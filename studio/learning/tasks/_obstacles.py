@@ -16,24 +16,25 @@ obstacles.
 from __future__ import annotations
 
 import functools
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from studio.kinematics import (
-    OBSTACLE_TOUCH_M,
-    TABLE,
-    KinematicsError,
-    Obstacle,
-    ObstacleGuard,
-    check_obstacles,
-    load_robot,
-)
+from studio.kinematics import KinematicsError
 
 from .._errors import ConfigError
+
+if TYPE_CHECKING:
+    from studio.kinematics import Obstacle, ObstacleGuard
+
+# The boxes' geometry (coal, Pinocchio) is imported where a task checks its boxes, not with this
+# module: `studio train --help` never loads it.
 
 
 def task_obstacles(value: object) -> tuple[Obstacle, ...]:
     """A task's boxes, checked, or a ConfigError (field ``obstacles``) naming the bad one."""
+    from studio.kinematics import check_obstacles
+
     try:
         return check_obstacles(value)
     except KinematicsError as err:
@@ -52,6 +53,8 @@ def obstacle_guard(
     """The guard of ``robot``'s collision geometry against ``obstacles`` (and, with ``table``,
     the table it stands on, kept :data:`TABLE_MARGIN_M` away); made once per pair; not
     thread-safe: callers on other threads make their own."""
+    from studio.kinematics import ObstacleGuard, load_robot
+
     return ObstacleGuard(load_robot(robot), obstacles, TABLE_MARGIN_M if table else None)
 
 
@@ -60,6 +63,8 @@ def check_goal_clear(
 ) -> None:
     """Refuse a goal pose that touches a box (ConfigError, field ``obstacles``) or, with
     ``table``, comes within :data:`TABLE_MARGIN_M` of the table (field ``goal``)."""
+    from studio.kinematics import OBSTACLE_TOUCH_M, TABLE
+
     touching = obstacle_guard(robot, obstacles, table).contacts(q_goal, OBSTACLE_TOUCH_M)
     if touching and touching[0].link_b == TABLE:
         raise ConfigError(
@@ -99,6 +104,8 @@ def blocked_grid_moves(
         joint-space path from one bin centre to the next touches a box; a state colliding when
         its pose does (it is no start, and every move into it is blocked).
     """
+    from studio.kinematics import OBSTACLE_TOUCH_M
+
     guard = obstacle_guard(robot, obstacles, table)
     gaps = np.array([guard.distances(q) for q in poses])  # (S, pairs)
     colliding = gaps.min(axis=1) < OBSTACLE_TOUCH_M

@@ -50,6 +50,14 @@ from functools import cached_property
 import numpy as np
 from numba import njit
 
+from .._config import (
+    ACTION_SETS,
+    DEFAULT_ACTIONS,
+    DEFAULT_JOINTS,
+    DEFAULT_SHAPING,
+    DEFAULT_STEP_DEG,
+    DEFAULT_TILINGS,
+)
 from .._errors import ConfigError, LearningError
 from .._tiles import TileCoding
 from ._arm import GOAL_REWARD, STEP_REWARD
@@ -91,10 +99,6 @@ from ._robot import PUMA560, check_robot, default_goal, task_arm
 
 MIN_JOINTS = 3
 """Fewest joints the continuous task offers (the paper's three)."""
-DEFAULT_JOINTS = 6
-"""All six joints, so the tool's orientation is learned too."""
-DEFAULT_STEP_DEG = 2.0
-"""Joint increment per action, degrees (no coarser than 2 degrees)."""
 MAX_STEP_DEG = 2.0
 """Coarsest step allowed: beyond it the tool jumps by several centimetres per step."""
 MIN_STEP_DEG = 0.05
@@ -103,10 +107,6 @@ DEFAULT_POSITION_TOLERANCE = 0.02
 """Tool within this many metres of the goal's tool position counts as reached."""
 DEFAULT_ANGLE_TOLERANCE_DEG = 10.0
 """...and within this many degrees of the goal's tool orientation."""
-DEFAULT_MAX_EPISODE_STEPS = 3_000
-"""Episode cap of the registered environment (about three times the longest greedy path)."""
-DEFAULT_TILINGS = 8
-"""Offset tilings of the arm's default features."""
 DEFAULT_TILES = 32
 """Fewest tiles per joint of the arm's default features (each joint tiled alone, see
 :meth:`ArmReach.features`): on the Puma560 about 17 degrees of the widest joint each, about 2
@@ -118,48 +118,8 @@ a step down within a degree or two of them; where they turn further (the UR arms
 the default adds tiles to keep this width. Measured on the UR5 (6 joints, 4,000 episodes, its
 ready goal): 32 tiles (22.5 degrees) 85% greedy success, the greedy policy stepping back and forth
 one or two degrees from the goal angles; 64 tiles 100%."""
-DEFAULT_SHAPING = 5.0
-"""Weight of the potential-based shaping reward (Ng, Harada & Russell 1999): ``shaping`` times the
-change of :func:`reach_potential` (minus the joints' distance to the goal's angles, in steps). It
-gives every step a direction toward the goal, without which a 6-joint random start almost never
-finds the goal's few-degree region; 0 gives the paper's bare +100 / -1. With gamma = 1 the terms of
-an episode telescope to a constant per start, so the optimal policies are unchanged; with the
-paper's gamma = 0.95 the term also charges ``(1 - gamma) x shaping x distance``, which only pulls
-harder toward the goal.
-
-Why 5 and not 1. A joint step toward the goal pays ``shaping - 1``, one away ``-shaping - 1``.
-With 1 the step cost cancels exactly: every move toward the goal pays 0, so which joint to move is
-told apart only by the discounted +100, ``100 x 0.95 ** (sum of the joints' distances)``, a
-*product* of per-joint factors that no sum of per-joint (or pair) tile weights represents; the
-fitted error exceeds the true gaps and the greedy policy steps a near-goal joint back and forth
-(measured at six joints: 16% greedy success after 4,000 episodes, 32% after 16,000). With 5, the
-value is dominated by a sum over joints of per-joint terms (+4 per step toward the goal, -6 per
-step away), which per-joint tilings represent exactly, and the +100 only settles the last steps:
-100% after 4,000 episodes (package README). A cycle still costs (toward then away:
-``4 - 0.95 x 6 < 0``), so no loop pays; that holds while ``shaping < (1 + gamma) / (1 - gamma)``
-(39 at gamma = 0.95)."""
 MAX_SHAPING = 100.0
 """Upper bound on ``shaping``."""
-ACTION_SETS = ("single", "pairs", "all", "follow")
-"""What one action may move: one joint (2J actions), one joint or two together (2J**2), any
-joints at once (3**J - 1), or one joint or all of them along the demonstrated paths (2J + 1, see
-:attr:`ArmReach.paths`); each of the first three begins with the one before it, in the same
-order, and ``"follow"`` with the singles."""
-DEFAULT_ACTIONS = "follow"
-"""One joint per action, and with demonstrations one more that follows them (without any, the
-task is ``"single"``'s bit for bit). With 3 demonstrations at six joints (package README): under
-the paper's reward its first 20 own episodes take 0.037 of the real steps without them (one
-joint per action: 0.204), 16 points ahead after 1,000 episodes and 4 after 4,000 (0.995); under
-the default shaping greedy success from random starts is higher or level (+8.4 points after
-1,000 episodes, +0.4 after 4,000, no planning; the learner's common value, :mod:`._common_value`);
-a policy taught by one demonstration moves like it (DTW 0.028-0.047 rad a sample, one joint per
-action 0.17-0.39).
-``"pairs"``, learned with the factored action value (:mod:`._factored`), reaches 95% greedy
-success in fewer real steps without demonstrations (81 k against 321 k at six joints), but its
-greedy success swings as training goes on: at six joints, 2 experiments, Puma560 93% / 78% /
-99% / 92% after 500 / 1,000 / 2,000 / 4,000 episodes and UR5 70% / 81% / 63% / 42%, where one
-joint per action ends at 100% on the Puma560, the Panda and the UR5. A default that gets worse
-with more training is the wrong default."""
 STORED_ACTIONS = "single"
 """What a task stored before ``actions`` existed moves: one joint per action."""
 LIMIT_SLACK_RAD = 1e-9

@@ -10,12 +10,16 @@ arm's joints, limits and forward kinematics (:func:`task_arm`), its default goal
 from __future__ import annotations
 
 import functools
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from studio.kinematics import DEFAULT_ROBOT, KinematicsError, RobotArm, load_robot, robot_spec
+from studio.kinematics import DEFAULT_ROBOT, KinematicsError, robot_spec
 
 from .._errors import ConfigError, LearningError
+
+if TYPE_CHECKING:
+    from studio.kinematics import RobotArm
 
 PUMA560 = DEFAULT_ROBOT
 """The paper's robot, and the robot of every task or file that names none."""
@@ -39,6 +43,8 @@ def task_arm(name: str) -> RobotArm:
     Raises:
         ConfigError: an unknown robot, or one whose model cannot be built (field ``robot``).
     """
+    from studio.kinematics import load_robot  # Pinocchio: only once a task needs the arm
+
     check_robot(name)
     try:
         return load_robot(name, geometry=False)
