@@ -217,4 +217,6 @@ def _report(
         unlimited_joints=tuple(
             n for n, e in zip(arm.joint_names, model.effort, strict=True) if not math.isfinite(e)
         ),
+        times=t,
+        q_simulated=got,
     )

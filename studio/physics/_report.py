@@ -7,7 +7,9 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+
+import numpy as np
 
 from studio.kinematics import TABLE
 
@@ -83,6 +85,9 @@ class SimulationReport:
         saturated_joints: the joints that saturated, in joint order.
         first_saturated_sample: the first sample that saturated (None: none did).
         unlimited_joints: the joints whose URDF gives no force limit (simulated unlimited).
+        times: the samples' times (s, from 0).
+        q_simulated: the simulated joints at each sample ``(samples, nq)`` (rad): the motion
+            the robot made, to play in a scene (NaN after the simulation went unstable).
     """
 
     robot: str
@@ -96,6 +101,8 @@ class SimulationReport:
     saturated_joints: tuple[str, ...] = ()
     first_saturated_sample: int | None = None
     unlimited_joints: tuple[str, ...] = ()
+    times: np.ndarray | None = field(default=None, compare=False, repr=False)
+    q_simulated: np.ndarray | None = field(default=None, compare=False, repr=False)
 
     def as_json(self) -> dict[str, object]:
         """The report as ``studio simulate --json`` prints it: exactly :data:`JSON_KEYS`."""

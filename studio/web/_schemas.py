@@ -776,3 +776,9 @@ class SimulationPublic(BaseModel):
     saturated_samples: int = Field(description="samples where a motor was at its force limit")
     contacts: list[ContactPublic]
     sentences: list[str] = Field(description="the report as the exported file states it")
+    times: list[float] = Field(default_factory=list, description="the samples' times (s, from 0)")
+    q_simulated: list[list[float]] = Field(
+        default_factory=list,
+        description="the joints (rad) the simulated robot reached at each sample: the motion "
+        "it makes (empty when the simulation went unstable)",
+    )

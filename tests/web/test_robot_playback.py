@@ -256,3 +256,20 @@ def test_the_mesh_cache_gives_the_same_parts_and_rebuilds_a_damaged_file(tmp_pat
     assert len(built) == 2 and len(rebuilt) == len(first)
     assert cached_parts(tmp_path, "so100", key, build) and len(built) == 2  # rewritten
     assert mesh_key(files, 0.01, 1.0) != key  # another simplification is read afresh
+
+
+def test_the_simulated_motion_plays_on_the_robot_in_the_scene(
+    studio: tuple[TestClient, StudioScene],
+) -> None:
+    """ "Play simulated": the scene's robot moves as MuJoCo moved it for what Export writes."""
+    client, scene = studio
+    url = f"/api/robot/simulate/demonstration/{DEMO}"
+    report = client.get(url, params={"fit": "true"}).json()
+    assert client.post(f"{url}/play").status_code == 202
+    assert wait_for(lambda: scene.playing, timeout=LOAD_S), client.get("/api/source").json()
+    playback = scene.scrub()
+    assert playback is not None and playback[0].robot == "puma560"
+    np.testing.assert_allclose(playback[0].times, report["times"], atol=1e-9)
+    np.testing.assert_allclose(playback[0].q, report["q_simulated"], atol=1e-9)
+    missing = client.post("/api/robot/simulate/recording/nope/play")
+    assert missing.status_code == 404 and isinstance(missing.json()["detail"], str)

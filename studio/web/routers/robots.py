@@ -6,12 +6,14 @@ import json
 import shutil
 from typing import Annotated, Literal
 
+import numpy as np
 from fastapi import APIRouter, Query
-from fastapi.responses import FileResponse
+from fastapi.responses import FileResponse, Response
 from starlette.background import BackgroundTask
 
 from studio._layout import physics_cache_dir
 from studio.kinematics import robot_spec
+from studio.physics import SimulationReport
 
 from .._deps import DemonstrationsDep, PoliciesDep, RecordingsDep, RobotsDep, SettingsDep
 from .._schemas import RobotChoice, RobotsPublic, SimulationPublic
@@ -23,6 +25,7 @@ from ..services import (
     export_for_robot,
     export_rollout,
     simulate_for_robot,
+    simulated_motion,
 )
 from . import file_responses
 
@@ -122,7 +125,45 @@ def simulate_for_the_robot(
     target = robot_spec(robot).name if robot is not None else robots.taught
     cache = physics_cache_dir(settings.data_dir)
     report = simulate_for_robot(path, target, retime, cache, limit_margin, fit=fit)
-    return SimulationPublic.model_validate({**report.as_json(), "sentences": report.sentences()})
+    return SimulationPublic.model_validate(
+        {**report.as_json(), "sentences": report.sentences(), **_trajectory(report)}
+    )
+
+
+def _trajectory(report: SimulationReport) -> dict[str, object]:
+    """The simulated joint trajectory, as the API answers it (empty when it went unstable)."""
+    q = report.q_simulated
+    if q is None or report.times is None or not np.all(np.isfinite(q)):
+        return {}
+    return {"times": report.times.tolist(), "q_simulated": q.tolist()}
+
+
+@router.post("/api/robot/simulate/{kind}/{name}/play", status_code=202, response_class=Response)
+def play_simulated(
+    kind: Literal["recording", "demonstration"],
+    name: str,
+    recordings: RecordingsDep,
+    demonstrations: DemonstrationsDep,
+    robots: RobotsDep,
+    settings: SettingsDep,
+    limit_margin: Annotated[float | None, Query(ge=0.0)] = None,
+) -> Response:
+    """Play in the scene the motion the robot taught makes in physics for what the page's
+    export writes (``fit``): the MuJoCo replay's joints at each sample drive the robot drawn,
+    its tool path drawn. It is simulated in the background (202 at once); the robot's notes
+    (``GET /api/source``) say meanwhile what is being made, and afterwards why it could not
+    play. 404 for no such recording or demonstration."""
+    store = recordings if kind == "recording" else demonstrations.store
+    path = store.path(name)
+    target = robots.taught
+    cache = physics_cache_dir(settings.data_dir)
+    stat = path.stat()
+    robots.play_motion(
+        f"the simulated motion of the {kind} {name}",
+        ("simulated", str(path), stat.st_mtime_ns, limit_margin, target, name),
+        lambda: simulated_motion(path, target, cache, limit_margin),
+    )
+    return Response(status_code=202)
 
 
 @router.get("/api/robot/export/rollout.mcap", responses=file_responses("application/octet-stream"))

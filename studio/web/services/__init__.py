@@ -18,6 +18,7 @@ from ._robot_export import ExportFormat as ExportFormat
 from ._robot_export import export_for_robot as export_for_robot
 from ._robot_export import export_rollout as export_rollout
 from ._robot_export import simulate_for_robot as simulate_for_robot
+from ._robot_export import simulated_motion as simulated_motion
 from ._robots import Robots as Robots
 from ._rollouts import Rollouts as Rollouts
 from ._runs import GROUP_SEPARATOR as GROUP_SEPARATOR

@@ -8,7 +8,7 @@ import errno
 import shutil
 import tempfile
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Literal, get_args
 
@@ -129,6 +129,27 @@ def simulate_for_robot(
         PhysicsError, ExportError, KinematicsError: no model can be built, an unknown robot.
     """
     return simulate_motion(_motion(path, robot, retime, fit, limit_margin)[0], cache=cache)
+
+
+def simulated_motion(
+    path: Path, robot: str, cache: Path | None = None, limit_margin: float | None = None
+) -> Motion:
+    """The motion the robot makes in physics for the samples the page's export writes
+    (:func:`simulate_for_robot` with ``fit``): the simulated joints at each sample, to play in
+    the scene.
+
+    Raises:
+        ExportError: the simulation went unstable (no motion to play).
+        PhysicsError, KinematicsError: no model can be built, an unknown robot.
+    """
+    motion = _motion(path, robot, False, True, limit_margin)[0]
+    report = simulate_motion(motion, cache=cache)
+    if report.q_simulated is None or not np.all(np.isfinite(report.q_simulated)):
+        raise ExportError(
+            f"The {motion.robot.spec.title} went unstable in the simulation, so there is no "
+            "simulated motion to play; check it in physics for the report."
+        )
+    return replace(motion, times=report.times, q=report.q_simulated, timed=True)
 
 
 def export_for_robot(

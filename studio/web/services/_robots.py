@@ -4,9 +4,11 @@ the live chain retargets the operator onto it."""
 from __future__ import annotations
 
 import threading
+from collections.abc import Callable, Hashable
 
 from studio.kinematics import LIMIT_MARGIN_RAD, load_robot, robot_names, robot_spec
 from studio.learning import default_goal_deg
+from studio.motion import Motion
 
 from ..live import Pipeline
 from ..scene import RobotPlayer, RobotViews, Scene
@@ -27,6 +29,15 @@ class Robots:
         self.player = player
         self._lock = threading.Lock()  # one robot switch at a time
         self._switching: str | None = None  # the robot whose model loads (set_robot)
+
+    def play_motion(self, what: str, key: Hashable, compute: Callable[[], Motion]) -> None:
+        """Play ``what`` (``the simulated motion of ...``), made by ``compute`` for the robot
+        taught (cached under ``key``, made in the background), on the robot in the scene; the
+        page is told meanwhile through :meth:`state`'s notes. Nothing without a scene."""
+        if self.player is None:
+            return
+        slug = "".join(c if c.isalnum() else "-" for c in str(key[-1]))
+        self.player.play(self.taught, what, key, compute, f"played-{slug}")
 
     @property
     def taught(self) -> str:

@@ -59,6 +59,7 @@ export function buildExportControl(kind) {
   if (k.items) {
     parts.push(el("input", { id: `${kind}-export-margin`, testid: `${kind}-export-margin`, type: "number", min: "0", step: "0.01", class: "export-margin", "aria-label": "Margin from each joint's limit (rad)", placeholder: marginHint(), title: MARGIN }));
     parts.push(el("button", { id: `${kind}-physics-go`, testid: `${kind}-physics-go`, title: PHYSICS, onclick: () => checkPhysics(kind) }, "Check in physics"));
+    parts.push(el("button", { id: `${kind}-physics-play`, testid: `${kind}-physics-play`, title: "play in the scene the motion the robot makes in physics (MuJoCo) for what Export writes: its motors, their force limits and gravity, not the plan", onclick: () => playSimulated(kind) }, "Play simulated"));
   }
   const anyway = el("button", { id: `${kind}-export-anyway`, testid: `${kind}-export-anyway`, hidden: true, title: "write the file even though the safety checks refuse it; every finding is stated in it", onclick: () => exportNow(kind, { unchecked: true }) }, ANYWAY);
   // the sentence, then the buttons that act on it, then the details: both stay in view
@@ -184,5 +185,22 @@ async function checkPhysics(kind) {
   const report = await guarded(errId, () => api("GET", `/api/robot/simulate/${kind}/${enc(name)}?${query}`), $(`${kind}-physics-go`));
   if (!report) return;
   box.replaceChildren(...report.sentences.map((line) => el("div", { text: line })));
+  setProp(box, "hidden", false);
+}
+
+/** Play in the scene the motion the robot makes in physics for what Export writes. */
+async function playSimulated(kind) {
+  const errId = `${kind}-export-error`;
+  const box = $(`${kind}-physics`);
+  const name = $(`${kind}-export-item`).value;
+  if (!name) { showError(errId, `Choose a ${KINDS[kind].noun} to play first.`); return; }
+  const query = new URLSearchParams();
+  margin(kind, query);
+  const done = await guarded(errId, async () => {
+    await api("POST", `/api/robot/simulate/${kind}/${enc(name)}/play?${query}`);
+    return true;
+  }, $(`${kind}-physics-play`));
+  if (!done) return;
+  box.replaceChildren(el("div", { text: `The robot in the scene plays the motion it makes in physics for ${name}, once simulated (the notes under Robot say meanwhile).` }));
   setProp(box, "hidden", false);
 }
