@@ -208,8 +208,15 @@ def main() -> None:
     )
     pace = demonstrated_pace(follow, [(d.times, d.q_robot) for d in demos])
     rng = np.random.default_rng([args.seed, 99])
-    starts = np.array([task.random_start(rng) for _ in range(starts_n)])
     arm = load_robot(ROBOT)
+    drawn = 0
+    starts_list: list[np.ndarray] = []
+    while len(starts_list) < starts_n:  # held-out starts the robot can stand in: a collision
+        start = task.random_start(rng)  # counted below is one the motion makes
+        drawn += 1
+        if not arm.contacts(task.full_q(start)):
+            starts_list.append(start)
+    starts = np.array(starts_list)
     print(
         f"Puma560, {JOINTS} joints, goal: {SAMPLES[0]}'s end (tool within 2 cm, orientation free), "
         f"the paper's reward (+100 at the goal, -1 a step), {len(SAMPLES)} samples as "
@@ -217,8 +224,10 @@ def main() -> None:
         f"{'zero planning' if not args.planning_steps else f'{args.planning_steps} planning steps'}, "
         f"pace {pace:.3f} s a step"
     )
-    touching = np.mean([bool(arm.contacts(task.full_q(s))) for s in starts])
-    print(f"{touching:.1%} of the starts touch the robot itself or the table already")
+    print(
+        f"{starts_n} collision-free starts of {drawn} drawn ({1 - starts_n / drawn:.1%} of the "
+        "task's random starts touch the robot itself or the table and are drawn again)"
+    )
     rows = baseline_rows(task, demos, starts, pace, arm)
     rows += dyna_rows(task, demos, starts, pace, arm, budgets, args.seed, args.planning_steps)
     teacher = rows[0]

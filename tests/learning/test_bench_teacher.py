@@ -36,6 +36,7 @@ def test_the_quick_benchmark_prints_every_row_beside_the_teacher():
     }
     assert tuple(table) == ROWS
     assert "the paper's reward (+100 at the goal, -1 a step)" in out
+    assert "collision-free starts of" in out  # a collision counted is one the motion makes
     teacher = table[ROWS[0]]
     assert teacher[0] == "100.0%" and teacher[3] == "1.00"  # its own ratio, and it always arrives
     for name, cells in table.items():
