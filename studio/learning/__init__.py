@@ -35,6 +35,9 @@ if typing.TYPE_CHECKING:  # the public names, each loaded when first used (see s
     from ._config import OWN_LEARNER as OWN_LEARNER
     from ._config import PLANNERS as PLANNERS
     from ._config import REACH_DEFAULTS as REACH_DEFAULTS
+    from ._config import ROLLOUT_MAX_STEPS as ROLLOUT_MAX_STEPS
+    from ._config import ROLLOUT_RATE_HZ as ROLLOUT_RATE_HZ
+    from ._config import ROLLOUT_SECONDS_PER_STEP as ROLLOUT_SECONDS_PER_STEP
     from ._config import TASK_KINDS as TASK_KINDS
     from ._config import TEACHER_KIND as TEACHER_KIND
     from ._config import TILE_ROLLOUT_MAX_STEPS as TILE_ROLLOUT_MAX_STEPS
@@ -118,9 +121,6 @@ if typing.TYPE_CHECKING:  # the public names, each loaded when first used (see s
     from .sweeps._spec import SweepSpec as SweepSpec
     from .sweeps._spec import load_sweep_spec as load_sweep_spec
     from .tabular._dynaq import warm_up as warm_up
-    from .tabular._policy import ROLLOUT_MAX_STEPS as ROLLOUT_MAX_STEPS
-    from .tabular._policy import ROLLOUT_RATE_HZ as ROLLOUT_RATE_HZ
-    from .tabular._policy import ROLLOUT_SECONDS_PER_STEP as ROLLOUT_SECONDS_PER_STEP
     from .tabular._policy import PolicyFile as PolicyFile
     from .tabular._policy import greedy_path as greedy_path
     from .tabular._policy import load_policy as load_policy

@@ -9,7 +9,7 @@ can show the messages next to its form fields.
 episodes) before any work starts.
 
 Also here, with their defaults, the other settings a person chooses for a run (the task's kind;
-the continuous task's joints, step, actions and tilings) and a tile-coded rollout's pace: this
+the continuous task's joints, step, actions and tilings) and a rollout's rate, pace and step cap: this
 module imports neither numba nor the robot models, so ``studio train --help`` reads them at once.
 """
 
@@ -91,6 +91,12 @@ REACH_DEFAULTS: Final = {
 """The continuous task's settings a person sets, and their defaults (:class:`ArmReach` and its
 default :meth:`ArmReach.features`; ``tiles`` None: the robot's :attr:`ArmReach.default_tiles`,
 32 for the Puma560)."""
+ROLLOUT_RATE_HZ = 50.0
+"""Default control rate of a rollout trajectory (every policy kind's)."""
+ROLLOUT_SECONDS_PER_STEP = 0.5
+"""Default time the arm takes to move one grid step."""
+ROLLOUT_MAX_STEPS = 1_000
+"""Default cap on greedy steps in a rollout."""
 TILE_ROLLOUT_SECONDS_PER_STEP = 0.04
 """Time the arm takes for one step of a tile-coded rollout (2 degrees in 0.04 s: 50 deg/s) when
 the policy was not taught from timed demonstrations (:func:`studio.learning.demonstrated_pace`)."""

@@ -42,6 +42,9 @@ from numpy.lib import format as npy_format
 from studio import JSONFileError, loads_json
 
 from .._config import MAX_EPISODES, DynaQConfig
+from .._config import ROLLOUT_MAX_STEPS as ROLLOUT_MAX_STEPS
+from .._config import ROLLOUT_RATE_HZ as ROLLOUT_RATE_HZ
+from .._config import ROLLOUT_SECONDS_PER_STEP as ROLLOUT_SECONDS_PER_STEP
 from .._errors import LearningError, PolicyFileError
 from ..tasks._arm import ArmGrid
 from ..tasks._robot import default_goal, task_arm
@@ -50,12 +53,6 @@ FORMAT_NAME = "teach-studio-policy"
 FORMAT_VERSION = 1
 ROBOT_JOINTS = 6
 """Columns of a rollout trajectory: the Puma560's six joints."""
-ROLLOUT_RATE_HZ = 50.0
-"""Default control rate of a rollout trajectory."""
-ROLLOUT_SECONDS_PER_STEP = 0.5
-"""Default time the arm takes to move one grid step."""
-ROLLOUT_MAX_STEPS = 1_000
-"""Default cap on greedy steps in a rollout."""
 MAX_NPY_HEADER_BYTES = 10_000
 """Longest ``.npy`` member header read (numpy's own safe limit)."""
 MAX_NPZ_BYTES = 256 * 1024 * 1024
