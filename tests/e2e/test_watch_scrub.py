@@ -92,7 +92,7 @@ def test_scrub_a_rollout_change_its_speed_and_step_it(
     assert _until(lambda: scene()["speed"] == 4)
     slider.press("Home")
     assert _until(lambda: scene()["sample"] == 0)
-    page.get_by_role("button", name="Play").click()
+    page.get_by_role("button", name="Play", exact=True).click()
     assert _until(lambda: not scene()["paused"])
     assert _until(lambda: float(slider.input_value()) > 0, 10)
     assert _until(lambda: scene()["finished"], 20)
@@ -163,7 +163,7 @@ def test_keyboard_shortcuts_scrub_the_rollout_but_not_while_typing(
     page.keyboard.press(" ")
     assert _until(lambda: not scene()["paused"])
     # the page has the scene's answer too (the server answers before the page reads it)
-    assert _until(lambda: page.get_by_role("button", name="Pause").count() == 1)
+    assert _until(lambda: page.get_by_role("button", name="Pause", exact=True).count() == 1)
     page.keyboard.press(" ")
     assert _until(lambda: scene()["paused"])
     paused_at = scene()["sample"]
@@ -197,7 +197,7 @@ def test_play_clicked_while_a_scrub_is_on_its_way_plays(
     slider.focus()
     slider.press("End")
     assert _until(lambda: scene()["paused"] and scene()["sample"] == scene()["samples"] - 1)
-    assert _until(lambda: page.get_by_role("button", name="Play").count() == 1)
+    assert _until(lambda: page.get_by_role("button", name="Play", exact=True).count() == 1)
 
     # hold the scrubs (they pause) in the browser; let anything else through
     held: list[Any] = []
@@ -216,7 +216,7 @@ def test_play_clicked_while_a_scrub_is_on_its_way_plays(
         while not held and time.monotonic() < deadline:  # (the route handler runs meanwhile)
             page.wait_for_timeout(50)
         assert held, "the scrub to the start never left the page"
-        page.get_by_role("button", name="Play").click()
+        page.get_by_role("button", name="Play", exact=True).click()
         page.wait_for_timeout(1000)  # a Play sent now would reach the scene before the scrub
     finally:
         for route in held:

@@ -47,8 +47,10 @@ export function connectEvents() {
 
 // A running run's row (its progress bar and CPU time) is redrawn every RUNS_EVERY_FRAMES live
 // frames, not with every frame of the chart: rebuilding and laying out the list was most of the
-// page's own work while a run trained, for a bar that moves a pixel. A run that appears or changes
-// status is drawn with the next frame.
+// page's own work while a run trained, for a bar that moves a pixel. A live frame is one with news
+// to draw (the timer's ticks without any are not counted: when a busy machine sends news less
+// often than the timer ticks, counting ticks redrew the row with every frame of the chart). A run
+// that appears or changes status is drawn with the next frame.
 export const RUNS_EVERY_FRAMES = 3;
 let runsRenderPending = false;
 let runsRenderUrgent = false;
@@ -58,6 +60,7 @@ function scheduleRunsRender(urgent) { // drawn by a coming renderLive, in the sa
   runsRenderUrgent ||= urgent;
 }
 export function renderLive() {
+  if (!S.curveDirty && !runsRenderPending) return; // nothing new since the last frame
   framesSinceRuns++;
   if (runsRenderPending && (runsRenderUrgent || framesSinceRuns >= RUNS_EVERY_FRAMES)) {
     runsRenderPending = false;
