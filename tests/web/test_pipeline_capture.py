@@ -49,3 +49,23 @@ def test_a_failed_write_ends_the_capture_with_its_reason(tmp_path):
     assert not capture["active"] and capture["error"] and "cut" in capture["error"]
     pipeline.dismiss_capture_error()
     assert pipeline.capture_status()["error"] is None
+
+
+def test_frames_of_the_source_before_a_switch_change_nothing_after_it():
+    """The pipeline's thread may hold a batch of the old source's frames when the source is
+    switched; fitted afterwards, they set the residual and the fitter of the source before (a
+    camera read the simulator's fit residual). They are dropped instead."""
+    from studio.capture import CameraSource
+
+    pipeline = Pipeline()
+    tape = CameraSource()  # any source object: the one switched away from
+    pipeline.set_source(tape, "camera")
+    frames = synthetic_frames(3)
+    assert pipeline._fit(tape, frames) is not None
+    assert pipeline.status()["fit_residual_mm"] is not None and pipeline._fitter is not None
+    camera = CameraSource()
+    pipeline.set_source(camera, "camera")
+    assert pipeline._fit(tape, frames) is None  # the old source's batch, after the switch
+    assert pipeline.status()["fit_residual_mm"] is None
+    assert pipeline._fitter is None
+    pipeline.close()

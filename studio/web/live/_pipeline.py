@@ -404,7 +404,7 @@ class Pipeline:
         """Append frames to the capture, if one runs (:meth:`Recorder.write`)."""
         self._recorder.write(frames)
 
-    def _live_fitter(self, observation: Observation) -> ObservationFitter:
+    def _live_fitter(self, source: FrameSource | None, observation: Observation) -> ObservationFitter:
         """The fitter for the current source's observations, built on its first one."""
         fitter = self._fitter
         if fitter is None:
@@ -415,7 +415,9 @@ class Pipeline:
             )
             if self.scene is not None:  # the scene draws that arm following (the tape on it)
                 self.scene.set_side(side, taped=isinstance(observation, TapeFrame))
-            self._fitter = fitter
+            with self._lock:
+                if source is self._source:  # not kept for the next source (switched meanwhile)
+                    self._fitter = fitter
         return fitter
 
     def _fit(
@@ -424,11 +426,17 @@ class Pipeline:
         """Fit observations in order and show the newest pose; a failing fit is shown, not fatal."""
         try:
             with self._fit_lock:
-                fitter = self._live_fitter(observations[0])
+                if source is not self._source:
+                    # the source was switched while its frames waited for the fit: they belong
+                    # to the source before, whose fitter, pose and residual are forgotten
+                    return None
+                fitter = self._live_fitter(source, observations[0])
                 fitted = None
                 for observation in observations:
                     fitted = self._onto_arm(fitter.fit(observation), float(observation.t))
                     with self._lock:
+                        if source is not self._source:
+                            return None  # switched meanwhile (see above)
                         self._q_human = fitted.q_human
                         self._q_robot = fitted.q_robot
                         # a frame the fit could not use (no person in view) has no residual
