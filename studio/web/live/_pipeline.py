@@ -404,7 +404,9 @@ class Pipeline:
         """Append frames to the capture, if one runs (:meth:`Recorder.write`)."""
         self._recorder.write(frames)
 
-    def _live_fitter(self, source: FrameSource | None, observation: Observation) -> ObservationFitter:
+    def _live_fitter(
+        self, source: FrameSource | None, observation: Observation
+    ) -> ObservationFitter:
         """The fitter for the current source's observations, built on its first one."""
         fitter = self._fitter
         if fitter is None:
