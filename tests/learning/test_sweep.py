@@ -80,6 +80,16 @@ def write_spec(path: Path, text: str) -> Path:
     return path
 
 
+def run_python(script: str) -> subprocess.CompletedProcess:
+    """``script`` run by a new Python of this checkout, which must end well."""
+    proc = subprocess.run(
+        [sys.executable, "-c", script], capture_output=True, text=True, timeout=WAIT_SECONDS,
+        cwd=REPO, env={**os.environ, "PYTHONPATH": str(REPO)},
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    return proc
+
+
 # ----------------------------------------------------------------------------- the spec
 
 
@@ -186,11 +196,7 @@ def test_a_huge_seed_count_is_refused_before_any_seed_is_listed() -> None:
         "except SweepError as err:\n"
         "    print(err)\n"
     )
-    proc = subprocess.run(
-        [sys.executable, "-c", script], capture_output=True, text=True, timeout=WAIT_SECONDS,
-        cwd=REPO, env={**os.environ, "PYTHONPATH": str(REPO)},
-    )  # fmt: skip
-    assert proc.returncode == 0, proc.stderr
+    proc = run_python(script)
     assert proc.stdout.strip() == (
         "big.toml makes 2,000,000,000 trials, over the limit of 100,000; sweep fewer values or seeds."
     ), proc.stdout
@@ -227,6 +233,18 @@ def test_an_unreachable_address_is_one_sentence(tmp_path: Path) -> None:
     line = proc.stderr.strip()
     assert "\n" not in line and f"127.0.0.1:{port}" in line and "Traceback" not in line, line
     assert not (tmp_path / "sweeps").exists()  # nothing written for a sweep that cannot run
+
+
+def test_a_trials_worker_starts_without_scipy_signal() -> None:
+    """Every Ray worker of a sweep imports the trial function, so the learners; scipy.signal (a
+    second of CPU, only for the likeness's filter) is imported when a path is filtered, not then."""
+    script = (
+        "import sys\n"
+        "from studio.learning.sweeps._ray import _trainable\n"
+        "print(sorted(m for m in sys.modules if m.startswith('scipy.signal')))\n"
+    )
+    proc = run_python(script)
+    assert proc.stdout.strip() == "[]", proc.stdout
 
 
 # ----------------------------------------------------------------------------- on a local Ray

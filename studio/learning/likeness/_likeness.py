@@ -38,7 +38,6 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 from numba import njit
-from scipy.signal import butter, sosfiltfilt
 
 from studio.kinematics import Puma560
 
@@ -194,6 +193,10 @@ def low_pass(times: np.ndarray, x: np.ndarray, cutoff_hz: float) -> np.ndarray:
     rate = _mean_rate(times)
     if cutoff_hz >= rate / 2:
         return x
+    # imported here: scipy.signal costs every process that imports the learners (a sweep's
+    # workers, each studio verb) over a second of CPU, and most never filter a path
+    from scipy.signal import butter, sosfiltfilt
+
     sos = butter(2, cutoff_hz, fs=rate, output="sos")
     return sosfiltfilt(sos, x, axis=0, padlen=min(x.shape[0] - 1, 3 * (2 * sos.shape[0] + 1)))
 
