@@ -187,11 +187,17 @@ def test_record_refuses_a_duration_that_is_not_positive(seconds, tmp_path, capsy
     assert not out.exists()  # no empty recording
 
 
-def test_record_from_a_silent_network_gives_up_with_a_sentence(tmp_path, capsys):
+def test_record_from_a_silent_network_gives_up_with_a_sentence(tmp_path, capsys, monkeypatch):
     """--seconds counts the frames' time from the first frame on, so without a sender it would
-    never end: --wait gives up, and leaves no empty recording behind."""
+    never end: --wait gives up, and leaves no empty recording behind.
+
+    The least wait for a first frame (30 s, tests/capture/test_first_frame_wait.py) is set to
+    --wait's here, so the test waits --wait's half second, not 30 s of real time."""
     import socket
 
+    import studio.capture._capture_loop as loop
+
+    monkeypatch.setattr(loop, "FIRST_FRAME_SECONDS", 0.5)
     with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as probe:
         probe.bind(("127.0.0.1", 0))
         port = probe.getsockname()[1]
