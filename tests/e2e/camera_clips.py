@@ -74,18 +74,20 @@ def rgb_to_i420(rgb: np.ndarray) -> bytes:
     return b"".join(np.clip(np.rint(p), 0, 255).astype(np.uint8).tobytes() for p in planes)
 
 
-def write_y4m(path: Path, frames: Iterable[np.ndarray], fps: int) -> Path:
-    """Write RGB frames (HEIGHT, WIDTH, 3) uint8, each stamped with its index, as a y4m clip."""
+def write_y4m(path: Path, frames: Iterable[np.ndarray], fps: int, first: int = 0) -> Path:
+    """Write RGB frames (HEIGHT, WIDTH, 3) uint8, each stamped with its index plus ``first``, as a
+    y4m clip (clips stamped from different ``first`` tell apart which one the camera played)."""
     with path.open("wb") as out:
         out.write(f"YUV4MPEG2 W{WIDTH} H{HEIGHT} F{fps}:1 Ip A1:1 C420\n".encode())
         for index, rgb in enumerate(frames):
             assert rgb.shape == (HEIGHT, WIDTH, 3), rgb.shape
+            assert first + index < 1 << STAMP_BITS, "the stamp holds no such index"
             out.write(b"FRAME\n")
-            out.write(rgb_to_i420(stamp(rgb, index)))
+            out.write(rgb_to_i420(stamp(rgb, first + index)))
     return path
 
 
-def astronaut_clip(path: Path, frames: int = 30, fps: int = 10) -> Path:
+def astronaut_clip(path: Path, frames: int = 30, fps: int = 10, first: int = 0) -> Path:
     """scikit-image's ``astronaut.png`` (a public-domain NASA portrait) centred in a 640x480 frame."""
     import skimage.data
     from PIL import Image
@@ -94,13 +96,13 @@ def astronaut_clip(path: Path, frames: int = 30, fps: int = 10) -> Path:
     canvas = np.full((HEIGHT, WIDTH, 3), 40, np.uint8)
     x0 = (WIDTH - HEIGHT) // 2
     canvas[:, x0 : x0 + HEIGHT] = np.asarray(photo)
-    return write_y4m(path, (canvas for _ in range(frames)), fps)
+    return write_y4m(path, (canvas for _ in range(frames)), fps, first)
 
 
-def blank_clip(path: Path, frames: int = 10, fps: int = 10) -> Path:
+def blank_clip(path: Path, frames: int = 10, fps: int = 10, first: int = 0) -> Path:
     """An empty grey room: no person in view."""
     canvas = np.full((HEIGHT, WIDTH, 3), 128, np.uint8)
-    return write_y4m(path, (canvas for _ in range(frames)), fps)
+    return write_y4m(path, (canvas for _ in range(frames)), fps, first)
 
 
 # ---------------------------------------------------------------------------- the drawn figure
@@ -180,9 +182,10 @@ def draw_figure(elbow_deg: float) -> np.ndarray:
     return np.asarray(img)
 
 
-def figure_clip(path: Path, frames: int = 120, fps: int = 10) -> Path:
+def figure_clip(path: Path, frames: int = 120, fps: int = 10, first: int = 0) -> Path:
     """The drawn figure raising and lowering its right arm once over ``frames`` (looped by Chromium)."""
-    return write_y4m(path, (draw_figure(figure_elbow_deg(k, frames)) for k in range(frames)), fps)
+    drawn = (draw_figure(figure_elbow_deg(k, frames)) for k in range(frames))
+    return write_y4m(path, drawn, fps, first)
 
 
 def image_elbow_deg(image: np.ndarray, side: str = "right") -> float:
@@ -269,13 +272,14 @@ class Mannequin:
         return np.asarray(img)
 
 
-def mannequin_clip(path: Path, frames: int = 40, fps: int = 10) -> Path:
+def mannequin_clip(path: Path, frames: int = 40, fps: int = 10, first: int = 0) -> Path:
     """The studio's mannequin raising and bending its right arm once over ``frames`` (looped)."""
     model = Mannequin()
-    return write_y4m(path, (model.render(mannequin_q(k, frames)) for k in range(frames)), fps)
+    rendered = (model.render(mannequin_q(k, frames)) for k in range(frames))
+    return write_y4m(path, rendered, fps, first)
 
 
-CLIPS: dict[str, Callable[[Path], Path]] = {
+CLIPS: dict[str, Callable[..., Path]] = {
     "astronaut": astronaut_clip,
     "blank": blank_clip,
     "figure": figure_clip,

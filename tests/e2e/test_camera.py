@@ -5,12 +5,21 @@ reads back for every frame it estimates, so results are matched to what was draw
 estimation runs in the page (the vendored BlazePose); only landmarks reach the studio.
 
 Without a GPU BlazePose runs at a few frames a second, far fewer on a busy machine: these tests
-wait for events (frames estimated, answers received), never for a time.
+wait for events (frames estimated, answers received), never for a time. So that the model loads
+once, the tests that estimate share one page in one Chromium, whose fake camera plays the file
+``live.y4m``: Chromium opens that file anew at each start of the camera, so a test puts its clip
+there before it switches the source to the camera, and afterwards the source goes back to the
+simulator (the camera stops). Each clip is stamped from its own first index
+(:data:`CLIP_FIRST`), so a frame of another clip is never taken for one of this test's. The 3D
+scene is left out of these pages (an empty page in its frame): none of these tests looks at it,
+and drawn in software it took a third of the CPU of each estimated frame.
 """
 
 from __future__ import annotations
 
 import math
+import os
+import shutil
 import statistics
 from collections.abc import Callable, Iterator
 from pathlib import Path
@@ -27,10 +36,9 @@ from tests.e2e.camera_clips import (
     MANNEQUIN_FLEXION_DEG,
     WIDTH,
     Mannequin,
-    figure_clip,
+    blank_clip,
     figure_elbow_deg,
     image_elbow_deg,
-    mannequin_clip,
     mannequin_q,
 )
 from tests.e2e.conftest import CHROMIUM, CHROMIUM_FLAGS, Studio, shot
@@ -62,6 +70,18 @@ ARM_PX = 40.0
 two shoulders are 92 px apart in the mannequin clip, the elbows 100-150 px."""
 LOOPBACK = {"127.0.0.1", "localhost", "::1", "[::1]"}
 POSE_FILES = "/static/vendor/mediapipe-pose/"
+CLIP_SPAN = 128
+"""Stamps each clip may use, from its first: no clip is longer."""
+CLIP_FIRST = {
+    "figure": 0,
+    "mannequin": CLIP_SPAN,
+    "astronaut": 2 * CLIP_SPAN,
+    "blank": 3 * CLIP_SPAN,
+}
+"""The stamp of each clip's first frame: the clips' stamps do not overlap."""
+CLIP_FRAMES = {"figure": FIGURE_FRAMES, "mannequin": MANNEQUIN_FRAMES}
+"""Frames of the clips whose length the tests set (the others keep their makers' length)."""
+LEFT_OUT_SCENE = "<!doctype html><title>3D scene left out of the camera tests</title>"
 
 
 @pytest.fixture(scope="module")
@@ -81,12 +101,8 @@ def make_clip(clip_dir: Path) -> Callable[[str], Path]:
                 except ImportError:
                     require(False, "scikit-image is not installed (pip install -e .[test])")
             path = clip_dir / f"{name}.y4m"
-            if name == "figure":
-                made[name] = figure_clip(path, FIGURE_FRAMES)
-            elif name == "mannequin":
-                made[name] = mannequin_clip(path, MANNEQUIN_FRAMES)
-            else:
-                made[name] = CLIPS[name](path)
+            sized = {"frames": CLIP_FRAMES[name]} if name in CLIP_FRAMES else {}
+            made[name] = CLIPS[name](path, first=CLIP_FIRST[name], **sized)
         return made[name]
 
     return make
@@ -98,6 +114,8 @@ class CameraPage:
     def __init__(self, page: Any, requests: list[str]) -> None:
         self.page = page
         self.requests = requests
+        self.clip: str | None = None
+        """The clip the camera plays (a name of :data:`CLIP_FIRST`), set by ``show``."""
 
     def use_camera(self, side: str = "right") -> None:
         self.page.select_option("[data-testid='source-kind']", "camera")
@@ -105,13 +123,23 @@ class CameraPage:
         self.page.click("[data-testid='source-apply']")
 
     def frames(self, count: int, where: str = "true") -> list[dict[str, Any]]:
-        """Wait for ``count`` answered frames satisfying ``where`` (a JS test of ``f``)."""
+        """Wait for ``count`` answered frames of this test's clip satisfying ``where`` (a JS test
+        of ``f``); ``f.tag`` is then the frame's index in the clip."""
+        if self.clip is not None:
+            first = CLIP_FIRST[self.clip]
+            where = (
+                f"f.tag !== null && f.tag >= {first} && f.tag < {first + CLIP_SPAN} && ({where})"
+            )
         test = f"(f) => {where}"
         self.page.wait_for_function(
             f"() => window.__frames.filter({test}).length >= {count}",
             timeout=ESTIMATE_TIMEOUT_MS,
         )
-        return self.page.evaluate(f"() => window.__frames.filter({test})")
+        frames = self.page.evaluate(f"() => window.__frames.filter({test})")
+        if self.clip is not None:
+            for f in frames:
+                f["tag"] -= CLIP_FIRST[self.clip]
+        return frames
 
     def status(self) -> str:
         return self.page.locator("[data-testid='camera-status']").inner_text().strip()
@@ -127,32 +155,100 @@ def camera_browser(browser: Any, clip: Path | None, *, allow: bool = True) -> An
     return browser.browser_type.launch(executable_path=CHROMIUM, args=args, headless=True)
 
 
+def open_studio(chromium: Any, studio: Studio, init_script: str | None = None) -> CameraPage:
+    """The studio, ready, in a new context of ``chromium``, its 3D scene left out, collecting
+    every answered frame (``COLLECT_FRAMES_JS``) and every request."""
+    context = chromium.new_context(viewport={"width": 1440, "height": 900})
+    scene_port = urlsplit(studio.get("/api/config")["viser_url"]).port
+
+    def is_scene(url: str) -> bool:  # the scene's page and files; not its instance check
+        parts = urlsplit(url)
+        return parts.port == scene_port and parts.path != "/studio-instance"
+
+    context.route(
+        is_scene,
+        lambda route: route.fulfill(status=200, content_type="text/html", body=LEFT_OUT_SCENE),
+    )
+    if init_script:
+        context.add_init_script(init_script)
+    page = context.new_page()
+    requests: list[str] = []
+    page.on("request", lambda r: requests.append(r.url))
+    page.goto(studio.base + "/")
+    page.wait_for_selector("body[data-ready='1']", timeout=READY_TIMEOUT_MS)
+    page.evaluate(COLLECT_FRAMES_JS)
+    return CameraPage(page, requests)
+
+
+@pytest.fixture(scope="module")
+def live_clip(clip_dir: Path) -> Path:
+    """The file the shared Chromium's fake camera plays: a test puts its clip here."""
+    return blank_clip(clip_dir / "live.y4m", first=CLIP_FIRST["blank"])
+
+
+@pytest.fixture(scope="module")
+def camera_page(browser: Any, live_clip: Path, studio_server: Studio) -> Iterator[CameraPage]:
+    """The studio page the estimating tests share (the pose model loads once), in the module's
+    one Chromium whose camera is allowed and plays ``live_clip``."""
+    chromium = camera_browser(browser, live_clip)
+    try:
+        yield open_studio(chromium, studio_server)
+    finally:
+        chromium.close()
+
+
 @pytest.fixture
-def open_camera(browser: Any, studio_server: Studio) -> Iterator[Callable[..., CameraPage]]:
-    """Open the studio in a Chromium with a fake camera; the source goes back to the simulator."""
+def show(
+    camera_page: CameraPage,
+    make_clip: Callable[[str], Path],
+    live_clip: Path,
+    studio_server: Studio,
+) -> Iterator[Callable[[str], CameraPage]]:
+    """Put a clip (by name) before the shared page's camera, to be played from its next start;
+    afterwards the source goes back to the simulator and the page's camera stops."""
+    cam = camera_page
+    p = hook(cam.page)
+    stopped = "p => !p.S.camera.running && !p.S.camera.starting && !p.S.camera.stream"
+
+    def show_(name: str) -> CameraPage:
+        assert cam.page.evaluate(stopped, p), "the camera is on: it would go on with its clip"
+        staged = live_clip.with_suffix(".next")
+        shutil.copyfile(make_clip(name), staged)
+        os.replace(staged, live_clip)  # whole: the camera never opens half a clip
+        cam.page.evaluate("() => { window.__frames = []; }")
+        cam.clip = name
+        return cam
+
+    try:
+        yield show_
+    finally:
+        cam.clip = None
+        studio_server.send("PUT", "/api/source", {"kind": "simulator"})
+        cam.page.wait_for_function(stopped, arg=p, timeout=STATUS_TIMEOUT_MS)
+
+
+@pytest.fixture
+def open_camera(
+    browser: Any, camera_page: CameraPage, studio_server: Studio
+) -> Iterator[Callable[..., CameraPage]]:
+    """Open the studio in a page of its own, in the shared Chromium (its camera allowed) or in
+    one whose camera is refused; the source goes back to the simulator afterwards."""
     opened: list[Any] = []
 
-    def open_(
-        clip: Path | None, *, allow: bool = True, init_script: str | None = None
-    ) -> CameraPage:
-        chromium = camera_browser(browser, clip, allow=allow)
-        opened.append(chromium)
-        context = chromium.new_context(viewport={"width": 1440, "height": 900})
-        if init_script:
-            context.add_init_script(init_script)
-        page = context.new_page()
-        requests: list[str] = []
-        page.on("request", lambda r: requests.append(r.url))
-        page.goto(studio_server.base + "/")
-        page.wait_for_selector("body[data-ready='1']", timeout=READY_TIMEOUT_MS)
-        page.evaluate(COLLECT_FRAMES_JS)
-        return CameraPage(page, requests)
+    def open_(*, allow: bool = True, init_script: str | None = None) -> CameraPage:
+        chromium = camera_page.page.context.browser
+        if not allow:
+            chromium = camera_browser(browser, None, allow=False)
+            opened.append(chromium)
+        cam = open_studio(chromium, studio_server, init_script)
+        opened.append(cam.page.context)
+        return cam
 
     try:
         yield open_
     finally:
-        for chromium in opened:
-            chromium.close()
+        for done in reversed(opened):
+            done.close()
         studio_server.send("PUT", "/api/source", {"kind": "simulator"})
 
 
@@ -177,9 +273,9 @@ def elbow_maes(frames: list[dict[str, Any]], drawn: list[float]) -> tuple[float,
 
 
 def test_a_photograph_is_seen_and_only_landmarks_reach_the_studio(
-    open_camera: Callable[..., CameraPage], make_clip: Callable[[str], Path], studio_server: Studio
+    show: Callable[[str], CameraPage], studio_server: Studio
 ) -> None:
-    cam = open_camera(make_clip("astronaut"))
+    cam = show("astronaut")
     cam.use_camera("right")
     seen = cam.frames(3, "f.answer && f.answer.person_detected")
     assert all(f["body"]["world"] and len(f["body"]["world"]) == 33 for f in seen)
@@ -209,11 +305,9 @@ def test_a_photograph_is_seen_and_only_landmarks_reach_the_studio(
     assert outside == []
 
 
-def test_the_studio_tracks_a_drawn_elbow(
-    open_camera: Callable[..., CameraPage], make_clip: Callable[[str], Path]
-) -> None:
+def test_the_studio_tracks_a_drawn_elbow(show: Callable[[str], CameraPage]) -> None:
     """A drawn figure bends its right elbow 170 -> 60 degrees: the studio's elbow follows the drawing."""
-    cam = open_camera(make_clip("figure"))
+    cam = show("figure")
     cam.use_camera("right")
     frames = cam.frames(
         FIGURE_SAMPLES + 2,
@@ -230,14 +324,14 @@ def test_the_studio_tracks_a_drawn_elbow(
 
 
 def test_the_studios_mannequin_is_seen_with_its_sides_put_back(
-    open_camera: Callable[..., CameraPage], make_clip: Callable[[str], Path]
+    show: Callable[[str], CameraPage],
 ) -> None:
     """The studio's own human model, rendered, raising its right arm: BlazePose sees a person in
     every frame but takes it for one seen from behind and swaps left and right. The page swaps
     them back (the person faces the camera), so the taped right arm's landmarks are the rendered
     right arm's, and the studio's elbow follows the rendered one."""
     model = Mannequin()
-    cam = open_camera(make_clip("mannequin"))
+    cam = show("mannequin")
     cam.use_camera("right")
     frames = cam.frames(MANNEQUIN_SAMPLES + 2, "f.tag !== null")[2:]  # two settle the filter
     assert all(f["body"]["world"] is not None for f in frames), "a frame without a person"
@@ -271,9 +365,9 @@ def test_the_studios_mannequin_is_seen_with_its_sides_put_back(
 
 
 def test_no_person_in_view_says_so(
-    open_camera: Callable[..., CameraPage], make_clip: Callable[[str], Path], studio_server: Studio
+    show: Callable[[str], CameraPage], studio_server: Studio
 ) -> None:
-    cam = open_camera(make_clip("blank"))
+    cam = show("blank")
     cam.use_camera()
     cam.frames(2, "f.body.world === null")
     cam.page.wait_for_function(
@@ -285,7 +379,7 @@ def test_no_person_in_view_says_so(
 
 
 def test_a_refused_camera_says_so(open_camera: Callable[..., CameraPage]) -> None:
-    cam = open_camera(None, allow=False)
+    cam = open_camera(allow=False)
     cam.use_camera()
     cam.page.wait_for_function(
         "() => /refused the camera/.test(document.querySelector(\"[data-testid='camera-status']\").textContent)",
@@ -302,7 +396,7 @@ navigator.mediaDevices.getUserMedia = () =>
 
 
 def test_a_busy_camera_says_so(open_camera: Callable[..., CameraPage]) -> None:
-    cam = open_camera(None, init_script=BUSY_CAMERA)
+    cam = open_camera(init_script=BUSY_CAMERA)
     cam.use_camera()
     cam.page.wait_for_function(
         "() => /camera is busy/.test(document.querySelector(\"[data-testid='camera-status']\").textContent)",
@@ -322,7 +416,7 @@ navigator.mediaDevices.getUserMedia = () =>
 def test_a_camera_error_goes_with_the_camera(open_camera: Callable[..., CameraPage]) -> None:
     """The red "No camera was found" stays while the camera is the source, and goes when the
     user switches to the hand guide or the simulator (it stayed until a reload)."""
-    cam = open_camera(None, init_script=NO_CAMERA)
+    cam = open_camera(init_script=NO_CAMERA)
     page = cam.page
     status = page.get_by_test_id("camera-status")
     for other in ("hand", "simulator"):
@@ -347,7 +441,7 @@ def test_hand_guide_countdown_and_named_controls(
 ) -> None:
     """The hand guide says what to do; Record counts down first (pressing it again cancels), and
     the recording is listed as the hand guide's."""
-    cam = open_camera(None)
+    cam = open_camera()
     page = cam.page
     for name in ("Teaching arm", "Pose model", "Mirror picture", "Countdown"):
         assert page.get_by_label(name, exact=True).count() == 1, name
