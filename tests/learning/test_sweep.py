@@ -588,42 +588,19 @@ def test_a_sweep_on_a_two_node_cluster_uses_both_nodes(tmp_path: Path) -> None:
     port = _free_port()
     address = f"127.0.0.1:{port}"
     common = ["--num-cpus=1", "--disable-usage-stats", "--block"]
+    heads = ["--head", f"--port={port}", "--include-dashboard=false"]
     nodes: list[subprocess.Popen] = []
     try:
-        nodes.append(
-            subprocess.Popen(
-                [
-                    ray_cli,
-                    "start",
-                    "--head",
-                    f"--port={port}",
-                    "--include-dashboard=false",
-                    *common,
-                ],
-                stdout=subprocess.DEVNULL,
-                stderr=subprocess.DEVNULL,
-                env=env,
+        # `ray start` says "Ray runtime started" once its node is registered in the cluster (it
+        # waits for that itself): the event each node is waited for, with no `ray status` polls.
+        for flags in (heads, [f"--address={address}"]):
+            node = subprocess.Popen(
+                [ray_cli, "start", *flags, *common],
+                stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, env=env,
             )  # fmt: skip
-        )
-
-        def head_up():
-            try:
-                with socket.create_connection(("127.0.0.1", port), timeout=1):
-                    return True
-            except OSError:
-                return False
-
-        wait_for(head_up, "the head node", proc=None)
-        nodes.append(
-            subprocess.Popen(
-                [ray_cli, "start", f"--address={address}", *common],
-                stdout=subprocess.DEVNULL,
-                stderr=subprocess.DEVNULL,
-                env=env,
-            )  # fmt: skip
-        )
-        status = [ray_cli, "status", f"--address={address}"]
-        wait_for(lambda: _run_quiet(status, env).count(" node_") >= 2, "two nodes")
+            nodes.append(node)
+            said = _lines_of(node)
+            wait_for(lambda s=said: any("Ray runtime started" in x for x in s), "a node", proc=node)
         # Tune re-uses a worker whose trial ended for the next trial waiting, also one waiting
         # for the other node's worker to start. Trials of 0.02-0.3 s (40 episodes) could all run
         # in the first worker up before the other started (CI saw it once); trials of about
@@ -654,11 +631,17 @@ def test_a_sweep_on_a_two_node_cluster_uses_both_nodes(tmp_path: Path) -> None:
                 node.wait()
 
 
-def _run_quiet(cmd: list[str], env: dict) -> str:
-    try:
-        return subprocess.run(cmd, capture_output=True, text=True, timeout=30, env=env).stdout
-    except subprocess.TimeoutExpired:
-        return ""
+def _lines_of(proc: subprocess.Popen) -> list[str]:
+    """The lines ``proc`` prints, gathered by a thread as they come (its pipe never fills)."""
+    lines: list[str] = []
+    assert proc.stdout is not None
+
+    def gather() -> None:
+        for line in proc.stdout:
+            lines.append(line)
+
+    threading.Thread(target=gather, daemon=True).start()
+    return lines
 
 
 def test_the_driver_waits_for_a_stopped_trial_to_save_its_run(tmp_path: Path, monkeypatch) -> None:
