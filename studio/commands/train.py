@@ -17,7 +17,7 @@ is a run's ``config.json`` (to repeat a run) or looks like::
      "demonstrations": [[12, 133, ...], ...]}
 
 Boxes no move may touch come from ``--obstacle CX,CY,CZ,SX,SY,SZ`` (centre and full sizes in
-metres, in the robot's base frame; repeatable), for either task.
+metres, in the robot's base frame; repeatable), for the grid task; the continuous task refuses them.
 
 Demonstrations may also come from ``--demos FILE.json`` (repeatable: each adds its demonstrations): a JSON list of state lists, an object with
 a ``"demonstrations"`` list, or a cut ``*.demo.json``, whose grid path is computed from its joint
@@ -144,7 +144,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         action="append",
         metavar="CX,CY,CZ,SX,SY,SZ",
         help="a box no move may touch, centre and full sizes in metres in the robot's base frame "
-        "(e.g. 0.56,0.18,1.08,0.12,0.12,0.12); repeatable",
+        "(e.g. 0.56,0.18,1.08,0.12,0.12,0.12); repeatable; the grid task only",
     )
     parser.add_argument("--generated-demos", type=int, help="replay N generated demonstrations")
     parser.add_argument("--workers", type=int, default=None, help="threads (default: all cores)")

@@ -146,3 +146,22 @@ def test_evaluate_counts_a_rollout_through_a_box_as_a_collision(arm, in_the_way)
     assert not _collides_with(())("puma560", swing)
     assert _collides_with((in_the_way,))("puma560", swing)
     assert _collides_with((in_the_way,))("puma560", clear)
+
+
+def test_the_continuous_task_refuses_obstacles_rather_than_ignore_them(tmp_path, capsys):
+    """The continuous task has no obstacles yet: a box given to it is refused in one sentence
+    naming the grid task, by the request (the page, the API) and by the command line, and no run
+    folder is written (it trained as if no box stood there)."""
+    box = Obstacle((0.5, 0.0, 0.5), (0.1, 0.1, 0.1))
+    request = RunRequest(task="arm-reach", obstacles=[box.to_dict()], experiments=1, episodes=1)
+    with pytest.raises(ConfigError) as refused:
+        resolve_run(request)
+    assert "arm-grid" in refused.value.by_field["obstacles"]
+    out = tmp_path / "run"
+    code = main(
+        ["train", "--task", "arm-reach", "--obstacle=0.5,0,0.5,0.1,0.1,0.1", f"--out={out}"]
+    )
+    assert code == 2
+    err = capsys.readouterr().err
+    assert "does not take obstacles" in err and err.count("\n") == 1
+    assert not out.exists()
