@@ -247,6 +247,33 @@ def test_a_trials_worker_starts_without_scipy_signal() -> None:
     assert proc.stdout.strip() == "[]", proc.stdout
 
 
+def test_a_sweep_that_cannot_start_is_refused_before_ray_is_imported(tmp_path: Path) -> None:
+    """A second start, or a resume, of a running sweep is refused at once: without importing Ray
+    and Tune (seconds of CPU) first. The sweep's driver here is this test's process: alive."""
+    script = (
+        "import json, os, sys\n"
+        "from pathlib import Path\n"
+        "from studio.learning.sweeps._folder import prepare_folder\n"
+        "from studio.learning.sweeps._ray import run_sweep\n"
+        "from studio.learning.sweeps._spec import SweepError, parse_sweep_spec\n"
+        f"spec = parse_sweep_spec({spec_dict()!r})\n"
+        f"data = Path({str(tmp_path)!r})\n"
+        "sweep_file = prepare_folder(data, spec, False) / 'sweep.json'\n"
+        "stored = json.loads(sweep_file.read_text())\n"
+        "sweep_file.write_text(json.dumps({**stored, 'pid': os.getppid()}))\n"
+        "for resume in (False, True):\n"
+        "    try:\n"
+        "        run_sweep(spec, data, resume=resume)\n"
+        "    except SweepError as err:\n"
+        "        print(err)\n"
+        "print('ray' in sys.modules)\n"
+    )
+    lines = run_python(script).stdout.strip().splitlines()
+    assert len(lines) == 3, lines
+    assert all("'s' is still running" in line for line in lines[:2]), lines
+    assert lines[2] == "False", lines
+
+
 # ----------------------------------------------------------------------------- on a local Ray
 
 

@@ -165,13 +165,7 @@ def prepare_folder(data_dir: Path, spec: SweepSpec, resume: bool) -> Path:
             it started with, or the disk refuses the folder.
     """
     folder = sweep_folder(data_dir, spec.name)
-    stored = read_sweep_file(folder)
-    if stored is not None:
-        _check_existing(folder, spec, stored, resume)
-    elif resume:
-        raise SweepError(
-            f"There is no sweep {spec.name!r} in {folder.parent} to resume; start it without --resume."
-        )
+    stored = check_folder(data_dir, spec, resume)
     try:
         (folder / TRIALS_DIR).mkdir(parents=True, exist_ok=True)
     except OSError as err:
@@ -192,6 +186,25 @@ def prepare_folder(data_dir: Path, spec: SweepSpec, resume: bool) -> Path:
     stored["pid"], stored["host"] = os.getpid(), this_host()
     atomic_write_text(folder / SWEEP_FILE, json.dumps(stored, indent=1))
     return folder
+
+
+def check_folder(data_dir: Path, spec: SweepSpec, resume: bool) -> SweepFile | None:
+    """What :func:`prepare_folder` checks, writing nothing: returns the stored sweep file (None
+    for a new sweep).
+
+    Raises:
+        SweepError: the sweep runs elsewhere, exists (or not, to resume), or differs from the
+            spec it started with.
+    """
+    folder = sweep_folder(data_dir, spec.name)
+    stored = read_sweep_file(folder)
+    if stored is not None:
+        _check_existing(folder, spec, stored, resume)
+    elif resume:
+        raise SweepError(
+            f"There is no sweep {spec.name!r} in {folder.parent} to resume; start it without --resume."
+        )
+    return stored
 
 
 def _check_existing(folder: Path, spec: SweepSpec, stored: SweepFile, resume: bool) -> None:

@@ -42,6 +42,7 @@ from ..runs._record import RunRecord
 from ._folder import (
     RAY_DIR,
     TrialEnd,
+    check_folder,
     finished_trials,
     prepare_folder,
     record_trial_end,
@@ -332,11 +333,14 @@ def run_sweep(
     """
     if workers is not None and (not is_int(workers) or workers < 1):
         raise SweepError(f"--workers is {workers!r}; give a whole number of cores, at least 1.")
+    data_dir = Path(data_dir).resolve()
+    # A sweep that runs already, exists, or is not there to resume is refused before Ray is
+    # imported (seconds of CPU): the answer comes at once.
+    check_folder(data_dir, spec, resume)
     # before anything is written: a missing Ray or cluster leaves no trace
     ray = _import_ray(local=address is None)
     if address is not None and not ray.is_initialized():
         _check_address(address)
-    data_dir = Path(data_dir).resolve()
     folder = prepare_folder(data_dir, spec, resume)
     trials = spec.trials()
     finished = finished_trials(data_dir, spec) if resume else set()
