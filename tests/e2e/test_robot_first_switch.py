@@ -43,8 +43,10 @@ def test_q_robot_is_the_drawn_robots_and_the_source_goes_on_while_meshes_load(
             assert wait_for(
                 lambda: studio_server.get("/api/robots")["drawn"] == ROBOT, LOAD_TIMEOUT_S
             ), studio_server.log_tail()
+            # drawn, and driven by the live chain (the scene draws it a moment before)
             page.wait_for_function(
-                f"() => window.__statuses.some((s) => s[1] === '{ROBOT}')", timeout=60_000
+                f"() => window.__statuses.some((s) => s[1] === '{ROBOT}' && s[4].length === {joints})",
+                timeout=60_000,
             )
             statuses = page.evaluate("() => window.__statuses")
         finally:
@@ -59,6 +61,8 @@ def test_q_robot_is_the_drawn_robots_and_the_source_goes_on_while_meshes_load(
             assert shown == "puma560" and len(q) == puma, (robot, shown, q)
             assert len(re.findall(r"-?\d+", text)) == puma, text
         assert len({tuple(s[4]) for s in loading}) >= 2, "the robot drawn stood still"
-        # once drawn, its own joints
+        # once drawn, its own joints; the scene flips the robot drawn just before the live chain
+        # takes it over, so one status (on a busy machine) may fall between the two, never more
         assert len(drawn[-1][4]) == joints and len(drawn[-1][3].split()) == joints + 1
+        assert sum(len(s[4]) != joints for s in drawn) <= 1, drawn
         assert not page.errors
