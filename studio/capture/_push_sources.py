@@ -8,11 +8,15 @@ caller to fit and record at once, so the answer can say what the fit made of it.
 than :data:`MAX_OBSERVATIONS_PER_SECOND` in one second) is refused with :class:`FloodError` and
 counted as dropped: the studio, and a recording in progress, carry on.
 
-Each page stamps its frames by its own clock. One page at a time sends: a frame whose clock does
-not run with the live page's is another page's (a second tab with the camera), refused with
-:class:`SecondSenderError` while the live one sends; once that one has been quiet for
+Each page stamps its frames by its own clock and names itself (``sender``, an id it picks once
+per load). One page at a time sends: a frame from another page (a second tab with the camera) is
+refused with :class:`SecondSenderError` while the live one sends; once that one has been quiet for
 :data:`SENDER_QUIET_S` (closed, reloaded), the next page takes over, its times continuing by the
-studio's own clock across the gap. So a recording's time is never a difference of two clocks.
+studio's own clock across the gap. So a recording's time is never a difference of two clocks. A
+client that sends no id is told apart by its clock instead: a frame whose time does not run with
+the live sender's (within :data:`CLOCK_TOLERANCE_S`) is another's. The page names itself because
+its frames' times are the camera's capture times: while a busy machine takes a second or more to
+estimate one frame and not the next, its own clock would seem to jump.
 """
 
 from __future__ import annotations
@@ -83,7 +87,8 @@ class PushSource(ThreadedSource[FedT]):
         self._counter = 0
         self._last_t: float | None = None
         self._offset = 0.0
-        self._sender: tuple[float, float] | None = None  # live page: (its last time, arrival)
+        # the live page: (its last time, that frame's arrival, its id or None)
+        self._sender: tuple[float, float, str | None] | None = None
         self._admitted: collections.deque[float] = collections.deque(
             maxlen=MAX_OBSERVATIONS_PER_SECOND
         )
@@ -130,37 +135,50 @@ class PushSource(ThreadedSource[FedT]):
         self._record_arrival()
         return counter, now
 
-    def _check_sender(self, t: float, now: float) -> None:
-        """Refuse a frame whose clock is not the live page's (see the module docstring).
+    @staticmethod
+    def _same_sender(
+        live: tuple[float, float, str | None], t: float, now: float, sender: str | None
+    ) -> bool:
+        """Whether a frame (its time ``t``, arrival ``now`` and id) is the ``live`` page's: by
+        their ids when both have one, else by their clocks."""
+        last_t, arrived, live_id = live
+        if sender is not None and live_id is not None:
+            return sender == live_id
+        return abs(t - (last_t + now - arrived)) <= CLOCK_TOLERANCE_S
+
+    def _check_sender(self, t: float, now: float, sender: str | None = None) -> None:
+        """Refuse a frame from another page than the live one (see the module docstring).
 
         Raises:
             SecondSenderError: another page sent within the last :data:`SENDER_QUIET_S`.
         """
         with self._admit_lock:
-            if self._sender is None or now - self._sender[1] > SENDER_QUIET_S:
+            live = self._sender
+            if live is None or now - live[1] > SENDER_QUIET_S:
                 return
-            last_t, arrived = self._sender
-            if abs(t - (last_t + now - arrived)) > CLOCK_TOLERANCE_S:
+            if not self._same_sender(live, t, now, sender):
                 raise SecondSenderError(
                     f"Another page is sending {self.observation_kind} frames to this studio "
                     "already; close the other tab (or stop its camera), then start the camera "
                     "here again."
                 )
 
-    def _stream_time(self, t: float, now: float | None = None) -> float:
+    def _stream_time(self, t: float, now: float | None = None, sender: str | None = None) -> float:
         """``t`` on a clock that always moves forward: a page that takes over from another
         (a reload) continues after the last time by the studio's own clock; a repeated time
         stamp moves on too, as the landmark filter needs."""
         now = time.monotonic() if now is None else now
         with self._admit_lock:
-            sender = self._sender
-            if self._last_t is not None and sender is not None:
-                same_clock = abs(t - (sender[0] + now - sender[1])) <= CLOCK_TOLERANCE_S
-                if not same_clock:  # a new page: continue by the studio's clock
-                    self._offset = self._last_t + max(now - sender[1], RESTART_STEP_S) - t
+            live = self._sender
+            if (
+                live is not None
+                and self._last_t is not None
+                and not self._same_sender(live, t, now, sender)
+            ):  # a new page: its time continues by the studio's clock
+                self._offset = self._last_t + max(now - live[1], RESTART_STEP_S) - t
             if self._last_t is not None and t + self._offset <= self._last_t:
                 self._offset = self._last_t + RESTART_STEP_S - t
-            self._sender = (t, now)
+            self._sender = (t, now, sender)
             self._last_t = t + self._offset
             return self._last_t
 
@@ -194,8 +212,10 @@ class CameraSource(PushSource[LandmarkFrame]):
         height: object,
         fps: float | None = None,
         model: str | None = None,
+        sender: str | None = None,
     ) -> LandmarkFrame:
         """Check and count one frame of landmarks; returns it for the caller to fit and record.
+        ``sender`` is the page's id (None: the page is told apart by its clock).
 
         Raises:
             CaptureError: bad landmarks (NaN, wrong sizes, bad image size or time).
@@ -206,13 +226,17 @@ class CameraSource(PushSource[LandmarkFrame]):
             raise CaptureError(f"fps is {fps!r}; send the page's frame rate (0 to 1000) or null.")
         if model is not None and model not in MODELS:
             raise CaptureError(f"model is {model!r}; send one of {', '.join(MODELS)} or null.")
-        self._check_sender(frame.t, time.monotonic())
+        if sender is not None and not (isinstance(sender, str) and 0 < len(sender) <= 64):
+            raise CaptureError(
+                f"sender is {sender!r}; send the page's id (1 to 64 characters) or null."
+            )
+        self._check_sender(frame.t, time.monotonic(), sender)
         counter, now = self._admit()
         self.person_detected = frame.person
         self.camera_fps = None if fps is None else float(fps)
         self.model = model
         return LandmarkFrame(
-            self._stream_time(frame.t, now),
+            self._stream_time(frame.t, now, sender),
             counter,
             frame.world,
             frame.image,

@@ -175,6 +175,13 @@ class LandmarksFrame(_Body):
     height: int = Field(description="image height, pixels")
     fps: float | None = None
     model: Literal["lite", "full", "heavy"] | None = None
+    sender: str | None = Field(
+        None,
+        min_length=1,
+        max_length=64,
+        pattern=r"^[A-Za-z0-9_-]+$",
+        description="the sending page's id, picked once per load (null: told apart by its clock)",
+    )
 
 
 class LandmarksPublic(BaseModel):

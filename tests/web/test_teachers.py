@@ -201,6 +201,42 @@ def test_a_second_page_sending_frames_is_refused_and_time_stays_true(
     assert t[-1] - t[0] == pytest.approx(59 / 25 + 2.0 + 1 / 25 + 9 / 25, abs=1e-6)
 
 
+def test_a_page_named_by_its_id_is_one_sender_however_slowly_its_frames_are_estimated(
+    client: TestClient, monkeypatch
+) -> None:
+    """A page stamps each frame with the camera's capture time. On a busy machine one frame may
+    take seconds to estimate and the next a tenth: by its times alone the page would seem to jump
+    clocks and be refused as a second tab (a browser test's camera once lost frames so). Pages
+    name themselves; a second tab is still refused, even one whose clock runs with the first's."""
+    clock = FakeClock(monkeypatch)
+    camera(client)
+    no_one = {**landmarks(), "world": None, "image": None}
+    assert client.post("/api/capture/start", json={"name": "slow"}).status_code in (200, 201)
+    # captured every 1/25 s and sent 0.1 s later, but for the fourth, estimated in 2.5 s
+    latency = [0.1, 0.1, 0.1, 2.5, 0.1, 0.1]
+    start = clock.now
+    for k, late in enumerate(latency):
+        clock.now = start + k / 25 + late
+        r = client.post(
+            "/api/source/landmarks", json={**no_one, "t": 50.0 + k / 25, "sender": "a-1"}
+        )
+        assert r.status_code == 200, r.text
+    # a second tab opened a moment after the first: its clock runs with the first's
+    r = client.post("/api/source/landmarks", json={**no_one, "t": 50.0 + 6 / 25, "sender": "b-2"})
+    assert r.status_code == 409 and r.json()["detail"].startswith("Another page is sending")
+    client.post("/api/capture/stop")
+    t = read_any_recording(client.app.state.studio.recordings.path("slow")).t
+    assert len(t) == 6 and np.allclose(np.diff(t), 1 / 25)  # the camera's own pace
+
+
+@pytest.mark.parametrize("sender", ["", "a" * 65, "caf\u00e9", "a b"])
+def test_a_malformed_sender_id_is_refused_in_one_sentence(client: TestClient, sender) -> None:
+    camera(client)
+    no_one = {**landmarks(), "world": None, "image": None}
+    r = client.post("/api/source/landmarks", json={**no_one, "t": 1.0, "sender": sender})
+    assert r.status_code == 422 and "sender" in r.text
+
+
 def test_hand_guide_moves_the_arm_and_the_robot(client: TestClient) -> None:
     r = client.put("/api/source", json={"kind": "hand"})
     assert r.status_code == 200 and r.json()["kind"] == "hand"

@@ -255,7 +255,14 @@ class Sources:
         camera = self._fed_source("camera")
         observation, fitted = self._observe_fed(
             lambda: camera.submit(
-                frame.t, frame.world, frame.image, frame.width, frame.height, frame.fps, frame.model
+                frame.t,
+                frame.world,
+                frame.image,
+                frame.width,
+                frame.height,
+                frame.fps,
+                frame.model,
+                frame.sender,
             )
         )
         observable = None if fitted is None else fitted.observable

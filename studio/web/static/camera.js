@@ -38,6 +38,11 @@ const FPS_WINDOW_S = 20;
 const CAPTURE_AGE_MS = 5000; // a frame's captureTime older than this is taken as another clock's
 const FRAME_WAIT_MS = 100; // wait at most this long for the next video frame (hidden tabs, old browsers)
 const PREFS_KEY = "studio.camera";
+// This page's id in every landmark frame: the studio tells a second tab by it. Frames' times are
+// the camera's capture times, so a frame estimated slowly on a busy machine would seem, by its
+// time alone, to come from another clock. (Not crypto.randomUUID: a plain-HTTP page on the LAN
+// is no secure context.)
+const SENDER = `${Date.now().toString(36)}-${Math.random().toString(36).slice(2, 12)}`;
 
 const C = {
   running: false, // the camera loop is on
@@ -297,6 +302,7 @@ function onResults(results) {
     height: frame.height,
     fps: C.fps,
     model: C.poseModel,
+    sender: SENDER,
   }, { tag: frame.tag, tResult: now, swapped });
 }
 
