@@ -13,16 +13,19 @@ matrix is the deepest, at four), so :data:`MAX_JSON_DEPTH` leaves ample room.
 
 from __future__ import annotations
 
+import functools
 import json
 import os
 import re
 import tomllib
 from pathlib import Path
-
-import numpy as np
+from typing import TYPE_CHECKING
 
 from ._errors import StudioError
 from ._files import human_size, read_bytes_bounded
+
+if TYPE_CHECKING:
+    import numpy as np
 
 MAX_JSON_BYTES = 64 * 1024 * 1024
 """Largest JSON file read (a demonstration of a long recording is a few MB)."""
@@ -33,9 +36,6 @@ MAX_TOML_BYTES = 1024 * 1024
 
 _STRING = re.compile(rb'"[^"\\]*(?:\\.[^"\\]*)*"', re.DOTALL)
 """A JSON string literal (escapes included), blanked before brackets are counted."""
-_BRACKET_STEP = np.zeros(256, dtype=np.int8)
-_BRACKET_STEP[[ord("["), ord("{")]] = 1
-_BRACKET_STEP[[ord("]"), ord("}")]] = -1
 _SURROGATE_ESCAPE = re.compile(rb"\\u[dD][89a-fA-F]")
 """A JSON escape of a UTF-16 surrogate: the only way a JSON text can hold an unpaired one."""
 _SURROGATE = re.compile("[\ud800-\udfff]")
@@ -54,10 +54,25 @@ class TOMLFileError(StudioError, ValueError):
     """A TOML file that is nested too deeply or not valid; the message names the file."""
 
 
+@functools.cache
+def _bracket_steps() -> np.ndarray:
+    """Each byte's step in nesting depth: +1 for ``[`` and ``{``, -1 for ``]`` and ``}``, else 0."""
+    import numpy as np
+
+    steps = np.zeros(256, dtype=np.int8)
+    steps[[ord("["), ord("{")]] = 1
+    steps[[ord("]"), ord("}")]] = -1
+    return steps
+
+
 def nesting_depth(text: str | bytes) -> int:
     """The deepest nesting of ``[]``/``{}`` in a JSON text, outside string literals, without recursion."""
+    # numpy is imported here, not with the module: every `studio` command imports this module
+    # (through `studio`), and its --help and usage errors must not wait for numpy.
+    import numpy as np
+
     data = text.encode("utf-8", errors="surrogatepass") if isinstance(text, str) else bytes(text)
-    steps = _BRACKET_STEP[np.frombuffer(_STRING.sub(b'""', data), dtype=np.uint8)]
+    steps = _bracket_steps()[np.frombuffer(_STRING.sub(b'""', data), dtype=np.uint8)]
     moves = steps[np.flatnonzero(steps)]
     if moves.size == 0:
         return 0

@@ -7,19 +7,31 @@ numpy scalars count (settings are often computed with numpy).
 from __future__ import annotations
 
 import math
+import sys
 
-import numpy as np
+
+def _numpy_types(*names: str) -> tuple[type, ...]:
+    """numpy's types of these names, or none while numpy is not loaded (no value can be one then):
+    settings are checked without importing numpy, so `studio train --help` and a mistyped flag
+    answer at once."""
+    numpy = sys.modules.get("numpy")
+    return () if numpy is None else tuple(getattr(numpy, name) for name in names)
+
+
+def is_numpy_scalar(value: object) -> bool:
+    """Whether ``value`` is a numpy integer or float scalar (``np.int64(3)``, ``np.float32(0.5)``)."""
+    return isinstance(value, _numpy_types("integer", "floating"))
 
 
 def is_int(value: object) -> bool:
     """Whether ``value`` is an integer (Python or numpy), and not a ``bool``."""
-    return isinstance(value, int | np.integer) and not isinstance(value, bool)
+    return isinstance(value, (int, *_numpy_types("integer"))) and not isinstance(value, bool)
 
 
 def is_number(value: object) -> bool:
     """Whether ``value`` is a finite integer or float (Python or numpy), and not a ``bool``."""
     return (
-        isinstance(value, int | float | np.integer | np.floating)
+        isinstance(value, (int, float, *_numpy_types("integer", "floating")))
         and not isinstance(value, bool)
-        and math.isfinite(value)
+        and math.isfinite(value)  # type: ignore[arg-type]
     )

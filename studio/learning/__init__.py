@@ -19,7 +19,7 @@ from __future__ import annotations
 import typing
 
 from .. import _lazy
-from .tasks._gym_ids import register as _register_environments
+from .tasks._gym_ids import register_when_imported as _register_environments
 
 if typing.TYPE_CHECKING:  # the public names, each loaded when first used (see studio/_lazy.py)
     from ._config import ACTION_SETS as ACTION_SETS
@@ -144,4 +144,4 @@ if typing.TYPE_CHECKING:  # the public names, each loaded when first used (see s
     from .tasks._robot import default_goal as default_goal
 
 __getattr__, __dir__, __all__ = _lazy.lazy_exports(__name__, __file__)
-_register_environments()  # "TeachStudio/ArmGrid-v0" and "TeachStudio/ArmReach-v0"
+_register_environments()  # "TeachStudio/ArmGrid-v0" and "TeachStudio/ArmReach-v0", once Gymnasium loads

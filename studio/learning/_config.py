@@ -18,9 +18,7 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass, fields
 from typing import Final
 
-import numpy as np
-
-from .._numbers import is_int, is_number
+from .._numbers import is_int, is_number, is_numpy_scalar
 from ._errors import ConfigError
 
 PLANNERS = ("zero", "full", "soft", "prioritized")
@@ -170,7 +168,7 @@ class DynaQConfig:
             raise ConfigError([text for _, text in problems], [name for name, _ in problems])
         for f in fields(self):  # plain Python numbers, so the settings serialise to JSON as is
             value = getattr(self, f.name)
-            if isinstance(value, np.integer | np.floating):
+            if is_numpy_scalar(value):
                 object.__setattr__(self, f.name, value.item())
 
     def to_dict(self) -> dict[str, object]:

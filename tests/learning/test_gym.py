@@ -13,6 +13,32 @@ from studio.learning.tasks._gym import ARM_GRID_ID, ARM_REACH_ID
 from studio.learning.tasks._reach import reach_step
 
 
+@pytest.mark.parametrize("gymnasium_first", [False, True])
+def test_import_studio_learning_registers_both_environments_in_either_order(gymnasium_first):
+    """``import studio.learning`` registers the environments without importing Gymnasium (the
+    CLI's parsers read its defaults): they are there once Gymnasium is, whichever came first."""
+    import subprocess
+    import sys
+
+    imports = ["import studio.learning", "import gymnasium.spaces"]
+    code = "\n".join(
+        [
+            "import sys",
+            *(reversed(imports) if gymnasium_first else imports[:1]),
+            "print('gymnasium' in sys.modules)",
+            *([] if gymnasium_first else imports[1:]),
+            "import gymnasium",
+            f"print([gymnasium.spec(i).id for i in {[ARM_GRID_ID, ARM_REACH_ID]!r}])",
+        ]
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, timeout=120, check=True
+    )
+    loaded, ids = done.stdout.splitlines()
+    assert loaded == str(gymnasium_first)
+    assert ids == str([ARM_GRID_ID, ARM_REACH_ID])
+
+
 @pytest.mark.filterwarnings("ignore:.*render_mode")
 @pytest.mark.parametrize(
     "env_id, kwargs",
