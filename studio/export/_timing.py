@@ -50,7 +50,10 @@ RETIME_TRIES = 4
 
 
 PACE_WINDOW_S = 0.1
-"""The source's pace at a sample is the rate it moved over this long around it (s)."""
+"""The source's pace at a place is its rate over the arc around it that it covers in this long at
+its typical (median) speed (s)."""
+PACE_PLACES = 2000
+"""Places along the path at which the source's pace is given to the timing."""
 SLOWEST_PACE = 0.002
 """The slowest the source's pace is taken to be, as a share of its median: where the source
 paused, the robot moves on slowly rather than stopping for good."""
@@ -244,22 +247,47 @@ def pace_path(
 
 
 def _pace(times: np.ndarray, q: np.ndarray, kept: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The source's pace sample by sample, along the thinned path's arc length: each sample is
-    placed on it in proportion to the distance it had come between two waypoints, and its speed
-    is the rate it moved along it then (never below :data:`SLOWEST_PACE` of its median, so that
-    a pause in the source does not stop the timing)."""
+    """The source's pace along the thinned path's arc length, such that the timing spends the
+    time the source did on every stretch of it, pauses included.
+
+    Each sample is placed on the thinned path in proportion to the distance it had come between
+    two waypoints. The arc is cut in :data:`PACE_PLACES` equal pieces and each is given the time
+    the source spent on it: a pause (the person held still, or moved only in ways the robot does
+    not follow) counts on the piece where it happened, so it becomes a crawl as long as it, not
+    an instant. Each piece's time is spread evenly over the arc the source covers in
+    :data:`PACE_WINDOW_S` at its median speed around it (a pace, not one noisy step; the total
+    is kept). The pace is never below :data:`SLOWEST_PACE` of the median, so that the timing
+    does not stop for good. Returns places (the pieces' middles, rad) and the pace (rad/s)."""
     from ._topp import arc_length
 
     along = arc_length(q)
-    s = np.interp(along, along[kept], arc_length(q[kept]))
-    # the rate over PACE_WINDOW_S around each sample: a pace, not one noisy step
-    half = max(1, int(round(PACE_WINDOW_S / 2 / float(np.median(np.diff(times))))))
-    before = np.maximum(np.arange(len(s)) - half, 0)
-    after = np.minimum(np.arange(len(s)) + half, len(s) - 1)
-    speed = (s[after] - s[before]) / (times[after] - times[before])
-    moving = speed[speed > 0]
-    floor = SLOWEST_PACE * (float(np.median(moving)) if len(moving) else 1.0)
-    return s, np.maximum(speed, floor)
+    s = np.maximum.accumulate(np.interp(along, along[kept], arc_length(q[kept])))
+    total = float(s[-1])
+    edges = np.linspace(0.0, total, PACE_PLACES + 1)
+    # when the source first reached each edge; the last piece ends with the source
+    reached = np.r_[_first_at(s, times, edges[:-1]), times[-1]]
+    spent = np.diff(reached)
+    piece = total / PACE_PLACES
+    moving = spent[spent > 0]
+    typical = piece / float(np.median(moving)) if len(moving) else total / float(times[-1])
+    width = min(int(PACE_WINDOW_S * typical / piece) // 2, PACE_PLACES // 2 - 1)  # either side
+    if width:  # each piece's time spread over its neighbours within the arc, none lost
+        index = np.arange(PACE_PLACES)
+        share = np.minimum(index + width, PACE_PLACES - 1) - np.maximum(index - width, 0) + 1
+        spent = np.convolve(spent / share, np.ones(2 * width + 1), mode="same")
+    pace = piece / np.maximum(spent, 1e-12)
+    return edges[:-1] + piece / 2, np.maximum(pace, SLOWEST_PACE * typical)
+
+
+def _first_at(s: np.ndarray, times: np.ndarray, at: np.ndarray) -> np.ndarray:
+    """When the source (at places ``s``, non-decreasing, at ``times``) first reached each of
+    ``at``: where it stood still at a place, the time it arrived there."""
+    i = np.clip(np.searchsorted(s, at, side="left"), 1, len(s) - 1)
+    s0, s1, t0, t1 = s[i - 1], s[i], times[i - 1], times[i]
+    rise = s1 - s0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        share = np.where(rise > 0, (at - s0) / rise, 0.0)
+    return t0 + np.clip(share, 0.0, 1.0) * (t1 - t0)
 
 
 def _slowdowns(source: np.ndarray, robot: np.ndarray) -> tuple[Slowdown, ...]:
