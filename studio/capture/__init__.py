@@ -21,7 +21,6 @@ from .. import _lazy
 if typing.TYPE_CHECKING:  # the public names, each loaded when first used (see studio/_lazy.py)
     from ._calibration import Calibration as Calibration
     from ._calibration import import_raw as import_raw
-    from ._capture_loop import SOURCE_SPECS as SOURCE_SPECS
     from ._capture_loop import capture as capture
     from ._capture_loop import cli_speed as cli_speed
     from ._capture_loop import describe as describe
@@ -38,7 +37,6 @@ if typing.TYPE_CHECKING:  # the public names, each loaded when first used (see s
     from ._fitters import Fitted as Fitted
     from ._fitters import ObservationFitter as ObservationFitter
     from ._fitters import fitter_for as fitter_for
-    from ._network import DEFAULT_PORT as DEFAULT_PORT
     from ._network import NetworkSource as NetworkSource
     from ._network import encode_frame as encode_frame
     from ._network import stream_source as stream_source
@@ -91,5 +89,7 @@ if typing.TYPE_CHECKING:  # the public names, each loaded when first used (see s
     from ._source import FrameSource as FrameSource
     from ._source import SourceStatus as SourceStatus
     from ._source import check_seconds as check_seconds
+    from ._source_specs import DEFAULT_PORT as DEFAULT_PORT
+    from ._source_specs import SOURCE_SPECS as SOURCE_SPECS
 
 __getattr__, __dir__, __all__ = _lazy.lazy_exports(__name__, __file__)

@@ -17,7 +17,6 @@ from pathlib import Path
 from studio import StudioError
 
 from ._errors import CaptureError
-from ._network import DEFAULT_PORT
 from ._observation_recording import ObservationWriter
 from ._recording_format import (
     DEFAULT_RATE_HZ,
@@ -27,11 +26,8 @@ from ._recording_format import (
 )
 from ._recording_writer import AppendWriter, RecordingWriter
 from ._source import SourceStatus, ThreadedSource, check_seconds
+from ._source_specs import DEFAULT_PORT, SOURCE_SPECS
 
-SOURCE_SPECS = (
-    "simulator[:SEED] | FILE.tape.csv|.pose.csv|.hand.csv | udp[:[HOST:]PORT] | serial:PORT"
-)
-"""What :func:`source_from_spec` accepts (for help texts)."""
 FED_KINDS = ("camera", "hand")
 """Sources whose observations are handed in by calls (the page's camera and hand guide)."""
 MAX_PORT = 65535

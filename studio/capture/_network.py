@@ -55,6 +55,7 @@ from ._errors import CaptureError
 from ._observations import TapeFrame
 from ._recording_format import MAX_REGIONS
 from ._source import DEFAULT_QUEUE_FRAMES, ThreadedSource, check_seconds
+from ._source_specs import DEFAULT_PORT
 
 MAGIC = b"STAP"
 """First four bytes of every datagram."""
@@ -62,8 +63,6 @@ WIRE_VERSION = 1
 """The version this code writes and the newest it reads."""
 HEADER = struct.Struct("!4sBBHIdH")
 """Everything before the angles."""
-DEFAULT_PORT = 47110
-"""UDP port of the network source unless told otherwise."""
 SIGNED = 0x01
 """Flags bit: the datagram ends with a signature (:data:`SIGNATURE_BYTES`)."""
 SIGNATURE_BYTES = 16

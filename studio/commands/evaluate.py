@@ -15,10 +15,12 @@ import argparse
 import json
 from collections.abc import Callable
 from pathlib import Path
-
-import numpy as np
+from typing import TYPE_CHECKING
 
 from studio import StudioError
+
+if TYPE_CHECKING:
+    import numpy as np
 
 NAME = "evaluate"
 HELP = "Judge a policy from held-out random starts (success, collisions, time to the goal) beside its teacher."
@@ -80,6 +82,8 @@ def _collides_with(obstacles: tuple) -> Callable[[str, np.ndarray], bool]:
     boxes anywhere along it (its samples joined by straight moves)."""
 
     def collides(robot: str, q: np.ndarray) -> bool:
+        import numpy as np  # with the robot models, when a rollout is judged: not for --help
+
         from studio.kinematics import load_robot
         from studio.learning import obstacle_guard
 

@@ -20,13 +20,10 @@ from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-import numpy as np
-
-# Only light modules here: the flags' defaults and choices. What an export needs (the robot
+# Only light modules here: the flags' defaults and choices. What an export needs (numpy, the robot
 # models, the learners, TOPP-RA, MuJoCo) is imported where it runs, so `studio export --help` and
 # a mistyped flag answer at once.
 from studio._layout import physics_cache_dir, robot_cache_dir
-from studio.capture import DEMO_SUFFIX, RECORDING_SUFFIXES
 from studio.export import FORMAT_SUFFIXES, FORMATS, LIMIT_FRACTION, ExportError
 from studio.kinematics import (
     LIMIT_MARGIN_RAD,
@@ -183,6 +180,8 @@ def _zero_outside(arm: RobotArm | None, joints: int) -> bool:
     (the Panda's joint 4 never reaches 0): then the robot's home pose starts the rollout."""
     if arm is None:
         return False
+    import numpy as np
+
     return bool(np.any((arm.lower[:joints] > 0.0) | (arm.upper[:joints] < 0.0)))
 
 
@@ -196,6 +195,8 @@ def _rollout(
     joints, or every joint of ``arm``; default: its learner's own start, the learned joints at
     0 or a movement primitive's demonstration's start, or ``arm``'s home pose where 0 lies
     outside its limits), and the phrase saying what it did."""
+    import numpy as np
+
     from studio.learning import Start, learner_of
 
     learner = learner_of(policy)
@@ -323,6 +324,7 @@ def _say_retargeting(source: Path, robot: str) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from studio.capture import DEMO_SUFFIX, RECORDING_SUFFIXES
     from studio.export import export_motion, find_source
     from studio.learning import POLICY_SUFFIX, load_any_policy
 

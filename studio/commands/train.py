@@ -39,7 +39,6 @@ from typing import TYPE_CHECKING, cast
 # flag answer at once.
 from studio import StudioError, read_json
 from studio._layout import RECORDINGS_DIR
-from studio.capture import DEMO_SUFFIX
 from studio.kinematics import DEFAULT_ROBOT, KinematicsError, robot_names, robot_spec
 from studio.learning import (
     ACTION_SETS,
@@ -49,12 +48,12 @@ from studio.learning import (
     DEFAULT_SEED,
     DEFAULT_SHAPING,
     DEMO_SHAPING,
+    GRID_DEFAULTS,
     OWN_LEARNER,
     PLANNERS,
     REACH_DEFAULTS,
     TASK_KINDS,
     TEACHER_KIND,
-    ArmGrid,
     DynaQConfig,
     LearningError,
 )
@@ -116,10 +115,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--joints",
         type=int,
-        help=f"grid joints (default: {ArmGrid.joints}); with --task arm-reach, joints 1..J learnt "
+        help=f"grid joints (default: {GRID_DEFAULTS['joints']}); with --task arm-reach, joints 1..J learnt "
         f"(default: {REACH_DEFAULTS['joints']})",
     )
-    parser.add_argument("--bins", type=int, help=f"bins per joint (default: {ArmGrid.bins})")
+    parser.add_argument(
+        "--bins", type=int, help=f"bins per joint (default: {GRID_DEFAULTS['bins']})"
+    )
     _add_reach_arguments(parser)
     goal = parser.add_mutually_exclusive_group()
     goal.add_argument(
@@ -227,6 +228,8 @@ def demonstration_file(given: Path) -> Path:
     Raises:
         LearningError: no such file or demonstration.
     """
+    from studio.capture import DEMO_SUFFIX  # with numpy: only when a demonstration is named
+
     if given.exists() or len(given.parts) != 1:
         return given
     name = given.name.removesuffix(DEMO_SUFFIX)

@@ -18,6 +18,9 @@ if typing.TYPE_CHECKING:  # the public names, each loaded when first used (see s
     from studio.motion import series_motion as series_motion
     from studio.motion import training_demonstration as training_demonstration
 
+    from ._choices import FORMAT_SUFFIXES as FORMAT_SUFFIXES
+    from ._choices import FORMATS as FORMATS
+    from ._choices import LIMIT_FRACTION as LIMIT_FRACTION
     from ._errors import ExportError as ExportError
     from ._errors import SafetyError as SafetyError
     from ._export import Exported as Exported
@@ -25,8 +28,6 @@ if typing.TYPE_CHECKING:  # the public names, each loaded when first used (see s
     from ._export import fit_timing as fit_timing
     from ._export import simulate_motion as simulate_motion
     from ._formats import DESCRIPTION_TOPIC as DESCRIPTION_TOPIC
-    from ._formats import FORMAT_SUFFIXES as FORMAT_SUFFIXES
-    from ._formats import FORMATS as FORMATS
     from ._formats import JOINT_STATE as JOINT_STATE
     from ._formats import JOINT_TRAJECTORY as JOINT_TRAJECTORY
     from ._formats import STATE_TOPIC as STATE_TOPIC
@@ -51,7 +52,6 @@ if typing.TYPE_CHECKING:  # the public names, each loaded when first used (see s
     from ._sources import source_kind as source_kind
     from ._tf import LinkTransforms as LinkTransforms
     from ._tf import link_transforms as link_transforms
-    from ._timing import LIMIT_FRACTION as LIMIT_FRACTION
     from ._timing import time_path as time_path
     from ._urdf import export_urdf as export_urdf
     from ._urdf import portable_urdf as portable_urdf

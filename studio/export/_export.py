@@ -27,13 +27,14 @@ from studio._files import now_iso
 from studio.motion import Finding, Motion
 from studio.physics import PhysicsError, SimulationReport
 
+from ._choices import LIMIT_FRACTION, Format
 from ._errors import ExportError
-from ._formats import Format, write_csv, write_mcap
+from ._formats import write_csv, write_mcap
 from ._lerobot import lerobot_conventions, write_lerobot
 from ._safety import COLLISION_MARGIN_M, check_trajectory, limit_findings, refuse, timing_findings
 from ._simulate import simulate_trajectory
 from ._tf import link_transforms
-from ._timing import LIMIT_FRACTION, PacedPath, Slowdown, pace_path, time_path
+from ._timing import PacedPath, Slowdown, pace_path, time_path
 
 TASKS = {
     "demonstration": "Reach the goal the way the person showed it.",

@@ -27,7 +27,7 @@ import io
 import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, BinaryIO, Literal
+from typing import TYPE_CHECKING, BinaryIO
 
 import numpy as np
 
@@ -37,12 +37,6 @@ from ._errors import ExportError
 
 if TYPE_CHECKING:
     from ._tf import LinkTransforms
-
-Format = Literal["csv", "mcap", "lerobot"]
-FORMATS: tuple[Format, ...] = ("csv", "mcap", "lerobot")
-"""The trajectory formats ``studio export --format`` writes."""
-FORMAT_SUFFIXES: dict[Format, str] = {"csv": ".csv", "mcap": ".mcap", "lerobot": ".lerobot"}
-"""Each format's default ending after the source's name (a LeRobot dataset is a folder)."""
 
 JOINT_TRAJECTORY = "trajectory_msgs/msg/JointTrajectory"
 JOINT_STATE = "sensor_msgs/msg/JointState"

@@ -27,6 +27,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ._choices import LIMIT_FRACTION
 from ._errors import ExportError
 
 if TYPE_CHECKING:
@@ -34,9 +35,6 @@ if TYPE_CHECKING:
 
 PATH_TOLERANCE_RAD = np.radians(0.5)
 """How far (rad, per joint) the thinned path may pass from a sample of the original one."""
-LIMIT_FRACTION = 0.8
-"""The share of each velocity and acceleration limit the timing uses by default: headroom for
-the controller's tracking and the spline's sampling, checked afterwards against the full limits."""
 STILL_RAD = 1e-6
 """A step of the path shorter than this on every joint (rad) is no motion: a sixth of a 20-bit
 encoder's count (6e-6 rad), and TOPP-RA's LP solver, whose tolerances are absolute, fails on

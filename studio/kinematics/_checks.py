@@ -13,11 +13,13 @@ exception further down.
 
 from __future__ import annotations
 
-import math
-
-import numpy as np
+from typing import TYPE_CHECKING
 
 from .._errors import StudioError
+from .._numbers import is_number
+
+if TYPE_CHECKING:
+    import numpy as np
 
 
 class KinematicsError(StudioError):
@@ -45,6 +47,8 @@ def real_array(value: object, what: str, hint: str = "pass an array of real numb
     Raises:
         KinematicsError: ``value`` is not an array of real numbers.
     """
+    import numpy as np  # here: the robot list reads this module's error without loading numpy
+
     try:
         raw = np.asarray(value)
     except (TypeError, ValueError):  # ragged nested lists
@@ -64,12 +68,9 @@ def real_array(value: object, what: str, hint: str = "pass an array of real numb
 
 def positive_number(value: object, what: str) -> float:
     """``value`` as a finite float above zero, or a KinematicsError naming ``what``."""
-    if isinstance(value, bool) or not isinstance(value, int | float | np.integer | np.floating):
+    if not (is_number(value) and float(value) > 0):  # type: ignore[arg-type]
         raise KinematicsError(f"{what} must be a positive number; got {value!r}.")
-    number = float(value)
-    if not (math.isfinite(number) and number > 0):
-        raise KinematicsError(f"{what} must be a positive number; got {value!r}.")
-    return number
+    return float(value)  # type: ignore[arg-type]
 
 
 def whole_number(value: object, what: str, minimum: int) -> int:
@@ -78,11 +79,9 @@ def whole_number(value: object, what: str, minimum: int) -> int:
     Floats with a whole value (``20.0``) are accepted; ``2.5``, ``inf``, NaN, text and bools are
     not.
     """
-    if isinstance(value, bool) or not isinstance(value, int | float | np.integer | np.floating):
+    if not (is_number(value) and int(value) == value and value >= minimum):  # type: ignore[arg-type, operator]
         raise KinematicsError(f"{what} must be a whole number >= {minimum}; got {value!r}.")
-    if not (math.isfinite(value) and int(value) == value and value >= minimum):
-        raise KinematicsError(f"{what} must be a whole number >= {minimum}; got {value!r}.")
-    return int(value)
+    return int(value)  # type: ignore[call-overload]
 
 
 def instance_of(value: object, kind: type, what: str, *, optional: bool = False) -> None:

@@ -21,13 +21,13 @@ from pathlib import PurePosixPath
 from typing import TYPE_CHECKING, Literal
 from xml.sax.saxutils import quoteattr
 
-import numpy as np
-
 if TYPE_CHECKING:
+    import numpy as np
     import pinocchio as pin
 
-# Pinocchio is imported where a pose is built, not with this module: the robot registry reads
-# the Puma560's ready pose and grid range here without loading it.
+# Pinocchio and numpy are imported where a pose is built, not with this module: the robot
+# registry reads the Puma560's ready pose and grid range here without loading them (`studio
+# train --help` lists the robots).
 
 PUMA_READY_DEG = (0.0, 45.0, -90.0, 0.0, 0.0, 0.0)
 """The Puma560's ``RobotSpec.ready``, the paper's goal: the paper shows its goal only as a picture
@@ -69,6 +69,7 @@ class DHRow:
 
     def fixed(self) -> pin.SE3:
         """The joint-independent part ``Tz(d) Tx(a) Rx(alpha)`` of this row."""
+        import numpy as np
         import pinocchio as pin
 
         c, s = math.cos(self.alpha), math.sin(self.alpha)
@@ -248,6 +249,8 @@ def urdf_from_dh(
     Returns:
         A complete URDF document.
     """
+    import numpy as np
+
     frames = range(len(dh) + 1)
     on = [[v for v in visuals if v.joint == i] for i in frames]
     drawn = [[m for m in meshes if m.joint == i] for i in frames]

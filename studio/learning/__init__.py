@@ -29,6 +29,7 @@ if typing.TYPE_CHECKING:  # the public names, each loaded when first used (see s
     from ._config import DEFAULT_SEED as DEFAULT_SEED
     from ._config import DEFAULT_SHAPING as DEFAULT_SHAPING
     from ._config import DEMO_SHAPING as DEMO_SHAPING
+    from ._config import GRID_DEFAULTS as GRID_DEFAULTS
     from ._config import MAX_EPISODE_RUNS as MAX_EPISODE_RUNS
     from ._config import MAX_EPISODES as MAX_EPISODES
     from ._config import MAX_EXPERIMENTS as MAX_EXPERIMENTS

@@ -79,6 +79,8 @@ greedy success swings as training goes on: at six joints, 2 experiments, Puma560
 joint per action ends at 100% on the Puma560, the Panda and the UR5. A default that gets worse
 with more training is the wrong default."""
 
+GRID_DEFAULTS: Final = {"joints": 3, "bins": 11}
+"""The paper's arm grid (:class:`ArmGrid`'s defaults): its first 3 joints, 11 bins each."""
 REACH_DEFAULTS: Final = {
     "joints": DEFAULT_JOINTS,
     "step_deg": DEFAULT_STEP_DEG,

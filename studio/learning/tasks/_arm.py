@@ -33,6 +33,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .._config import GRID_DEFAULTS
 from .._errors import LearningError
 from ._mdp import TabularMDP
 from ._obstacles import blocked_grid_moves, check_goal_clear, task_obstacles
@@ -75,8 +76,8 @@ class ArmGrid:
         LearningError: for a bad value, or a grid whose table would not fit in memory.
     """
 
-    joints: int = 3
-    bins: int = 11
+    joints: int = GRID_DEFAULTS["joints"]
+    bins: int = GRID_DEFAULTS["bins"]
     low_deg: float | tuple[float, ...] | None = None
     high_deg: float | tuple[float, ...] | None = None
     goal: tuple[int, ...] | None = None
