@@ -23,6 +23,13 @@ def is_numpy_scalar(value: object) -> bool:
     return isinstance(value, _numpy_types("integer", "floating"))
 
 
+def is_real(value: object) -> bool:
+    """Whether ``value`` is an integer or float (Python or numpy, NaN and infinities included),
+    and not a ``bool``."""
+    numbers = (int, float, *_numpy_types("integer", "floating"))
+    return isinstance(value, numbers) and not isinstance(value, bool)
+
+
 def is_int(value: object) -> bool:
     """Whether ``value`` is an integer (Python or numpy), and not a ``bool``."""
     return isinstance(value, (int, *_numpy_types("integer"))) and not isinstance(value, bool)
@@ -30,8 +37,4 @@ def is_int(value: object) -> bool:
 
 def is_number(value: object) -> bool:
     """Whether ``value`` is a finite integer or float (Python or numpy), and not a ``bool``."""
-    return (
-        isinstance(value, (int, float, *_numpy_types("integer", "floating")))
-        and not isinstance(value, bool)
-        and math.isfinite(value)  # type: ignore[arg-type]
-    )
+    return is_real(value) and math.isfinite(value)  # type: ignore[arg-type]

@@ -222,6 +222,13 @@ ARGUMENT_ERRORS = {
     "simulate": ["simulate"],
 }
 """One usage error per verb: a value that is not a number, a missing file, an unknown flag."""
+VALUE_ERRORS = (
+    ["train", "--obstacle", "1,2"],
+    ["train", "--obstacle", "0,0,1,0.1,0.1,-1", "--task", "arm-grid"],
+    ["export", "sample-reach-1", "--format", "pdf"],
+)
+"""Values argparse refuses by the project's own parsers and choices (``Obstacle.parse``, the
+export formats)."""
 
 
 def _loaded_after(*argvs: list[str]) -> tuple[list[str], list[int]]:
@@ -268,3 +275,10 @@ def test_a_verbs_help_and_its_usage_errors_import_none_of_the_heavy_packages(ver
     loaded, codes = _loaded_after([verb, "--help"], ARGUMENT_ERRORS[verb])
     assert codes == [0, 2]
     assert loaded == [], f"studio {verb} --help or a usage error imported {loaded}"
+
+
+def test_a_flags_value_refused_by_its_own_parser_imports_none_of_the_heavy_packages():
+    """``--obstacle``'s box is read by :meth:`Obstacle.parse` before any collision model loads."""
+    loaded, codes = _loaded_after(*VALUE_ERRORS)
+    assert codes == [2] * len(VALUE_ERRORS)
+    assert loaded == []

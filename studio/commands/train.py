@@ -39,7 +39,13 @@ from typing import TYPE_CHECKING, cast
 # flag answer at once.
 from studio import StudioError, read_json
 from studio._layout import RECORDINGS_DIR
-from studio.kinematics import DEFAULT_ROBOT, KinematicsError, robot_names, robot_spec
+from studio.kinematics import (
+    DEFAULT_ROBOT,
+    KinematicsError,
+    Obstacle,
+    robot_names,
+    robot_spec,
+)
 from studio.learning import (
     ACTION_SETS,
     CLONING_KIND,
@@ -60,7 +66,6 @@ from studio.learning import (
 from studio.samples import SAMPLES_DIR
 
 if TYPE_CHECKING:
-    from studio.kinematics import Obstacle
     from studio.learning import DemonstrationPath, LiveProgress, RunRecord, RunRequest
 
 NAME = "train"
@@ -203,8 +208,6 @@ def _add_reach_arguments(parser: argparse.ArgumentParser) -> None:
 
 def _obstacle(text: str) -> Obstacle:
     """``--obstacle``'s value as a box, or argparse's one-line refusal."""
-    from studio.kinematics import Obstacle  # with coal and Pinocchio: only when one is given
-
     try:
         return Obstacle.parse(text)
     except KinematicsError as err:

@@ -9,10 +9,10 @@ from .. import _lazy
 
 if typing.TYPE_CHECKING:  # the public names, each loaded when first used (see studio/_lazy.py)
     from ._checks import KinematicsError as KinematicsError
+    from ._checks import Obstacle as Obstacle
+    from ._checks import check_obstacles as check_obstacles
     from ._clearance import OBSTACLE_TOUCH_M as OBSTACLE_TOUCH_M
-    from ._clearance import Obstacle as Obstacle
     from ._clearance import ObstacleGuard as ObstacleGuard
-    from ._clearance import check_obstacles as check_obstacles
     from ._fit import ArmFitter as ArmFitter
     from ._fit import FitConfig as FitConfig
     from ._hand_ik import HandIKConfig as HandIKConfig
