@@ -22,6 +22,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
+from urllib.parse import urlsplit
 
 import pytest
 
@@ -43,6 +44,8 @@ CHROMIUM_FLAGS = [
     "--enable-unsafe-swiftshader",
 ]
 SERVER_START_TIMEOUT_S = 90.0
+LEFT_OUT_SCENE = "<!doctype html><title>3D scene left out of this test</title>"
+"""What a page whose test does not look at the 3D scene gets in its place (:func:`leave_out_scene`)."""
 
 
 class Studio:
@@ -166,13 +169,39 @@ def page(browser: Any, studio_server: Studio) -> Iterator[Any]:
         context.close()
 
 
+def leave_out_scene(context: Any, studio: Studio) -> None:
+    """Serve :data:`LEFT_OUT_SCENE` for the 3D scene's page and files in ``context`` (its
+    instance check still reaches the studio). Here WebGL is drawn in software: a live scene
+    costs the browser most of a core while the simulator streams, which a test that does not
+    look at the scene only takes from the tests beside it."""
+    scene_port = urlsplit(studio.get("/api/config")["viser_url"]).port
+
+    def is_scene(url: str) -> bool:
+        parts = urlsplit(url)
+        return parts.port == scene_port and parts.path != "/studio-instance"
+
+    context.route(
+        is_scene,
+        lambda route: route.fulfill(status=200, content_type="text/html", body=LEFT_OUT_SCENE),
+    )
+
+
 @contextmanager
 def own_page(
-    browser: Any, studio: Studio, width: int = 1440, height: int = 900, **options: Any
+    browser: Any,
+    studio: Studio,
+    width: int = 1440,
+    height: int = 900,
+    *,
+    scene: bool = False,
+    **options: Any,
 ) -> Iterator[Any]:
     """A page of its own on the studio, ready, at ``width`` x ``height``; ``page.errors`` holds
-    its script errors. Its browser context is closed afterwards."""
+    its script errors. Its 3D scene is left out (:func:`leave_out_scene`) unless ``scene``. Its
+    browser context is closed afterwards."""
     context = browser.new_context(viewport={"width": width, "height": height}, **options)
+    if not scene:
+        leave_out_scene(context, studio)
     page = context.new_page()
     errors: list[str] = []
     page.on("pageerror", lambda e: errors.append(str(e)))

@@ -41,7 +41,7 @@ from tests.e2e.camera_clips import (
     image_elbow_deg,
     mannequin_q,
 )
-from tests.e2e.conftest import CHROMIUM, CHROMIUM_FLAGS, Studio, shot
+from tests.e2e.conftest import CHROMIUM, CHROMIUM_FLAGS, Studio, leave_out_scene, shot
 from tests.page_hooks import hook
 
 pytestmark = pytest.mark.e2e
@@ -81,7 +81,6 @@ CLIP_FIRST = {
 """The stamp of each clip's first frame: the clips' stamps do not overlap."""
 CLIP_FRAMES = {"figure": FIGURE_FRAMES, "mannequin": MANNEQUIN_FRAMES}
 """Frames of the clips whose length the tests set (the others keep their makers' length)."""
-LEFT_OUT_SCENE = "<!doctype html><title>3D scene left out of the camera tests</title>"
 
 
 @pytest.fixture(scope="module")
@@ -159,16 +158,7 @@ def open_studio(chromium: Any, studio: Studio, init_script: str | None = None) -
     """The studio, ready, in a new context of ``chromium``, its 3D scene left out, collecting
     every answered frame (``COLLECT_FRAMES_JS``) and every request."""
     context = chromium.new_context(viewport={"width": 1440, "height": 900})
-    scene_port = urlsplit(studio.get("/api/config")["viser_url"]).port
-
-    def is_scene(url: str) -> bool:  # the scene's page and files; not its instance check
-        parts = urlsplit(url)
-        return parts.port == scene_port and parts.path != "/studio-instance"
-
-    context.route(
-        is_scene,
-        lambda route: route.fulfill(status=200, content_type="text/html", body=LEFT_OUT_SCENE),
-    )
+    leave_out_scene(context, studio)
     if init_script:
         context.add_init_script(init_script)
     page = context.new_page()

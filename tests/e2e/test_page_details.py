@@ -13,7 +13,7 @@ from typing import Any
 
 import pytest
 
-from tests.e2e.conftest import Studio, shot
+from tests.e2e.conftest import Studio, own_page, shot
 from tests.web.conftest import wait_for
 
 pytestmark = pytest.mark.e2e
@@ -28,18 +28,12 @@ LONG_NAME = "a-run-name-long-enough-to-be-cut-in-the-list"
 
 @pytest.fixture
 def fresh_page(browser: Any, studio_server: Studio) -> Iterator[Any]:
-    """A page of its own on the studio; the source is the simulator again afterwards."""
-    context = browser.new_context(viewport={"width": 1440, "height": 900})
-    page = context.new_page()
-    errors: list[str] = []
-    page.on("pageerror", lambda e: errors.append(str(e)))
+    """A page of its own on the studio (its 3D scene left out); the source is the simulator
+    again afterwards."""
     try:
-        page.goto(studio_server.base + "/")
-        page.wait_for_selector("body[data-ready='1']", timeout=READY_TIMEOUT_MS)
-        page.errors = errors
-        yield page
+        with own_page(browser, studio_server) as page:
+            yield page
     finally:
-        context.close()
         studio_server.send("PUT", "/api/source", {"kind": "simulator"})  # as the stories expect
 
 
@@ -144,19 +138,21 @@ SCENE_COVERED = """() => {
 }"""
 
 
-def test_viser_covers_nothing_of_the_scene(fresh_page: Any, studio_server: Studio) -> None:
-    page = fresh_page
-    page.wait_for_function("() => document.querySelector('#scene').src !== ''")
-    scene = page.frame_locator("#scene")
-    scene.locator("canvas").first.wait_for(state="visible", timeout=60_000)
-    frame = page.locator("#scene").element_handle().content_frame()
-    # The scene has loaded once its websocket is connected (viser then sends the scene).
-    assert wait_for(lambda: frame.evaluate("() => !!document.querySelector('canvas')"), T)
-    toast = scene.get_by_text("Software WebGL rendering detected")
-    assert wait_for(lambda: toast.count() == 0 or not toast.first.is_visible(), T)
-    assert wait_for(lambda: frame.evaluate(SCENE_COVERED) == [], T), frame.evaluate(SCENE_COVERED)
-    assert not scene.get_by_role("button", name="Reset view").is_visible()  # folded in the rail
-    shot(page, "13-scene-uncovered")
+def test_viser_covers_nothing_of_the_scene(browser: Any, studio_server: Studio) -> None:
+    with own_page(browser, studio_server, scene=True) as page:
+        page.wait_for_function("() => document.querySelector('#scene').src !== ''")
+        scene = page.frame_locator("#scene")
+        scene.locator("canvas").first.wait_for(state="visible", timeout=60_000)
+        frame = page.locator("#scene").element_handle().content_frame()
+        # The scene has loaded once its websocket is connected (viser then sends the scene).
+        assert wait_for(lambda: frame.evaluate("() => !!document.querySelector('canvas')"), T)
+        toast = scene.get_by_text("Software WebGL rendering detected")
+        assert wait_for(lambda: toast.count() == 0 or not toast.first.is_visible(), T)
+        assert wait_for(lambda: frame.evaluate(SCENE_COVERED) == [], T), frame.evaluate(
+            SCENE_COVERED
+        )
+        assert not scene.get_by_role("button", name="Reset view").is_visible()  # folded in the rail
+        shot(page, "13-scene-uncovered")
 
 
 def test_the_scene_and_the_chart_explain_their_marks(
@@ -263,15 +259,11 @@ def test_every_control_of_the_side_panel_fits_it(
             "/api/demonstrations",
             {"recording": "sample-reach-1", "t0": 0.2, "t1": 2.5, "name": long_name},
         )
-    context = browser.new_context(viewport={"width": size[0], "height": size[1]})
-    page = context.new_page()
     try:
-        page.goto(studio_server.base + "/")
-        page.wait_for_selector("body[data-ready='1']", timeout=READY_TIMEOUT_MS)
-        page.wait_for_selector(f"#watch-demo option[value*='{long_name}']", state="attached")
-        page.locator("#sec-watch").scroll_into_view_if_needed()
-        shot(page, f"side-panel-watch-{size[0]}x{size[1]}", "sec-watch")
-        assert page.evaluate(CUT_CONTROLS_JS) == []
+        with own_page(browser, studio_server, *size) as page:
+            page.wait_for_selector(f"#watch-demo option[value*='{long_name}']", state="attached")
+            page.locator("#sec-watch").scroll_into_view_if_needed()
+            shot(page, f"side-panel-watch-{size[0]}x{size[1]}", "sec-watch")
+            assert page.evaluate(CUT_CONTROLS_JS) == []
     finally:
-        context.close()
         studio_server.send("DELETE", f"/api/demonstrations/{long_name}")  # the others' lists

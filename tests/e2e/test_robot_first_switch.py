@@ -36,7 +36,7 @@ def test_q_robot_is_the_drawn_robots_and_the_source_goes_on_while_meshes_load(
     studio_server.send("PUT", "/api/source", {"kind": "simulator"})
     joints = load_robot(ROBOT, geometry=False).nq
     puma = load_robot("puma560", geometry=False).nq
-    with own_page(browser, studio_server) as page:
+    with own_page(browser, studio_server, scene=True) as page:
         try:
             page.evaluate(RECORD_JS, hook(page))
             page.get_by_role("combobox", name="Robot").select_option(ROBOT)

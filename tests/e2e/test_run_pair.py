@@ -10,7 +10,7 @@ from typing import Any
 
 import pytest
 
-from tests.e2e.conftest import ARTIFACTS, Studio, own_page
+from tests.e2e.conftest import ARTIFACTS, Studio, leave_out_scene, own_page
 from tests.page_hooks import hook
 from tests.web.conftest import wait_for
 
@@ -93,6 +93,7 @@ def test_a_run_that_finished_unseen_is_plotted_when_the_runs_list_reloads(
     assert wait_for(lambda: studio_server.get(f"/api/runs/{run['id']}")["status"] == "done", 180)
     context = browser.new_context(viewport={"width": 1280, "height": 720})
     try:
+        leave_out_scene(context, studio_server)
         context.route("**/api/events*", lambda route: route.abort())
         page = context.new_page()
         page.goto(studio_server.base + "/")
