@@ -19,15 +19,14 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import PurePosixPath
 from typing import TYPE_CHECKING, Literal
-from xml.sax.saxutils import quoteattr
 
 if TYPE_CHECKING:
     import numpy as np
     import pinocchio as pin
 
-# Pinocchio and numpy are imported where a pose is built, not with this module: the robot
-# registry reads the Puma560's ready pose and grid range here without loading them (`studio
-# train --help` lists the robots).
+# Pinocchio, numpy and the XML quoting (which loads urllib, http and email) are imported where a
+# pose or the URDF is built, not with this module: the robot registry reads the Puma560's ready
+# pose and grid range here without loading them (`studio train --help` lists the robots).
 
 PUMA_READY_DEG = (0.0, 45.0, -90.0, 0.0, 0.0, 0.0)
 """The Puma560's ``RobotSpec.ready``, the paper's goal: the paper shows its goal only as a picture
@@ -197,16 +196,23 @@ def _geometry(visual: LinkVisual) -> str:
     return f'<sphere radius="{_num(dims[0])}"/>'
 
 
+def _quoted(text: str) -> str:
+    """``text`` as a quoted XML attribute value."""
+    from xml.sax.saxutils import quoteattr
+
+    return quoteattr(text)
+
+
 def _shape(name: str, origin: str, geometry: str, rgb: Sequence[float]) -> list[str]:
     """A ``<visual>`` of ``geometry`` in ``rgb`` and its ``<collision>`` twin."""
     rgba = " ".join(_num(v) for v in (*rgb, 1.0))
     return [
-        f"    <visual name={quoteattr(name)}>",
+        f"    <visual name={_quoted(name)}>",
         f"      {origin}",
         f"      <geometry>{geometry}</geometry>",
-        f'      <material name={quoteattr(name + "_colour")}><color rgba="{rgba}"/></material>',
+        f'      <material name={_quoted(name + "_colour")}><color rgba="{rgba}"/></material>',
         "    </visual>",
-        f"    <collision name={quoteattr(name)}>",
+        f"    <collision name={_quoted(name)}>",
         f"      {origin}",
         f"      <geometry>{geometry}</geometry>",
         "    </collision>",
@@ -225,7 +231,7 @@ def _link(
         origin = _origin(linkMjoint @ visual.offset)
         lines += _shape(visual.name, origin, _geometry(visual), visual.rgb)
     for mesh in meshes:
-        geometry = f"<mesh filename={quoteattr(mesh.filename)}/>"
+        geometry = f"<mesh filename={_quoted(mesh.filename)}/>"
         lines += _shape(f"{name}_mesh", _origin(linkMjoint), geometry, mesh.rgb)
     return [*lines, "  </link>"]
 
