@@ -271,7 +271,7 @@ def _print_likeness(args: argparse.Namespace, path: Path, policy: AnyPolicy) -> 
 def _motion(args: argparse.Namespace, source: Path, robot: str) -> tuple[Motion, str]:
     """The source's motion on ``robot``, and a phrase saying what it is."""
     from studio.export import check_policy_robot, source_kind
-    from studio.learning import load_any_policy
+    from studio.learning import load_any_policy, policy_obstacles
     from studio.motion import Motion, demonstration_motion, recording_motion
 
     kind = source_kind(source)
@@ -287,7 +287,11 @@ def _motion(args: argparse.Namespace, source: Path, robot: str) -> tuple[Motion,
     arm = check_policy_robot(source, policy.robot, robot)
     rollout, summary = _rollout(args, policy, args.seconds_per_step, arm)
     timed = args.seconds_per_step is not None
-    return Motion("policy", source.name, arm, rollout.times, rollout.q, timed, args.rate), summary
+    boxes = policy_obstacles(policy)  # its task's: the export is checked against them
+    motion = Motion(
+        "policy", source.name, arm, rollout.times, rollout.q, timed, args.rate, obstacles=boxes
+    )
+    return motion, summary
 
 
 def _say_loading(robot: str, cache: Path) -> None:

@@ -4,7 +4,9 @@
 (:func:`studio.export.read_trajectory`), replays it in physics (:func:`studio.export.simulate_trajectory`:
 the robot's URDF in MuJoCo, its motors' force limits, gravity, the table it stands on) and reports
 whether the motion completed, the largest joint and tool tracking errors, the samples where a motor
-saturates and every contact. ``--json`` prints one JSON object with exactly the keys
+saturates and every contact: with the table, between links, and with each ``--obstacle``
+box (``CX,CY,CZ,SX,SY,SZ``, repeatable, as ``studio train`` takes it; a contact of ``kind``
+``"obstacle"`` naming ``obstacle_1``, ...). ``--json`` prints one JSON object with exactly the keys
 ``completed``, ``max_joint_error_rad``, ``max_tool_error_m``, ``saturated_samples`` and
 ``contacts``. The exit status is 0 once the motion is simulated, whatever the report says, and 2
 for a bad input (a missing or malformed file, a robot it was not exported for).
@@ -15,6 +17,8 @@ from __future__ import annotations
 import argparse
 import json
 from pathlib import Path
+
+from ._options import add_obstacle_option
 
 NAME = "simulate"
 HELP = "Replay an exported CSV or MCAP trajectory in MuJoCo physics and report tracking, saturation and contacts."
@@ -30,6 +34,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--json", action="store_true", help="print one JSON object instead of sentences"
     )
+    add_obstacle_option(parser, "in the robot's workspace, reported when the arm touches it")
     parser.add_argument(
         "--data-dir",
         type=Path,
@@ -53,6 +58,7 @@ def run(args: argparse.Namespace) -> int:
         trajectory.q,
         names=trajectory.names,
         cache=physics_cache_dir(args.data_dir),
+        obstacles=tuple(args.obstacle or ()),
     )
     if args.json:
         print(json.dumps(report.as_json()))

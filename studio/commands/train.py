@@ -17,7 +17,7 @@ is a run's ``config.json`` (to repeat a run) or looks like::
      "demonstrations": [[12, 133, ...], ...]}
 
 Boxes no move may touch come from ``--obstacle CX,CY,CZ,SX,SY,SZ`` (centre and full sizes in
-metres, in the robot's base frame; repeatable), for the grid task; the continuous task refuses them.
+metres, in the robot's base frame; repeatable), for either task.
 
 Demonstrations may also come from ``--demos FILE.json`` (repeatable: each adds its demonstrations): a JSON list of state lists, an object with
 a ``"demonstrations"`` list, or a cut ``*.demo.json``, whose grid path is computed from its joint
@@ -39,13 +39,7 @@ from typing import TYPE_CHECKING, cast
 # flag answer at once.
 from studio import StudioError, read_json
 from studio._layout import RECORDINGS_DIR
-from studio.kinematics import (
-    DEFAULT_ROBOT,
-    KinematicsError,
-    Obstacle,
-    robot_names,
-    robot_spec,
-)
+from studio.kinematics import DEFAULT_ROBOT, robot_names, robot_spec
 from studio.learning import (
     ACTION_SETS,
     CLONING_KIND,
@@ -67,6 +61,8 @@ from studio.samples import SAMPLES_DIR
 
 if TYPE_CHECKING:
     from studio.learning import DemonstrationPath, LiveProgress, RunRecord, RunRequest
+
+from ._options import add_obstacle_option
 
 NAME = "train"
 HELP = "Train Dyna-Q on the arm grid or the arm's continuous joints: a run folder with curves and a policy out."
@@ -144,14 +140,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="a cut demonstration (a *.demo.json file, or the name of one in recordings/ or of a "
         "shipped sample such as sample-reach-2), or a JSON file of grid state lists; repeatable",
     )
-    parser.add_argument(
-        "--obstacle",
-        type=_obstacle,
-        action="append",
-        metavar="CX,CY,CZ,SX,SY,SZ",
-        help="a box no move may touch, centre and full sizes in metres in the robot's base frame "
-        "(e.g. 0.56,0.18,1.08,0.12,0.12,0.12); repeatable; the grid task only",
-    )
+    add_obstacle_option(parser, "no move may touch")
     parser.add_argument("--generated-demos", type=int, help="replay N generated demonstrations")
     parser.add_argument("--workers", type=int, default=None, help="threads (default: all cores)")
     parser.add_argument("--no-progress", action="store_true", help="hide the progress bar")
@@ -204,14 +193,6 @@ def _add_reach_arguments(parser: argparse.ArgumentParser) -> None:
         f"(the --demos followed at every step) or {CLONING_KIND} (behaviour cloning: the nearest "
         f"demonstrated state's move) (default: {OWN_LEARNER})",
     )
-
-
-def _obstacle(text: str) -> Obstacle:
-    """``--obstacle``'s value as a box, or argparse's one-line refusal."""
-    try:
-        return Obstacle.parse(text)
-    except KinematicsError as err:
-        raise argparse.ArgumentTypeError(str(err).rstrip(".")) from None
 
 
 def _read_json(path: Path, what: str) -> object:

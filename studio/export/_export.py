@@ -153,7 +153,9 @@ def _physics(
 ) -> tuple[SimulationReport | None, list[str]]:
     """The samples replayed in MuJoCo, and the report's lines for the file."""
     try:
-        report = simulate_trajectory(motion.robot, times, q, cache=cache)
+        report = simulate_trajectory(
+            motion.robot, times, q, cache=cache, obstacles=motion.obstacles
+        )
     except (PhysicsError, ExportError) as err:
         return None, [f"physics: not simulated ({err})"]
     return report, report.sentences()
@@ -217,7 +219,9 @@ def export_motion(
         motion = replace(motion, notes=(*motion.notes, _pace_note(samples.paced)))
     # a recording at its capture times is what the arm did (joint states); timed, a trajectory
     as_captured = motion.kind == "recording" and timed_by == "source"
-    findings = check_trajectory(robot, times, q, extra=list(motion.findings))
+    findings = check_trajectory(
+        robot, times, q, extra=list(motion.findings), obstacles=motion.obstacles
+    )
     if not unchecked:
         refuse(findings, f"{motion.kind} {motion.name}", robot, own_times=as_captured)
     notes = _notes(motion, findings, checked=not unchecked)

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from studio.kinematics import TABLE, RobotArm
+from studio.kinematics import OBSTACLE_TOUCH_M, TABLE, Obstacle, ObstacleGuard, RobotArm
 from studio.motion import Finding
 
 from ._errors import SafetyError
@@ -141,6 +141,28 @@ def collision_findings(
     return list(found.values())
 
 
+def obstacle_findings(
+    robot: RobotArm, times: np.ndarray, q: np.ndarray, obstacles: tuple[Obstacle, ...]
+) -> list[Finding]:
+    """The first sample by which the arm touches one of ``obstacles`` (boxes in its base frame),
+    checked along the straight moves between the samples, not only at them
+    (:class:`~studio.kinematics.ObstacleGuard`)."""
+    if not obstacles or not robot.checks_collisions:
+        return []
+    guard = ObstacleGuard(robot, obstacles)
+    for i in range(len(q)):
+        if not guard.path_collides(q[max(i - 1, 0) : i + 1]):
+            continue
+        hits = guard.contacts(q[i], OBSTACLE_TOUCH_M) or guard.contacts(q[max(i - 1, 0)], 1.0)
+        link, box = (hits[0].link_a, hits[0].link_b) if hits else ("arm", "obstacle")
+        sentence = (
+            f"sample {i} (t = {times[i]:.3f} s): link {link} touches {box.replace('_', ' ')} "
+            "of the policy's task on its way there"
+        )
+        return [Finding(i, float(times[i]), "collision", f"{link}/{box}", sentence)]
+    return []
+
+
 def check_trajectory(
     robot: RobotArm,
     times: np.ndarray,
@@ -148,6 +170,7 @@ def check_trajectory(
     *,
     margin: float = COLLISION_MARGIN_M,
     extra: list[Finding] | None = None,
+    obstacles: tuple[Obstacle, ...] = (),
 ) -> list[Finding]:
     """Every safety finding of ``q`` (N, nq) at ``times`` (N,), sorted by time.
 
@@ -157,9 +180,11 @@ def check_trajectory(
         q: joint angles (rad), one row per sample, in ``robot.joint_names`` order.
         margin: the self-collision margin (m).
         extra: findings made earlier (targets out of reach while retargeting).
+        obstacles: boxes the trajectory must not touch, along it (a policy's task's).
     """
     findings = [*(extra or []), *limit_findings(robot, times, q)]
     findings += collision_findings(robot, times, q, margin)
+    findings += obstacle_findings(robot, times, q, tuple(obstacles))
     return sorted(findings, key=lambda f: (f.sample, f.what))
 
 

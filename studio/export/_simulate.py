@@ -16,13 +16,13 @@ from pathlib import Path
 
 import numpy as np
 
-from studio.kinematics import RobotArm, load_robot
+from studio.kinematics import Obstacle, RobotArm, load_robot
 from studio.physics import PhysicsModel, SimulationReport, build_model, mujoco_urdf, simulate
 
 from ._errors import ExportError
 from ._urdf import export_urdf
 
-_models: dict[str, PhysicsModel] = {}
+_models: dict[tuple[str, tuple[Obstacle, ...]], PhysicsModel] = {}
 _lock = threading.Lock()
 _scratch: list[Path] = []
 
@@ -47,8 +47,11 @@ def _folder(arm: RobotArm, cache: Path | None) -> Path:
     return folder
 
 
-def physics_model(robot: RobotArm | str, cache: Path | None = None) -> PhysicsModel:
-    """The robot's MuJoCo model (built once per process; its files kept in ``cache``).
+def physics_model(
+    robot: RobotArm | str, cache: Path | None = None, obstacles: tuple[Obstacle, ...] = ()
+) -> PhysicsModel:
+    """The robot's MuJoCo model with ``obstacles`` (built once per process and set of boxes;
+    its files kept in ``cache``).
 
     Raises:
         ExportError: the URDF folder cannot be written.
@@ -57,11 +60,13 @@ def physics_model(robot: RobotArm | str, cache: Path | None = None) -> PhysicsMo
     # always the model with its collision geometry: the contacts are the studio's pairs
     arm = load_robot(robot if isinstance(robot, str) else robot.name)
     with _lock:
-        model = _models.get(arm.name)
+        key = (arm.name, tuple(obstacles))
+        model = _models.get(key)
         if model is None:
             folder = _folder(arm, cache)
-            model = build_model(arm, mujoco_urdf(folder / f"{arm.name}.urdf", folder / "converted"))
-            _models[arm.name] = model
+            urdf = mujoco_urdf(folder / f"{arm.name}.urdf", folder / "converted")
+            model = build_model(arm, urdf, tuple(obstacles))
+            _models[key] = model
     return model
 
 
@@ -72,6 +77,7 @@ def simulate_trajectory(
     *,
     names: tuple[str, ...] | None = None,
     cache: Path | None = None,
+    obstacles: tuple[Obstacle, ...] = (),
 ) -> SimulationReport:
     """Replay ``q`` at ``times`` in MuJoCo on ``robot`` (:func:`studio.physics.simulate`).
 
@@ -82,6 +88,8 @@ def simulate_trajectory(
         names: the joint names the trajectory gives, checked against the robot's (``q1`` ..
             ``qN``, a policy rollout's columns, stand for its joints in order).
         cache: the folder the robot's MuJoCo files are kept in (None: a temporary one).
+        obstacles: boxes in the robot's base frame, added as fixed geoms: contacts with them are
+            reported (``kind`` ``"obstacle"``).
 
     Raises:
         ExportError: ``names`` are not the robot's joints.
@@ -96,4 +104,4 @@ def simulate_trajectory(
             f"The trajectory's joints ({', '.join(names)}) are not the {light.spec.title}'s "
             f"({', '.join(light.joint_names)}); give the --robot it was exported for."
         )
-    return simulate(physics_model(robot, cache), times, q)
+    return simulate(physics_model(robot, cache, tuple(obstacles)), times, q)

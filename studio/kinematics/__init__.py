@@ -13,6 +13,7 @@ if typing.TYPE_CHECKING:  # the public names, each loaded when first used (see s
     from ._checks import check_obstacles as check_obstacles
     from ._clearance import OBSTACLE_TOUCH_M as OBSTACLE_TOUCH_M
     from ._clearance import ObstacleGuard as ObstacleGuard
+    from ._clearance import sphere_cover as sphere_cover
     from ._fit import ArmFitter as ArmFitter
     from ._fit import FitConfig as FitConfig
     from ._hand_ik import HandIKConfig as HandIKConfig

@@ -31,6 +31,7 @@ from studio.capture import (
 )
 from studio.kinematics import (
     KinematicsError,
+    Obstacle,
     RetargetConfig,
     RetargetedPath,
     RobotArm,
@@ -86,6 +87,8 @@ class Motion:
             motion retargeted from a human arm; None for a stored or rolled-out joint path.
         started: when the first sample happened, seconds since the Unix epoch (a recording's
             capture); None: the export's own time stamps the file.
+        obstacles: boxes in the robot's base frame the motion must not touch (a policy's task's),
+            checked along the motion before it is written.
     """
 
     kind: SourceKind
@@ -99,6 +102,7 @@ class Motion:
     notes: tuple[str, ...] = field(default=())
     path: RetargetedPath | None = None
     started: float | None = None
+    obstacles: tuple[Obstacle, ...] = field(default=())
 
     def retimed(self, rate_hz: float) -> Motion:
         """This motion as a path that :func:`time_path` times within the robot's limits and

@@ -16,18 +16,21 @@ what a URDF does not say but a real arm has:
   :meth:`RobotArm.table_contacts` models it (the links the first joint turns about the vertical
   stand on it and never touch it; the others can be driven into it);
 - **the same self-collision pairs as the studio's checks** (:meth:`RobotArm.self_collisions`):
-  link pairs the studio leaves out (adjacent links, the SRDF's disabled pairs) are excluded.
+  link pairs the studio leaves out (adjacent links, the SRDF's disabled pairs) are excluded;
+- **the task's obstacles** when given (:class:`~studio.kinematics.Obstacle`): fixed boxes in the
+  base frame, named ``obstacle_1``, ``obstacle_2``, ... as the studio's own check names them,
+  which every link a joint moves can touch.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 import numpy as np
 
-from studio.kinematics import TABLE, RobotArm
+from studio.kinematics import TABLE, Obstacle, RobotArm
 
 from ._errors import PhysicsError
 
@@ -61,6 +64,8 @@ _ROBOT_CONTACT = 1
 """The contact bit every link's geometry has: link against link."""
 _TABLE_CONTACT = 2
 """The contact bit of the table and of the links that can be driven into it."""
+_OBSTACLE_CONTACT = 4
+"""The contact bit of the obstacles and of every link a joint moves."""
 
 
 @dataclass(frozen=True)
@@ -77,6 +82,7 @@ class PhysicsModel:
         tool: the body whose pose is the tool's (:attr:`RobotSpec.tool`).
         table: the table's geom id.
         links: each body's name (the URDF's link names), by body id.
+        obstacles: each obstacle's geom id, by its name (``obstacle_1``, ...).
     """
 
     arm: RobotArm
@@ -89,6 +95,7 @@ class PhysicsModel:
     tool: int
     table: int
     links: tuple[str, ...]
+    obstacles: dict[int, str] = field(default_factory=dict)
 
     def tool_poses(self, q: np.ndarray) -> np.ndarray:
         """The tool's pose (4x4, base frame) at each row of ``q``, from MuJoCo's kinematics."""
@@ -147,11 +154,12 @@ def _collision_links(arm: RobotArm) -> tuple[set[frozenset[str]], set[str]]:
     return pairs, table
 
 
-def _set_contacts(spec: mujoco.MjSpec, arm: RobotArm) -> None:
-    """The table plane, and contact bits and exclusions so that MuJoCo collides exactly the
-    pairs the studio checks."""
+def _set_contacts(spec: mujoco.MjSpec, arm: RobotArm, obstacles: tuple[Obstacle, ...]) -> None:
+    """The table plane, the obstacles, and contact bits and exclusions so that MuJoCo collides
+    exactly the pairs the studio checks."""
     import mujoco
 
+    frames = arm.model.frames
     pairs, on_table = _collision_links(arm)
     with_geoms = []
     for body in spec.bodies:
@@ -173,11 +181,35 @@ def _set_contacts(spec: mujoco.MjSpec, arm: RobotArm) -> None:
         contype=_TABLE_CONTACT,
         conaffinity=0,
     )
+    moving = (
+        {
+            frames[obj.parentFrame].name
+            for obj in arm.collision_model.geometryObjects
+            if obj.parentJoint >= 1
+        }
+        if obstacles
+        else set()
+    )
+    for body in spec.bodies:
+        if body.name in moving:
+            for g in body.geoms:
+                g.conaffinity |= _OBSTACLE_CONTACT
+    for i, box in enumerate(obstacles):
+        spec.worldbody.add_geom(
+            name=f"obstacle_{i + 1}",
+            type=mujoco.mjtGeom.mjGEOM_BOX,
+            pos=list(box.centre),
+            size=[0.5 * side for side in box.size],
+            contype=_OBSTACLE_CONTACT,
+            conaffinity=0,
+        )
 
 
-def build_model(arm: RobotArm, urdf_text: str) -> PhysicsModel:
-    """Compile ``urdf_text`` (:func:`~._mjcf.mujoco_urdf`'s) for ``arm``, with servos, gravity
-    and the table (see the module docstring).
+def build_model(
+    arm: RobotArm, urdf_text: str, obstacles: tuple[Obstacle, ...] = ()
+) -> PhysicsModel:
+    """Compile ``urdf_text`` (:func:`~._mjcf.mujoco_urdf`'s) for ``arm``, with servos, gravity,
+    the table and ``obstacles`` (see the module docstring).
 
     Raises:
         PhysicsError: MuJoCo cannot compile it, or it lacks a joint or the tool of ``arm``.
@@ -224,7 +256,7 @@ def build_model(arm: RobotArm, urdf_text: str) -> PhysicsModel:
         )
         actuator.set_to_motor()
         actuator.ctrllimited = mujoco.mjtLimited.mjLIMITED_FALSE
-    _set_contacts(spec, arm)
+    _set_contacts(spec, arm, tuple(obstacles))
     try:
         model = spec.compile()
     except ValueError as err:
@@ -256,6 +288,7 @@ def build_model(arm: RobotArm, urdf_text: str) -> PhysicsModel:
         links.index(arm.spec.tool),
         model.geom(TABLE).id,
         links,
+        {model.geom(f"obstacle_{i + 1}").id: f"obstacle_{i + 1}" for i in range(len(obstacles))},
     )
 
 

@@ -150,6 +150,9 @@ def simulate(model: PhysicsModel, times: object, q: object) -> SimulationReport:
 
 
 def _pair(model: PhysicsModel, g1: int, g2: int) -> tuple[str, str]:
+    for box, other in ((g1, g2), (g2, g1)):
+        if box in model.obstacles:
+            return model.links[model.model.geom_bodyid[other]], model.obstacles[box]
     if g1 == model.table or g2 == model.table:
         other = g2 if g1 == model.table else g1
         return model.links[model.model.geom_bodyid[other]], TABLE

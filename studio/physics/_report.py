@@ -13,6 +13,9 @@ import numpy as np
 
 from studio.kinematics import TABLE
 
+OBSTACLE_PREFIX = "obstacle_"
+"""How a contact names an obstacle box: ``obstacle_1``, ``obstacle_2``, ..."""
+
 JSON_KEYS = (
     "completed",
     "max_joint_error_rad",
@@ -28,7 +31,8 @@ class Contact:
     """Two links, or a link and the table, that touched during the replay.
 
     Attributes:
-        link_a, link_b: the links (``link_b`` is ``"table"`` for the table the robot stands on).
+        link_a, link_b: the links (``link_b`` is ``"table"`` for the table the robot stands on,
+            ``obstacle_<i>`` for the i-th obstacle box).
         first_sample: the first trajectory sample at which they touched (0-based).
         first_time_s: that sample's time (s).
         samples: how many samples they touched at.
@@ -44,8 +48,10 @@ class Contact:
 
     @property
     def kind(self) -> str:
-        """``"table"`` or ``"self"``."""
-        return "table" if self.link_b == TABLE else "self"
+        """``"table"``, ``"obstacle"`` (``link_b`` names it: ``obstacle_1``, ...) or ``"self"``."""
+        if self.link_b == TABLE:
+            return "table"
+        return "obstacle" if self.link_b.startswith(OBSTACLE_PREFIX) else "self"
 
     def as_json(self) -> dict[str, object]:
         return {
@@ -59,7 +65,9 @@ class Contact:
         }
 
     def sentence(self) -> str:
-        what = "the table" if self.kind == "table" else f"link {self.link_b}"
+        what = {"table": "the table", "obstacle": self.link_b.replace("_", " ")}.get(
+            self.kind, f"link {self.link_b}"
+        )
         return (
             f"link {self.link_a} touched {what} at {self.samples} sample(s) from sample "
             f"{self.first_sample} (t = {self.first_time_s:.3f} s), up to "

@@ -434,6 +434,19 @@ class MarkPublic(BaseModel):
 # ----------------------------------------------------------------------------- runs
 
 
+class ObstacleBody(_Body):
+    """A box in the robot's base frame (m): its centre and full sizes, as runs store it."""
+
+    centre: list[float] = Field(..., min_length=3, max_length=3)
+    size: list[float] = Field(..., min_length=3, max_length=3)
+
+
+class ObstaclesPublic(_Body):
+    """The boxes placed in the scene for the next run, where their handles stand."""
+
+    obstacles: list[ObstacleBody] = Field(default_factory=list, max_length=16)
+
+
 class _RunCreateBase(_Body):
     """What every training run sets. Every default is the learning package's (``DynaQConfig``,
     ``ArmGrid``, the run defaults), which also checks every value and reports all bad fields at
@@ -460,6 +473,8 @@ class _RunCreateBase(_Body):
     """What trains the run: left out (or ``"dyna-q"``), the task's own Dyna-Q; ``"teacher"`` (the
     demonstrations followed at every step) or ``"cloning"`` (behaviour cloning), baselines of the
     continuous task that learn nothing from reward (``studio train --learner``)."""
+    obstacles: list[ObstacleBody] = Field(default_factory=list, max_length=16)
+    """Boxes in the robot's base frame no move of the task may touch."""
 
     def request(self, robot: str, demonstrations: Sequence[DemonstrationPath] = ()) -> RunRequest:
         """The learning package's request of this run on ``robot`` (the one named here, or the
@@ -483,6 +498,7 @@ class _RunCreateBase(_Body):
             name=self.name or "",
             origin="page",
             learner=self.learner or "",
+            obstacles=[box.model_dump() for box in self.obstacles],
             **self._task_settings(),
         )
 

@@ -99,3 +99,25 @@ def test_a_policy_rollouts_q_columns_are_the_robots_joints_in_order(tmp_path, ca
     args = ["simulate", str(tmp_path / "rollout.csv"), "--robot", "puma560", "--json"]
     assert main([*args, "--data-dir", str(tmp_path)]) == 0
     assert json.loads(capsys.readouterr().out)["completed"] is True
+
+
+def test_an_obstacle_in_the_way_is_reported_as_a_contact(tmp_path, capsys, physics_cache):
+    """``studio simulate --obstacle``: the box is a MuJoCo geom, and the arm swinging through it
+    touches it; the same file without it reports no contact with a box."""
+    arm = load_robot("puma560")
+    reach = np.radians([0.0, 45.0, -90.0, 0.0, 0.0, 0.0])
+    start, end = reach.copy(), reach.copy()
+    start[0], end[0] = np.radians(-40), np.radians(40)
+    times, q = smooth_move(start, end, 2.0)
+    write_csv(tmp_path / "swing.csv", arm.joint_names, times, q, [])
+    x, y, z = arm.forward(reach)[:3, 3]
+    argv = ["simulate", str(tmp_path / "swing.csv"), "--robot", "puma560", "--json"]
+    argv += ["--data-dir", str(physics_cache)]
+    assert main([*argv, f"--obstacle={x},{y},{z},0.05,0.05,0.05"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert list(report) == list(JSON_KEYS)
+    boxes = [c for c in report["contacts"] if c["kind"] == "obstacle"]
+    assert boxes and boxes[0]["link_b"] == "obstacle_1"
+    assert main(argv) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert not [c for c in report["contacts"] if c["kind"] == "obstacle"]

@@ -25,6 +25,7 @@ REACH = np.radians([0.0, 45.0, -90.0, 0.0, 0.0, 0.0])
 
 
 def _swing(degrees: float) -> np.ndarray:
+    """The goal pose turned by joint 1 to ``degrees``."""
     q = REACH.copy()
     q[0] = np.radians(degrees)
     return q
@@ -148,20 +149,120 @@ def test_evaluate_counts_a_rollout_through_a_box_as_a_collision(arm, in_the_way)
     assert _collides_with((in_the_way,))("puma560", clear)
 
 
-def test_the_continuous_task_refuses_obstacles_rather_than_ignore_them(tmp_path, capsys):
-    """The continuous task has no obstacles yet: a box given to it is refused in one sentence
-    naming the grid task, by the request (the page, the API) and by the command line, and no run
-    folder is written (it trained as if no box stood there)."""
-    box = Obstacle((0.5, 0.0, 0.5), (0.1, 0.1, 0.1))
-    request = RunRequest(task="arm-reach", obstacles=[box.to_dict()], experiments=1, episodes=1)
-    with pytest.raises(ConfigError) as refused:
-        resolve_run(request)
-    assert "arm-grid" in refused.value.by_field["obstacles"]
-    out = tmp_path / "run"
-    code = main(
-        ["train", "--task", "arm-reach", "--obstacle=0.5,0,0.5,0.1,0.1,0.1", f"--out={out}"]
+def test_the_continuous_task_takes_a_box_and_a_rollout_into_it_is_a_collision(
+    tmp_path, in_the_way
+):
+    """The continuous task takes boxes as the grid does, from the request (the page, the API)
+    and from the command line: its run and its policy keep them (none is dropped), and
+    ``studio evaluate`` counts a rollout of that policy's task through the box as a collision."""
+    from studio.commands.evaluate import _collides_with
+
+    away = "120,45,-90"  # the goal turned away from the box in the tool's way at joint 1 = 0
+    request = RunRequest(
+        task="arm-reach",
+        obstacles=[in_the_way.to_dict()],
+        goal_deg=[float(v) for v in away.split(",")],
+        experiments=1,
+        episodes=1,
     )
-    assert code == 2
-    err = capsys.readouterr().err
-    assert "does not take obstacles" in err and err.count("\n") == 1
-    assert not out.exists()
+    assert resolve_run(request).arm_reach().obstacles == (in_the_way,)
+    box = ",".join(f"{v!r}" for v in (*in_the_way.centre, *in_the_way.size))
+    out = tmp_path / "run"
+    argv = ["train", "--task", "arm-reach", f"--obstacle={box}", f"--goal-deg={away}"]
+    argv += ["--episodes", "1", "--experiments", "1", "--no-progress", f"--out={out}"]
+    assert main(argv) == 0
+    stored = json.loads((out / "config.json").read_text())
+    assert stored["task"]["obstacles"] == [in_the_way.to_dict()]
+    kept = policy_obstacles(load_any_policy(out / "policy.policy.npz"))
+    assert kept == (in_the_way,)
+    swing = np.array([_swing(d) for d in (-60.0, 60.0)])  # both ends clear, the box between
+    assert not _collides_with(())("puma560", swing)
+    assert _collides_with(kept)("puma560", swing)
+
+
+# ------------------------------------------------------------------ the continuous task
+
+AWAY = tuple(float(v) for v in _swing(120.0))
+"""A goal far from the box in the tool's way at joint 1 = 0."""
+
+
+@pytest.fixture(scope="module")
+def boxed_reach(in_the_way):
+    from studio.learning import ArmReach
+
+    return ArmReach(obstacles=(in_the_way,), goal=AWAY)
+
+
+def test_the_continuous_task_refuses_a_move_through_a_box_along_it(boxed_reach):
+    from studio.learning.tasks._obstacles import move_blocked
+
+    start, end = (np.ascontiguousarray(_swing(d)) for d in (-60, 60))
+    p = boxed_reach.params
+    assert not move_blocked(p, start, start) and not move_blocked(p, end, end)
+    assert move_blocked(p, start, end)  # neither end touches it; the swing between does
+
+
+def test_the_continuous_check_holds_every_pose_and_move_coal_finds_touching(
+    boxed_reach, arm, in_the_way
+):
+    """The compiled check (spheres holding the links) never lets through what coal's exact
+    geometry finds touching the box: random poses and random single steps."""
+    from studio.learning.tasks._obstacles import move_blocked
+    from studio.learning.tasks._reach import reach_step
+
+    guard = ObstacleGuard(arm, [in_the_way])
+    rng = np.random.default_rng(4)
+    p, touching, stayed = boxed_reach.params, 0, 0
+    for _ in range(400):
+        q = rng.uniform(boxed_reach.lower, boxed_reach.upper)
+        if guard.contacts(boxed_reach.full_q(q)):
+            touching += 1
+            assert move_blocked(p, q, q)
+        moved = q.copy()
+        reward, _ = reach_step(p, moved, int(rng.integers(boxed_reach.n_actions)))
+        if np.array_equal(moved, q):
+            stayed += 1
+            continue
+        assert not guard.move_collides(boxed_reach.full_q(q), boxed_reach.full_q(moved))
+    assert stayed > 0
+
+
+def test_a_step_into_a_box_leaves_the_arm_where_it_is_and_costs_the_step(in_the_way):
+    from studio.learning import ArmReach
+    from studio.learning.tasks._obstacles import move_blocked
+    from studio.learning.tasks._reach import reach_step
+
+    task = ArmReach(obstacles=(in_the_way,), shaping=0.0, goal=AWAY)
+    q = np.ascontiguousarray(_swing(-60))
+    for _ in range(200):  # joint 1 up, one step at a time, until the box stops it
+        before = q.copy()
+        reward, done = reach_step(task.params, q, 0)
+        if np.array_equal(q, before):
+            break
+    assert np.array_equal(q, before) and reward == -1.0 and not done
+    assert move_blocked(task.params, before, before + np.eye(6)[0] * task.step)
+    assert np.degrees(q[0]) < 0  # stopped before the tool's arc reaches the box
+
+
+def test_a_continuous_task_keeps_its_obstacles_in_its_settings(boxed_reach, in_the_way):
+    from studio.learning import ArmReach
+
+    stored = json.loads(json.dumps(boxed_reach.to_dict()))
+    assert stored["obstacles"] == [in_the_way.to_dict()]
+    assert ArmReach.from_dict(stored).obstacles == (in_the_way,)
+    assert "obstacles" not in ArmReach().to_dict()  # a task without boxes is stored as before
+
+
+def test_an_export_is_checked_along_it_against_the_obstacles(arm, in_the_way):
+    from studio.export import check_trajectory
+
+    swing = np.array([_swing(d) for d in np.linspace(-60, 60, 5)])
+    times = np.arange(len(swing), dtype=float)
+    assert not [f for f in check_trajectory(arm, times, swing) if "obstacle" in f.where]
+    found = [
+        f
+        for f in check_trajectory(arm, times, swing, obstacles=(in_the_way,))
+        if "obstacle" in f.where
+    ]
+    assert len(found) == 1 and "touches obstacle 1" in found[0].sentence
+    assert 0 < found[0].sample < len(swing)

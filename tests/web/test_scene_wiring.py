@@ -13,6 +13,16 @@ from tests.web.test_demonstrations import save_demo
 from tests.web.test_policies import policy_bytes, upload
 
 
+class _FakeObstacles:
+    """Records the boxes the studio asks the scene to draw (``StudioScene.obstacles``)."""
+
+    def __init__(self, calls: list) -> None:
+        self.calls = calls
+
+    def show_watched(self, boxes) -> None:
+        self.calls.append(("show_watched", (tuple(boxes),)))
+
+
 class FakeScene:
     """Records the calls the studio makes on ``StudioScene`` (same method names)."""
 
@@ -20,6 +30,7 @@ class FakeScene:
         self.calls: list[tuple[str, tuple]] = []
         self.playing = False
         self.q_robot = np.zeros(6)
+        self.obstacles = _FakeObstacles(self.calls)
 
     def update_live(self, q_human, q_robot, tape_positions=None) -> None:
         self.calls.append(("update_live", (q_human, q_robot)))

@@ -9,6 +9,9 @@ twin when an environment is one of these, unwrapped but for wrappers that change
 (:data:`_PASS_THROUGH_WRAPPERS`); any other environment runs as a Python loop. Start states come
 from ``env.reset`` in both paths (:func:`reset_states`, seeded per experiment by
 :func:`reset_seed`), so both give the same result bit for bit.
+
+The twins compile in the arm's dynamics (:mod:`..tasks._reach` and what it calls); numba's disk
+cache is keyed on this file alone, so after editing those, touch this file too.
 """
 
 from __future__ import annotations

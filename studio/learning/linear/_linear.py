@@ -45,10 +45,9 @@ priority heap and the run around the kernels from :mod:`._learner`), seeded per 
 ``(seed, experiment)``; the environment's resets by ``seed`` and the experiment index.
 
 Caching caveat: numba's disk cache of these kernels is keyed on this file alone, yet they compile
-in the dynamics of ``_reach.py`` and ``_linear_env.py``, the features of ``_tiles.py``, the
-demonstrations' potential of ``_demo_shaping.py`` and the helpers of ``_learner.py``; after
-editing one of those, touch this file (or delete ``__pycache__/_linear*.nb*``) so the kernels
-recompile.
+in the dynamics of ``tasks/`` (``_reach``, ``_follow``, ``_chain``, ``_obstacles``, their layout)
+and ``_env.py``, the features of ``_tiles.py``, the demonstrations' potential of
+``_demo_shaping.py`` and the helpers of ``_learner.py``; after editing one, touch this file.
 """
 
 from __future__ import annotations

@@ -11,6 +11,9 @@ the follow cost (:func:`follow_cost`, between 0 and :func:`cost_bound`), tiled o
 default shaping (a step there pays anything from -31 to +29): measured, 3 demonstrations then
 lowered greedy success from random starts by 14.8 points after 1,000 episodes; with the cost
 observed they do not lower it (package README).
+
+Its compiled functions read the parameter array by the offsets of :mod:`._reach_layout`, which
+numba bakes in: numba's disk cache is keyed on this file alone, so touch it when the layout moves.
 """
 
 from __future__ import annotations

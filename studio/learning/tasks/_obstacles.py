@@ -10,19 +10,26 @@ ends is refused too).
 
 On the grid every move is known beforehand, so the refused ones are found once per grid and
 written into its transition table (:func:`blocked_grid_moves`): learning runs as fast as without
-obstacles.
+obstacles. The continuous task's moves are checked as they are taken, inside the compiled
+kernel, which cannot call coal: against spheres that hold every link's collision geometry
+(:func:`studio.kinematics.sphere_cover`), swept along the move (:func:`move_blocked`), a
+superset of the robot, so what they let through is clear by coal too.
 """
 
 from __future__ import annotations
 
 import functools
+import math
 from typing import TYPE_CHECKING
 
 import numpy as np
+from numba import njit
 
 from studio.kinematics import KinematicsError
 
 from .._errors import ConfigError
+from ._chain import chain_frames
+from ._reach_layout import _BOX, _FRAMES_N, _N_BOXES, _N_SPHERES, _OBST, _SPHERE, _SWEEP
 
 if TYPE_CHECKING:
     from studio.kinematics import Obstacle, ObstacleGuard
@@ -127,3 +134,99 @@ def policy_obstacles(policy: object) -> tuple[Obstacle, ...]:
     for a policy whose task holds none)."""
     task = getattr(policy, "grid", None) or getattr(policy, "task", None)
     return tuple(getattr(task, "obstacles", ()))
+
+
+# ------------------------------------------------------------- the continuous task's compiled check
+
+
+@functools.lru_cache(maxsize=8)
+def _spheres(robot: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    from studio.kinematics import load_robot, sphere_cover
+
+    return sphere_cover(load_robot(robot))
+
+
+def obstacle_values(robot: str, obstacles: tuple[Obstacle, ...], frames: int) -> np.ndarray:
+    """The boxes, then the spheres holding ``robot``'s links (:func:`studio.kinematics.sphere_cover`),
+    as the continuous task's parameter array keeps them (:data:`._reach_layout._BOX`,
+    :data:`._reach_layout._SPHERE`); the spheres of joints beyond the first ``frames`` are left
+    out (the compiled chain does not reach them)."""
+    if not obstacles:
+        return np.zeros(0)
+    joint, centre, radius = _spheres(robot)
+    kept = joint <= frames
+    boxes = np.array([[*box.centre, *(0.5 * np.asarray(box.size))] for box in obstacles])
+    spheres = np.column_stack([joint[kept], centre[kept], radius[kept]])
+    return np.concatenate([boxes.reshape(-1), spheres.reshape(-1)])
+
+
+def sphere_count(robot: str, frames: int) -> int:
+    """How many spheres :func:`obstacle_values` keeps."""
+    return int(np.count_nonzero(_spheres(robot)[0] <= frames))
+
+
+def sweep_bound(robot: str, translations: np.ndarray) -> float:
+    """A bound on any sphere point's distance from any joint axis (m): the chain's link lengths
+    and the largest sphere's reach from its joint."""
+    joint, centre, radius = _spheres(robot)
+    reach = float(np.max(np.linalg.norm(centre, axis=1) + radius)) if len(radius) else 0.0
+    return float(np.linalg.norm(translations, axis=1).sum()) + reach
+
+
+@njit(nogil=True, cache=True)
+def _box_distance(params, box, x, y, z):
+    """Distance (m) from a point to box ``box`` (0 inside)."""
+    base = int(params[_OBST]) + _BOX * box
+    gx = max(abs(x - params[base]) - params[base + 3], 0.0)
+    gy = max(abs(y - params[base + 1]) - params[base + 4], 0.0)
+    gz = max(abs(z - params[base + 2]) - params[base + 5], 0.0)
+    return math.sqrt(gx * gx + gy * gy + gz * gz)
+
+
+@njit(nogil=True, cache=True)
+def move_blocked(params, start, end):
+    """Whether moving the learned joints from ``start`` to ``end`` (every joint at a constant
+    rate) would bring a sphere holding a link into a box.
+
+    Each sphere's centre moves from ``c0`` to ``c1``; its path stays within
+    ``sweep * (sum |dq|)**2 / 8`` of that chord (the sagitta of the turns, with ``sweep`` a
+    bound on its distance from every axis), so spheres along the chord no more than their radius
+    apart, each grown to cover the gaps between them and by that sagitta, hold every place the
+    sphere passes. A superset: a move this finds clear is clear.
+    """
+    boxes = int(params[_N_BOXES])
+    if boxes == 0:
+        return False
+    n = int(params[_FRAMES_N])
+    scratch = np.empty((4, 4))
+    rotation = np.empty(12)
+    before = np.empty((n, 4, 4))
+    after = np.empty((n, 4, 4))
+    chain_frames(params, start, scratch, rotation, before)
+    chain_frames(params, end, scratch, rotation, after)
+    turn = 0.0
+    for j in range(start.shape[0]):
+        turn += abs(end[j] - start[j])
+    sagitta = params[_SWEEP] * turn * turn / 8.0
+    first = int(params[_OBST]) + _BOX * boxes
+    for k in range(int(params[_N_SPHERES])):
+        base = first + _SPHERE * k
+        joint = int(params[base]) - 1
+        lx, ly, lz = params[base + 1], params[base + 2], params[base + 3]
+        m0, m1 = before[joint], after[joint]
+        x0 = m0[0, 0] * lx + m0[0, 1] * ly + m0[0, 2] * lz + m0[0, 3]
+        y0 = m0[1, 0] * lx + m0[1, 1] * ly + m0[1, 2] * lz + m0[1, 3]
+        z0 = m0[2, 0] * lx + m0[2, 1] * ly + m0[2, 2] * lz + m0[2, 3]
+        dx = m1[0, 0] * lx + m1[0, 1] * ly + m1[0, 2] * lz + m1[0, 3] - x0
+        dy = m1[1, 0] * lx + m1[1, 1] * ly + m1[1, 2] * lz + m1[1, 3] - y0
+        dz = m1[2, 0] * lx + m1[2, 1] * ly + m1[2, 2] * lz + m1[2, 3] - z0
+        radius = params[base + 4]
+        chord = math.sqrt(dx * dx + dy * dy + dz * dz)
+        pieces = max(1, math.ceil(chord / radius))
+        grown = math.sqrt(radius * radius + (0.5 * chord / pieces) ** 2) + sagitta
+        for i in range(pieces + 1):
+            u = i / pieces
+            for b in range(boxes):
+                if _box_distance(params, b, x0 + u * dx, y0 + u * dy, z0 + u * dz) < grown:
+                    return True
+    return False

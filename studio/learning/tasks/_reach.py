@@ -46,6 +46,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cached_property
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numba import njit
@@ -61,6 +62,7 @@ from .._config import (
 from .._errors import ConfigError, LearningError
 from .._tiles import TileCoding
 from ._arm import GOAL_REWARD, STEP_REWARD
+from ._chain import chain_joint, compose, put_chain
 from ._follow import (
     checked_paths,
     cost_bound,
@@ -69,25 +71,35 @@ from ._follow import (
     followed_points,
     with_cost_group,
 )
+from ._obstacles import (
+    check_goal_clear,
+    move_blocked,
+    obstacle_values,
+    sphere_count,
+    sweep_bound,
+    task_obstacles,
+)
 from ._reach_layout import (
     _ANG_TOL,
-    _CHAIN,
     _CHAIN_N,
     _COUNTS,
     _GOAL_P,
     _GOAL_R,
     _HOLD,
     _J,
-    _LINK,
     _LOWER,
     _MIN_TRACE,
     _MULTI,
+    _N_BOXES,
     _N_PARAMS,
+    _N_SPHERES,
+    _OBST,
     _POINT,
     _POS_TOL,
     _POS_TOL2,
     _SHAPING,
     _STEP,
+    _SWEEP,
     _TABLE,
     _TOOL,
     _UPPER,
@@ -96,6 +108,9 @@ from ._reach_layout import (
     action_directions,
 )
 from ._robot import PUMA560, check_robot, default_goal, task_arm
+
+if TYPE_CHECKING:
+    from studio.kinematics import Obstacle
 
 MIN_JOINTS = 3
 """Fewest joints the continuous task offers (the paper's three)."""
@@ -152,6 +167,9 @@ class ArmReach:
             :mod:`._demo_shaping`), in reward per joint step; 0 switches it off; None (the
             default) gives what :data:`._demo_shaping.DEMO_SHAPING` leaves beside ``shaping``
             (5 under the paper's reward ``shaping=0``, 0 under the default shaping).
+        obstacles: boxes in the robot's base frame (:class:`studio.kinematics.Obstacle`, or
+            their dicts): a move that would bring a link into one does not happen
+            (:mod:`._obstacles`).
 
     Raises:
         LearningError: a bad value, or a goal outside the joint limits.
@@ -167,9 +185,11 @@ class ArmReach:
     robot: str = PUMA560
     paths: tuple[tuple[tuple[float, ...], ...], ...] = ()
     demo_potential: float | None = None
+    obstacles: tuple[Obstacle, ...] = ()
 
     def __post_init__(self) -> None:
         arm = task_arm(check_robot(self.robot))
+        object.__setattr__(self, "obstacles", task_obstacles(self.obstacles))
         most = min(MAX_JOINTS, arm.nq)
         if self.actions not in ACTION_SETS:
             raise ConfigError(
@@ -239,6 +259,16 @@ class ArmReach:
             "paths",
             checked_paths(self.paths, self.actions, self.joints, self.lower, self.upper, self.step),
         )
+        if self.obstacles:
+            goal_q = np.ascontiguousarray(self.goal[: self.joints])
+            if move_blocked(self.params, goal_q, goal_q):
+                check_goal_clear(self.robot, self.obstacles, np.asarray(self.goal))
+                raise ConfigError(
+                    [
+                        "An obstacle comes within a few centimetres of the robot at the goal; move or shrink the box, or choose another goal."
+                    ],
+                    ["obstacles"],
+                )
 
     def with_paths(self, q_paths: Sequence[np.ndarray]) -> ArmReach:
         """This task following ``q_paths`` (joint paths, radians, ``(N, joints)`` or wider) when
@@ -296,6 +326,7 @@ class ArmReach:
                 else {}
             ),
             **({} if self.demo_potential is None else {"demo_potential": self.demo_potential}),
+            **({"obstacles": [o.to_dict() for o in self.obstacles]} if self.obstacles else {}),
         }
 
     @classmethod
@@ -304,7 +335,9 @@ class ArmReach:
         joint per action; one written before ``robot`` existed is the Puma560's)."""
         goal = None if data.get("goal") is None else tuple(data["goal"])
         paths = tuple(tuple(tuple(row) for row in path) for path in data.get("paths") or ())
-        return cls(**{"actions": STORED_ACTIONS, **data, "goal": goal, "paths": paths})
+        obstacles = tuple(data.get("obstacles") or ())
+        settings = {"actions": STORED_ACTIONS, **data, "goal": goal, "paths": paths}
+        return cls(**{**settings, "obstacles": obstacles})
 
     @property
     def default_tiles(self) -> int:
@@ -361,14 +394,24 @@ class ArmReach:
         """The flat parameter array of :func:`reach_step` and friends (read-only)."""
         table = self.directions
         points = followed_points(self.paths, self.joints, self.step)
-        p = np.zeros(_N_PARAMS + MAX_JOINTS * table.shape[0] + _POINT * points.shape[0], np.float64)
+        chain = task_arm(self.robot).chain
+        frames = min(MAX_CHAIN, len(chain.translations))
+        blocks = obstacle_values(self.robot, self.obstacles, frames)
+        obstacles_at = _N_PARAMS + MAX_JOINTS * table.shape[0] + _POINT * points.shape[0]
+        p = np.zeros(obstacles_at + blocks.shape[0], np.float64)
+        p[obstacles_at:] = blocks
+        p[_OBST] = obstacles_at
+        if self.obstacles:
+            p[_N_BOXES] = len(self.obstacles)
+            p[_N_SPHERES] = sphere_count(self.robot, frames)
+            p[_SWEEP] = sweep_bound(self.robot, chain.translations[:frames])
         p[_MULTI] = 0.0 if self.n_actions == 2 * self.joints else 1.0  # single joints only
         p[_COUNTS] = table.shape[0]
         p[_COUNTS + 1] = points.shape[0]
         followed = _TABLE + MAX_JOINTS * table.shape[0]
         p[_TABLE:followed].reshape(-1, MAX_JOINTS)[:, : self.joints] = table
-        p[followed:].reshape(-1, _POINT)[:, : self.joints] = points[:, : self.joints]
-        p[followed:].reshape(-1, _POINT)[:, MAX_JOINTS:] = points[:, self.joints :]
+        p[followed:obstacles_at].reshape(-1, _POINT)[:, : self.joints] = points[:, : self.joints]
+        p[followed:obstacles_at].reshape(-1, _POINT)[:, MAX_JOINTS:] = points[:, self.joints :]
         p[_J] = self.joints
         p[_STEP] = self.step
         p[_POS_TOL2] = self.position_tolerance**2
@@ -380,7 +423,7 @@ class ArmReach:
         p[_SHAPING] = self.shaping
         p[_POS_TOL] = self.position_tolerance
         p[_ANG_TOL] = math.radians(self.angle_tolerance_deg)
-        _put_chain(p, self.robot)
+        put_chain(p, self.robot)
         oMgoal = np.empty((4, 4))
         tool_pose(p, np.asarray(self.goal[: self.joints]), oMgoal)
         p[_GOAL_P : _GOAL_P + 3] = oMgoal[:3, 3]
@@ -408,10 +451,11 @@ class ArmReach:
         return full
 
     def random_start(self, rng: np.random.Generator) -> np.ndarray:
-        """A start drawn uniformly across the limits, not already at the goal."""
+        """A start drawn uniformly across the limits, not already at the goal nor touching an
+        obstacle."""
         while True:
             q = rng.uniform(self.lower, self.upper)
-            if not reach_success(self.params, q):
+            if not reach_success(self.params, q) and not move_blocked(self.params, q, q):
                 return q
 
     def _state(self, q: Sequence[float] | np.ndarray) -> np.ndarray:
@@ -463,9 +507,11 @@ class ArmReach:
             )
         q = np.clip(q, lower, upper)
         actions = np.empty(_walk_capacity(q, self.step), np.int64)
-        n = _follow_walk(self.params, q[0], actions) if self.paths else -1
+        free = self.params.copy()
+        free[_N_BOXES] = 0.0  # the demonstrated moves as if nothing stood in the way
+        n = _follow_walk(free, q[0], actions) if self.paths else -1
         if n < 0:
-            n = _walk(self.params, q, actions)
+            n = _walk(free, q, actions)
         if n < 0:
             raise LearningError(
                 f"Demonstration {index} never brings the tool within {self.position_tolerance * 100:g} cm and {self.angle_tolerance_deg:g} deg of the goal; end it at the goal or make the goal its final pose."
@@ -495,26 +541,6 @@ def _limits(robot: str) -> tuple[np.ndarray, np.ndarray]:
     return np.asarray(arm.lower, dtype=np.float64), np.asarray(arm.upper, dtype=np.float64)
 
 
-def _put_chain(p: np.ndarray, robot: str) -> None:
-    """Write ``robot``'s serial chain (:attr:`studio.kinematics.RobotArm.chain`, the one reading
-    of its Pinocchio model, which the compiled IK also runs on) into the parameter array ``p``."""
-    chain = task_arm(robot).chain
-    moving = chain.tool_joint + 1  # the joints, from the first, that move the tool
-    if moving > MAX_CHAIN or moving < 1:
-        raise ConfigError(
-            [f"The {robot} moves its tool with {moving} joints; give an arm of 1 to {MAX_CHAIN}."],
-            ["robot"],
-        )
-    p[_CHAIN_N] = moving
-    for i in range(moving):
-        link = p[_CHAIN + _LINK * i : _CHAIN + _LINK * (i + 1)]
-        link[:9] = chain.rotations[i].reshape(-1)
-        link[9:12] = chain.translations[i]
-        link[12:] = chain.axes[i]
-    p[_TOOL : _TOOL + 9] = chain.tool_rotation.reshape(-1)
-    p[_TOOL + 9 : _TOOL + 12] = chain.tool_translation
-
-
 def _walk_capacity(q: np.ndarray, step: float) -> int:
     """An upper bound on the walk's actions: the path's joint travel in steps, plus slack."""
     travel = np.abs(np.diff(q, axis=0)).sum() if q.shape[0] > 1 else 0.0
@@ -531,41 +557,13 @@ def tool_pose(params, state, out):
     angles in ``params``. Serial-chain forward kinematics: per joint its fixed placement, then the
     rotation by its angle about its axis (Rodrigues), then the tool frame's placement; the
     composition of Pinocchio's ``oMi = oMparent * jointPlacement * M(q)``."""
-    joints = int(params[_J])
     for i in range(4):
         for k in range(4):
             out[i, k] = 1.0 if i == k else 0.0
     rotation = np.empty(12)
     for i in range(int(params[_CHAIN_N])):
-        base = _CHAIN + _LINK * i
-        _compose(out, params, base)
-        theta = state[i] if i < joints else params[_HOLD + i]
-        c, s = math.cos(theta), math.sin(theta)
-        ux, uy, uz = params[base + 12], params[base + 13], params[base + 14]
-        t = 1.0 - c
-        rotation[0] = c + t * ux * ux
-        rotation[1] = t * ux * uy - s * uz
-        rotation[2] = t * ux * uz + s * uy
-        rotation[3] = t * ux * uy + s * uz
-        rotation[4] = c + t * uy * uy
-        rotation[5] = t * uy * uz - s * ux
-        rotation[6] = t * ux * uz - s * uy
-        rotation[7] = t * uy * uz + s * ux
-        rotation[8] = c + t * uz * uz
-        rotation[9] = rotation[10] = rotation[11] = 0.0
-        _compose(out, rotation, 0)
-    _compose(out, params, _TOOL)
-
-
-@njit(nogil=True, cache=True, inline="always")
-def _compose(out, values, base):
-    """``out = out @ M`` with ``M``'s rotation row-major at ``values[base:base + 9]`` and its
-    translation at ``values[base + 9:base + 12]``."""
-    for r in range(3):
-        x, y, z = out[r, 0], out[r, 1], out[r, 2]
-        for c in range(3):
-            out[r, c] = x * values[base + c] + y * values[base + 3 + c] + z * values[base + 6 + c]
-        out[r, 3] += x * values[base + 9] + y * values[base + 10] + z * values[base + 11]
+        chain_joint(out, params, state, i, rotation)
+    compose(out, params, _TOOL)
 
 
 @njit(nogil=True, cache=True)
@@ -606,11 +604,14 @@ def reach_step(params, state, action):
     Action ``2 j`` moves joint ``j`` up one step, ``2 j + 1`` down; a multi-joint task's other
     actions move the joints of their row of the action table (:func:`action_directions`), and
     the one after the table follows the demonstrated paths (:func:`._follow.follow`). A joint whose move
-    would leave its limits stays where it is. The reward is the paper's (+100 at
+    would leave its limits stays where it is; a move that would bring a link into an obstacle
+    does not happen (:func:`._obstacles.move_blocked`: the arm stays, the step pays -1). The reward is the paper's (+100 at
     the goal, -1 otherwise) plus ``shaping`` times the change of :func:`reach_potential`.
     """
     shaping = params[_SHAPING]
     before = reach_potential(params, state) if shaping != 0.0 else 0.0
+    boxed = params[_N_BOXES] != 0.0
+    start = state.copy() if boxed else state
     if params[_MULTI] == 0.0:
         j = action // 2
         moved = state[j] + (params[_STEP] if action % 2 == 0 else -params[_STEP])
@@ -626,6 +627,8 @@ def reach_step(params, state, action):
                 moved = state[j] + direction * params[_STEP]
                 if params[_LOWER + j] <= moved <= params[_UPPER + j]:
                     state[j] = moved
+    if boxed and move_blocked(params, start, state):
+        state[:] = start  # the move would touch an obstacle: it does not happen
     done = reach_success(params, state)
     reward = GOAL_REWARD if done else STEP_REWARD
     if shaping != 0.0:

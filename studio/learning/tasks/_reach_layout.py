@@ -30,10 +30,17 @@ _HOLD = 51  # MAX_CHAIN values: every joint's angle when not learned (the goal's
 _CHAIN = _HOLD + MAX_CHAIN  # per joint: placement rotation (9, row-major), translation, axis
 _LINK = 15
 _TOOL = _CHAIN + _LINK * MAX_CHAIN  # jointMtool: rotation (9, row-major), translation (3)
-_COUNTS = _TOOL + 12  # the action table's rows, then the followed paths' points
+_FRAMES_N = _TOOL + 12  # the chain's joints, written for every robot (the obstacle check's frames)
+_N_BOXES = _TOOL + 13  # obstacles: how many boxes (0: none, no check)
+_N_SPHERES = _TOOL + 14  # how many spheres hold the links
+_OBST = _TOOL + 15  # where the boxes, then the spheres, start in the array
+_SWEEP = _TOOL + 16  # a bound on any link point's distance from any joint axis (m)
+_COUNTS = _TOOL + 17  # the action table's rows, then the followed paths' points
 _TABLE = _COUNTS + 2  # per action, MAX_JOINTS directions -1/0/+1; then the followed points
 _N_PARAMS = _TABLE
 _POINT = MAX_JOINTS + 2  # a followed point: its joints, its path's last point, the path left (rad)
+_BOX = 6  # an obstacle: its centre, then its half sizes (m)
+_SPHERE = 5  # a sphere: its joint (1 = the first), its centre in that joint's frame, its radius
 
 
 def action_directions(joints: int, actions: str = "single") -> np.ndarray:

@@ -1,4 +1,5 @@
-"""``/api/scene``: scrub the rollout being watched, point the cameras, pose the robot by hand.
+"""``/api/scene``: scrub the rollout being watched, point the cameras, pose the robot by hand,
+place the boxes of the next run.
 
 The scene keeps the scrub position, speed and pause as part of its playback
 (:func:`studio.web.scene._model.rescheduled`); this router only checks the values and passes them
@@ -13,11 +14,11 @@ import numpy as np
 from fastapi import APIRouter
 from pydantic import BaseModel, Field
 
-from studio.kinematics import RobotArm, load_robot
+from studio.kinematics import KinematicsError, RobotArm, check_obstacles, load_robot
 
 from .._deps import RobotsDep, RolloutsDep, SceneDep
 from .._errors import ConflictError, InvalidError
-from .._schemas import _Body
+from .._schemas import ObstacleBody, ObstaclesPublic, _Body
 from ..scene import PLAYBACK_SPEEDS, VIEW_NAMES, Playback, Scene
 from ..services import Robots
 
@@ -250,3 +251,21 @@ def jog(body: JogChange, scene: SceneDep, robots: RobotsDep, rollouts: RolloutsD
     rollouts.release()  # a pose by hand replaces the policy being watched
     scene.hold_pose(np.radians(body.q_deg), robot=arm.name)
     return JogPublic(joints=joints, q_deg=list(body.q_deg), robot=arm.name, title=arm.spec.title)
+
+
+@router.get("/obstacles")
+def edited_obstacles(scene: SceneDep) -> ObstaclesPublic:
+    """The boxes placed for the next run, where their handles stand now (dragged in the scene)."""
+    boxes = _shown(scene).obstacles.edited()
+    return ObstaclesPublic(obstacles=[ObstacleBody(**box.to_dict()) for box in boxes])
+
+
+@router.put("/obstacles")
+def edit_obstacles(body: ObstaclesPublic, scene: SceneDep) -> ObstaclesPublic:
+    """Place these boxes for the next run, each with a handle to drag it (422: a bad box)."""
+    try:
+        boxes = check_obstacles([box.model_dump() for box in body.obstacles])
+    except KinematicsError as err:
+        raise InvalidError(str(err)) from None
+    placed = _shown(scene).obstacles.edit(list(boxes))
+    return ObstaclesPublic(obstacles=[ObstacleBody(**box.to_dict()) for box in placed])

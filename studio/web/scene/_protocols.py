@@ -16,6 +16,7 @@ import numpy as np
 from studio.kinematics import RobotArm
 
 from ._model import Playback
+from ._obstacles import SceneObstacles
 from ._views import SceneCamera
 
 
@@ -108,6 +109,7 @@ class Scene(LiveScene, Protocol):
 
     robot: JointLimits
     camera: SceneCamera
+    obstacles: SceneObstacles
 
     def tool_positions(self, q_robot: np.ndarray, robot: str | None = None) -> np.ndarray:
         """World tool positions of ``robot``'s joint configurations ``(N, n)`` -> ``(N, 3)``."""

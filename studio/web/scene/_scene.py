@@ -44,6 +44,7 @@ from ._frames import FramePacer
 from ._hand_handle import HandHandle
 from ._model import Mode, Playback, SceneLayout, playback_time, pose_at, rescheduled
 from ._model import camera_projection as camera_projection
+from ._obstacles import SceneObstacles
 from ._operator import SceneOperator, _placed
 from ._paths import ScenePaths
 from ._protocols import LivePose
@@ -144,6 +145,7 @@ class StudioScene(ScenePaths, SceneRobot, SceneOperator, SceneReach):
         self._build()
         self.frames = FramePacer(server)  # viser's page draws less: a slow stream, a still scene
         self.hand_handle = HandHandle(server)
+        self.obstacles = SceneObstacles(server)  # boxes placed for a run, a watched run's
         self.camera = SceneCamera(server, self.layout)  # presets, following the tool
         self._thread = threading.Thread(target=self._loop, name="studio-scene", daemon=True)
         self._thread.start()

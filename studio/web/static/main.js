@@ -22,6 +22,7 @@ import { buildExportControl } from "./exports.js";
 import { applySource, loadRobots, playback, setRetarget, setRobot, simulatorReach, syncKindOptions } from "./sources.js";
 import { S, listen, markCurvesDirty, set } from "./state.js";
 import { checkTrainForm, resetTrainForm, startRun, syncTaskFields } from "./training.js";
+import { addObstacle, refreshObstacles } from "./obstacles.js";
 
 function wire() {
   // The buttons that follow the live source, after its status line; camera.js listens after them.
@@ -74,6 +75,8 @@ function wire() {
   $("train-form").elements.task.addEventListener("change", syncTaskFields);
   $("train-form").addEventListener("change", (ev) => { if (ev.target.closest("#train-demos, .goal3") || ["task", "bins"].includes(ev.target.name)) checkTrainForm(); });
   $("train-defaults").addEventListener("click", resetTrainForm);
+  $("train-add-obstacle").addEventListener("click", addObstacle);
+  refreshObstacles(); // boxes placed before a reload stay listed
   $("train-defaults").addEventListener("click", syncTaskFields); // after the reset above
   $("curve-log").addEventListener("change", markCurvesDirty);
   $("curve-band").addEventListener("change", markCurvesDirty);

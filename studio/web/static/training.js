@@ -6,6 +6,7 @@ import { $, el, showError } from "./dom.js";
 import { openCompare } from "./compare.js";
 import { renderRuns, upsertRun } from "./runs.js";
 import { S, listen, markCurvesDirty } from "./state.js";
+import { placedObstacles, refreshObstacles } from "./obstacles.js";
 
 /** Form inputs of a field the API names (the goal is three inputs). */
 const TRAIN_INPUTS = { goal_deg: ["goal0", "goal1", "goal2"] };
@@ -108,6 +109,7 @@ function readTrainForm() {
     seed: num("seed"),
     goal_deg: [num("goal0"), num("goal1"), num("goal2")],
     demonstrations: [...$("train-demos").querySelectorAll("input:checked")].map((i) => i.value),
+    obstacles: placedObstacles(),
   };
   if (empty.length) {
     const problems = empty.map((k) => `${k.replace("_", " ")} is empty; enter a number.`);
@@ -171,6 +173,7 @@ export async function startRun(ev) {
   const button = $("train-start");
   button.disabled = true;
   try {
+    await refreshObstacles(); // where the boxes were dragged in the scene
     const body = readTrainForm();
     const pair = $("train-form").elements.baseline.checked;
     // with "also train without demonstrations": the run and its twin, plotted alone and compared

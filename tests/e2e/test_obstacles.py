@@ -1,0 +1,83 @@
+"""Browser: the train form's "Add obstacle" puts a box in the scene, sized in the form, listed
+where its handle stands, and sent with the run the form starts (issue 40)."""
+
+from __future__ import annotations
+
+import json
+import time
+from typing import Any
+
+import pytest
+
+from tests.e2e.conftest import Studio
+
+pytestmark = pytest.mark.e2e
+
+T = 60_000  # ms: the longest a single UI step may take on a busy machine
+
+
+def _wait(predicate: Any, timeout: float = 60.0) -> Any:
+    """Poll ``predicate`` until it returns something truthy (the event, not a fixed sleep)."""
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        value = predicate()
+        if value:
+            return value
+        time.sleep(0.1)
+    return predicate()
+
+
+def _boxes(studio: Studio) -> list[dict]:
+    return studio.get("/api/scene/obstacles")["obstacles"]
+
+
+def _stored_with_obstacles(studio: Studio) -> list[dict]:
+    found = []
+    for config in (studio.data_dir / "runs").glob("*/config.json"):
+        task = json.loads(config.read_text()).get("task", {})
+        if task.get("obstacles"):
+            found.append(task)
+    return found
+
+
+def test_add_an_obstacle_size_it_and_train_around_it(page: Any, studio_server: Studio) -> None:
+    row = "[data-testid='obstacle-row']"
+    try:
+        page.click("[data-testid='train-add-obstacle']")
+        page.wait_for_selector(row, timeout=T)
+        assert page.locator(row).count() == 1
+        placed = _wait(lambda: _boxes(studio_server))
+        assert len(placed) == 1  # drawn in the scene, with its handle
+
+        # sized in the form: the scene's box follows
+        page.fill("[data-testid='obstacle-0-size-0']", "0.2")
+        page.press("[data-testid='obstacle-0-size-0']", "Tab")
+        assert _wait(lambda: _boxes(studio_server)[0]["size"][0] == 0.2)
+
+        # moved in the scene (what dragging its handle does to the scene's boxes): the form
+        # lists it where it stands now
+        moved = {**_boxes(studio_server)[0], "centre": [0.55, 0.45, 0.85]}
+        studio_server.send("PUT", "/api/scene/obstacles", {"obstacles": [moved]})
+        page.wait_for_function(
+            "() => document.querySelector(\"[data-testid='obstacle-0-centre']\")"
+            ".textContent.includes('0.55, 0.45, 0.85')",
+            timeout=T,
+        )
+
+        # a small grid run: the box goes with it into its config.json
+        page.fill("[data-testid='train-bins']", "5")
+        page.fill("[data-testid='train-episodes']", "3")
+        page.fill("[data-testid='train-experiments']", "1")
+        before = len(_stored_with_obstacles(studio_server))
+        page.click("[data-testid='train-start']")
+        stored = _wait(lambda: _stored_with_obstacles(studio_server)[before:], 180)
+        assert stored, page.inner_text("[data-testid='train-error']")
+        assert stored[0]["obstacles"] == [{"centre": [0.55, 0.45, 0.85], "size": [0.2, 0.15, 0.15]}]
+
+        # removed: the form and the scene hold none
+        page.click("[data-testid='obstacle-0-remove']")
+        assert _wait(lambda: not _boxes(studio_server))
+        page.wait_for_selector(row, state="detached", timeout=T)
+    finally:
+        studio_server.send("PUT", "/api/scene/obstacles", {"obstacles": []})
+        page.click("[data-testid='train-defaults']")
