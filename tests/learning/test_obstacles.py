@@ -149,9 +149,7 @@ def test_evaluate_counts_a_rollout_through_a_box_as_a_collision(arm, in_the_way)
     assert _collides_with((in_the_way,))("puma560", clear)
 
 
-def test_the_continuous_task_takes_a_box_and_a_rollout_into_it_is_a_collision(
-    tmp_path, in_the_way
-):
+def test_the_continuous_task_takes_a_box_and_a_rollout_into_it_is_a_collision(tmp_path, in_the_way):
     """The continuous task takes boxes as the grid does, from the request (the page, the API)
     and from the command line: its run and its policy keep them (none is dropped), and
     ``studio evaluate`` counts a rollout of that policy's task through the box as a collision."""

@@ -19,8 +19,8 @@ class _FakeObstacles:
     def __init__(self, calls: list) -> None:
         self.calls = calls
 
-    def show_watched(self, boxes) -> None:
-        self.calls.append(("show_watched", (tuple(boxes),)))
+    def show_watched(self, boxes, robot=None) -> None:
+        self.calls.append(("show_watched", (tuple(boxes), robot)))
 
 
 class FakeScene:

@@ -193,5 +193,6 @@ def export_the_rollout(
         unchecked,
         fit=fit,
         cache=physics_cache_dir(settings.data_dir),
+        obstacles=watched.obstacles,
     )
     return _send(done, MEDIA_TYPES["mcap"])

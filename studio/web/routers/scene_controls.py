@@ -267,5 +267,6 @@ def edit_obstacles(body: ObstaclesPublic, scene: SceneDep) -> ObstaclesPublic:
         boxes = check_obstacles([box.model_dump() for box in body.obstacles])
     except KinematicsError as err:
         raise InvalidError(str(err)) from None
-    placed = _shown(scene).obstacles.edit(list(boxes))
+    shown = _shown(scene)
+    placed = shown.obstacles.edit(list(boxes), shown.robot_name)  # the robot a run would train
     return ObstaclesPublic(obstacles=[ObstacleBody(**box.to_dict()) for box in placed])

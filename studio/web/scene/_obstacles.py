@@ -1,19 +1,26 @@
 """Obstacle boxes in the scene: the ones a person places for a run, and a watched run's.
 
-A box (:class:`studio.kinematics.Obstacle`) lives in the robot's base frame. The training form's
-boxes are drawn with a handle each (viser's transform controls, moved, not turned): dragging one
-moves its box, and :meth:`SceneObstacles.edited` gives the boxes where they stand now, for the
-run the form starts. A watched run's boxes are drawn see-through beside them, without handles.
+A box (:class:`studio.kinematics.Obstacle`) lives in its robot's base frame; the scene draws it
+where that robot is drawn (:func:`robot_frame`: a robot other than the Puma560 is turned to face
+the operator, enlarged and raised on a pedestal), so the box stands where the task checks it
+against the arm. The training form's boxes belong to the robot drawn (the one a run from the form
+trains) and are drawn with a handle each (viser's transform controls, moved, not turned):
+dragging one moves its box, and :meth:`SceneObstacles.edited` gives the boxes where they stand
+now, for the run the form starts. A watched run's boxes are drawn see-through beside them, on
+the policy's robot, without handles.
 """
 
 from __future__ import annotations
 
+import functools
 import threading
 
 import numpy as np
 import viser
 
-from studio.kinematics import KinematicsError, Obstacle
+from studio.kinematics import DEFAULT_ROBOT, KinematicsError, Obstacle, load_robot
+
+from ._robot_view import arm_framing, wxyz_of
 
 EDIT_COLOR = (235, 140, 40)
 """The boxes placed for the next run."""
@@ -24,14 +31,34 @@ OPACITY = 0.45
 HANDLE_SCALE = 0.25
 
 
+@functools.lru_cache(maxsize=8)
+def robot_frame(robot: str) -> tuple[np.ndarray, float, np.ndarray]:
+    """``(turn, scale, lift)``: where the scene draws ``robot``'s base frame, as it draws the
+    robot (:func:`._robot_view.arm_framing`): a point ``p`` of that frame is drawn at
+    ``turn @ p * scale + lift`` (the Puma560's: the identity, 1 and none)."""
+    arm = load_robot(robot, geometry=False)
+    scale, pedestal = arm_framing(arm)
+    return np.asarray(arm.base_rotation, dtype=float), scale, np.array([0.0, 0.0, pedestal])
+
+
+def _drawn(box: Obstacle, robot: str) -> dict[str, object]:
+    """Where and how big the scene draws ``box`` of ``robot``."""
+    turn, scale, lift = robot_frame(robot)
+    return {
+        "position": tuple(float(v) for v in turn @ np.asarray(box.centre) * scale + lift),
+        "wxyz": tuple(float(v) for v in wxyz_of(turn)),
+        "dimensions": tuple(float(s) * scale for s in box.size),
+    }
+
+
 class SceneObstacles:
-    """The boxes the scene draws, in the Puma560's frame (the scene's world: its base at the
-    origin, z up)."""
+    """The boxes the scene draws: those placed for the next run and a watched run's."""
 
     def __init__(self, server: viser.ViserServer) -> None:
         self.server = server
         self._lock = threading.Lock()
         self._edited: list[Obstacle] = []
+        self._robot = DEFAULT_ROBOT  # the robot the placed boxes are drawn on
         self._edit_nodes: list[viser.SceneNodeHandle] = []
         self._watch_nodes: list[viser.SceneNodeHandle] = []
 
@@ -40,48 +67,69 @@ class SceneObstacles:
         with self._lock:
             return list(self._edited)
 
-    def edit(self, boxes: list[Obstacle]) -> list[Obstacle]:
-        """Draw ``boxes`` as the ones placed for the next run, each with a handle to move it."""
+    def edit(self, boxes: list[Obstacle], robot: str | None = None) -> list[Obstacle]:
+        """Draw ``boxes`` (in ``robot``'s base frame; None: the robot they were drawn on) as the
+        ones placed for the next run, each with a handle to move it."""
         with self._lock:
             for node in self._edit_nodes:
                 node.remove()
             self._edit_nodes = []
             self._edited = list(boxes)
+            self._robot = robot or self._robot
             for i, box in enumerate(boxes):
+                drawn = _drawn(box, self._robot)
                 handle = self.server.scene.add_transform_controls(
                     f"/obstacles/edit/{i}",
                     scale=HANDLE_SCALE,
-                    position=box.centre,
+                    position=drawn["position"],
+                    wxyz=drawn["wxyz"],
                     disable_rotations=True,
                     depth_test=False,
                 )
                 shape = self.server.scene.add_box(
                     f"/obstacles/edit/{i}/box",
                     color=EDIT_COLOR,
-                    dimensions=box.size,
+                    dimensions=drawn["dimensions"],
                     opacity=OPACITY,
                     cast_shadow=False,
                 )
-                handle.on_update(self._moved(i))
+                handle.on_update(self._moved(i, self._robot))
                 self._edit_nodes += [shape, handle]
             return list(self._edited)
 
-    def _moved(self, index: int):
+    def follow_robot(self, robot: str) -> None:
+        """Draw the placed boxes on ``robot``, now drawn in the scene (the same place in its base
+        frame: the run the form starts is that robot's)."""
+        with self._lock:
+            boxes, same = list(self._edited), robot == self._robot
+        if not same:
+            self.edit(boxes, robot)
+
+    def _moved(self, index: int, robot: str):
+        turn, scale, lift = robot_frame(robot)
+
         def moved(event: viser.TransformControlsEvent) -> None:
             position = np.asarray(event.target.position, dtype=float)
             with self._lock:
-                if index >= len(self._edited) or not np.all(np.isfinite(position)):
+                if (
+                    robot != self._robot
+                    or index >= len(self._edited)
+                    or not np.all(np.isfinite(position))
+                ):
                     return
                 old = self._edited[index]
+                centre = turn.T @ (position - lift) / scale  # back into the robot's base frame
                 try:
-                    self._edited[index] = Obstacle(tuple(position), old.size)
+                    self._edited[index] = Obstacle(tuple(float(v) for v in centre), old.size)
                 except KinematicsError:  # dragged out of reach: it stays where it was
                     return
 
         return moved
 
-    def show_watched(self, boxes: tuple[Obstacle, ...] | list[Obstacle]) -> None:
-        """Draw a watched run's boxes (none: clear them)."""
+    def show_watched(
+        self, boxes: tuple[Obstacle, ...] | list[Obstacle], robot: str | None = None
+    ) -> None:
+        """Draw a watched run's boxes on its ``robot`` (None: the Puma560; no boxes: clear them)."""
         with self._lock:
             for node in self._watch_nodes:
                 node.remove()
@@ -89,10 +137,9 @@ class SceneObstacles:
                 self.server.scene.add_box(
                     f"/obstacles/watched/{i}",
                     color=WATCH_COLOR,
-                    dimensions=box.size,
-                    position=box.centre,
                     opacity=OPACITY,
                     cast_shadow=False,
+                    **_drawn(box, robot or DEFAULT_ROBOT),  # type: ignore[arg-type]
                 )
                 for i, box in enumerate(boxes)
             ]

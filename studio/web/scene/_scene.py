@@ -290,6 +290,7 @@ class StudioScene(ScenePaths, SceneRobot, SceneOperator, SceneReach):
         if view is not None:
             with self.server.atomic():
                 self._draw_robot(view)
+                self.obstacles.follow_robot(view.name)  # the form's boxes: the robot drawn's
             shown.q_robot = None
             if drawn is not None:
                 drawn()  # the live chain drives it from now on

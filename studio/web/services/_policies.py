@@ -8,8 +8,8 @@ from typing import Literal, NamedTuple
 
 import numpy as np
 
-from studio.kinematics import DEFAULT_ROBOT
-from studio.learning import POLICY_SUFFIX, AnyPolicy
+from studio.kinematics import DEFAULT_ROBOT, Obstacle
+from studio.learning import POLICY_SUFFIX, AnyPolicy, policy_obstacles
 
 from .._errors import ConflictError, InvalidError, NotFoundError
 from ._changes import OnChange
@@ -30,6 +30,7 @@ class WatchedRollout(NamedTuple):
         robot: the robot it was learnt on.
         times: sample times ``(N,)`` (s).
         q: the robot's joints ``(N, nq)`` (rad).
+        obstacles: the boxes of the policy's task, which an export of it is checked against.
     """
 
     path: Path
@@ -37,6 +38,7 @@ class WatchedRollout(NamedTuple):
     robot: str
     times: np.ndarray
     q: np.ndarray
+    obstacles: tuple[Obstacle, ...] = ()
 
 
 class Policies:
@@ -147,4 +149,4 @@ class Policies:
         _, times, q = last
         watched = self.store.load_file(path)
         robot = watched.robot or DEFAULT_ROBOT  # (None: not an arm's policy; never watched)
-        return WatchedRollout(path, name, robot, times, q)
+        return WatchedRollout(path, name, robot, times, q, policy_obstacles(watched))

@@ -25,6 +25,7 @@ from studio.export import (
     fit_timing,
     simulate_motion,
 )
+from studio.kinematics import Obstacle
 from studio.learning import ROLLOUT_RATE_HZ
 from studio.motion import Finding, Motion, demonstration_motion, recording_motion
 from studio.physics import SimulationReport
@@ -209,10 +210,12 @@ def export_rollout(
     *,
     fit: bool = False,
     cache: Path | None = None,
+    obstacles: tuple[Obstacle, ...] = (),
 ) -> Download:
     """A policy's watched rollout ``(times, q)`` as an MCAP of its robot's
     ``JointTrajectory``, at the rollout's own times (``fit``: unless they break the robot's
-    limits, then timed within them), checked for safety first (``unchecked``: written despite
+    limits, then timed within them), checked for safety first, against the robot's limits, itself,
+    the table and ``obstacles`` (its task's boxes) along it (``unchecked``: written despite
     failed checks, the findings stated in it), with the physics report stated in it.
 
     Raises:
@@ -220,7 +223,9 @@ def export_rollout(
         ExportError: the file cannot be written, or ``robot`` is not one offered.
     """
     arm = check_policy_robot(policy, robot, robot)
-    motion = Motion("policy", policy.name, arm, times, q, True, ROLLOUT_RATE_HZ)
+    motion = Motion(
+        "policy", policy.name, arm, times, q, True, ROLLOUT_RATE_HZ, obstacles=tuple(obstacles)
+    )
     motion, too_fast = fit_timing(motion, ROLLOUT_RATE_HZ) if fit else (motion, ())
     done: list[Exported] = []
 

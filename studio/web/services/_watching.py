@@ -106,7 +106,7 @@ class Watching:
             record = self._run_record(key)
             beside = learner.beside(policy, record.demonstrations if record is not None else [])
             scene.set_goal(rollout.goal, robot=rollout.robot)
-            scene.obstacles.show_watched(policy_obstacles(policy))
+            scene.obstacles.show_watched(policy_obstacles(policy), rollout.robot)
             if beside is not None:  # the demonstration it learned from, beside it
                 scene.show_path(TILE_DEMONSTRATION_PATH, beside, robot=rollout.robot)
             else:
