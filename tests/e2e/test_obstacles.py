@@ -54,6 +54,17 @@ def test_add_an_obstacle_size_it_and_train_around_it(page: Any, studio_server: S
         page.press("[data-testid='obstacle-0-size-0']", "Tab")
         assert _wait(lambda: _boxes(studio_server)[0]["size"][0] == 0.2)
 
+        # a size that is no size: one sentence under the list, and the box keeps its size
+        page.fill("[data-testid='obstacle-0-size-1']", "0")
+        page.press("[data-testid='obstacle-0-size-1']", "Tab")
+        error = page.wait_for_selector("[data-testid='obstacle-error']:visible", timeout=T)
+        assert "above zero" in error.inner_text() and error.inner_text().count(".") == 1
+        assert _boxes(studio_server)[0]["size"] == [0.2, 0.15, 0.15]
+        page.wait_for_function(
+            "() => document.querySelector(\"[data-testid='obstacle-0-size-1']\").value === '0.15'",
+            timeout=T,
+        )
+
         # moved in the scene (what dragging its handle does to the scene's boxes): the form
         # lists it where it stands now
         moved = {**_boxes(studio_server)[0], "centre": [0.55, 0.45, 0.85]}

@@ -125,3 +125,18 @@ def test_the_page_export_of_a_watched_rollout_is_checked_against_its_tasks_boxes
             tmp_path / "swing.policy.npz", "puma560", "swing", times, swing, obstacles=(box,)
         )
     assert "obstacle 1" in str(refused.value)
+
+
+@pytest.mark.parametrize("robot", ["puma560", "so100"])
+def test_a_new_box_stands_beside_any_robot_where_it_stands_beside_the_puma560(robot):
+    """ "Add obstacle" puts a box at one place in the scene, whatever robot is drawn: in the
+    SO-100's base frame (turned, drawn 3x enlarged) that is a smaller box, nearer its base."""
+    from studio.web.scene._obstacles import NEW_BOX
+
+    boxes, scene = _boxes()
+    new = boxes.new_box(robot)
+    boxes.edit([new], robot)
+    assert np.allclose(scene.nodes["/obstacles/edit/0"].kw["position"], NEW_BOX.centre)
+    assert np.allclose(scene.nodes["/obstacles/edit/0/box"].kw["dimensions"], NEW_BOX.size)
+    if robot != "puma560":
+        assert max(new.size) < 0.06 and np.linalg.norm(new.centre) < 0.5

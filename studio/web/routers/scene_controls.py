@@ -270,3 +270,17 @@ def edit_obstacles(body: ObstaclesPublic, scene: SceneDep) -> ObstaclesPublic:
     shown = _shown(scene)
     placed = shown.obstacles.edit(list(boxes), shown.robot_name)  # the robot a run would train
     return ObstaclesPublic(obstacles=[ObstacleBody(**box.to_dict()) for box in placed])
+
+
+@router.post("/obstacles", status_code=201)
+def add_obstacle(scene: SceneDep) -> ObstaclesPublic:
+    """Place one more box for the next run, beside the robot drawn (``Add obstacle``; 422 past
+    the most boxes a run takes)."""
+    shown = _shown(scene)
+    boxes = [*shown.obstacles.edited(), shown.obstacles.new_box(shown.robot_name)]
+    try:
+        check_obstacles(boxes)
+    except KinematicsError as err:
+        raise InvalidError(str(err)) from None
+    placed = shown.obstacles.edit(boxes, shown.robot_name)
+    return ObstaclesPublic(obstacles=[ObstacleBody(**box.to_dict()) for box in placed])

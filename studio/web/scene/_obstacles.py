@@ -29,6 +29,10 @@ WATCH_COLOR = (200, 60, 60)
 OPACITY = 0.45
 """See-through, so the arm shows inside a box it touches."""
 HANDLE_SCALE = 0.25
+NEW_BOX = Obstacle((0.6, 0.4, 0.9), (0.15, 0.15, 0.15))
+"""Where "Add obstacle" puts a box, in the scene (the Puma560's base frame): 15 cm a side, in
+front of the robot and to its left, clear of the Puma560's default goal; another robot's new box
+is put at the same place in the scene (:meth:`SceneObstacles.new_box`)."""
 
 
 @functools.lru_cache(maxsize=8)
@@ -96,6 +100,14 @@ class SceneObstacles:
                 handle.on_update(self._moved(i, self._robot))
                 self._edit_nodes += [shape, handle]
             return list(self._edited)
+
+    def new_box(self, robot: str) -> Obstacle:
+        """A new box for ``robot``: :data:`NEW_BOX`'s place and size in the scene, in that robot's
+        base frame (so it stands beside any robot drawn as beside the Puma560)."""
+        turn, scale, lift = robot_frame(robot)
+        centre = turn.T @ (np.asarray(NEW_BOX.centre) - lift) / scale
+        size = np.asarray(NEW_BOX.size) / scale
+        return Obstacle(tuple(float(v) for v in centre), tuple(float(v) for v in size))
 
     def follow_robot(self, robot: str) -> None:
         """Draw the placed boxes on ``robot``, now drawn in the scene (the same place in its base

@@ -4,8 +4,6 @@
 import { api } from "./api.js";
 import { $, el, showError } from "./dom.js";
 
-/** A new box: 15 cm a side, in front of the robot and to its left, clear of the default goal. */
-const NEW_BOX = { centre: [0.6, 0.4, 0.9], size: [0.15, 0.15, 0.15] };
 /** How often the list reads where the scene's handles stand while boxes are placed (ms). */
 const POLL_MS = 1000;
 
@@ -24,10 +22,14 @@ export async function refreshObstacles() {
   renderObstacles();
 }
 
+/** Ask the scene for ``next`` (the boxes; none: one more, beside the robot drawn), and list
+ * what it placed; a refusal is said in one sentence under the list. */
 async function place(next) {
   showError("obstacle-error", null);
   try {
-    const data = await api("PUT", "/api/scene/obstacles", { obstacles: next });
+    const data = next === undefined
+      ? await api("POST", "/api/scene/obstacles")
+      : await api("PUT", "/api/scene/obstacles", { obstacles: next });
     boxes = data.obstacles || [];
   } catch (e) {
     showError("obstacle-error", e.message || String(e));
@@ -35,7 +37,8 @@ async function place(next) {
   renderObstacles();
 }
 
-export function addObstacle() { return place([...placedObstacles(), NEW_BOX]); }
+/** "Add obstacle": one more box, 15 cm a side as the scene shows it, beside the robot drawn. */
+export function addObstacle() { return place(); }
 
 const fmt = (v) => (Math.round(v * 1000) / 1000).toString();
 
