@@ -16,7 +16,7 @@ from studio.kinematics import robot_spec
 from studio.physics import SimulationReport
 
 from .._deps import DemonstrationsDep, PoliciesDep, RecordingsDep, RobotsDep, SettingsDep
-from .._schemas import RobotChoice, RobotsPublic, SimulationPublic
+from .._robot_schemas import RobotChoice, RobotsPublic, SimulationPublic
 from ..services import (
     EXPORT_HEADER,
     MEDIA_TYPES,
