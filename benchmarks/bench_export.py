@@ -94,7 +94,7 @@ def recorded_noise() -> None:
 
     from studio.capture import RecordingWriter, human_angles, read_any_recording, simulate
     from studio.kinematics import ArmTracker, retarget_path
-    from studio.kinematics._filter import turn_backs
+    from studio.kinematics.human._filter import turn_backs
 
     print("\na recording's export, smoothed with the future (ours) against the live filter (base):")
     print(f"{'take':<8}{'robot':<8}{'duration / true':>18}{'turns back':>14}"

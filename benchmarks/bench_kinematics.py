@@ -145,8 +145,8 @@ def smoothing(seeds: tuple[int, ...] = (3, 4, 5), seconds: float = 7.0) -> None:
     """Section (c): the timed tracker against the one-frame-at-a-time baseline."""
     from studio.capture import simulate
     from studio.kinematics import load_robot, retarget_path
-    from studio.kinematics._filter import OneEuroFilter, turn_backs
-    from studio.kinematics._tracker import SMOOTHING_CUTOFF_HZ
+    from studio.kinematics.human._filter import OneEuroFilter, turn_backs
+    from studio.kinematics.human._tracker import SMOOTHING_CUTOFF_HZ
 
     panda = load_robot("panda")
     counts = {"one frame at a time": np.zeros(3), "smoothed in time": np.zeros(3)}

@@ -52,7 +52,7 @@ from studio.kinematics import (
     robot_names,
     tool_reaches,
 )
-from studio.kinematics._filter import turn_backs
+from studio.kinematics.human._filter import turn_backs
 
 
 def previous_inverse(

@@ -475,6 +475,9 @@ def test_the_import_scan_finds_every_import_that_runs():
 
 
 MAX_FILE_LINES = 800
+MAX_FOLDER_MODULES = 20
+"""The most modules (its ``__init__`` counted) one folder of ``studio`` holds: a fuller folder
+hides its parts in name prefixes; give them a subpackage."""
 MAX_FUNCTION_LINES = 100
 MAX_PAGE_SCRIPT_LINES = 600
 MAX_ANY_LINES = 115
@@ -501,6 +504,15 @@ def test_no_python_file_in_studio_is_over_the_budget():
         if (lines := len(path.read_text().splitlines())) > MAX_FILE_LINES
     }
     assert long_files == {}, f"over {MAX_FILE_LINES} lines: split by responsibility"
+
+
+def test_no_folder_of_studio_holds_more_than_its_share_of_modules():
+    full = {
+        str(folder.relative_to(STUDIO.parent)): count
+        for folder in sorted({path.parent for path in _python_files()})
+        if (count := len(list(folder.glob("*.py")))) > MAX_FOLDER_MODULES
+    }
+    assert full == {}, f"over {MAX_FOLDER_MODULES} modules: group their parts in subpackages"
 
 
 def test_no_function_in_studio_is_over_the_budget_but_the_named_ones():

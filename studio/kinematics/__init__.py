@@ -14,11 +14,6 @@ if typing.TYPE_CHECKING:  # the public names, each loaded when first used (see s
     from ._clearance import OBSTACLE_TOUCH_M as OBSTACLE_TOUCH_M
     from ._clearance import ObstacleGuard as ObstacleGuard
     from ._clearance import sphere_cover as sphere_cover
-    from ._fit import ArmFitter as ArmFitter
-    from ._fit import FitConfig as FitConfig
-    from ._hand_ik import HandIKConfig as HandIKConfig
-    from ._hand_ik import fit_hand_pose as fit_hand_pose
-    from ._human import HumanArm as HumanArm
     from ._meshes import SLEEVE_LIFT_M as SLEEVE_LIFT_M
     from ._meshes import HumanBody as HumanBody
     from ._meshes import MeshConfig as MeshConfig
@@ -27,15 +22,6 @@ if typing.TYPE_CHECKING:  # the public names, each loaded when first used (see s
     from ._meshes import pose_body as pose_body
     from ._meshes import puma560_meshes as puma560_meshes
     from ._meshes import robot_meshes as robot_meshes
-    from ._pose import PoseConfig as PoseConfig
-    from ._pose import PoseFit as PoseFit
-    from ._pose import fit_pose_landmarks as fit_pose_landmarks
-    from ._pose_stream import BodyShape as BodyShape
-    from ._pose_stream import PoseStreamFitter as PoseStreamFitter
-    from ._pose_stream import StreamConfig as StreamConfig
-    from ._pose_stream import arm_motion as arm_motion
-    from ._pose_stream import landmarks_from_arm as landmarks_from_arm
-    from ._pose_stream import smooth_landmarks as smooth_landmarks
     from ._puma import IKConfig as IKConfig
     from ._puma import Puma560 as Puma560
     from ._retarget import RetargetConfig as RetargetConfig
@@ -54,11 +40,25 @@ if typing.TYPE_CHECKING:  # the public names, each loaded when first used (see s
     from ._robot_specs import robot_spec as robot_spec
     from ._robots import TABLE as TABLE
     from ._robots import RobotArm as RobotArm
-    from ._tape import TapeConfig as TapeConfig
-    from ._tape import reconstruct as reconstruct
-    from ._tape import tape_from_arm as tape_from_arm
-    from ._tracker import ArmTracker as ArmTracker
-    from ._tracker import TrackerConfig as TrackerConfig
-    from ._tracker import smooth_recorded_arm as smooth_recorded_arm
+    from .human._fit import ArmFitter as ArmFitter
+    from .human._fit import FitConfig as FitConfig
+    from .human._hand_ik import HandIKConfig as HandIKConfig
+    from .human._hand_ik import fit_hand_pose as fit_hand_pose
+    from .human._human import HumanArm as HumanArm
+    from .human._pose import PoseConfig as PoseConfig
+    from .human._pose import PoseFit as PoseFit
+    from .human._pose import fit_pose_landmarks as fit_pose_landmarks
+    from .human._pose_stream import BodyShape as BodyShape
+    from .human._pose_stream import PoseStreamFitter as PoseStreamFitter
+    from .human._pose_stream import StreamConfig as StreamConfig
+    from .human._pose_stream import arm_motion as arm_motion
+    from .human._pose_stream import landmarks_from_arm as landmarks_from_arm
+    from .human._pose_stream import smooth_landmarks as smooth_landmarks
+    from .human._tape import TapeConfig as TapeConfig
+    from .human._tape import reconstruct as reconstruct
+    from .human._tape import tape_from_arm as tape_from_arm
+    from .human._tracker import ArmTracker as ArmTracker
+    from .human._tracker import TrackerConfig as TrackerConfig
+    from .human._tracker import smooth_recorded_arm as smooth_recorded_arm
 
 __getattr__, __dir__, __all__ = _lazy.lazy_exports(__name__, __file__)

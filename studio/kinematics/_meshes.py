@@ -6,7 +6,7 @@ Both come from installed data packages, never from the network:
 - ``human.urdf``'s own meshes (example-robot-data's ``human_description``, BSD-2), posed by the
   full 36-joint Pinocchio model of the same file the arm fit uses. The taped arm's seven joints
   take the fitted ``q_human``; every other joint stays at its neutral (the other arm hangs).
-  Poses are given in the taped arm's *arm base frame* (see :mod:`studio.kinematics._human`: Z
+  Poses are given in the taped arm's *arm base frame* (see :mod:`studio.kinematics.human._human`: Z
   up, shoulder at the origin), the frame the fit and the tape live in.
 - The Puma560 link meshes of ``rtb-data`` (MIT, Peter Corke; the data files of the Robotics
   Toolbox for Python), which the Toolbox attaches as ``link{j}.stl`` to DH frame ``j`` of its
@@ -38,7 +38,7 @@ import pinocchio as pin
 
 from ._checks import KinematicsError, check_side
 from ._dh import PUMA_LINK_COLORS, PUMA_MESH_DIR
-from ._human import ARM_JOINTS, YUP_TO_ZUP, find_human_urdf
+from .human._human import ARM_JOINTS, YUP_TO_ZUP, find_human_urdf
 
 HUMAN_COLORS = {
     "skin": (0.89, 0.72, 0.60),

@@ -60,8 +60,6 @@ import numpy as np
 
 from ._checks import KinematicsError, instance_of, positive_number, whole_number
 from ._clearance import ClearanceGuard
-from ._hand_ik import fit_hand_pose
-from ._human import SAGITTAL_MIRROR, HumanArm, _as_q
 from ._puma import IKConfig, IKResult, Puma560
 from ._robot_load import load_robot
 from ._robots import IK_DAMPING, RobotArm, RobotIK, tool_errors
@@ -74,6 +72,8 @@ from ._workspace import (
     unbent,
     unfloored,
 )
+from .human._hand_ik import fit_hand_pose
+from .human._human import SAGITTAL_MIRROR, HumanArm, _as_q
 
 Mode = Literal["joint", "cartesian"]
 

@@ -57,10 +57,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._human import HumanArm
 from ._puma import Puma560
 from ._retarget import RetargetConfig, Retargeter
 from ._robots import RobotArm, RobotIK, tool_errors
+from .human._human import HumanArm
 
 REACHABLE_STARTS = 24
 """Random starts of :func:`reachable`'s search over the joint ranges, besides home."""

@@ -11,7 +11,7 @@ import pytest
 from studio.capture import RecordingWriter, simulate
 from studio.export import recording_motion, time_path
 from studio.kinematics import load_robot, retarget_path
-from studio.kinematics._filter import turn_backs
+from studio.kinematics.human._filter import turn_backs
 
 RATE_HZ = 50.0
 

@@ -28,7 +28,7 @@ from studio.kinematics import (
     reconstruct,
     tape_from_arm,
 )
-from studio.kinematics._tape import TapeShape
+from studio.kinematics.human._tape import TapeShape
 
 ARMS = {side: HumanArm(side) for side in ("right", "left")}
 CONFIGS = {side: TapeConfig(side=side) for side in ("right", "left")}

@@ -8,7 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from studio.kinematics import HumanArm, KinematicsError, fit_hand_pose
-from studio.kinematics._hand_ik import HandFit
+from studio.kinematics.human._hand_ik import HandFit
 
 REACH_M = 0.01
 

@@ -11,8 +11,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from studio.kinematics import HumanArm, KinematicsError, _human, _robots
-from studio.kinematics._human import ArmPose, mirror_human_q
+from studio.kinematics import HumanArm, KinematicsError, _robots
+from studio.kinematics.human import _human
+from studio.kinematics.human._human import ArmPose, mirror_human_q
 
 RIGHT = HumanArm("right")
 LEFT = HumanArm("left")

@@ -24,7 +24,7 @@ from studio.kinematics import (
     fit_pose_landmarks,
     landmarks_from_arm,
 )
-from studio.kinematics._pose import LANDMARKS
+from studio.kinematics.human._pose import LANDMARKS
 
 PERSON = {"upper_arm": 0.31, "forearm": 0.25, "hand": 0.17}
 """A person whose limbs are not the model's defaults (0.276, 0.287, 0.153 m)."""

@@ -19,7 +19,7 @@ from studio.kinematics import (
     landmarks_from_arm,
     smooth_landmarks,
 )
-from studio.kinematics._filter import ConstantVelocityFilter, smooth_constant_velocity
+from studio.kinematics.human._filter import ConstantVelocityFilter, smooth_constant_velocity
 from studio.learning import ArmGrid
 from tests.kinematics.test_pose_landmarks import PERSON, errors, noisy
 

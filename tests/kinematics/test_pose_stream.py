@@ -17,7 +17,7 @@ from studio.kinematics import (
     fit_pose_landmarks,
     landmarks_from_arm,
 )
-from studio.kinematics._filter import ConstantVelocityFilter, OneEuroFilter
+from studio.kinematics.human._filter import ConstantVelocityFilter, OneEuroFilter
 from tests.kinematics.test_pose_landmarks import PERSON, errors, noisy
 
 RATE_HZ = 30.0

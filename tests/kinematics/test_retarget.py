@@ -20,8 +20,8 @@ from studio.kinematics import (
     load_robot,
     retarget_path,
 )
-from studio.kinematics._filter import turn_backs
 from studio.kinematics._retarget import DROPPED_HUMAN_JOINT, JOINT_MAP
+from studio.kinematics.human._filter import turn_backs
 
 RIGHT = HumanArm("right")
 LEFT = HumanArm("left")

@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
 from studio.kinematics import HumanArm, KinematicsError, TapeConfig, reconstruct, tape_from_arm
-from studio.kinematics._tape import tape_angles
+from studio.kinematics.human._tape import tape_angles
 
 CONFIG = TapeConfig()
 R = CONFIG.regions

@@ -20,8 +20,8 @@ from studio.kinematics import (
     smooth_recorded_arm,
     tape_from_arm,
 )
-from studio.kinematics._filter import turn_backs, white_noise
-from studio.kinematics._tracker import Tracked
+from studio.kinematics.human._filter import turn_backs, white_noise
+from studio.kinematics.human._tracker import Tracked
 from tests.kinematics.test_fit import observable_box, observable_q
 
 TRACKERS = {side: ArmTracker(TapeConfig(side=side)) for side in ("right", "left")}

@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING, Literal
 import numpy as np
 from numba import njit
 
-from ._checks import KinematicsError, check_side, positive_number, real_array, whole_number
+from .._checks import KinematicsError, check_side, positive_number, real_array, whole_number
 
 if TYPE_CHECKING:
     from ._human import HumanArm

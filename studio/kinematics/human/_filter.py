@@ -15,7 +15,7 @@ import math
 
 import numpy as np
 
-from ._checks import KinematicsError, positive_number, real_array
+from .._checks import KinematicsError, positive_number, real_array
 
 
 def _alpha(cutoff: np.ndarray | float, dt: float) -> np.ndarray | float:

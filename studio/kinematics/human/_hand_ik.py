@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from ._checks import (
+from .._checks import (
     KinematicsError,
     check_side,
     instance_of,

@@ -21,12 +21,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ._checks import KinematicsError, instance_of, positive_number
+from .._checks import KinematicsError, instance_of, positive_number
+from .._puma import IKResult, Puma560
+from .._retarget import Mode, RetargetConfig, Retargeter
 from ._filter import OneEuroFilter, smooth_constant_velocity, white_noise
 from ._fit import ArmFit, ArmFitter, FitConfig
 from ._human import HumanArm
-from ._puma import IKResult, Puma560
-from ._retarget import Mode, RetargetConfig, Retargeter
 from ._tape import TapeConfig, reconstruct
 
 SMOOTHING_CUTOFF_HZ = (3.0, 3.0, 0.5, 3.0, 0.5, 0.5, 0.5)

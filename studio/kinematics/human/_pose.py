@@ -72,7 +72,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pinocchio as pin
 
-from ._checks import KinematicsError, check_side, positive_number, real_array, whole_number
+from .._checks import KinematicsError, check_side, positive_number, real_array, whole_number
 from ._human import HumanArm
 
 N_LANDMARKS = 33

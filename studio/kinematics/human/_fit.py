@@ -43,7 +43,7 @@ import numpy as np
 import pinocchio as pin
 from numba import njit
 
-from ._checks import KinematicsError, instance_of, positive_number, real_array, whole_number
+from .._checks import KinematicsError, instance_of, positive_number, real_array, whole_number
 from ._human import HumanArm
 from ._tape import TapeConfig, TapeShape, reconstruct
 

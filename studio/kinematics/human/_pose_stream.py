@@ -42,7 +42,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ._checks import (
+from .._checks import (
     KinematicsError,
     check_side,
     instance_of,
