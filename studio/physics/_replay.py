@@ -217,6 +217,7 @@ def _report(
             n for n, s in zip(arm.joint_names, per_sample.any(axis=0), strict=True) if s
         ),
         first_saturated_sample=int(np.argmax(hit)) if hit.any() else None,
+        obstacles=len(model.obstacles),
         unlimited_joints=tuple(
             n for n, e in zip(arm.joint_names, model.effort, strict=True) if not math.isfinite(e)
         ),

@@ -93,6 +93,8 @@ class SimulationReport:
         saturated_joints: the joints that saturated, in joint order.
         first_saturated_sample: the first sample that saturated (None: none did).
         unlimited_joints: the joints whose URDF gives no force limit (simulated unlimited).
+        obstacles: how many obstacle boxes stood in the replay (their contacts are among
+            ``contacts``).
         times: the samples' times (s, from 0).
         q_simulated: the simulated joints at each sample ``(samples, nq)`` (rad): the motion
             the robot made, to play in a scene (NaN after the simulation went unstable).
@@ -109,6 +111,7 @@ class SimulationReport:
     saturated_joints: tuple[str, ...] = ()
     first_saturated_sample: int | None = None
     unlimited_joints: tuple[str, ...] = ()
+    obstacles: int = 0
     times: np.ndarray | None = field(default=None, compare=False, repr=False)
     q_simulated: np.ndarray | None = field(default=None, compare=False, repr=False)
 
@@ -147,7 +150,8 @@ class SimulationReport:
         if self.contacts:
             lines += [f"contact: {c.sentence()}" for c in self.contacts]
         else:
-            lines.append("contacts: none (self or table)")
+            boxes = f"self, table or the {self.obstacles} obstacle box(es)"
+            lines.append(f"contacts: none ({boxes if self.obstacles else 'self or table'})")
         if self.unlimited_joints:
             lines.append(
                 f"note: the URDF gives {', '.join(self.unlimited_joints)} no force limit; "

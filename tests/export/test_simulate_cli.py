@@ -121,3 +121,7 @@ def test_an_obstacle_in_the_way_is_reported_as_a_contact(tmp_path, capsys, physi
     assert main(argv) == 0
     report = json.loads(capsys.readouterr().out)
     assert not [c for c in report["contacts"] if c["kind"] == "obstacle"]
+    argv.remove("--json")  # a box away from the swing: the sentences say it was checked
+    assert main([*argv, "--obstacle=-0.6,-0.6,0.3,0.1,0.1,0.1"]) == 0
+    out = capsys.readouterr().out
+    assert "contacts: none (self, table or the 1 obstacle box(es))" in out
