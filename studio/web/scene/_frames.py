@@ -27,6 +27,17 @@ SwiftShader in the browser's GPU process: about 50 ms of CPU a frame for this sc
   viser's page applies what it receives in its next frame, so the page must not wait for a
   frame to read the message that lifts the limit: while still, the page reads as hidden
   (``document.hidden``), for which viser applies each message as it comes.
+- **Waking a still page for an update of the whole scene** (a pose): the script that wakes the
+  page goes through that page's own message queue, the update through viser's queue for every
+  page, so the page receives them in two batches, and a frame let go when the first is applied
+  may be drawn before the second arrives (the old pose, on a busy machine; and while a slow
+  stream drives the scene, the pose then waits for the next one). So the frames held back are
+  let go only once viser has applied the update (its ``requestRender``, which it calls after
+  each batch of scene messages), or at once if the update came first: the frame let go draws
+  the update. Until then the page draws no frame at all (for at most
+  :data:`UPDATE_AWAITED_MS`), not even one whose turn comes meanwhile. An update for one page
+  alone is sent in one batch with the script that wakes it (viser's ``atomic``), and the frames
+  are let go at once.
 
 Anything the user does in the scene (a pointer, the wheel, a key) or a resize of its window lifts
 the limit for :data:`INPUT_LIFTS_MS` and draws any frame held back, so orbiting stays as smooth
@@ -67,6 +78,10 @@ LOADING_S = 5.0
 it draws freely."""
 INPUT_LIFTS_MS = 1500.0
 """How long a pointer, wheel or key event in the scene, or a resize, lifts the limit."""
+UPDATE_AWAITED_MS = 2000.0
+"""A page woken for an update of the scene draws no frame until it has applied it, for at most
+this long (the update comes right behind the script waking the page; a message that changes
+nothing in the scene, a label's, wakes the page too)."""
 WATCH_EVERY_S = 0.1
 """How often the pacer looks whether the scene has become still."""
 
@@ -74,7 +89,14 @@ _PACING_JS = """
 (() => {
   let p = window.__studioFramePacing;
   if (!p) {
-    p = window.__studioFramePacing = { gapMs: 0, inputUntil: 0, next: 0, at: 0, lastT: -1, frames: 0 };
+    p = window.__studioFramePacing = {
+      gapMs: 0, inputUntil: 0, next: 0, at: 0, lastT: -1, frames: 0,
+      inFrame: false, // a frame let through is running
+      inScript: false, // this script ran in the task now running (viser's batch carrying it)
+      woken: false, // woken for an update still to come: let the held frames go once it is applied
+      awaitUntil: 0, // and until then (at most this long) hold every frame, whenever its turn
+      changed: false, // an update was applied while still, and no frame drew it yet
+    };
     const raf = window.requestAnimationFrame.bind(window);
     const caf = window.cancelAnimationFrame.bind(window);
     const waiting = new Map(); // our id -> [timeout, the browser's frame id, callback]
@@ -83,7 +105,8 @@ _PACING_JS = """
       waiting.get(id)[1] = raf((t) => {
         waiting.delete(id);
         if (t !== p.lastT) { p.lastT = t; p.frames += 1; p.at = performance.now(); p.next = p.at + p.gapMs; }
-        cb(t);
+        p.inFrame = true;
+        try { cb(t); } finally { p.inFrame = false; p.changed = false; }
       });
     };
     p.release = () => { // hand every frame held back to the browser now
@@ -96,7 +119,8 @@ _PACING_JS = """
     };
     const wait = () => { // how long a frame requested now waits for its turn
       const now = performance.now();
-      return p.gapMs > 0 && now >= p.inputUntil ? p.next - now : 0;
+      if (now < p.inputUntil) return 0;
+      return Math.max(p.awaitUntil - now, p.gapMs > 0 ? p.next - now : 0);
     };
     const hold = (id, cb) => { // until its turn, counted again when it comes (the gap may have grown)
       const ms = wait();
@@ -129,25 +153,60 @@ _PACING_JS = """
     Object.defineProperty(document, "hidden", { configurable: true, get: () => p.still || p.atOnce || hidden.call(document) });
     p.hides = true;
   }
+  // viser calls requestRender once it has applied a batch of scene messages (messageQueue.ts);
+  // set again whenever viser set its own (it does so when its canvas mounts).
+  const viewer = window.__viserMutable;
+  const hooked = !!viewer && typeof viewer.requestRender === "function";
+  if (hooked && !viewer.requestRender.__studio) {
+    const render = viewer.requestRender;
+    const applied = () => {
+      render();
+      // asked for by a frame, or for the batch carrying this script: not an update arriving
+      if (p.inFrame || p.inScript) return;
+      if (p.woken) { p.woken = false; p.awaitUntil = 0; p.release(); }
+      else if (p.still) p.changed = true;
+    };
+    applied.__studio = true;
+    viewer.requestRender = applied;
+  }
+  // viser calls requestRender for the batch carrying this script too, right after it
+  p.inScript = true;
+  queueMicrotask(() => { p.inScript = false; });
   const before = p.gapMs;
   p.gapMs = %(gap)s;
   p.still = %(still)s;
   p.atOnce = %(at_once)s;
+  p.woken = false;
+  p.awaitUntil = 0;
   if (p.gapMs !== before) p.next = p.at ? p.at + p.gapMs : 0; // from the last frame drawn
-  if (p.gapMs < before) p.release();
+  if (p.gapMs < before) {
+    if (!%(update_follows)s || !hooked || p.changed) p.release();
+    else { // the update comes in a batch of its own, applied in a task of its own
+      p.woken = true;
+      p.awaitUntil = performance.now() + %(await_ms)s;
+    }
+  }
 })();
 """
 
 
-def pacing_js(gap_ms: float, still: bool = False, at_once: bool = False) -> str:
+def pacing_js(
+    gap_ms: float, still: bool = False, at_once: bool = False, update_follows: bool = False
+) -> str:
     """The script that sets the least time between frames of viser's page (0: no limit),
     whether its scene is still, and whether a slow stream drives it (in both viser applies each
-    update as it comes, see above: the frame that draws it is then the only one it needs)."""
+    update as it comes, see above: the frame that draws it is then the only one it needs).
+
+    ``update_follows``: the script wakes a still page for an update of the scene that reaches it
+    in a batch of its own; the frames held back are let go once viser has applied it (at once on
+    a page whose viser does not say so)."""
     return _PACING_JS % {
         "gap": float(gap_ms),
         "lift": INPUT_LIFTS_MS,
         "still": "true" if still else "false",
         "at_once": "true" if at_once else "false",
+        "update_follows": "true" if update_follows else "false",
+        "await_ms": UPDATE_AWAITED_MS,
     }
 
 
@@ -204,19 +263,28 @@ class FramePacer:
         self._closed.set()
         self._thread.join(timeout=2.0)
 
-    def _wrap(self, handler: object) -> Callable[[object], None]:
-        """Route ``handler``'s outgoing messages through :meth:`_sent`; its original sender."""
+    def _wrap(self, handler: object, client_id: int | None = None) -> Callable[[object], None]:
+        """Route ``handler``'s outgoing messages through :meth:`_sent`; its original sender.
+
+        ``client_id``: the page ``handler`` sends to alone (None: every page)."""
         send = handler.queue_message  # type: ignore[attr-defined]
 
         def queue_message(message: object) -> None:
-            self._sent()
-            send(message)
+            if client_id is None:
+                self._sent(None)
+                send(message)
+                return
+            with handler.atomic():  # type: ignore[attr-defined]
+                self._sent(client_id)  # its page gets the message in the batch that wakes it
+                send(message)
 
         handler.queue_message = queue_message  # type: ignore[attr-defined]
         return send
 
-    def _sent(self) -> None:
-        """A message is about to go to the pages: wake the still ones first."""
+    def _sent(self, to: int | None) -> None:
+        """A message is about to go to page ``to`` (None: to every page): wake the still ones
+        first. A message to every page reaches each in a batch of its own, after the one waking
+        it: a woken page lets its frames go once it has applied that batch."""
         with self._lock:
             self._last_sent = time.monotonic()
             if not self._still:
@@ -224,13 +292,13 @@ class FramePacer:
             for client_id in self._still:
                 page = self._pages.get(client_id)
                 if page is not None:
-                    self._tell(page, self.gap_ms)
+                    self._tell(page, self.gap_ms, update_follows=to is None)
             self._still.clear()
 
     def _connected(self, client: viser.ClientHandle) -> None:
         # viser has no public call to run a script in one browser, nor to see what it sends;
         # its plotly support sends scripts through the connection the same way.
-        page = _Page(self._wrap(client._websock_connection))
+        page = _Page(self._wrap(client._websock_connection, client.client_id))
         with self._lock:
             self._pages[client.client_id] = page
             if self.gap_ms > 0:  # else the page draws as viser made it, without the wrapper
@@ -241,11 +309,14 @@ class FramePacer:
             self._pages.pop(client.client_id, None)
             self._still.discard(client.client_id)
 
-    def _tell(self, page: _Page, gap_ms: float, still: bool = False) -> None:
+    def _tell(
+        self, page: _Page, gap_ms: float, still: bool = False, update_follows: bool = False
+    ) -> None:
         """Send ``page`` the gap (the caller holds the lock)."""
         from viser import _messages
 
-        page.send(_messages.RunJavascriptMessage(pacing_js(gap_ms, still, self.gap_ms > 0)))
+        script = pacing_js(gap_ms, still, self.gap_ms > 0, update_follows)
+        page.send(_messages.RunJavascriptMessage(script))
 
     def _watch(self) -> None:
         """Tell each loaded page the still gap once nothing was sent for STILL_AFTER_S (for
