@@ -10,8 +10,9 @@ One rule for both servers. The API (:class:`GuardMiddleware`) and the scene serv
   DELETE) is refused when its ``Origin``, or failing that its ``Referer``, is another site; a
   websocket is refused from another site whatever its method; a read of the API (``GET
   /api/...``: an export, a figure, a rollout can cost minutes of CPU) is refused when its
-  ``Origin`` is another site or the browser marks it ``Sec-Fetch-Site: cross-site`` (an
-  ``<img>`` or a link another site's page loads sends no ``Origin``);
+  ``Origin`` is another site or the browser marks it ``Sec-Fetch-Site: cross-site`` or
+  ``same-site`` (an ``<img>`` or a link another page loads sends no ``Origin``; a page of
+  another program on this machine, on another port, is the same site but not the studio);
 - when a token is set (required beyond loopback), only requests carrying it: ``?token=`` once
   (the link printed at start; the answer sets a cookie the page's later requests carry), the
   cookie, or an ``Authorization: token <token>`` (or ``Bearer``) header for scripts.
@@ -221,8 +222,11 @@ class GuardMiddleware:
 
     def _cross_site_read(self, headers: dict[str, str]) -> bool:
         """Whether a read comes from another site's page: a foreign ``Origin`` (a script's
-        ``fetch``), or the browser's own ``Sec-Fetch-Site: cross-site`` (an image, a link)."""
-        if headers.get("sec-fetch-site", "").strip().lower() == "cross-site":
+        ``fetch``), or the browser's own ``Sec-Fetch-Site`` (an image, a link), ``cross-site`` or
+        ``same-site``: another port of this machine (a local program's page) is the same site,
+        and only ``same-origin`` (the studio's page) or ``none`` (typed, a bookmark) is the
+        studio's."""
+        if headers.get("sec-fetch-site", "").strip().lower() in ("cross-site", "same-site"):
             return True
         return not self.rule.origin_ok(headers.get("origin"), headers.get("host"))
 

@@ -59,7 +59,12 @@ def test_a_cross_site_upload_stores_nothing(client: TestClient, tmp_path: Path) 
 
 @pytest.mark.parametrize(
     "headers",
-    [{"Origin": EVIL}, {"Sec-Fetch-Site": "cross-site"}, {"Origin": "http://127.0.0.1:1"}],
+    [
+        {"Origin": EVIL},
+        {"Sec-Fetch-Site": "cross-site"},
+        {"Origin": "http://127.0.0.1:1"},
+        {"Sec-Fetch-Site": "same-site"},  # an <img> on another local port's page sends no Origin
+    ],
 )
 def test_a_read_from_another_site_does_no_work(
     client: TestClient, headers: dict[str, str], monkeypatch: pytest.MonkeyPatch
@@ -78,7 +83,13 @@ def test_a_read_from_another_site_does_no_work(
     assert client.get("/api/capture", headers=headers).status_code == 403
     assert started == []
     # the studio's own page, a link typed into the address bar, a command-line client
-    for own in ({"Origin": "http://testserver"}, {"Sec-Fetch-Site": "same-origin"}, {}):
+    own_reads = (
+        {"Origin": "http://testserver"},
+        {"Sec-Fetch-Site": "same-origin"},
+        {"Sec-Fetch-Site": "none"},
+        {},
+    )
+    for own in own_reads:
         assert client.get("/api/capture", headers=own).status_code == 200
     assert client.get("/", headers={"Sec-Fetch-Site": "cross-site"}).status_code == 200
 
