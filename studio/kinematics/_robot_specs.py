@@ -47,7 +47,8 @@ class RobotSpec:
             faces the operator (the SO-100's URDF faces -y).
         hollow: the radius, as a share of :attr:`RobotArm.reach`, of the column around the
             first joint's axis that the tool cannot enter with the arm raised (an arm whose
-            shoulder is offset sideways, the UR's): the retargeting keeps hand targets out of
+            shoulder is offset sideways, the UR's), or can enter only by turning its first
+            joint faster than it can (the SO-100's): the retargeting keeps hand targets out of
             it smoothly (:attr:`RetargetConfig.hollow_softness`); 0 for none.
         usable_reach: the share of :attr:`RobotArm.reach` (the farthest the tool gets, at
             whatever orientation) that the retargeting maps the operator's reach onto, times
@@ -103,6 +104,19 @@ nearer the axis than about that: a hand held straight above or below the operato
 mapped there, was out of every pose's reach (85-211 of the 566 frames ``test_reach`` judges).
 Kept 0.2 of the reach out, such a frame is reached. Between 0.15
 and 0.25 the frames reached change by a few points either way, differently on each motion."""
+
+SO100_HOLLOW = 0.1
+"""The SO-100's :attr:`RobotSpec.hollow`. It follows the hand's position only, and its first
+joint turns the whole arm about the vertical: a target near that axis is reached by turning it
+by the target's angle around the axis, which a hand passing a centimetre or two from it swings
+through 120 degrees in a fraction of a second. The operator's hand held near the shoulder (a
+reach's start) mapped there: the first joint then had to turn 8.6 times as fast as its 1 rad/s
+allows, and the exports of sample-reach-2 and -3 took 2.3 and 3.0 times the person's duration.
+Kept 0.1 of the reach out, they take 1.15 and 1.38 times it, and the arm reaches every frame of
+the three samples and the simulator minute (it missed 10% of sample-reach-3). At 0.15 the
+exports took longer (1.39 and 1.42 times), and at 0.2-0.25 the hand's targets were moved out by
+more than a centimetre on 5-27% of the frames of samples 2 and 3 (``benchmarks/bench_reach.py``).
+The SO-101, whose URDF allows its joints 10 rad/s, keeps pace without it."""
 
 UR_USABLE_REACH = 0.9
 """The UR5's and UR10's :attr:`RobotSpec.usable_reach`. Their wrist offsets (0.09-0.16 m) put
@@ -183,6 +197,7 @@ ROBOT_SPECS: dict[str, RobotSpec] = {
             5,
             orientation=False,
             facing=-math.pi / 2,
+            hollow=SO100_HOLLOW,
             lerobot_driver="so100_follower",
         ),
         RobotSpec(
