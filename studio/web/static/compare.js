@@ -66,7 +66,7 @@ function compareRow(r, columns) {
     ...columns.map((c) => el("td", { class: c.differs && plotted ? "differs" : null, "data-key": c.key, text: shown((r.config || {})[c.key]) })),
     el("td", { class: "num", text: fmtCpu(r.cpu_seconds) }),
     el("td", {}, el("input", { type: "text", testid: "compare-tags", "aria-label": `Tags of ${label}`,
-      placeholder: "tags, comma separated", onchange: save })),
+      placeholder: "tags: a, b", title: "Tags, comma separated", onchange: save })),
     el("td", {}, el("textarea", { rows: 1, testid: "compare-notes", "aria-label": `Notes of ${label}`, placeholder: "notes", onchange: save })),
   );
   row.drawn = row.outerHTML; // the browser may touch its fields' attributes (autofill's style)
