@@ -278,9 +278,11 @@ def _wait_for_checkpoints(path: Path, proc: subprocess.Popen, count: int) -> lis
 # Long enough (about a minute even on a quiet machine) that the signal always lands mid-training:
 # with 100 planning updates the 100,000 episodes could end in the ~2 s before the kill.
 LONG_RUN = [
-    "--planning", "full", "--planning-steps", "2000",
+    "--planning", "full", "--planning-steps", "10000",
     "--experiments", "1", "--episodes", "100000", "--no-progress",
 ]  # fmt: skip
+"""A run the tests stop mid-way: minutes of CPU. (At 2,000 planning steps it ended in 24 s, and on
+a busy machine it could end before a test saw its first checkpoint, so no signal stopped it.)"""
 
 
 def test_kill_9_mid_training_keeps_the_curve_and_the_policy_to_the_last_checkpoint(tmp_path):
