@@ -45,6 +45,25 @@ def require(condition: bool, reason: str) -> None:
     pytest.skip(reason)
 
 
+def interruptible() -> None:
+    """``preexec_fn`` of a child a test stops with Ctrl-C (SIGINT): the signal delivered and not
+    ignored, as in a terminal. A blocked or ignored SIGINT is inherited across ``exec``, and a
+    worker that ran other tests first may carry one; the child would then never see Ctrl-C."""
+    import signal
+
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
+def signal_masks(pid: int) -> str:
+    """A process's blocked, ignored and caught signals (``/proc``), for a failure's message."""
+    try:
+        lines = Path(f"/proc/{pid}/status").read_text().splitlines()
+    except OSError as err:
+        return f"(no /proc status for {pid}: {err})"
+    return " ".join(line for line in lines if line.startswith(("SigBlk", "SigIgn", "SigCgt")))
+
+
 def free_port() -> int:
     """A TCP port on loopback that nobody listens on now (the OS picks it)."""
     with socket.socket() as sock:

@@ -106,19 +106,27 @@ def test_ctrl_c_during_record_keeps_every_frame(tmp_path):
     import sys
     import time
 
+    from tests.conftest import interruptible, signal_masks
+
     out = tmp_path / "interrupted.tape.csv"
     child = subprocess.Popen(
         [sys.executable, "-m", "studio.cli", "record", "--out", str(out)],
         stderr=subprocess.PIPE,
         text=True,
+        preexec_fn=interruptible,
     )
     deadline = time.monotonic() + 60
     while time.monotonic() < deadline:  # wait for frames on disk
         if out.exists() and out.read_text().count("\n") > 60:
             break
         time.sleep(0.1)
+    masks = signal_masks(child.pid)
     child.send_signal(signal.SIGINT)
-    _, err = child.communicate(timeout=120)  # it then summarises the file: slow on a busy machine
+    try:  # it then summarises the file: slow on a busy machine
+        _, err = child.communicate(timeout=120)
+    except subprocess.TimeoutExpired:
+        child.kill()
+        raise AssertionError(f"Ctrl-C did not stop studio record; its signals: {masks}") from None
     rec = read_recording(out)
     assert not rec.recovered and len(rec) > 50  # closed cleanly with its '# end' line
     assert "every captured frame is kept" in err

@@ -34,6 +34,7 @@ from studio.learning import (
     load_policy,
 )
 from studio.learning.runs._curves import CURVE_COLUMNS, curve_plot
+from tests.conftest import interruptible, signal_masks
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -253,6 +254,7 @@ def _studio(*args: str, cwd: Path) -> subprocess.Popen:
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
+        preexec_fn=interruptible,
     )
 
 
@@ -317,12 +319,13 @@ def test_ctrl_c_mid_training_keeps_the_curve_and_writes_a_policy(tmp_path):
     folder = tmp_path / "runs" / "interrupted"
     try:
         _wait_for_checkpoints(folder, proc, 1)
+        masks = signal_masks(proc.pid)
         proc.send_signal(signal.SIGINT)
         out, err = proc.communicate(timeout=120)
     finally:
         if proc.poll() is None:
             proc.kill()
-    assert proc.returncode == 130, err
+    assert proc.returncode == 130, f"{err}\nits signals: {masks}; its output: {out[-2000:]}"
     assert "Stopped:" in out and "policy" in out
     run = RunFolder.load(folder)
     assert run.status == "stopped" and not run.interrupted and run.has_policy
