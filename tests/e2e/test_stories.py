@@ -31,6 +31,26 @@ def _pixels(png: bytes) -> np.ndarray:
     return np.asarray(Image.open(io.BytesIO(png)).convert("RGB"), dtype=float)
 
 
+def _chart_png(page: Any) -> bytes:
+    """The curve chart's canvas. The chart draws itself anew (a new canvas) when a run's news
+    comes, so a screenshot that finds its canvas gone is taken again, of the new one."""
+    from playwright.sync_api import Error as PlaywrightError
+
+    shots: list[bytes] = []
+
+    def took() -> bool:
+        try:
+            shots.append(page.locator("#curve-plot canvas").first.screenshot(timeout=10_000))
+        except PlaywrightError as err:
+            if "not attached" not in str(err):
+                raise
+            return False
+        return True
+
+    assert _wait(took, 60), "the chart's canvas never held still for a screenshot"
+    return shots[-1]
+
+
 def _scene_png(page: Any, name: str) -> bytes:
     png = page.locator("[data-testid='scene-frame']").screenshot()
     (ARTIFACTS / f"{name}.png").write_bytes(png)
@@ -389,7 +409,7 @@ def test_story5_training_curve_updates_live(page: Any, studio_server: Studio) ->
     # The chart draws both: its canvas is not blank, and it has a legend row per run.
     legend = page.locator("#curve-plot .u-legend .u-series:visible")
     assert legend.count() >= 3  # the episode readout and one row per plotted run
-    plot = _pixels(page.locator("#curve-plot canvas").first.screenshot())
+    plot = _pixels(_chart_png(page))
     assert len(np.unique(plot.reshape(-1, 3).round(-1), axis=0)) > 8
 
     # A supervised run replays the demonstration cut in story 4 (its goal is the demo's end).

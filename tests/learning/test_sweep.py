@@ -590,8 +590,10 @@ def test_a_scheduler_sweep_ends_every_trial_done_or_early_stopped(
     result = run_sweep(spec, tmp_path)
     assert not result.interrupted and not result.failed
     records = trial_records(sweep_folder(tmp_path, "asha"))
-    assert records["t0002"]["status"] == "early-stopped", records
-    assert records["t0003"]["status"] in ("done", "early-stopped"), records
+    # one of zero planning's two seeds reaches the first rung behind the others and is stopped:
+    # t0002 as a rule, t0003 when the busy machine's reports come in the other order
+    zero = {records[key]["status"] for key in ("t0002", "t0003")}
+    assert "early-stopped" in zero and zero <= {"done", "early-stopped"}, records
     assert len({record["pid"] for record in records.values()}) == 1, records  # one worker
     for row in result.rows:
         run = RunFolder.load(trial_run_path(tmp_path, "asha", row["trial"]))
