@@ -4,27 +4,16 @@ where its handle stands, and sent with the run the form starts (issue 40)."""
 from __future__ import annotations
 
 import json
-import time
 from typing import Any
 
 import pytest
 
 from tests.e2e.conftest import Studio
+from tests.web.conftest import wait_for
 
 pytestmark = pytest.mark.e2e
 
 T = 60_000  # ms: the longest a single UI step may take on a busy machine
-
-
-def _wait(predicate: Any, timeout: float = 60.0) -> Any:
-    """Poll ``predicate`` until it returns something truthy (the event, not a fixed sleep)."""
-    end = time.monotonic() + timeout
-    while time.monotonic() < end:
-        value = predicate()
-        if value:
-            return value
-        time.sleep(0.1)
-    return predicate()
 
 
 def _boxes(studio: Studio) -> list[dict]:
@@ -46,13 +35,13 @@ def test_add_an_obstacle_size_it_and_train_around_it(page: Any, studio_server: S
         page.click("[data-testid='train-add-obstacle']")
         page.wait_for_selector(row, timeout=T)
         assert page.locator(row).count() == 1
-        placed = _wait(lambda: _boxes(studio_server))
-        assert len(placed) == 1  # drawn in the scene, with its handle
+        assert wait_for(lambda: _boxes(studio_server), 60)
+        assert len(_boxes(studio_server)) == 1  # drawn in the scene, with its handle
 
         # sized in the form: the scene's box follows
         page.fill("[data-testid='obstacle-0-size-0']", "0.2")
         page.press("[data-testid='obstacle-0-size-0']", "Tab")
-        assert _wait(lambda: _boxes(studio_server)[0]["size"][0] == 0.2)
+        assert wait_for(lambda: _boxes(studio_server)[0]["size"][0] == 0.2, 60)
 
         # a size that is no size: one sentence under the list, and the box keeps its size
         page.fill("[data-testid='obstacle-0-size-1']", "0")
@@ -81,13 +70,14 @@ def test_add_an_obstacle_size_it_and_train_around_it(page: Any, studio_server: S
         page.fill("[data-testid='train-experiments']", "1")
         before = len(_stored_with_obstacles(studio_server))
         page.click("[data-testid='train-start']")
-        stored = _wait(lambda: _stored_with_obstacles(studio_server)[before:], 180)
-        assert stored, page.inner_text("[data-testid='train-error']")
+        ran = wait_for(lambda: _stored_with_obstacles(studio_server)[before:], 180)
+        assert ran, page.inner_text("[data-testid='train-error']")
+        stored = _stored_with_obstacles(studio_server)[before:]
         assert stored[0]["obstacles"] == [{"centre": [0.55, 0.45, 0.85], "size": [0.2, 0.15, 0.15]}]
 
         # removed: the form and the scene hold none
         page.click("[data-testid='obstacle-0-remove']")
-        assert _wait(lambda: not _boxes(studio_server))
+        assert wait_for(lambda: not _boxes(studio_server), 60)
         page.wait_for_selector(row, state="detached", timeout=T)
     finally:
         studio_server.send("PUT", "/api/scene/obstacles", {"obstacles": []})
