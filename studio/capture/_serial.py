@@ -38,6 +38,7 @@ import numpy as np
 from ._calibration import Calibration, load_calibration
 from ._errors import CaptureError
 from ._observations import STATUS_BITS_MASK, TapeFrame
+from ._recording_format import DEFAULT_RATE_HZ  # polling rate: the paper's tape rate
 from ._source import DEFAULT_QUEUE_FRAMES, ThreadedSource
 
 REQUEST = b"\x20"
@@ -142,8 +143,6 @@ def decode_reply(prefix: bytes, rest: bytes) -> RawFrame:
     return RawFrame(status, serial, counter, timer, raw)
 
 
-DEFAULT_RATE_HZ = 110.0
-"""Polling rate (the paper's 110 Hz)."""
 REPLY_TIMEOUT_SECONDS = 0.1
 """How long to wait for one reply before counting the frame lost: a 16-region reply takes 7 ms at
 115200 baud, so this only trips when the tape (or a loaded host) really stalls; the schedule's
