@@ -3,7 +3,8 @@
 The server gets random free ports and a temporary data directory (with the repo's sample
 recordings copied in); one browser and one page serve the whole session of a worker, so the
 stories run in order like a user's visit (the files that take the shared ``page`` all run on one
-worker: ``tests/conftest.py`` hands them out as one unit). Screenshots of each step go to
+worker: ``tests/conftest.py`` hands them out as one unit). Pages leave the 3D scene out unless
+a test looks at it (:func:`live_scene`, ``own_page(scene=True)``). Screenshots of each step go to
 ``test-artifacts/e2e/``.
 """
 
@@ -11,6 +12,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -154,10 +156,14 @@ def browser() -> Iterator[Any]:
 # package scope: closed with tests/e2e, so the sync Playwright loop does not outlive it
 @pytest.fixture(scope="package")
 def page(browser: Any, studio_server: Studio) -> Iterator[Any]:
-    """The studio page, loaded once for the whole session (stories follow one another)."""
+    """The studio page, loaded once for the whole session (stories follow one another). Its 3D
+    scene is left out (:func:`leave_out_scene`); a test shows it with :func:`live_scene` for
+    the part that looks at it."""
     ARTIFACTS.mkdir(parents=True, exist_ok=True)
     context = browser.new_context(viewport={"width": 1440, "height": 900}, accept_downloads=True)
+    left_out = leave_out_scene(context, studio_server)
     pg = context.new_page()
+    pg.left_out_scene = left_out  # type: ignore[attr-defined]
     errors: list[str] = []
     pg.on("pageerror", lambda e: errors.append(str(e)))
     pg.goto(studio_server.base + "/")
@@ -169,21 +175,79 @@ def page(browser: Any, studio_server: Studio) -> Iterator[Any]:
         context.close()
 
 
-def leave_out_scene(context: Any, studio: Studio) -> None:
+class LeftOutScene:
+    """The 3D scene of a browser context served as :data:`LEFT_OUT_SCENE` (its instance check
+    still reaches the studio), until :meth:`let_in` lets the real one through again."""
+
+    def __init__(self, context: Any, studio: Studio) -> None:
+        self.context = context
+        self.studio = studio
+        port = urlsplit(studio.get("/api/config")["viser_url"]).port
+        # a pattern, not a function: the browser then asks Playwright about the scene's
+        # requests only, not about every request of the page
+        self._scene = re.compile(rf"^[a-z]+://[^/]+:{port}/(?!studio-instance(?:$|[?#]))")
+        self.left_out = False
+        self.leave_out()
+
+    @staticmethod
+    def _blank(route: Any) -> None:
+        route.fulfill(status=200, content_type="text/html", body=LEFT_OUT_SCENE)
+
+    def leave_out(self) -> None:
+        """Serve the blank page for the scene from now on."""
+        if not self.left_out:
+            self.context.route(self._scene, self._blank)
+            self.left_out = True
+
+    def let_in(self) -> None:
+        """Let the real scene through from now on."""
+        if self.left_out:
+            self.context.unroute(self._scene, self._blank)
+            self.left_out = False
+
+
+def leave_out_scene(context: Any, studio: Studio) -> LeftOutScene:
     """Serve :data:`LEFT_OUT_SCENE` for the 3D scene's page and files in ``context`` (its
     instance check still reaches the studio). Here WebGL is drawn in software: a live scene
     costs the browser most of a core while the simulator streams, which a test that does not
     look at the scene only takes from the tests beside it."""
-    scene_port = urlsplit(studio.get("/api/config")["viser_url"]).port
+    return LeftOutScene(context, studio)
 
-    def is_scene(url: str) -> bool:
-        parts = urlsplit(url)
-        return parts.port == scene_port and parts.path != "/studio-instance"
 
-    context.route(
-        is_scene,
-        lambda route: route.fulfill(status=200, content_type="text/html", body=LEFT_OUT_SCENE),
-    )
+def _scene_clients(studio: Studio) -> int:
+    """How many browsers show the studio's scene now (each reports its camera)."""
+    return len(studio.get("/api/scene/views")["cameras"])
+
+
+def _reload_scene_frame(page: Any) -> None:
+    """Load the page's scene iframe again from the URL the page gave it, the page left as it is."""
+    page.wait_for_function("() => document.querySelector('#scene').src !== ''")
+    src = page.locator("#scene").get_attribute("src")
+    page.locator("#scene").element_handle().content_frame().goto(src, wait_until="load")
+
+
+@contextmanager
+def live_scene(page: Any) -> Iterator[Any]:
+    """The real 3D scene in the shared ``page`` (which leaves it out) while the block runs:
+    its iframe alone is loaded again (the stories on the page keep their state), and the block
+    starts once the scene is drawn (its canvas visible) and connected (the studio has its
+    camera). Yields the scene's frame locator. Afterwards the scene is left out again and its
+    iframe made blank, once the studio has seen it go."""
+    from tests.web.conftest import wait_for
+
+    left_out: LeftOutScene = page.left_out_scene
+    studio = left_out.studio
+    left_out.let_in()
+    try:
+        _reload_scene_frame(page)
+        frame = page.frame_locator("#scene")
+        frame.locator("canvas").first.wait_for(state="visible", timeout=60_000)
+        assert wait_for(lambda: _scene_clients(studio) >= 1, 60), "the scene never connected"
+        yield frame
+    finally:
+        left_out.leave_out()
+        _reload_scene_frame(page)
+    assert wait_for(lambda: _scene_clients(studio) == 0, 60), "the left-out scene stayed connected"
 
 
 @contextmanager

@@ -11,7 +11,7 @@ from urllib.parse import parse_qs, urlsplit
 
 import pytest
 
-from tests.e2e.conftest import Studio
+from tests.e2e.conftest import Studio, live_scene
 
 pytestmark = pytest.mark.e2e
 
@@ -39,9 +39,9 @@ def test_the_scene_is_drawn_at_half_resolution_without_a_gpu(
     assert query.get("fixedDpr") == [str(page.evaluate(f"async () => {SCENE}.SOFTWARE_SCENE_DPR"))]
     assert float(query["fixedDpr"][0]) < 1
     assert page.get_by_test_id("scene-note").is_visible()
-    # the scene still loads and draws at that ratio
-    frame = page.frame_locator("#scene")
-    frame.locator("canvas").first.wait_for(state="attached", timeout=60_000)
+    # the scene still loads and draws at that ratio (the shared page leaves it out otherwise)
+    with live_scene(page) as frame:
+        frame.locator("canvas").first.wait_for(state="attached", timeout=60_000)
 
 
 def test_only_software_renderers_are_taken_for_software(page: Any) -> None:

@@ -16,7 +16,7 @@ import pytest
 
 from studio.samples import SAMPLES_DIR
 
-from .conftest import ARTIFACTS, Studio, shot
+from .conftest import ARTIFACTS, Studio, live_scene, shot
 
 pytestmark = pytest.mark.e2e
 
@@ -74,25 +74,25 @@ def _rows(page: Any, testid: str) -> list[str]:
 
 def test_story1_scene_renders_and_moves(page: Any, studio_server: Studio) -> None:
     """The page shows the viser scene (not blank) moving live from the default simulator."""
-    frame = page.frame_locator("[data-testid='scene-frame']")
-    frame.locator("canvas").first.wait_for(state="visible", timeout=30_000)
-    assert _wait(lambda: float(page.inner_text("[data-testid='source-rate']") or 0) > 10, 20)
-    shots: list[np.ndarray] = []
+    with live_scene(page) as frame:
+        frame.locator("canvas").first.wait_for(state="visible", timeout=30_000)
+        assert _wait(lambda: float(page.inner_text("[data-testid='source-rate']") or 0) > 10, 20)
+        shots: list[np.ndarray] = []
 
-    def drawn() -> bool:  # the scene's first frames arrived and were drawn
-        shots.append(_pixels(_scene_png(page, "01-scene")))
-        # Not blank: a blank canvas is one colour; a floor, a robot and an arm give many.
-        colours = np.unique(shots[-1].reshape(-1, 3).round(-1), axis=0)
-        return shots[-1].std() > 12.0 and len(colours) > 50
+        def drawn() -> bool:  # the scene's first frames arrived and were drawn
+            shots.append(_pixels(_scene_png(page, "01-scene")))
+            # Not blank: a blank canvas is one colour; a floor, a robot and an arm give many.
+            colours = np.unique(shots[-1].reshape(-1, 3).round(-1), axis=0)
+            return shots[-1].std() > 12.0 and len(colours) > 50
 
-    assert _wait(drawn, 20), "the scene stayed blank"
-    first = shots[-1]
-    shot(page, "01-page")
+        assert _wait(drawn, 20), "the scene stayed blank"
+        first = shots[-1]
+        shot(page, "01-page")
 
-    def moved() -> bool:  # the simulator moves the arm (and so the robot) between two screenshots
-        return np.abs(first - _pixels(_scene_png(page, "01-scene-later"))).mean() > 0.05
+        def moved() -> bool:  # the simulator moves the arm (and so the robot) between two shots
+            return np.abs(first - _pixels(_scene_png(page, "01-scene-later"))).mean() > 0.05
 
-    assert _wait(moved, 20), "the scene did not move"
+        assert _wait(moved, 20), "the scene did not move"
     assert not page.errors  # type: ignore[attr-defined]
 
 
@@ -441,26 +441,28 @@ def test_story6_watch_policy_moves_robot(page: Any, studio_server: Studio) -> No
     # The live source is a paused recording (story 5), so only the watched policy moves things.
     assert page.get_attribute("[data-testid='playback-toggle']", "data-playing") == "0"
 
-    def still() -> bool:  # nothing moves while paused (once the last frames are drawn)
-        shots = [_pixels(_scene_png(page, "06-still")) for _ in range(2)]
-        return np.abs(shots[0] - shots[1]).mean() < 0.5
+    with live_scene(page):
 
-    assert _wait(still, 20)
+        def still() -> bool:  # nothing moves while paused (once the last frames are drawn)
+            shots = [_pixels(_scene_png(page, "06-still")) for _ in range(2)]
+            return np.abs(shots[0] - shots[1]).mean() < 0.5
 
-    page.select_option("[data-testid='watch-policy']", f"run:{runs[0]['id']}")
-    page.select_option("[data-testid='watch-start']", "random")
-    page.fill("[data-testid='watch-seed']", "3")
-    page.click("[data-testid='watch-go']")
-    page.wait_for_selector("[data-testid='watch-result']:has-text('steps')", timeout=T)
-    assert not page.is_visible("[data-testid='watch-error']")
-    frames = [_pixels(_scene_png(page, "06-watch-0"))]
+        assert _wait(still, 20)
 
-    def moved() -> bool:  # the robot moves along the rollout
-        frames.append(_pixels(_scene_png(page, f"06-watch-{len(frames)}")))
-        return np.abs(frames[-1] - frames[0]).mean() > 0.05
+        page.select_option("[data-testid='watch-policy']", f"run:{runs[0]['id']}")
+        page.select_option("[data-testid='watch-start']", "random")
+        page.fill("[data-testid='watch-seed']", "3")
+        page.click("[data-testid='watch-go']")
+        page.wait_for_selector("[data-testid='watch-result']:has-text('steps')", timeout=T)
+        assert not page.is_visible("[data-testid='watch-error']")
+        frames = [_pixels(_scene_png(page, "06-watch-0"))]
 
-    assert _wait(moved, 20), [np.abs(f - frames[0]).mean() for f in frames]
-    shot(page, "06-watch", "sec-watch")
+        def moved() -> bool:  # the robot moves along the rollout
+            frames.append(_pixels(_scene_png(page, f"06-watch-{len(frames)}")))
+            return np.abs(frames[-1] - frames[0]).mean() > 0.05
+
+        assert _wait(moved, 20), [np.abs(f - frames[0]).mean() for f in frames]
+        shot(page, "06-watch", "sec-watch")
 
 
 def test_story7_export_and_reload(page: Any, studio_server: Studio, tmp_path: Path) -> None:

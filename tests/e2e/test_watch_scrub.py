@@ -16,7 +16,7 @@ import pytest
 
 from tests.web.test_policies import policy_bytes
 
-from .conftest import Studio, pose_by_hand, shot
+from .conftest import Studio, live_scene, pose_by_hand, shot
 from .test_stories import _pixels, _scene_png, _wait
 
 pytestmark = pytest.mark.e2e
@@ -228,34 +228,35 @@ def test_play_clicked_while_a_scrub_is_on_its_way_plays(
 
 
 def test_camera_presets_move_the_scene_camera(page: Any, studio_server: Studio) -> None:
-    frame = page.frame_locator("[data-testid='scene-frame']")
-    frame.locator("canvas").first.wait_for(state="visible", timeout=30_000)
+    with live_scene(page):
 
-    def cameras() -> list[dict]:
-        return studio_server.get("/api/scene/views")["cameras"]
+        def cameras() -> list[dict]:
+            return studio_server.get("/api/scene/views")["cameras"]
 
-    assert _until(lambda: len(cameras()) >= 1, 20)
-    shots = [_pixels(_scene_png(page, "23-4-before-top-view"))]
-    page.get_by_role("button", name="Top view").click()
-    assert _until(lambda: all(c["position"][2] > 4.0 for c in cameras()))
+        assert _until(lambda: len(cameras()) >= 1, 20)
+        shots = [_pixels(_scene_png(page, "23-4-before-top-view"))]
+        page.get_by_role("button", name="Top view").click()
+        assert _until(lambda: all(c["position"][2] > 4.0 for c in cameras()))
 
-    def drawn() -> bool:  # the browser drew the new view
-        shots.append(_pixels(_scene_png(page, "23-4-top-view")))
-        return np.abs(shots[-1] - shots[0]).mean() > 1.0
+        def drawn() -> bool:  # the browser drew the new view
+            shots.append(_pixels(_scene_png(page, "23-4-top-view")))
+            return np.abs(shots[-1] - shots[0]).mean() > 1.0
 
-    assert _until(drawn)
-    top = shots[-1]
-    page.get_by_role("button", name="Side view").click()
-    assert _until(lambda: all(c["position"][0] < -2.0 for c in cameras()))
-    page.get_by_role("button", name="Front view").click()
-    assert _until(lambda: all(c["position"][1] < -3.0 for c in cameras()))
-    assert _until(lambda: np.abs(_pixels(_scene_png(page, "23-4-front-view")) - top).mean() > 1.0)
-    follow = page.get_by_role("checkbox", name="Follow the tool")
-    follow.check()
-    assert _until(lambda: studio_server.get("/api/scene/views")["following"])
-    follow.uncheck()
-    assert _until(lambda: not studio_server.get("/api/scene/views")["following"])
-    shot(page, "23-4-camera", "sec-watch")
+        assert _until(drawn)
+        top = shots[-1]
+        page.get_by_role("button", name="Side view").click()
+        assert _until(lambda: all(c["position"][0] < -2.0 for c in cameras()))
+        page.get_by_role("button", name="Front view").click()
+        assert _until(lambda: all(c["position"][1] < -3.0 for c in cameras()))
+        assert _until(
+            lambda: np.abs(_pixels(_scene_png(page, "23-4-front-view")) - top).mean() > 1.0
+        )
+        follow = page.get_by_role("checkbox", name="Follow the tool")
+        follow.check()
+        assert _until(lambda: studio_server.get("/api/scene/views")["following"])
+        follow.uncheck()
+        assert _until(lambda: not studio_server.get("/api/scene/views")["following"])
+        shot(page, "23-4-camera", "sec-watch")
 
 
 def test_pose_the_robot_by_hand_and_use_it_as_the_goal(page: Any, studio_server: Studio) -> None:
