@@ -8,6 +8,11 @@ runs as one numba kernel over the chain's constant geometry, read once from the 
 log) and the damped solve are each a few lines of arithmetic, and a whole solve takes tens of
 microseconds. Pinocchio stays the one model: the chain is its joints' placements and axes, and the
 tests hold the kernel's poses to Pinocchio's.
+
+The same forward kinematics gives the height of each link's lowest point above the table the robot
+stands on (:class:`LinkPoints`, :meth:`RobotArm.table_contacts`): asked for every pose the
+retargeting and the planner consider, it cost more than a frame's IK as a loop over Pinocchio's
+geometry placements.
 """
 
 from __future__ import annotations
@@ -20,6 +25,13 @@ import pinocchio as pin
 from numba import njit
 
 from ._checks import KinematicsError
+
+STALLED_STEP = 1e-9
+"""A solve stops where its next step would move no joint further than this (rad), within the
+limits: it has stalled, at a target out of its reach from there or held at a limit, and the
+iterations left would hold the pose (they move it by nanometres). On targets out of reach, most
+solves stall within their first iterations; running the rest took two thirds of the Z1's IK
+iterations over ``tests/kinematics/test_reach.py``, and changed no frame reached."""
 
 _AXES = {"RX": (1.0, 0.0, 0.0), "RY": (0.0, 1.0, 0.0), "RZ": (0.0, 0.0, 1.0)}
 
@@ -119,6 +131,69 @@ def _tool(chain: SerialChain, R: np.ndarray, p: np.ndarray, tool_R: np.ndarray, 
 
 
 @dataclass(frozen=True)
+class LinkPoints:
+    """The collision geometries of a chain's links, as the compiled table check reads them
+    (:meth:`RobotArm.table_contacts`): per geometry its joint, its placement in that joint's
+    frame, a sphere around its points and the points (in its own frame), all stacked.
+
+    Attributes:
+        joints: each geometry's 0-based chain joint, shape (m,).
+        rotations, translations: each geometry's placement in its joint's frame, (m, 3, 3) and
+            (m, 3).
+        centres, radii: each geometry's bounding sphere in its own frame, (m, 3) and (m,).
+        starts: geometry ``k``'s points are ``points[starts[k]:starts[k + 1]]``, shape (m + 1,).
+        points: every geometry's points in its own frame, (P, 3).
+    """
+
+    joints: np.ndarray
+    rotations: np.ndarray
+    translations: np.ndarray
+    centres: np.ndarray
+    radii: np.ndarray
+    starts: np.ndarray
+    points: np.ndarray
+
+    @classmethod
+    def from_geometry(
+        cls, geom: pin.GeometryModel, found: list[tuple[int, np.ndarray, np.ndarray, float]]
+    ) -> LinkPoints:
+        """The stacked form of ``found``: (geometry index in ``geom``, its points, its sphere's
+        centre and radius) per geometry."""
+        objects = [geom.geometryObjects[k] for k, *_ in found]
+        counts = [len(points) for _, points, _, _ in found]
+        return cls(
+            np.array([obj.parentJoint - 1 for obj in objects], dtype=np.int64),
+            np.array([obj.placement.rotation for obj in objects], dtype=float).reshape(-1, 3, 3),
+            np.array([obj.placement.translation for obj in objects], dtype=float).reshape(-1, 3),
+            np.array([centre for _, _, centre, _ in found], dtype=float).reshape(-1, 3),
+            np.array([radius for *_, radius in found], dtype=float),
+            np.concatenate([[0], np.cumsum(counts)]).astype(np.int64),
+            np.concatenate([p for _, p, _, _ in found] or [np.zeros((0, 3))]).astype(float),
+        )
+
+    def heights(self, chain: SerialChain, q: np.ndarray, margin: float) -> np.ndarray:
+        """Each geometry's lowest point's height above the base's plane at ``q`` (m), or
+        infinity where its bounding sphere is ``margin`` or more above it; shape (m,)."""
+        out = np.empty(len(self.joints))
+        _heights(
+            chain.rotations,
+            chain.translations,
+            chain.axes,
+            np.asarray(q, dtype=float),
+            self.joints,
+            self.rotations,
+            self.translations,
+            self.centres,
+            self.radii,
+            self.starts,
+            self.points,
+            float(margin),
+            out,
+        )
+        return out
+
+
+@dataclass(frozen=True)
 class ChainSolve:
     """The settings of one :func:`solve` call (see :meth:`RobotArm.inverse`)."""
 
@@ -193,33 +268,32 @@ def _matvec3(A, v, out):  # pragma: no cover - compiled
 @njit(nogil=True, cache=True)
 def _forward(rotations, translations, axes, q, R, p):  # pragma: no cover - compiled
     """Each joint frame's rotation ``R[k]`` and origin ``p[k]`` in the base frame at ``q``."""
-    n = q.shape[0]
-    Rk = np.empty((3, 3))
-    rot = np.empty((3, 3))
-    step = np.empty(3)
-    for k in range(n):
+    for k in range(q.shape[0]):
         # the parent frame, then the fixed placement, then the rotation about the joint's axis
         if k == 0:
-            Rk[:, :] = rotations[0]
-            p[0] = translations[0]
-        else:
-            _matmul3(R[k - 1], rotations[k], Rk)
-            _matvec3(R[k - 1], translations[k], step)
             for i in range(3):
-                p[k, i] = p[k - 1, i] + step[i]
+                p[0, i] = translations[0, i]
+                for j in range(3):
+                    R[0, i, j] = rotations[0, i, j]
+        else:
+            _matmul3(R[k - 1], rotations[k], R[k])
+            parent, t = R[k - 1], translations[k]
+            for i in range(3):
+                p[k, i] = p[k - 1, i] + (
+                    parent[i, 0] * t[0] + parent[i, 1] * t[1] + parent[i, 2] * t[2]
+                )
         x, y, z = axes[k, 0], axes[k, 1], axes[k, 2]
         c, s = math.cos(q[k]), math.sin(q[k])
-        t = 1.0 - c
-        rot[0, 0] = c + x * x * t
-        rot[0, 1] = x * y * t - z * s
-        rot[0, 2] = x * z * t + y * s
-        rot[1, 0] = y * x * t + z * s
-        rot[1, 1] = c + y * y * t
-        rot[1, 2] = y * z * t - x * s
-        rot[2, 0] = z * x * t - y * s
-        rot[2, 1] = z * y * t + x * s
-        rot[2, 2] = c + z * z * t
-        _matmul3(Rk, rot, R[k])
+        t1 = 1.0 - c
+        r00, r01, r02 = c + x * x * t1, x * y * t1 - z * s, x * z * t1 + y * s
+        r10, r11, r12 = y * x * t1 + z * s, c + y * y * t1, y * z * t1 - x * s
+        r20, r21, r22 = z * x * t1 - y * s, z * y * t1 + x * s, c + z * z * t1
+        Rk = R[k]
+        for i in range(3):  # Rk = Rk @ rot, in place: each row is read before it is written
+            a0, a1, a2 = Rk[i, 0], Rk[i, 1], Rk[i, 2]
+            Rk[i, 0] = a0 * r00 + a1 * r10 + a2 * r20
+            Rk[i, 1] = a0 * r01 + a1 * r11 + a2 * r21
+            Rk[i, 2] = a0 * r02 + a1 * r12 + a2 * r22
 
 
 @njit(nogil=True, cache=True)
@@ -253,11 +327,11 @@ def _log3(M, w):  # pragma: no cover - compiled
             w[j] = theta * axis[j] / norm
 
 
-@njit(nogil=True, cache=True)
-def _spd_solve(A, b):  # pragma: no cover - compiled
-    """``A^-1 b`` for a small symmetric positive-definite ``A`` (Cholesky)."""
+@njit(nogil=True, cache=True, inline="always")
+def _spd_solve(A, b, L, y, x):  # pragma: no cover - compiled
+    """``x = A^-1 b`` for a small symmetric positive-definite ``A`` (Cholesky into ``L``, forward
+    substitution into ``y``)."""
     n = A.shape[0]
-    L = np.zeros((n, n))
     for i in range(n):
         for j in range(i + 1):
             s = A[i, j]
@@ -267,29 +341,25 @@ def _spd_solve(A, b):  # pragma: no cover - compiled
                 L[i, i] = math.sqrt(max(s, 1e-300))
             else:
                 L[i, j] = s / L[j, j]
-    y = np.empty(n)
     for i in range(n):
         s = b[i]
         for k in range(i):
             s -= L[i, k] * y[k]
         y[i] = s / L[i, i]
-    x = np.empty(n)
     for i in range(n - 1, -1, -1):
         s = y[i]
         for k in range(i + 1, n):
             s -= L[k, i] * x[k]
         x[i] = s / L[i, i]
-    return x
 
 
 @njit(nogil=True, cache=True, inline="always")
-def _transpose_times(J, y):  # pragma: no cover - compiled
-    """``J.T @ y``."""
-    out = np.zeros(J.shape[1])
+def _transpose_times(J, y, out):  # pragma: no cover - compiled
+    """``out = J.T @ y``."""
+    out[:] = 0.0
     for i in range(J.shape[0]):
         for k in range(J.shape[1]):
             out[k] += J[i, k] * y[i]
-    return out
 
 
 @njit(nogil=True, cache=True, inline="always")
@@ -297,15 +367,17 @@ def _jacobian(R, p, axes, point, columns, J):  # pragma: no cover - compiled
     """The geometric Jacobian (world axes) of ``point`` in the first ``columns`` joints' frames;
     rows 0-2 its velocity, rows 3-5 (when ``J`` has them) the angular velocity."""
     J[:, :] = 0.0
-    z = np.empty(3)
     for k in range(columns):
-        _matvec3(R[k], axes[k], z)
-        d = point - p[k]
-        J[0, k] = z[1] * d[2] - z[2] * d[1]
-        J[1, k] = z[2] * d[0] - z[0] * d[2]
-        J[2, k] = z[0] * d[1] - z[1] * d[0]
+        Rk, a = R[k], axes[k]
+        z0 = Rk[0, 0] * a[0] + Rk[0, 1] * a[1] + Rk[0, 2] * a[2]
+        z1 = Rk[1, 0] * a[0] + Rk[1, 1] * a[1] + Rk[1, 2] * a[2]
+        z2 = Rk[2, 0] * a[0] + Rk[2, 1] * a[1] + Rk[2, 2] * a[2]
+        d0, d1, d2 = point[0] - p[k, 0], point[1] - p[k, 1], point[2] - p[k, 2]
+        J[0, k] = z1 * d2 - z2 * d1
+        J[1, k] = z2 * d0 - z0 * d2
+        J[2, k] = z0 * d1 - z1 * d0
         if J.shape[0] == 6:
-            J[3, k], J[4, k], J[5, k] = z[0], z[1], z[2]
+            J[3, k], J[4, k], J[5, k] = z0, z1, z2
 
 
 @njit(nogil=True, cache=True, inline="always")
@@ -323,15 +395,19 @@ def _damped_gram(J, damping, A):  # pragma: no cover - compiled
 
 
 @njit(nogil=True, cache=True, inline="always")
-def _elbow_pull(R, p, axes, elbow_joint, elbow):  # pragma: no cover - compiled
-    """``J_e^T (elbow - p_e)``: the joint motion that pulls the elbow's origin towards ``elbow``."""
-    Je = np.zeros((3, R.shape[0]))
+def _elbow_pull(R, p, axes, elbow_joint, elbow, Je, toward, pull):  # pragma: no cover - compiled
+    """``pull = J_e^T (elbow - p_e)``: the joint motion that pulls the elbow's origin towards
+    ``elbow`` (``Je`` and ``toward`` are scratch)."""
     _jacobian(R, p, axes, p[elbow_joint], elbow_joint, Je)
-    return _transpose_times(Je, elbow - p[elbow_joint])
+    for i in range(3):
+        toward[i] = elbow[i] - p[elbow_joint, i]
+    _transpose_times(Je, toward, pull)
 
 
 @njit(nogil=True, cache=True)
-def _clamped_step(J, e, pull, secondary_task, q, lower, upper, damping, A):  # pragma: no cover
+def _clamped_step(  # pragma: no cover - compiled
+    J, e, pull, secondary_task, q, lower, upper, damping, A, dq, secondary, locked, L, y, x, Jpull
+):
     """The DLS step ``J^T (J J^T + damping^2 I)^-1 e`` plus ``pull`` projected into the tool
     task's null space, with the joints held at a limit they would be pushed beyond taken out.
 
@@ -339,26 +415,32 @@ def _clamped_step(J, e, pull, secondary_task, q, lower, upper, damping, A):  # p
     ``pull`` zeroed) and the step solved again by the others, until none is pushed beyond:
     clipping it afterwards instead left the rest of the step aimed at a motion that does not
     happen, and the solve stalled with the tool short of a target the other joints could reach.
-    Returns (step, its null-space part); ``J`` and ``pull`` are overwritten.
+    Writes the step into ``dq`` and its null-space part into ``secondary``; ``J`` and ``pull``
+    are overwritten, ``A``, ``locked``, ``L``, ``y``, ``x`` and ``Jpull`` are scratch.
     """
     rows, n = J.shape
-    locked = np.zeros(n, dtype=np.bool_)
-    dq = np.zeros(n)
-    secondary = np.zeros(n)
+    locked[:] = False
+    dq[:] = 0.0
+    secondary[:] = 0.0
     for _ in range(n):
         for k in range(n):
             if locked[k]:
                 J[:, k] = 0.0
                 pull[k] = 0.0
         _damped_gram(J, damping, A)
-        dq = _transpose_times(J, _spd_solve(A, e))
+        _spd_solve(A, e, L, y, x)
+        _transpose_times(J, x, dq)
         if secondary_task:
-            Jpull = np.zeros(rows)
             for i in range(rows):
+                total = 0.0
                 for k in range(n):
-                    Jpull[i] += J[i, k] * pull[k]
-            secondary = pull - _transpose_times(J, _spd_solve(A, Jpull))
-            dq += secondary
+                    total += J[i, k] * pull[k]
+                Jpull[i] = total
+            _spd_solve(A, Jpull, L, y, x)
+            _transpose_times(J, x, secondary)
+            for k in range(n):
+                secondary[k] = pull[k] - secondary[k]
+                dq[k] += secondary[k]
         more = False
         for k in range(n):
             pushed = (q[k] <= lower[k] and dq[k] < 0.0) or (q[k] >= upper[k] and dq[k] > 0.0)
@@ -367,7 +449,15 @@ def _clamped_step(J, e, pull, secondary_task, q, lower, upper, damping, A):  # p
                 more = True
         if not more:
             break
-    return dq, secondary
+
+
+@njit(nogil=True, cache=True, inline="always")
+def _largest(v):  # pragma: no cover - compiled
+    """The largest absolute value in ``v``."""
+    out = 0.0
+    for value in v:
+        out = max(out, abs(value))
+    return out
 
 
 @njit(nogil=True, cache=True)
@@ -396,7 +486,8 @@ def _solve(  # noqa: PLR0913 - the kernel's flat arguments  # pragma: no cover -
     out,
 ):
     """Projected DLS in place on ``q``; ``out`` = (position error, rotation error); returns the
-    iterations used. The algorithm of :meth:`RobotArm.inverse`."""
+    iterations used. The algorithm of :meth:`RobotArm.inverse`; every array it needs is made
+    once here, none in the loop."""
     n = q.shape[0]
     rows = 3 if position_only else 6
     R = np.empty((n, 3, 3))
@@ -408,6 +499,16 @@ def _solve(  # noqa: PLR0913 - the kernel's flat arguments  # pragma: no cover -
     w = np.zeros(3)
     J = np.zeros((rows, n))
     A = np.empty((rows, rows))
+    Je = np.zeros((3, n))
+    toward = np.empty(3)
+    pull = np.zeros(n)
+    dq = np.zeros(n)
+    secondary = np.zeros(n)
+    locked = np.zeros(n, dtype=np.bool_)
+    L = np.zeros((rows, rows))
+    y = np.empty(rows)
+    x = np.empty(rows)
+    Jpull = np.empty(rows)
     pos_err = math.inf
     rot_err = math.inf
     elbow_steps = elbow_iterations
@@ -432,20 +533,90 @@ def _solve(  # noqa: PLR0913 - the kernel's flat arguments  # pragma: no cover -
             break
         _jacobian(R, p, axes, tool_p, min(n, tool_joint + 1), J)
         secondary_task = use_elbow and n > rows
-        # the elbow's pull, J_e^T (target - elbow)
-        pull = 0.5 * _elbow_pull(R, p, axes, elbow_joint, elbow) if secondary_task else np.zeros(n)
-        dq, secondary = _clamped_step(J, e, pull, secondary_task, q, lower, upper, damping, A)
+        if secondary_task:  # the elbow's pull, J_e^T (target - elbow), halved
+            _elbow_pull(R, p, axes, elbow_joint, elbow, Je, toward, pull)
+            for k in range(n):
+                pull[k] = 0.5 * pull[k]
+        else:
+            pull[:] = 0.0
+        _clamped_step(
+            J,
+            e,
+            pull,
+            secondary_task,
+            q,
+            lower,
+            upper,
+            damping,
+            A,
+            dq,
+            secondary,
+            locked,
+            L,
+            y,
+            x,
+            Jpull,
+        )
         if secondary_task:
-            biggest_secondary = np.abs(secondary).max()
+            biggest_secondary = _largest(secondary)
             if reached and (elbow_steps <= 0 or biggest_secondary < 1e-4):
                 break  # the elbow is as near as the tool lets it be, or left to next time
             if reached:
                 elbow_steps -= 1
-        biggest = np.abs(dq).max()
+        biggest = _largest(dq)
         if biggest > max_step:
-            dq *= max_step / biggest
+            scale = max_step / biggest
+            for k in range(n):
+                dq[k] *= scale
+        moved = 0.0
+        for k in range(n):
+            moved = max(moved, abs(min(max(q[k] + dq[k], lower[k]), upper[k]) - q[k]))
+        if moved < STALLED_STEP:
+            break  # stalled: the iterations left would hold this pose
         for k in range(n):
             q[k] = min(max(q[k] + dq[k], lower[k]), upper[k])
     out[0] = pos_err
     out[1] = rot_err
     return it
+
+
+@njit(nogil=True, cache=True)
+def _heights(  # noqa: PLR0913 - the kernel's flat arguments  # pragma: no cover - compiled
+    rotations,
+    translations,
+    axes,
+    q,
+    joints,
+    geometry_rotations,
+    geometry_translations,
+    centres,
+    radii,
+    starts,
+    points,
+    margin,
+    out,
+):
+    """``out[k]``: geometry ``k``'s lowest point's height (base z) at ``q``, or infinity where
+    its bounding sphere lies ``margin`` or more above the base's plane (see
+    :meth:`LinkPoints.heights`)."""
+    n = q.shape[0]
+    R = np.empty((n, 3, 3))
+    p = np.empty((n, 3))
+    _forward(rotations, translations, axes, q, R, p)
+    for k in range(joints.shape[0]):
+        j = joints[k]
+        Rg, pg = geometry_rotations[k], geometry_translations[k]
+        # the geometry's frame is the joint's times its placement; its up row is the third
+        r0, r1, r2 = R[j, 2, 0], R[j, 2, 1], R[j, 2, 2]
+        u0 = r0 * Rg[0, 0] + r1 * Rg[1, 0] + r2 * Rg[2, 0]
+        u1 = r0 * Rg[0, 1] + r1 * Rg[1, 1] + r2 * Rg[2, 1]
+        u2 = r0 * Rg[0, 2] + r1 * Rg[1, 2] + r2 * Rg[2, 2]
+        height = p[j, 2] + (r0 * pg[0] + r1 * pg[1] + r2 * pg[2])
+        c = centres[k]
+        if u0 * c[0] + u1 * c[1] + u2 * c[2] + height - radii[k] >= margin:
+            out[k] = math.inf  # its bounding sphere clears the table
+            continue
+        lowest = math.inf
+        for i in range(starts[k], starts[k + 1]):
+            lowest = min(lowest, u0 * points[i, 0] + u1 * points[i, 1] + u2 * points[i, 2])
+        out[k] = lowest + height

@@ -598,9 +598,11 @@ class Retargeter:
                 seeds.insert(0, self.last_ik.q)
             for seed in seeds:
                 other = robot.inverse(oMdes, q0=seed, **settings)
+                if not self._reached(other):
+                    continue
                 q = _turned_near(robot, other.q, start)
                 distance = float(np.abs(q - start).max()) + self._cramped(robot, q)
-                if self._reached(other) and distance < nearest and not touches(q):
+                if distance < nearest and not touches(q):
                     found, nearest = replace(other, q=q), distance
             settings["iterations"] = config.ik_iterations
         if not self._reached(found) and robot.spec.orientation:

@@ -32,7 +32,7 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
-from ._chain_ik import ChainSolve, SerialChain, solve
+from ._chain_ik import ChainSolve, LinkPoints, SerialChain, solve
 from ._checks import KinematicsError, real_array
 from ._robot_specs import DEFAULT_ROBOT as DEFAULT_ROBOT
 from ._robot_specs import LIMIT_MARGIN_RAD as LIMIT_MARGIN_RAD
@@ -96,7 +96,9 @@ class RobotIK:
         success: whether the tool reached the target within the tolerances.
         position_error: tool position error (m).
         rotation_error: tool rotation error (rad; 0 when only the position was asked).
-        iterations: iterations used.
+        iterations: iterations used: fewer than allowed where the tool reached the target, or
+            where the solve stalled (its next step would move no joint further than
+            ``STALLED_STEP``, 1e-9 rad).
     """
 
     q: np.ndarray
@@ -194,7 +196,7 @@ class RobotArm:
         self.reach = self._sampled_reach()
         self._collision_data: pin.GeometryData | None = None
         self._table_points = _table_points(collision_model)
-        self._table_data: pin.GeometryData | None = None  # made at first use
+        self._table = LinkPoints.from_geometry(collision_model, self._table_points)
         if len(collision_model.geometryObjects):
             self._set_collision_pairs(srdf)
 
@@ -224,7 +226,6 @@ class RobotArm:
         geometry are shared (never written), the data each computation writes is not."""
         other = copy.copy(self)
         other.data = self.model.createData()
-        other._table_data = None
         if self._collision_data is not None:
             other._collision_data = pin.GeometryData(self.collision_model)
         return other
@@ -428,21 +429,12 @@ class RobotArm:
         arr = self.check_q(q)
         if not self._table_points:
             return []
-        geom = self.collision_model
-        if self._table_data is None:
-            self._table_data = pin.GeometryData(geom)
-        gdata = self._table_data
-        pin.updateGeometryPlacements(self.model, self.data, geom, gdata, arr)
+        heights = self._table.heights(self.chain, arr, margin)  # compiled: every pose asks
         lowest: dict[str, float] = {}
-        for k, points, centre, radius in self._table_points:
-            placement = gdata.oMg[k]
-            up, height = placement.rotation[2], placement.translation[2]
-            if up @ centre + height - radius >= margin:  # its bounding sphere clears the table
-                continue
-            z = float((points @ up).min() + height)
-            link = _link_of(geom.geometryObjects[k].name)
-            lowest[link] = min(lowest.get(link, math.inf), z)
-        found = [Collision(link, TABLE, z) for link, z in lowest.items() if z < margin]
+        for i in np.flatnonzero(heights < margin):
+            link = _link_of(self.collision_model.geometryObjects[self._table_points[i][0]].name)
+            lowest[link] = min(lowest.get(link, math.inf), float(heights[i]))
+        found = [Collision(link, TABLE, z) for link, z in lowest.items()]
         return sorted(found, key=lambda c: c.distance)
 
     def contacts(self, q: object, margin: float = 0.0) -> list[Collision]:
