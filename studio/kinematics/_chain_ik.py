@@ -460,6 +460,28 @@ def _largest(v):  # pragma: no cover - compiled
     return out
 
 
+@njit(nogil=True, cache=True, inline="always")
+def _tool_error(  # noqa: PLR0913 - the kernel's flat arguments  # pragma: no cover - compiled
+    R, p, tool_joint, tool_rotation, tool_translation, target_R, target_p, position_only,
+    tool_R, tool_p, err_R, w, e,
+):  # fmt: skip
+    """The tool's pose for the joints' frames ``R``, ``p`` (into ``tool_R``, ``tool_p``) and its
+    error towards the target (into ``e``: position, then rotation unless ``position_only``);
+    returns (position error, rotation error). ``err_R`` and ``w`` are scratch."""
+    _matmul3(R[tool_joint], tool_rotation, tool_R)
+    _matvec3(R[tool_joint], tool_translation, tool_p)
+    for i in range(3):
+        tool_p[i] += p[tool_joint, i]
+        e[i] = target_p[i] - tool_p[i]
+    pos_err = math.sqrt(e[0] ** 2 + e[1] ** 2 + e[2] ** 2)
+    if position_only:
+        return pos_err, 0.0
+    _matmul3(target_R, tool_R.T, err_R)
+    _log3(err_R, w)
+    e[3], e[4], e[5] = w[0], w[1], w[2]
+    return pos_err, math.sqrt(w[0] ** 2 + w[1] ** 2 + w[2] ** 2)
+
+
 @njit(nogil=True, cache=True)
 def _solve(  # noqa: PLR0913 - the kernel's flat arguments  # pragma: no cover - compiled
     rotations,
@@ -515,19 +537,10 @@ def _solve(  # noqa: PLR0913 - the kernel's flat arguments  # pragma: no cover -
     it = 0
     for it in range(iterations + 1):
         _forward(rotations, translations, axes, q, R, p)
-        _matmul3(R[tool_joint], tool_rotation, tool_R)
-        _matvec3(R[tool_joint], tool_translation, tool_p)
-        for i in range(3):
-            tool_p[i] += p[tool_joint, i]
-            e[i] = target_p[i] - tool_p[i]
-        pos_err = math.sqrt(e[0] ** 2 + e[1] ** 2 + e[2] ** 2)
-        if position_only:
-            rot_err = 0.0
-        else:
-            _matmul3(target_R, tool_R.T, err_R)
-            _log3(err_R, w)
-            e[3], e[4], e[5] = w[0], w[1], w[2]
-            rot_err = math.sqrt(w[0] ** 2 + w[1] ** 2 + w[2] ** 2)
+        pos_err, rot_err = _tool_error(
+            R, p, tool_joint, tool_rotation, tool_translation, target_R, target_p, position_only,
+            tool_R, tool_p, err_R, w, e,
+        )  # fmt: skip
         reached = pos_err <= position_tolerance and rot_err <= rotation_tolerance
         if it == iterations or (reached and not use_elbow):
             break
@@ -540,23 +553,9 @@ def _solve(  # noqa: PLR0913 - the kernel's flat arguments  # pragma: no cover -
         else:
             pull[:] = 0.0
         _clamped_step(
-            J,
-            e,
-            pull,
-            secondary_task,
-            q,
-            lower,
-            upper,
-            damping,
-            A,
-            dq,
-            secondary,
-            locked,
-            L,
-            y,
-            x,
-            Jpull,
-        )
+            J, e, pull, secondary_task, q, lower, upper, damping, A, dq, secondary, locked, L, y,
+            x, Jpull,
+        )  # fmt: skip
         if secondary_task:
             biggest_secondary = _largest(secondary)
             if reached and (elbow_steps <= 0 or biggest_secondary < 1e-4):
