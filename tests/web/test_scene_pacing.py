@@ -12,9 +12,11 @@ page is asked to draw fewer frames (``studio/web/scene/_frames.py``).
 from __future__ import annotations
 
 import asyncio
+import contextlib
 import itertools
 import threading
 import time
+from collections.abc import Iterator
 
 import msgspec
 import numpy as np
@@ -36,9 +38,14 @@ SLOW = {"slow_live_s": 0.04, "slow_live_rate_hz": 5.0, "rate_hz": 100.0}
 
 @pytest.fixture(scope="module")
 def scene():
-    server = viser.ViserServer(host="127.0.0.1", port=free_port(), verbose=False)
+    """A scene a browser shows (one that no browser shows is pushed at ``unviewed_rate_hz``)."""
+    port = free_port()
+    server = viser.ViserServer(host="127.0.0.1", port=port, verbose=False)
     sc = StudioScene(server, body=HumanBody("right"), layout=SceneLayout(**SLOW))
+    viewer = _ScriptWatch(port)
+    assert wait_for(lambda: len(server.get_clients()) == 1), "the viewer never connected"
     yield sc
+    viewer.stop.set()
     sc.close()
     server.stop()
 
@@ -133,6 +140,42 @@ class _ScriptWatch:
     def gap(self) -> float | None:
         """The frame gap the last script set, or None before any script."""
         return self.gaps()[-1] if self.scripts else None
+
+
+@contextlib.contextmanager
+def _unviewed_scene(unviewed_hz: float) -> Iterator[tuple[StudioScene, int]]:
+    """A scene no browser shows yet, pushed at most ``unviewed_hz`` times a second; its port."""
+    port = free_port()
+    server = viser.ViserServer(host="127.0.0.1", port=port, verbose=False)
+    layout = SceneLayout(**SLOW, unviewed_rate_hz=unviewed_hz)
+    sc = StudioScene(server, body=HumanBody("right"), layout=layout)
+    try:
+        yield sc, port
+    finally:
+        sc.close()
+        server.stop()
+
+
+def test_a_scene_no_browser_shows_is_pushed_rarely_and_kept_current():
+    hz = SceneLayout().unviewed_rate_hz
+    with _unviewed_scene(hz) as (sc, _):
+        pushed, took, last = _stream(sc, count=200, gap_s=0.002)
+        assert pushed <= took * hz + 2, f"{pushed} pushes in {took:.2f} s"
+        assert wait_for(lambda: np.allclose(sc.current_q_robot(), last))
+
+
+def test_a_browser_connecting_is_shown_the_latest_pose_at_once():
+    """The first browser to connect wakes the scene: it does not wait out the slow period."""
+    with _unviewed_scene(0.01) as (sc, port):  # a push every 100 s
+        _stream(sc, count=1, gap_s=0.0)
+        assert wait_for(lambda: sc.pushes >= 1)  # the first pose: the slow period starts
+        q = np.full(6, 0.42)
+        sc.update_live(np.zeros(7), q, None)
+        viewer = _ScriptWatch(port)
+        try:
+            assert wait_for(lambda: np.allclose(sc.current_q_robot(), q)), "the browser waits"
+        finally:
+            viewer.stop.set()
 
 
 def test_a_slow_stream_limits_the_browsers_frames_and_a_fast_one_lifts_the_limit():

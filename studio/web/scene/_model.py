@@ -29,6 +29,9 @@ class SceneLayout:
             after each push, so each of its poses would cost the browser a burst of redraws in
             the very process that runs the pose model, slowing it by a third.
         slow_live_rate_hz: most pushes per second of a slow live stream (latest wins).
+        unviewed_rate_hz: most pushes per second while no browser shows the scene (latest
+            wins); the first browser to connect wakes the scene at once. Posing the operator's
+            meshes and sending them at ``rate_hz`` to nobody took half of an idle studio's CPU.
         floor_half_size: the floor plate reaches this far from its centre (m).
         floor_cell: spacing of the floor's grid lines (m).
         playback_hold_s: how long the robot keeps the last pose of a finished playback before
@@ -49,6 +52,7 @@ class SceneLayout:
     rate_hz: float = 60.0
     slow_live_s: float = 0.2
     slow_live_rate_hz: float = 1.0
+    unviewed_rate_hz: float = 5.0
     floor_half_size: float = 1.6
     floor_cell: float = 0.25
     playback_hold_s: float = 5.0

@@ -35,7 +35,6 @@ import viser
 
 from studio.kinematics import (
     HumanBody,
-    PosedBody,
     Puma560,
     pose_body,
 )
@@ -81,11 +80,10 @@ def _close_software_webgl_notice(client: viser.ClientHandle) -> None:
 
 @dataclass(frozen=True, eq=False)
 class _Live:
-    """The newest live pose with the operator posed for it (once, by the caller of
-    :meth:`StudioScene.show_live`), for the operator of that ``version``."""
+    """The newest live pose, for the operator of that ``version`` (the scene thread poses the
+    operator for it when it shows it)."""
 
     pose: LivePose
-    posed: PosedBody
     version: int
 
 
@@ -141,6 +139,7 @@ class StudioScene(ScenePaths, SceneRobot, SceneOperator, SceneReach):
         self._paths_lock = threading.Lock()
         self._wake = threading.Event()
         self._closed = threading.Event()
+        self._viewer = threading.Event()  # a browser connected: the scene's full rate again
 
         self._build()
         self.frames = FramePacer(server)  # viser's page draws less: a slow stream, a still scene
@@ -228,6 +227,7 @@ class StudioScene(ScenePaths, SceneRobot, SceneOperator, SceneReach):
         self.server.gui.main_panel.dock_right()
         self.server.gui.main_panel.minimize()
         self.server.on_client_connect(_close_software_webgl_notice)
+        self.server.on_client_connect(lambda client: self._viewer.set())
 
     # ------------------------------------------------------------------ geometry
 
@@ -253,17 +253,26 @@ class StudioScene(ScenePaths, SceneRobot, SceneOperator, SceneReach):
         self._trace_line.visible = False
         self._trace_marks.visible = False
 
+    def _period(self) -> float:
+        """Seconds between pushes: ``rate_hz`` while a browser shows the scene, else
+        ``unviewed_rate_hz`` (the state stays current for readers, and viser's copy for the next
+        browser to connect)."""
+        lay = self.layout
+        viewed = bool(self.server.get_clients())
+        return 1.0 / (lay.rate_hz if viewed else min(lay.rate_hz, lay.unviewed_rate_hz))
+
     def _loop(self) -> None:
-        period = 1.0 / self.layout.rate_hz
         shown = _Shown()
         last = 0.0
         last_logged = -np.inf
         while not self._closed.is_set():
+            period = self._period()
             self._wake.wait(timeout=period)
             self._wake.clear()
             wait = last + period - time.perf_counter()
-            if wait > 0 and self._closed.wait(wait):
-                break
+            if wait > 0 and not self._viewer.is_set():
+                self._viewer.wait(wait)  # a browser connecting ends the wait: it sees now
+            self._viewer.clear()
             if self._closed.is_set():
                 break
             last = time.perf_counter()
@@ -330,7 +339,9 @@ class StudioScene(ScenePaths, SceneRobot, SceneOperator, SceneReach):
                 self._hide_trace()
                 shown.trace_upto = -1
             if new_live and live is not None:
-                self._push_operator(operator, live.posed, whole=operator_changed)
+                p = live.pose
+                posed = pose_body(operator.body, p.q_human, p.tape, self.layout.tape_lift_m)
+                self._push_operator(operator, posed, whole=operator_changed)
             elif operator_changed:
                 self._push_operator(operator, operator.rest, whole=True)
             if operator_changed:
@@ -371,9 +382,9 @@ class StudioScene(ScenePaths, SceneRobot, SceneOperator, SceneReach):
         """Show the latest live pose (never waits for the browser; the scene thread pushes the
         newest).
 
-        The operator is posed for it here, once (:func:`studio.kinematics.pose_body`: the meshes
-        and the tape on the sleeve), so the scene thread only places what it is given. A pose
-        without a tape leaves the tape as drawn.
+        The scene thread poses the operator (:func:`studio.kinematics.pose_body`: the meshes and
+        the tape on the sleeve) for the poses it shows only, not for each one a 110 Hz source
+        gives. A pose without a tape leaves the tape as drawn.
         """
         pose = LivePose(
             np.array(pose.q_human, dtype=float),
@@ -382,10 +393,7 @@ class StudioScene(ScenePaths, SceneRobot, SceneOperator, SceneReach):
         )
         now = time.perf_counter()
         with self._lock:
-            operator = self._operator
-        posed = pose_body(operator.body, pose.q_human, pose.tape, self.layout.tape_lift_m)
-        with self._lock:
-            self._live = _Live(pose, posed, operator.version)
+            self._live = _Live(pose, self._operator.version)
             self._live_version += 1
             gap = min(now - self._live_at, 1.0)  # a pause counts as one slow gap, not more
             smooth = self._live_gap + 0.25 * (gap - self._live_gap)
@@ -531,6 +539,7 @@ class StudioScene(ScenePaths, SceneRobot, SceneOperator, SceneReach):
         """Stop the scene thread (the viser server is the caller's to stop)."""
         self._closed.set()
         self._wake.set()
+        self._viewer.set()
         self._thread.join(timeout=2.0)
         self.frames.close()
 
