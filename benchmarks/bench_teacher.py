@@ -18,8 +18,9 @@ The split, the same for every row:
   for every row.
 
 The rows: the teacher (the demonstrations followed at every step, no learning); the DMP fitted
-to ``sample-reach-1`` (a movement primitive learns one demonstration); behaviour cloning (the
-nearest demonstrated state's move); and linear Dyna-Q (zero planning unless
+to ``sample-reach-1`` (a movement primitive learns one demonstration); behaviour cloning (one
+nearest neighbour over the demonstrated states, moving toward the state the demonstration went to
+next from it); and linear Dyna-Q (zero planning unless
 ``--planning-steps``, the paper's alpha 0.1, gamma 0.95, epsilon 0.1, per-joint tile coding):
 without demonstrations (one joint per action); with the paper's replay only (the demonstrations
 replayed as the first episodes, one joint per action); with the follow option (the action that

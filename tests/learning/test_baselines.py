@@ -61,7 +61,7 @@ def test_a_run_trained_by_the_teacher_or_by_cloning_is_a_policy_of_its_kind(runs
         assert facts["planning"] == "none" and facts["episodes"] == 6
 
 
-def test_the_teacher_follows_the_demonstrations_and_cloning_copies_the_nearest_move(runs):
+def test_the_teacher_follows_the_demonstrations_and_cloning_rejoins_them(runs):
     teacher = load_any_policy(runs / "teacher" / "policy.policy.npz")
     cloning = load_any_policy(runs / "cloning" / "policy.policy.npz")
     task = teacher.task
@@ -71,11 +71,13 @@ def test_the_teacher_follows_the_demonstrations_and_cloning_copies_the_nearest_m
     assert judged.success == 1.0  # following reaches the goal from anywhere
     assert judged.mean_steps == pytest.approx(np.mean([len(p) - 1 for p, _ in walks]))
     # cloning from the demonstration's own start walks it to the goal; from elsewhere it
-    # makes the nearest sample's move, parallel to the demonstration, and falls short
+    # heads for the nearest sample's demonstrated next state, so it rejoins the demonstration
+    # and walks it to its end (copying the sample's move instead, parallel to it, fell short
+    # from every one of these starts)
     first = np.asarray(load_any_policy(runs / "cloning" / "policy.policy.npz").cloning.states[0])
     path, reached = cloning_rollout(cloning.task, cloning.cloning, first, 5_000)
     assert reached and len(path) > 10
-    assert learner_of(cloning).evaluate(cloning, starts).success < judged.success
+    assert learner_of(cloning).evaluate(cloning, starts).success == 1.0
     out = learner_of(cloning).roll_out(cloning, Start(seed=3), 50.0)
     assert out.q.shape[1] == 6 and out.times[0] == 0.0
 
@@ -119,6 +121,24 @@ def test_cloning_learns_each_demonstrated_move():
     assert not cloning.moves[-1].any()  # the demonstration's end: no move
     with pytest.raises(LearningError, match="at least one"):
         fit_cloning(task, [])
+
+
+def test_cloning_heads_for_the_demonstrated_next_state_so_it_rejoins_the_demonstration():
+    """Off the demonstration the cloned action closes the gap to it: copying the nearest
+    sample's move instead went parallel to the demonstration and never reached the goal."""
+    task = ArmReach(joints=3)
+    path = np.linspace([0.3, 0.2, -0.5], task.goal[:3], 40)
+    cloning = fit_cloning(task, [path])
+    start = cloning.states[0] + np.array([0.0, 0.15, 0.0])  # off the path, beside its start
+    walk, reached = cloning_rollout(task, cloning, start, 5_000)
+    first = walk[1] - walk[0]
+    nearest = int(np.argmin(np.linalg.norm(cloning.states - start, axis=1)))
+    toward = cloning.states[nearest + 1] - start  # that sample's demonstrated next state
+    assert np.abs(first).max() == pytest.approx(task.step)  # one step, every joint at once
+    np.testing.assert_allclose(first, toward * task.step / np.abs(toward).max())
+    assert reached
+    copied = start + np.cumsum(np.repeat(cloning.moves[nearest : nearest + 1], 5, axis=0), axis=0)
+    assert np.linalg.norm(copied[-1] - cloning.states[nearest + 5]) > 0.1  # the move stayed off
 
 
 def test_the_demonstrations_potential_is_a_setting_of_its_own():

@@ -1,5 +1,6 @@
 """Baselines beside Dyna-Q, each a learner like the others: the teacher (the demonstrations
-followed, no learning) and behaviour cloning (the nearest demonstrated state's move)."""
+followed, no learning) and behaviour cloning (toward the demonstrated next state of the nearest
+demonstrated state)."""
 
 from ._cloning import Cloning as Cloning
 from ._cloning import fit_cloning as fit_cloning

@@ -265,8 +265,8 @@ class TeacherLearner(_BaselineLearner):
 
 
 class CloningLearner(_BaselineLearner):
-    """Behaviour cloning (:mod:`._cloning`): the nearest demonstrated state's move; its policies
-    are :class:`CloningPolicyFile`."""
+    """Behaviour cloning (:mod:`._cloning`): toward the demonstrated next state of the nearest
+    demonstrated state; its policies are :class:`CloningPolicyFile`."""
 
     kind = CLONING_KIND
     title = "behaviour cloning"
