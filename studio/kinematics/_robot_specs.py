@@ -7,9 +7,12 @@ only when a robot is loaded.
 
 from __future__ import annotations
 
+import importlib.metadata
 import math
+import sysconfig
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from pathlib import Path
 
 from ._checks import KinematicsError
 from ._dh import PAPER_GRID_RANGE_DEG, PUMA_READY_DEG, PUMA_WRIST_PAIRS, puma560_urdf
@@ -258,3 +261,26 @@ def robot_spec(name: object) -> RobotSpec:
             "lists them with their joints)."
         )
     return spec
+
+
+ROBOTS_RELATIVE = Path("cmeel.prefix/share/example-robot-data/robots")
+"""Where the ``example-robot-data`` wheel installs its robots, relative to site-packages."""
+
+
+def robots_folder() -> Path:
+    """The folder of example-robot-data's robots, or a KinematicsError saying how to install it."""
+    candidates: list[Path] = []
+    try:
+        dist = importlib.metadata.distribution("example-robot-data")
+        candidates.append(Path(str(dist.locate_file(ROBOTS_RELATIVE))))
+    except importlib.metadata.PackageNotFoundError:
+        pass
+    for key in ("purelib", "platlib"):
+        candidates.append(Path(sysconfig.get_paths()[key]) / ROBOTS_RELATIVE)
+    for path in candidates:
+        if path.is_dir():
+            return path
+    raise KinematicsError(
+        "The robot models of example-robot-data were not found; install them with "
+        "`pip install example-robot-data`."
+    )

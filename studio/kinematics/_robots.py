@@ -22,10 +22,8 @@ Puma560's too: the sources of its speed and torque limits give none).
 from __future__ import annotations
 
 import copy
-import importlib.metadata
 import math
 import re
-import sysconfig
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -40,10 +38,7 @@ from ._robot_specs import ROBOT_SPECS as ROBOT_SPECS
 from ._robot_specs import RobotSpec as RobotSpec
 from ._robot_specs import robot_names as robot_names
 from ._robot_specs import robot_spec as robot_spec
-
-ROBOTS_RELATIVE = Path("cmeel.prefix/share/example-robot-data/robots")
-"""Where the ``example-robot-data`` wheel installs its robots, relative to site-packages."""
-
+from ._robot_specs import robots_folder as robots_folder
 
 IK_DAMPING = 1e-2
 """The damping (lambda, m) of :meth:`RobotArm.inverse`'s least-squares steps by default."""
@@ -54,25 +49,6 @@ TOOL_AXES = {
     "x": np.array([[0.0, 0.0, -1.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]]),
 }
 """A robot's tool axes (columns) in the studio's tool frame (z along the fingers), by approach."""
-
-
-def robots_folder() -> Path:
-    """The folder of example-robot-data's robots, or a KinematicsError saying how to install it."""
-    candidates: list[Path] = []
-    try:
-        dist = importlib.metadata.distribution("example-robot-data")
-        candidates.append(Path(str(dist.locate_file(ROBOTS_RELATIVE))))
-    except importlib.metadata.PackageNotFoundError:
-        pass
-    for key in ("purelib", "platlib"):
-        candidates.append(Path(sysconfig.get_paths()[key]) / ROBOTS_RELATIVE)
-    for path in candidates:
-        if path.is_dir():
-            return path
-    raise KinematicsError(
-        "The robot models of example-robot-data were not found; install them with "
-        "`pip install example-robot-data`."
-    )
 
 
 def tool_errors(

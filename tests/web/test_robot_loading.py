@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from studio.kinematics import MeshConfig, Puma560, load_robot
-from studio.web.scene import _robot_view
+from studio.web.scene import _robot_view, _simplify
 from studio.web.scene._robot_view import RobotViews, arm_view
 from tests.web.conftest import wait_for
 
@@ -18,7 +18,7 @@ def test_a_robots_meshes_are_simplified_outside_the_studios_process(tmp_path, mo
     def not_here(*args, **kwargs):
         raise AssertionError("the meshes were simplified in the studio's own process")
 
-    monkeypatch.setattr(_robot_view, "robot_meshes", not_here)
+    monkeypatch.setattr(_simplify, "robot_meshes", not_here)
     views = RobotViews(Puma560(), MeshConfig(), cache=tmp_path)
     drawn: list[_robot_view.RobotView] = []
     views.request(arm, drawn.append)

@@ -26,7 +26,7 @@ import numpy as np
 import pinocchio as pin
 
 from .._checks import KinematicsError, check_side, positive_number, real_array
-from .._robots import robots_folder
+from .._robot_specs import robots_folder
 
 URDF_IN_ROBOTS = Path("human_description/robots/human.urdf")
 """Where ``human.urdf`` lies in example-robot-data's robots folder (see ``robots_folder``)."""

@@ -12,10 +12,8 @@ reads at the scene's distance from the operator beside it.
 from __future__ import annotations
 
 import logging
-import multiprocessing
 import threading
 from collections.abc import Callable, Sequence
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -31,11 +29,11 @@ from studio.kinematics import (
     RobotArm,
     load_robot,
     puma560_meshes,
-    robot_meshes,
     robot_spec,
 )
 
 from ._mesh_cache import cached_parts, mesh_key
+from ._simplify import Geometry, Visuals, simplified, simplified_elsewhere
 
 
 @dataclass(frozen=True, eq=False)
@@ -112,40 +110,6 @@ def arm_tool(arm: RobotArm) -> Callable[[np.ndarray], np.ndarray]:
     return tool
 
 
-@dataclass(frozen=True)
-class _Geometry:
-    """What :func:`~studio.kinematics.robot_meshes` reads of one of a URDF's visual objects,
-    as plain values a child process is handed (a Pinocchio model does not cross)."""
-
-    name: str
-    meshPath: str  # noqa: N815  (Pinocchio's GeometryObject names)
-    meshScale: tuple[float, ...]  # noqa: N815
-    meshColor: tuple[float, ...]  # noqa: N815
-
-
-@dataclass(frozen=True)
-class _Visuals:
-    geometryObjects: tuple[_Geometry, ...]  # noqa: N815
-
-
-def _simplified(visuals: _Visuals, config: MeshConfig, scale: float) -> list[MeshPart]:
-    """The robot's meshes read and simplified at the size drawn (in a child process)."""
-    return [
-        MeshPart(p.name, p.frame, p.vertices * np.float32(scale), p.faces, p.rgb)
-        for p in robot_meshes(visuals, config)  # type: ignore[arg-type]
-    ]
-
-
-def _simplified_elsewhere(visuals: _Visuals, config: MeshConfig, scale: float) -> list[MeshPart]:
-    """:func:`_simplified` in a child process: reading and simplifying a robot's meshes holds
-    the interpreter for seconds at a time (a Panda: 14 s, with pauses of up to a second in the
-    other threads on a busy machine), and the live scene, the fit and the page's requests must
-    go on meanwhile. Only the simplified parts come back."""
-    spawn = multiprocessing.get_context("spawn")  # a fork would copy the server's threads
-    with ProcessPoolExecutor(max_workers=1, mp_context=spawn) as child:
-        return child.submit(_simplified, visuals, config, scale).result()
-
-
 def arm_view(
     arm: RobotArm, config: MeshConfig, cache: Path | None = None, elsewhere: bool = False
 ) -> RobotView:
@@ -158,10 +122,10 @@ def arm_view(
     """
     scale, pedestal = arm_framing(arm)
     # simplified at the size drawn: an enlarged arm keeps the detail of a full-size one
-    simplified = replace(config, cell_m=config.cell_m / scale)
-    visuals = _Visuals(
+    at_size = replace(config, cell_m=config.cell_m / scale)
+    visuals = Visuals(
         tuple(
-            _Geometry(
+            Geometry(
                 g.name,
                 str(g.meshPath),
                 tuple(float(x) for x in np.asarray(g.meshScale, dtype=float)),
@@ -172,13 +136,13 @@ def arm_view(
     )
 
     def build() -> list[MeshPart]:
-        return (_simplified_elsewhere if elsewhere else _simplified)(visuals, simplified, scale)
+        return (simplified_elsewhere if elsewhere else simplified)(visuals, at_size, scale)
 
     geometries = arm.visual_model.geometryObjects
     files = [str(g.meshPath) for g in geometries]
     # the parts are attached to the visual model's objects by index: the key covers that model
     model = [(g.name, int(g.parentJoint), int(g.parentFrame)) for g in geometries]
-    key = mesh_key(files, simplified.cell_m, scale, arm.model.nq, model)
+    key = mesh_key(files, at_size.cell_m, scale, arm.model.nq, model)
     parts = cached_parts(cache, arm.name, key, build, frames=range(len(geometries)))
     # Its own scratch data: the arm's own is the retargeting's, in another thread.
     data, geometry_data = arm.model.createData(), arm.visual_model.createData()
