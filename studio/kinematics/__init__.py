@@ -31,8 +31,10 @@ if typing.TYPE_CHECKING:  # the public names, each loaded when first used (see s
     from ._retarget_path import retarget_path as retarget_path
     from ._retarget_path import tool_reaches as tool_reaches
     from ._robot_load import isolate_robot_loading as isolate_robot_loading
+    from ._robot_load import keep_robot_geometry as keep_robot_geometry
     from ._robot_load import load_robot as load_robot
     from ._robot_load import prepare_arm_ik_in_background as prepare_arm_ik_in_background
+    from ._robot_load import robot_cache_folder as robot_cache_folder
     from ._robot_load import robot_is_kept as robot_is_kept
     from ._robot_specs import DEFAULT_ROBOT as DEFAULT_ROBOT
     from ._robot_specs import LIMIT_MARGIN_RAD as LIMIT_MARGIN_RAD

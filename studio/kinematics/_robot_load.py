@@ -113,8 +113,23 @@ def isolate_robot_loading(cache: Path | None = None) -> None:
         cache: a folder where each robot's built geometry is kept, so that it is built once per
             machine (safe to delete; None: nothing kept).
     """
-    _cache[:] = [] if cache is None else [Path(cache)]
+    keep_robot_geometry(cache)
     _isolated.set()
+
+
+def keep_robot_geometry(cache: Path | None) -> None:
+    """From now on in this process, read each robot's built geometry from the folder ``cache``
+    when it keeps it, and keep it there after a build (built in this process, unless
+    :func:`isolate_robot_loading`): for a process that loads robots on a studio's behalf, such
+    as its planning's child (None: nothing kept)."""
+    _cache[:] = [] if cache is None else [Path(cache)]
+
+
+def robot_cache_folder() -> Path | None:
+    """The cache folder :func:`isolate_robot_loading` was given (None: none), for a child
+    process that loads robots on this one's behalf: given it, the child reads the geometry kept
+    there instead of building it again."""
+    return _cache[0] if _cache else None
 
 
 def robot_is_kept(name: str) -> bool:
@@ -160,6 +175,8 @@ def _load(spec: RobotSpec, geometry: bool) -> RobotArm:
     text = _urdf_text(spec)
     if geometry and _isolated.is_set():
         model, visual, collision = _built_in_child(spec, text)
+    elif geometry and _cache:
+        model, visual, collision = _built_kept(spec, text)
     else:
         model, visual, collision = _built(spec, text, geometry)
     srdf = robots_folder() / spec.srdf if spec.srdf else None
@@ -251,6 +268,23 @@ def _built_in_child(spec: RobotSpec, text: str) -> Parts:
             )
         parts = _read_archives(files)
         if kept is not None:
+            _keep(kept, files)
+    return parts
+
+
+def _built_kept(spec: RobotSpec, text: str) -> Parts:
+    """:func:`_built` in this process, read from the cache folder when it keeps this robot, and
+    kept there after a build."""
+    kept = _cache_entry(spec, text)
+    parts = None if kept is None else _read_kept(kept)
+    if parts is not None:
+        return parts
+    parts = _built(spec, text, True)
+    if kept is not None:
+        with tempfile.TemporaryDirectory(prefix="studio-robot-") as folder:
+            files = [Path(folder) / f"{part}.bin" for part in _PARTS]
+            for part, file in zip(parts, files, strict=True):
+                part.saveToBinary(str(file))
             _keep(kept, files)
     return parts
 

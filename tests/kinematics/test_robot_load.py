@@ -146,6 +146,26 @@ def test_a_built_robot_is_kept_in_the_cache_and_read_back_without_a_child(tmp_pa
     _same_robot(built, robot_load._built_in_child(SPEC, TEXT))
 
 
+def test_a_robot_built_in_this_process_is_kept_and_read_back(tmp_path, monkeypatch):
+    """``keep_robot_geometry`` (a studio's planning child): built here, without a child, kept in
+    the cache folder as a child's build is, and read back from it the next time."""
+    monkeypatch.setattr(robot_load, "_cache", [])
+    robot_load.keep_robot_geometry(tmp_path)
+    assert robot_load.robot_cache_folder() == tmp_path
+    monkeypatch.setattr(robot_load, "_CHILD", FAILING_CHILD)  # a child would fail: none runs
+    built = robot_load._load(SPEC, True)
+    (kept,) = tmp_path.iterdir()
+    assert kept.name.startswith("so100-") and (kept / robot_load._MANIFEST).is_file()
+    monkeypatch.setattr(robot_load, "_built", None)  # built again here, it would raise
+    again = robot_load._load(SPEC, True)
+    assert again.joint_names == built.joint_names
+    for q in np.random.default_rng(6).uniform(built.lower, built.upper, size=(4, built.nq)):
+        np.testing.assert_allclose(again.forward(q), built.forward(q))
+        assert [(c.link_a, c.link_b) for c in again.self_collisions(q, 0.05)] == [
+            (c.link_a, c.link_b) for c in built.self_collisions(q, 0.05)
+        ]
+
+
 def test_a_damaged_kept_robot_is_built_again_and_kept_anew(tmp_path, monkeypatch, caplog):
     monkeypatch.setattr(robot_load, "_cache", [tmp_path])
     built = robot_load._built_in_child(SPEC, TEXT)

@@ -6,6 +6,8 @@ from __future__ import annotations
 import subprocess
 import threading
 import time
+from collections.abc import Iterator
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -21,6 +23,16 @@ from tests.export.conftest import smooth_arm, write_arm_recording
 SAMPLE = SAMPLES_DIR / "sample-reach-2.tape.csv"
 STEP = RetargetConfig().max_joint_step
 WAIT_S = 60.0
+
+
+@pytest.fixture(scope="module", autouse=True)
+def robots_kept(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Path]:
+    """The plans' children read each robot's geometry from this cache folder, as the studio's
+    read its own (``studio serve`` keeps one): built once for the module, not once a plan."""
+    cache = tmp_path_factory.mktemp("robots")
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(_planned_playback, "robot_cache_folder", lambda: cache)
+        yield cache
 
 
 @pytest.fixture(scope="module")
@@ -142,10 +154,11 @@ def test_the_robot_moves_onto_the_plan_where_it_meets_it_or_at_the_loop_never_ju
     np.testing.assert_array_equal(q_again, planned)
 
 
-def test_a_seek_back_or_a_loop_moves_the_robot_onto_the_plan_with_the_arm(playing):
+def test_a_seek_back_or_a_loop_moves_the_robot_onto_the_plan_with_the_arm(playing, robots_kept):
     pipeline, recording = playing
     pipeline.observe(recording.frame_at(200))
     wait_for(pipeline, "is planned")
+    assert list(robots_kept.glob("ur3-*/sha256.json"))  # its child kept the UR3 for the next
     q, _ = play(pipeline, recording, [201, 202, 10, 11])  # a seek back to row 10
     planned = recording_motion(SAMPLE, "ur3").q
     np.testing.assert_array_equal(q[2:], planned[10:12])
@@ -175,9 +188,10 @@ def test_a_recording_that_cannot_be_planned_plays_live_and_says_why(ur3, tmp_pat
         pipeline.close()
 
 
-def test_a_plan_no_longer_wanted_stops_its_process(children):
+def test_a_plan_no_longer_wanted_stops_its_process(children, robots_kept):
     assert _planned_playback.plan_recording(SAMPLE, "ur3", lambda: True) is None
     assert len(children) == 1 and children[0].returncode is not None  # killed, and reaped
+    assert children[0].args[-1] == str(robots_kept)  # told where the studio keeps its robots
 
 
 def test_switching_the_source_or_the_robot_forgets_the_plan(playing):
@@ -235,7 +249,6 @@ def test_the_planning_child_quits_and_cleans_up_when_its_studio_is_killed(tmp_pa
     ``studio-plan-*`` folder stayed in the temporary folder."""
     import os
     import sys
-    from pathlib import Path
 
     studio = (
         "import subprocess, sys\n"

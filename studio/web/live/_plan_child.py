@@ -1,11 +1,14 @@
 """The child process that plans a recording's path on a robot for the studio
 (:func:`studio.web.live._planned_playback.plan_recording`).
 
-``python -m studio.web.live._plan_child RECORDING ROBOT OUT.npz`` writes the recording's
-:class:`~studio.kinematics.RetargetedPath` (:func:`studio.export.recording_motion`) to
+``python -m studio.web.live._plan_child RECORDING ROBOT OUT.npz [ROBOT_CACHE]`` writes the
+recording's :class:`~studio.kinematics.RetargetedPath` (:func:`studio.export.recording_motion`) to
 ``OUT.npz`` and exits 0; a recording or robot it cannot plan prints the one sentence saying why
 and exits 2. It runs apart from the studio because the planning holds the interpreter for up to
-0.2 s at a time, which would stall the live pipeline's frames in a thread of the studio's.
+0.2 s at a time, which would stall the live pipeline's frames in a thread of the studio's. Given
+the studio's robot cache folder (:func:`studio.kinematics.robot_cache_folder`), it reads the
+robot's collision geometry kept there (the studio built it when the robot was chosen) instead of
+building it again; it loads only the modules planning needs, not the studio's app.
 
 The studio holds the child's stdin open while it waits for it. When the studio dies (even by
 ``kill -9``), the kernel closes that pipe: the child sees the end of its stdin, removes its
@@ -24,7 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from studio import StudioError
-from studio.kinematics import RetargetedPath
+from studio.kinematics import RetargetedPath, keep_robot_geometry
 from studio.motion import recording_motion
 
 CANNOT = 2
@@ -64,8 +67,10 @@ def quit_with_the_studio(out: Path) -> None:
 
 
 def main(argv: list[str]) -> int:
-    recording, robot, out = argv
+    recording, robot, out, *cache = argv
     quit_with_the_studio(Path(out))
+    if cache:
+        keep_robot_geometry(Path(cache[0]))  # a robot not kept there is built and kept
     try:
         motion = recording_motion(Path(recording), robot)
     except (StudioError, OSError) as err:

@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from studio.capture import PlaybackSource
-from studio.kinematics import RetargetedPath, RobotArm
+from studio.kinematics import RetargetedPath, RobotArm, robot_cache_folder
 
 from ._plan_child import CANNOT, TEMP_PREFIX, load_path
 
@@ -188,6 +188,9 @@ def plan_recording(
     with tempfile.TemporaryDirectory(prefix=TEMP_PREFIX) as folder:
         out = Path(folder) / "path.npz"
         command = [sys.executable, "-m", "studio.web.live._plan_child", str(path), robot, str(out)]
+        cache = robot_cache_folder()  # the robot's geometry, kept when the studio built it
+        if cache is not None:
+            command.append(str(cache))
         said_at, errors_at = Path(folder) / "said.txt", Path(folder) / "errors.txt"
         try:
             with said_at.open("w") as said_to, errors_at.open("w") as errors_to:
