@@ -7,8 +7,9 @@ so a frame rate comes in steps of the picture interval: at 10 frames/s an infere
 ms reads as 2.0 frames/s on either side, which hides differences of up to a fifth.
 
 1. Inference frame rate: the bare package (a minimal page that loads only the vendored
-   ``pose.js`` from the studio and runs the same camera loop: each frame copied into a canvas,
-   its stamp read, the copy given to the model) against the studio page with the camera as its
+   ``@mediapipe/tasks-vision`` from the studio and runs the same camera loop with the same
+   PoseLandmarker on the CPU: each frame copied into a canvas, its stamp read, the copy given to
+   the model) against the studio page with the camera as its
    source (drawing, sending landmarks, the 3D scene), in alternating windows of the same run,
    for the lite and the full model. Both sides run beside the same studio server with the same
    API probe, and each opens the camera only for its own windows: they differ by the studio page
@@ -16,8 +17,8 @@ ms reads as 2.0 frames/s on either side, which hides differences of up to a fift
 
    Beside the frame rates, the CPU seconds each process spends per inferred frame, from /proc
    (``process_cpu.py``): the renderer of each page (bare, studio, the scene's iframe), the GPU
-   process (where SwiftShader draws every page's WebGL: the pose model's and the scene's, split
-   by thread), the browser, its utilities and the studio server. On a shared machine this moves
+   process (where SwiftShader draws every page's WebGL: the scene's, and the pose model's before
+   it ran on the CPU; split by thread), the browser, its utilities and the studio server. On a shared machine this moves
    far less with other work than frames/s do.
 2. Camera-to-scene latency while the studio page runs: from the picture's capture time (the
    video frame's ``captureTime``, else when the page took it) to the landmarks (the model's
@@ -30,15 +31,15 @@ ms reads as 2.0 frames/s on either side, which hides differences of up to a fift
    after a result), so without a GPU the answer comes later than the scene.
 3. The API while it runs: ``GET /api/source`` and ``GET /api/runs`` latencies, p50 and p99 (goal:
    p99 < 250 ms).
-4. The scene's pushes for a camera at the bare package's rate on an idle machine without a GPU
-   (3.5 frames/s, lite), landmarks of a known arm motion posted straight to the studio (no
+4. The scene's pushes for a camera at the rate the older WebGL pose solution reached on an idle
+   machine without a GPU (3.5 frames/s, lite), landmarks of a known arm motion posted straight to the studio (no
    browser, so the figure does not depend on the machine's load): how many robot poses a second
    reach a viser client. Beside it, from the studio windows: the frames the page's scene drew
    for each robot pose (the studio limits its frames while a slow stream drives it, and each is
-   drawn in the browser's software-GL process that also runs the pose model).
+   drawn in the browser's software-GL process).
 
-On a 2-core machine without a GPU the model runs at a few frames a second and figures swing with
-other work on the machine: read the ratios of neighbouring windows, and rerun.
+On a 2-core machine without a GPU figures swing with other work on the machine: read the ratios
+of neighbouring windows, and rerun.
 
 Run: ``python benchmarks/bench_camera.py`` (two to five minutes on an idle machine, far longer on
 a busy one; ``--models lite`` for half; needs /usr/bin/chromium).
@@ -87,11 +88,12 @@ SAME_POSITION_M = 1e-7
 BARE_HTML = (
     """<!doctype html><html><head><meta charset="utf-8"><title>bare BlazePose</title></head>
 <body><video id="v" playsinline muted style="position:absolute;width:1px;height:1px;opacity:0"></video>
-<script src="/static/vendor/mediapipe-pose/pose.js"></script>
-<script>
+<script type="module">
 // The vendored package alone, with the studio page's loop: one frame at a time, a yield between,
 // each frame copied into a canvas (camera.js's grab) whose stamp is read before the model sees it.
-const MODELS = { lite: 0, full: 1 };
+import { FilesetResolver, PoseLandmarker } from "/static/vendor/mediapipe-tasks-vision/vision_bundle.mjs";
+const MODELS = { lite: "/static/vendor/pose-landmarker/pose_landmarker_lite.task",
+                 full: "/static/vendor/pose-landmarker/pose_landmarker_full.task" };
 const readStamp = """
     + READ_STAMP_JS
     + """;
@@ -104,8 +106,8 @@ function grab() {
 }
 window.bench = { times: [], running: false, model: null, ready: false };
 const video = document.getElementById("v");
-const pose = new Pose({ locateFile: (f) => `/static/vendor/mediapipe-pose/${f}` });
-pose.onResults(() => { window.bench.times.push(performance.now() / 1000); });
+const fileset = await FilesetResolver.forVisionTasks("/static/vendor/mediapipe-tasks-vision");
+let pose = null, poseTime = 0;
 function nextFrame() {
   return new Promise((resolve) => {
     let done = false;
@@ -114,12 +116,14 @@ function nextFrame() {
     setTimeout(go, 100);
   });
 }
-async function setModel(model) {
-  pose.setOptions({ modelComplexity: MODELS[model], smoothLandmarks: false, enableSegmentation: false,
-                    selfieMode: false, minDetectionConfidence: 0.5, minTrackingConfidence: 0.5 });
+window.setModel = async (model) => {
+  if (pose) pose.close();
+  pose = await PoseLandmarker.createFromOptions(fileset, {
+    baseOptions: { modelAssetPath: MODELS[model], delegate: "CPU" }, runningMode: "VIDEO", numPoses: 1,
+    minPoseDetectionConfidence: 0.5, minPosePresenceConfidence: 0.5, minTrackingConfidence: 0.5,
+    outputSegmentationMasks: false });
   window.bench.model = model;
-  await pose.initialize();
-}
+};
 async function loop() {
   while (window.bench.running) {
     await nextFrame();
@@ -127,7 +131,9 @@ async function loop() {
     if (video.readyState < 2 || !video.videoWidth) continue;
     const frame = grab();
     window.bench.tag = readStamp(frame);
-    await pose.send({ image: frame });
+    poseTime = Math.max(poseTime + 1, performance.now());
+    pose.detectForVideo(frame, poseTime);
+    window.bench.times.push(performance.now() / 1000);
   }
 }
 // The camera is open only while the page measures, as in the studio page (which opens it when
@@ -145,10 +151,8 @@ window.benchStop = () => {
   for (const track of video.srcObject ? video.srcObject.getTracks() : []) track.stop();
   video.srcObject = null;
 };
-(async () => {
-  await setModel("lite");
-  window.bench.ready = true;
-})();
+await setModel("lite");
+window.bench.ready = true;
 </script></body></html>"""
 )
 
@@ -305,7 +309,8 @@ def scene_latencies(
 
 
 FED_RATE_HZ = 3.5
-"""The lite model's rate in a bare page on an idle 2-core machine with software WebGL."""
+"""The lite model's rate in a bare page on an idle 2-core machine with software WebGL, when it ran
+there (``@mediapipe/pose``; on the CPU it keeps up with the camera)."""
 
 
 def fed_scene_rate(base: str, scene: SceneWatch, seconds: float) -> tuple[float, float]:

@@ -1,14 +1,16 @@
 """The vendored front-end libraries: every file is the one the manifest names, served as is.
 
 ``studio/web/static/vendor/SHA256SUMS`` holds the SHA-256 of every file copied from a registry
-package (uPlot, BlazePose's ``@mediapipe/pose``). A file edited by hand, half-copied, or added
-without its hash fails here; so does a vendored file the studio would serve with the wrong type
-(Chromium compiles ``.wasm`` streamed from the network only when it is ``application/wasm``).
+package (uPlot, ``@mediapipe/tasks-vision``) or built from one (BlazePose's model bundles). A
+file edited by hand, half-copied, or added without its hash fails here; so does a vendored file the
+studio would serve with the wrong type (Chromium compiles ``.wasm`` streamed from the network only
+when it is ``application/wasm``).
 """
 
 from __future__ import annotations
 
 import hashlib
+import zipfile
 from pathlib import Path
 
 import pytest
@@ -17,21 +19,19 @@ from studio.web._app import STATIC_DIR
 
 VENDOR = STATIC_DIR / "vendor"
 MANIFEST = VENDOR / "SHA256SUMS"
-POSE = "mediapipe-pose"
-POSE_FILES = {
+TASKS = "mediapipe-tasks-vision"
+TASKS_FILES = {
     "LICENSE",
-    "pose.js",
-    "pose_solution_packed_assets_loader.js",
-    "pose_solution_packed_assets.data",
-    "pose_web.binarypb",
-    "pose_solution_simd_wasm_bin.js",
-    "pose_solution_simd_wasm_bin.wasm",
-    "pose_solution_wasm_bin.js",
-    "pose_solution_wasm_bin.wasm",
-    "pose_landmark_lite.tflite",
-    "pose_landmark_full.tflite",
+    "vision_bundle.mjs",
+    "vision_wasm_internal.js",
+    "vision_wasm_internal.wasm",
+    "vision_wasm_nosimd_internal.js",
+    "vision_wasm_nosimd_internal.wasm",
 }
-"""What the page loads for BlazePose lite and full (SIMD or not), and the licence: nothing else."""
+"""What the page loads to run BlazePose (SIMD or not), and the licence: nothing else."""
+POSE = "pose-landmarker"
+POSE_FILES = {"LICENSE", "pose_landmarker_lite.task", "pose_landmarker_full.task"}
+"""BlazePose lite and full, and the licence."""
 
 
 def manifest() -> dict[str, str]:
@@ -60,23 +60,38 @@ def test_every_vendored_file_is_in_the_manifest_and_matches_it():
         )
 
 
-def test_blazepose_is_vendored_with_only_what_the_page_loads():
-    assert {n.split("/", 1)[1] for n in manifest() if n.startswith(POSE + "/")} == POSE_FILES
-    assert "Apache License" in (VENDOR / POSE / "LICENSE").read_text()
+@pytest.mark.parametrize(("folder", "files"), [(TASKS, TASKS_FILES), (POSE, POSE_FILES)])
+def test_blazepose_is_vendored_with_only_what_the_page_loads(folder, files):
+    assert {n.split("/", 1)[1] for n in manifest() if n.startswith(folder + "/")} == files
+    assert "Apache License" in (VENDOR / folder / "LICENSE").read_text()
+
+
+def test_the_pose_bundles_hold_the_two_blazepose_models():
+    """A ``.task`` is a zip the PoseLandmarker opens by these two names, stored uncompressed."""
+    for model in ("lite", "full"):
+        with zipfile.ZipFile(VENDOR / POSE / f"pose_landmarker_{model}.task") as bundle:
+            entries = bundle.infolist()
+        assert {e.filename for e in entries} == {
+            "pose_detector.tflite",
+            "pose_landmarks_detector.tflite",
+        }
+        assert all(e.compress_type == zipfile.ZIP_STORED for e in entries)
 
 
 @pytest.mark.parametrize(
     ("name", "media_type"),
     [
-        ("pose_solution_simd_wasm_bin.wasm", "application/wasm"),
-        ("pose_solution_wasm_bin.wasm", "application/wasm"),
-        ("pose.js", "javascript"),
-        ("pose_landmark_lite.tflite", None),
+        (f"{TASKS}/vision_wasm_internal.wasm", "application/wasm"),
+        (f"{TASKS}/vision_wasm_nosimd_internal.wasm", "application/wasm"),
+        # a module script runs only when served as JavaScript
+        (f"{TASKS}/vision_bundle.mjs", "javascript"),
+        (f"{TASKS}/vision_wasm_internal.js", "javascript"),
+        (f"{POSE}/pose_landmarker_lite.task", None),
     ],
 )
 def test_the_studio_serves_the_vendored_model_files(client, name, media_type):
-    r = client.get(f"/static/vendor/{POSE}/{name}")
+    r = client.get(f"/static/vendor/{name}")
     assert r.status_code == 200
-    assert r.content == Path(VENDOR / POSE / name).read_bytes()
+    assert r.content == Path(VENDOR / name).read_bytes()
     if media_type:
         assert media_type in r.headers["content-type"]

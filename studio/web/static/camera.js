@@ -4,22 +4,24 @@
  * in state.js, on every status), keeps its loop in `S.camera`, and announces each frame it sent
  * and the studio's answer as `S.landmarks` (the browser tests collect them).
  *
- * When the live source is `camera`, the page asks for the camera, runs BlazePose (the vendored
- * `@mediapipe/pose`, loaded only then) on each new video frame, draws the picture small with the
- * skeleton over it, and sends each frame's 33 world and image landmarks to
- * POST /api/source/landmarks. No picture leaves the page. Frames are taken one at a time, with a
- * yield to the page between them: `pose.send()` called back to back blocks the page. A person the
- * model takes for one seen from behind has their left and right put back (see facesAway).
+ * When the live source is `camera`, the page asks for the camera, runs BlazePose (MediaPipe Tasks'
+ * PoseLandmarker from the vendored `@mediapipe/tasks-vision`, loaded only then, on the CPU) on each
+ * new video frame, draws the picture small with the skeleton over it, and sends each frame's 33
+ * world and image landmarks to POST /api/source/landmarks. No picture leaves the page. Frames are
+ * taken one at a time, with a yield to the page between them: the model runs on the page's thread.
+ * A person the model takes for one seen from behind has their left and right put back (see
+ * facesAway).
  */
 
 import { api } from "./api.js";
 import { $, setProp, setText } from "./dom.js";
 import { S, listen, set } from "./state.js";
 
-const VENDOR = "/static/vendor/mediapipe-pose";
-const MODELS = { lite: 0, full: 1 }; // BlazePose modelComplexity
-// Lite by measurement: without a GPU (2 cores, software WebGL) lite runs at 3.5 frames/s and full
-// at 2.2 (benchmarks/bench_camera.py); with a GPU both reach camera rate.
+const VENDOR = "/static/vendor/mediapipe-tasks-vision";
+const MODELS = { lite: "/static/vendor/pose-landmarker/pose_landmarker_lite.task", full: "/static/vendor/pose-landmarker/pose_landmarker_full.task" };
+// On the CPU (XNNPACK in WebAssembly), not WebGL: without a GPU, browsers draw WebGL in software
+// (SwiftShader), where the same model took about 20 times the CPU per frame (vendor/README.md);
+// lite takes about two thirds of full's.
 const DEFAULT_MODEL = "lite";
 const CAMERA_SIZE = { width: 640, height: 480 }; // asked of the camera; BlazePose works on 256 px
 const ARM_LANDMARKS = { right: [12, 14, 16], left: [11, 13, 15] }; // shoulder, elbow, wrist
@@ -49,8 +51,9 @@ const C = {
   starting: null, // the promise of a start under way
   session: 0, // bumped by stop(): a start still under way then gives up quietly
   stream: null,
-  pose: null,
-  poseModel: null, // the model the loaded graph runs
+  pose: null, // the PoseLandmarker
+  poseModel: null, // the model it runs
+  poseTime: 0, // the last timestamp (ms) given to the model: each must be later than the one before
   fps: null,
   frames: 0, // results drawn
   sent: 0, // landmark frames the studio accepted
@@ -107,35 +110,33 @@ function cameraErrorSentence(e) {
 }
 
 /* ------------------------------------------------------------------ BlazePose */
-function loadScript(src) {
-  return new Promise((resolve, reject) => {
-    const s = document.createElement("script");
-    s.src = src;
-    s.onload = resolve;
-    s.onerror = () => reject(new Error(`${src} did not load; reinstall Teach Studio`));
-    document.head.appendChild(s);
-  });
-}
+let vision = null; // the @mediapipe/tasks-vision module, once loaded
 
 async function ensurePose(model) {
-  if (!window.Pose) await loadScript(`${VENDOR}/pose.js`);
-  if (!C.pose) {
-    // Every file comes from the studio's own vendored copy: nothing from another host.
-    C.pose = new window.Pose({ locateFile: (file) => `${VENDOR}/${file}` });
-    C.pose.onResults(onResults);
+  if (C.pose && C.poseModel === model) return;
+  if (!vision) {
+    try {
+      vision = await import(`${VENDOR}/vision_bundle.mjs`);
+    } catch (e) {
+      throw new Error(`${VENDOR}/vision_bundle.mjs did not load; reinstall Teach Studio`);
+    }
   }
-  if (C.poseModel !== model) {
-    C.pose.setOptions({
-      modelComplexity: MODELS[model],
-      smoothLandmarks: false, // the studio filters (One Euro) and reports the lag it adds
-      enableSegmentation: false,
-      selfieMode: false, // landmarks as the camera sees them; the picture is mirrored on screen only
-      minDetectionConfidence: 0.5,
-      minTrackingConfidence: 0.5,
-    });
-    C.poseModel = model;
-  }
-  await C.pose.initialize();
+  // Every file comes from the studio's own vendored copy: nothing from another host.
+  const fileset = await vision.FilesetResolver.forVisionTasks(VENDOR);
+  const pose = await vision.PoseLandmarker.createFromOptions(fileset, {
+    baseOptions: { modelAssetPath: MODELS[model], delegate: "CPU" },
+    runningMode: "VIDEO", // each frame's person found from the last one's, as a video
+    numPoses: 1,
+    minPoseDetectionConfidence: 0.5,
+    minPosePresenceConfidence: 0.5,
+    minTrackingConfidence: 0.5,
+    outputSegmentationMasks: false,
+  });
+  // Landmarks as the camera sees them, unsmoothed (the studio filters, One Euro, and reports the
+  // lag it adds); the picture is mirrored on screen only.
+  if (C.pose) C.pose.close();
+  C.pose = pose;
+  C.poseModel = model;
 }
 
 /* ------------------------------------------------------------------ the camera loop */
@@ -244,7 +245,8 @@ async function loop() {
         await ensurePose($("camera-model").value);
         setStatus(null);
       }
-      await C.pose.send({ image: frame });
+      C.poseTime = Math.max(C.poseTime + 1, captured);
+      onResults(C.pose.detectForVideo(frame, C.poseTime));
     } catch (e) {
       setStatus(`Pose estimation stopped (${(e && e.message) || e}): press Apply to start the camera again.`, "error");
       C.running = false;
@@ -283,8 +285,8 @@ function onResults(results) {
   C.times.push(now);
   while (C.times.length > FPS_FRAMES || (C.times.length && C.times[0] < now - FPS_WINDOW_S)) C.times.shift();
   C.fps = C.times.length > 1 ? (C.times.length - 1) / (C.times[C.times.length - 1] - C.times[0]) : null;
-  let image = results.poseLandmarks || null;
-  let world = results.poseWorldLandmarks || null;
+  let image = results.landmarks[0] || null;
+  let world = results.worldLandmarks[0] || null;
   // Seen "from behind": swap the labels back, so the taped arm is the person's taped arm.
   const swapped = !!(image && world && facesAway(image, frame.width, frame.height));
   if (swapped) {
@@ -336,9 +338,7 @@ async function post(body, info) {
 
 /* ------------------------------------------------------------------ drawing */
 function draw(lm, side) {
-  // The frame the model saw, from the page's own copy: drawing the model's WebGL output
-  // (results.image) would read it back from the GPU, stalling it with software WebGL.
-  const picture = C.grabbed;
+  const picture = C.grabbed; // the frame the model saw, from the page's own copy
   const canvas = $("camera-view");
   const w = canvas.width;
   const h = Math.round((w * picture.height) / picture.width) || canvas.height;
@@ -351,7 +351,7 @@ function draw(lm, side) {
     ctx.lineWidth = 2;
     ctx.strokeStyle = "rgba(255,255,255,0.85)";
     ctx.beginPath();
-    for (const [a, b] of window.POSE_CONNECTIONS || []) {
+    for (const { start: a, end: b } of vision.PoseLandmarker.POSE_CONNECTIONS) {
       if (lm[a].visibility < VISIBLE || lm[b].visibility < VISIBLE) continue;
       ctx.moveTo(lm[a].x * w, lm[a].y * h);
       ctx.lineTo(lm[b].x * w, lm[b].y * h);
