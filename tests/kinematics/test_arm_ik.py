@@ -12,7 +12,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from studio.kinematics import HumanArm, Retargeter, arm_motion, load_robot, robot_names
-from studio.kinematics._chain_ik import _log3, _solve
+from studio.kinematics._chain_ik import _heights, _log3, _solve
 from studio.kinematics._clearance import ClearanceGuard
 from studio.kinematics._puma import closed_form_solutions
 from studio.kinematics._robot_load import prepare_arm_ik
@@ -165,6 +165,11 @@ def test_an_arm_that_jumps_is_a_new_pose_the_puma_reaches_at_once():
     assert np.linalg.norm(retargeter.robot.forward(q)[:3, 3] - target[:3, 3]) < 1e-4
 
 
-def test_preparing_the_ik_leaves_the_kernel_compiled():
+def test_preparing_the_ik_leaves_the_kernels_compiled():
     assert prepare_arm_ik() >= 0.0
     assert _solve.signatures  # loaded or compiled: the first arm chosen will not compile it
+    # nor the first pose checked against the table, whose geometry has these types
+    (signature,) = _heights.signatures
+    arm = load_robot("panda")
+    assert arm.table_contacts(arm.home) == []
+    assert _heights.signatures == [signature]
