@@ -19,6 +19,15 @@
     Puma560 (joint mode) and the Panda (cartesian, ``retarget_path``), and the shoulder and
     elbow's mean error against the true arm.
 
+(d) A held reach (the simulator's reach, held 10 s, after 10 s of wandering), frame by frame
+    through ``ArmTracker.track``: how often the warm start stalls above ``FitConfig.tolerance``
+    and the fit reseeds, the fit's CPU per frame, and how far the reseeds move the arm from
+    where the warm start stalled. The Puma560's default goal (0, 45, -90 degrees) mirrors onto
+    a straight arm (elbow at its limit, wrist straight): there humeral and forearm rotation are
+    unobservable, so the noisy tape is met exactly only by a reseed, almost every frame. The
+    same goal with joint 3 at -86 degrees (elbow bent by 4 degrees) is held as cheaply as
+    wandering.
+
 Run: ``python benchmarks/bench_kinematics.py`` (about a minute; ``--frames`` sets the live
 frames).
 """
@@ -32,11 +41,13 @@ import time
 import numpy as np
 import pinocchio as pin
 
+from studio.capture import OperatorConfig, simulate
 from studio.kinematics import (
     ArmFitter,
     ArmTracker,
     HumanArm,
     TapeConfig,
+    TrackerConfig,
     reconstruct,
     tape_from_arm,
 )
@@ -180,6 +191,46 @@ def smoothing(seeds: tuple[int, ...] = (3, 4, 5), seconds: float = 7.0) -> None:
     )
 
 
+HOLD_SECONDS = 10.0
+WANDER_SECONDS = 10.0
+MOVED_RAD = 1e-4  # a reseed that moves a joint further than this from the stalled warm start
+
+
+def held_reach(goal_deg: tuple[float, ...], seed: int = 0) -> None:
+    """Reseeds and fit CPU per frame while wandering and while holding a reach to ``goal_deg``."""
+    operator = OperatorConfig(hold_seconds=HOLD_SECONDS)
+    tail = operator.move_seconds[1] + HOLD_SECONDS
+    sim = simulate(WANDER_SECONDS + tail, seed=seed, goal=np.radians(goal_deg), operator=operator)
+    tracker = ArmTracker(TrackerConfig(tape=sim.config))
+    fitter = tracker.fitter
+    reseeds: list[tuple[int, float]] = []  # (frame, largest joint move from the warm start)
+    reseed = fitter._reseed
+    frame = 0
+
+    def counted(relative, target, warm):  # type: ignore[no-untyped-def]
+        q, err, it = reseed(relative, target, warm)
+        moved = math.inf if warm is None else float(np.abs(q - warm[0]).max())
+        reseeds.append((frame, moved))
+        return q, err, it
+
+    fitter._reseed = counted  # type: ignore[method-assign]
+    cpu = np.empty(len(sim.frames))
+    for frame, f in enumerate(sim.frames):
+        t0 = time.process_time()
+        tracker.track(f.bend, f.twist, f.t)
+        cpu[frame] = time.process_time() - t0
+    assert sim.reach_start is not None and sim.reach_end is not None
+    spans = {"wandering": (1, sim.reach_start), "holding": (sim.reach_end, len(sim.frames))}
+    for name, (a, b) in spans.items():
+        moves = [m for k, m in reseeds if a <= k < b]
+        moved = sum(m > MOVED_RAD for m in moves)
+        print(
+            f"  {name:9s} {b - a} frames: {len(moves) / (b - a):.3f} reseeds/frame, "
+            f"{moved} moved the arm > {MOVED_RAD:g} rad from the stalled warm start; "
+            f"fit CPU/frame mean {cpu[a:b].mean() * 1e3:.2f} ms"
+        )
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--frames", type=int, default=3000, help="live-path frames")
@@ -248,6 +299,9 @@ def main() -> None:
     print(f"  same answers: vertices agree to {gap:.1e} m")
     print(f"  speed-up: {fps / naive_fps:.0f}x")
     smoothing()
+    for goal in ((0.0, 45.0, -90.0, 0.0, 0.0, 0.0), (0.0, 45.0, -86.0, 0.0, 0.0, 0.0)):
+        print(f"(d) a held reach to {goal[:3]} degrees, seed 0")
+        held_reach(goal)
 
 
 if __name__ == "__main__":
