@@ -179,7 +179,7 @@ class LinkPoints:
             chain.rotations,
             chain.translations,
             chain.axes,
-            np.asarray(q, dtype=float),
+            np.array(q, dtype=float),  # a writable copy: one compiled signature for every q
             self.joints,
             self.rotations,
             self.translations,
