@@ -4,7 +4,7 @@ Each clip (``tests/e2e/camera_clips.py``) carries its frame index in a corner, w
 reads back for every frame it estimates, so results are matched to what was drawn. Pose
 estimation runs in the page (the vendored BlazePose); only landmarks reach the studio.
 
-Without a GPU BlazePose runs at a few frames a second, far fewer on a busy machine: these tests
+BlazePose runs on the CPU, at up to the camera's rate, far slower on a busy machine: these tests
 wait for events (frames estimated, answers received), never for a time. So that the model loads
 once, the tests that estimate share one page in one Chromium, whose fake camera plays the file
 ``live.y4m``: Chromium opens that file anew at each start of the camera, so a test puts its clip
