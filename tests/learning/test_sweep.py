@@ -43,6 +43,9 @@ REPO = Path(__file__).resolve().parents[2]
 RAY_ENV = {
     "RAY_USAGE_STATS_ENABLED": "0",
     "RAY_AUTH_MODE": "disabled",  # a loopback test cluster; `ray start` would enable tokens
+    # no idle worker per CPU when a driver connects: Tune's trials never use them (a sweep's own
+    # local Ray is started so too)
+    "RAY_prestart_worker_first_driver": "0",
 }
 WAIT_SECONDS = 120.0
 
@@ -249,7 +252,11 @@ def test_a_trials_worker_starts_without_scipy_signal() -> None:
 
 def test_a_sweep_that_cannot_start_is_refused_before_ray_is_imported(tmp_path: Path) -> None:
     """A second start, or a resume, of a running sweep is refused at once: without importing Ray
-    and Tune (seconds of CPU) first. The sweep's driver here is this test's process: alive."""
+    and Tune (seconds of CPU) first. The sweep's driver here is this test's process: alive. So is
+    a sweep on a cluster out of reach."""
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]  # nothing listens once it is closed
     script = (
         "import json, os, sys\n"
         "from pathlib import Path\n"
@@ -266,12 +273,17 @@ def test_a_sweep_that_cannot_start_is_refused_before_ray_is_imported(tmp_path: P
         "        run_sweep(spec, data, resume=resume)\n"
         "    except SweepError as err:\n"
         "        print(err)\n"
+        "try:\n"
+        f"    run_sweep(spec, data / 'other', address='127.0.0.1:{port}')\n"
+        "except SweepError as err:\n"
+        "    print(err)\n"
         "print('ray' in sys.modules)\n"
     )
     lines = run_python(script).stdout.strip().splitlines()
-    assert len(lines) == 3, lines
+    assert len(lines) == 4, lines
     assert all("'s' is still running" in line for line in lines[:2]), lines
-    assert lines[2] == "False", lines
+    assert lines[2].startswith(f"Cannot reach a Ray cluster at 127.0.0.1:{port}"), lines
+    assert lines[3] == "False", lines
 
 
 # ----------------------------------------------------------------------------- on a local Ray
@@ -512,20 +524,25 @@ def test_a_running_sweep_listens_on_loopback_only_and_cannot_be_resumed_twice(
             proc.kill()
             proc.wait()
     assert proc.returncode == 130, out
+    assert "studio sweep --resume long" in out, out
 
 
 def test_an_interrupted_sweep_resumes_with_only_the_unfinished_trials(
     local_ray, tmp_path: Path
 ) -> None:
+    """``studio sweep``, interrupted by Ctrl-C, then resumed. Its driver joins this module's local
+    Ray (2 CPUs) rather than starting a Ray of its own (the sweep's own local Ray is interrupted in
+    the loopback test)."""
     spec_path = write_spec(
         tmp_path / "resume.toml",
         'task = "arm-grid"\nseeds = [0, 1, 2, 3]\nexperiments = 2\nepisodes = 60\n'
         '[fixed]\nplanning_steps = 150\n[space]\nplanning = ["full", "soft"]\n',
     )  # fmt: skip
     data = tmp_path / "data"
+    address = local_ray.get_runtime_context().gcs_address
     proc = subprocess.Popen(
         [sys.executable, "-m", "studio", "sweep", str(spec_path), "--data-dir", str(data),
-         "--workers", "2", "--no-progress"],
+         "--address", address, "--no-progress"],
         stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
         env={**os.environ, **RAY_ENV},
     )  # fmt: skip
@@ -616,7 +633,9 @@ def test_a_sweep_on_a_two_node_cluster_uses_both_nodes(tmp_path: Path) -> None:
     env = {**os.environ, **RAY_ENV}
     port = _free_port()
     address = f"127.0.0.1:{port}"
-    common = ["--num-cpus=1", "--disable-usage-stats", "--block"]
+    # No log monitor: it forwards the workers' output to drivers, and a sweep's driver shows none
+    # (log_to_driver=False); each would poll the node's log folder ten times a second.
+    common = ["--num-cpus=1", "--disable-usage-stats", "--include-log-monitor=false", "--block"]
     heads = ["--head", f"--port={port}", "--include-dashboard=false"]
     nodes: list[subprocess.Popen] = []
     try:

@@ -19,11 +19,13 @@ On a multi-machine cluster the data folder must be on storage every node sees at
 from __future__ import annotations
 
 import contextlib
+import importlib.util
 import logging
 import math
 import os
 import shutil
 import socket
+import sys
 import time
 from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, field
@@ -58,6 +60,7 @@ MAX_RETRIES = 3
 ADDRESS_TIMEOUT_SECONDS = 5.0
 """How long to try to reach a cluster's ``HOST:PORT`` before calling it unreachable."""
 RAY_HINT = "install it with pip install -e '.[cluster]'"
+_NO_RAY = f"Sweeps run on Ray Tune, which is not installed; {RAY_HINT}."
 STOP_WAIT_SECONDS = 300
 """How long a worker whose trial the scheduler stopped waits for the trial to save its run (the
 learners end at their next episode boundary) before Tune gives up re-using the worker for the next
@@ -78,14 +81,25 @@ RAY_ENVIRONMENT = {
 }
 """Set (unless already set) before Ray is imported, in the driver and in every worker (a cluster's
 workers do not inherit the driver's environment)."""
-LOCAL_RAY_ENVIRONMENT = {"RAY_ENABLE_WINDOWS_OR_OSX_CLUSTER": "0"}
-"""Set (always) before Ray is imported when the sweep starts its own Ray. This is Ray's switch for
-a single-machine Ray: the node's address is then loopback, so the GCS, the raylet, the workers and
-the agents all listen on 127.0.0.1 only. Without it every one of them listens on all interfaces,
-and anyone who reaches the machine could join the Ray and run code as the user. (Ray turns
-``ray.init(_node_ip_address="127.0.0.1")`` back into the machine's network address, so that is no
-way to do it.) Set while Ray is imported and while it starts its processes, which inherit it;
-then put back, so that nothing else the process starts inherits it."""
+LOCAL_RAY_ENVIRONMENT = {
+    "RAY_ENABLE_WINDOWS_OR_OSX_CLUSTER": "0",
+    "RAY_prestart_worker_first_driver": "0",
+}
+"""Set (always) before Ray is imported when the sweep starts its own Ray.
+
+- ``RAY_ENABLE_WINDOWS_OR_OSX_CLUSTER=0`` is Ray's switch for a single-machine Ray: the node's
+  address is then loopback, so the GCS, the raylet, the workers and the agents all listen on
+  127.0.0.1 only. Without it every one of them listens on all interfaces, and anyone who reaches
+  the machine could join the Ray and run code as the user. (Ray turns
+  ``ray.init(_node_ip_address="127.0.0.1")`` back into the machine's network address, so that is
+  no way to do it.)
+- ``RAY_prestart_worker_first_driver=0``: the raylet starts no idle worker per core when the
+  sweep's driver connects. Tune's trials never run in those (each trial's actor gets a worker of
+  its own), so they only cost a Python start with Ray imported each, about half a second of CPU
+  per core, and were stopped unused.
+
+Set while Ray is imported and while it starts its processes, which inherit it; then put back, so
+that nothing else the process starts inherits it."""
 
 Report = dict[str, float | str | None]
 """What a trial reports to Tune: its :data:`Metrics`, ``episodes``, ``final``, where it runs
@@ -255,8 +269,22 @@ def _import_ray(local: bool = False) -> ModuleType:
             import ray
             from ray import tune  # noqa: F401
     except ImportError:
-        raise SweepError(f"Sweeps run on Ray Tune, which is not installed; {RAY_HINT}.") from None
+        raise SweepError(_NO_RAY) from None
     return ray
+
+
+def _ray_installed() -> bool:
+    """Whether Ray can be imported, found without importing it."""
+    try:
+        return importlib.util.find_spec("ray") is not None
+    except ValueError:  # in sys.modules as None: taken out on purpose
+        return False
+
+
+def _ray_initialized() -> bool:
+    """Whether this process has already initialised Ray (read without importing it)."""
+    ray = sys.modules.get("ray")
+    return ray is not None and ray.is_initialized()
 
 
 def _check_address(address: str) -> None:
@@ -337,10 +365,13 @@ def run_sweep(
     # A sweep that runs already, exists, or is not there to resume is refused before Ray is
     # imported (seconds of CPU): the answer comes at once.
     check_folder(data_dir, spec, resume)
-    # before anything is written: a missing Ray or cluster leaves no trace
-    ray = _import_ray(local=address is None)
-    if address is not None and not ray.is_initialized():
+    # Before anything is written: a missing Ray or cluster leaves no trace. A cluster out of
+    # reach is told before Ray is imported too (seconds of CPU), a missing Ray first.
+    if address is not None and not _ray_initialized():
+        if not _ray_installed():
+            raise SweepError(_NO_RAY)
         _check_address(address)
+    ray = _import_ray(local=address is None)
     folder = prepare_folder(data_dir, spec, resume)
     trials = spec.trials()
     finished = finished_trials(data_dir, spec) if resume else set()
