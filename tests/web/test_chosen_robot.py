@@ -17,7 +17,7 @@ from studio.samples import SAMPLES_DIR
 from studio.web.scene._model import Mode
 from studio.web.scene._scene import StudioScene
 from tests.web.conftest import wait_for, wait_run
-from tests.web.test_robot_playback import studio  # noqa: F401  (a studio with a scene)
+from tests.web.test_robot_playback import kept_meshes, studio  # noqa: F401  (a studio with a scene)
 
 LOAD_S = 120.0
 """Reading a robot's model and meshes takes seconds alone, far longer on a shared machine."""

@@ -32,14 +32,20 @@ LOAD_S = 120.0
 """Reading a robot's model and meshes takes seconds alone, far longer on a shared machine."""
 
 
+@pytest.fixture(scope="session")
+def kept_meshes(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """One mesh cache for the studios of the tests (their data folders are each their own): a
+    robot's meshes are read and simplified once, as on a machine whose studio keeps them,
+    not once a test."""
+    return tmp_path_factory.mktemp("meshes")
+
+
 @pytest.fixture
-def studio(tmp_path: Path) -> Iterator[tuple[TestClient, StudioScene]]:
-    """A studio with a scene (its robots' meshes cached under the data folder)."""
+def studio(tmp_path: Path, kept_meshes: Path) -> Iterator[tuple[TestClient, StudioScene]]:
+    """A studio with a scene (its robots' meshes kept in :func:`kept_meshes`)."""
     settings = make_settings(tmp_path)
     server = viser.ViserServer(host="127.0.0.1", port=0, verbose=False)
-    scene = StudioScene(
-        server, layout=SceneLayout(rate_hz=100.0), mesh_cache=settings.mesh_cache_dir
-    )
+    scene = StudioScene(server, layout=SceneLayout(rate_hz=100.0), mesh_cache=kept_meshes)
     try:
         with TestClient(create_app(settings, scene)) as client:
             yield client, scene
