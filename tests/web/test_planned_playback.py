@@ -6,7 +6,6 @@ from __future__ import annotations
 import subprocess
 import threading
 import time
-from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
@@ -14,7 +13,7 @@ import pytest
 
 from studio.capture import PlaybackSource, human_angles, read_any_recording
 from studio.export import recording_motion
-from studio.kinematics import RetargetConfig, load_robot, retarget_path
+from studio.kinematics import RetargetConfig, keep_robot_geometry, load_robot, retarget_path
 from studio.samples import SAMPLES_DIR
 from studio.web.live import _planned_playback
 from studio.web.live._pipeline import Pipeline
@@ -25,14 +24,18 @@ STEP = RetargetConfig().max_joint_step
 WAIT_S = 60.0
 
 
-@pytest.fixture(scope="module", autouse=True)
-def robots_kept(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Path]:
-    """The plans' children read each robot's geometry from this cache folder, as the studio's
-    read its own (``studio serve`` keeps one): built once for the module, not once a plan."""
-    cache = tmp_path_factory.mktemp("robots")
-    with pytest.MonkeyPatch.context() as patch:
-        patch.setattr(_planned_playback, "robot_cache_folder", lambda: cache)
-        yield cache
+@pytest.fixture(scope="module")
+def robots_kept(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The module's robot cache folder (a studio keeps one in its data folder)."""
+    return tmp_path_factory.mktemp("robots")
+
+
+@pytest.fixture(autouse=True)
+def _robots_kept_there(robots_kept: Path) -> None:
+    """This process and its plans' children read each robot's geometry from
+    :func:`robots_kept`, as a studio and its children read its own: each robot built once for
+    the module, not once a plan (``tests/conftest.py`` forgets the folder after each test)."""
+    keep_robot_geometry(robots_kept)
 
 
 @pytest.fixture(scope="module")
@@ -158,7 +161,7 @@ def test_a_seek_back_or_a_loop_moves_the_robot_onto_the_plan_with_the_arm(playin
     pipeline, recording = playing
     pipeline.observe(recording.frame_at(200))
     wait_for(pipeline, "is planned")
-    assert list(robots_kept.glob("ur3-*/sha256.json"))  # its child kept the UR3 for the next
+    assert list(robots_kept.glob("ur3-*/sha256.json"))  # kept for the next plan
     q, _ = play(pipeline, recording, [201, 202, 10, 11])  # a seek back to row 10
     planned = recording_motion(SAMPLE, "ur3").q
     np.testing.assert_array_equal(q[2:], planned[10:12])
