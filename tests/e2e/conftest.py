@@ -312,6 +312,29 @@ def blank_page(browser: Any) -> Iterator[Any]:
         context.close()
 
 
+WATCH_RESULT = "[data-testid='watch-result']"
+WATCH_ERROR = "[data-testid='watch-error']"
+
+
+def watched(page: Any, click: Any, timeout_ms: float) -> str:
+    """The Watch result line after ``click()`` (the Watch button, a policy row's Watch): a fresh
+    one, not the line of the watch before, with no error beside it."""
+    page.evaluate(f"document.querySelector({json.dumps(WATCH_RESULT)}).textContent = ''")
+    click()
+    page.wait_for_selector(f"{WATCH_RESULT}:has-text(' steps, ')", timeout=timeout_ms)
+    assert not page.is_visible(WATCH_ERROR), page.inner_text(WATCH_ERROR)
+    return page.inner_text(WATCH_RESULT)
+
+
+def watch_policy(page: Any, key: str, seed: int, timeout_ms: float) -> str:
+    """Watch the policy ``key`` (``run:ID``, or a listed policy's option) from the random start
+    ``seed`` with the page's Watch controls, as a person would; its result line."""
+    page.select_option("[data-testid='watch-policy']", key)
+    page.select_option("[data-testid='watch-start']", "random")
+    page.fill("[data-testid='watch-seed']", str(seed))
+    return watched(page, lambda: page.click("[data-testid='watch-go']"), timeout_ms)
+
+
 def shot(page: Any, name: str, section: str | None = None) -> Path:
     """Save a screenshot of the page under ``test-artifacts/e2e/``, ``section`` scrolled into view."""
     ARTIFACTS.mkdir(parents=True, exist_ok=True)

@@ -11,7 +11,7 @@ from typing import Any
 import numpy as np
 import pytest
 
-from tests.e2e.conftest import Studio, shot
+from tests.e2e.conftest import Studio, shot, watch_policy, watched
 
 pytestmark = pytest.mark.e2e
 
@@ -91,12 +91,7 @@ def test_a_continuous_run_trains_from_the_page_is_watched_and_downloaded(
 
     run = continuous_run
     defaults = studio_server.get("/api/config")["training"]
-    page.select_option("[data-testid='watch-policy']", f"run:{run['id']}")
-    page.select_option("[data-testid='watch-start']", "random")
-    page.fill("[data-testid='watch-seed']", "3")
-    page.click("[data-testid='watch-go']")
-    page.wait_for_selector("[data-testid='watch-result']:has-text(' s ')", timeout=T)
-    assert not page.is_visible("[data-testid='watch-error']")
+    watch_policy(page, f"run:{run['id']}", 3, T)
     shot(page, "continuous-02-watch", "sec-watch")
     with urllib.request.urlopen(studio_server.base + "/api/watch/trajectory.csv") as answer:
         rollout = np.loadtxt(io.StringIO(answer.read().decode()), delimiter=",", skiprows=1)
@@ -116,17 +111,6 @@ def test_a_continuous_run_trains_from_the_page_is_watched_and_downloaded(
     assert policy.task.joints == 3 and policy.task.actions == "follow" and policy.task.paths
     assert policy.weights.shape[1] == policy.task.n_actions == 7
     assert not page.errors  # type: ignore[attr-defined]
-
-
-def _watch_text(page: Any, click: Any) -> str:
-    """The Watch result after ``click()``, waiting for a fresh one."""
-    page.evaluate("document.querySelector(\"[data-testid='watch-result']\").textContent = ''")
-    click()
-    page.wait_for_selector("[data-testid='watch-result']:has-text(' s ')", timeout=T)
-    assert not page.is_visible("[data-testid='watch-error']"), page.inner_text(
-        "[data-testid='watch-error']"
-    )
-    return page.inner_text("[data-testid='watch-result']")
 
 
 def _download(page: Any, testid: str, folder: Path) -> Path:
@@ -158,11 +142,8 @@ def test_a_continuous_policy_is_listed_watched_uploaded_and_downloaded_in_the_po
     assert RUN_NAME in label and option == f"run {label}"
 
     # Watch and the list's ▶ agree, with the rollout's own step count
-    page.select_option("[data-testid='watch-policy']", key)
-    page.select_option("[data-testid='watch-start']", "random")
-    page.fill("[data-testid='watch-seed']", "3")
-    by_watch = _watch_text(page, lambda: page.click("[data-testid='watch-go']"))
-    by_row = _watch_text(page, lambda: row.locator("[data-testid='policy-watch']").click())
+    by_watch = watch_policy(page, key, 3, T)
+    by_row = watched(page, lambda: row.locator("[data-testid='policy-watch']").click(), T)
     assert by_watch == by_row, (by_watch, by_row)
     api = studio_server.send("POST", "/api/watch", {"run": run["id"], "seed": 3})
     assert by_watch.startswith(f"{api['steps']} steps, ") and api["steps"] > 0
@@ -182,7 +163,7 @@ def test_a_continuous_policy_is_listed_watched_uploaded_and_downloaded_in_the_po
     upload_key = uploaded.get_attribute("data-key")
     assert page.input_value("[data-testid='watch-policy']") == upload_key  # selected on upload
     page.fill("[data-testid='watch-seed']", "4")
-    of_upload = _watch_text(page, lambda: page.click("[data-testid='watch-go']"))
+    of_upload = watched(page, lambda: page.click("[data-testid='watch-go']"), T)
     assert int(of_upload.split(" steps, ")[0]) > 0
     (tmp_path / "again").mkdir()
     again = load_any_policy(_download(page, "download-policy", tmp_path / "again"))

@@ -16,7 +16,7 @@ import pytest
 
 from studio.samples import SAMPLES_DIR
 
-from .conftest import ARTIFACTS, Studio, live_scene, shot
+from .conftest import ARTIFACTS, Studio, live_scene, shot, watch_policy
 
 pytestmark = pytest.mark.e2e
 
@@ -452,12 +452,7 @@ def test_story6_watch_policy_moves_robot(page: Any, studio_server: Studio) -> No
 
         assert _wait(still, 20)
 
-        page.select_option("[data-testid='watch-policy']", f"run:{runs[0]['id']}")
-        page.select_option("[data-testid='watch-start']", "random")
-        page.fill("[data-testid='watch-seed']", "3")
-        page.click("[data-testid='watch-go']")
-        page.wait_for_selector("[data-testid='watch-result']:has-text('steps')", timeout=T)
-        assert not page.is_visible("[data-testid='watch-error']")
+        watch_policy(page, f"run:{runs[0]['id']}", 3, T)
         frames = [_pixels(_scene_png(page, "06-watch-0"))]
 
         def moved() -> bool:  # the robot moves along the rollout
