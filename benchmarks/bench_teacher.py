@@ -26,9 +26,11 @@ without demonstrations (one joint per action); with the paper's replay only (the
 replayed as the first episodes, one joint per action); with the follow option (the action that
 follows the demonstrations beside the single joints, no potential); with the demonstration
 potential (Brys et al. 2015, weight 5, one joint per action); with both, the studio's
-default when demonstrations are given; and with the potential and every joint -1, 0 or +1 at
+default when demonstrations are given; with the potential and every joint -1, 0 or +1 at
 once (``actions="all"``, the factored value), the agent's own way to cut the demonstrated paths
-short with direct multi-joint moves.
+short with direct multi-joint moves; and with the potential, those moves and the follow action
+(``actions="all-follow"``: its greedy policy hands the motion to the follow action where its
+moves would loop, and the line after the table says how it does without that hand-over).
 
 The columns: greedy success from the held-out starts; collisions (the share of starts whose
 rollout touches the robot itself or the table, by the robot's collision geometry, at every
@@ -62,7 +64,7 @@ from studio.learning import (
     learner,
     resolve_run,
 )
-from studio.learning.linear._linear import greedy_rollout
+from studio.learning.linear._greedy import greedy_rollout, greedy_success, hand_over_action
 from studio.learning.runs._train import train_learner
 from studio.motion import training_demonstration
 from studio.samples import SAMPLES_DIR
@@ -85,6 +87,7 @@ DYNA_ROWS = {
     "Dyna-Q + demonstration potential": {"actions": "single", "demo_potential": 5.0},
     "Dyna-Q + follow + potential (default)": {"actions": "follow"},
     "Dyna-Q + potential, any joints at once": {"actions": "all", "demo_potential": 5.0},
+    "Dyna-Q + potential, any joints or follow": {"actions": "all-follow", "demo_potential": 5.0},
 }
 
 
@@ -97,6 +100,8 @@ class Row:
     steps_to_95: str
     cpu: float
     first_own: int | None = None
+    alone: float | None = None
+    """With a hand-over to the follow action: the greedy policy's success without it."""
 
 
 def demonstrations():
@@ -189,6 +194,11 @@ def dyna_rows(task, demos, starts, pace, arm, budgets, seed, planning_steps) -> 
         first = int(result.steps[0][replayed : replayed + FIRST_OWN].sum())
         cpu = float(result.cpu_seconds.sum())
         rows.append(judge(name, walks, result.task, pace, arm, reached_at, cpu, first))
+        if hand_over_action(result.task) >= 0:  # the same greedy policy, never handing over
+            alone = greedy_success(
+                result.task, result.coder, result.weights[0], starts, CAP, hand_over=False
+            )
+            rows[-1].alone = float(alone.mean())
     return rows
 
 
@@ -254,6 +264,12 @@ def main() -> None:
         f"{0.9 * teacher.mean_seconds:.2f} s): "
         + (", ".join(r.name for r in best) if best else "no Dyna-Q row")
     )
+    for row in rows:
+        if row.alone is not None:
+            print(
+                f"{row.name}: without the hand-over to the follow action where its moves loop, "
+                f"its greedy policy reaches the goal from {row.alone:.1%} of the starts"
+            )
     without = next(r for r in rows if r.name == "Dyna-Q, no demonstrations").first_own
     for row in rows[4:]:
         if row.first_own is not None and without and "any joints" not in row.name:

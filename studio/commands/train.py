@@ -157,7 +157,8 @@ def _add_reach_arguments(parser: argparse.ArgumentParser) -> None:
         "--actions",
         choices=ACTION_SETS,
         help="arm-reach: what one action moves: one joint, also two joints together, any "
-        "joints at once, or one joint or all of them along the --demos (follow) "
+        "joints at once, one joint or all of them along the --demos (follow), or any joints "
+        "at once or all of them along the --demos (all-follow) "
         f"(default: {REACH_DEFAULTS['actions']})",
     )
     parser.add_argument(

@@ -58,11 +58,15 @@ DEFAULT_STEP_DEG = 2.0
 """Joint increment per action, degrees (no coarser than 2 degrees)."""
 DEFAULT_TILINGS = 8
 """Offset tilings of the arm's default features."""
-ACTION_SETS = ("single", "pairs", "all", "follow")
+ACTION_SETS = ("single", "pairs", "all", "follow", "all-follow")
 """What one action may move: one joint (2J actions), one joint or two together (2J**2), any
-joints at once (3**J - 1), or one joint or all of them along the demonstrated paths (2J + 1, see
-:attr:`ArmReach.paths`); each of the first three begins with the one before it, in the same
-order, and ``"follow"`` with the singles."""
+joints at once (3**J - 1), one joint or all of them along the demonstrated paths (2J + 1, see
+:attr:`ArmReach.paths`), or any joints at once or all of them along the demonstrated paths
+(3**J, :data:`FOLLOW_ACTION_SETS`); each of the first three begins with the one before it, in the
+same order, ``"follow"`` with the singles and ``"all-follow"`` with ``"all"``."""
+FOLLOW_ACTION_SETS = ("follow", "all-follow")
+"""The action sets that end with the action following the demonstrated paths (when there are
+any; without demonstrations ``"follow"`` is ``"single"`` and ``"all-follow"`` is ``"all"``)."""
 DEFAULT_ACTIONS = "follow"
 """One joint per action, and with demonstrations one more that follows them (without any, the
 task is ``"single"``'s bit for bit). With 3 demonstrations at six joints (package README): under

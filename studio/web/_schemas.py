@@ -534,8 +534,9 @@ class ReachRunCreate(_RunCreateBase):
     step_deg: float = REACH_DEFAULTS["step_deg"]
     """Joint increment per action, degrees."""
     actions: str = REACH_DEFAULTS["actions"]
-    """What one action moves: "single" (one joint), "pairs" (also two together), "all", or
-    "follow" (one joint, or all of them along the picked demonstrations)."""
+    """What one action moves: "single" (one joint), "pairs" (also two together), "all",
+    "follow" (one joint, or all of them along the picked demonstrations), or "all-follow" (any
+    joints, or all of them along the picked demonstrations)."""
     tilings: int = REACH_DEFAULTS["tilings"]
     """Offset tilings of each joint."""
     tiles: int | None = REACH_DEFAULTS["tiles"]

@@ -36,6 +36,7 @@ def test_each_action_set_has_its_size_and_begins_with_the_one_before(joints):
         "pairs": 2 * joints**2,
         "all": 3**joints - 1,
         "follow": 2 * joints,
+        "all-follow": 3**joints - 1,
     }
     tables = {name: action_directions(joints, name) for name in ACTION_SETS}
     for name, table in tables.items():
@@ -45,6 +46,7 @@ def test_each_action_set_has_its_size_and_begins_with_the_one_before(joints):
     assert np.array_equal(tables["pairs"][: 2 * joints], tables["single"])
     assert np.array_equal(tables["all"][: 2 * joints**2], tables["pairs"])
     assert np.array_equal(tables["follow"], tables["single"])
+    assert np.array_equal(tables["all-follow"], tables["all"])
     assert np.abs(tables["pairs"]).sum(axis=1).max() == 2
     single = tables["single"]  # action 2j moves joint j up, 2j + 1 down, as before
     for j in range(joints):

@@ -18,6 +18,7 @@ ROWS = (
     "Dyna-Q + demonstration potential",
     "Dyna-Q + follow + potential (default)",
     "Dyna-Q + potential, any joints at once",
+    "Dyna-Q + potential, any joints or follow",
 )
 
 
@@ -50,3 +51,4 @@ def test_the_quick_benchmark_prints_every_row_beside_the_teacher():
     assert table["Dyna-Q, no demonstrations"][0] == "0.0%"  # the paper's reward, no help
     assert "Better than its teacher" in out
     assert "First 20 own episodes, Dyna-Q + follow option" in out
+    assert "Dyna-Q + potential, any joints or follow: without the hand-over" in out

@@ -17,8 +17,9 @@ from studio.learning.linear._factored import (
     slot_joints,
     split_reward,
 )
-from studio.learning.linear._linear import greedy_success
+from studio.learning.linear._linear import greedy_rollout, greedy_success
 from studio.learning.tasks._demo_shaping import demo_potential, no_potential, potential
+from studio.learning.tasks._follow import with_cost_group
 from studio.learning.tasks._gym import ARM_REACH_ID
 from studio.learning.tasks._reach import reach_potential, reach_step
 
@@ -163,3 +164,70 @@ def test_the_factored_value_learns_the_pairs_where_one_column_per_action_does_no
     bad = greedy_success(task, plain.coder, plain.weights[0], starts, 3000).mean()
     assert ok >= 0.9 and ok > bad + 0.2, (ok, bad)
     assert factored.steps.sum() < 0.7 * plain.steps.sum()
+
+
+def followed(joints=4, shaping=5.0):
+    """An ``"all-follow"`` task with one demonstrated path to follow, and its bound features."""
+    task = ArmReach(joints=joints, actions="all-follow", shaping=shaping)
+    goal = np.array(task.goal[:joints])
+    task = task.with_paths([np.linspace(goal + np.radians(20.0), goal, 30)])
+    coder = with_cost_group(task.features(), joints).bind(*task.observation_bounds)
+    return task, coder
+
+
+def test_any_joints_or_follow_is_factored_with_a_column_of_its_own_for_the_follow_action():
+    """The moves' joint terms read their joint's tiles and the follow cost's; the follow action
+    reads every tile in its own column; the expanded table gives the same values."""
+    task, coder = followed()
+    joints = task.joints
+    assert task.n_actions == 3**joints and task.actions == "all-follow"
+    slots = slot_joints(coder, joints, follows=True)
+    assert slots is not None and slot_joints(coder, joints) is None
+    comp = action_components(task.directions)
+    rng = np.random.default_rng(7)
+    w = rng.normal(size=(coder.size, 3 * joints + 1))
+    for _ in range(5):
+        obs = task.observe(task.random_start(rng))
+        feats = coder.active(obs)
+        expected = np.zeros(task.n_actions)
+        for a, move in enumerate(task.directions):
+            for i, f in enumerate(feats):
+                js = [slots[i]] if slots[i] < joints else range(joints)  # the cost: every joint
+                expected[a] += sum(w[f, 3 * j + int(move[j]) + 1] for j in js)
+        expected[-1] = w[feats, 3 * joints].sum()
+        out = np.empty(task.n_actions)
+        factored_values(w, comp, slots, np.empty(3 * joints + 1), feats, out)
+        assert np.allclose(out, expected)
+        table = expand(w, comp, row_joints(coder))
+        assert table.shape == (coder.size, task.n_actions)
+        assert np.allclose(table[feats].sum(axis=0), expected)
+
+
+def test_a_run_with_any_joints_or_follow_learns_the_follow_action_too():
+    task, _ = followed(joints=3, shaping=0.0)
+    path = np.asarray(task.paths[0])
+    config = DynaQConfig(planning="zero", max_steps_per_episode=300)
+    result = run_experiments(
+        make("all-follow", 0.0), config, 1, 4, 0, [path], ArmReach(joints=3).features()
+    )
+    assert result.task.actions == "all-follow" and result.task.paths
+    assert result.weights.shape[-1] == 3**3  # 26 moves and the follow action, expanded
+    q = result.q_values(result.task.observe(path[0]))
+    assert q[-1] > 1.0  # the replayed demonstration pressed it, and it reached the goal
+
+
+def test_the_greedy_policy_of_any_joints_or_follow_hands_over_where_its_moves_stall():
+    """Weights that always move joint 1 up: at its limit the move leaves the arm where it is;
+    the greedy policy hands over to the follow action and reaches the goal, where without the
+    hand-over (or with another action set) it stays at the limit."""
+    task, coder = followed(joints=3)
+    table = np.zeros((coder.size, task.n_actions))
+    table[:, 0] = 1.0  # joint 1 up, everywhere
+    start = np.array(task.goal[:3])
+    start[0] = task.upper[0] - 3.5 * task.step
+    path, reached = greedy_rollout(task, coder, table, start, 2_000)
+    assert reached and task.success(path[-1])
+    assert path[3, 0] == pytest.approx(task.upper[0] - 0.5 * task.step)  # three moves up
+    np.testing.assert_allclose(path[:4, 1:], np.tile(start[1:], (4, 1)))  # of joint 1 alone
+    assert np.abs(path[4] - path[3]).max() > 0.5 * task.step  # then the follow action, not a stay
+    assert not greedy_success(task, coder, table, start[None], 2_000, hand_over=False)[0]

@@ -71,6 +71,19 @@ def update_common(w, feats, n_actions, change):
     return change
 
 
+@njit(nogil=True, cache=True, inline="always")
+def q_values(w, feats, out):
+    """``out[a] = Q(s, a)``: the active features' weights summed in feature order."""
+    n_actions = out.shape[0]
+    for a in range(n_actions):
+        out[a] = 0.0
+    for i in range(feats.shape[0]):
+        f = feats[i]
+        for a in range(n_actions):
+            out[a] += w[f, a]
+    add_common(w, feats, out)
+
+
 def without_common(weights: np.ndarray) -> np.ndarray:
     """The ordinary ``(..., size, n_actions)`` table of weights with a common last column."""
     return weights[..., :-1] + weights[..., -1:]

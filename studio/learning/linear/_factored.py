@@ -14,6 +14,12 @@ the ``n_actions`` (18 instead of 728 at six joints). It is a linear function of 
 ``phi(s) x onehot(a_j)``, so the semi-gradient update is the ordinary one, the step divided among
 the ``active x J`` weights it touches.
 
+With ``actions="all-follow"`` and demonstrations the last action follows the demonstrated
+paths: it moves no joint by a fixed step, so it has no per-joint terms but one column of its own,
+``Q(s, follow) = sum_f w[f, 3 J]`` over every active feature (the follow cost's tiles included,
+which no joint's term reads). Its update is the ordinary one; a move whose next state's greedy
+action is the follow action shares that value equally among its joints' targets.
+
 A factored table is expanded into the ordinary ``(size, n_actions)`` table (:func:`expand`),
 ``W[f, a] = sum_j w[f, comp[a, j]]``, which gives the same Q: policy files, rollouts and
 greedy evaluations read that and need not know how it was learned.
@@ -31,7 +37,7 @@ from .._tiles import TileCoder
 from ..tasks._arm import GOAL_REWARD, STEP_REWARD
 from ..tasks._demo_shaping import nearest
 
-FACTORED_ACTION_SETS = ("pairs", "all")
+FACTORED_ACTION_SETS = ("pairs", "all", "all-follow")
 """Action sets of the arm task learned with the factored value (one joint per action keeps its
 one column per action: there each action already owns one joint's move)."""
 
@@ -50,18 +56,32 @@ def no_components(n_actions: int) -> np.ndarray:
 
 def expand(weights: np.ndarray, comp: np.ndarray, rows: np.ndarray) -> np.ndarray:
     """The ordinary ``(..., size, n_actions)`` table of factored weights ``(..., size, 3 J)``:
-    row ``f``, one of joint ``rows[f]``'s tiles, holds ``w[f, comp[a, rows[f]]]`` for action ``a``."""
-    columns = comp[:, rows].T  # (size, n_actions): the column each row reads for each action
+    row ``f``, one of joint ``rows[f]``'s tiles, holds ``w[f, comp[a, rows[f]]]`` for action ``a``.
+    Weights with a follow column (``3 J + 1`` columns) add the follow action last, from that
+    column; the follow cost's rows (``rows[f] == J``) hold 0 for every other action."""
+    joints = comp.shape[1]
+    if weights.shape[-1] == 3 * joints:
+        columns = comp[:, rows].T  # (size, n_actions): the column each row reads for each action
+        shape = (*weights.shape[:-1], comp.shape[0])
+        return np.take_along_axis(weights, np.broadcast_to(columns, shape), axis=-1)
+    padded = np.concatenate([weights, np.zeros_like(weights[..., :1])], axis=-1)
+    unread = np.full((comp.shape[0], 1), 3 * joints + 1)  # the zero column, for the cost's rows
+    columns = np.hstack([comp, unread])[:, rows].T
     shape = (*weights.shape[:-1], comp.shape[0])
-    return np.take_along_axis(weights, np.broadcast_to(columns, shape), axis=-1)
+    moves = np.take_along_axis(padded, np.broadcast_to(columns, shape), axis=-1)
+    cost = rows == joints
+    moves[..., cost, :] = weights[..., cost, :][..., comp].sum(axis=-1)
+    return np.concatenate([moves, weights[..., 3 * joints :]], axis=-1)
 
 
-def slot_joints(coder: TileCoder, joints: int) -> np.ndarray | None:
+def slot_joints(coder: TileCoder, joints: int, follows: bool = False) -> np.ndarray | None:
     """Which joint's term each active feature slot feeds: int64 ``(tilings x groups,)``, or None
     when the features do not tile each of the ``joints`` joints alone in rows of their own (the
     default features of :meth:`._reach.ArmReach.features` do; hashed ones do not): then the
-    value is not factored."""
-    if coder.hashed or sorted(coder.groups) != [(j,) for j in range(joints)]:
+    value is not factored. A task that ``follows`` demonstrated paths also tiles its follow
+    cost alone (:func:`..tasks._follow.with_cost_group`): its slots get ``joints``, no joint's."""
+    own = [(j,) for j in range(joints)] + ([(joints,)] if follows else [])
+    if coder.hashed or sorted(coder.groups) != own:
         return None
     return np.repeat(np.array([g[0] for g in coder.groups], np.int64), coder.coding.tilings)
 
@@ -116,30 +136,52 @@ def split_reward(split, pot, obs, obs_next, reward, terminal, out):
 
 @njit(nogil=True, cache=True, inline="always")
 def column_sums(w, slots, feats, sums):
-    """``sums[3 j + c] = Q_j(s, c - 1)``: each joint's slots summed into its three columns."""
+    """``sums[3 j + c] = Q_j(s, c - 1)``: each joint's slots summed into its three columns; with
+    a follow column (``sums`` of ``3 J + 1``), every slot summed into ``sums[3 J]``."""
+    moves = sums.shape[0] - sums.shape[0] % 3  # 3 J
     for c in range(sums.shape[0]):
         sums[c] = 0.0
     for i in range(feats.shape[0]):
         f = feats[i]
         base = 3 * slots[i]
-        for c in range(base, base + 3):
-            sums[c] += w[f, c]
+        if base < moves:
+            for c in range(base, base + 3):
+                sums[c] += w[f, c]
+        else:  # the follow cost's tiles feed every joint's term
+            for c in range(moves):
+                sums[c] += w[f, c]
+        if moves < sums.shape[0]:
+            sums[moves] += w[f, moves]
 
 
 @njit(nogil=True, cache=True, inline="always")
 def factored_values(w, comp, slots, sums, feats, out):
-    """``out[a] = Q(s, a)`` of factored weights; leaves the per-joint terms in ``sums``."""
+    """``out[a] = Q(s, a)`` of factored weights (the follow action's, after the moves, from its
+    own column); leaves the per-joint terms in ``sums``."""
     column_sums(w, slots, feats, sums)
-    for a in range(out.shape[0]):
+    for a in range(comp.shape[0]):
         v = 0.0
         for j in range(comp.shape[1]):
             v += sums[comp[a, j]]
         out[a] = v
+    if out.shape[0] > comp.shape[0]:
+        out[comp.shape[0]] = sums[3 * comp.shape[1]]
 
 
 @njit(nogil=True, cache=True, inline="always")
 def factored_add(w, comp, slots, feats, action, changes):
-    """Add ``changes[j]`` to each weight of joint ``j``'s term of ``Q(s, action)``."""
+    """Add ``changes[j]`` to each weight of joint ``j``'s term of ``Q(s, action)`` (a move)."""
     for i in range(feats.shape[0]):
         j = slots[i]
-        w[feats[i], comp[action, j]] += changes[j]
+        if j < comp.shape[1]:
+            w[feats[i], comp[action, j]] += changes[j]
+        else:
+            for k in range(comp.shape[1]):
+                w[feats[i], comp[action, k]] += changes[k]
+
+
+@njit(nogil=True, cache=True, inline="always")
+def follow_add(w, feats, column, change):
+    """Add ``change`` to each active weight of the follow action's own ``column``."""
+    for i in range(feats.shape[0]):
+        w[feats[i], column] += change

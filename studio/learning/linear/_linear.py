@@ -83,11 +83,11 @@ from .._learner import (
 )
 from .._tiles import TileCoder, TileCoding, active_features
 from ..tasks._demo_shaping import demo_potential, no_potential, potential, shaped
-from ..tasks._follow import check_observed, with_cost_group
+from ..tasks._follow import with_cost_group
 from ..tasks._reach import ArmReach
-from ._common_value import add_common, update_common, without_common
+from ._common_value import q_values as _q_values
+from ._common_value import update_common, without_common
 from ._env import (
-    TASK_REACH,
     env_demonstrations,
     followed_task,
     make_env,
@@ -103,12 +103,16 @@ from ._factored import (
     expand,
     factored_add,
     factored_values,
+    follow_add,
     no_components,
     reward_split,
     row_joints,
     slot_joints,
     split_reward,
 )
+from ._greedy import _greedy_episode as _greedy_episode
+from ._greedy import greedy_rollout as greedy_rollout
+from ._greedy import greedy_success as greedy_success
 
 if TYPE_CHECKING:
     import gymnasium
@@ -120,14 +124,16 @@ Agent = namedtuple(
     "Agent",
     "w spec gamma step planner threshold "
     "model_obs model_next model_action model_reward model_terminal model_stamp model_follows "
-    "heap_idx heap_pri heap_pos counters feats feats_next plan_s plan_next qvals comp slots sums split pot deltas",
+    "heap_idx heap_pri heap_pos counters feats feats_next plan_s plan_next qvals comp slots sums split pot deltas "
+    "whole_step",
 )
 """The learner's arrays and settings as one numba-friendly value (see :func:`_new_agent`).
 
 ``comp`` ``(actions, J)``: each action's weight column per joint when the value is factored
 (:mod:`._factored`), ``(actions, 0)`` for one column per action; ``slots`` the joint each active
 feature slot feeds, ``split`` and ``pot`` what splits a reward among the joints, ``sums`` and
-``deltas`` scratch.
+``deltas`` scratch; ``whole_step`` the step of a column every active feature feeds (the
+factored value's follow column: ``alpha`` divided among all of them).
 
 ``counters`` int64: ``[stored, next slot, heap size, transitions ever stored]``.
 """
@@ -143,19 +149,6 @@ planning budget, epsilon and the demonstrations' shaping potential (:mod:`._demo
 
 
 # --------------------------------------------------------------------------- learning steps
-
-
-@njit(nogil=True, cache=True, inline="always")
-def _q_values(w, feats, out):
-    """``out[a] = Q(s, a)``: the active features' weights summed in feature order."""
-    n_actions = out.shape[0]
-    for a in range(n_actions):
-        out[a] = 0.0
-    for i in range(feats.shape[0]):
-        f = feats[i]
-        for a in range(n_actions):
-            out[a] += w[f, a]
-    add_common(w, feats, out)
 
 
 @njit(nogil=True, cache=True, inline="always")
@@ -221,19 +214,34 @@ def _choose(q, epsilon, rng):
 @njit(nogil=True, cache=True)
 def _factored_deltas(agent, obs, feats_s, action, reward, terminal, obs_next, feats_next):
     """Each joint term's TD error into ``agent.deltas`` (its share of the reward, plus gamma
-    times its term at the next state's greedy action, minus its term now); returns their sum."""
+    times its term at the next state's greedy action, minus its term now); returns their sum.
+
+    The follow action (after the moves) has no joint terms: its TD error is returned alone. A
+    move whose next greedy action is the follow action gives each joint an equal share of that
+    action's value."""
     comp = agent.comp
     deltas = agent.deltas
+    moves = comp.shape[0]
+    q = agent.qvals
+    if action >= moves:
+        target = reward
+        if not terminal:
+            factored_values(agent.w, comp, agent.slots, agent.sums, feats_next, q)
+            target += agent.gamma * _max(q)
+        column_sums(agent.w, agent.slots, feats_s, agent.sums)
+        return target - agent.sums[3 * comp.shape[1]]
     split_reward(agent.split, agent.pot, obs, obs_next, reward, terminal, deltas)
     if not terminal:
-        q = agent.qvals
         factored_values(agent.w, comp, agent.slots, agent.sums, feats_next, q)
         best = 0
         for a in range(1, q.shape[0]):
             if q[a] > q[best]:
                 best = a
         for j in range(comp.shape[1]):
-            deltas[j] += agent.gamma * agent.sums[comp[best, j]]
+            if best < moves:
+                deltas[j] += agent.gamma * agent.sums[comp[best, j]]
+            else:
+                deltas[j] += agent.gamma * q[best] / comp.shape[1]
     column_sums(agent.w, agent.slots, feats_s, agent.sums)
     total = 0.0
     for j in range(comp.shape[1]):
@@ -251,6 +259,9 @@ def _td_update(agent, obs, feats_s, action, reward, terminal, obs_next, feats_ne
         delta = _factored_deltas(
             agent, obs, feats_s, action, reward, terminal, obs_next, feats_next
         )
+        if action >= agent.comp.shape[0]:  # the follow action: its own column
+            follow_add(agent.w, feats_s, 3 * agent.comp.shape[1], agent.whole_step * delta)
+            return delta
         for j in range(agent.deltas.shape[0]):
             agent.deltas[j] *= agent.step
         factored_add(agent.w, agent.comp, agent.slots, feats_s, action, agent.deltas)
@@ -438,34 +449,6 @@ def _run_compiled(task, params, agent, plays, seed, stop, steps_out, updates_out
     return done
 
 
-@njit(nogil=True, cache=True)
-def _greedy_episode(task, params, spec, w, state, max_steps, path):
-    """Follow the greedy policy (ties: lowest action) from ``state`` (in place).
-
-    Writes each visited state into ``path`` rows (the start first) and returns the number of
-    steps taken, negative (``-steps - 1``) when ``max_steps`` ran out before the goal.
-    """
-    n_actions = w.shape[1]
-    obs = np.empty(spec.low.shape[0])
-    feats = np.empty(spec.bases.size, np.int64)
-    q = np.empty(n_actions)
-    path[0] = state
-    for steps in range(max_steps):
-        observe(task, params, state, obs)
-        active_features(spec, obs, feats)
-        _q_values(w, feats, q)
-        best = 0
-        for a in range(1, n_actions):
-            if q[a] > q[best]:
-                best = a
-        _, terminal = task_step(task, params, state, best)
-        if steps + 1 < path.shape[0]:
-            path[steps + 1] = state
-        if terminal:
-            return steps + 1
-    return -max_steps - 1
-
-
 # --------------------------------------------------------------------------- set-up
 
 
@@ -487,8 +470,12 @@ def _new_agent(
         np.zeros(0),
         no_potential(dims),
     )
-    touched = coder.n_active // max(comp.shape[1], 1)  # the slots that feed one term
+    touched = coder.coding.tilings if comp.shape[1] else coder.n_active  # slots feeding a term
+    if comp.shape[1] and n_actions > comp.shape[0]:
+        touched *= 2
     columns = n_actions if comp.shape[1] == 0 else int(comp.max()) + 1
+    if comp.shape[1] and n_actions > comp.shape[0]:
+        columns += 1  # the follow action's own column
     planner = PLANNER_CODE[config.planning]
     cap = 0 if planner == ZERO or config.planning_steps == 0 else capacity
     queue = cap if planner == PRIORITIZED else 0
@@ -521,6 +508,7 @@ def _new_agent(
         split,
         pot,
         np.zeros(comp.shape[1], np.float64),
+        float(config.alpha) / coder.n_active,
     )
 
 
@@ -531,7 +519,7 @@ def value_factors(task, coder: TileCoder, pot) -> tuple | None:
     reach = task.reach
     if reach is None or reach.actions not in FACTORED_ACTION_SETS:
         return None
-    slots = slot_joints(coder, reach.joints)
+    slots = slot_joints(coder, reach.joints, follows=bool(reach.paths))
     if slots is None:
         return None
     return action_components(reach.directions), slots, reward_split(reach), pot
@@ -623,7 +611,7 @@ def run_linear_experiments(
         factors = value_factors(task, coder, pot)
         comp = None if factors is None else factors[0]
         columns = task.n_actions if comp is None else int(comp.max()) + 1
-        common = task.follows  # (never factored: follow is not in FACTORED_ACTION_SETS)
+        common = task.follows  # a common column, or the factored value's follow column
         columns += common
         learned = np.zeros((experiments, coder.size, columns), np.float64)
         agents = [  # each learns into its row of ``learned``, which checkpoints read as it learns
@@ -644,7 +632,7 @@ def run_linear_experiments(
 
         def so_far() -> LinearResult:
             weights = learned if comp is None else expand(learned, comp, row_joints(coder))
-            weights = without_common(weights) if common else weights
+            weights = without_common(weights) if common and comp is None else weights
             return result_so_far(
                 LinearResult, live, cpu_seconds, weights, config, seed,
                 weights=weights, coder=coder, task=task.reach, env_id=task.env_id,
@@ -745,54 +733,3 @@ def _python_experiment(env, task, agent, config, seed, e, demo_starts, demo_acti
             feats[:] = agent.feats_next
         live.steps[e, episode] = steps
         live.updates[e, episode] = updates
-
-
-def greedy_rollout(
-    task: ArmReach, coder: TileCoder, weights: np.ndarray, start: np.ndarray, max_steps: int
-) -> tuple[np.ndarray, bool]:
-    """The greedy policy's path on the arm task from ``start``: ``(states (K + 1, joints), reached)``.
-
-    Ties go to the lowest action, so a rollout is deterministic.
-
-    Raises:
-        LearningError: features of another observation than ``task``'s.
-    """
-    check_observed(task, coder)
-    state = np.array(start, dtype=np.float64)
-    path = np.empty((max_steps + 1, task.joints))
-    steps = _greedy_episode(
-        np.int64(TASK_REACH), task.params, coder.spec,
-        np.ascontiguousarray(weights, np.float64), state, np.int64(max_steps), path,
-    )  # fmt: skip
-    reached = steps >= 0
-    taken = steps if reached else -steps - 1
-    return path[: taken + 1].copy(), reached
-
-
-def greedy_success(
-    task: ArmReach,
-    coder: TileCoder,
-    weights: np.ndarray,
-    starts: np.ndarray,
-    max_steps: int,
-) -> np.ndarray:
-    """Per start ``(N, joints)``: whether the greedy policy reaches the goal within ``max_steps``.
-
-    Raises:
-        LearningError: features of another observation than ``task``'s.
-    """
-    check_observed(task, coder)
-    out = np.zeros(starts.shape[0], np.bool_)
-    _success_many(
-        task.params, coder.spec, np.ascontiguousarray(weights, np.float64),
-        np.ascontiguousarray(starts, np.float64), np.int64(max_steps), out,
-    )  # fmt: skip
-    return out
-
-
-@njit(nogil=True, cache=True)
-def _success_many(params, spec, w, starts, max_steps, out):
-    path = np.empty((1, starts.shape[1]))
-    for i in range(starts.shape[0]):
-        state = starts[i].copy()
-        out[i] = _greedy_episode(TASK_REACH, params, spec, w, state, max_steps, path) >= 0

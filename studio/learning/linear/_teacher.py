@@ -11,12 +11,13 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._config import FOLLOW_ACTION_SETS
 from ..tasks._reach import ArmReach, reach_step, reach_success
 
 
 def follows_demonstrations(task: ArmReach) -> bool:
     """Whether ``task`` has the action that follows demonstrated paths (so a teacher)."""
-    return task.actions == "follow" and bool(task.paths)
+    return task.actions in FOLLOW_ACTION_SETS and bool(task.paths)
 
 
 def teacher_walk(task: ArmReach, start: np.ndarray, max_steps: int) -> tuple[np.ndarray, bool]:

@@ -26,6 +26,7 @@ from typing import TYPE_CHECKING, Protocol
 import numpy as np
 from numba import njit
 
+from .._config import FOLLOW_ACTION_SETS
 from .._errors import ConfigError, LearningError
 from .._tiles import TileCoding
 from ._reach_layout import _COUNTS, _LOWER, _POINT, _STEP, _TABLE, _UPPER, MAX_JOINTS
@@ -70,15 +71,15 @@ def checked_paths(
     to the limits, its samples :data:`FOLLOW_SPACING_STEPS` apart.
 
     Raises:
-        ConfigError: paths with another action set than ``"follow"``, a path of the wrong shape,
+        ConfigError: paths with an action set that does not follow (:data:`FOLLOW_ACTION_SETS`), a path of the wrong shape,
             or one holding NaN.
     """
     if paths is None or len(paths) == 0:  # (an array of paths has no single truth value)
         return ()
-    if actions != "follow":
+    if actions not in FOLLOW_ACTION_SETS:
         raise ConfigError(
             [
-                f'paths are given with actions={actions!r}; give actions="follow" to follow them, or no paths.'
+                f'paths are given with actions={actions!r}; give actions="follow" or "all-follow" to follow them, or no paths.'
             ],
             ["paths"],
         )

@@ -107,7 +107,8 @@ class ArmReachEnv(gymnasium.Env):
         angle_tolerance_deg: degrees.
         shaping: weight of the potential-based shaping reward.
         actions: what one action moves: ``"single"`` (one joint), ``"pairs"`` (also two
-            together), ``"all"`` (any joints at once) or ``"follow"`` (one joint, or all of them
+            together), ``"all"`` (any joints at once), ``"all-follow"`` (any joints, or all of them
+            along the demonstrations) or ``"follow"`` (one joint, or all of them
             along the demonstrated ``paths``; :meth:`follow`).
         paths: the demonstrated joint paths ``"follow"`` follows (:class:`ArmReach`).
         robot: the robot's registry name (``studio robots``; default ``"puma560"``): its first

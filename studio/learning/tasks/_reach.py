@@ -10,7 +10,9 @@ diagonals, 2J**2 actions), and
 :func:`action_directions`. ``actions="follow"`` adds to the single joints one action that moves
 every joint at once along the demonstrated paths (:attr:`ArmReach.paths`, :mod:`._follow`), so a
 policy can move as its demonstrations did; it is the default, and without demonstrations it is
-one joint per action. A joint whose move would leave its limits stays where it is, as on
+one joint per action. ``actions="all-follow"`` adds the follow action to ``"all"``'s moves
+instead: the follow action reaches the goal, the multi-joint moves let a policy cut the
+demonstrated paths short (without demonstrations it is ``"all"``). A joint whose move would leave its limits stays where it is, as on
 the paper's grid (the action's other joints still move). Reaching the goal pays :data:`GOAL_REWARD` and ends the
 episode, every other step pays :data:`STEP_REWARD` (the paper's rewards), plus a potential-based
 shaping term (:data:`DEFAULT_SHAPING`). Episodes start uniformly across the limits (a start already
@@ -58,6 +60,7 @@ from .._config import (
     DEFAULT_SHAPING,
     DEFAULT_STEP_DEG,
     DEFAULT_TILINGS,
+    FOLLOW_ACTION_SETS,
 )
 from .._errors import ConfigError, LearningError
 from .._tiles import TileCoding
@@ -157,7 +160,7 @@ class ArmReach:
         shaping: weight of the potential-based shaping reward (:data:`DEFAULT_SHAPING`).
         actions: what one action moves, one of :data:`ACTION_SETS`.
         robot: the robot's registry name (``studio robots`` lists them).
-        paths: with ``actions="follow"``, the demonstrated joint paths (each ``(N, joints)``
+        paths: with ``actions="follow"`` or ``"all-follow"``, the demonstrated joint paths (each ``(N, joints)``
             radians, ending at the goal) that the last action follows: it moves every joint at
             once, by at most one step, along them to the goal (:func:`._follow.follow`), so a policy
             can move as the demonstrations did.
@@ -194,7 +197,7 @@ class ArmReach:
         if self.actions not in ACTION_SETS:
             raise ConfigError(
                 [
-                    f"actions is {self.actions!r}; give {', '.join(map(repr, ACTION_SETS))} (one joint per action, also two together, or any joints at once)."
+                    f"actions is {self.actions!r}; give {', '.join(map(repr, ACTION_SETS))} (one joint per action, also two together, any joints at once, one joint or following the demonstrations, or any joints at once or following them)."
                 ],
                 ["actions"],
             )
@@ -272,8 +275,9 @@ class ArmReach:
 
     def with_paths(self, q_paths: Sequence[np.ndarray]) -> ArmReach:
         """This task following ``q_paths`` (joint paths, radians, ``(N, joints)`` or wider) when
-        its actions are ``"follow"`` and it has none yet; else this task unchanged."""
-        if self.actions != "follow" or self.paths or len(q_paths) == 0:
+        its actions follow (:data:`FOLLOW_ACTION_SETS`) and it has none yet; else this task
+        unchanged."""
+        if self.actions not in FOLLOW_ACTION_SETS or self.paths or len(q_paths) == 0:
             return self
         return dataclasses.replace(
             self, paths=tuple(np.asarray(q)[:, : self.joints] for q in q_paths)
@@ -283,8 +287,8 @@ class ArmReach:
 
     @property
     def n_actions(self) -> int:
-        """2J (one joint up or down by one step), 2J**2 with the pairs, 3**J - 1 with all, 2J + 1
-        when following paths."""
+        """2J (one joint up or down by one step), 2J**2 with the pairs, 3**J - 1 with all, one
+        more when following paths (2J + 1, or 3**J with ``"all-follow"``)."""
         return int(self.directions.shape[0]) + (1 if self.paths else 0)
 
     @cached_property

@@ -49,7 +49,10 @@ def action_directions(joints: int, actions: str = "single") -> np.ndarray:
     Singles first (joint 1 up, joint 1 down, joint 2 up, ...), then with ``"pairs"`` or ``"all"``
     each pair of joints ``j < k`` as (+, +), (+, -), (-, +), (-, -), then with ``"all"`` the
     moves of three or more joints (in ``itertools.product((1, 0, -1), repeat=joints)`` order).
+    ``"all-follow"``'s table is ``"all"``'s (its follow action comes after the table).
     """
+    if actions == "all-follow":
+        actions = "all"
     rows: list[tuple[int, ...]] = []
     for j in range(joints):
         for d in (1, -1):
