@@ -16,9 +16,12 @@ the ``active x J`` weights it touches.
 
 With ``actions="all-follow"`` and demonstrations the last action follows the demonstrated
 paths: it moves no joint by a fixed step, so it has no per-joint terms but one column of its own,
-``Q(s, follow) = sum_f w[f, 3 J]`` over every active feature (the follow cost's tiles included,
-which no joint's term reads). Its update is the ordinary one; a move whose next state's greedy
-action is the follow action shares that value equally among its joints' targets.
+``Q(s, follow) = sum_f w[f, 3 J]`` over every active feature (the follow cost's tiles included).
+Its update is the ordinary one; a move whose next state's greedy action is the follow action
+shares that value equally among its joints' targets. The follow cost's tiles also feed every
+joint's term (``Q_j`` reads joint ``j``'s tiles and the cost's, so twice as many weights, and
+the learner halves the step), so a joint's term can tell how far along the demonstrations the
+arm is (package README: without them greedy success swung between 12% and 85% with the budget).
 
 A factored table is expanded into the ordinary ``(size, n_actions)`` table (:func:`expand`),
 ``W[f, a] = sum_j w[f, comp[a, j]]``, which gives the same Q: policy files, rollouts and

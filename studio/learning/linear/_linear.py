@@ -472,7 +472,7 @@ def _new_agent(
     )
     touched = coder.coding.tilings if comp.shape[1] else coder.n_active  # slots feeding a term
     if comp.shape[1] and n_actions > comp.shape[0]:
-        touched *= 2
+        touched *= 2  # the follow cost's slots feed every joint's term too (:mod:`._factored`)
     columns = n_actions if comp.shape[1] == 0 else int(comp.max()) + 1
     if comp.shape[1] and n_actions > comp.shape[0]:
         columns += 1  # the follow action's own column
