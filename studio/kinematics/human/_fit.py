@@ -28,7 +28,9 @@ tape strapped slightly off; the offset shows in the residual.
 
 Observability: the three directions give six numbers for seven joints. Shoulder flexion,
 abduction, humeral rotation and elbow flexion are determined (humeral rotation only when the elbow
-is bent); forearm rotation and the two wrist joints share one unobservable direction (they all
+is bent beyond the tape's noise: a bend whose sine is below ``FitConfig.straight_sine`` is taken as
+straight, the wrist and hand turned about the elbow onto the upper arm's line, so humeral rotation
+is held where it was instead of following the noise's direction); forearm rotation and the two wrist joints share one unobservable direction (they all
 turn the hand about the forearm), which the damped steps resolve by moving least from the
 previous frame. The residual is the RMS distance from the tape's arm vertices to the fitted arm,
 so a badly placed or mis-configured tape shows up as a number.
@@ -47,7 +49,6 @@ from .._checks import KinematicsError, instance_of, positive_number, real_array,
 from ._human import HumanArm
 from ._tape import TapeConfig, TapeShape, reconstruct
 
-_SEEN = 1e-6  # sine of a bend below which the rotation about the limb is not observable
 _DEGENERATE = 1e-12  # m: two tape points closer than this give no direction
 _AT_LIMIT = 1e-9  # rad: a closed-form angle this far past a limit is on it (rounding), not beyond
 
@@ -75,6 +76,15 @@ class FitConfig:
             on the chosen branch count as equivalent; the one nearest the previous frame wins.
         branch_jump: a shoulder flexion change (rad) beyond this between frames is a switch
             of branch (a switch turns flexion by pi; continuous motion by little per frame).
+        straight_sine: an elbow (or, in the closed-form seed, a wrist) whose landmarks bend by
+            an angle with a smaller sine is taken as straight: the rotation about the limb is
+            then not observable and is held (the previous frame's, or the neutral arm's)
+            instead of following the tape's noise. The default is four standard deviations of
+            the bend the ShapeTape's noise puts on a straight elbow with the default tape:
+            0.002 rad per region angle (``OperatorConfig.noise_rad``) bends the chord from the
+            elbow to the first forearm vertex by ``0.002 * sqrt(0.23**2 + 0.115**2) / 0.069``,
+            about 0.0075 rad (one std; measured 0.0064 mean, 0.023 largest over 10 s held).
+            A tape with other regions or noise may need another value (below 1).
     """
 
     warm_iterations: int = 8
@@ -87,6 +97,7 @@ class FitConfig:
     branch_slack: float = 0.02
     equivalent_error: float = 1e-6
     branch_jump: float = math.pi / 2
+    straight_sine: float = 0.03
 
     def __post_init__(self) -> None:
         whole_number(self.warm_iterations, "FitConfig.warm_iterations", 0)
@@ -100,8 +111,14 @@ class FitConfig:
             "branch_slack",
             "equivalent_error",
             "branch_jump",
+            "straight_sine",
         ):
             positive_number(getattr(self, name), f"FitConfig.{name}")
+        if not self.straight_sine < 1:
+            raise KinematicsError(
+                f"FitConfig.straight_sine is the sine of a bend and must be below 1; got "
+                f"{self.straight_sine!r}."
+            )
 
 
 @dataclass(frozen=True)
@@ -280,7 +297,11 @@ class ArmFitter:
         return points, int(last)
 
     def _seed(
-        self, points: np.ndarray, forearm_rotation: float | None = None, overhead: bool = False
+        self,
+        points: np.ndarray,
+        forearm_rotation: float | None = None,
+        overhead: bool = False,
+        humeral_rotation: float = 0.0,
     ) -> np.ndarray:
         """Closed-form arm angles from the landmark directions.
 
@@ -289,9 +310,12 @@ class ArmFitter:
         ``forearm_rotation`` (the previous frame's, for continuity) the wrist follows; without
         it, wrist deviation is taken as zero. ``overhead`` picks the other shoulder branch
         (abduction beyond 90 degrees, flexion turned by 180), the one an arm raised sideways
-        over the head needs.
+        over the head needs. An elbow straight to ``FitConfig.straight_sine`` leaves humeral
+        rotation unseen: it is held at ``humeral_rotation`` (given on the anatomical branch;
+        turned by 180 degrees on the overhead one, the same arm).
         """
         S, E, W, H = points
+        seen = self.settings.straight_sine
         d = _unit(E - S)
         q = np.zeros(self.arm.nq)
         sign = -1.0 if self.arm.side == "right" else 1.0  # mirrored lateral axes
@@ -307,8 +331,11 @@ class ArmFitter:
         joints = self._joints
         # the forearm in the frame before humeral rotation
         fA = self.data.oMi[joints.shoulder_X].rotation.T @ f
-        if math.sin(q[3]) > _SEEN:  # humeral rotation is seen only with a bent elbow
+        if math.sin(q[3]) > seen:  # humeral rotation is seen only with a bent elbow
             q[2] = math.atan2(sign * fA[2], fA[0])
+        else:
+            q[2] = humeral_rotation + math.pi if overhead else humeral_rotation
+            q[2] = math.remainder(q[2], 2 * math.pi)
         q = np.minimum(np.maximum(q, self._lower), self._upper)
         lower, upper = self._lower, self._upper
         if forearm_rotation is not None:
@@ -325,7 +352,7 @@ class ArmFitter:
         h = self.data.oMi[joints.elbow_Z].rotation.T @ _unit(H - W)
         q5 = math.acos(float(np.clip(-h[1], -1.0, 1.0)))
         # A straight wrist leaves forearm rotation unseen: keep it at zero then.
-        q4 = math.atan2(sign * h[2], h[0]) if math.sin(q5) > _SEEN else 0.0
+        q4 = math.atan2(sign * h[2], h[0]) if math.sin(q5) > seen else 0.0
         lo, hi = lower - _AT_LIMIT, upper + _AT_LIMIT
         for q4_try, q5_try in ((q4, q5), (q4 + math.pi, -q5), (q4 - math.pi, -q5)):
             if lo[4] <= q4_try <= hi[4] and lo[5] <= q5_try <= hi[5]:
@@ -395,7 +422,18 @@ class ArmFitter:
         cfg = self.settings
         previous = self._q
         rotations = [None] if previous is None else [float(previous[4]), None]
-        seeds = [self._seed(relative, r, overhead) for overhead in (False, True) for r in rotations]
+        humeral = (
+            0.0  # held when the elbow is straight: the previous frame's, on the anatomical branch
+        )
+        if previous is not None:
+            humeral = float(previous[2]) - (
+                math.pi if abs(float(previous[1])) > math.pi / 2 else 0.0
+            )
+        seeds = [
+            self._seed(relative, r, overhead, humeral)
+            for overhead in (False, True)
+            for r in rotations
+        ]
         # (q, error, refine): a seed's error as it stands; the stalled warm start is not refined
         # again (it had its iterations), the closed-form seeds may be.
         candidates = [(seed, self._solve(seed, target, 0)[1], True) for seed in seeds]
@@ -497,6 +535,8 @@ class ArmFitter:
         if last < 0:
             return self._no_directions(positions, points)
         relative = points - points[0]  # the arm's shoulder is at the origin
+        if self._q is not None:  # a cold start has no rotation to hold: it meets the tape
+            relative = self._straighten(relative)
         target = relative[1:].reshape(-1)
         cfg = self.settings
         iterations = 0
@@ -522,6 +562,33 @@ class ArmFitter:
             landmark_error=landmark_error,
             iterations=iterations,
         )
+
+    def _straighten(self, relative: np.ndarray) -> np.ndarray:
+        """``relative`` with an elbow bent within the tape's noise made straight.
+
+        When the sine of the angle between the upper arm (shoulder to elbow) and the forearm
+        (elbow to wrist) is below ``FitConfig.straight_sine``, the wrist and hand centre are
+        turned about the elbow so that the forearm continues the upper arm. The bend's direction
+        is then noise, and following it would turn humeral rotation (and forearm rotation with
+        it) at random from frame to frame; straight landmarks leave both where they were, the
+        damped steps moving them least. The fit's landmark error is still measured against the
+        tape's own landmarks. Only warm frames are straightened: a cold start has no rotation
+        to hold, and meets the tape's landmarks as they are.
+        """
+        S, E, W, H = relative
+        d, f = E - S, W - E
+        d = d / np.linalg.norm(d)
+        f = f / np.linalg.norm(f)
+        axis = np.cross(f, d)
+        sine = float(np.linalg.norm(axis))
+        if sine >= self.settings.straight_sine or float(d @ f) <= 0:
+            return relative
+        out = relative.copy()
+        if sine > 0:
+            rotation = pin.exp3(axis * (math.asin(sine) / sine))  # turns f onto d
+            out[2] = E + rotation @ (W - E)
+            out[3] = E + rotation @ (H - E)
+        return out
 
     def _quality(self, positions: np.ndarray, points: np.ndarray, last: int) -> tuple[float, float]:
         """(residual, landmark error) of the arm at ``self.data``'s pose against the tape."""
