@@ -11,7 +11,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from studio.kinematics import HumanArm, KinematicsError, _robots
+from studio.kinematics import HumanArm, KinematicsError, _robot_specs
 from studio.kinematics.human import _human
 from studio.kinematics.human._human import ArmPose, mirror_human_q
 
@@ -165,9 +165,11 @@ def test_missing_example_robot_data_names_the_package(monkeypatch, tmp_path):
     def missing(name):
         raise importlib.metadata.PackageNotFoundError(name)
 
-    monkeypatch.setattr(_robots.importlib.metadata, "distribution", missing)
+    monkeypatch.setattr(_robot_specs.importlib.metadata, "distribution", missing)
     monkeypatch.setattr(
-        _robots.sysconfig, "get_paths", lambda: {"purelib": str(tmp_path), "platlib": str(tmp_path)}
+        _robot_specs.sysconfig,
+        "get_paths",
+        lambda: {"purelib": str(tmp_path), "platlib": str(tmp_path)},
     )
     with pytest.raises(KinematicsError, match="example-robot-data"):
         HumanArm()
