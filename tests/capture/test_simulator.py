@@ -51,7 +51,8 @@ def test_minimum_jerk_profile():
 
 
 def _read_with_times(source, count: int) -> tuple[list, list[float]]:
-    """Read ``count`` frames (or give up after a generous wait); each with a time it was read."""
+    """Read ``count`` frames (or give up after a generous wait); each with a time it was read.
+    A late source hands over several frames in one read: those past ``count`` are left out."""
     got: list = []
     read_at: list[float] = []
     deadline = time.monotonic() + 30.0  # only a hung source reaches this
@@ -60,7 +61,7 @@ def _read_with_times(source, count: int) -> tuple[list, list[float]]:
         now = time.monotonic()  # after the frames were released: an upper bound on their release
         got += frames
         read_at += [now] * len(frames)
-    return got, read_at
+    return got[:count], read_at[:count]
 
 
 def test_live_source_keeps_110_hz_without_drops():
