@@ -334,13 +334,15 @@ class StudioScene(ScenePaths, SceneRobot, SceneOperator, SceneReach):
             or pose.mode != shown.mode
         ):
             return
+        posed = None  # the operator posed for the new live pose: before viser's batch opens
+        if new_live and live is not None:
+            p = live.pose
+            posed = pose_body(operator.body, p.q_human, p.tape, self.layout.tape_lift_m)
         with self.server.atomic():
             if playback_changed or (pose.mode is Mode.LIVE and shown.trace_upto >= 0):
                 self._hide_trace()
                 shown.trace_upto = -1
-            if new_live and live is not None:
-                p = live.pose
-                posed = pose_body(operator.body, p.q_human, p.tape, self.layout.tape_lift_m)
+            if posed is not None:
                 self._push_operator(operator, posed, whole=operator_changed)
             elif operator_changed:
                 self._push_operator(operator, operator.rest, whole=True)
