@@ -17,16 +17,22 @@ and 3 over +-180 degrees, beyond the arm's limits, so many of its states lie in 
 share is the grid's, obstacles or not), and the mean steps to the goal; then whether replaying
 each demonstration's grid path (the teacher) would pass through the box.
 
-With ``--task arm-reach`` the same for the six-joint continuous task (tile coding, the default
-actions and shaping), its teacher being the demonstrations followed, taught by
-``sample-reach-2`` alone (``--samples`` to choose): the three samples end at wrist angles 147
-degrees apart about the forearm (joint 4 at -158, -11 and -116 degrees), so at six joints the
-goal pose of one is not the goal of the others and the task refuses them together.
+With ``--task arm-reach`` the same for the six-joint continuous task with its defaults (the
+paper's reward plus shaping 5 toward the goal's joint angles, no demonstration potential; one
+joint a step and the follow action; full planning of 100 steps; the tiles of a task with
+obstacles: each joint alone, joint 1 with joint 2 and with joint 3; the greedy policy of a task
+with obstacles stepping around refused moves), its teacher being the demonstrations followed,
+taught by ``sample-reach-2`` alone (``--samples`` to choose): the three samples end at wrist
+angles 147 degrees apart about the forearm (joint 4 at -158, -11 and -116 degrees), so at six
+joints the goal pose of one is not the goal of the others and the task refuses them together.
+Each run's row also gives the same weights' greedy success pressing refused moves again, and
+``--per-joint-tiles`` trains both runs on each joint's tiles alone (the features before).
 """
 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import tempfile
 import time
 from pathlib import Path
@@ -44,6 +50,8 @@ from studio.learning import (
     obstacle_guard,
     resolve_run,
 )
+from studio.learning.linear._greedy import greedy_success, steps_around
+from studio.learning.linear._policy import DEFAULT_MAX_STEPS, TilePolicyFile
 from studio.motion import training_demonstration
 
 BOX = Obstacle((0.56, 0.18, 1.08), (0.12, 0.12, 0.12))
@@ -56,8 +64,13 @@ def _demonstrations(robot: str, names: list[str]) -> list[DemonstrationPath]:
     return [training_demonstration(demonstration_file(Path(n)), robot, n) for n in names]
 
 
-def _run(request: RunRequest, root: Path):
+def _run(request: RunRequest, root: Path, per_joint: bool = False):
     record = resolve_run(request)
+    if per_joint:  # the features before a box added joint 1 with joints 2 and 3
+        singles = tuple((j,) for j in range(record.arm_reach().joints))
+        record = dataclasses.replace(
+            record, coding=dataclasses.replace(record.tile_coding(), groups=singles)
+        )
     folder = RunFolder.create(root, record)
     start = time.process_time()
     folder.train()
@@ -72,7 +85,15 @@ def _judge(folder: RunFolder, starts: int, robot: str) -> dict:
     other = evaluate_policy(
         policy, starts, 0, lambda r, q: any(arm.contacts(row) for row in np.atleast_2d(q))
     )
-    return {"judged": boxed, "table_or_self": other.policy.collisions}
+    seeds = np.random.default_rng(0).integers(0, 2**31 - 1, size=starts)
+    alone = None
+    if isinstance(policy, TilePolicyFile) and steps_around(policy.task):  # the same weights,
+        task = policy.task  # the greedy policy pressing refused moves again
+        q = np.array([task.random_start(np.random.default_rng(int(s))) for s in seeds])
+        alone = greedy_success(
+            task, policy.coder, policy.weights, q, DEFAULT_MAX_STEPS, True, False
+        )
+    return {"judged": boxed, "table_or_self": other.policy.collisions, "alone": alone}
 
 
 def main() -> None:
@@ -82,6 +103,11 @@ def main() -> None:
     parser.add_argument("--experiments", type=int, default=20)
     parser.add_argument("--starts", type=int, default=200)
     parser.add_argument("--samples", nargs="+", help="the demonstrations (default: see above)")
+    parser.add_argument(
+        "--per-joint-tiles",
+        action="store_true",
+        help="arm-reach: tile each joint alone, as before a box added joint 1 with joints 2 and 3",
+    )
     args = parser.parse_args()
     robot = "puma560"
     names = args.samples or (list(SAMPLES) if args.task == "arm-grid" else ["sample-reach-2"])
@@ -96,30 +122,54 @@ def main() -> None:
     guard = obstacle_guard(robot, (BOX,))
     with tempfile.TemporaryDirectory() as tmp:
         root = Path(tmp)
-        taught, cpu_taught = _run(RunRequest(**common, demonstrations=demos, name="taught"), root)
+        per_joint = args.task == "arm-reach" and args.per_joint_tiles
+        taught, cpu_taught = _run(
+            RunRequest(**common, demonstrations=demos, name="taught"), root, per_joint
+        )
         record = taught.record
-        goal = None if args.task == "arm-grid" else {"goal": record.arm_reach().goal}
+        goal = {"goal": record.arm_reach().goal} if args.task == "arm-reach" else None
         bare_request = RunRequest(**common, name="bare", reach=goal or {})
-        bare, cpu_bare = _run(bare_request, root)
+        bare, cpu_bare = _run(bare_request, root, per_joint)
         print(
             f"{args.task}, box {BOX.text()}, {args.experiments} x {args.episodes} episodes, "
             f"{args.starts} held-out starts"
         )
+        if args.task == "arm-reach":
+            task, coding = record.arm_reach(), record.tile_coding()
+            config = record.config
+            print(
+                f"  reward: the paper's (+100 at the goal, -1 a step) plus shaping "
+                f"{task.shaping:g} toward the goal's joint angles, no demonstration potential; "
+                f"actions {task.actions!r} (one joint a step, and with demonstrations the "
+                f"follow action); tiles {coding.tilings} x {coding.tiles}, groups "
+                f"{coding.groups} (and the follow cost's); planning {config.planning} "
+                f"{config.planning_steps}; the greedy policy steps around refused moves"
+            )
+        how = ""
+        if args.task == "arm-reach":
+            tiles = "each joint's tiles" if per_joint else "tiles of each joint, joint 1 x 2, 1 x 3"
+            how = f" ({tiles}; greedy stepping around refused moves)"
         for label, folder, cpu in (
-            (", ".join(names), taught, cpu_taught),
-            ("none", bare, cpu_bare),
+            ("taught by " + ", ".join(names) + how, taught, cpu_taught),
+            ("no demonstrations, same budget" + how, bare, cpu_bare),
         ):
             out = _judge(folder, args.starts, robot)
             p, t = out["judged"].policy, out["judged"].teacher
             print(
-                f"  demonstrations {label}: success {p.success:.1%}, box collisions "
+                f"  {label}: success {p.success:.1%}, box collisions "
                 f"{p.collisions:.1%}, table/self {out['table_or_self']:.1%}, mean steps "
-                f"{p.mean_steps:.1f}, CPU {cpu:.1f} s"
+                f"{p.mean_steps:.1f} ({p.mean_seconds:.2f} s), CPU {cpu:.1f} s"
             )
+            if out["alone"] is not None:
+                print(
+                    f"    the same weights, the greedy policy pressing refused moves again: "
+                    f"success {out['alone'].mean():.1%}"
+                )
             if t is not None:
                 print(
-                    f"    its teacher (demonstrations followed): success {t.success:.1%}, box "
-                    f"collisions {t.collisions:.1%}"
+                    f"    its teacher (the demonstrations followed, no learning): success "
+                    f"{t.success:.1%}, box collisions {t.collisions:.1%}, mean steps "
+                    f"{t.mean_steps:.1f}"
                 )
         for demo in demos:
             touches = guard.path_collides(demo.q_robot)

@@ -67,6 +67,9 @@ same order, ``"follow"`` with the singles and ``"all-follow"`` with ``"all"``.""
 FOLLOW_ACTION_SETS = ("follow", "all-follow")
 """The action sets that end with the action following the demonstrated paths (when there are
 any; without demonstrations ``"follow"`` is ``"single"`` and ``"all-follow"`` is ``"all"``)."""
+FACTORED_ACTION_SETS = ("pairs", "all", "all-follow")
+"""Action sets of the arm task learned with the factored value (one joint per action keeps its
+one column per action: there each action already owns one joint's move)."""
 DEFAULT_ACTIONS = "follow"
 """One joint per action, and with demonstrations one more that follows them (without any, the
 task is ``"single"``'s bit for bit). With 3 demonstrations at six joints (package README): under

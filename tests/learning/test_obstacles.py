@@ -171,6 +171,7 @@ def test_the_continuous_task_takes_a_box_and_a_rollout_into_it_is_a_collision(tm
     assert main(argv) == 0
     stored = json.loads((out / "config.json").read_text())
     assert stored["task"]["obstacles"] == [in_the_way.to_dict()]
+    assert stored["task"]["tile_coding"]["groups"][-2:] == [[0, 1], [0, 2]]  # joint 1 with 2, 3
     kept = policy_obstacles(load_any_policy(out / "policy.policy.npz"))
     assert kept == (in_the_way,)
     swing = np.array([_swing(d) for d in (-60.0, 60.0)])  # both ends clear, the box between
@@ -264,3 +265,42 @@ def test_an_export_is_checked_along_it_against_the_obstacles(arm, in_the_way):
     ]
     assert len(found) == 1 and "touches obstacle 1" in found[0].sentence
     assert 0 < found[0].sample < len(swing)
+
+
+def test_with_a_box_one_joint_per_action_also_tiles_joint_1_with_joints_2_and_3(in_the_way):
+    """Where a box refuses a move depends on where the arm stands as a whole: a task with one
+    joint per action and obstacles tiles joint 1 with joint 2 and with joint 3 too. The factored
+    action sets keep the per-joint tiles their value is factored over; without a box nothing
+    changes."""
+    from studio.learning import ArmReach
+
+    singles = tuple((j,) for j in range(6))
+    for actions in ("single", "follow"):
+        boxed = ArmReach(obstacles=(in_the_way,), goal=AWAY, actions=actions)
+        assert boxed.features().groups == (*singles, (0, 1), (0, 2))
+        assert ArmReach(goal=AWAY, actions=actions).features().groups == singles
+    for actions in ("pairs", "all-follow"):
+        boxed = ArmReach(obstacles=(in_the_way,), goal=AWAY, actions=actions)
+        assert boxed.features().groups == singles
+
+
+def test_the_greedy_policy_steps_around_a_move_a_box_refuses(in_the_way):
+    """Weights that prefer joint 1 up, then joint 2 up, wherever the arm is: pressing the move
+    the box refuses again, the greedy policy stays in front of the box to the cap; stepping
+    around refused moves (the policy of a task with obstacles), it climbs past the box, never
+    staying put nor stepping back to where it was."""
+    from studio.learning import ArmReach
+    from studio.learning.linear._greedy import greedy_rollout, steps_around
+
+    task = ArmReach(obstacles=(in_the_way,), shaping=0.0, goal=AWAY)
+    assert steps_around(task) and not steps_around(ArmReach(goal=AWAY))
+    coder = task.features().bind(task.lower, task.upper)
+    weights = np.zeros((coder.size, task.n_actions))
+    weights[:, 0], weights[:, 2] = 2.0, 1.0  # joint 1 up, else joint 2 up
+    start = np.ascontiguousarray(_swing(-60))
+    pressed, _ = greedy_rollout(task, coder, weights, start, 300, step_around=False)
+    around, _ = greedy_rollout(task, coder, weights, start, 300)
+    assert np.degrees(pressed[:, 0]).max() < 0 and np.array_equal(pressed[-1], pressed[-2])
+    assert np.degrees(around[:, 0]).max() > 10
+    assert not any(np.array_equal(a, b) for a, b in zip(around[1:], around[:-1], strict=True))
+    assert not any(np.array_equal(a, b) for a, b in zip(around[2:], around[:-2], strict=True))

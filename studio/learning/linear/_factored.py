@@ -36,13 +36,10 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from .._config import FACTORED_ACTION_SETS as FACTORED_ACTION_SETS
 from .._tiles import TileCoder
 from ..tasks._arm import GOAL_REWARD, STEP_REWARD
 from ..tasks._demo_shaping import nearest
-
-FACTORED_ACTION_SETS = ("pairs", "all", "all-follow")
-"""Action sets of the arm task learned with the factored value (one joint per action keeps its
-one column per action: there each action already owns one joint's move)."""
 
 
 def action_components(directions: np.ndarray) -> np.ndarray:

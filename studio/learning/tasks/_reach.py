@@ -60,6 +60,7 @@ from .._config import (
     DEFAULT_SHAPING,
     DEFAULT_STEP_DEG,
     DEFAULT_TILINGS,
+    FACTORED_ACTION_SETS,
     FOLLOW_ACTION_SETS,
 )
 from .._errors import ConfigError, LearningError
@@ -140,6 +141,11 @@ MAX_SHAPING = 100.0
 """Upper bound on ``shaping``."""
 STORED_ACTIONS = "single"
 """What a task stored before ``actions`` existed moves: one joint per action."""
+AROUND_GROUPS = ((0, 1), (0, 2))
+"""The tile groups a task with obstacles adds to the per-joint ones (:meth:`ArmReach.features`):
+joint 1 with joint 2, joint 1 with joint 3, the joints that carry the arm around its base and
+up. Measured with a box where a demonstration passes (package README, "Around an obstacle";
+``benchmarks/bench_obstacles.py --task arm-reach``, against ``--per-joint-tiles``)."""
 LIMIT_SLACK_RAD = 1e-9
 """A demonstration may touch its joint limits within this rounding."""
 
@@ -368,11 +374,21 @@ class ArmReach:
         of joints (``J (J - 1) / 2 x (tiles + 1) ** 2`` tiles per tiling) at six joints, 4,000
         episodes: 100% greedy success for single joints against 77% for pairs and 94% for both
         (see the package README); pass ``TileCoding(groups=...)`` for other choices.
+
+        With obstacles, one joint per action (``"single"``, ``"follow"``) also tiles joint 1
+        with joint 2 and joint 1 with joint 3 (:data:`AROUND_GROUPS`): where a box refuses a
+        move depends on where the arm stands as a whole, which a sum of per-joint terms cannot
+        tell. The factored action sets (:data:`FACTORED_ACTION_SETS`) keep the per-joint
+        features their value is factored over.
         """
         singles = tuple((j,) for j in range(self.joints))
         tiles = self.default_tiles if tiles is None else tiles
         coding = TileCoding(tilings=tilings, tiles=tiles, size=size, groups=singles)
-        return with_cost_group(coding, self.joints) if self.paths else coding
+        if self.paths:
+            coding = with_cost_group(coding, self.joints)
+        if self.obstacles and self.actions not in FACTORED_ACTION_SETS:
+            coding = dataclasses.replace(coding, groups=(*(coding.groups or ()), *AROUND_GROUPS))
+        return coding
 
     @cached_property
     def observation_bounds(self) -> tuple[np.ndarray, np.ndarray]:
