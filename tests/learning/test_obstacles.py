@@ -304,3 +304,26 @@ def test_the_greedy_policy_steps_around_a_move_a_box_refuses(in_the_way):
     assert np.degrees(around[:, 0]).max() > 10
     assert not any(np.array_equal(a, b) for a, b in zip(around[1:], around[:-1], strict=True))
     assert not any(np.array_equal(a, b) for a, b in zip(around[2:], around[:-2], strict=True))
+
+
+def test_a_follow_move_the_box_refuses_hands_the_motion_back(in_the_way):
+    """``"all-follow"`` hands over to the follow action where its greedy moves loop. Following a
+    demonstration that swings through the box, that hand-over stalls in front of it for good;
+    stepping around refused moves, the follow move the box refuses hands back to the greedy moves,
+    which climb past the box."""
+    from studio.learning import ArmReach
+    from studio.learning.linear._greedy import greedy_rollout, hand_over_action
+
+    swing = np.array([_swing(d) for d in np.arange(-60.0, 121.0, 2.0)])  # through the box
+    task = ArmReach(
+        obstacles=(in_the_way,), shaping=0.0, goal=AWAY, actions="all-follow", paths=(swing,)
+    )
+    assert hand_over_action(task) == task.n_actions - 1
+    coder = task.features().bind(*task.observation_bounds)
+    weights = np.zeros((coder.size, task.n_actions))
+    weights[:, 0], weights[:, 2] = 2.0, 1.0  # joint 1 up, else joint 2 up
+    start = np.ascontiguousarray(_swing(-60))
+    pressed, _ = greedy_rollout(task, coder, weights, start, 300, step_around=False)
+    around, _ = greedy_rollout(task, coder, weights, start, 300)
+    assert np.degrees(pressed[:, 0]).max() < 0 and np.array_equal(pressed[-1], pressed[-2])
+    assert np.degrees(around[:, 0]).max() > 10
