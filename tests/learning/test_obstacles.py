@@ -284,17 +284,13 @@ def test_with_a_box_one_joint_per_action_also_tiles_joint_1_with_joints_2_and_3(
         assert boxed.features().groups == singles
 
 
-def test_the_greedy_policy_steps_around_a_move_a_box_refuses(in_the_way):
-    """Weights that prefer joint 1 up, then joint 2 up, wherever the arm is: pressing the move
-    the box refuses again, the greedy policy stays in front of the box to the cap; stepping
-    around refused moves (the policy of a task with obstacles), it climbs past the box, never
-    staying put nor stepping back to where it was."""
-    from studio.learning import ArmReach
-    from studio.learning.linear._greedy import greedy_rollout, steps_around
+def _pressed_then_around(task) -> np.ndarray:
+    """The greedy path of weights that prefer joint 1 up, then joint 2 up, wherever the arm is,
+    from joint 1 at -60 degrees toward the box: pressing refused moves again it stays in front of
+    the box; stepping around them it passes the box (returned)."""
+    from studio.learning.linear._greedy import greedy_rollout
 
-    task = ArmReach(obstacles=(in_the_way,), shaping=0.0, goal=AWAY)
-    assert steps_around(task) and not steps_around(ArmReach(goal=AWAY))
-    coder = task.features().bind(task.lower, task.upper)
+    coder = task.features().bind(*task.observation_bounds)
     weights = np.zeros((coder.size, task.n_actions))
     weights[:, 0], weights[:, 2] = 2.0, 1.0  # joint 1 up, else joint 2 up
     start = np.ascontiguousarray(_swing(-60))
@@ -302,6 +298,20 @@ def test_the_greedy_policy_steps_around_a_move_a_box_refuses(in_the_way):
     around, _ = greedy_rollout(task, coder, weights, start, 300)
     assert np.degrees(pressed[:, 0]).max() < 0 and np.array_equal(pressed[-1], pressed[-2])
     assert np.degrees(around[:, 0]).max() > 10
+    return around
+
+
+def test_the_greedy_policy_steps_around_a_move_a_box_refuses(in_the_way):
+    """Weights that prefer joint 1 up, then joint 2 up, wherever the arm is: pressing the move
+    the box refuses again, the greedy policy stays in front of the box to the cap; stepping
+    around refused moves (the policy of a task with obstacles), it climbs past the box, never
+    staying put nor stepping back to where it was."""
+    from studio.learning import ArmReach
+    from studio.learning.linear._greedy import steps_around
+
+    task = ArmReach(obstacles=(in_the_way,), shaping=0.0, goal=AWAY)
+    assert steps_around(task) and not steps_around(ArmReach(goal=AWAY))
+    around = _pressed_then_around(task)
     assert not any(np.array_equal(a, b) for a, b in zip(around[1:], around[:-1], strict=True))
     assert not any(np.array_equal(a, b) for a, b in zip(around[2:], around[:-2], strict=True))
 
@@ -312,18 +322,11 @@ def test_a_follow_move_the_box_refuses_hands_the_motion_back(in_the_way):
     stepping around refused moves, the follow move the box refuses hands back to the greedy moves,
     which climb past the box."""
     from studio.learning import ArmReach
-    from studio.learning.linear._greedy import greedy_rollout, hand_over_action
+    from studio.learning.linear._greedy import hand_over_action
 
     swing = np.array([_swing(d) for d in np.arange(-60.0, 121.0, 2.0)])  # through the box
     task = ArmReach(
         obstacles=(in_the_way,), shaping=0.0, goal=AWAY, actions="all-follow", paths=(swing,)
     )
     assert hand_over_action(task) == task.n_actions - 1
-    coder = task.features().bind(*task.observation_bounds)
-    weights = np.zeros((coder.size, task.n_actions))
-    weights[:, 0], weights[:, 2] = 2.0, 1.0  # joint 1 up, else joint 2 up
-    start = np.ascontiguousarray(_swing(-60))
-    pressed, _ = greedy_rollout(task, coder, weights, start, 300, step_around=False)
-    around, _ = greedy_rollout(task, coder, weights, start, 300)
-    assert np.degrees(pressed[:, 0]).max() < 0 and np.array_equal(pressed[-1], pressed[-2])
-    assert np.degrees(around[:, 0]).max() > 10
+    _pressed_then_around(task)
