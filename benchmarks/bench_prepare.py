@@ -31,7 +31,7 @@ from bench_api_load import Studio  # noqa: E402
 
 COMPILE = """
 import json, sys, time
-from studio.learning import prepare_learner
+from studio.learning._prepare import prepare_learner
 kind = sys.argv[1]
 wall, cpu = time.perf_counter(), time.process_time()
 prepare_learner(kind)

@@ -24,6 +24,7 @@ import numpy as np
 import pinocchio as pin
 from numba import njit
 
+from .._kernels import frozen
 from ._checks import KinematicsError
 
 STALLED_STEP = 1e-9
@@ -104,7 +105,7 @@ class SerialChain:
         """Each joint frame's rotation and origin at ``q``, and the tool's, by the kernel."""
         R, p = np.empty((len(self.axes), 3, 3)), np.empty((len(self.axes), 3))
         tool_R, tool_p = np.empty((3, 3)), np.empty(3)
-        _forward(self.rotations, self.translations, self.axes, np.asarray(q, float), R, p)
+        _forward(self.rotations, self.translations, self.axes, np.array(q, float), R, p)
         _tool(self, R, p, tool_R, tool_p)
         return R, p, tool_R, tool_p
 
@@ -229,8 +230,8 @@ def solve(
         chain.tool_translation,
         chain.tool_joint,
         chain.elbow_joint,
-        lower,
-        upper,
+        frozen(lower),
+        frozen(upper),
         q,
         np.ascontiguousarray(target_R, dtype=float),
         np.ascontiguousarray(target_p, dtype=float),

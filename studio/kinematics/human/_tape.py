@@ -22,6 +22,7 @@ from typing import TYPE_CHECKING, Literal
 import numpy as np
 from numba import njit
 
+from ..._kernels import frozen
 from .._checks import KinematicsError, check_side, positive_number, real_array, whole_number
 
 if TYPE_CHECKING:
@@ -244,13 +245,11 @@ def _chain(
     lead = bend.shape[:-1]
     regions = bend.shape[-1]
     count = math.prod(lead)  # explicit: reshape(-1, 0) is ambiguous for a tape with no regions
-    flat_b = np.ascontiguousarray(bend, dtype=np.float64).reshape(count, regions)
-    flat_t = np.ascontiguousarray(twist, dtype=np.float64).reshape(count, regions)
+    flat_b = frozen(np.reshape(bend, (count, regions)))
+    flat_t = frozen(np.reshape(twist, (count, regions)))
     positions = np.empty((flat_b.shape[0], regions + 1, 3))
     frames = np.empty((flat_b.shape[0], regions + 1, 3, 3))
-    _chain_kernel(
-        flat_b, flat_t, np.ascontiguousarray(base, dtype=np.float64), float(step), positions, frames
-    )
+    _chain_kernel(flat_b, flat_t, frozen(base), float(step), positions, frames)
     return positions.reshape(*lead, regions + 1, 3), frames.reshape(*lead, regions + 1, 3, 3)
 
 

@@ -24,6 +24,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numba import njit
 
+from ..._kernels import frozen
 from .._config import DynaQConfig
 from .._errors import LearningError
 from ..tasks._follow import follow_cost
@@ -171,14 +172,14 @@ def inspect_env(env: gymnasium.Env, config: DynaQConfig) -> EnvTask:
     raw = env.unwrapped
     space = env.observation_space
     code: int | None = None
-    params = np.zeros(0)
+    params = frozen(np.zeros(0))
     reach = None
     if plain and type(raw) is ArmReachEnv:
         code, reach = TASK_REACH, raw.task
         params = reach.params
     elif plain and type(raw) is MountainCarEnv:
         code = TASK_MOUNTAIN_CAR
-        params = np.array([float(getattr(raw, p)) for p in _MOUNTAIN_CAR_PARAMS])
+        params = frozen([float(getattr(raw, p)) for p in _MOUNTAIN_CAR_PARAMS])
     spec_id = getattr(getattr(env, "spec", None), "id", None)
     return EnvTask(
         code,

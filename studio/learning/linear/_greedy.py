@@ -221,7 +221,8 @@ def _success_many(params, spec, w, starts, max_steps, out, hand_over, around):
     path = np.empty((1, starts.shape[1]))
     for i in range(starts.shape[0]):
         state = starts[i].copy()
+        # np.int64: the constant itself would compile a second, literal-typed episode kernel
         steps = _greedy_episode(
-            TASK_REACH, params, spec, w, state, max_steps, path, hand_over, around
+            np.int64(TASK_REACH), params, spec, w, state, max_steps, path, hand_over, around
         )
         out[i] = steps >= 0

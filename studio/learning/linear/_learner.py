@@ -24,12 +24,14 @@ from .._tiles import TileCoding
 from ..likeness._likeness import LikenessCard, likeness_card, robot_tool_positions
 from ..tasks._demo_motion import DemonstrationMotion
 from ..tasks._gym import ARM_REACH_ID
-from ..tasks._reach import ArmReach
+from ..tasks._reach import ArmReach, _follow_walk, _walk
+from ._greedy import _success_many
 from ._linear import (
     LinearResult,
     _greedy_episode,
     _run_compiled,
     greedy_rollout,
+    greedy_success,
     run_linear_experiments,
 )
 from ._policy import (
@@ -109,21 +111,29 @@ class TileLearner:
         )
 
     def kernels(self) -> list[object]:
-        return [_run_compiled, _greedy_episode]
+        return [_run_compiled, _greedy_episode, _success_many, _walk, _follow_walk]
 
     def warm(self) -> None:
-        task = ArmReach(joints=3)
-        result = run_linear_experiments(
-            lambda: gymnasium.make(ARM_REACH_ID, arm_reach=task),
-            DynaQConfig(planning_steps=1),
-            1,
-            1,
-            0,
-            None,
-            task.features(),
-            workers=1,
-        )
-        greedy_rollout(task, result.coder, result.weights[0], np.zeros(3), 1)
+        # every kernel a run uses, without and with a demonstration (replayed, and followed by
+        # the follow action), then a rollout and an evaluation from given starts
+        plain = ArmReach(joints=3)
+        goal = np.asarray(plain.goal[:3])
+        demonstration = np.linspace(goal + np.radians([30.0, -30.0, 30.0]), goal, 40)
+        plain.demonstration_actions(demonstration)  # walked over the action table
+        followed = ArmReach(joints=3, paths=(tuple(map(tuple, demonstration)),))
+        for task, demonstrations in ((plain, None), (followed, [demonstration])):
+            result = run_linear_experiments(
+                lambda task=task: gymnasium.make(ARM_REACH_ID, arm_reach=task),
+                DynaQConfig(planning_steps=1),
+                1,
+                1,
+                0,
+                demonstrations,
+                task.features(),
+                workers=1,
+            )
+            greedy_rollout(task, result.coder, result.weights[0], np.zeros(3), 1)
+        greedy_success(followed, result.coder, result.weights[0], np.zeros((1, 3)), 1)
 
     def save(
         self,

@@ -53,6 +53,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numba import njit
 
+from ..._kernels import frozen
 from .._config import (
     ACTION_SETS,
     DEFAULT_ACTIONS,
@@ -445,7 +446,7 @@ class ArmReach:
         p[_ANG_TOL] = math.radians(self.angle_tolerance_deg)
         put_chain(p, self.robot)
         oMgoal = np.empty((4, 4))
-        tool_pose(p, np.asarray(self.goal[: self.joints]), oMgoal)
+        tool_pose(frozen(p), np.asarray(self.goal[: self.joints]), oMgoal)  # the kernels' form
         p[_GOAL_P : _GOAL_P + 3] = oMgoal[:3, 3]
         p[_GOAL_R : _GOAL_R + 9] = oMgoal[:3, :3].reshape(-1)
         p.flags.writeable = False
@@ -529,6 +530,7 @@ class ArmReach:
         actions = np.empty(_walk_capacity(q, self.step), np.int64)
         free = self.params.copy()
         free[_N_BOXES] = 0.0  # the demonstrated moves as if nothing stood in the way
+        free = frozen(free)  # read-only, as the kernels always get it
         n = _follow_walk(free, q[0], actions) if self.paths else -1
         if n < 0:
             n = _walk(free, q, actions)
@@ -546,11 +548,12 @@ def tool_positions(robot: str, q: np.ndarray) -> np.ndarray:
     q = np.asarray(q, dtype=np.float64).reshape(-1, arm.nq)
     joints = min(MAX_JOINTS, arm.nq)
     p = ArmReach(joints=joints, robot=robot).params.copy()
+    read_only = frozen(p)  # the kernels' form; it follows the writes to p
     out = np.empty((q.shape[0], 3))
     pose = np.empty((4, 4))
     for i, row in enumerate(q):
         p[_HOLD : _HOLD + arm.nq] = row
-        tool_pose(p, np.ascontiguousarray(row[:joints]), pose)
+        tool_pose(read_only, np.ascontiguousarray(row[:joints]), pose)
         out[i] = pose[:3, 3]
     return out
 
@@ -671,7 +674,7 @@ def _walk(params, path, actions):
     n = 0
     for i in range(1, path.shape[0]):
         while n < actions.shape[0]:
-            best = -1
+            best = np.int64(-1)  # not the constant: reach_step would compile again for a literal
             best_score = 0.5 * step
             for a in range(n_actions):
                 row = _TABLE + MAX_JOINTS * a
