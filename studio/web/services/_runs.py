@@ -535,12 +535,12 @@ class RunQueue:
             self.on_change("runs")
 
     def wait_idle(self, timeout: float) -> bool:
-        """Block until nothing is queued or running here (for scripts and tests)."""
+        """Block until nothing is queued or running here (for scripts and tests): until each
+        run's worker let it go (``live`` None), which is after its last file is written. (Its
+        status reads "done" before that, while its status file is still being written.)"""
         deadline = time.monotonic() + timeout
         with self._cond:
-            while self._queue or any(
-                r.status == "running" and r.live is not None for r in self._runs.values()
-            ):
+            while self._queue or any(r.live is not None for r in self._runs.values()):
                 left = deadline - time.monotonic()
                 if left <= 0:
                     return False
