@@ -70,7 +70,7 @@ def _greedy_episode(task, params, spec, w, state, max_steps, path, hand_over=-1,
     before = state.copy()
     last = state.copy()
     trial = state.copy()
-    handed = False
+    handed = np.bool_(False)  # not the constant: _around would compile again for a literal
     path[0] = state
     for steps in range(max_steps):
         if around:
@@ -124,9 +124,10 @@ def _around(task, params, spec, w, state, last, has_last, hand_over, handed, obs
     _q_values(w, feats, q)
     n_actions = q.shape[0]
     tried = np.zeros(n_actions, np.bool_)
-    first = -1
+    # np.int64, not the constants: the kernels called with them would compile again for literals
+    first = np.int64(-1)
     for rank in range(n_actions):
-        best = -1
+        best = np.int64(-1)
         for a in range(n_actions):
             if not tried[a] and (best < 0 or q[a] > q[best]):
                 best = a
