@@ -66,25 +66,31 @@ def test_scrub_a_rollout_change_its_speed_and_step_it(
     def scene() -> dict:
         return studio_server.get("/api/scene/playback")
 
-    # To the start and to the end: the robot's joints follow the slider, and stay there.
+    # To the start and to the end: the robot's joints follow the slider, and stay there. The
+    # joints are read once the scene shows the sample the playback stands at (the scene pushes
+    # a new time up to a tick later: ``shown_sample``).
+    def shown(sample: int) -> np.ndarray:
+        def at() -> bool:
+            now = scene()
+            return now["paused"] and now["sample"] == sample and now["shown_sample"] == sample
+
+        assert _until(at), scene()
+        return np.array(scene()["q_robot_deg"])
+
     slider.focus()
     slider.press("Home")
-    assert _until(lambda: scene()["paused"] and scene()["sample"] == 0)
-    start = np.array(scene()["q_robot_deg"])
+    start = shown(0)
     slider.press("End")
-    assert _until(lambda: scene()["sample"] == scene()["samples"] - 1)
-    assert _until(lambda: not np.allclose(scene()["q_robot_deg"], start, atol=1e-3))
-    end = np.array(scene()["q_robot_deg"])
+    last = scene()["samples"] - 1
+    end = shown(last)
+    assert not np.allclose(end, start, atol=1e-3)
     shot(page, "23-4-scrubbed-end", "sec-watch")
 
     # One sample back, one forward: the robot moves between neighbouring samples.
     page.get_by_role("button", name="Step back").click()
-    last = scene()["samples"] - 1
-    assert _until(lambda: scene()["sample"] == last - 1)
-    assert _until(lambda: not np.allclose(scene()["q_robot_deg"], end, atol=1e-6))
+    assert not np.allclose(shown(last - 1), end, atol=1e-6)
     page.get_by_role("button", name="Step forward").click()
-    assert _until(lambda: scene()["sample"] == last)
-    assert _until(lambda: np.allclose(scene()["q_robot_deg"], end, atol=1e-3))
+    np.testing.assert_allclose(shown(last), end, atol=1e-3)
     assert page.inner_text("[data-testid='rollout-clock']").endswith(" s")
 
     # Speed 4x, then play from the start: the scene plays at that speed and the slider follows.

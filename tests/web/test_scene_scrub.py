@@ -136,8 +136,17 @@ def test_scrub_a_watched_rollout_through_the_api(scene_api):
     p = client.post("/api/scene/playback", json={"step": -1}).json()
     assert p["sample"] == mid
     assert wait_for(lambda: np.allclose(scene.current_q_robot(), q[mid], atol=1e-6), 5)
-    shown = np.radians(client.get("/api/scene/playback").json()["q_robot_deg"])
-    assert np.allclose(shown, q[mid], atol=1e-5)
+    now = client.get("/api/scene/playback").json()
+    assert np.allclose(np.radians(now["q_robot_deg"]), q[mid], atol=1e-5)
+    assert now["shown_sample"] == mid  # which sample the joints shown are
+    # to the end: the joints read with shown_sample at the last sample are the last sample's
+    client.post("/api/scene/playback", json={"t": times[-1], "paused": True})
+    assert wait_for(
+        lambda: client.get("/api/scene/playback").json()["shown_sample"] == len(times) - 1, 5
+    )
+    assert np.allclose(
+        np.radians(client.get("/api/scene/playback").json()["q_robot_deg"]), q[-1], atol=1e-5
+    )
     # speed and resume
     p = client.post("/api/scene/playback", json={"speed": 4, "paused": False}).json()
     assert p["speed"] == 4 and not p["paused"]

@@ -61,6 +61,9 @@ class FakeScene:
     def current_q_robot(self):
         return self.q_robot.copy()
 
+    def shown_robot(self):
+        return self.q_robot.copy(), -1
+
     def named(self, name: str) -> list[tuple]:
         return [args for call, args in self.calls if call == name]
 

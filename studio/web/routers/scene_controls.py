@@ -55,7 +55,10 @@ class PlaybackPublic(BaseModel):
     speeds: list[float]
     """The speeds the page offers."""
     q_robot_deg: list[float]
-    """The robot joints the scene shows now (deg)."""
+    """The robot joints the scene shows now (deg). The scene draws a new time up to a tick after
+    the playback reaches it: ``shown_sample`` says which sample these joints are."""
+    shown_sample: int = -1
+    """The sample ``q_robot_deg`` stands at (or after, between two samples); -1 for a live pose."""
     robot: str = "puma560"
     """The robot whose joints the playback holds (it moves only while that robot is drawn)."""
     drawn: str = "puma560"
@@ -121,12 +124,14 @@ def _shown(scene: Scene | None) -> Scene:
 
 
 def _public(scene: Scene, playback: Playback | None, t: float) -> PlaybackPublic:
-    q = np.degrees(scene.current_q_robot()).round(6).tolist()
+    q_rad, shown_sample = scene.shown_robot()
+    q = np.degrees(q_rad).round(6).tolist()
     speeds = list(PLAYBACK_SPEEDS)
     if playback is None:
         return PlaybackPublic(
             active=False, t=0, duration=0, samples=0, sample=0, speed=1, paused=False,
-            finished=False, speeds=speeds, q_robot_deg=q, drawn=scene.robot_name,
+            finished=False, speeds=speeds, q_robot_deg=q, shown_sample=shown_sample,
+            drawn=scene.robot_name,
         )  # fmt: skip
     at = min(max(t, 0.0), playback.duration)
     sample = int(np.searchsorted(playback.times, at, side="right")) - 1
@@ -141,6 +146,7 @@ def _public(scene: Scene, playback: Playback | None, t: float) -> PlaybackPublic
         finished=not playback.paused and t >= playback.duration,
         speeds=speeds,
         q_robot_deg=q,
+        shown_sample=shown_sample,
         robot=playback.robot,
         drawn=scene.robot_name,
     )

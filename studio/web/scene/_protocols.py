@@ -107,6 +107,9 @@ class Scene(LiveScene, Protocol):
     def current_q_robot(self) -> np.ndarray:
         """The robot joints shown now."""
 
+    def shown_robot(self) -> tuple[np.ndarray, int]:
+        """The robot joints shown now and the playback sample they are (-1: live)."""
+
     robot: JointLimits
     camera: SceneCamera
     obstacles: SceneObstacles

@@ -129,6 +129,7 @@ class StudioScene(ScenePaths, SceneRobot, SceneOperator, SceneReach):
         self._playback: Playback | None = None
         # Published by the loop (under _lock) for readers.
         self._q_robot_shown = np.array(self.robot.qz, dtype=float)
+        self._sample_shown = -1  # the playback sample of the pose pushed last (-1: live)
         self._q_human_shown = np.zeros(7)
         self._side_shown = body.side
         self._shown_playback: Playback | None = None
@@ -369,6 +370,7 @@ class StudioScene(ScenePaths, SceneRobot, SceneOperator, SceneReach):
         with self._lock:
             if pose.q_robot is not None:
                 self._q_robot_shown = shown.q_robot.copy()
+                self._sample_shown = pose.trace_upto
             if operator_changed:
                 self._side_shown = operator.body.side
                 self._q_human_shown = np.zeros(len(self._q_human_shown))  # the new arm rests
@@ -511,6 +513,13 @@ class StudioScene(ScenePaths, SceneRobot, SceneOperator, SceneReach):
         """The robot joints the scene shows now (rad, (nq,))."""
         with self._lock:
             return self._q_robot_shown.copy()
+
+    def shown_robot(self) -> tuple[np.ndarray, int]:
+        """The robot joints the scene shows now (rad, (nq,)) and, for a playback, the sample
+        they stand at or after (-1 for a live pose), read together: the scene pushes a new pose
+        up to a tick after the playback's clock reaches it."""
+        with self._lock:
+            return self._q_robot_shown.copy(), self._sample_shown
 
     def current_q_human(self) -> np.ndarray:
         """The arm joints the scene shows now (rad, (7,))."""
