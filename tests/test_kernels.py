@@ -10,7 +10,8 @@ learner with and without a demonstration, a rollout and an evaluation).
 A kernel called from Python lists each signature it was called with, loaded from the disk cache
 or compiled. A kernel called only from other kernels lists one only where it was compiled in this
 process: a second signature of those (a literal constant passed in, as ``reach_step(..., -1)``
-once was) shows where the cache is cold, as on a fresh clone.
+once was) shows only where they compile here, with a cold cache (this file alone with ``-n 0``
+on a fresh clone; the whole suite prepares them before its workers start).
 """
 
 from __future__ import annotations
