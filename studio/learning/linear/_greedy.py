@@ -67,7 +67,6 @@ def _greedy_episode(task, params, spec, w, state, max_steps, path, hand_over=-1,
     obs = np.empty(spec.low.shape[0])
     feats = np.empty(spec.bases.size, np.int64)
     q = np.empty(n_actions)
-    before = state.copy()
     last = state.copy()
     trial = state.copy()
     handed = np.bool_(False)  # not the constant: _around would compile again for a literal
@@ -78,8 +77,6 @@ def _greedy_episode(task, params, spec, w, state, max_steps, path, hand_over=-1,
                 task, params, spec, w, state, last, steps > 0, hand_over, handed,
                 obs, feats, q, trial,
             )  # fmt: skip
-            last[:] = state
-            state[:] = trial
         else:
             best = hand_over
             if not handed:
@@ -90,14 +87,12 @@ def _greedy_episode(task, params, spec, w, state, max_steps, path, hand_over=-1,
                 for a in range(1, n_actions):
                     if q[a] > q[best]:
                         best = a
-            before[:] = state
-            _, terminal = task_step(task, params, state, best)
-            looped = np.array_equal(state, before) or (steps > 0 and np.array_equal(state, last))
-            if hand_over >= 0 and not handed and looped:
+            moved, terminal = _moved(task, params, state, best, last, steps > 0, trial)
+            if hand_over >= 0 and not handed and not moved:  # looped: hand over
                 handed = True
-                state[:] = before
-                _, terminal = task_step(task, params, state, hand_over)
-            last[:] = before
+                _, terminal = _moved(task, params, state, hand_over, last, steps > 0, trial)
+        last[:] = state
+        state[:] = trial
         if steps + 1 < path.shape[0]:
             path[steps + 1] = state
         if terminal:
