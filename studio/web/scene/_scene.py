@@ -511,8 +511,7 @@ class StudioScene(ScenePaths, SceneRobot, SceneOperator, SceneReach):
 
     def current_q_robot(self) -> np.ndarray:
         """The robot joints the scene shows now (rad, (nq,))."""
-        with self._lock:
-            return self._q_robot_shown.copy()
+        return self.shown_robot()[0]
 
     def shown_robot(self) -> tuple[np.ndarray, int]:
         """The robot joints the scene shows now (rad, (nq,)) and, for a playback, the sample
